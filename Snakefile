@@ -1,0 +1,20 @@
+# opnav-repro: regenerate every table and figure of both papers.
+#   snakemake --cores 2                               full reproduction
+#   snakemake --cores 2 --configfile config/quick.yaml   tiny profile
+# No science here: rules live in workflow/rules/, science in src/opnav/.
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/landing.smk"
+
+
+rule all:
+    default_target: True
+    input:
+        ALL_TARGETS,

@@ -1,0 +1,19 @@
+"""opnav: reproducible Mars optical-navigation studies.
+
+Subpackages
+-----------
+approach
+    Paper A: EM-EKF estimation of the navigation camera's optical-axis bias on
+    Mars approach (EKF, RTS smoother, EM, Cramer-Rao bound).
+landing
+    Paper B: vision-aided inertial navigation for Mars powered descent and
+    landmark selection by depth estimation error against observability
+    baselines.
+
+Shared modules: :mod:`opnav.config` (configuration loading and validation),
+:mod:`opnav.tables` (CSV/LaTeX/Markdown writers), :mod:`opnav.figures` (the
+shared matplotlib style and deterministic saving), :mod:`opnav.published`
+(the papers' published values, always labelled as such).
+"""
+
+__version__ = "0.1.0"

@@ -1,0 +1,1 @@
+"""Paper A: EM-EKF camera optical-axis bias estimation on Mars approach."""

@@ -1,0 +1,1 @@
+"""Paper B: Mars powered descent, vision-aided inertial EKF, landmark selection."""

@@ -1,0 +1,70 @@
+"""Glue for the thin ``workflow/scripts`` wrappers.
+
+:func:`script_context` sends stderr/stdout and the ``logging`` module to the
+rule's log file; :func:`mock_snakemake` builds a stand-in ``snakemake`` object
+so a script can be run by hand for debugging, e.g.::
+
+    python workflow/scripts/landing_tables.py   # uses mock_snakemake defaults
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Iterator
+
+
+@contextlib.contextmanager
+def script_context(snakemake) -> Iterator[logging.Logger]:
+    """Redirect output to ``snakemake.log[0]`` (if any) and yield a logger."""
+    log_path = snakemake.log[0] if len(getattr(snakemake, "log", [])) else None
+    logger = logging.getLogger("opnav")
+    if log_path is None:
+        logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
+        yield logger
+        return
+    Path(log_path).parent.mkdir(parents=True, exist_ok=True)
+    with open(log_path, "w") as fh:
+        handler = logging.StreamHandler(fh)
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"))
+        logger.addHandler(handler)
+        logger.setLevel(logging.INFO)
+        old_err, old_out = sys.stderr, sys.stdout
+        sys.stderr = sys.stdout = fh
+        try:
+            yield logger
+        finally:
+            sys.stderr, sys.stdout = old_err, old_out
+            logger.removeHandler(handler)
+
+
+def mock_snakemake(input=None, output=None, params=None, log=None, wildcards=None,
+                   threads: int = 1, config: dict | None = None) -> SimpleNamespace:
+    """A minimal stand-in for the ``snakemake`` object of a script directive."""
+
+    def ns(x):
+        if x is None:
+            return _Named([], {})
+        if isinstance(x, dict):
+            return _Named(list(x.values()), x)
+        return _Named(list(x), {})
+
+    if config is None:
+        from opnav.config import load_config
+
+        config = load_config()
+    return SimpleNamespace(input=ns(input), output=ns(output), params=ns(params),
+                           log=ns(log), wildcards=ns(wildcards), threads=threads,
+                           config=config)
+
+
+class _Named(list):
+    """A list whose items are also attributes, like Snakemake's Namedlist."""
+
+    def __init__(self, items, names):
+        super().__init__(items)
+        for k, v in names.items():
+            setattr(self, k, v)

@@ -1,0 +1,96 @@
+"""Write result tables as CSV, LaTeX (booktabs) and Markdown, deterministically.
+
+Every table of the pipeline goes through :func:`write_table`, so all three
+formats carry the same numbers, floats are printed with a fixed format, and a
+file is either complete or absent (written to a temporary name, then renamed).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Iterable
+
+import pandas as pd
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` to ``path`` via a temporary file and an atomic rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _latex_escape(s: str) -> str:
+    for a, b in [("\\", r"\textbackslash{}"), ("&", r"\&"), ("%", r"\%"), ("_", r"\_"),
+                 ("#", r"\#"), ("$", r"\$")]:
+        s = s.replace(a, b)
+    return s
+
+
+def to_latex(df: pd.DataFrame, caption: str | None = None, label: str | None = None,
+             float_format: str = "{:.4g}") -> str:
+    """A booktabs tabular (no float environment) for ``\\input`` in the manuscript.
+
+    Column headers and string cells are escaped; the caption, if given, is a
+    LaTeX comment on the first line so the file stays a bare tabular that the
+    manuscript wraps in its own ``table`` environment.
+    """
+    body = df.to_latex(
+        index=False,
+        escape=True,
+        float_format=lambda x: float_format.format(x),
+        na_rep="--",
+        column_format="l" * df.shape[1],
+    )
+    head = []
+    if caption:
+        head.append("% " + caption.replace("\n", " "))
+    if label:
+        head.append(f"% label: {label}")
+    return "\n".join(head + [body])
+
+
+def to_markdown(df: pd.DataFrame, caption: str | None = None, float_format: str = "{:.4g}") -> str:
+    """A GitHub-flavoured Markdown table with an optional caption line above."""
+    fmt = df.copy()
+    for c in fmt.columns:
+        if pd.api.types.is_float_dtype(fmt[c]):
+            fmt[c] = [("--" if pd.isna(x) else float_format.format(x)) for x in fmt[c]]
+    md = fmt.to_markdown(index=False)
+    return (f"{caption}\n\n{md}\n" if caption else md + "\n")
+
+
+def write_table(df: pd.DataFrame, paths: Iterable[str | Path] | str | Path,
+                caption: str | None = None, float_format: str = "{:.4g}") -> list[Path]:
+    """Write ``df`` to every path given, choosing the format by suffix.
+
+    ``paths`` is either a stem (writes ``stem.csv``, ``stem.tex``, ``stem.md``)
+    or an explicit list of files ending in .csv/.tex/.md. CSV keeps full
+    precision (``%.10g``); LaTeX and Markdown use ``float_format``.
+    """
+    if isinstance(paths, (str, Path)) and Path(paths).suffix == "":
+        paths = [Path(f"{paths}{ext}") for ext in (".csv", ".tex", ".md")]
+    elif isinstance(paths, (str, Path)):
+        paths = [paths]
+    written = []
+    for p in map(Path, paths):
+        if p.suffix == ".csv":
+            text = df.to_csv(index=False, float_format="%.10g", lineterminator="\n")
+        elif p.suffix == ".tex":
+            text = to_latex(df, caption=caption, float_format=float_format)
+        elif p.suffix == ".md":
+            text = to_markdown(df, caption=caption, float_format=float_format)
+        else:
+            raise ValueError(f"unknown table format for {p} (use .csv, .tex or .md)")
+        atomic_write_text(p, text)
+        written.append(p)
+    return written

@@ -1,0 +1,66 @@
+"""The pipeline as a user meets it: config validation, dry runs, the quick profile."""
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from conftest import REPO, run_snakemake
+
+
+def _write_bad(workdir: Path, mutate) -> Path:
+    cfg = yaml.safe_load((REPO / "config" / "quick.yaml").read_text())
+    mutate(cfg)
+    path = workdir / "bad.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    return path
+
+
+@pytest.mark.parametrize(
+    "mutate, key, fragment",
+    [
+        (lambda c: c["landing"]["mc"].__setitem__("n_runs", "many"), "landing.mc.n_runs", "not of type"),
+        (lambda c: c["landing"]["mc"].__setitem__("n_runs", 0), "landing.mc.n_runs", "minimum"),
+        (lambda c: c["landing"]["mc"]["bounds"].__setitem__("att_deg", 400), "landing.mc.bounds.att_deg", "maximum"),
+        (lambda c: c["landing"].__setitem__("colour", "red"), "landing", "'colour' was unexpected"),
+        (lambda c: c.__setitem__("profile", "fast"), "profile", "is not one of"),
+    ],
+)
+def test_bad_config_is_refused_naming_the_key(workdir, mutate, key, fragment):
+    bad = _write_bad(workdir, mutate)
+    proc = run_snakemake(workdir, "-n", "--cores", "1", "--configfile", str(bad))
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0
+    assert f"invalid config key '{key}'" in out, out[-2000:]
+    assert fragment in out
+
+
+@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/quick.yaml"])
+def test_dry_run_succeeds(workdir, configfile):
+    proc = run_snakemake(workdir, "-n", "--cores", "2", "--configfile", configfile)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+
+
+def test_configs_have_the_same_keys():
+    def keys(d, prefix=""):
+        out = set()
+        for k, v in d.items():
+            out.add(prefix + k)
+            if isinstance(v, dict):
+                out |= keys(v, prefix + k + ".")
+        return out
+
+    full = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    quick = yaml.safe_load((REPO / "config" / "quick.yaml").read_text())
+    assert keys(full) == keys(quick)
+
+
+@pytest.mark.slow
+def test_quick_profile_end_to_end(workdir):
+    before = sorted(p.relative_to(REPO) for p in (REPO / "results").rglob("*")) if (REPO / "results").exists() else []
+    proc = run_snakemake(workdir, "--cores", "2", "--configfile", "config/quick.yaml")
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
+    t1 = (workdir / "results" / "landing" / "B-T1_initial_state.csv").read_text()
+    assert "3300" in t1 and "published" in t1
+    after = sorted(p.relative_to(REPO) for p in (REPO / "results").rglob("*")) if (REPO / "results").exists() else []
+    assert before == after, "the quick run must not touch the repository's results/"

@@ -1,0 +1,40 @@
+# Shared helpers: config validation, output paths, and the list `rule all` gathers.
+import sys
+from pathlib import Path
+
+from snakemake.utils import validate
+from snakemake.exceptions import WorkflowError
+
+sys.path.insert(0, str(Path(workflow.basedir) / "src"))
+from opnav.config import ConfigError, describe_validation_error  # noqa: E402
+
+try:
+    validate(config, "../schemas/config.schema.yaml", set_default=True)
+except WorkflowError as exc:
+    raise ConfigError(describe_validation_error(exc)) from None
+
+RESULTS = config["results_dir"]
+SRC = Path(workflow.basedir) / "src" / "opnav"
+
+# Each rules file appends the final outputs it owns; `rule all` requests them.
+ALL_TARGETS = []
+
+
+def res(*parts):
+    """Path under the results directory."""
+    return str(Path(RESULTS, *parts))
+
+
+def src(*modules):
+    """The package modules a rule depends on, so editing one reruns the rule."""
+    return [str(SRC / m) for m in modules]
+
+
+def table_outputs(stem):
+    """A table is written as CSV, LaTeX and Markdown."""
+    return [f"{stem}.csv", f"{stem}.tex", f"{stem}.md"]
+
+
+def figure_outputs(stem):
+    """A figure is written as PDF and PNG."""
+    return [f"{stem}.pdf", f"{stem}.png"]

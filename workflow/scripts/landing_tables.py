@@ -1,0 +1,20 @@
+"""B-T1, B-T2: the descent's initial state and Monte-Carlo error bounds, from the config."""
+
+from opnav.landing.scenario import error_bounds_table, initial_state_table
+from opnav.snakeio import mock_snakemake, script_context
+from opnav.tables import write_table
+
+if "snakemake" not in globals():  # standalone debugging run
+    snakemake = mock_snakemake(
+        output={"t1": ["results/landing/B-T1_initial_state.csv"],
+                "t2": ["results/landing/B-T2_error_bounds.csv"]}
+    )
+    snakemake.params = type("P", (), {"landing": snakemake.config["landing"]})()
+
+with script_context(snakemake) as log:
+    cfg = snakemake.params.landing
+    write_table(initial_state_table(cfg), snakemake.output.t1,
+                caption="B-T1: lander initial state in the landing frame {L} (paper B Table 1).")
+    write_table(error_bounds_table(cfg), snakemake.output.t2,
+                caption="B-T2: Monte-Carlo initial-error bounds, uniform per axis (paper B Table 2).")
+    log.info("wrote %s and %s", snakemake.output.t1, snakemake.output.t2)
