@@ -14,6 +14,8 @@ except WorkflowError as exc:
     raise ConfigError(describe_validation_error(exc)) from None
 
 RESULTS = config["results_dir"]
+
+report: "../report/workflow.rst"
 SRC = Path(workflow.basedir) / "src" / "opnav"
 
 # Each rules file appends the final outputs it owns; `rule all` requests them.
@@ -38,3 +40,23 @@ def table_outputs(stem):
 def figure_outputs(stem):
     """A figure is written as PDF and PNG."""
     return [f"{stem}.pdf", f"{stem}.png"]
+
+
+def _caption(caption_id):
+    path = Path(workflow.basedir) / "workflow" / "report" / f"{caption_id}.rst"
+    if not path.is_file():
+        raise FileNotFoundError(f"missing report caption {path} for output id {caption_id}")
+    return str(path)
+
+
+def report_table(stem, caption_id, category):
+    """Table outputs; the CSV goes into `snakemake --report` with its caption."""
+    csv, tex, md = table_outputs(stem)
+    return [report(csv, caption=_caption(caption_id), category=category), tex, md]
+
+
+def report_figure(stem, caption_id, category, subcategory=None):
+    """Figure outputs; the PNG goes into `snakemake --report` with its caption."""
+    pdf, png = figure_outputs(stem)
+    kw = {"subcategory": subcategory} if subcategory else {}
+    return [pdf, report(png, caption=_caption(caption_id), category=category, **kw)]

@@ -8,8 +8,8 @@ rule landing_tables:
     input:
         src("landing/scenario.py", "tables.py", "published.py", "data/published.yaml"),
     output:
-        t1=table_outputs(f"{LANDING}/B-T1_initial_state"),
-        t2=table_outputs(f"{LANDING}/B-T2_error_bounds"),
+        t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
+        t2=report_table(f"{LANDING}/B-T2_error_bounds", "B-T2", "Paper B"),
     params:
         landing=lambda wc: {k: config["landing"][k] for k in ("initial_state", "mc")},
     log:
