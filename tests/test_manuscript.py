@@ -1,0 +1,50 @@
+"""Generated manuscript pieces: macro names, number formatting, floats, captions."""
+
+from pathlib import Path
+
+from hypothesis import given, strategies as st
+
+from opnav.manuscript import (float_block, format_number, macro_name, macros_from_summary,
+                              render_macros, rst_to_latex)
+
+
+@given(st.lists(st.text(min_size=1, max_size=12), min_size=1, max_size=4))
+def test_macro_names_are_letters_only(parts):
+    parts = ["A"] + parts
+    assert macro_name(parts).isalpha()
+
+
+def test_macros_flatten_and_format():
+    m = macros_from_summary({"literal": {"est_x": 11.4321, "n_seeds": 20, "note": "a_b"},
+                             "crlb": [1.5, 250.0]}, "A")
+    assert m["ALiteralEstX"] == "11.4"
+    assert m["ALiteralNSeeds"] == "20"
+    assert m["ALiteralNote"] == r"a\_b"
+    assert m["ACrlbOne"] == "1.50" and m["ACrlbTwo"] == "250"
+    text = render_macros(m)
+    assert text.splitlines() == sorted(text.splitlines())
+    assert r"\newcommand{\ALiteralEstX}{11.4}" in text
+
+
+def test_format_number_ranges():
+    assert format_number(79.06) == "79.1"
+    assert format_number(18.43) == "18.4"
+    assert format_number(1234.5) == "1{,}234"
+    assert format_number(0.0123) == "0.0123"
+    assert format_number(2.5e-6) == r"2.50\times10^{-6}"
+    assert format_number(float("nan")) == "--"
+
+
+def test_rst_caption_to_latex():
+    assert rst_to_latex("Error in *km*, ``theta_x`` 50%") == r"Error in \emph{km}, \texttt{theta\_x} 50\%"
+
+
+def test_float_block_uses_caption_and_relative_path(tmp_path: Path):
+    caps = tmp_path / "report"
+    caps.mkdir()
+    (caps / "A-F4.rst").write_text("Bias estimate vs iteration, arcsec.\n")
+    fig = tmp_path / "results" / "approach" / "A-F4_bias_estimate_roll.pdf"
+    tex = float_block([fig], caps, relative_to=tmp_path / "paper")
+    assert "../results/approach/A-F4_bias_estimate_roll.pdf" in tex
+    assert "Bias estimate vs iteration, arcsec." in tex
+    assert "A-F4 (bias estimate roll)" in tex
