@@ -1,0 +1,121 @@
+# The reproduction manuscript: generated floats, macros, scorecard, and the PDF.
+# Included last, so ALL_TARGETS already lists every table and figure.
+import os
+import shutil
+
+PAPER = res("paper")
+PAPER_DIR = Path(workflow.basedir) / "paper"
+CAPTIONS = Path(workflow.basedir) / "workflow" / "report"
+
+_targets = [str(t) for t in ALL_TARGETS]
+
+
+def _floats(part):
+    """The part's final figures (PDF) and tables (.tex), in id order."""
+    prefix = str(Path(RESULTS, part)) + os.sep
+    keep = [t for t in _targets if t.startswith(prefix) and t.endswith((".pdf", ".tex"))]
+    return sorted(keep, key=lambda p: (Path(p).stem.split("_")[0][2:3] != "T", Path(p).stem))
+
+
+SUMMARIES = {
+    k: p
+    for k, p in {"A": res("approach", "A-summary.json"), "B": res("landing", "B-summary.json")}.items()
+    if p in _targets
+}
+SCORE_INPUTS = {
+    k: p
+    for k, p in {
+        "a_table1": res("approach", "A-T1_table1.csv"),
+        "b_summary_table": res("landing", "B-T3_summary.csv"),
+    }.items()
+    if p in _targets
+}
+
+
+rule paper_floats:
+    """Figure and table floats for the manuscript, captions from workflow/report/."""
+    input:
+        approach=_floats("approach"),
+        landing=_floats("landing"),
+        captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
+        code=src("manuscript.py"),
+    output:
+        approach=f"{PAPER}/floats_approach.tex",
+        landing=f"{PAPER}/floats_landing.tex",
+    params:
+        paper_dir=str(PAPER_DIR),
+        captions_dir=str(CAPTIONS),
+    log:
+        f"{PAPER}/logs/paper_floats.log",
+    localrule: True
+    script:
+        "../scripts/paper_floats.py"
+
+
+rule paper_scorecard:
+    """Every published number beside ours, with a verdict (opnav.scorecard)."""
+    input:
+        **SCORE_INPUTS,
+        **{f"summary_{k}": p for k, p in SUMMARIES.items()},
+        published=src("data/published.yaml"),
+        code=src("scorecard.py", "published.py"),
+    output:
+        table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
+        json=f"{PAPER}/scorecard.json",
+    log:
+        f"{PAPER}/logs/paper_scorecard.log",
+    localrule: True
+    script:
+        "../scripts/paper_scorecard.py"
+
+
+rule paper_macros:
+    """One \\newcommand per number quoted in the manuscript's text."""
+    input:
+        **{f"summary_{k}": p for k, p in SUMMARIES.items()},
+        scorecard=rules.paper_scorecard.output.json,
+        code=src("manuscript.py"),
+    output:
+        f"{PAPER}/macros.tex",
+    params:
+        profile=config["profile"],
+    log:
+        f"{PAPER}/logs/paper_macros.log",
+    localrule: True
+    script:
+        "../scripts/paper_macros.py"
+
+
+PAPER_INPUTS = [rules.paper_floats.output, rules.paper_macros.output, rules.paper_scorecard.output]
+ALL_TARGETS.extend(PAPER_INPUTS)
+
+LATEX_HINT = (
+    "opnav: LaTeX not found, skipping results/paper/main.pdf; to build it install: "
+    "apt-get install latexmk texlive-latex-base texlive-latex-recommended "
+    "texlive-fonts-recommended texlive-science lmodern"
+)
+HAVE_LATEX = shutil.which("latexmk") is not None and shutil.which("pdflatex") is not None
+
+
+rule paper_pdf:
+    """The manuscript, built reproducibly (SOURCE_DATE_EPOCH) with latexmk."""
+    input:
+        tex=str(PAPER_DIR / "main.tex"),
+        generated=PAPER_INPUTS,
+        results=[t for t in _targets if t.endswith((".pdf", ".tex"))],
+    output:
+        f"{PAPER}/main.pdf",
+    params:
+        paper_dir=str(PAPER_DIR),
+        build=f"{PAPER}/build",
+    log:
+        f"{PAPER}/logs/paper_pdf.log",
+    localrule: True
+    script:
+        "../scripts/paper_pdf.py"
+
+
+if config["paper"]["build_pdf"] and HAVE_LATEX:
+    ALL_TARGETS.append(rules.paper_pdf.output[0])
+elif config["paper"]["build_pdf"]:
+    print(LATEX_HINT, file=sys.stderr)

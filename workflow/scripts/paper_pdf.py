@@ -1,0 +1,24 @@
+"""Build the manuscript PDF with latexmk, reproducibly (fixed SOURCE_DATE_EPOCH)."""
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+from opnav.snakeio import script_context
+
+with script_context(snakemake) as log:
+    paper_dir = Path(snakemake.params.paper_dir).resolve()
+    build = Path(snakemake.params.build).resolve()
+    out = Path(snakemake.output[0]).resolve()
+    results_rel = os.path.relpath(out.parent.parent, paper_dir)
+    env = dict(os.environ, SOURCE_DATE_EPOCH="0", FORCE_SOURCE_DATE="1", TZ="UTC")
+    shutil.rmtree(build, ignore_errors=True)
+    cmd = ["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", f"-outdir={build}",
+           f"-usepretex=\\def\\resultsdir{{{Path(results_rel).as_posix()}}}", "main.tex"]
+    log.info("running %s in %s", " ".join(cmd), paper_dir)
+    proc = subprocess.run(cmd, cwd=paper_dir, env=env, capture_output=True, text=True)
+    log.info(proc.stdout[-20000:])
+    if proc.returncode != 0:
+        raise RuntimeError(f"latexmk failed (exit {proc.returncode}); see {build}/main.log")
+    shutil.copyfile(build / "main.pdf", out)

@@ -1,0 +1,26 @@
+"""The reproduced-vs-published scorecard from the generated tables and summaries."""
+
+import json
+
+import pandas as pd
+
+from opnav import published, scorecard
+from opnav.snakeio import script_context
+from opnav.tables import atomic_write_text, write_table
+
+with script_context(snakemake) as log:
+    inp = snakemake.input
+    rows = []
+    if "a_table1" in inp.keys():
+        summary_a = json.loads(open(inp["summary_A"]).read()) if "summary_A" in inp.keys() else {}
+        rows += scorecard.rows_paper_a(pd.read_csv(inp["a_table1"]), summary_a, published.paper_a())
+    if "b_summary_table" in inp.keys():
+        summary_b = json.loads(open(inp["summary_B"]).read()) if "summary_B" in inp.keys() else {}
+        rows += scorecard.rows_paper_b(pd.read_csv(inp["b_summary_table"]), summary_b, published.paper_b())
+    df = scorecard.score_rows(rows)
+    write_table(df, snakemake.output.table, caption="Scorecard: published values beside ours.")
+    counts = df["verdict"].value_counts().to_dict() if len(df) else {}
+    atomic_write_text(snakemake.output.json, json.dumps(
+        {"n_items": int(len(df)), "verdicts": {k: int(v) for k, v in sorted(counts.items())}},
+        indent=2, sort_keys=True) + "\n")
+    log.info("scorecard: %d items, %s", len(df), counts)
