@@ -32,6 +32,23 @@ def src(*modules):
     return [str(SRC / m) for m in modules]
 
 
+def canonical(value):
+    """A deep copy with dict keys sorted, so `params:` compare equal whatever the
+    key order in the YAML (Snakemake compares params by their text)."""
+    if isinstance(value, dict):
+        return {k: canonical(value[k]) for k in sorted(value)}
+    if isinstance(value, (list, tuple)):
+        return [canonical(v) for v in value]
+    return value
+
+
+def cfg(section, *keys):
+    """The config values a rule depends on, canonical, for its `params:`:
+    cfg("landing", "mc", "initial_state") -> {"initial_state": ..., "mc": ...}."""
+    sec = config[section]
+    return canonical({k: sec[k] for k in keys} if keys else sec)
+
+
 def table_outputs(stem):
     """A table is written as CSV, LaTeX and Markdown."""
     return [f"{stem}.csv", f"{stem}.tex", f"{stem}.md"]

@@ -11,7 +11,7 @@ rule landing_tables:
         t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
         t2=report_table(f"{LANDING}/B-T2_error_bounds", "B-T2", "Paper B"),
     params:
-        landing=lambda wc: {k: config["landing"][k] for k in ("initial_state", "mc")},
+        landing=cfg("landing", "initial_state", "mc"),
     log:
         f"{LANDING}/logs/landing_tables.log",
     localrule: True
