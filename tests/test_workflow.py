@@ -1,5 +1,6 @@
 """The pipeline as a user meets it: config validation, dry runs, the quick profile."""
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -62,5 +63,20 @@ def test_quick_profile_end_to_end(workdir):
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
     t1 = (workdir / "results" / "landing" / "B-T1_initial_state.csv").read_text()
     assert "3300" in t1 and "published" in t1
+    assert (workdir / "results" / "paper" / "scorecard.csv").is_file()
+    if shutil.which("latexmk"):
+        assert (workdir / "results" / "paper" / "main.pdf").stat().st_size > 10_000
+    # the Snakemake report, with a caption for every figure and table
+    rep = run_snakemake(workdir, "--cores", "1", "--configfile", "config/quick.yaml",
+                        "--report", "results/report.html")
+    assert rep.returncode == 0, rep.stderr[-3000:]
+    assert (workdir / "results" / "report.html").stat().st_size > 10_000
     after = sorted(p.relative_to(REPO) for p in (REPO / "results").rglob("*")) if (REPO / "results").exists() else []
     assert before == after, "the quick run must not touch the repository's results/"
+
+
+def test_slurm_profile_dry_run(workdir):
+    pytest.importorskip("snakemake_executor_plugin_slurm")
+    proc = run_snakemake(workdir, "-n", "--profile", "profiles/slurm", "--configfile", "config/quick.yaml")
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "Job stats" in proc.stdout
