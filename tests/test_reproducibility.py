@@ -50,22 +50,6 @@ def test_tables_rebuild_byte_identical(workdir):
     assert _digest(sorted(out.glob("B-T*"))) == first
 
 
-@pytest.mark.skipif(shutil.which("latexmk") is None, reason="LaTeX not installed")
-def test_manuscript_pdf_rebuild_byte_identical(workdir):
-    cfg = workdir / "config" / "quick.yaml"
-    pdf = workdir / "results" / "paper" / "main.pdf"
-    args = ("--cores", "2", "--configfile", str(cfg), "results/paper/main.pdf",
-            "--allowed-rules", "landing_tables", "paper_floats", "paper_scorecard",
-            "paper_macros", "paper_pdf")
-    proc = run_snakemake(workdir, *args)
-    if proc.returncode != 0:
-        pytest.skip("the manuscript needs the simulation outputs; covered by the end-to-end test")
-    first = pdf.read_bytes()
-    pdf.unlink()
-    assert run_snakemake(workdir, *args, "-f", "results/paper/main.pdf").returncode == 0
-    assert pdf.read_bytes() == first
-
-
 def test_reruns_follow_params_and_modules(workdir):
     assert run_snakemake(workdir, "--cores", "1", TARGET).returncode == 0
     assert _planned_rules(workdir, TARGET) == set()
