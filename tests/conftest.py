@@ -1,3 +1,4 @@
+import os
 import shutil
 import subprocess
 import sys
@@ -20,8 +21,11 @@ def copy_workflow(dst: Path) -> Path:
 
 
 def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.CompletedProcess:
+    """Run snakemake in ``cwd``; its scripts import the ``opnav`` copy under ``cwd/src``."""
     cmd = [sys.executable, "-m", "snakemake", *args]
-    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, check=check)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        p for p in (str(Path(cwd) / "src"), os.environ.get("PYTHONPATH", "")) if p))
+    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, check=check, env=env)
 
 
 @pytest.fixture()

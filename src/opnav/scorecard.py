@@ -197,3 +197,13 @@ def rows_paper_b(t3: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
                          "published": float(pub["table1_initial_state"]["att_deg"][i]),
                          "ours": float(att[i]), "unit": "deg", "abs_tol": 1.0})
     return rows
+
+
+def to_longtable(df: pd.DataFrame) -> str:
+    """The scorecard as a LaTeX longtable (it spans pages in the manuscript)."""
+    if df.empty:
+        return "% scorecard: no published numbers compared yet\n"
+    show = df.drop(columns=["difference"]).rename(columns={"ours (mean)": "ours", "ours (spread)": "spread"})
+    return show.to_latex(index=False, longtable=True, escape=True, na_rep="--",
+                         float_format=lambda x: f"{x:.4g}",
+                         column_format="llp{1.2cm}rrrp{2.4cm}p{4.2cm}".replace("p{1.2cm}", "l"))

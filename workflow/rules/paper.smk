@@ -61,6 +61,7 @@ rule paper_scorecard:
         code=src("scorecard.py", "published.py"),
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
+        longtable=f"{PAPER}/scorecard_longtable.tex",
         json=f"{PAPER}/scorecard.json",
     log:
         f"{PAPER}/logs/paper_scorecard.log",
@@ -79,6 +80,7 @@ rule paper_macros:
         f"{PAPER}/macros.tex",
     params:
         profile=config["profile"],
+        config=canonical({k: config[k] for k in ("approach", "landing")}),
     log:
         f"{PAPER}/logs/paper_macros.log",
     localrule: True

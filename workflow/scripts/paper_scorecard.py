@@ -19,6 +19,7 @@ with script_context(snakemake) as log:
         rows += scorecard.rows_paper_b(pd.read_csv(inp["b_summary_table"]), summary_b, published.paper_b())
     df = scorecard.score_rows(rows)
     write_table(df, snakemake.output.table, caption="Scorecard: published values beside ours.")
+    atomic_write_text(snakemake.output.longtable, scorecard.to_longtable(df))
     counts = df["verdict"].value_counts().to_dict() if len(df) else {}
     atomic_write_text(snakemake.output.json, json.dumps(
         {"n_items": int(len(df)), "verdicts": {k: int(v) for k, v in sorted(counts.items())}},
