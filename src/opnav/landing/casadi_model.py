@@ -1,0 +1,201 @@
+"""Two-landmark bearing measurement model of paper B, written once in CasADi.
+
+Description
+-----------
+Paper B (Li et al., J. Deep Space Explor. 2023, 10(2)) measures unit bearing
+vectors to landmarks in the body frame {B} (eq. 11-12),
+
+    b_i = C(q) (r_pi - r) / || C(q) (r_pi - r) ||,
+
+and linearises them about the estimate (eq. 13) with the Jacobian blocks of
+eq. 14-18 (H_r = -H_C, H_theta = [b x], H_p = H_C,
+H_C = C (|r_i|^2 I - r_i r_i^T) / |r_i|^3, r_i = r_pi - r).  For landmark
+selection (sec. 2.2) the paper uses one known landmark at the {L} origin
+(n_s = 1) and one unknown landmark in the state (n_p = 1), so the stacked
+measurement is a 6-vector and the Jacobian H is 6 x 12 with respect to the
+error state [dr (3), dv (3), dtheta (3), dp_cand (3)] (eq. 5).
+
+This module writes the measurement *once* symbolically (CasADi SX), takes H
+with ``casadi.jacobian`` at dtheta = 0 and compiles it to ``casadi.Function``
+objects:
+
+* :func:`bearing_function` -- z(r, v, dtheta, p_known, p_cand, R_LtoB), 6-vector;
+* :func:`jacobian_function` -- H(r, v, p_known, p_cand, R_LtoB), 6 x 12, dtheta = 0;
+* :func:`jacobian_map` -- ``Function.map(N)`` of the latter over N candidates.
+
+and provides a vectorised numpy evaluation of the same expressions
+(:func:`jacobian_numpy`, :func:`bearings_numpy`) which the tests prove equal to
+the CasADi Function to 1e-10.
+
+Conventions
+-----------
+* Frames: {L} landing frame (m), {B} body frame; ``R_LtoB`` maps {L} vectors
+  into {B} (paper's C(q)).
+* Attitude error (paper eq. 5): dq = q (x) q_hat^-1, dq ~ [dtheta/2, 1]
+  (JPL / passive quaternion), so the true rotation is
+  ``R_true = C(dq) R_hat`` with ``C(dq) = I - [dtheta x] + O(dtheta^2)``:
+  the error is a rotation of the *body* frame, expressed in {B}.  This gives
+  paper eq. 16, H_theta = H_C [r_i x] C^T = [b_i x].  For finite dtheta we
+  use the Cayley map ``C(dq) = cay(-dtheta/2)``, an exact rotation that agrees
+  with exp(-[dtheta x]) to second order and has no branch at dtheta = 0 (only
+  the derivative at dtheta = 0 enters H).
+* v enters no measurement; it is kept so the columns follow the 12-state layout.
+* Units: positions m, H position/landmark columns 1/m, attitude columns 1/rad
+  (dimensionless), bearings dimensionless.
+
+Speed (measured by ``benchmarks/bench_metrics.py``, see its docstring): one
+Function call from Python costs tens of microseconds; ``Function.map`` costs a
+few microseconds per point; the numpy evaluation is the fastest per batch and
+the closed forms in :mod:`opnav.landing.metrics` are fastest overall.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import casadi as ca
+import numpy as np
+
+#: column slices of the 12-state layout [r, v, dtheta, p_cand]
+SL_R = slice(0, 3)
+SL_V = slice(3, 6)
+SL_THETA = slice(6, 9)
+SL_P = slice(9, 12)
+N_STATE = 12
+N_MEAS = 6
+
+
+def _skew(a):
+    return ca.vertcat(
+        ca.horzcat(0, -a[2], a[1]),
+        ca.horzcat(a[2], 0, -a[0]),
+        ca.horzcat(-a[1], a[0], 0),
+    )
+
+
+def _cayley(a):
+    """Rotation matrix of the Cayley map: ((1-|a|^2) I + 2 a a^T + 2 [a x]) / (1 + |a|^2)."""
+    n2 = ca.dot(a, a)
+    return ((1 - n2) * ca.SX.eye(3) + 2 * (a @ a.T) + 2 * _skew(a)) / (1 + n2)
+
+
+@lru_cache(maxsize=None)
+def _symbols():
+    r = ca.SX.sym("r_L", 3)
+    v = ca.SX.sym("v_L", 3)
+    dth = ca.SX.sym("dtheta", 3)
+    pk = ca.SX.sym("p_known_L", 3)
+    pc = ca.SX.sym("p_cand_L", 3)
+    R = ca.SX.sym("R_LtoB", 3, 3)
+    R_true = _cayley(-dth / 2) @ R  # C(dq) C(q_hat), C(dq) = I - [dtheta x] + ...
+
+    def unit_bearing(p):
+        w = R_true @ (p - r)
+        return w / ca.norm_2(w)
+
+    z = ca.vertcat(unit_bearing(pk), unit_bearing(pc))
+    x = ca.vertcat(r, v, dth, pc)
+    H = ca.jacobian(z, x)
+    H0 = ca.substitute(H, dth, ca.SX.zeros(3))
+    return r, v, dth, pk, pc, R, z, H0
+
+
+@lru_cache(maxsize=None)
+def bearing_function() -> ca.Function:
+    """z = [b_known; b_cand] (6,) in {B} (paper eq. 11-12), inputs
+    (r_L, v_L, dtheta, p_known_L, p_cand_L, R_LtoB)."""
+    r, v, dth, pk, pc, R, z, _ = _symbols()
+    return ca.Function(
+        "bearings",
+        [r, v, dth, pk, pc, R],
+        [z],
+        ["r_L", "v_L", "dtheta", "p_known_L", "p_cand_L", "R_LtoB"],
+        ["z"],
+    )
+
+
+@lru_cache(maxsize=None)
+def jacobian_function() -> ca.Function:
+    """H (6 x 12) = dz/d[r, v, dtheta, p_cand] at dtheta = 0 (paper eq. 14-18),
+    inputs (r_L, v_L, p_known_L, p_cand_L, R_LtoB)."""
+    r, v, _, pk, pc, R, _, H0 = _symbols()
+    return ca.Function(
+        "H",
+        [r, v, pk, pc, R],
+        [H0],
+        ["r_L", "v_L", "p_known_L", "p_cand_L", "R_LtoB"],
+        ["H"],
+    )
+
+
+@lru_cache(maxsize=None)
+def jacobian_map(n: int, parallelization: str = "serial") -> ca.Function:
+    """``jacobian_function().map(n, parallelization)``: p_cand_L given as 3 x n,
+    other inputs broadcast; output 6 x (12 n), horizontally stacked."""
+    return jacobian_function().map(n, parallelization)
+
+
+def jacobian_casadi(r_L, v_L, p_known_L, p_cand_L, R_LtoB) -> np.ndarray:
+    """One candidate through the compiled Function: (6, 12) ndarray."""
+    return jacobian_function()(r_L, v_L, p_known_L, p_cand_L, R_LtoB).full()
+
+
+def jacobian_casadi_batch(r_L, v_L, p_known_L, cand_L, R_LtoB, parallelization="serial") -> np.ndarray:
+    """n candidates (n, 3) through ``Function.map``: (n, 6, 12) ndarray."""
+    cand_L = np.atleast_2d(np.asarray(cand_L, dtype=float))
+    n = cand_L.shape[0]
+    out = jacobian_map(n, parallelization)(r_L, v_L, p_known_L, cand_L.T, R_LtoB).full()
+    return out.reshape(N_MEAS, n, N_STATE).transpose(1, 0, 2)
+
+
+# --------------------------------------------------------------------------
+# numpy evaluation of the same expressions (vectorised over candidates)
+# --------------------------------------------------------------------------
+
+
+def skew_np(a: np.ndarray) -> np.ndarray:
+    """[a x] for a of shape (..., 3) -> (..., 3, 3)."""
+    a = np.asarray(a, dtype=float)
+    S = np.zeros(a.shape[:-1] + (3, 3))
+    S[..., 0, 1] = -a[..., 2]
+    S[..., 0, 2] = a[..., 1]
+    S[..., 1, 0] = a[..., 2]
+    S[..., 1, 2] = -a[..., 0]
+    S[..., 2, 0] = -a[..., 1]
+    S[..., 2, 1] = a[..., 0]
+    return S
+
+
+def bearings_numpy(r_L, p_L, R_LtoB) -> np.ndarray:
+    """Unit bearings in {B} to landmarks p_L (..., 3) from r_L (paper eq. 12, dtheta = 0)."""
+    d = np.asarray(p_L, dtype=float) - np.asarray(r_L, dtype=float)
+    w = d @ np.asarray(R_LtoB, dtype=float).T
+    return w / np.linalg.norm(w, axis=-1, keepdims=True)
+
+
+def _blocks(r_L, p_L, R_LtoB):
+    """(H_C, [b x]) for landmarks p_L (..., 3): eq. 18 and eq. 16."""
+    R = np.asarray(R_LtoB, dtype=float)
+    d = np.asarray(p_L, dtype=float) - np.asarray(r_L, dtype=float)
+    rho = np.linalg.norm(d, axis=-1)
+    u = d / rho[..., None]
+    P = np.eye(3) - u[..., :, None] * u[..., None, :]
+    HC = (R @ P) / rho[..., None, None]  # eq. 18: C (|r|^2 I - r r^T) / |r|^3
+    b = u @ R.T
+    return HC, skew_np(b)  # eq. 16: H_C [r x] C^T = [b x]
+
+
+def jacobian_numpy(r_L, v_L, p_known_L, cand_L, R_LtoB) -> np.ndarray:
+    """H (n, 6, 12) for candidates cand_L (n, 3), same expressions as the
+    CasADi Function (eq. 14-18); v_L is unused (zero columns)."""
+    cand_L = np.atleast_2d(np.asarray(cand_L, dtype=float))
+    n = cand_L.shape[0]
+    HCk, Bk = _blocks(r_L, p_known_L, R_LtoB)
+    HCc, Bc = _blocks(r_L, cand_L, R_LtoB)
+    H = np.zeros((n, N_MEAS, N_STATE))
+    H[:, 0:3, SL_R] = -HCk
+    H[:, 0:3, SL_THETA] = Bk
+    H[:, 3:6, SL_R] = -HCc
+    H[:, 3:6, SL_THETA] = Bc
+    H[:, 3:6, SL_P] = HCc
+    return H

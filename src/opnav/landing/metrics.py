@@ -1,0 +1,510 @@
+"""Observability / information metrics for landmark selection (paper B, sec. 2.2;
+SPEC B.3 baselines and B-X1).
+
+Description
+-----------
+Every metric scores a *candidate* unknown landmark p_cand (in {L}, m) given the
+lander state and the known landmark at the {L} origin, from the two-landmark
+bearing Jacobian H (6 x 12, paper eq. 14-18, columns [dr, dv, dtheta, dp_cand],
+built in :mod:`opnav.landing.casadi_model`).  LARGER IS BETTER for all of them:
+
+==========  ================================================================
+``svd``     sigma_min(H): smallest *structural* singular value (see below)
+``gdop``    1 / trace[(H^T H)^+]  (paper's GDOP-type metric, pseudo-inverse)
+``cond``    1 / cond(H) = sigma_min / sigma_max (structural)
+``logdet``  D-optimal  log det(P^-1 + H^T R^-1 H)          (B-X1, beyond paper)
+``mineig``  E-optimal  lambda_min(P^-1 + H^T R^-1 H)        (B-X1, beyond paper)
+==========  ================================================================
+
+Rank choice (documented deviation from a literal reading of the SPEC)
+---------------------------------------------------------------------
+Each unit-bearing block of H has the left null vector b_i: b_i^T H_C = 0 and
+b_i^T [b_i x] = 0 (eq. 16-18), because a unit vector has only two degrees of
+freedom.  Hence rank(H) <= 4 for every geometry, and the 5th and 6th singular
+values of the 6 x 12 H are zero up to rounding (~1e-16): the smallest of the 6
+singular values is rounding noise and 1/cond(H) over all 6 is 0 for every
+candidate, so they cannot rank landmarks.  We therefore use the four
+*structural* singular values s1 >= s2 >= s3 >= s4 (those of the 4 x 12
+tangent-plane projection T^T H, which is how a pixel measurement enters):
+``svd`` = s4, ``cond`` = s4 / s1, ``gdop`` = 1 / sum_i s_i^-2.  For ``gdop`` this
+is exactly trace[(H^T H)^+]^-1 with the pseudo-inverse rank tolerance set at
+rank 4; the per-candidate reference computes it with ``numpy.linalg.pinv(H,
+rcond=1e-10)`` (singular values below 1e-10 sigma_max dropped) and agrees
+whenever s4 > 1e-10 s1 (always in the descent geometry, where s4/s1 ~ 1e-5 and
+the structural zeros are ~1e-16).  As s4 -> 0 the structural score goes to 0
+continuously instead of jumping as a tolerance-based rank would.
+
+Closed form (the fast path)
+---------------------------
+The structural singular values are invariant to the attitude R_LtoB (H =
+blockdiag(R, R) H_L blockdiag(I, I, R^T, I) with orthogonal factors), and
+depend only on x = 1/rho_1, y = 1/rho_2 (inverse ranges to the known and the
+candidate landmark, 1/m) and c = cos(gamma) = u . w (unit lines of sight).
+Reducing H H^T to tangent bases aligned with u x w gives a 2 x 2 diagonal
+coupling, so (with a = 1 + x^2, d = 1 + 2 y^2, m = (a + d)/2, e = (a - d)/2)
+
+    k1 = c + x y,  k2 = 1 + c x y,
+    s^2 in { m + sqrt(e^2 + k_j^2),  D_j / (m + sqrt(e^2 + k_j^2)) },  j = 1, 2,
+    D1 = a d - k1^2 = sin^2(gamma) + (x - c y)^2 + (2 - c^2) y^2 + x^2 y^2,
+    D2 = a d - k2^2 = (x - c y)^2 + (2 - c^2) y^2 + (2 - c^2) x^2 y^2,
+
+written without cancellation.  Tests prove it equal to the SVD of the
+CasADi-derived H (relative 1e-9; the closed form is the more accurate of the two,
+LAPACK's s4 carries ~eps s1 / s4 ~ 1e-12 relative error).  Note the mixed units
+of H (1/m for position columns, 1 for attitude columns): s1..s3 ~ 1 come from
+the attitude columns and s4 ~ 1/range from the position columns, so ``svd``
+effectively rewards short ranges and ``cond`` is s4/sqrt(2).
+
+Information metrics (``logdet``, ``mineig``) need ``ctx.P`` (12 x 12 prior
+covariance of [r (m), v (m/s), dtheta (rad), p (m)]) and ``ctx.R_meas`` (6 x 6
+bearing-noise covariance, rad^2); they depend on the attitude through P.
+``logdet`` is 2 sum(log(diag(cholesky))) of the Jacobi-equilibrated 12 x 12
+information plus a k*eps jitter (escalated only if Cholesky fails), never
+log(prod).  (The determinant lemma -log det P - log det R + log det(R + H P H^T)
+would need only a 6 x 6 Cholesky, but R + H P H^T has condition ~1e9 in the
+descent geometry -- the radial bearing directions carry only R -- and lost
+~1e-6 nats against a 50-digit reference, while the equilibrated 12 x 12 form
+is exact to ~1e-10; batched, the cost difference is negligible.)
+``mineig`` = 1 / lambda_max(P_post) with
+P_post = P - P H^T (R + H P H^T)^-1 H P (the posterior covariance), which
+keeps relative accuracy where eigvalsh on the mixed-unit information matrix
+(entries from 1e-6 to 1e7) loses it; it is in SI units (m, rad) and therefore
+unit-dependent, like every metric of a mixed-unit matrix.
+
+Degenerate inputs (never a silent NaN)
+--------------------------------------
+* candidate within ``ctx.min_range_m`` of the lander: score -inf;
+* candidate or known landmark behind the camera, i.e. b . boresight_B <= 0
+  (``ctx.boresight_B``, default body -z per SPEC B.2; None disables): -inf;
+* non-finite or wrongly shaped inputs: ``ValueError`` naming the field;
+* information metric without ``P``/``R_meas``: ``ValueError``;
+* non-positive-definite information (bad P): -inf.
+
+Implementations and counting
+----------------------------
+``make_metric(name)`` returns a :class:`Metric`, callable as
+``metric(ctx, cand_L) -> scores`` for ``cand_L`` of shape (n, 3) (fastest
+faithful implementation: closed form or batched numpy) and
+``metric.scalar(ctx, p_L) -> float`` (minimal-overhead single candidate, the
+path a sequential golden-section search calls).  ``metric.reference`` calls the
+compiled CasADi Function once per candidate (slow, obvious), ``metric.casadi_map``
+uses ``Function.map(n)``, ``metric.numpy_H`` builds H in numpy and applies
+batched LAPACK.  Every path adds the number of candidates it scored to
+``metric.n_evals`` (and 1 to ``metric.n_calls``); ``metric.reset()`` zeroes both.
+See ``benchmarks/bench_metrics.py`` for the timings.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from opnav.landing import casadi_model as cm
+
+METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig")
+H_METRICS = ("svd", "gdop", "cond")
+INFO_METRICS = ("logdet", "mineig")
+#: structural rank of the 6 x 12 two-bearing Jacobian (2 per unit bearing)
+STRUCTURAL_RANK = 4
+#: pseudo-inverse rank tolerance of the reference GDOP, relative to sigma_max
+PINV_RCOND = 1e-10
+
+
+def _vec3(name: str, a) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if a.shape != (3,):
+        raise ValueError(f"MetricContext.{name} must have shape (3,), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"MetricContext.{name} must be finite, got {a}")
+    return a
+
+
+def _mat(name: str, a, n: int) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if a.shape != (n, n):
+        raise ValueError(f"MetricContext.{name} must have shape ({n}, {n}), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"MetricContext.{name} must be finite")
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class MetricContext:
+    """Everything a metric needs besides the candidate.
+
+    r_L: lander position in {L} (m); v_L: velocity (m/s, enters no metric);
+    R_LtoB: rotation {L} -> {B}; p_known_L: known landmark (m, the {L} origin in
+    paper B); P: 12 x 12 prior covariance of [r, v, dtheta, p] (m, m/s, rad, m)
+    for the information metrics, or None; R_meas: 6 x 6 bearing-noise covariance
+    (rad^2) or None; boresight_B: camera boresight in {B} (candidates with
+    b . boresight_B <= 0 are behind the camera and score -inf; None disables);
+    min_range_m: candidates closer than this to the lander score -inf.
+    """
+
+    r_L: np.ndarray
+    v_L: np.ndarray
+    R_LtoB: np.ndarray
+    p_known_L: np.ndarray
+    P: np.ndarray | None = None
+    R_meas: np.ndarray | None = None
+    boresight_B: np.ndarray | None = field(default_factory=lambda: np.array([0.0, 0.0, -1.0]))
+    min_range_m: float = 1e-6
+
+    def __post_init__(self):
+        s = object.__setattr__
+        s(self, "r_L", _vec3("r_L", self.r_L))
+        s(self, "v_L", _vec3("v_L", self.v_L))
+        s(self, "p_known_L", _vec3("p_known_L", self.p_known_L))
+        R = _mat("R_LtoB", self.R_LtoB, 3)
+        if not np.allclose(R @ R.T, np.eye(3), atol=1e-8) or np.linalg.det(R) <= 0:
+            raise ValueError("MetricContext.R_LtoB must be a proper rotation matrix")
+        s(self, "R_LtoB", R)
+        if self.P is not None:
+            P = _mat("P", self.P, 12)
+            if not np.allclose(P, P.T, rtol=1e-10, atol=0):
+                raise ValueError("MetricContext.P must be symmetric")
+            s(self, "P", P)
+        if self.R_meas is not None:
+            Rm = _mat("R_meas", self.R_meas, 6)
+            if not np.allclose(Rm, Rm.T, rtol=1e-10, atol=0):
+                raise ValueError("MetricContext.R_meas must be symmetric")
+            s(self, "R_meas", Rm)
+        if self.boresight_B is not None:
+            bs = _vec3("boresight_B", self.boresight_B)
+            nb = np.linalg.norm(bs)
+            if nb == 0:
+                raise ValueError("MetricContext.boresight_B must be non-zero (or None)")
+            s(self, "boresight_B", bs / nb)
+        if not (math.isfinite(self.min_range_m) and self.min_range_m >= 0):
+            raise ValueError("MetricContext.min_range_m must be finite and >= 0")
+        s(self, "_cache", {})
+
+    # ---- per-context precomputation (cached on the frozen instance) ----
+    def _geom(self):
+        """(u, x, boresight_in_L, known_ok): known line of sight, 1/rho_1, ..."""
+        c = self._cache
+        if "geom" not in c:
+            d1 = self.p_known_L - self.r_L
+            rho1 = float(np.linalg.norm(d1))
+            bs_L = None if self.boresight_B is None else self.R_LtoB.T @ self.boresight_B
+            known_ok = rho1 > self.min_range_m and (bs_L is None or float(d1 @ bs_L) > 0.0)
+            u = d1 / rho1 if rho1 > 0 else np.full(3, np.nan)
+            c["geom"] = (u, (1.0 / rho1) if rho1 > 0 else math.inf, bs_L, known_ok)
+        return c["geom"]
+
+    def _info(self):
+        """(P, R_meas, P^-1, R_meas^-1) for the information metrics."""
+        c = self._cache
+        if "info" not in c:
+            if self.P is None or self.R_meas is None:
+                missing = [k for k in ("P", "R_meas") if getattr(self, k) is None]
+                raise ValueError(f"information metrics need MetricContext.{' and '.join(missing)}")
+            if not (np.isfinite(chol_logdet(self.P[None])[0]) and np.isfinite(chol_logdet(self.R_meas[None])[0])):
+                raise ValueError("MetricContext.P and R_meas must be positive definite")
+            Pinv = np.linalg.inv(self.P)
+            W = np.linalg.inv(self.R_meas)
+            c["info"] = (self.P, self.R_meas, 0.5 * (Pinv + Pinv.T), 0.5 * (W + W.T))
+        return c["info"]
+
+
+# --------------------------------------------------------------------------
+# linear-algebra helpers
+# --------------------------------------------------------------------------
+
+
+def chol_logdet(A: np.ndarray, jitter: float | None = None) -> np.ndarray:
+    """log det of a stack of SPD matrices (..., k, k) as 2 sum(log(diag(L))) of
+    the Jacobi-equilibrated matrix D^-1/2 A D^-1/2 + jitter I, plus sum(log D).
+
+    ``jitter`` defaults to k * machine epsilon (~1e-15, shifts log det by
+    < 1e-8 for equilibrated eigenvalues >= 1e-6); a matrix whose Cholesky still
+    fails is retried with the jitter multiplied by 1e3 up to 1e-8, then scored
+    -inf (non-positive-definite; never NaN)."""
+    A = np.asarray(A, dtype=float)
+    k = A.shape[-1]
+    if jitter is None:
+        jitter = k * np.finfo(float).eps
+    dg = np.diagonal(A, axis1=-2, axis2=-1)
+    out = np.full(A.shape[:-2], -np.inf)
+    ok = np.all(dg > 0, axis=-1) & np.all(np.isfinite(A), axis=(-2, -1))
+    if not np.any(ok):
+        return out
+    s = 1.0 / np.sqrt(dg[ok])
+    As = A[ok] * s[..., :, None] * s[..., None, :]
+    eye = np.eye(k)
+    try:
+        L = np.linalg.cholesky(As + jitter * eye)
+        vals = 2.0 * np.sum(np.log(np.diagonal(L, axis1=-2, axis2=-1)), axis=-1)
+    except np.linalg.LinAlgError:
+        vals = np.full(As.shape[0], -np.inf)
+        for i, Ai in enumerate(As):
+            j = jitter
+            while j <= 1e-8:
+                try:
+                    vals[i] = 2.0 * np.sum(np.log(np.diag(np.linalg.cholesky(Ai + j * eye))))
+                    break
+                except np.linalg.LinAlgError:
+                    j *= 1e3
+    out[ok] = vals - 2.0 * np.sum(np.log(s), axis=-1)
+    return out
+
+
+def structural_singular_values(x, y, c, s2):
+    """The 4 nonzero singular values of H (descending, last axis) from
+    x = 1/rho_1, y = 1/rho_2 (1/m), c = u . w and s2 = |u x w|^2 (closed form,
+    module docstring).  Broadcasts over arrays."""
+    lam = _structural_sq(x, y, c, s2)
+    return np.sqrt(np.stack(lam, axis=-1))
+
+
+def _structural_sq(x, y, c, s2):
+    """(l1+, l1-, l2+, l2-) squared singular values, cancellation-free."""
+    a = 1.0 + x * x
+    d = 1.0 + 2.0 * y * y
+    m = 0.5 * (a + d)
+    e = 0.5 * (a - d)
+    k1 = c + x * y
+    k2 = 1.0 + c * x * y
+    xy2 = x * x * y * y
+    base = (x - c * y) ** 2 + (2.0 - c * c) * y * y
+    D1 = s2 + base + xy2
+    D2 = base + (1.0 + s2) * xy2  # (2 - c^2) x^2 y^2
+    lp1 = m + np.sqrt(e * e + k1 * k1)
+    lp2 = m + np.sqrt(e * e + k2 * k2)
+    return lp1, D1 / lp1, lp2, D2 / lp2
+
+
+def _scores_from_sq(name, lp1, lm1, lp2, lm2):
+    if name == "svd":
+        return np.sqrt(np.minimum(lm1, lm2))
+    if name == "cond":
+        return np.sqrt(np.minimum(lm1, lm2) / np.maximum(lp1, lp2))
+    # gdop: 1 / sum 1/s^2 = 1 / sum_j (l+ + l-)/(l+ l-); l+ l- = D_j
+    with np.errstate(divide="ignore"):
+        tr = (lp1 + lm1) / (lp1 * lm1) + (lp2 + lm2) / (lp2 * lm2)
+        return 1.0 / tr
+
+
+def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
+    """The obvious linear algebra on explicit H (n, 6, 12)."""
+    if name in H_METRICS:
+        s = np.linalg.svd(H, compute_uv=False)  # descending, 6 values
+        if name == "svd":
+            return s[:, STRUCTURAL_RANK - 1]
+        if name == "cond":
+            return s[:, STRUCTURAL_RANK - 1] / s[:, 0]
+        Hp = np.linalg.pinv(H, rcond=PINV_RCOND)  # (H^T H)^+ = H^+ H^+T
+        return 1.0 / np.einsum("nij,nij->n", Hp, Hp)
+    P, Rm, _, _ = ctx._info()
+    Lam = np.linalg.inv(P) + np.einsum("nki,kl,nlj->nij", H, np.linalg.inv(Rm), H)
+    Lam = 0.5 * (Lam + np.swapaxes(Lam, 1, 2))
+    if name == "logdet":
+        return chol_logdet(Lam)
+    return np.linalg.eigvalsh(Lam)[:, 0]
+
+
+def _info_scores_fast(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
+    """Batched information metrics: logdet by equilibrated Cholesky of the 12 x 12
+    information; mineig = 1 / lambda_max of the posterior covariance via the
+    6 x 6 innovation covariance S = R + H P H^T."""
+    P, Rm, Pinv, W = ctx._info()
+    if name == "logdet":
+        Lam = Pinv + np.swapaxes(H, 1, 2) @ W @ H
+        return chol_logdet(0.5 * (Lam + np.swapaxes(Lam, 1, 2)))
+    HP = H @ P  # (n, 6, 12)
+    S = HP @ np.swapaxes(H, 1, 2) + Rm
+    S = 0.5 * (S + np.swapaxes(S, 1, 2))
+    K = np.linalg.solve(S, HP)  # S^-1 H P
+    Ppost = P - np.swapaxes(HP, 1, 2) @ K
+    Ppost = 0.5 * (Ppost + np.swapaxes(Ppost, 1, 2))
+    lmax = np.linalg.eigvalsh(Ppost)[:, -1]
+    with np.errstate(divide="ignore"):
+        return np.where(lmax > 0, 1.0 / lmax, -np.inf)
+
+
+# --------------------------------------------------------------------------
+# the metric object
+# --------------------------------------------------------------------------
+
+
+def _as_cands(cand_L) -> np.ndarray:
+    c = np.asarray(cand_L, dtype=float)
+    if c.ndim == 1:
+        c = c[None, :]
+    if c.ndim != 2 or c.shape[1] != 3:
+        raise ValueError(f"cand_L must have shape (n, 3), got {np.shape(cand_L)}")
+    if not np.all(np.isfinite(c)):
+        raise ValueError("cand_L must be finite")
+    return c
+
+
+def _valid(ctx: MetricContext, c: np.ndarray):
+    """(d2, rho2, valid mask) for candidates c (n, 3)."""
+    u, x, bs_L, known_ok = ctx._geom()
+    d2 = c - ctx.r_L
+    rho2 = np.sqrt(np.einsum("ij,ij->i", d2, d2))
+    ok = rho2 > ctx.min_range_m
+    if bs_L is not None:
+        ok &= d2 @ bs_L > 0.0
+    if not known_ok:
+        ok[:] = False
+    return d2, rho2, ok
+
+
+class Metric:
+    """A selection metric (larger is better) with evaluation counters.
+
+    ``metric(ctx, cand_L (n,3)) -> (n,)`` fastest faithful batch path;
+    ``metric.scalar(ctx, p_L (3,)) -> float`` minimal-overhead single candidate;
+    ``metric.reference``, ``metric.casadi_map``, ``metric.numpy_H``: the
+    CasADi-per-candidate, CasADi ``Function.map`` and numpy-H paths (same values).
+    ``n_evals`` counts candidate evaluations, ``n_calls`` calls, over all paths.
+    """
+
+    larger_is_better = True
+
+    def __init__(self, name: str):
+        if name not in METRIC_NAMES:
+            raise ValueError(f"unknown metric {name!r}; expected one of {METRIC_NAMES}")
+        self.name = name
+        self.n_evals = 0
+        self.n_calls = 0
+
+    def __repr__(self):
+        return f"Metric({self.name!r}, n_evals={self.n_evals}, n_calls={self.n_calls})"
+
+    def reset(self) -> None:
+        self.n_evals = 0
+        self.n_calls = 0
+
+    def _count(self, n: int) -> None:
+        self.n_evals += n
+        self.n_calls += 1
+
+    # ---- fastest batch path ----
+    def __call__(self, ctx: MetricContext, cand_L) -> np.ndarray:
+        c = _as_cands(cand_L)
+        if c.shape[0] == 1:  # the sequential golden-section case: scalar fast path
+            return np.array([self.scalar(ctx, c[0])])
+        self._count(c.shape[0])
+        d2, rho2, ok = _valid(ctx, c)
+        out = np.full(c.shape[0], -np.inf)
+        if not np.any(ok):
+            return out
+        if self.name in H_METRICS:
+            u, x, _, _ = ctx._geom()
+            w = d2[ok] / rho2[ok, None]
+            y = 1.0 / rho2[ok]
+            cg = w @ u
+            cr = np.cross(u, w)
+            s2 = np.einsum("ij,ij->i", cr, cr)
+            out[ok] = _scores_from_sq(self.name, *_structural_sq(x, y, cg, s2))
+        else:
+            H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c[ok], ctx.R_LtoB)
+            out[ok] = _info_scores_fast(self.name, H, ctx)
+        return out
+
+    # ---- minimal-overhead single candidate (golden-section inner loop) ----
+    def scalar(self, ctx: MetricContext, p_L) -> float:
+        self.n_evals += 1
+        self.n_calls += 1
+        u, x, bs_L, known_ok = ctx._geom()
+        r = ctx.r_L
+        d0 = float(p_L[0]) - float(r[0])
+        d1 = float(p_L[1]) - float(r[1])
+        d2 = float(p_L[2]) - float(r[2])
+        if not (math.isfinite(d0) and math.isfinite(d1) and math.isfinite(d2)):
+            raise ValueError("p_L must be finite")
+        rho2 = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if not known_ok or rho2 <= ctx.min_range_m:
+            return -math.inf
+        if bs_L is not None and d0 * bs_L[0] + d1 * bs_L[1] + d2 * bs_L[2] <= 0.0:
+            return -math.inf
+        if self.name not in H_METRICS:
+            H = cm.jacobian_numpy(r, ctx.v_L, ctx.p_known_L, np.array([[d0, d1, d2]]) + r, ctx.R_LtoB)
+            return float(_info_scores_fast(self.name, H, ctx)[0])
+        y = 1.0 / rho2
+        w0, w1, w2 = d0 * y, d1 * y, d2 * y
+        u0, u1, u2 = float(u[0]), float(u[1]), float(u[2])
+        cg = u0 * w0 + u1 * w1 + u2 * w2
+        c0, c1, c2 = u1 * w2 - u2 * w1, u2 * w0 - u0 * w2, u0 * w1 - u1 * w0
+        s2 = c0 * c0 + c1 * c1 + c2 * c2
+        a = 1.0 + x * x
+        dd = 1.0 + 2.0 * y * y
+        m = 0.5 * (a + dd)
+        e2 = (0.5 * (a - dd)) ** 2
+        xy = x * y
+        k1 = cg + xy
+        k2 = 1.0 + cg * xy
+        base = (x - cg * y) ** 2 + (2.0 - cg * cg) * y * y
+        D1 = s2 + base + xy * xy
+        D2 = base + (1.0 + s2) * xy * xy
+        lp1 = m + math.sqrt(e2 + k1 * k1)
+        lp2 = m + math.sqrt(e2 + k2 * k2)
+        lm1 = D1 / lp1
+        lm2 = D2 / lp2
+        if self.name == "svd":
+            return math.sqrt(min(lm1, lm2))
+        if self.name == "cond":
+            return math.sqrt(min(lm1, lm2) / max(lp1, lp2))
+        if D1 <= 0.0 or D2 <= 0.0:
+            return 0.0
+        return 1.0 / ((lp1 + lm1) / D1 + (lp2 + lm2) / D2)
+
+    # ---- slower paths with identical values (tests, benchmark) ----
+    def _explicit(self, ctx, cand_L, build) -> np.ndarray:
+        c = _as_cands(cand_L)
+        self._count(c.shape[0])
+        _, _, ok = _valid(ctx, c)
+        out = np.full(c.shape[0], -np.inf)
+        if np.any(ok):
+            out[ok] = build(c[ok])
+        return out
+
+    def reference(self, ctx: MetricContext, cand_L) -> np.ndarray:
+        """One compiled CasADi Function call and one explicit linear-algebra
+        evaluation (SVD / pinv / 12 x 12 information) per candidate."""
+        f = cm.jacobian_function()
+
+        def build(c):
+            vals = []
+            for p in c:
+                H = f(ctx.r_L, ctx.v_L, ctx.p_known_L, p, ctx.R_LtoB).full()
+                vals.append(_scores_from_H(self.name, H[None], ctx)[0])
+            return np.array(vals)
+
+        return self._explicit(ctx, cand_L, build)
+
+    def casadi_map(self, ctx: MetricContext, cand_L, parallelization: str = "serial") -> np.ndarray:
+        """H for all candidates via ``Function.map(n)``, then batched linear algebra."""
+
+        def build(c):
+            H = cm.jacobian_casadi_batch(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB, parallelization)
+            if self.name in H_METRICS:
+                return _scores_from_H(self.name, H, ctx)
+            return _info_scores_fast(self.name, H, ctx)
+
+        return self._explicit(ctx, cand_L, build)
+
+    def numpy_H(self, ctx: MetricContext, cand_L) -> np.ndarray:
+        """H for all candidates in numpy (eq. 14-18), then batched SVD / pinv / Cholesky."""
+
+        def build(c):
+            H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB)
+            if self.name in H_METRICS:
+                return _scores_from_H(self.name, H, ctx)
+            return _info_scores_fast(self.name, H, ctx)
+
+        return self._explicit(ctx, cand_L, build)
+
+
+def make_metric(name: str) -> Metric:
+    """The selection metric ``name`` (one of :data:`METRIC_NAMES`), larger is
+    better; see :class:`Metric` for the call forms and counters."""
+    return Metric(name)
+
+
+ScoreFn = Callable[[MetricContext, np.ndarray], np.ndarray]
