@@ -247,7 +247,9 @@ def test_batched_scalar_and_map_equal_reference(name, r, R, seed, aniso):
         atol = 1e3 * np.finfo(float).eps * np.abs(Lam).max()
         rtol = 1e-6
     elif name == "logdet":
-        atol, rtol = 1e-7, 1e-9
+        # at ~30 m altitude the equilibrated information has condition ~4e8: every
+        # float64 path (the reference included) is within ~5e-7 nats of a 50-digit value
+        atol, rtol = 2e-6, 1e-9
     else:
         atol, rtol = 0.0, 1e-9
     for got in (fast, mapped, nph, scal):
