@@ -1,0 +1,267 @@
+"""Table-1 cases and the segment-wise EM-EKF run of one case over many seeds (paper A sec. 2.3, 3).
+
+Description
+    :func:`table1_cases` lists the paper's 17 cases in its 5 groups (bias size,
+    polarity, initial value, pixel accuracy, installation angle); every case
+    not varied keeps the headline values of the config.
+
+    :func:`run_case` runs one case for a batch of seeds (all seeds go through
+    the filter together as stacked arrays):
+
+    1. simulate the measurements of every seed (truth: exact misalignment);
+    2. run the theta = 0 EKF over the whole arc from the prior (the paper's
+       "already observed data", step 1 of sec. 2.3);
+    3. for segment l = 0..L-1 take the window of N samples starting at
+       ``N0 + l N`` (``sliding``, the paper's reading) or all samples from N0
+       to ``N0 + (l+1) N`` (``growing``); start it from the variant's state
+       (see :mod:`opnav.approach.scenario`) and run M EM iterations seeded
+       with the previous segment's estimate;
+    4. run the EKF over the whole arc again with the final estimate.
+
+Written rules (Table 1 columns)
+    *Data needed to converge* (samples): for each seed, the smallest amount
+    of data ``(l+1) N`` such that after segment l and after every later
+    segment both |tx - tx_final| and |ty - ty_final| are at most
+    ``em.converge_tol_arcsec``; the table reports the median over seeds.
+    *Navigation error before / after compensation* (km): for each seed, the
+    RMS of the position-error norm |r_hat - r_true| of the full-arc EKF
+    (step 2 with theta = 0, step 4 with the final estimate) over the last
+    ``nav_error.last_fraction`` of the arc; the table reports the mean (and
+    standard deviation) over seeds.
+Units: arcsec and km in outputs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import scenario as sc
+from .ekf import predict_only, run_filter
+from .em import em_window
+
+GROUPS = ("size", "polarity", "initial", "pixel", "install")
+GROUP_TITLES = {
+    "size": "bias size", "polarity": "polarity", "initial": "initial value",
+    "pixel": "pixel accuracy (3-sigma)", "install": "installation angle",
+}
+
+
+@dataclass(frozen=True)
+class Case:
+    case_index: int  # 1..17, also the Monte-Carlo stream index
+    case_id: str
+    group: str
+    truth_arcsec: tuple
+    init_arcsec: tuple
+    sigma3_px: tuple
+    install_deg: float
+
+
+def table1_cases(cfg: dict) -> list[Case]:
+    """The 17 cases of paper A Table 1 (ids T1-01..T1-17, paper row order)."""
+    truth = tuple(cfg["truth_bias_arcsec"])
+    init = tuple(cfg["theta_init_arcsec"])
+    px = tuple(cfg["camera"]["sigma3_px"])
+    ratio = cfg["camera"]["radius_to_centroid_ratio"]
+    rows = []
+    for b in ([10, 20, 10], [10, 10, 10], [10, 3, 10]):
+        rows.append(("size", tuple(map(float, b)), init, px, 0.0))
+    for b in ([10, 20, 10], [-10, 20, 10], [-10, -20, 10], [10, -20, 10]):
+        rows.append(("polarity", tuple(map(float, b)), init, px, 0.0))
+    for i in ([0, 0, 0], [-20, -20, -20]):
+        rows.append(("initial", truth, tuple(map(float, i)), px, 0.0))
+    for p in (0.1, 0.5, 1.0):
+        rows.append(("pixel", truth, init, (p, p, ratio * p), 0.0))
+    for a in (0.0, 45.0, 90.0, 135.0, 180.0):
+        rows.append(("install", truth, init, px, a))
+    return [Case(i + 1, f"T1-{i + 1:02d}", *r) for i, r in enumerate(rows)]
+
+
+def headline_case(cfg: dict) -> Case:
+    return table1_cases(cfg)[0]
+
+
+def rms_last(err_norm: np.ndarray, last_fraction: float) -> np.ndarray:
+    """RMS over the last fraction of the samples (axis -1)."""
+    n = err_norm.shape[-1]
+    k0 = int(np.floor(n * (1.0 - last_fraction)))
+    return np.sqrt(np.mean(err_norm[..., k0:] ** 2, axis=-1))
+
+
+def data_to_converge(theta_seg_arcsec: np.ndarray, seg_data: np.ndarray, tol: float) -> np.ndarray:
+    """Per seed, the data amount after which tx, ty stay within ``tol`` of their final value.
+
+    theta_seg_arcsec (S, L, 3); seg_data (L,) samples used after each segment.
+    """
+    dev = np.abs(theta_seg_arcsec[:, :, :2] - theta_seg_arcsec[:, -1:, :2]).max(-1)  # (S,L)
+    bad = dev > tol
+    # last segment index that is still outside, +1 -> first index from which all stay inside
+    L = bad.shape[1]
+    last_bad = np.where(bad.any(1), L - 1 - np.argmax(bad[:, ::-1], axis=1), -1)
+    return seg_data[last_bad + 1]
+
+
+def segment_windows(cfg: dict) -> list[tuple[int, int]]:
+    """(a, b) sample ranges of the L segments (start sample a has no measurement)."""
+    s = cfg["segments"]
+    N0, N, L = s["N0"], s["N"], s["L"]
+    if s["mode"] == "sliding":
+        return [(N0 + l * N, N0 + (l + 1) * N) for l in range(L)]
+    return [(N0, N0 + (l + 1) * N) for l in range(L)]
+
+
+def start_state(start: str, a: int, f0, dx_true: np.ndarray, dx0: np.ndarray, P_X0: np.ndarray,
+                win) -> tuple[np.ndarray, np.ndarray]:
+    """State (S,6) and covariance at window start ``a`` for a variant's start rule.
+
+    ``filter``: the theta = 0 EKF's own ``X_a, P_a`` (``literal``); ``prior``: the
+    prior propagated to ``a`` without data; ``truth``: the true state with the
+    filter's ``P_a`` (``reference-start`` diagnostic).
+    """
+    S = dx0.shape[0]
+    if start == "filter":
+        return f0.xf[:, a], f0.Pf[:, a]
+    if start == "truth":
+        return np.broadcast_to(dx_true[a], (S, 6)).copy(), f0.Pf[:, a]
+    if start == "prior":
+        return predict_only(dx0, P_X0, win.slice(0, a))
+    raise ValueError(f"unknown start rule {start!r}")
+
+
+def run_case(cfg: dict, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
+             method: str | None = None, init_mode: str | None = None) -> dict:
+    """EM-EKF for one case and variant over the given seeds; arrays in arcsec / km."""
+    geo = geo or sc.build_geometry(cfg, variant)
+    method = method or cfg["em"]["method"]
+    init_mode = init_mode or cfg["initial_error"]["mode"]
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    win = geo.window(Rvar)
+    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
+    theta_true = sc.rad(case.truth_arcsec)
+    z, e0 = sc.simulate(geo, Rvar, theta_true, rngs)
+    S = z.shape[0]
+    dx0 = sc.prior_mean_deviation(geo, e0, init_mode)
+    dx_true = geo.dx_true
+    tz_tol = cfg["em"]["tz_tol"]
+
+    zero = np.zeros((S, 3))
+    f0 = run_filter(z, zero, dx0, geo.P0, win)
+    err_before = np.linalg.norm(f0.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
+
+    start = sc.START_OF[variant]
+    theta = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
+    windows = segment_windows(cfg)
+    seg_theta, it_theta, it_ll, it_data, seg_err, seg_sig = [], [], [], [], [], []
+    unobs = None
+    for (a, b) in windows:
+        x0, P0 = start_state(start, a, f0, dx_true, dx0, geo.P0, win)
+        tr = em_window(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), cfg["segments"]["M"],
+                       method, tz_tol)
+        theta = tr.theta[-1]
+        unobs = tr.unobservable
+        used = b - cfg["segments"]["N0"] if cfg["segments"]["mode"] == "growing" else b - windows[0][0]
+        seg_theta.append(theta)
+        it_theta.extend(tr.theta)
+        it_ll.extend(tr.loglik)
+        it_data.extend([used] * len(tr.theta))
+        f = tr.last_filter
+        seg_err.append(np.linalg.norm(f.xf[:, -1, :3] - dx_true[b, :3], axis=-1))
+        seg_sig.append(3.0 * np.sqrt(np.trace(f.Pf[:, -1, :3, :3], axis1=1, axis2=2)))
+
+    f1 = run_filter(z, theta, dx0, geo.P0, win)
+    err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
+    frac = cfg["nav_error"]["last_fraction"]
+    seg_theta_as = sc.arcsec(np.stack(seg_theta, 1))
+    N = cfg["segments"]["N"]
+    seg_data = np.array([(l + 1) * N for l in range(len(windows))])
+    return {
+        "variant": variant,
+        "case_id": case.case_id,
+        "seed_indices": np.asarray(list(seed_indices)),
+        "truth_arcsec": np.asarray(case.truth_arcsec, float),
+        "theta_final_arcsec": sc.arcsec(theta),
+        "theta_seg_arcsec": seg_theta_as,
+        "theta_iter_arcsec": sc.arcsec(np.stack(it_theta, 1)),
+        "loglik_iter": np.stack(it_ll, 1),
+        "iter_data_used": np.asarray(it_data),
+        "seg_data_used": seg_data,
+        "seg_pos_err_km": np.stack(seg_err, 1),
+        "seg_pos_3sig_km": np.stack(seg_sig, 1),
+        "tz_unobservable": bool(np.all(unobs[:, 0])) if unobs is not None else False,
+        "data_to_converge": data_to_converge(seg_theta_as, seg_data, cfg["em"]["converge_tol_arcsec"]),
+        "nav_err_before_km": rms_last(err_before, frac),
+        "nav_err_after_km": rms_last(err_after, frac),
+        "err_before_t_km": err_before,
+        "err_after_t_km": err_after,
+        "t_s": geo.t,
+    }
+
+
+def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_samples: int,
+                      max_maps: int, tol_arcsec: float, geo: sc.Geometry | None = None,
+                      init_mode: str | None = None) -> dict:
+    """Iterations of plain EM and SQUAREM to reach the maximum-likelihood estimate.
+
+    One window of ``data_samples`` samples from ``N0`` (start rule of the
+    variant). The reference ``theta*`` is SQUAREM run until its step is below
+    1e-4 arcsec (or ``max_maps`` maps). "Maps to converge" counts filter +
+    smoother + M-step evaluations until |theta - theta*| <= ``tol_arcsec`` in
+    both tx and ty and stays there; a run that does not get there within
+    ``max_maps`` is reported as ``max_maps + 1`` (stalled) together with the
+    contraction rate per map measured over its last iterations.
+    """
+    from .em import em_window
+
+    N0 = cfg["segments"]["N0"]
+    geo = geo or sc.build_geometry(cfg, variant, n=N0 + data_samples)
+    init_mode = init_mode or cfg["initial_error"]["mode"]
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    win = geo.window(Rvar)
+    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
+    z, e0 = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), rngs)
+    S = z.shape[0]
+    dx0 = sc.prior_mean_deviation(geo, e0, init_mode)
+    f0 = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
+    x0, P0 = start_state(sc.START_OF[variant], N0, f0, geo.dx_true, dx0, geo.P0, win)
+    a, b = N0, N0 + data_samples
+    wz, ww = z[:, a:b + 1], win.slice(a, b)
+    tz_tol = cfg["em"]["tz_tol"]
+    theta0 = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
+
+    # reference: SQUAREM to a tight fixed point
+    ref = theta0
+    cycles = 0
+    while cycles * 3 < max(max_maps, 30):
+        tr = em_window(wz, ref, x0, P0, ww, 1, "squarem", tz_tol)
+        step = np.abs(sc.arcsec(tr.theta[-1] - ref))[:, :2].max()
+        ref = tr.theta[-1]
+        cycles += 1
+        if step < 1e-4:
+            break
+    ref_as = sc.arcsec(ref)
+
+    out = {"variant": variant, "theta_star_arcsec": ref_as, "truth_arcsec": np.asarray(case.truth_arcsec),
+           "data_samples": data_samples, "max_maps": max_maps}
+    for method in ("plain", "squarem"):
+        tr = em_window(wz, theta0, x0, P0, ww, max_maps, method, tz_tol)
+        hist = sc.arcsec(np.stack(tr.theta, 1))  # (S, maps, 3)
+        dist = np.abs(hist[:, :, :2] - ref_as[:, None, :2]).max(-1)
+        ok = dist <= tol_arcsec
+        maps_needed = np.full(S, max_maps + 1)
+        for i in range(S):
+            bad = np.where(~ok[i])[0]
+            last_bad = bad[-1] if bad.size else -1
+            if last_bad + 1 < ok.shape[1]:
+                maps_needed[i] = last_bad + 2  # maps are 1-based
+        d = np.maximum(dist[:, -11:], 1e-300)
+        rate = np.exp(np.mean(np.diff(np.log(d), axis=1), axis=1))
+        # stalled runs: maps still needed at the measured linear rate (extrapolation, labelled so)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            extra = np.where(rate < 1.0, np.log(tol_arcsec / d[:, -1]) / np.log(rate), np.inf)
+        extrap = np.where(maps_needed > max_maps, dist.shape[1] + np.maximum(extra, 0.0),
+                          maps_needed.astype(float))
+        out[method] = {"maps_to_converge": maps_needed, "maps_extrapolated": extrap, "dist_arcsec": dist,
+                       "theta_hist_arcsec": hist, "loglik": np.stack(tr.loglik, 1), "rate_per_map": rate}
+    return out

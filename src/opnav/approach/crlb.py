@@ -1,0 +1,95 @@
+"""Cramér-Rao lower bound of the misalignment jointly with the unknown state (A-X1; SPEC A.3b).
+
+Description
+    The measurement model is linear in ``(dX, theta)`` to first order:
+
+        z_k = H_k dX_k + U_k theta + v_k,  H_k = [-A_m C_k, 0],  U_k = [u_k x],
+
+    with ``u_k = A_c^i,k (X_M - r_k)`` at the truth. With a Gaussian prior on
+    the start state and process noise ``Q``, the Bayesian information of theta
+    after marginalising every state is the inverse of the theta block of the
+    posterior covariance of the augmented linear model. :func:`crlb_curve`
+    computes it recursively with a covariance Kalman filter on ``[dX; theta]``
+    (theta constant, a diffuse prior ``sigma_theta`` that carries no practical
+    information, Joseph update); :func:`batch_crlb` builds the dense joint
+    information matrix of ``X_0..X_n, theta`` and inverts it (small cases,
+    used by the tests to check the recursion).
+
+    The bound is a property of the data and the prior, not of the estimator:
+    ``literal`` and ``prior`` share the measurement geometry (the literal
+    filter start uses the same data again); ``roll`` changes the geometry;
+    ``reference-start`` replaces the prior by knowledge of the true state
+    (diagnostic).
+Units: rad (bounds returned in rad, 1-sigma).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .camera import misalignment_small, skew
+from .ekf import Window
+
+
+def theta_sensitivity(u: np.ndarray) -> np.ndarray:
+    """dz/dtheta of the small-angle model, ``[u x]`` (n, 3, 3)."""
+    return skew(u)
+
+
+def crlb_curve(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.ndarray,
+               sigma_theta: float = 1.0) -> np.ndarray:
+    """1-sigma bound on theta after 0..n samples of ``win`` (n+1, 3), rad.
+
+    ``u_true`` (n+1, 3): Mars vector in the calibrated camera frame at the truth.
+    ``P_start``: covariance of the state at the window start (prior).
+    """
+    n = win.n
+    P = np.zeros((9, 9))
+    P[:6, :6] = P_start
+    P[6:, 6:] = sigma_theta**2 * np.eye(3)
+    A = misalignment_small(theta)
+    Qa = np.zeros((9, 9))
+    Qa[:6, :6] = win.Q
+    Fa = np.eye(9)
+    out = np.empty((n + 1, 3))
+    out[0] = np.sqrt(np.diag(P)[6:])
+    Us = theta_sensitivity(u_true)
+    I9 = np.eye(9)
+    for k in range(1, n + 1):
+        Fa[:6, :6] = win.Phi[k]
+        P = Fa @ P @ Fa.T + Qa
+        H = np.zeros((3, 9))
+        H[:, :3] = -A @ win.C[k]
+        H[:, 6:] = Us[k]
+        R = np.diag(win.Rvar[k])
+        S = H @ P @ H.T + R
+        K = np.linalg.solve(S, H @ P).T
+        IKH = I9 - K @ H
+        P = IKH @ P @ IKH.T + K @ R @ K.T
+        P = 0.5 * (P + P.T)
+        out[k] = np.sqrt(np.diag(P)[6:])
+    return out
+
+
+def batch_crlb(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.ndarray,
+               sigma_theta: float = 1.0) -> np.ndarray:
+    """Same bound at n from the dense joint information of ``X_0..X_n, theta`` (3,), rad."""
+    n = win.n
+    dim = 6 * (n + 1) + 3
+    J = np.zeros((dim, dim))
+    J[:6, :6] += np.linalg.inv(P_start)
+    J[-3:, -3:] += np.eye(3) / sigma_theta**2
+    Qi = np.linalg.inv(win.Q)
+    A = misalignment_small(theta)
+    Us = theta_sensitivity(u_true)
+    for k in range(1, n + 1):
+        D = np.zeros((6, dim))
+        D[:, 6 * k:6 * k + 6] = np.eye(6)
+        D[:, 6 * (k - 1):6 * k] = -win.Phi[k]
+        J += D.T @ Qi @ D
+        M = np.zeros((3, dim))
+        M[:, 6 * k:6 * k + 3] = -A @ win.C[k]
+        M[:, -3:] = Us[k]
+        J += M.T @ np.diag(1.0 / win.Rvar[k]) @ M
+    cov = np.linalg.inv(J)
+    return np.sqrt(np.diag(cov)[-3:])

@@ -1,0 +1,162 @@
+"""Extended Kalman filter of the approach navigation, batched over Monte-Carlo seeds (paper A eq. 6).
+
+Description
+    The filter works in deviations ``dX = X - X_ref`` from a reference
+    trajectory (the nonlinearly propagated prior mean), with the one-step state
+    transition matrices ``Phi_{k,k-1}`` of the variational equations
+    (:mod:`opnav.approach.dynamics`). The measurement (SPEC A.2, paper eq. 3)
+
+        z_k = A_m^c(theta) A_c^i,k (X_M,k - r_k) + v_k
+            = A_m(theta) (u_ref,k - C_k dr_k) + v_k,   C_k = A_c^i,k,
+
+    is linear in the state: ``H_k = [-A_m(theta) C_k, 0_3x3]`` (the paper's
+    eq. 27 has ``+`` because it differentiates with respect to the
+    spacecraft-to-Mars vector). The estimator uses the small-angle ``A_m``.
+
+    All arrays carry a leading seed axis ``S``; each seed may have its own
+    ``theta``. Sample 0 of a window is its start (no measurement); samples
+    1..n carry ``z``. ``Phi[k]`` maps sample k-1 to sample k.
+
+Outputs (:class:`FilterResult`)
+    filtered ``xf, Pf`` (index 0 = the start state), predicted ``xp, Pp``
+    (index 0 unused), the observed-data log-likelihood by the prediction-error
+    decomposition, and ``KH_last`` for the smoother's lag-one initialisation.
+
+Units: km, km/s, rad.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .camera import misalignment_small
+
+LOG2PI = np.log(2.0 * np.pi)
+
+
+@dataclass
+class Window:
+    """Model arrays of one data window (n samples after the start sample 0)."""
+
+    Phi: np.ndarray  # (n+1, 6, 6), Phi[k] = Phi_{k,k-1}; Phi[0] unused
+    C: np.ndarray  # (n+1, 3, 3) A_c^i at each sample; index 0 unused
+    u_ref: np.ndarray  # (n+1, 3) A_c^i (X_M - r_ref), km
+    Rvar: np.ndarray  # (n+1, 3) measurement variances, km^2
+    Q: np.ndarray  # (6, 6) process noise per step
+
+    def slice(self, a: int, b: int) -> "Window":
+        """Samples a..b (inclusive; a becomes the start sample 0)."""
+        return Window(self.Phi[a:b + 1], self.C[a:b + 1], self.u_ref[a:b + 1],
+                      self.Rvar[a:b + 1], self.Q)
+
+    @property
+    def n(self) -> int:
+        return self.Phi.shape[0] - 1
+
+
+@dataclass
+class FilterResult:
+    xf: np.ndarray  # (S, n+1, 6)
+    Pf: np.ndarray  # (S, n+1, 6, 6)
+    xp: np.ndarray  # (S, n+1, 6)
+    Pp: np.ndarray  # (S, n+1, 6, 6)
+    loglik: np.ndarray  # (S,)
+    KH_last: np.ndarray  # (S, 6, 6)
+    K: np.ndarray | None = None  # (S, n+1, 6, 3) gains
+    Sinv: np.ndarray | None = None  # (S, n+1, 3, 3) inverse innovation covariances
+    nu: np.ndarray | None = None  # (S, n+1, 3) innovations
+    Hr: np.ndarray | None = None  # (S, n+1, 3, 3) position block of H
+
+
+def inv_sym3(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Inverse and determinant of stacked symmetric 3x3 matrices (cofactors; fast for small stacks)."""
+    a, b, c = M[:, 0, 0], M[:, 0, 1], M[:, 0, 2]
+    d, e, f = M[:, 1, 1], M[:, 1, 2], M[:, 2, 2]
+    A00, A01, A02 = d * f - e * e, c * e - b * f, b * e - c * d
+    A11, A12, A22 = a * f - c * c, b * c - a * e, a * d - b * b
+    det = a * A00 + b * A01 + c * A02
+    out = np.empty_like(M)
+    r = 1.0 / det
+    out[:, 0, 0] = A00 * r
+    out[:, 0, 1] = out[:, 1, 0] = A01 * r
+    out[:, 0, 2] = out[:, 2, 0] = A02 * r
+    out[:, 1, 1] = A11 * r
+    out[:, 1, 2] = out[:, 2, 1] = A12 * r
+    out[:, 2, 2] = A22 * r
+    return out, det
+
+
+def predicted_measurement(theta: np.ndarray, C: np.ndarray, u_ref: np.ndarray,
+                          dx: np.ndarray) -> np.ndarray:
+    """``h(dX) = A_m(theta) (u_ref - C dr)`` (S, 3) for one sample."""
+    A = misalignment_small(theta)
+    return np.einsum("sij,sj->si", A, u_ref - np.einsum("ij,sj->si", C, dx[..., :3]))
+
+
+def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """``H = [-A_m(theta) C, 0]`` (S, 3, 6)."""
+    A = misalignment_small(theta)
+    H = np.zeros(A.shape[:-2] + (3, 6))
+    H[..., :3] = -A @ C
+    return H
+
+
+def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
+               win: Window) -> FilterResult:
+    """EKF over a window for every seed at once (eq. 6).
+
+    z (S, n+1, 3) (index 0 ignored), theta (S, 3) rad, x0 (S, 6), P0 (S, 6, 6) or (6, 6).
+    """
+    S, n = z.shape[0], win.n
+    A = misalignment_small(theta)
+    Hrs = -np.einsum("sij,kjl->skil", A, win.C)  # (S, n+1, 3, 3) position block of H
+    Au = np.einsum("sij,kj->ski", A, win.u_ref)
+    xf = np.empty((S, n + 1, 6))
+    Pf = np.empty((S, n + 1, 6, 6))
+    xp = np.zeros((S, n + 1, 6))
+    Pp = np.zeros((S, n + 1, 6, 6))
+    x = np.array(x0, float)
+    P = np.broadcast_to(P0, (S, 6, 6)).copy()
+    xf[:, 0], Pf[:, 0] = x, P
+    Q = win.Q
+    Ks = np.zeros((S, n + 1, 6, 3))
+    Sinvs = np.zeros((S, n + 1, 3, 3))
+    nus = np.zeros((S, n + 1, 3))
+    dets = np.ones((S, n + 1))
+    diag = [0, 1, 2]
+    for k in range(1, n + 1):
+        Phi = win.Phi[k]
+        x = x @ Phi.T
+        P = Phi @ P @ Phi.T + Q
+        xp[:, k], Pp[:, k] = x, P
+        Hr = Hrs[:, k]
+        nu = z[:, k] - Au[:, k] - (Hr @ x[:, :3, None])[..., 0]
+        PHt = P[:, :, :3] @ Hr.transpose(0, 2, 1)  # (S,6,3)
+        Sm = Hr @ PHt[:, :3, :]
+        Sm[:, diag, diag] += win.Rvar[k]
+        Sinv, det = inv_sym3(Sm)
+        K = PHt @ Sinv
+        x = x + (K @ nu[..., None])[..., 0]
+        P = P - K @ PHt.transpose(0, 2, 1)
+        P = 0.5 * (P + P.transpose(0, 2, 1))
+        xf[:, k], Pf[:, k] = x, P
+        Ks[:, k], Sinvs[:, k], nus[:, k], dets[:, k] = K, Sinv, nu, det
+    if np.any(dets <= 0):
+        raise FloatingPointError("innovation covariance not positive definite")
+    ll = -0.5 * (np.log(dets[:, 1:]).sum(1)
+                 + np.einsum("ski,skij,skj->s", nus[:, 1:], Sinvs[:, 1:], nus[:, 1:])
+                 + 3.0 * n * LOG2PI)
+    KH = np.zeros((S, 6, 6))
+    KH[:, :, :3] = Ks[:, n] @ Hrs[:, n]
+    return FilterResult(xf, Pf, xp, Pp, ll, KH, Ks, Sinvs, nus, Hrs)
+
+
+def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window) -> tuple[np.ndarray, np.ndarray]:
+    """Prior mean and covariance propagated through the window without data."""
+    x, P = np.array(x0, float), np.array(P0, float)
+    for k in range(1, win.n + 1):
+        x = x @ win.Phi[k].T
+        P = win.Phi[k] @ P @ win.Phi[k].T + win.Q
+    return x, P

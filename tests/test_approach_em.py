@@ -1,0 +1,159 @@
+"""EM-EKF: monotone likelihood, closed-form M-step, identifiability against the CRLB."""
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+from opnav.approach import cases, crlb, ekf, em, smoother
+from opnav.approach import scenario as sc
+from opnav.approach.dynamics import ARCSEC
+
+from approach_helpers import approach_cfg, small_window
+
+
+def _approach_window(variant="prior", n=200, bias=(10.0, 20.0, 10.0), seeds=range(3), N0=50):
+    cfg = approach_cfg(N0=N0)
+    geo = sc.build_geometry(cfg, variant, n=N0 + n)
+    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    win = geo.window(Rvar)
+    z, e0 = sc.simulate(geo, Rvar, sc.rad(bias), sc.seed_streams(cfg["base_seed"], 99, seeds))
+    S = z.shape[0]
+    dx0 = np.zeros((S, 6))
+    f0 = ekf.run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
+    x0, P0 = cases.start_state(sc.START_OF[variant], N0, f0, geo.dx_true, dx0, geo.P0, win)
+    return cfg, geo, z[:, N0:], x0, P0, win.slice(N0, N0 + n)
+
+
+@pytest.mark.parametrize("variant", ["prior", "roll", "reference-start"])
+def test_em_log_likelihood_never_decreases(variant):
+    cfg, geo, z, x0, P0, win = _approach_window(variant, n=150)
+    theta0 = np.tile(sc.rad([30.0, -15.0, 5.0]), (z.shape[0], 1))
+    tr = em.em_window(z, theta0, x0, P0, win, 8, "plain")
+    ll = np.stack(tr.loglik, 1)
+    assert np.all(np.diff(ll, axis=1) >= -1e-9 * np.abs(ll).max())
+    tr = em.em_window(z, theta0, x0, P0, win, 12, "squarem")
+    ll = np.stack(tr.loglik, 1)[:, ::3]  # LL at the start of each SQUAREM cycle
+    assert np.all(np.diff(ll, axis=1) >= -1e-6)
+
+
+def test_closed_form_mstep_matches_numerical_minimiser_random_geometry():
+    win, rng = small_window(n=12, seed=4)
+    S = 2
+    z = rng.standard_normal((S, win.n + 1, 3)) + win.u_ref
+    theta = rng.normal(size=(S, 3)) * 0.01
+    f = ekf.run_filter(z, theta, rng.normal(size=(S, 6)), np.eye(6), win)
+    s = smoother.rts(f, win)
+    new, unobs = em.mstep(em.estep(z, s, win), theta)
+    assert not unobs.any()
+    for i in range(S):
+        def obj(t):
+            th = np.tile(t, (S, 1))
+            return em.trace_RinvB(th, z, s, win)[i]
+        res = minimize(obj, theta[i], method="BFGS", options={"gtol": 1e-10})
+        np.testing.assert_allclose(new[i], res.x, atol=1e-6)
+
+
+def test_closed_form_mstep_matches_numerical_minimiser_on_the_approach():
+    cfg, geo, z, x0, P0, win = _approach_window("roll", n=100)
+    S = z.shape[0]
+    theta = np.tile(sc.rad([3.0, 4.0, 1.0]), (S, 1))
+    f = ekf.run_filter(z, theta, x0, P0, win)
+    s = smoother.rts(f, win)
+    new, unobs = em.mstep(em.estep(z, s, win), theta)
+    assert unobs[:, 0].all() and not unobs[:, 1:].any()  # exactly one direction (tz) held
+    np.testing.assert_allclose(new[:, 2], theta[:, 2])  # tz is unobservable: kept
+    for i in range(S):
+        def obj(t_as):
+            th = theta.copy()
+            th[i, :2] = np.asarray(t_as) * ARCSEC
+            return em.trace_RinvB(th, z, s, win)[i] * 1e-6
+        res = minimize(obj, sc.arcsec(theta[i, :2]), method="Nelder-Mead",
+                       options={"xatol": 1e-7, "fatol": 1e-14, "maxiter": 4000})
+        np.testing.assert_allclose(sc.arcsec(new[i, :2]), res.x, atol=2e-3)
+
+
+def test_mstep_increases_expected_complete_loglik_which_uses_lag_one():
+    win, rng = small_window(n=10, seed=8)
+    S = 3
+    z = rng.standard_normal((S, win.n + 1, 3)) + win.u_ref
+    theta = rng.normal(size=(S, 3)) * 0.05
+    mu0, P0 = rng.normal(size=(S, 6)), np.eye(6)
+    f = ekf.run_filter(z, theta, mu0, P0, win)
+    s = smoother.rts(f, win)
+    new, _ = em.mstep(em.estep(z, s, win), theta)
+    q_old = em.expected_complete_loglik(theta, z, s, win, mu0, P0)
+    q_new = em.expected_complete_loglik(new, z, s, win, mu0, P0)
+    assert np.all(q_new >= q_old)
+    # EM's key inequality: LL(new) - LL(old) >= Q(new) - Q(old) >= 0
+    ll_new = ekf.run_filter(z, new, mu0, P0, win).loglik
+    assert np.all(ll_new - f.loglik >= (q_new - q_old) - 1e-8)
+
+
+def test_crlb_recursion_matches_batch_fisher_information():
+    win, rng = small_window(n=8, seed=11)
+    P0 = np.diag(rng.random(6) + 0.5)
+    theta = np.array([0.01, -0.02, 0.005])
+    u = win.u_ref + rng.normal(size=win.u_ref.shape)
+    rec = crlb.crlb_curve(win, u, P0, theta, sigma_theta=3.0)[-1]
+    bat = crlb.batch_crlb(win, u, P0, theta, sigma_theta=3.0)
+    np.testing.assert_allclose(rec, bat, rtol=1e-8)
+
+
+def test_crlb_recursion_matches_batch_on_the_approach_geometry():
+    cfg, geo, z, x0, P0, win = _approach_window("roll", n=30)
+    win.Q = np.diag([1e-2, 1e-2, 1e-2, 1e-8, 1e-8, 1e-8])  # keep the dense matrix invertible
+    P0 = np.diag([1e2, 1e2, 1e2, 1e-4, 1e-4, 1e-4])
+    u = geo.u_true[50:81]
+    th = sc.rad([10, 20, 10])
+    rec = crlb.crlb_curve(win, u, P0, th, sigma_theta=1e-2)[-1]
+    bat = crlb.batch_crlb(win, u, P0, th, sigma_theta=1e-2)
+    np.testing.assert_allclose(rec[:2], bat[:2], rtol=1e-5)
+
+
+def _converged_estimate(variant, bias, n, seeds, mode="fixed"):
+    cfg = approach_cfg(N0=100)
+    cfg["initial_error"]["mode"] = mode
+    case = cases.Case(1, "T", "size", tuple(bias), (0.0, 0.0, 0.0), tuple(cfg["camera"]["sigma3_px"]), 0.0)
+    r = cases.convergence_study(cfg, variant, case, seeds, n, 30, 0.05)
+    geo = sc.build_geometry(cfg, variant, n=100 + n)
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    win = geo.window(Rvar)
+    zdummy = np.zeros((1, 101, 3))
+    f0 = ekf.run_filter(zdummy, np.zeros((1, 3)), np.zeros((1, 6)), geo.P0, win.slice(0, 100))
+    if variant == "reference-start":
+        Pst = f0.Pf[0, -1]
+    else:
+        Pst = ekf.predict_only(np.zeros(6), geo.P0, win.slice(0, 100))[1]
+    bound = sc.arcsec(crlb.crlb_curve(win.slice(100, 100 + n), geo.u_true[100:], Pst,
+                                      sc.rad(bias), 1e-2)[-1])
+    return r["theta_star_arcsec"], bound
+
+
+def test_zero_bias_gives_estimate_within_few_crlb_of_zero():
+    est, bound = _converged_estimate("reference-start", (0.0, 0.0, 0.0), 200, range(6))
+    assert bound[0] < 1.0
+    assert np.all(np.abs(est[:, :2]) < 4 * bound[:2])
+
+
+def test_observable_scenario_estimate_within_few_crlb_of_truth():
+    """Roll about the boresight separates theta from the position error (SPEC A.3b)."""
+    est, bound = _converged_estimate("roll", (10.0, 20.0, 10.0), 800, range(4), mode="sampled")
+    assert bound[0] < 2.0
+    err = est[:, :2] - np.array([10.0, 20.0])
+    assert np.all(np.abs(err) < 4 * bound[:2])
+
+
+def test_literal_geometry_bound_is_far_above_two_arcsec():
+    """Without roll, the bound is set by the prior: about 100 km / 1e6 km = 20 arcsec."""
+    cfg, geo, z, x0, P0, win = _approach_window("prior", n=400)
+    b = sc.arcsec(crlb.crlb_curve(win, geo.u_true[50:], P0, sc.rad([10, 20, 10]), 1e-2)[-1])
+    assert 15.0 < b[0] < 25.0 and 15.0 < b[1] < 25.0
+    assert b[2] > 1000.0  # tz: the bound stays at the diffuse prior (unobservable)
+
+
+def test_data_to_converge_rule():
+    th = np.zeros((1, 5, 3))
+    th[0, :, 0] = [0.0, 5.0, 9.0, 9.8, 10.0]
+    seg = np.array([50, 100, 150, 200, 250])
+    assert cases.data_to_converge(th, seg, 0.5)[0] == 200
+    assert cases.data_to_converge(th, seg, 2.0)[0] == 150

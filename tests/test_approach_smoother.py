@@ -1,0 +1,129 @@
+"""RTS smoother: dense joint-Gaussian posterior, covariance invariants, lag-one forms."""
+
+import numpy as np
+import pytest
+
+from opnav.approach import ekf, smoother
+from opnav.approach.camera import misalignment_small
+
+from approach_helpers import small_window
+
+
+def _dense_posterior(z, theta, x0, P0, win):
+    """Mean and covariance of X_0..X_n given z, from the joint information matrix."""
+    n = win.n
+    dim = 6 * (n + 1)
+    J = np.zeros((dim, dim))
+    h = np.zeros(dim)
+    P0i = np.linalg.inv(P0)
+    J[:6, :6] += P0i
+    h[:6] += P0i @ x0
+    Qi = np.linalg.inv(win.Q)
+    A = misalignment_small(theta)
+    for k in range(1, n + 1):
+        D = np.zeros((6, dim))
+        D[:, 6 * k:6 * k + 6] = np.eye(6)
+        D[:, 6 * (k - 1):6 * k] = -win.Phi[k]
+        J += D.T @ Qi @ D
+        M = np.zeros((3, dim))
+        M[:, 6 * k:6 * k + 3] = -A @ win.C[k]
+        W = np.diag(1.0 / win.Rvar[k])
+        J += M.T @ W @ M
+        h += M.T @ W @ (z[k] - A @ win.u_ref[k])
+    cov = np.linalg.inv(J)
+    return (cov @ h).reshape(n + 1, 6), cov
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_rts_equals_dense_joint_gaussian_posterior(seed):
+    win, rng = small_window(n=7, seed=seed)
+    S = 2
+    z = rng.standard_normal((S, win.n + 1, 3)) * 3 + win.u_ref
+    theta = rng.normal(size=(S, 3)) * 0.05
+    x0 = rng.normal(size=(S, 6))
+    P0 = np.diag(rng.random(6) + 0.5)
+    f = ekf.run_filter(z, theta, x0, P0, win)
+    s = smoother.rts(f, win)
+    sb = smoother.bryson_frazier(f, win)
+    for i in range(S):
+        mean, cov = _dense_posterior(z[i], theta[i], x0[i], P0, win)
+        np.testing.assert_allclose(s.xs[i], mean, atol=1e-9)
+        np.testing.assert_allclose(sb.xs[i], mean, atol=1e-9)
+        for k in range(win.n + 1):
+            blk = cov[6 * k:6 * k + 6, 6 * k:6 * k + 6]
+            np.testing.assert_allclose(s.Ps[i, k], blk, atol=1e-9)
+            np.testing.assert_allclose(sb.Ps[i, k], blk, atol=1e-9)
+            if k >= 1:  # lag-one smoothed cross-covariance, eq. 18
+                lag = cov[6 * k:6 * k + 6, 6 * (k - 1):6 * k]
+                np.testing.assert_allclose(s.Plag[i, k], lag, atol=1e-9)
+        # the filtered estimate at the last sample is the smoothed one
+        np.testing.assert_allclose(f.xf[i, -1], mean[-1], atol=1e-9)
+
+
+def test_lag_one_gain_form_equals_recursion():
+    win, rng = small_window(n=10, seed=5)
+    z = rng.standard_normal((3, win.n + 1, 3)) + win.u_ref
+    f = ekf.run_filter(z, np.zeros((3, 3)), np.zeros((3, 6)), np.eye(6), win)
+    s = smoother.rts(f, win)
+    rec = smoother.lag_one_recursive(f, s, win)
+    np.testing.assert_allclose(rec[:, 1:], s.Plag[:, 1:], atol=1e-10)
+
+
+def test_filter_log_likelihood_equals_dense_gaussian_density():
+    win, rng = small_window(n=4, seed=7)
+    z = rng.standard_normal((1, win.n + 1, 3)) + win.u_ref
+    theta = np.array([[0.01, -0.02, 0.03]])
+    x0, P0 = rng.normal(size=(1, 6)), np.eye(6)
+    f = ekf.run_filter(z, theta, x0, P0, win)
+    # dense: z stacked = M X + A u_ref + v, X ~ N(m, Sigma)
+    n = win.n
+    A = misalignment_small(theta[0])
+    Phi_cum = [np.eye(6)]
+    for k in range(1, n + 1):
+        Phi_cum.append(win.Phi[k] @ Phi_cum[-1])
+    # covariance of X_k from the linear model
+    covX = np.zeros((6 * (n + 1), 6 * (n + 1)))
+    G = np.zeros((6 * (n + 1), 6 * (n + 1)))  # X = G [x0; w1..wn]
+    for k in range(n + 1):
+        G[6 * k:6 * k + 6, :6] = Phi_cum[k]
+        for j in range(1, k + 1):
+            T = np.eye(6)
+            for m in range(j + 1, k + 1):
+                T = win.Phi[m] @ T
+            G[6 * k:6 * k + 6, 6 * j:6 * j + 6] = T
+    Sw = np.zeros_like(covX)
+    Sw[:6, :6] = P0
+    for j in range(1, n + 1):
+        Sw[6 * j:6 * j + 6, 6 * j:6 * j + 6] = win.Q
+    covX = G @ Sw @ G.T
+    meanX = G[:, :6] @ x0[0]
+    M = np.zeros((3 * n, 6 * (n + 1)))
+    for k in range(1, n + 1):
+        M[3 * (k - 1):3 * k, 6 * k:6 * k + 3] = -A @ win.C[k]
+    mz = M @ meanX + np.concatenate([A @ win.u_ref[k] for k in range(1, n + 1)])
+    Sz = M @ covX @ M.T + np.diag(win.Rvar[1:].ravel())
+    from scipy.stats import multivariate_normal
+    ll = multivariate_normal(mz, Sz).logpdf(z[0, 1:].ravel())
+    assert f.loglik[0] == pytest.approx(ll, rel=1e-9)
+
+
+def test_smoothed_covariances_no_larger_and_spd_on_the_approach():
+    from opnav.approach import scenario as sc
+    from approach_helpers import approach_cfg
+
+    cfg = approach_cfg()
+    geo = sc.build_geometry(cfg, "roll", n=300)
+    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    win = geo.window(Rvar)
+    z, _ = sc.simulate(geo, Rvar, sc.rad([10, 20, 10]), sc.seed_streams(1, 1, range(3)))
+    f = ekf.run_filter(z, np.full((3, 3), 1e-5), np.zeros((3, 6)), geo.P0, win)
+    for s in (smoother.rts(f, win), smoother.bryson_frazier(f, win)):
+        for P in (f.Pf, f.Pp[:, 1:], s.Ps):
+            np.testing.assert_allclose(P, np.swapaxes(P, -1, -2), rtol=0, atol=1e-9 * np.abs(P).max())
+            # SPD: Cholesky of the Jacobi-scaled matrix succeeds
+            d = 1 / np.sqrt(np.diagonal(P, axis1=-2, axis2=-1))
+            np.linalg.cholesky(P * d[..., :, None] * d[..., None, :])
+        diff = f.Pf - s.Ps  # filtered minus smoothed must be PSD (scaled)
+        d = 1 / np.sqrt(np.diagonal(f.Pf, axis1=-2, axis2=-1))
+        eig = np.linalg.eigvalsh(diff * d[..., :, None] * d[..., None, :])
+        assert eig.min() > -1e-7
