@@ -1,0 +1,281 @@
+"""One simulated powered descent with the vision-aided inertial EKF and a
+landmark-planning method (paper B sec. 3, SPEC B.1-B.3).
+
+Description
+-----------
+:func:`build_scenario` turns the ``landing`` config into everything shared by
+all runs and methods (truth trajectory, noise-free IMU, landmark field,
+camera, process noise); :func:`run_descent` flies one run:
+
+* random streams from ``SeedSequence([base_seed, run_index])`` only (spawned
+  into: initial error, IMU noise, pixel noise, picker), so a run is the same
+  whatever the chunking and the same draws serve every method (paired);
+* initial estimate = truth minus an error uniform within the Table 2 bounds
+  per axis, initial covariance diag(bound^2 / 3);
+* every ``dt_s`` the IMU increments propagate the filter; while the estimated
+  altitude exceeds ``min_update_altitude_m`` the camera measures the landing
+  site (known landmark, {L} origin) and the current unknown landmark. The
+  observation strategy of Fig. 3: a landmark is observed ``obs_per_landmark``
+  times (its first bearing initialises it), then a new one is planned,
+  initialised and the old one dropped; a landmark that leaves the image before
+  that is replaced at once. Below the altitude limit the filter coasts on the
+  IMU (the site is then metres away and bearings are no longer linear in the
+  position error; our guidance creeps the last ~30 s at a few metres).
+
+Returned per run: errors (truth - estimate) of position, velocity (m, m/s),
+attitude (small-angle ``dtheta`` and roll/pitch/yaw differences, deg) at the
+filter times, 1-sigma of the filter, position and velocity NEES, and per
+planning call its wall time (ns) and evaluation count.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from opnav.landing import ekf, imu
+from opnav.landing.camera import Camera, camera_from_config
+from opnav.landing.landmarks import LandmarkField, make_field
+from opnav.landing.planner import PlannerConfig, PlanState, plan
+from opnav.landing.trajectory import Truth, euler_rpy_deg, truth_states
+
+__all__ = ["Scenario", "build_scenario", "run_descent", "initial_error", "summarize_run"]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    truth: Truth               # at the filter times (n_steps + 1)
+    truth_imu: Truth           # at the IMU nodes
+    f: np.ndarray              # noise-free IMU specific force (m, 3)
+    w: np.ndarray              # noise-free IMU rate (m, 3)
+    g: np.ndarray
+    dt_imu: float
+    n_sub: int
+    Dt: float
+    n_steps: int
+    Q: np.ndarray
+    sigma_a: float
+    sigma_w: float             # rad/s
+    camera: Camera
+    field: LandmarkField
+    planner: PlannerConfig
+    obs_per_landmark: int
+    depth_sigma_frac: float
+    min_update_alt: float
+    oc: bool                   # observability-constrained update
+    iterations: int            # iterated-EKF relinearisations per update
+    bounds: tuple              # (m, m/s, rad)
+    base_seed: int
+
+
+def _scenario_from_json(text: str) -> Scenario:
+    c = json.loads(text)
+    T = float(c["duration_s"])
+    Dt = float(c["filter"]["dt_s"])
+    rate = float(c["imu"]["rate_hz"])
+    n_sub = int(round(rate * Dt))
+    if n_sub < 1 or abs(n_sub / rate - Dt) > 1e-9:
+        raise ValueError(f"landing.imu.rate_hz ({rate}) times landing.filter.dt_s ({Dt}) "
+                         "must be a positive integer")
+    n_steps = int(round(T / Dt))
+    if abs(n_steps * Dt - T) > 1e-9:
+        raise ValueError(f"landing.duration_s ({T}) must be a multiple of landing.filter.dt_s ({Dt})")
+    dt = Dt / n_sub
+    g = np.asarray(c["gravity_mps2"], float)
+    s0 = c["initial_state"]
+    yaw = float(c.get("yaw_deg", 0.0))
+    t_imu = np.arange(n_steps * n_sub + 1) * dt
+    tr_imu = truth_states(t_imu, s0["r_m"], s0["v_mps"], T, g, yaw)
+    tr = Truth(t=tr_imu.t[::n_sub], r=tr_imu.r[::n_sub], v=tr_imu.v[::n_sub],
+               a=tr_imu.a[::n_sub], R_LtoB=tr_imu.R_LtoB[::n_sub])
+    f, w = imu.synthesize(tr_imu.v, tr_imu.R_LtoB, dt, g)
+    sa = float(c["imu"]["sigma_a_mps2"])
+    sw = math.radians(float(c["imu"]["sigma_w_degps"]))
+    pl = c["planner"]
+    pcfg = PlannerConfig(t_s=Dt, n_sigma_v=float(pl["n_sigma_v"]), tol_rad=float(pl["tol_rad"]),
+                         n_grid=int(pl["n_grid"]), margin_px=float(pl["margin_px"]),
+                         knn=int(pl["knn"]), eval_path=str(pl["eval_path"]))
+    lm = c["landmarks"]
+    b = c["mc"]["bounds"]
+    fl = c["filter"]
+    return Scenario(truth=tr, truth_imu=tr_imu, f=f, w=w, g=g, dt_imu=dt, n_sub=n_sub, Dt=Dt,
+                    n_steps=n_steps, Q=ekf.process_noise(sa, sw, dt, n_sub), sigma_a=sa, sigma_w=sw,
+                    camera=camera_from_config(c["camera"]),
+                    field=make_field(float(lm["half_width_m"]), int(lm["count"]), int(lm["seed"])),
+                    planner=pcfg, obs_per_landmark=int(fl["obs_per_landmark"]),
+                    depth_sigma_frac=float(fl["depth_sigma_frac"]),
+                    min_update_alt=float(fl["min_update_altitude_m"]),
+                    oc=bool(fl["observability_constrained"]),
+                    iterations=int(fl["iterations"]),
+                    bounds=(float(b["r_m"]), float(b["v_mps"]), math.radians(float(b["att_deg"]))),
+                    base_seed=int(c["mc"]["base_seed"]))
+
+
+_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "imu", "camera", "landmarks",
+         "filter", "planner", "mc")
+
+
+def build_scenario(landing_cfg: dict) -> Scenario:
+    """The shared scenario of a ``landing`` config (cached per distinct config)."""
+    sub = {k: landing_cfg[k] for k in _KEYS if k in landing_cfg}
+    return _cached(json.dumps(sub, sort_keys=True))
+
+
+@lru_cache(maxsize=4)
+def _cached(text: str) -> Scenario:
+    return _scenario_from_json(text)
+
+
+def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
+    """Error state (truth - estimate) [dr, dv, dtheta] (9,), uniform per axis."""
+    br, bv, bt = bounds
+    return np.concatenate([rng.uniform(-br, br, 3), rng.uniform(-bv, bv, 3),
+                           rng.uniform(-bt, bt, 3)])
+
+
+def _att_error(R_true: np.ndarray, R_est: np.ndarray) -> np.ndarray:
+    """dtheta (rad) with R_true = Exp(-dtheta) R_est."""
+    return -Rotation.from_matrix(R_true @ R_est.T).as_rotvec()
+
+
+def _wrap_deg(x):
+    return (np.asarray(x) + 180.0) % 360.0 - 180.0
+
+
+def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | None = None,
+                imu_noise: bool = True, init_error: bool = True) -> dict:
+    """Fly one descent; see the module docstring for the returned arrays."""
+    seed = scn.base_seed if base_seed is None else int(base_seed)
+    ss = np.random.SeedSequence([seed, int(run_index)])
+    rng_init, rng_imu, rng_px, rng_pick = (np.random.default_rng(s) for s in ss.spawn(4))
+    e0 = initial_error(rng_init, scn.bounds)
+    if not init_error:
+        e0[:] = 0.0
+    if imu_noise:
+        f, w = imu.add_noise(scn.f, scn.w, scn.sigma_a, scn.sigma_w, rng_imu)
+    else:
+        f, w = scn.f, scn.w
+    noise_px = rng_px.standard_normal((scn.n_steps + 1, 2, 2))
+    pre = imu.preintegrate(f, w, scn.dt_imu, scn.n_sub)
+
+    tr = scn.truth
+    cam = scn.camera
+    sb = cam.sigma_b
+    p_site = np.zeros(3)
+    P0 = np.zeros((12, 12))
+    br, bv, bt = scn.bounds
+    P0[:9, :9] = np.diag(np.repeat([br**2 / 3, bv**2 / 3, bt**2 / 3], 3))
+    P0[9:, 9:] = np.eye(3) * 1e8      # dormant until the first landmark is initialised
+    st = ekf.NavState(r=tr.r[0] - e0[0:3], v=tr.v[0] - e0[3:6],
+                      R=imu.exp_batch(e0[6:9][None])[0] @ tr.R_LtoB[0], p=np.zeros(3), P=P0)
+    n = scn.n_steps
+    err_r = np.empty((n + 1, 3))
+    err_v = np.empty((n + 1, 3))
+    err_th = np.empty((n + 1, 3))
+    sig = np.empty((n + 1, 9))
+    nees_r = np.empty(n + 1)
+    nees_v = np.empty(n + 1)
+    updated = np.zeros(n + 1, bool)
+    plan_ns, plan_evals, plan_t = [], [], []
+    cur, n_obs, n_used = -1, 0, 0
+    a_est = tr.a[0]
+
+    def record(k):
+        er = tr.r[k] - st.r
+        ev = tr.v[k] - st.v
+        err_r[k], err_v[k] = er, ev
+        err_th[k] = _att_error(tr.R_LtoB[k], st.R)
+        sig[k] = np.sqrt(np.clip(np.diag(st.P)[:9], 0, None))
+        nees_r[k] = er @ np.linalg.solve(st.P[0:3, 0:3], er)
+        nees_v[k] = ev @ np.linalg.solve(st.P[3:6, 3:6], ev)
+
+    record(0)
+    # observability constraint (OC-EKF): unobservable direction at the prior
+    # estimates, the landmark part at its first estimate
+    p_first = np.zeros(3)
+    N = ekf.nullspace(st.r, st.v, st.R, p_first)
+    C_prior = st.R
+    for j in range(n):
+        v_prev = st.v
+        oc = (N, C_prior, p_first) if scn.oc else None
+        st = ekf.propagate(st, pre.dR[j], pre.dv[j], pre.dp[j], scn.Dt, scn.g, scn.Q, oc)
+        N = ekf.nullspace(st.r, st.v, st.R, p_first)
+        C_prior = st.R
+        a_est = (st.v - v_prev) / scn.Dt
+        k = j + 1
+        if k < n and st.r[2] > scn.min_update_alt:
+            r_t, R_t = tr.r[k], tr.R_LtoB[k]
+
+            def visible(pts, margin=scn.planner.margin_px):
+                return cam.in_view((np.asarray(pts) - r_t) @ R_t.T, margin)
+
+            meas = []
+            d_site = R_t @ (p_site - r_t)
+            if cam.in_view(d_site[None])[0]:
+                meas.append((cam.measure(d_site, noise_px[k, 0]), p_site))
+            still = cur >= 0 and visible(scn.field.xyz[cur][None], 0.0)[0]
+            if cur < 0 or n_obs >= scn.obs_per_landmark or not still:
+                res = plan(method, PlanState(st.r, st.v, a_est, st.R, st.P), cam, scn.field,
+                           visible, scn.planner, exclude={cur} if cur >= 0 else set(),
+                           rng=rng_pick)
+                plan_ns.append(res.time_ns)
+                plan_evals.append(res.n_evals)
+                plan_t.append(k * scn.Dt)
+                cur, n_obs = res.index, 0
+                if cur >= 0:
+                    b = cam.measure(R_t @ (scn.field.xyz[cur] - r_t), noise_px[k, 1])
+                    try:
+                        st = ekf.init_landmark(st, b, scn.depth_sigma_frac, sb)
+                        p_first = st.p.copy()
+                        N = ekf.nullspace(st.r, st.v, st.R, p_first)
+                        n_obs, n_used = 1, n_used + 1
+                    except ValueError:
+                        cur = -1
+            else:
+                b = cam.measure(R_t @ (scn.field.xyz[cur] - r_t), noise_px[k, 1])
+                meas.append((b, None))
+                n_obs += 1
+            if meas:
+                st, _ = ekf.update(st, meas, sb, N if scn.oc else None, scn.iterations)
+                updated[k] = True
+        record(k)
+
+    rpy_t = euler_rpy_deg(tr.R_LtoB)
+    return {
+        "t": tr.t.copy(),
+        "err_r": err_r, "err_v": err_v, "err_th_deg": np.degrees(err_th),
+        "err_rpy_deg": _wrap_deg(rpy_t - _est_rpy(tr.R_LtoB, err_th)),
+        "sig_r": sig[:, 0:3], "sig_v": sig[:, 3:6], "sig_th_deg": np.degrees(sig[:, 6:9]),
+        "nees_r": nees_r, "nees_v": nees_v, "updated": updated,
+        "plan_ns": np.asarray(plan_ns, np.int64), "plan_evals": np.asarray(plan_evals, np.int64),
+        "plan_t": np.asarray(plan_t, float), "n_landmarks": n_used,
+        "init_error": e0,
+    }
+
+
+def _est_rpy(R_true: np.ndarray, dth: np.ndarray) -> np.ndarray:
+    """Estimated roll/pitch/yaw (deg) from the truth and dtheta (R_est = Exp(dtheta) R_true)."""
+    R_est = imu.exp_batch(dth) @ R_true
+    return euler_rpy_deg(R_est)
+
+
+def summarize_run(run: dict) -> dict:
+    """Final and RMS error norms of one run (m, m/s, deg) and its mean NEES."""
+    out = {}
+    for key, name in (("err_r", "pos_err_m"), ("err_v", "vel_err_mps"), ("err_th_deg", "att_err_deg")):
+        nrm = np.linalg.norm(run[key], axis=1)
+        out[f"final_{name}"] = float(nrm[-1])
+        out[f"rms_{name}"] = float(np.sqrt(np.mean(nrm**2)))
+    out["final_yaw_err_deg"] = float(run["err_rpy_deg"][-1, 2])
+    out["mean_nees_pos"] = float(np.mean(run["nees_r"]))
+    out["mean_nees_vel"] = float(np.mean(run["nees_v"]))
+    out["n_landmarks"] = int(run["n_landmarks"])
+    out["n_plans"] = int(len(run["plan_ns"]))
+    out["median_plan_time_us"] = float(np.median(run["plan_ns"]) / 1e3) if len(run["plan_ns"]) else math.nan
+    out["median_plan_evals"] = float(np.median(run["plan_evals"])) if len(run["plan_evals"]) else math.nan
+    return out

@@ -1,0 +1,347 @@
+"""Landmark planner: golden-section search over the visible interval, then the
+nearest visible landmark (paper B sec. 2.2, eq. 26; SPEC B.3).
+
+Description
+-----------
+Every method runs the SAME search; only the scalar objective differs:
+
+1. the vertical plane through the lander that holds the estimated velocity
+   (``opnav.landing.depth_error.plane_geometry``), parametrised by the signed
+   angle ``beta`` between velocity and line of sight;
+2. the visible interval: the ``beta`` whose line of sight meets the ground and
+   lies inside the camera's field of view (with the planning margin) under the
+   *estimated* attitude, resolved on a grid of ``n_grid`` angles (the interval
+   ends are the outermost visible grid angles); it is split at ``beta = 0``
+   (no parallax there, the depth error is infinite), giving at most two
+   sub-intervals;
+3. a golden-section search (:func:`golden_section`, tolerance ``tol_rad``) on
+   each sub-interval; the better of the two optima wins;
+4. ``beta*`` is mapped to its ground point (eq. 26: the ideal direction) and
+   the landmark nearest to it (horizontal distance, ``cKDTree``) among those
+   actually detected in the image (truly inside the field of view with the
+   margin) is chosen.
+
+Objectives (minimised) are built by a table of factories, :data:`OBJECTIVES`:
+``depth`` is the depth estimation error (eq. 23-25, scalar fast path tested
+against the vectorised :func:`~opnav.landing.depth_error.depth_error`); every
+name of :data:`opnav.landing.metrics.METRIC_NAMES` (``svd``, ``gdop``,
+``cond``, ``logdet``, ``mineig``) is the negated metric at the ground point of
+``beta`` (``metrics.make_metric``; larger is better there). Methods without a
+search (e.g. a random pick) can be added to :data:`PICKERS`. Adding a method
+is adding one entry.
+
+How a baseline metric is evaluated inside the search is ``eval_path``:
+``numpy_H`` (default: the Jacobian H of eq. 14-18 in numpy, then LAPACK SVD /
+pseudo-inverse per candidate, the matrix computation the paper describes),
+``reference`` (a compiled CasADi Function call per candidate), ``casadi_map``
+or ``closed_form`` (the metrics module's closed-form singular values, a
+finding beyond the paper, see ``opnav.landing.metrics``).
+
+Timing: :func:`plan` measures its whole call with ``time.perf_counter_ns`` and
+counts objective evaluations, so a timing comparison rests on both.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from opnav.landing.camera import Camera
+from opnav.landing.depth_error import (PlaneGeometry, baseline, error_radius, ground_point,
+                                       plane_geometry)
+from opnav.landing.landmarks import LandmarkField
+
+__all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig",
+           "plan", "OBJECTIVES", "PICKERS", "available_methods", "depth_objective"]
+
+INVPHI = (math.sqrt(5.0) - 1.0) / 2.0      # 1/phi = 0.618...
+
+
+def golden_section(fun: Callable[[float], float], a: float, b: float, tol: float
+                   ) -> tuple[float, float, int]:
+    """Minimise ``fun`` on ``[a, b]`` by golden-section search.
+
+    Returns ``(x, f(x), n_evals)`` where ``x`` is the best evaluated point; the
+    bracket shrinks by 1/phi per evaluation until shorter than ``tol``. ``+inf``
+    values are allowed (treated as large). Raises ``ValueError`` for a bad
+    interval or tolerance.
+    """
+    if not (math.isfinite(a) and math.isfinite(b)) or b < a:
+        raise ValueError(f"golden_section: bad interval [{a}, {b}]")
+    if not tol > 0:
+        raise ValueError(f"golden_section: tolerance must be positive, got {tol}")
+    c = b - INVPHI * (b - a)
+    d = a + INVPHI * (b - a)
+    fc = fun(c)
+    fd = fun(d)
+    n = 2
+    while (b - a) > tol:
+        if fc <= fd:
+            b, d, fd = d, c, fc
+            c = b - INVPHI * (b - a)
+            fc = fun(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + INVPHI * (b - a)
+            fd = fun(d)
+        n += 1
+    return (c, fc, n) if fc <= fd else (d, fd, n)
+
+
+@dataclass(frozen=True)
+class PlanState:
+    """The filter's estimate used for planning (all {L}, SI): position, velocity,
+    acceleration (m/s^2), attitude, 12x12 covariance of [r, v, dtheta, p]."""
+
+    r: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    R_LtoB: np.ndarray
+    P: np.ndarray
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    t_s: float = 1.0                 # observation interval of the depth model, s
+    n_sigma_v: float = 3.0           # eps_v = n_sigma * sqrt(max eig P_vv)
+    tol_rad: float = 1e-3            # golden-section tolerance
+    n_grid: int = 181                # visible-interval grid
+    margin_px: float = 40.0          # planning margin inside the detector edge, px
+    knn: int = 16                    # nearest-landmark candidates checked
+    eval_path: str = "numpy_H"       # how baseline metrics are evaluated
+    p_known: tuple = (0.0, 0.0, 0.0)  # known landmark (landing site), m
+
+
+@dataclass
+class PlanResult:
+    method: str
+    index: int                 # chosen landmark (field index), -1 if none
+    beta: float                # signed beta*, rad (nan if no search)
+    ground: np.ndarray         # ideal ground point, m
+    objective: float           # objective at beta* (minimised)
+    n_evals: int               # objective evaluations
+    time_ns: int               # wall time of the planning call
+    note: str = ""
+
+
+def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n_grid: int,
+                      margin_px: float) -> list[tuple[float, float]]:
+    """Sub-intervals of signed beta (rad) whose lines of sight meet the ground
+    inside the field of view (estimated attitude), split at 0."""
+    eps = 1e-9
+    lo, hi = -(math.pi - geom.gamma) + eps, geom.gamma - eps
+    betas = np.linspace(lo, hi, int(n_grid))
+    u = np.cos(betas)[:, None] * geom.v_hat + np.sin(betas)[:, None] * geom.w_hat
+    ok = camera.in_view(u @ R_LtoB.T, margin_px)
+    if not ok.any():
+        return []
+    idx = np.flatnonzero(ok)
+    # the field of view cut by a plane through its apex is one arc: take the
+    # longest run of visible grid angles (guards against grid artefacts)
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    run = max(runs, key=len)
+    b0, b1 = float(betas[run[0]]), float(betas[run[-1]])
+    out = []
+    if b0 < 0:
+        out.append((b0, min(b1, -eps)))
+    if b1 > 0:
+        out.append((max(b0, eps), b1))
+    return [(a, b) for a, b in out if b > a]
+
+
+# ----------------------------------------------------------------- objectives
+
+def depth_objective(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, **_) -> Callable:
+    """Depth estimation error (eq. 23-25) as a scalar function of signed beta
+    (fast path of ``depth_error.signed_depth_error``; +inf outside the domain)."""
+    b = baseline(state.v, state.a, cfg.t_s)
+    if not b > 0:
+        raise ValueError("depth error: zero baseline (zero velocity)")
+    r_e = error_radius(state.P[3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
+    cd, g = geom.cd, geom.gamma
+    sin, cos, sqrt, pi, inf = math.sin, math.cos, math.sqrt, math.pi, math.inf
+
+    def f(beta: float) -> float:
+        if beta > 0.0:
+            alpha = pi - g
+        elif beta < 0.0:
+            alpha = g
+            beta = -beta
+        else:
+            return inf
+        s = sin(alpha + beta)
+        if alpha + beta >= pi or s <= 0.0:
+            return inf
+        d = cd * sin(alpha) / s                                   # law of sines
+        rks = sqrt(max(b * b + d * d - 2.0 * b * d * cos(beta), 0.0))   # eq. 25
+        if rks <= 0.0:
+            return inf
+        st = b * sin(beta) / rks                                  # eq. 24
+        return 2.0 * r_e / st if st > 0.0 else inf                # eq. 23
+
+    return f
+
+
+_METRIC_CACHE: dict = {}
+
+
+def _metric(name: str):
+    if name not in _METRIC_CACHE:
+        from opnav.landing import metrics
+
+        _METRIC_CACHE[name] = metrics.make_metric(name)
+    return _METRIC_CACHE[name]
+
+
+def _ground_fn(geom: PlaneGeometry):
+    C0, C1, C2 = (float(x) for x in geom.C)
+    v0, v1, v2 = (float(x) for x in geom.v_hat)
+    w0, w1, w2 = (float(x) for x in geom.w_hat)
+    cd, g = geom.cd, geom.gamma
+    sin, cos, pi = math.sin, math.cos, math.pi
+
+    def ground(beta: float):
+        alpha = pi - g if beta > 0 else g
+        ab = abs(beta)
+        s = sin(alpha + ab)
+        if beta == 0.0 or alpha + ab >= pi or s <= 0.0:
+            return None
+        d = cd * sin(alpha) / s
+        cb, sb = cos(beta), sin(beta)
+        return (C0 + d * (cb * v0 + sb * w0), C1 + d * (cb * v1 + sb * w1),
+                C2 + d * (cb * v2 + sb * w2))
+
+    return ground
+
+
+def metric_objective(name: str) -> Callable:
+    """Factory: the negated metric ``name`` at the ground point of beta."""
+
+    def build(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, camera: Camera,
+              sigma_b: float, **_) -> Callable:
+        from opnav.landing.metrics import MetricContext
+
+        m = _metric(name)
+        ctx = MetricContext(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
+                            p_known_L=np.asarray(cfg.p_known, float), P=state.P,
+                            R_meas=(sigma_b**2) * np.eye(6), boresight_B=camera.boresight_B)
+        ground = _ground_fn(geom)
+        path = cfg.eval_path
+        if path == "closed_form":
+            def f(beta: float) -> float:
+                p = ground(beta)
+                return math.inf if p is None else -m.scalar(ctx, p)
+            return f
+        call = {"numpy_H": m.numpy_H, "reference": m.reference, "casadi_map": m.casadi_map}.get(path)
+        if call is None:
+            raise ValueError(f"landing.planner.eval_path: unknown {path!r}")
+
+        def f(beta: float) -> float:
+            p = ground(beta)
+            if p is None:
+                return math.inf
+            return -float(call(ctx, np.array([p]))[0])
+        return f
+
+    return build
+
+
+def _metric_names() -> tuple[str, ...]:
+    try:
+        from opnav.landing.metrics import METRIC_NAMES
+    except ImportError:  # metrics module not available: depth only
+        return ()
+    return tuple(METRIC_NAMES)
+
+
+#: method name -> objective factory (minimised over signed beta)
+OBJECTIVES: dict[str, Callable] = {"depth": depth_objective}
+OBJECTIVES.update({n: metric_objective(n) for n in _metric_names()})
+
+#: method name -> direct picker without search: f(candidates (k,) indices,
+#: dirs_B (k, 3), rng) -> chosen position in candidates
+PICKERS: dict[str, Callable] = {}
+
+
+def available_methods() -> tuple[str, ...]:
+    return tuple(OBJECTIVES) + tuple(PICKERS)
+
+
+# ----------------------------------------------------------------- planning
+
+def _pick_nearest(field_: LandmarkField, point: np.ndarray, visible: Callable, knn: int,
+                  exclude: set) -> int:
+    idx = field_.nearest(point, knn)
+    idx = np.array([i for i in idx if i not in exclude], dtype=int)
+    if idx.size:
+        vis = visible(field_.xyz[idx])
+        if vis.any():
+            return int(idx[np.argmax(vis)])
+    # fallback: all detected landmarks, nearest to the point
+    vis = visible(field_.xyz)
+    for i in exclude:
+        vis[i] = False
+    if not vis.any():
+        return -1
+    cand = np.flatnonzero(vis)
+    d2 = np.sum((field_.xyz[cand, :2] - np.asarray(point)[:2]) ** 2, axis=1)
+    return int(cand[np.argmin(d2)])
+
+
+def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
+         visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
+         exclude: set = frozenset(), rng: np.random.Generator | None = None) -> PlanResult:
+    """One planning call: choose the next unknown landmark.
+
+    ``visible(points_L (n, 3)) -> bool (n,)`` says which landmarks the camera
+    actually detects (truth pose; the same for every method). ``exclude``
+    holds field indices not to choose (the current landmark). If the planning
+    geometry is degenerate (velocity not descending, zero velocity) or no
+    interval is visible, the detected landmark nearest to the image centre is
+    chosen and ``note`` says why (never a silent NaN).
+    """
+    t0 = time.perf_counter_ns()
+    if method in PICKERS:
+        vis = visible(field_.xyz)
+        for i in exclude:
+            vis[i] = False
+        cand = np.flatnonzero(vis)
+        k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
+        return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
+                          math.nan, 0, time.perf_counter_ns() - t0)
+    build = OBJECTIVES.get(method)
+    if build is None:
+        raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
+    note = ""
+    best = (math.inf, math.nan)
+    n = 0
+    try:
+        geom = plane_geometry(state.r, state.v)
+        intervals = visible_intervals(geom, state.R_LtoB, camera, cfg.n_grid, cfg.margin_px)
+        if intervals:
+            fun = build(state=state, geom=geom, cfg=cfg, camera=camera, sigma_b=camera.sigma_b)
+            for a, b in intervals:
+                x, fx, k = golden_section(fun, a, b, cfg.tol_rad)
+                n += k
+                if fx < best[0] or math.isnan(best[1]):
+                    best = (fx, x)
+        else:
+            note = "no visible interval"
+    except ValueError as exc:
+        if "depth error" not in str(exc):
+            raise
+        note = str(exc)
+    if math.isnan(best[1]):
+        # documented fallback: the detected landmark nearest the boresight
+        point = state.r + state.R_LtoB.T @ camera.boresight_B * max(state.r[2], 1.0) / max(
+            -(state.R_LtoB.T @ camera.boresight_B)[2], 1e-3)
+        k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
+        return PlanResult(method, k, math.nan, point, math.nan, n, time.perf_counter_ns() - t0,
+                          note or "no finite objective")
+    point = ground_point(best[1], geom)[0]
+    k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
+    return PlanResult(method, k, best[1], point, best[0], n, time.perf_counter_ns() - t0, note)
