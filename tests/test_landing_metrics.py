@@ -239,6 +239,7 @@ def test_batched_scalar_and_map_equal_reference(name, r, R, seed, aniso):
     mapped = m.casadi_map(ctx, cand)
     nph = m.numpy_H(ctx, cand)
     scal = np.array([m.scalar(ctx, p) for p in cand])
+    mats = np.array([m.numpy_H(ctx, p[None])[0] for p in cand])  # -> matrix_scalar
     assert np.all(np.isfinite(ref))
     if name == "mineig":
         # eigvalsh on the mixed-unit information (entries 1e-7..1e7) has absolute
@@ -252,9 +253,9 @@ def test_batched_scalar_and_map_equal_reference(name, r, R, seed, aniso):
         atol, rtol = 2e-6, 1e-9
     else:
         atol, rtol = 0.0, 1e-9
-    for got in (fast, mapped, nph, scal):
+    for got in (fast, mapped, nph, scal, mats):
         np.testing.assert_allclose(got, ref, rtol=rtol, atol=atol)
-    assert m.n_evals == 4 * 7 + 7 and m.n_calls == 4 + 7
+    assert m.n_evals == 6 * 7 and m.n_calls == 4 + 2 * 7
 
 
 @pytest.mark.parametrize("name", METRIC_NAMES)
@@ -351,7 +352,12 @@ def test_degenerate_candidates_score_minus_inf(name):
     r = ctx.r_L
     cand = np.array([r, r + np.array([0, 0, 100.0]), [0.0, 0.0, 0.0], [100.0, -200.0, 0.0]])
     m = make_metric(name)
-    for vals in (m(ctx, cand), m.reference(ctx, cand), np.array([m.scalar(ctx, p) for p in cand])):
+    for vals in (
+        m(ctx, cand),
+        m.reference(ctx, cand),
+        np.array([m.scalar(ctx, p) for p in cand]),
+        np.array([m.matrix_scalar(ctx, p) for p in cand]),
+    ):
         assert vals[0] == -np.inf and vals[1] == -np.inf  # at the lander / behind the camera
         assert np.all(np.isfinite(vals[2:]))
         assert not np.any(np.isnan(vals))
@@ -413,3 +419,19 @@ def test_information_metrics_against_50_digit_reference():
             assert got == pytest.approx(true_ld, abs=1e-8)
         for got in (fast[1][i], scal[1][i]):
             assert got == pytest.approx(true_me, rel=1e-8)
+
+
+def test_benchmark_script_runs_and_every_path_agrees():
+    """Smoke run of benchmarks/bench_metrics.py (2 candidates, 1 repetition)."""
+    import importlib.util as iu
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_metrics.py"
+    spec = iu.spec_from_file_location("bench_metrics", path)
+    mod = iu.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    df = mod.run(n=2, reps=1)
+    assert set(df.metric) == set(METRIC_NAMES) and set(df.impl) == set(mod.IMPLEMENTATIONS)
+    assert (df.us_per_call > 0).all()
+    tol = np.where(df.metric == "mineig", 1e-5, 1e-8)
+    assert (df.max_rel_diff_vs_ref < tol).all(), df[df.max_rel_diff_vs_ref >= tol]

@@ -110,6 +110,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+from scipy.linalg.lapack import dgesvd as _dgesvd
 from scipy.linalg.lapack import dposv as _dposv
 from scipy.linalg.lapack import dpotrf as _dpotrf
 from scipy.linalg.lapack import dsyev as _dsyev
@@ -467,18 +468,15 @@ def _tangent_scalar(name: str, ctx: MetricContext, tg, d0: float, d1: float, d2:
     return 1.0 / lmax if info == 0 and lmax > 0 else -math.inf
 
 
-def _info_scalar(name: str, ctx: MetricContext, d0: float, d1: float, d2: float, rho: float) -> float:
-    """Single-candidate information metric with minimal numpy overhead: the
-    known-landmark rows of H and P^-1, P, R^-1 are cached on ``ctx``; the
-    candidate rows are eq. 15-18 written out.  Same formulas as the batch path."""
+def _candidate_H(ctx: MetricContext, d0: float, d1: float, d2: float, rho: float) -> np.ndarray:
+    """H (6 x 12) of eq. 14-18 for one candidate at offset d = p - r, with the
+    known-landmark rows cached on ``ctx`` and the candidate rows written out."""
     c = ctx._cache
-    if "info_rows" not in c:
-        P, Rm, Pinv, W = ctx._info()
+    if "known_rows" not in c:
         Hb = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, ctx.p_known_L[None], ctx.R_LtoB)[0]
         Hb[3:6] = 0.0
-        c["info_rows"] = Hb
-    P, Rm, Pinv, W = ctx._info()
-    H = c["info_rows"].copy()
+        c["known_rows"] = Hb
+    H = c["known_rows"].copy()
     R = ctx.R_LtoB
     inv = 1.0 / rho
     u = np.array([d0 * inv, d1 * inv, d2 * inv])
@@ -488,6 +486,31 @@ def _info_scalar(name: str, ctx: MetricContext, d0: float, d1: float, d2: float,
     H[3:6, 0:3] = -HC  # eq. 15
     H[3:6, 6:9] = ((0.0, -b2, b1), (b2, 0.0, -b0), (-b1, b0, 0.0))  # eq. 16: [b x]
     H[3:6, 9:12] = HC  # eq. 17
+    return H
+
+
+def _matrix_scalar(name: str, ctx: MetricContext, d0: float, d1: float, d2: float, rho: float) -> float:
+    """The explicit matrix computation for one candidate with minimal overhead:
+    H by eq. 14-18, then one LAPACK SVD (dgesvd) of the 6 x 12 H for
+    svd/gdop/cond (gdop from the singular values above PINV_RCOND sigma_max,
+    i.e. exactly the pseudo-inverse trace), or the generic 12 x 12 information."""
+    H = _candidate_H(ctx, d0, d1, d2, rho)
+    if name not in H_METRICS:
+        return _info_scalar(name, ctx, H)
+    sv = _dgesvd(H, compute_uv=0)[1]
+    if name == "svd":
+        return float(sv[STRUCTURAL_RANK - 1])
+    if name == "cond":
+        return float(sv[STRUCTURAL_RANK - 1] / sv[0])
+    keep = sv[sv > PINV_RCOND * sv[0]]
+    return float(1.0 / np.sum(1.0 / (keep * keep)))
+
+
+def _info_scalar(name: str, ctx: MetricContext, H: np.ndarray) -> float:
+    """Single-candidate information metric, generic R_meas: equilibrated Cholesky
+    of the 12 x 12 information (logdet) or the posterior covariance (mineig),
+    with direct LAPACK calls.  Same formulas as the batch path."""
+    P, Rm, Pinv, W = ctx._info()
     if name == "logdet":
         Lam = Pinv + H.T @ W @ H
         s = 1.0 / np.sqrt(np.diagonal(Lam))
@@ -613,7 +636,7 @@ class Metric:
             tg = _tangent_setup(ctx)
             if tg is not None:
                 return _tangent_scalar(self.name, ctx, tg, d0, d1, d2, rho2)
-            return _info_scalar(self.name, ctx, d0, d1, d2, rho2)
+            return _info_scalar(self.name, ctx, _candidate_H(ctx, d0, d1, d2, rho2))
         y = 1.0 / rho2
         w0, w1, w2 = d0 * y, d1 * y, d2 * y
         u0, u1, u2 = float(u[0]), float(u[1]), float(u[2])
@@ -641,6 +664,24 @@ class Metric:
         if D1 <= 0.0 or D2 <= 0.0:
             return 0.0
         return 1.0 / ((lp1 + lm1) / D1 + (lp2 + lm2) / D2)
+
+    def matrix_scalar(self, ctx: MetricContext, p_L) -> float:
+        """One candidate by the explicit matrix computation the paper describes
+        (H of eq. 14-18, then a LAPACK SVD / the 12 x 12 information), with
+        minimal Python overhead; same value as :meth:`scalar`."""
+        self.n_evals += 1
+        self.n_calls += 1
+        p = np.asarray(p_L, dtype=float)
+        if p.shape != (3,) or not np.isfinite(p).all():
+            raise ValueError(f"p_L must be a finite (3,) vector, got {p_L!r}")
+        _, _, bs_L, known_ok = ctx._geom()
+        d0, d1, d2 = (p - ctx.r_L).tolist()
+        rho2 = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if not known_ok or rho2 <= ctx.min_range_m:
+            return -math.inf
+        if bs_L is not None and d0 * bs_L[0] + d1 * bs_L[1] + d2 * bs_L[2] <= 0.0:
+            return -math.inf
+        return _matrix_scalar(self.name, ctx, d0, d1, d2, rho2)
 
     # ---- slower paths with identical values (tests, benchmark) ----
     def _explicit(self, ctx, cand_L, build) -> np.ndarray:
@@ -678,7 +719,11 @@ class Metric:
         return self._explicit(ctx, cand_L, build)
 
     def numpy_H(self, ctx: MetricContext, cand_L) -> np.ndarray:
-        """H for all candidates in numpy (eq. 14-18), then batched SVD / pinv / Cholesky."""
+        """H for all candidates in numpy (eq. 14-18), then batched SVD / pinv /
+        Cholesky; a single candidate goes through :meth:`matrix_scalar`."""
+        c = _as_cands(cand_L)
+        if c.shape[0] == 1:
+            return np.array([self.matrix_scalar(ctx, c[0])])
 
         def build(c):
             H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB)

@@ -1,0 +1,145 @@
+"""Timing of the landmark-selection metrics (paper B sec. 2.2 baselines, B-X1).
+
+Description
+-----------
+Project issue 5 ("Fair timing"): the paper's Fig. 7 compares planning times of
+its depth-error model against matrix metrics.  How fast a matrix metric is
+depends on how it is implemented, so this script times every implementation
+of every metric of :mod:`opnav.landing.metrics` on the same inputs:
+
+* ``casadi_per_cand``  one compiled CasADi Function call + numpy SVD / pinv /
+  12 x 12 information per candidate (``Metric.reference``, the obvious way);
+* ``casadi_map``       ``Function.map(n)`` for all n candidates at once, then
+  batched numpy linear algebra (``Metric.casadi_map``);
+* ``numpy_batch``      H of eq. 14-18 in numpy for all n, batched LAPACK
+  (``Metric.numpy_H``);
+* ``fast_batch``       what ``make_metric`` returns for a batch: closed-form
+  structural singular values (svd/gdop/cond) or batched numpy (logdet/mineig);
+* ``seq_scalar``       n sequential single-candidate calls of ``Metric.scalar``
+  -- the golden-section search evaluates one candidate at a time, so this is
+  the path a planner calls (``metric(ctx, cand (1,3))`` dispatches to it);
+* ``seq_matrix``       n sequential ``Metric.numpy_H(ctx, p[None])`` calls, i.e.
+  ``Metric.matrix_scalar``: explicit H of eq. 14-18 + one LAPACK SVD (or the
+  12 x 12 information) per candidate with minimal overhead -- the paper's
+  matrix computation done as lean as we could (planner ``numpy_H`` path);
+* ``seq_casadi_map``   n sequential ``Metric.casadi_map(ctx, p[None])`` calls;
+* ``seq_casadi``       n sequential ``Metric.reference(ctx, p[None])`` calls.
+
+A "call" is one planning call of n candidate evaluations (default n = 50, the
+order of a golden-section search to 1e-3 rad over a 60 deg field of view);
+``ctx`` is the cost of building the :class:`MetricContext` once per call (not
+included in the per-call figures).  Each figure is the median over ``--reps``
+repetitions of ``time.perf_counter_ns``; ``ratio_to_svd`` divides by the svd
+metric's time with the same implementation.  Geometry: paper B Table 1 initial
+state, candidates uniformly on the ground in a +-6 km square.
+
+Use::
+
+    python benchmarks/bench_metrics.py [--n 50] [--reps 30] [--csv out.csv]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+from opnav.landing import casadi_model as cm
+from opnav.landing.metrics import METRIC_NAMES, MetricContext, make_metric
+
+IMPLEMENTATIONS = (
+    "casadi_per_cand",
+    "casadi_map",
+    "numpy_batch",
+    "fast_batch",
+    "seq_scalar",
+    "seq_matrix",
+    "seq_casadi_map",
+    "seq_casadi",
+)
+
+
+def make_inputs(n: int, seed: int = 0):
+    """(ctx kwargs, candidates (n, 3)) at paper B's initial state."""
+    rng = np.random.default_rng(seed)
+    r = np.array([3300.0, 5870.0, 6570.0])
+    R = Rotation.from_euler("xyz", [-25.7, -9.8, 0.0], degrees=True).as_matrix()
+    P = np.diag([577.0**2] * 3 + [5.8**2] * 3 + [np.deg2rad(1.15) ** 2] * 3 + [2000.0**2] * 3)
+    kw = dict(
+        r_L=r, v_L=np.array([-56.0, -66.0, -90.0]), R_LtoB=R, p_known_L=np.zeros(3),
+        P=P, R_meas=(5e-4) ** 2 * np.eye(6), boresight_B=None,
+    )
+    cand = rng.uniform(-6000.0, 6000.0, size=(n, 3))
+    cand[:, 2] = 0.0
+    return kw, cand
+
+
+def _median_ns(fn, reps: int) -> float:
+    fn()  # warm-up (CasADi map compilation, caches)
+    ts = []
+    for _ in range(reps):
+        t0 = time.perf_counter_ns()
+        fn()
+        ts.append(time.perf_counter_ns() - t0)
+    return float(np.median(ts))
+
+
+def run(n: int = 50, reps: int = 30, seed: int = 0) -> pd.DataFrame:
+    kw, cand = make_inputs(n, seed)
+    ctx = MetricContext(**kw)
+    cm.jacobian_map(n), cm.jacobian_map(1)  # build the mapped Functions outside the timing
+    t_ctx = _median_ns(lambda: MetricContext(**kw)._info(), reps)
+    rows = []
+    for name in METRIC_NAMES:
+        m = make_metric(name)
+        paths = {
+            "casadi_per_cand": lambda: m.reference(ctx, cand),
+            "casadi_map": lambda: m.casadi_map(ctx, cand),
+            "numpy_batch": lambda: m.numpy_H(ctx, cand),
+            "fast_batch": lambda: m(ctx, cand),
+            "seq_scalar": lambda: [m.scalar(ctx, p) for p in cand],
+            "seq_matrix": lambda: [m.numpy_H(ctx, p[None]) for p in cand],
+            "seq_casadi_map": lambda: [m.casadi_map(ctx, p[None]) for p in cand],
+            "seq_casadi": lambda: [m.reference(ctx, p[None]) for p in cand],
+        }
+        ref = m.reference(ctx, cand)
+        for impl in IMPLEMENTATIONS:
+            vals = np.ravel(np.asarray(paths[impl](), dtype=float))
+            err = float(np.max(np.abs(vals - ref) / np.maximum(np.abs(ref), 1e-300)))
+            t = _median_ns(paths[impl], reps)
+            rows.append(
+                dict(metric=name, impl=impl, n=n, us_per_call=t / 1e3, us_per_eval=t / 1e3 / n,
+                     max_rel_diff_vs_ref=err)
+            )
+    df = pd.DataFrame(rows)
+    svd = df[df.metric == "svd"].set_index("impl").us_per_call
+    df["ratio_to_svd"] = df.us_per_call / df.impl.map(svd)
+    df.attrs["us_ctx"] = t_ctx / 1e3
+    return df
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=50, help="candidate evaluations per planning call")
+    ap.add_argument("--reps", type=int, default=30, help="repetitions (median)")
+    ap.add_argument("--csv", default=None, help="also write the table as CSV")
+    a = ap.parse_args(argv)
+    df = run(a.n, a.reps)
+    with pd.option_context("display.width", 200, "display.max_rows", 200):
+        print(f"MetricContext build + info precompute: {df.attrs['us_ctx']:.1f} us per planning call")
+        print(df.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+        print()
+        print("us per call (n = %d evaluations), median of %d:" % (a.n, a.reps))
+        print(df.pivot(index="impl", columns="metric", values="us_per_call")
+              .loc[list(IMPLEMENTATIONS), list(METRIC_NAMES)].to_string(float_format=lambda x: f"{x:.1f}"))
+    if a.csv:
+        df.to_csv(a.csv, index=False)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
