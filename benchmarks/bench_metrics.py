@@ -25,6 +25,9 @@ of every metric of :mod:`opnav.landing.metrics` on the same inputs:
 * ``seq_casadi_map``   n sequential ``Metric.casadi_map(ctx, p[None])`` calls;
 * ``seq_casadi``       n sequential ``Metric.reference(ctx, p[None])`` calls.
 
+A second table times the Jacobian alone by each route (per-candidate
+Function, ``Function.map`` serial and thread, numpy).
+
 A "call" is one planning call of n candidate evaluations (default n = 50, the
 order of a golden-section search to 1e-3 rad over a 60 deg field of view);
 ``ctx`` is the cost of building the :class:`MetricContext` once per call (not
@@ -122,6 +125,24 @@ def run(n: int = 50, reps: int = 30, seed: int = 0) -> pd.DataFrame:
     return df
 
 
+def run_jacobian(n: int = 50, reps: int = 30, seed: int = 0) -> pd.DataFrame:
+    """The Jacobian alone (n candidates -> (n, 6, 12) ndarray) by each route."""
+    kw, cand = make_inputs(n, seed)
+    args = (kw["r_L"], kw["v_L"], kw["p_known_L"])
+    R = kw["R_LtoB"]
+    routes = {
+        "casadi_per_cand": lambda: [cm.jacobian_casadi(*args, p, R) for p in cand],
+        "casadi_map_serial": lambda: cm.jacobian_casadi_batch(*args, cand, R, "serial"),
+        "casadi_map_thread": lambda: cm.jacobian_casadi_batch(*args, cand, R, "thread"),
+        "numpy": lambda: cm.jacobian_numpy(*args, cand, R),
+    }
+    rows = []
+    for k, f in routes.items():
+        t = _median_ns(f, reps)
+        rows.append(dict(route=k, n=n, us_per_call=t / 1e3, us_per_eval=t / 1e3 / n))
+    return pd.DataFrame(rows)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=50, help="candidate evaluations per planning call")
@@ -136,6 +157,9 @@ def main(argv=None) -> int:
         print("us per call (n = %d evaluations), median of %d:" % (a.n, a.reps))
         print(df.pivot(index="impl", columns="metric", values="us_per_call")
               .loc[list(IMPLEMENTATIONS), list(METRIC_NAMES)].to_string(float_format=lambda x: f"{x:.1f}"))
+        print()
+        print("Jacobian H only (n = %d):" % a.n)
+        print(run_jacobian(a.n, a.reps).to_string(index=False, float_format=lambda x: f"{x:.4g}"))
     if a.csv:
         df.to_csv(a.csv, index=False)
     return 0
