@@ -52,9 +52,7 @@ class Camera:
         d = np.asarray(dirs_B, float).reshape(-1, 3) @ self.R_BtoC.T
         z = d[:, 2]
         lim = (self.half_px - margin_px) / self.focal_px
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ok = (z > 0) & (np.abs(d[:, 0]) < lim * z) & (np.abs(d[:, 1]) < lim * z)
-        return ok
+        return (z > 0) & (np.abs(d[:, 0]) < lim * z) & (np.abs(d[:, 1]) < lim * z)
 
     def measure(self, dir_B: np.ndarray, noise_px: np.ndarray) -> np.ndarray:
         """Noisy unit bearing in {B} of the true direction ``dir_B`` (3,), given the

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["depth", "depth_error", "PlaneGeometry", "plane_geometry", "signed_alpha",
-           "signed_depth_error", "ground_point", "baseline", "error_radius",
+           "signed_depth_error", "ground_point", "baseline", "error_radius", "max_eig_sym3",
            "angles_to_landmarks", "depth_error_at_landmarks"]
 
 
@@ -106,30 +106,35 @@ def plane_geometry(r_L, v_L, horizontal_ref=None) -> PlaneGeometry:
 
     ``horizontal_ref`` (3,) chooses the plane when the velocity is vertical
     (default {L} +x). Raises ``ValueError`` for zero velocity, a velocity that
-    does not descend, or a lander not above the ground.
+    does not descend, or a lander not above the ground. (Scalar arithmetic: it
+    is on the planner's timed path.)
     """
-    r = np.asarray(r_L, float)
-    v = np.asarray(v_L, float)
-    sp = float(np.linalg.norm(v))
-    if not np.isfinite(sp) or sp < 1e-9:
+    r0, r1, r2 = (float(x) for x in r_L)
+    v0, v1, v2 = (float(x) for x in v_L)
+    sp = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+    if not math.isfinite(sp) or sp < 1e-9:
         raise ValueError("depth error: zero velocity, the velocity line is undefined")
-    if r[2] <= 0:
-        raise ValueError(f"depth error: lander not above the ground (z = {r[2]} m)")
-    vh = v / sp
-    if vh[2] >= 0:
+    if not (r2 > 0):
+        raise ValueError(f"depth error: lander not above the ground (z = {r2} m)")
+    a0, a1, a2 = v0 / sp, v1 / sp, v2 / sp
+    if a2 >= 0:
         raise ValueError("depth error: velocity does not descend, it never meets the ground")
-    h = np.array([vh[0], vh[1], 0.0])
-    nh = float(np.linalg.norm(h))
+    nh = math.hypot(a0, a1)
     if nh < 1e-9:
         h = np.array([1.0, 0.0, 0.0]) if horizontal_ref is None else np.asarray(horizontal_ref, float)
-        h = h - h[2] * np.array([0, 0, 1.0])
-        nh = float(np.linalg.norm(h))
-    h = h / nh
-    w = h - (h @ vh) * vh
-    w /= np.linalg.norm(w)
-    cd = r[2] / -vh[2]
-    gamma = math.asin(min(1.0, -vh[2]))
-    return PlaneGeometry(C=r, v_hat=vh, w_hat=w, cd=float(cd), gamma=float(gamma))
+        h0, h1 = float(h[0]), float(h[1])
+        nh = math.hypot(h0, h1)
+        if nh == 0:
+            raise ValueError("depth error: horizontal_ref must have a horizontal part")
+        h0, h1 = h0 / nh, h1 / nh
+    else:
+        h0, h1 = a0 / nh, a1 / nh
+    hv = h0 * a0 + h1 * a1
+    w0, w1, w2 = h0 - hv * a0, h1 - hv * a1, -hv * a2
+    nw = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    return PlaneGeometry(C=np.array([r0, r1, r2]), v_hat=np.array([a0, a1, a2]),
+                         w_hat=np.array([w0 / nw, w1 / nw, w2 / nw]), cd=r2 / -a2,
+                         gamma=math.asin(min(1.0, -a2)))
 
 
 def signed_alpha(beta_signed, gamma: float) -> np.ndarray:
@@ -156,13 +161,32 @@ def ground_point(beta_signed, geom: PlaneGeometry) -> np.ndarray:
 
 def baseline(v_L, a_L, t_s: float) -> float:
     """Estimated baseline ``|v t_s + a t_s^2/2|`` (m), eq. 19."""
-    return float(np.linalg.norm(np.asarray(v_L, float) * t_s + 0.5 * np.asarray(a_L, float) * t_s**2))
+    h = 0.5 * t_s * t_s
+    x, y, z = (float(v) * t_s + float(a) * h for v, a in zip(v_L, a_L))
+    return math.sqrt(x * x + y * y + z * z)
+
+
+def max_eig_sym3(A: np.ndarray) -> float:
+    """Largest eigenvalue of a symmetric 3x3 matrix (closed form, trigonometric)."""
+    a = [[float(A[i][j]) for j in range(3)] for i in range(3)]
+    p1 = a[0][1] ** 2 + a[0][2] ** 2 + a[1][2] ** 2
+    q = (a[0][0] + a[1][1] + a[2][2]) / 3.0
+    if p1 <= 1e-30 * max(1.0, q * q):
+        return max(a[0][0], a[1][1], a[2][2])
+    p2 = (a[0][0] - q) ** 2 + (a[1][1] - q) ** 2 + (a[2][2] - q) ** 2 + 2.0 * p1
+    p = math.sqrt(p2 / 6.0)
+    b = [[(a[i][j] - (q if i == j else 0.0)) / p for j in range(3)] for i in range(3)]
+    det = (b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+           - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+           + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]))
+    r = max(-1.0, min(1.0, det / 2.0))
+    return q + 2.0 * p * math.cos(math.acos(r) / 3.0)
 
 
 def error_radius(P_vv: np.ndarray, t_s: float, n_sigma: float) -> float:
     """Error-ball radius ``r_e = eps_v t_s`` (m), eq. 22, with
     ``eps_v = n_sigma * sqrt(largest eigenvalue of P_vv)`` (m/s)."""
-    lam = float(np.linalg.eigvalsh(0.5 * (P_vv + P_vv.T))[-1])
+    lam = max_eig_sym3(0.5 * (np.asarray(P_vv) + np.asarray(P_vv).T))
     return n_sigma * math.sqrt(max(lam, 0.0)) * t_s
 
 

@@ -67,8 +67,9 @@ class Scenario:
     obs_per_landmark: int
     depth_sigma_frac: float
     min_update_alt: float
-    oc: bool                   # observability-constrained update
+    oc: bool                   # observability-constrained EKF (ekf.oc_transition)
     iterations: int            # iterated-EKF relinearisations per update
+    noise_scale: float         # filter bearing noise / true pixel noise
     bounds: tuple              # (m, m/s, rad)
     base_seed: int
 
@@ -112,6 +113,7 @@ def _scenario_from_json(text: str) -> Scenario:
                     min_update_alt=float(fl["min_update_altitude_m"]),
                     oc=bool(fl["observability_constrained"]),
                     iterations=int(fl["iterations"]),
+                    noise_scale=float(fl["meas_noise_scale"]),
                     bounds=(float(b["r_m"]), float(b["v_mps"]), math.radians(float(b["att_deg"]))),
                     base_seed=int(c["mc"]["base_seed"]))
 
@@ -165,7 +167,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
 
     tr = scn.truth
     cam = scn.camera
-    sb = cam.sigma_b
+    sb = cam.sigma_b * scn.noise_scale      # the filter's bearing-noise model
     p_site = np.zeros(3)
     P0 = np.zeros((12, 12))
     br, bv, bt = scn.bounds
@@ -196,15 +198,13 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
 
     record(0)
     # observability constraint (OC-EKF): unobservable direction at the prior
-    # estimates, the landmark part at its first estimate
-    p_first = np.zeros(3)
-    N = ekf.nullspace(st.r, st.v, st.R, p_first)
+    N = ekf.nullspace(st.r, st.v, st.R, st.p)
     C_prior = st.R
     for j in range(n):
         v_prev = st.v
-        oc = (N, C_prior, p_first) if scn.oc else None
+        oc = (N, C_prior) if scn.oc else None
         st = ekf.propagate(st, pre.dR[j], pre.dv[j], pre.dp[j], scn.Dt, scn.g, scn.Q, oc)
-        N = ekf.nullspace(st.r, st.v, st.R, p_first)
+        N = ekf.nullspace(st.r, st.v, st.R, st.p)
         C_prior = st.R
         a_est = (st.v - v_prev) / scn.Dt
         k = j + 1
@@ -231,8 +231,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                     b = cam.measure(R_t @ (scn.field.xyz[cur] - r_t), noise_px[k, 1])
                     try:
                         st = ekf.init_landmark(st, b, scn.depth_sigma_frac, sb)
-                        p_first = st.p.copy()
-                        N = ekf.nullspace(st.r, st.v, st.R, p_first)
+                        N = ekf.nullspace(st.r, st.v, st.R, st.p)
                         n_obs, n_used = 1, n_used + 1
                     except ValueError:
                         cur = -1
@@ -241,7 +240,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                 meas.append((b, None))
                 n_obs += 1
             if meas:
-                st, _ = ekf.update(st, meas, sb, N if scn.oc else None, scn.iterations)
+                st, _ = ekf.update(st, meas, sb, None, scn.iterations)
                 updated[k] = True
         record(k)
 

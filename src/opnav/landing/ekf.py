@@ -94,7 +94,12 @@ def process_noise(sigma_a: float, sigma_w: float, dt: float, n_sub: int) -> np.n
 def oc_transition(Phi: np.ndarray, N_i: np.ndarray, N_j: np.ndarray, C_i_prior: np.ndarray,
                   C_j: np.ndarray, Dt: float) -> np.ndarray:
     """Observability-constrained Phi (Hesch et al. 2013): the smallest change of
-    the attitude columns with ``Phi N_i = N_j``, ``N`` from the *prior* estimates."""
+    the attitude columns with ``Phi N_i = N_j``, ``N`` from the *prior*
+    (propagated) estimates at ``i`` and ``j``. Because the update moves the
+    estimate between the two priors, the unconstrained Phi maps the direction
+    at the *posterior* instead, and the filter gains spurious yaw information
+    (paper B ref. [16]); the landmark rows get the rank-one term that carries
+    its part of ``N`` from its prior to its posterior estimate."""
     Phi = Phi.copy()
     Phi[6:9, 6:9] = C_j @ C_i_prior.T
     u = N_i[6:9]
@@ -105,6 +110,9 @@ def oc_transition(Phi: np.ndarray, N_i: np.ndarray, N_j: np.ndarray, C_i_prior: 
     Phi[0:3, 6:9] = A - np.outer(A @ u - w1, u) / uu
     B = Phi[3:6, 6:9]
     Phi[3:6, 6:9] = B - np.outer(B @ u - w2, u) / uu
+    # the landmark's estimate moved in the update: carry its part of N too
+    w3 = N_j[9:12] - N_i[9:12]
+    Phi[9:12, 6:9] = np.outer(w3, u) / uu
     return Phi
 
 
@@ -112,10 +120,11 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
               oc: tuple | None = None) -> NavState:
     """Closed-form propagation of one interval (imu.apply_increment) and of P.
 
-    ``oc = (N_i, C_i_prior, p_first)`` switches on the observability constraint:
-    ``N_i`` the unobservable direction at the prior estimate of step i (attitude
-    ``C_i_prior``), ``p_first`` the landmark's first estimate; ``Phi`` is then
-    modified by :func:`oc_transition` toward ``N_j`` at the new prior.
+    ``oc = (N_i, C_i_prior)`` switches on the observability constraint: ``N_i``
+    the unobservable direction at the prior estimate of step i (attitude
+    ``C_i_prior``); ``Phi`` is then modified by :func:`oc_transition` to map it
+    to ``N_j`` at the new prior. The update Jacobian, evaluated at that prior,
+    annihilates ``N_j`` exactly, so the linearised system keeps yaw unobservable.
     """
     g = np.asarray(g, float)
     C_i = st.R
@@ -125,8 +134,8 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
     C_j = (R_BtoL @ dR).T
     Phi = transition_matrix(st.r, st.v, C_i, r_j, v_j, C_j, Dt, g)
     if oc is not None:
-        N_i, C_i_prior, p_first = oc
-        Phi = oc_transition(Phi, N_i, nullspace(r_j, v_j, C_j, p_first), C_i_prior, C_j, Dt)
+        N_i, C_i_prior = oc
+        Phi = oc_transition(Phi, N_i, nullspace(r_j, v_j, C_j, st.p), C_i_prior, C_j, Dt)
     P = Phi @ st.P @ Phi.T + Q
     return NavState(r_j, v_j, C_j, st.p.copy(), 0.5 * (P + P.T))
 

@@ -31,11 +31,13 @@ search (e.g. a random pick) can be added to :data:`PICKERS`. Adding a method
 is adding one entry.
 
 How a baseline metric is evaluated inside the search is ``eval_path``:
-``numpy_H`` (default: the Jacobian H of eq. 14-18 in numpy, then LAPACK SVD /
-pseudo-inverse per candidate, the matrix computation the paper describes),
-``reference`` (a compiled CasADi Function call per candidate), ``casadi_map``
-or ``closed_form`` (the metrics module's closed-form singular values, a
-finding beyond the paper, see ``opnav.landing.metrics``).
+``matrix_scalar`` (default: the Jacobian H of eq. 14-18, checked against its
+CasADi derivation, then one LAPACK SVD of the 6 x 12 H per candidate, the
+matrix computation the paper describes, with minimal call overhead),
+``numpy_H`` (the batch numpy route, called with one candidate), ``reference``
+(a compiled CasADi Function call per candidate), ``casadi_map``, or
+``closed_form`` (the metrics module's closed-form singular values, a finding
+beyond the paper, see ``opnav.landing.metrics``).
 
 Timing: :func:`plan` measures its whole call with ``time.perf_counter_ns`` and
 counts objective evaluations, so a timing comparison rests on both.
@@ -51,8 +53,7 @@ from typing import Callable
 import numpy as np
 
 from opnav.landing.camera import Camera
-from opnav.landing.depth_error import (PlaneGeometry, baseline, error_radius, ground_point,
-                                       plane_geometry)
+from opnav.landing.depth_error import PlaneGeometry, baseline, error_radius, plane_geometry
 from opnav.landing.landmarks import LandmarkField
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig",
@@ -109,10 +110,10 @@ class PlannerConfig:
     t_s: float = 1.0                 # observation interval of the depth model, s
     n_sigma_v: float = 3.0           # eps_v = n_sigma * sqrt(max eig P_vv)
     tol_rad: float = 1e-3            # golden-section tolerance
-    n_grid: int = 181                # visible-interval grid
+    n_grid: int = 361                # visible-interval grid over [-pi, pi]
     margin_px: float = 40.0          # planning margin inside the detector edge, px
     knn: int = 16                    # nearest-landmark candidates checked
-    eval_path: str = "numpy_H"       # how baseline metrics are evaluated
+    eval_path: str = "matrix_scalar"  # how baseline metrics are evaluated
     p_known: tuple = (0.0, 0.0, 0.0)  # known landmark (landing site), m
 
 
@@ -128,23 +129,46 @@ class PlanResult:
     note: str = ""
 
 
+_GRID_CACHE: dict = {}
+
+
+def _unit_grid(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    if n not in _GRID_CACHE:
+        t = np.linspace(-math.pi, math.pi, int(n))
+        _GRID_CACHE[n] = (t, np.cos(t)[:, None], np.sin(t)[:, None])
+    return _GRID_CACHE[n]
+
+
 def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n_grid: int,
                       margin_px: float) -> list[tuple[float, float]]:
     """Sub-intervals of signed beta (rad) whose lines of sight meet the ground
-    inside the field of view (estimated attitude), split at 0."""
+    inside the field of view (estimated attitude), split at 0.
+
+    The circle of directions in the plane is sampled at ``n_grid`` angles over
+    [-pi, pi] (step ``2 pi / (n_grid - 1)``); the interval ends are the outermost
+    visible samples.
+    """
     eps = 1e-9
-    lo, hi = -(math.pi - geom.gamma) + eps, geom.gamma - eps
-    betas = np.linspace(lo, hi, int(n_grid))
-    u = np.cos(betas)[:, None] * geom.v_hat + np.sin(betas)[:, None] * geom.w_hat
-    ok = camera.in_view(u @ R_LtoB.T, margin_px)
+    betas, cb, sb = _unit_grid(n_grid)
+    # the two in-plane directions in camera axes; u(beta) = cos v_hat + sin w_hat
+    M = camera.R_BtoC @ R_LtoB
+    d = cb * (M @ geom.v_hat) + sb * (M @ geom.w_hat)
+    lim = (camera.half_px - margin_px) / camera.focal_px
+    z = d[:, 2]
+    ok = ((z > 0) & (np.abs(d[:, 0]) < lim * z) & (np.abs(d[:, 1]) < lim * z)
+          & (betas > -(math.pi - geom.gamma)) & (betas < geom.gamma))
     if not ok.any():
         return []
     idx = np.flatnonzero(ok)
     # the field of view cut by a plane through its apex is one arc: take the
     # longest run of visible grid angles (guards against grid artefacts)
-    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
-    run = max(runs, key=len)
-    b0, b1 = float(betas[run[0]]), float(betas[run[-1]])
+    if idx[-1] - idx[0] + 1 == idx.size:
+        i0, i1 = idx[0], idx[-1]
+    else:
+        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+        run = max(runs, key=len)
+        i0, i1 = run[0], run[-1]
+    b0, b1 = float(betas[i0]), float(betas[i1])
     out = []
     if b0 < 0:
         out.append((b0, min(b1, -eps)))
@@ -231,10 +255,12 @@ def metric_objective(name: str) -> Callable:
                             R_meas=(sigma_b**2) * np.eye(6), boresight_B=camera.boresight_B)
         ground = _ground_fn(geom)
         path = cfg.eval_path
-        if path == "closed_form":
+        if path in ("matrix_scalar", "closed_form"):
+            call1 = m.matrix_scalar if path == "matrix_scalar" else m.scalar
+
             def f(beta: float) -> float:
                 p = ground(beta)
-                return math.inf if p is None else -m.scalar(ctx, p)
+                return math.inf if p is None else -call1(ctx, p)
             return f
         call = {"numpy_H": m.numpy_H, "reference": m.reference, "casadi_map": m.casadi_map}.get(path)
         if call is None:
@@ -273,10 +299,11 @@ def available_methods() -> tuple[str, ...]:
 
 # ----------------------------------------------------------------- planning
 
-def _pick_nearest(field_: LandmarkField, point: np.ndarray, visible: Callable, knn: int,
+def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
                   exclude: set) -> int:
     idx = field_.nearest(point, knn)
-    idx = np.array([i for i in idx if i not in exclude], dtype=int)
+    if exclude:
+        idx = idx[~np.isin(idx, list(exclude))]
     if idx.size:
         vis = visible(field_.xyz[idx])
         if vis.any():
@@ -342,6 +369,6 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
         k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
         return PlanResult(method, k, math.nan, point, math.nan, n, time.perf_counter_ns() - t0,
                           note or "no finite objective")
-    point = ground_point(best[1], geom)[0]
+    point = np.array(_ground_fn(geom)(best[1]))
     k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
     return PlanResult(method, k, best[1], point, best[0], n, time.perf_counter_ns() - t0, note)

@@ -1,0 +1,168 @@
+"""Monte Carlo of the powered descent: chunks, gathering, and the B-T3 summary
+(paper B sec. 3, Fig. 6-7; SPEC B.4).
+
+Description
+-----------
+Run ``i`` of every method uses the random stream ``SeedSequence([base_seed,
+i])`` only (``opnav.landing.descent.run_descent``), so the methods are paired
+(same initial errors, IMU and pixel noise) and a run's result does not depend
+on how runs are grouped into Snakemake jobs. :func:`run_chunk` flies a list of
+run indices and stacks the per-run arrays; :func:`gather` concatenates chunks
+in run order; :func:`summary_table` builds B-T3.
+
+Statistics (per method, over the runs): final and RMS (over time) error norms
+of position (m), velocity (m/s) and attitude (deg, small-angle ``dtheta``),
+each as mean and ``3 sigma`` (three sample standard deviations); the median
+wall time of a planning call over every planning call of every run (us), the
+median objective evaluations per call; the depth method's time reduction
+against each baseline ``100 (1 - median_depth / median_baseline)`` (%), with a
+bootstrap standard deviation over runs.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from opnav.landing.descent import build_scenario, run_descent
+
+__all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
+           "time_reduction", "chunks"]
+
+_TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
+           "nees_r", "nees_v")
+
+
+def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
+    """Run indices grouped into jobs of ``runs_per_job``."""
+    if n_runs < 1 or runs_per_job < 1:
+        raise ValueError("landing.mc.n_runs and runs_per_job must be >= 1")
+    return [list(range(a, min(a + runs_per_job, n_runs))) for a in range(0, n_runs, runs_per_job)]
+
+
+def run_chunk(landing_cfg: dict, method: str, run_indices) -> dict:
+    """Fly the runs ``run_indices`` with ``method``; stacked arrays (see module doc)."""
+    scn = build_scenario(landing_cfg)
+    runs = [run_descent(scn, method, int(i)) for i in run_indices]
+    out = {"run_index": np.asarray(list(run_indices), np.int64), "t": scn.truth.t.copy()}
+    for k in _TRACKS:
+        out[k] = np.stack([r[k] for r in runs])
+    out["plan_ns"] = np.concatenate([r["plan_ns"] for r in runs]) if runs else np.zeros(0, np.int64)
+    out["plan_evals"] = np.concatenate([r["plan_evals"] for r in runs]) if runs else np.zeros(0, np.int64)
+    out["plan_run"] = np.concatenate([np.full(len(r["plan_ns"]), int(i), np.int64)
+                                      for i, r in zip(run_indices, runs)]) if runs else np.zeros(0, np.int64)
+    out["n_landmarks"] = np.array([r["n_landmarks"] for r in runs], np.int64)
+    out["init_error"] = np.stack([r["init_error"] for r in runs])
+    return out
+
+
+def save(path, data: dict, method: str) -> None:
+    """Write a chunk or gathered result (``.npz``, atomically)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp.npz")
+    np.savez_compressed(tmp, method=np.array(method), **data)
+    tmp.replace(path)
+
+
+def load(path) -> dict:
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def gather(parts: list[dict]) -> dict:
+    """Concatenate chunk results in run-index order; checks for gaps/duplicates."""
+    if not parts:
+        raise ValueError("no Monte-Carlo chunks to gather")
+    methods = {str(p["method"]) for p in parts if "method" in p}
+    if len(methods) > 1:
+        raise ValueError(f"chunks of different methods gathered together: {sorted(methods)}")
+    idx = np.concatenate([p["run_index"] for p in parts])
+    order = np.argsort(idx, kind="stable")
+    if len(np.unique(idx)) != len(idx):
+        raise ValueError("duplicate run indices in the Monte-Carlo chunks")
+    out = {"run_index": idx[order], "t": parts[0]["t"]}
+    for k in _TRACKS + ("n_landmarks", "init_error"):
+        out[k] = np.concatenate([p[k] for p in parts])[order]
+    pr = np.concatenate([p["plan_run"] for p in parts])
+    po = np.argsort(pr, kind="stable")
+    for k in ("plan_ns", "plan_evals"):
+        out[k] = np.concatenate([p[k] for p in parts])[po]
+    out["plan_run"] = pr[po]
+    if methods:
+        out["method"] = np.array(methods.pop())
+    return out
+
+
+def per_run_stats(data: dict) -> pd.DataFrame:
+    """Per run: final and RMS error norms (m, m/s, deg) and mean NEES."""
+    rows = {}
+    for key, name in (("err_r", "pos_err_m"), ("err_v", "vel_err_mps"), ("err_th_deg", "att_err_deg")):
+        nrm = np.linalg.norm(data[key], axis=2)
+        rows[f"final_{name}"] = nrm[:, -1]
+        rows[f"rms_{name}"] = np.sqrt(np.mean(nrm**2, axis=1))
+    rows["mean_nees_pos"] = data["nees_r"].mean(axis=1)
+    rows["mean_nees_vel"] = data["nees_v"].mean(axis=1)
+    rows["n_landmarks"] = data["n_landmarks"]
+    return pd.DataFrame(rows, index=pd.Index(data["run_index"], name="run"))
+
+
+def _median_us(ns: np.ndarray) -> float:
+    return float(np.median(ns) / 1e3) if len(ns) else math.nan
+
+
+def time_reduction(a: dict, b: dict, n_boot: int = 200, seed: int = 0) -> tuple[float, float]:
+    """``100 (1 - median_a / median_b)`` (%) of planning times and its bootstrap
+    standard deviation (runs resampled, paired by run index)."""
+    ta, tb = _median_us(a["plan_ns"]), _median_us(b["plan_ns"])
+    red = 100.0 * (1.0 - ta / tb)
+    runs = np.intersect1d(np.unique(a["plan_run"]), np.unique(b["plan_run"]))
+    if len(runs) < 2:
+        return red, math.nan
+    rng = np.random.default_rng(seed)
+    ga = {r: a["plan_ns"][a["plan_run"] == r] for r in runs}
+    gb = {r: b["plan_ns"][b["plan_run"] == r] for r in runs}
+    vals = []
+    for _ in range(n_boot):
+        pick = rng.choice(runs, size=len(runs), replace=True)
+        ma = np.median(np.concatenate([ga[r] for r in pick]))
+        mb = np.median(np.concatenate([gb[r] for r in pick]))
+        vals.append(100.0 * (1.0 - ma / mb))
+    return red, float(np.std(vals, ddof=1))
+
+
+def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | None = None
+                  ) -> pd.DataFrame:
+    """B-T3: one row per method (see the module docstring for the columns)."""
+    methods = list(data)
+    rows = []
+    for m in methods:
+        st = per_run_stats(data[m])
+        row = {"method": m, "n_runs": len(st)}
+        for q in ("pos_err_m", "vel_err_mps", "att_err_deg"):
+            for kind in ("final", "rms"):
+                col = st[f"{kind}_{q}"]
+                row[f"{kind}_{q}_mean"] = float(col.mean())
+                row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
+        row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
+        row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
+        row["landmarks_per_run"] = float(st["n_landmarks"].mean())
+        row["median_plan_time_us"] = _median_us(data[m]["plan_ns"])
+        ev = data[m]["plan_evals"]
+        row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
+        row["plan_calls"] = int(len(ev))
+        for b in methods:
+            if b == m:
+                continue
+            red, sd = time_reduction(data[m], data[b])
+            row[f"time_reduction_vs_{b}_pct"] = red
+            row[f"time_reduction_vs_{b}_pct_std"] = sd
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    if published_reduction_vs_svd is not None:
+        df["time_reduction_vs_svd_pct_published"] = [
+            float(published_reduction_vs_svd) if m == "depth" else math.nan for m in df["method"]]
+    return df
