@@ -11,6 +11,7 @@ configfile: "config/config.yaml"
 
 
 include: "workflow/rules/common.smk"
+include: "workflow/rules/approach.smk"
 include: "workflow/rules/landing.smk"
 include: "workflow/rules/paper.smk"
 

@@ -1,0 +1,141 @@
+# Paper A: EM-EKF camera-misalignment estimation on Mars approach (SPEC section A).
+# Simulation rules (Monte Carlo, convergence study, CRLB) write pickles under
+# results/approach/work/; table and figure rules only read them.
+
+APPROACH = res("approach")
+A_WORK = f"{APPROACH}/work"
+A_CFG = cfg("approach")
+A_GROUPS = ["size", "polarity", "initial", "pixel", "install"]
+A_VARIANTS = config["approach"]["variants"]
+A_METHODS = config["approach"]["methods"]
+A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/ekf.py", "approach/smoother.py",
+            "approach/em.py", "approach/crlb.py", "approach/scenario.py", "approach/cases.py",
+            "approach/pipeline.py")
+
+
+def a_groups(variant):
+    return A_GROUPS if variant in config["approach"]["table1_variants"] else ["headline"]
+
+
+A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
+        for v in A_VARIANTS for g in a_groups(v) for m in A_METHODS}
+
+
+def a_headline_mc(wildcards):
+    g = "size" if wildcards.variant in config["approach"]["table1_variants"] else "headline"
+    return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS]
+
+
+wildcard_constraints:
+    variant="literal|prior|roll|reference-start",
+    group="size|polarity|initial|pixel|install|headline",
+    method="plain|squarem",
+
+
+rule approach_mc:
+    """Monte Carlo of one case group, scenario variant and EM scheme (seeds batched)."""
+    input:
+        A_SRC,
+    output:
+        f"{A_WORK}/mc/{{variant}}__{{group}}__{{method}}.pkl",
+    params:
+        approach=A_CFG,
+    log:
+        f"{APPROACH}/logs/mc_{{variant}}__{{group}}__{{method}}.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/mc_{{variant}}__{{group}}__{{method}}.tsv"
+    script:
+        "../scripts/approach_mc.py"
+
+
+rule approach_convergence:
+    """Plain EM vs SQUAREM to the maximum-likelihood estimate on one window (headline case)."""
+    input:
+        A_SRC,
+    output:
+        f"{A_WORK}/conv/{{variant}}.pkl",
+    params:
+        approach=A_CFG,
+    log:
+        f"{APPROACH}/logs/conv_{{variant}}.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/conv_{{variant}}.tsv"
+    script:
+        "../scripts/approach_convergence.py"
+
+
+rule approach_crlb:
+    """CRLB of (tx, ty) vs data length per variant (headline case)."""
+    input:
+        A_SRC,
+    output:
+        f"{A_WORK}/crlb.pkl",
+    params:
+        approach=A_CFG,
+    log:
+        f"{APPROACH}/logs/crlb.log",
+    script:
+        "../scripts/approach_crlb.py"
+
+
+rule approach_tables:
+    """A-T1 (Table 1 with published values), A-X1 table and verdict, A-summary.json."""
+    input:
+        mc=list(A_MC.values()),
+        conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
+        crlb=f"{A_WORK}/crlb.pkl",
+        code=src("approach/pipeline.py", "tables.py", "published.py", "data/published.yaml"),
+    output:
+        t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
+        x1=report_table(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),
+        verdict=f"{APPROACH}/A-X1_identifiability.md",
+        summary=f"{APPROACH}/A-summary.json",
+    params:
+        approach=A_CFG,
+        profile=config["profile"],
+    log:
+        f"{APPROACH}/logs/tables.log",
+    localrule: True
+    script:
+        "../scripts/approach_tables.py"
+
+
+rule approach_figures:
+    """A-F4, A-F5, A-F6 for the headline case of one variant."""
+    input:
+        mc=a_headline_mc,
+        code=src("approach/plots.py", "figures.py", "opnav.mplstyle", "data/published.yaml"),
+    output:
+        f4=report_figure(f"{APPROACH}/A-F4_bias_estimate_{{variant}}", "A-F4", "Paper A", "{variant}"),
+        f5=report_figure(f"{APPROACH}/A-F5_nav_accuracy_{{variant}}", "A-F5", "Paper A", "{variant}"),
+        f6=report_figure(f"{APPROACH}/A-F6_nav_error_compensation_{{variant}}", "A-F6", "Paper A", "{variant}"),
+    params:
+        segments=cfg("approach", "segments"),
+    log:
+        f"{APPROACH}/logs/figures_{{variant}}.log",
+    localrule: True
+    script:
+        "../scripts/approach_figures.py"
+
+
+rule approach_x1_figure:
+    """A-X1 figure: CRLB vs data per variant, EM errors, EM iterations plain vs SQUAREM."""
+    input:
+        crlb=f"{A_WORK}/crlb.pkl",
+        conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
+        x1=f"{APPROACH}/A-X1_crlb.csv",
+        code=src("approach/plots.py", "figures.py", "opnav.mplstyle"),
+    output:
+        fig=report_figure(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),
+    params:
+        approach=A_CFG,
+    log:
+        f"{APPROACH}/logs/x1_figure.log",
+    localrule: True
+    script:
+        "../scripts/approach_x1_figure.py"
+
+
+ALL_TARGETS.extend(rules.approach_tables.output)
+ALL_TARGETS.extend(rules.approach_x1_figure.output)
+ALL_TARGETS.extend(expand(rules.approach_figures.output, variant=A_VARIANTS))

@@ -1,0 +1,26 @@
+"""CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case)."""
+
+import pickle
+from pathlib import Path
+
+from opnav.approach import scenario as sc
+from opnav.approach.cases import headline_case
+from opnav.approach.pipeline import bound_curve
+from opnav.snakeio import mock_snakemake, script_context
+
+if "snakemake" not in globals():  # standalone debugging run
+    snakemake = mock_snakemake(output=["results/approach/work/crlb.pkl"])
+    snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
+
+with script_context(snakemake) as log:
+    cfg = snakemake.params.approach
+    case = headline_case(cfg)
+    curves = {}
+    for v in cfg["variants"]:
+        geo = sc.build_geometry(cfg, v)
+        Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+        curves[v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v)
+        log.info("%s: CRLB at end %s arcsec", v, curves[v][-1])
+    Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
+    with open(snakemake.output[0], "wb") as fh:
+        pickle.dump(curves, fh)
