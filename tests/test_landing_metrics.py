@@ -430,3 +430,14 @@ def test_benchmark_script_runs_and_every_path_agrees():
     tol = np.where(df.metric == "mineig", 1e-5, 1e-8)
     assert (df.max_rel_diff_vs_ref < tol).all(), df[df.max_rel_diff_vs_ref >= tol]
     assert len(mod.run_jacobian(n=2, reps=1)) == 4
+
+
+def test_context_copies_inputs():
+    """The per-context cache stays valid if the caller reuses its arrays."""
+    r = R0.copy()
+    ctx = MetricContext(r, V0, np.eye(3), np.zeros(3), boresight_B=None)
+    m = make_metric("svd")
+    cand = _ground(np.random.default_rng(3), 4)
+    before = m(ctx, cand)
+    r[:] = [1.0, 2.0, 3.0]
+    np.testing.assert_array_equal(m(ctx, cand), before)

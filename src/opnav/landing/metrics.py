@@ -136,7 +136,7 @@ PINV_RCOND = 1e-10
 
 
 def _vec3(name: str, a) -> np.ndarray:
-    a = np.asarray(a, dtype=float)
+    a = np.array(a, dtype=float)  # a private copy: the per-context cache must not go stale
     if a.shape != (3,):
         raise ValueError(f"MetricContext.{name} must have shape (3,), got {a.shape}")
     if not np.isfinite(a).all():
@@ -145,7 +145,7 @@ def _vec3(name: str, a) -> np.ndarray:
 
 
 def _mat(name: str, a, n: int, symmetric: bool = False) -> np.ndarray:
-    a = np.asarray(a, dtype=float)
+    a = np.array(a, dtype=float)  # a private copy: the per-context cache must not go stale
     if a.shape != (n, n):
         raise ValueError(f"MetricContext.{name} must have shape ({n}, {n}), got {a.shape}")
     if not np.isfinite(a).all():
