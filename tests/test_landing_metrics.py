@@ -441,3 +441,14 @@ def test_context_copies_inputs():
     before = m(ctx, cand)
     r[:] = [1.0, 2.0, 3.0]
     np.testing.assert_array_equal(m(ctx, cand), before)
+
+
+def test_paper_baselines_rank_identically_in_descent_geometry():
+    """Mixed units make s4 ~ 1/range dominate: svd, cond and gdop order the
+    candidates the same way (a finding reported in the metrics docstring)."""
+    rng = np.random.default_rng(21)
+    ctx = _ctx(with_info=False)
+    cand = _ground(rng, 200, half=6000.0)
+    orders = [np.argsort(make_metric(n)(ctx, cand)) for n in H_METRICS]
+    np.testing.assert_array_equal(orders[0], orders[1])
+    np.testing.assert_array_equal(orders[0], orders[2])

@@ -52,8 +52,13 @@ written without cancellation.  Tests prove it equal to the SVD of the
 CasADi-derived H (relative 1e-9; the closed form is the more accurate of the two,
 LAPACK's s4 carries ~eps s1 / s4 ~ 1e-12 relative error).  Note the mixed units
 of H (1/m for position columns, 1 for attitude columns): s1..s3 ~ 1 come from
-the attitude columns and s4 ~ 1/range from the position columns, so ``svd``
-effectively rewards short ranges and ``cond`` is s4/sqrt(2).
+the attitude columns and s4 ~ 1/range from the position columns: for ranges
+>> 1 m, s4^2 ~ ((x - c y)^2 + (2 - c^2) y^2) / 2 and s1 ~ sqrt(2), so ``svd``
+mostly rewards short candidate ranges; ``cond`` ~ s4 / sqrt(2) and ``gdop`` =
+s4^2 (1 + O(s4^2)) (1/s4^2 ~ 1e8 m^2 dwarfs 1/s1..3^2 ~ 1-10), so all three
+paper baselines rank candidates identically in the descent geometry (checked:
+identical argsort over 300 candidates at the Table 1 state) and can differ
+only in timing.
 
 Information metrics (``logdet``, ``mineig``) need ``ctx.P`` (12 x 12 prior
 covariance of [r (m), v (m/s), dtheta (rad), p (m)]) and ``ctx.R_meas`` (6 x 6
@@ -66,7 +71,12 @@ Both are computed from the information Lambda = P^-1 + H^T R^-1 H:
   relative accuracy where eigvalsh on the mixed-unit information (entries
   1e-7 .. 1e7) loses it (the per-candidate reference does the obvious
   eigvalsh(Lambda) and is off by up to ~1e-5 relative in low-altitude cases).
-  It is in SI units (m, rad) and therefore unit-dependent.
+  It is in SI units (m, rad) and therefore unit-dependent.  Caution: a single
+  epoch of two bearings cannot inform velocity or the new landmark's depth,
+  so with a large isotropic landmark prior in P (e.g. (2000 m)^2 I, no
+  cross-covariance) lambda_min is that prior's 1/2000^2 for every candidate
+  (measured spread 2e-15 relative) and the argmax is decided by rounding; with
+  a 50 m prior it varies by ~90 %.  ``logdet`` has no such plateau.
 
 Fast path (``R_meas`` block diagonal with candidate block sigma^2 I_3, the
 descent case): the known landmark's information Lambda_k and Sigma_k =
@@ -87,7 +97,8 @@ Degenerate inputs (never a silent NaN)
   (``ctx.boresight_B``, default body -z per SPEC B.2; None disables): -inf;
 * non-finite or wrongly shaped inputs: ``ValueError`` naming the field;
 * information metric without ``P``/``R_meas``: ``ValueError``;
-* non-positive-definite information (bad P): -inf.
+* ``P`` or ``R_meas`` not positive definite: ``ValueError``; an information
+  matrix whose Cholesky fails even with jitter: -inf.
 
 Implementations and counting
 ----------------------------
@@ -99,10 +110,10 @@ path a sequential golden-section search calls; ``metric(ctx, cand (1, 3))``
 dispatches to it).  ``metric.matrix_scalar`` is the paper's explicit matrix
 computation for one candidate done as lean as we could (H of eq. 14-18 with
 the known-landmark rows cached, one LAPACK dgesvd of the 6 x 12 H, or the
-12 x 12 information); ``metric.numpy_H`` with one candidate dispatches to it.  ``metric.reference`` calls the
-compiled CasADi Function once per candidate (slow, obvious), ``metric.casadi_map``
-uses ``Function.map(n)``, ``metric.numpy_H`` builds H in numpy and applies
-batched LAPACK.  Every path adds the number of candidates it scored to
+12 x 12 information); ``metric.numpy_H`` with one candidate dispatches to it,
+with n > 1 it builds all H in numpy and applies batched LAPACK.
+``metric.reference`` calls the compiled CasADi Function once per candidate
+(slow, obvious); ``metric.casadi_map`` uses ``Function.map(n)``.  Every path adds the number of candidates it scored to
 ``metric.n_evals`` (and 1 to ``metric.n_calls``); ``metric.reset()`` zeroes both.
 See ``benchmarks/bench_metrics.py`` for the timings; on this machine (2 shared
 cores, median, us per candidate evaluation): svd/gdop/cond ~2-4 (scalar closed
