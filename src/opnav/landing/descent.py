@@ -278,3 +278,51 @@ def summarize_run(run: dict) -> dict:
     out["median_plan_time_us"] = float(np.median(run["plan_ns"]) / 1e3) if len(run["plan_ns"]) else math.nan
     out["median_plan_evals"] = float(np.median(run["plan_evals"])) if len(run["plan_evals"]) else math.nan
     return out
+
+
+def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
+    """B-F5 data: the depth estimation error of every landmark in the image at
+    ``time_s`` (truth state; error ball from the Table 2 velocity bound,
+    ``eps_v = n_sigma_v * bound_v / sqrt(3)``), the single optimum, and the
+    in-plane curve over signed beta with the visible interval and the
+    golden-section optimum."""
+    from opnav.landing.depth_error import (baseline, depth_error_at_landmarks, ground_point,
+                                           plane_geometry, signed_depth_error)
+    from opnav.landing.planner import golden_section, visible_intervals
+
+    k = int(round(time_s / scn.Dt))
+    if not 0 <= k < scn.n_steps:
+        raise ValueError(f"landing.figures.f5_time_s = {time_s} outside the descent")
+    tr = scn.truth
+    r, v, a, R = tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k]
+    cam = scn.camera
+    dirs = (scn.field.xyz - r) @ R.T
+    vis = cam.in_view(dirs)
+    pts = scn.field.xyz[vis]
+    dc = dirs[vis] @ cam.R_BtoC.T
+    uv = cam.focal_px * dc[:, :2] / dc[:, 2:3]
+    r_e = scn.planner.n_sigma_v * scn.bounds[1] / math.sqrt(3.0) * scn.Dt
+    dr = depth_error_at_landmarks(r, v, a, pts, scn.Dt, r_e)
+    best = int(np.nanargmin(np.where(np.isfinite(dr), dr, np.nan)))
+    geom = plane_geometry(r, v)
+    b = baseline(v, a, scn.Dt)
+    betas = np.linspace(-(math.pi - geom.gamma) + 1e-3, geom.gamma - 1e-3, n_curve)
+    curve = signed_depth_error(betas, geom, b, r_e)
+    ivs = visible_intervals(geom, R, cam, scn.planner.n_grid, 0.0)
+    best_b, best_f = math.nan, math.inf
+    for lo, hi in ivs:
+        x, fx, _ = golden_section(lambda bb: float(signed_depth_error(bb, geom, b, r_e)), lo, hi,
+                                  scn.planner.tol_rad)
+        if fx < best_f:
+            best_b, best_f = x, fx
+    opt_uv = np.full(2, np.nan)
+    if math.isfinite(best_b):
+        g = ground_point(best_b, geom)[0]
+        d = cam.R_BtoC @ (R @ (g - r))
+        if d[2] > 0:
+            opt_uv = cam.focal_px * d[:2] / d[2]
+    return {"time_s": k * scn.Dt, "uv_px": uv, "dr_m": dr, "best": best, "points": pts,
+            "half_px": cam.half_px, "beta_deg": np.degrees(betas), "curve_dr": curve,
+            "interval_deg": [(math.degrees(lo), math.degrees(hi)) for lo, hi in ivs],
+            "opt_beta_deg": math.degrees(best_b), "opt_dr": best_f, "opt_uv_px": opt_uv,
+            "r_e_m": r_e, "n_visible": int(vis.sum())}
