@@ -28,11 +28,9 @@ ALL_TARGETS.extend(rules.landing_tables.output)
 # A new planning method is a new name in landing.mc.methods (table-driven
 # dispatch in opnav.landing.planner). Wildcards are named bmethod/bchunk so the
 # other parts' global wildcard constraints do not apply.
-sys.path.insert(0, str(Path(workflow.basedir) / "src"))
-from opnav.landing.montecarlo import chunks as _b_chunks  # noqa: E402
-
 B_METHODS = list(config["landing"]["mc"]["methods"])
-B_CHUNKS = _b_chunks(config["landing"]["mc"]["n_runs"], config["landing"]["mc"]["runs_per_job"])
+_n, _k = config["landing"]["mc"]["n_runs"], config["landing"]["mc"]["runs_per_job"]
+B_CHUNKS = [list(range(a, min(a + _k, _n))) for a in range(0, _n, _k)]  # = montecarlo.chunks
 B_SIM = cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg", "imu", "camera",
             "landmarks", "filter", "planner")
 B_SIM["mc"] = canonical({k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")})

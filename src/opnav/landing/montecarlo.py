@@ -30,8 +30,9 @@ import pandas as pd
 from opnav.landing.descent import build_scenario, run_descent
 
 __all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
-           "time_reduction", "chunks"]
+           "time_reduction", "chunks", "same_pick_pct"]
 
+_PLAN = ("plan_ns", "plan_evals", "plan_t", "plan_beta", "plan_index")
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
            "nees_r", "nees_v")
 
@@ -50,8 +51,8 @@ def run_chunk(landing_cfg: dict, method: str, run_indices) -> dict:
     out = {"run_index": np.asarray(list(run_indices), np.int64), "t": scn.truth.t.copy()}
     for k in _TRACKS:
         out[k] = np.stack([r[k] for r in runs])
-    out["plan_ns"] = np.concatenate([r["plan_ns"] for r in runs]) if runs else np.zeros(0, np.int64)
-    out["plan_evals"] = np.concatenate([r["plan_evals"] for r in runs]) if runs else np.zeros(0, np.int64)
+    for k in _PLAN:
+        out[k] = np.concatenate([r[k] for r in runs]) if runs else np.zeros(0)
     out["plan_run"] = np.concatenate([np.full(len(r["plan_ns"]), int(i), np.int64)
                                       for i, r in zip(run_indices, runs)]) if runs else np.zeros(0, np.int64)
     out["n_landmarks"] = np.array([r["n_landmarks"] for r in runs], np.int64)
@@ -89,7 +90,7 @@ def gather(parts: list[dict]) -> dict:
         out[k] = np.concatenate([p[k] for p in parts])[order]
     pr = np.concatenate([p["plan_run"] for p in parts])
     po = np.argsort(pr, kind="stable")
-    for k in ("plan_ns", "plan_evals"):
+    for k in _PLAN:
         out[k] = np.concatenate([p[k] for p in parts])[po]
     out["plan_run"] = pr[po]
     if methods:
@@ -134,6 +135,17 @@ def time_reduction(a: dict, b: dict, n_boot: int = 200, seed: int = 0) -> tuple[
     return red, float(np.std(vals, ddof=1))
 
 
+def same_pick_pct(a: dict, b: dict) -> float:
+    """Percentage of planning calls (matched by run and time) at which two
+    methods chose the same landmark."""
+    ka = {(int(r), float(t)): int(i) for r, t, i in zip(a["plan_run"], a["plan_t"], a["plan_index"])}
+    kb = {(int(r), float(t)): int(i) for r, t, i in zip(b["plan_run"], b["plan_t"], b["plan_index"])}
+    common = set(ka) & set(kb)
+    if not common:
+        return math.nan
+    return 100.0 * sum(ka[k] == kb[k] for k in common) / len(common)
+
+
 def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | None = None
                   ) -> pd.DataFrame:
     """B-T3: one row per method (see the module docstring for the columns)."""
@@ -154,6 +166,8 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
         ev = data[m]["plan_evals"]
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
+        if m != methods[0]:
+            row[f"same_pick_as_{methods[0]}_pct"] = same_pick_pct(data[m], data[methods[0]])
         for b in methods:
             if b == m:
                 continue

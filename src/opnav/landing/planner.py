@@ -19,7 +19,8 @@ Every method runs the SAME search; only the scalar objective differs:
 4. ``beta*`` is mapped to its ground point (eq. 26: the ideal direction) and
    the landmark nearest to it (horizontal distance, ``cKDTree``) among those
    actually detected in the image (truly inside the field of view with the
-   margin) is chosen.
+   margin) is chosen; if none of its ``knn`` nearest landmarks is detected
+   (low altitude: the image holds few landmarks) no landmark is chosen.
 
 Objectives (minimised) are built by a table of factories, :data:`OBJECTIVES`:
 ``depth`` is the depth estimation error (eq. 23-25, scalar fast path tested
@@ -301,6 +302,8 @@ def available_methods() -> tuple[str, ...]:
 
 def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
                   exclude: set) -> int:
+    """The detected landmark nearest (horizontally) to ``point`` among its
+    ``knn`` nearest landmarks, -1 if none of them is detected."""
     idx = field_.nearest(point, knn)
     if exclude:
         idx = idx[~np.isin(idx, list(exclude))]
@@ -308,15 +311,7 @@ def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
         vis = visible(field_.xyz[idx])
         if vis.any():
             return int(idx[np.argmax(vis)])
-    # fallback: all detected landmarks, nearest to the point
-    vis = visible(field_.xyz)
-    for i in exclude:
-        vis[i] = False
-    if not vis.any():
-        return -1
-    cand = np.flatnonzero(vis)
-    d2 = np.sum((field_.xyz[cand, :2] - np.asarray(point)[:2]) ** 2, axis=1)
-    return int(cand[np.argmin(d2)])
+    return -1
 
 
 def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
