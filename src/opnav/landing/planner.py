@@ -10,8 +10,8 @@ Every method runs the SAME search; only the scalar objective differs:
    angle ``beta`` between velocity and line of sight;
 2. the visible interval: the ``beta`` whose line of sight meets the ground and
    lies inside the camera's field of view (with the planning margin) under the
-   *estimated* attitude, resolved on a grid of ``n_grid`` angles (the interval
-   ends are the outermost visible grid angles); it is split at ``beta = 0``
+   *estimated* attitude, computed exactly as an intersection of half circles
+   (:func:`visible_intervals`); it is split at ``beta = 0``
    (no parallax there, the depth error is infinite), giving at most two
    sub-intervals;
 3. a golden-section search (:func:`golden_section`, tolerance ``tol_rad``) on
@@ -111,7 +111,7 @@ class PlannerConfig:
     t_s: float = 1.0                 # observation interval of the depth model, s
     n_sigma_v: float = 3.0           # eps_v = n_sigma * sqrt(max eig P_vv)
     tol_rad: float = 1e-3            # golden-section tolerance
-    n_grid: int = 361                # visible-interval grid over [-pi, pi]
+    n_grid: int = 0                  # visible interval: 0 exact, > 0 grid over [-pi, pi]
     margin_px: float = 40.0          # planning margin inside the detector edge, px
     knn: int = 16                    # nearest-landmark candidates checked
     eval_path: str = "matrix_scalar"  # how baseline metrics are evaluated
@@ -140,16 +140,66 @@ def _unit_grid(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return _GRID_CACHE[n]
 
 
+def _split_at_zero(b0: float, b1: float) -> list[tuple[float, float]]:
+    eps = 1e-9
+    out = []
+    if b0 < 0:
+        out.append((b0, min(b1, -eps)))
+    if b1 > 0:
+        out.append((max(b0, eps), b1))
+    return [(a, b) for a, b in out if b > a]
+
+
 def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n_grid: int,
                       margin_px: float) -> list[tuple[float, float]]:
     """Sub-intervals of signed beta (rad) whose lines of sight meet the ground
     inside the field of view (estimated attitude), split at 0.
 
-    The circle of directions in the plane is sampled at ``n_grid`` angles over
-    [-pi, pi] (step ``2 pi / (n_grid - 1)``); the interval ends are the outermost
-    visible samples.
+    ``n_grid = 0``: exact. Each of the four side planes of the (square) field
+    of view and the ground condition ``u_z < 0`` is, on the circle of in-plane
+    directions ``u(beta) = cos(beta) v_hat + sin(beta) w_hat``, an open half
+    circle centred at some angle ``phi_i``; their intersection is empty unless
+    all ``phi_i`` fit in an arc shorter than pi, and is then
+    ``(max phi_i - pi/2, min phi_i + pi/2)``. ``n_grid > 0``: the circle is
+    sampled at ``n_grid`` angles and the interval ends are the outermost
+    visible samples (reference implementation).
     """
-    eps = 1e-9
+    if n_grid <= 0:
+        return _visible_exact(geom, R_LtoB, camera, margin_px)
+    return _visible_grid(geom, R_LtoB, camera, n_grid, margin_px)
+
+
+def _visible_exact(geom, R_LtoB, camera, margin_px):
+    M = camera.R_BtoC @ R_LtoB
+    a0, a1, a2 = (M @ geom.v_hat).tolist()
+    c0, c1, c2 = (M @ geom.w_hat).tolist()
+    k = (camera.half_px - margin_px) / camera.focal_px
+    if k <= 0:
+        return []
+    atan2, pi = math.atan2, math.pi
+    # k z -+ x > 0, k z -+ y > 0 (camera axes); ground: -u_z(L) > 0
+    phis = [atan2(k * c2 - c0, k * a2 - a0), atan2(k * c2 + c0, k * a2 + a0),
+            atan2(k * c2 - c1, k * a2 - a1), atan2(k * c2 + c1, k * a2 + a1),
+            geom.gamma - pi / 2]
+    phis.sort()
+    gaps = [phis[i + 1] - phis[i] for i in range(4)] + [phis[0] + 2 * pi - phis[4]]
+    j = max(range(5), key=gaps.__getitem__)
+    if gaps[j] <= pi:
+        return []                      # the centres do not fit in a half circle
+    start = (j + 1) % 5
+    un = [phis[(start + i) % 5] for i in range(5)]
+    for i in range(1, 5):              # unwrap into one window
+        while un[i] < un[i - 1]:
+            un[i] += 2 * pi
+    b0, b1 = un[-1] - pi / 2, un[0] + pi / 2
+    # express in the ground arc (-(pi - gamma), gamma)
+    mid = 0.5 * (b0 + b1)
+    g0 = geom.gamma - pi / 2
+    shift = 2 * pi * round((g0 - mid) / (2 * pi))
+    return _split_at_zero(b0 + shift + 1e-12, b1 + shift - 1e-12)
+
+
+def _visible_grid(geom, R_LtoB, camera, n_grid, margin_px):
     betas, cb, sb = _unit_grid(n_grid)
     # the two in-plane directions in camera axes; u(beta) = cos v_hat + sin w_hat
     M = camera.R_BtoC @ R_LtoB
@@ -169,13 +219,7 @@ def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n
         runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
         run = max(runs, key=len)
         i0, i1 = run[0], run[-1]
-    b0, b1 = float(betas[i0]), float(betas[i1])
-    out = []
-    if b0 < 0:
-        out.append((b0, min(b1, -eps)))
-    if b1 > 0:
-        out.append((max(b0, eps), b1))
-    return [(a, b) for a, b in out if b > a]
+    return _split_at_zero(float(betas[i0]), float(betas[i1]))
 
 
 # ----------------------------------------------------------------- objectives
@@ -188,25 +232,30 @@ def depth_objective(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, *
         raise ValueError("depth error: zero baseline (zero velocity)")
     r_e = error_radius(state.P[3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
     cd, g = geom.cd, geom.gamma
-    sin, cos, sqrt, pi, inf = math.sin, math.cos, math.sqrt, math.pi, math.inf
+    sin, cos, sqrt, inf = math.sin, math.cos, math.sqrt, math.inf
+    # the two sides of the velocity: alpha = pi - gamma (beta > 0), gamma (beta < 0)
+    sa = sin(g)                        # sin(alpha) on both sides
+    ca_pos, ca_neg = -math.cos(g), math.cos(g)
+    k = 2.0 * r_e / b
+    b2 = b * b
 
     def f(beta: float) -> float:
         if beta > 0.0:
-            alpha = pi - g
+            ca = ca_pos
         elif beta < 0.0:
-            alpha = g
+            ca = ca_neg
             beta = -beta
         else:
             return inf
-        s = sin(alpha + beta)
-        if alpha + beta >= pi or s <= 0.0:
-            return inf
-        d = cd * sin(alpha) / s                                   # law of sines
-        rks = sqrt(max(b * b + d * d - 2.0 * b * d * cos(beta), 0.0))   # eq. 25
+        sb, cb = sin(beta), cos(beta)
+        s = sa * cb + ca * sb                                     # sin(alpha + beta)
+        if s <= 0.0:
+            return inf                                            # ray misses the ground
+        d = cd * sa / s                                           # law of sines
+        rks = sqrt(b2 + d * d - 2.0 * b * d * cb)                 # eq. 25
         if rks <= 0.0:
             return inf
-        st = b * sin(beta) / rks                                  # eq. 24
-        return 2.0 * r_e / st if st > 0.0 else inf                # eq. 23
+        return k * rks / sb                                       # eq. 23-24: 2 r_e / sin(theta)
 
     return f
 
@@ -305,8 +354,8 @@ def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
     """The detected landmark nearest (horizontally) to ``point`` among its
     ``knn`` nearest landmarks, -1 if none of them is detected."""
     idx = field_.nearest(point, knn)
-    if exclude:
-        idx = idx[~np.isin(idx, list(exclude))]
+    for e in exclude:
+        idx = idx[idx != e]
     if idx.size:
         vis = visible(field_.xyz[idx])
         if vis.any():
