@@ -32,7 +32,9 @@ A "call" is one planning call of n candidate evaluations (default n = 50, the
 order of a golden-section search to 1e-3 rad over a 60 deg field of view);
 ``ctx`` is the cost of building the :class:`MetricContext` once per call (not
 included in the per-call figures).  Each figure is the median over ``--reps``
-repetitions of ``time.perf_counter_ns``; ``ratio_to_svd`` divides by the svd
+repetitions of ``time.perf_counter_ns``, the repetitions interleaved across
+all (metric, implementation) pairs so that load on a shared machine hits them
+alike; ``ratio_to_svd`` divides by the svd
 metric's time with the same implementation.  Geometry: paper B Table 1 initial
 state, candidates uniformly on the ground in a +-6 km square.
 
@@ -91,37 +93,51 @@ def _median_ns(fn, reps: int) -> float:
     return float(np.median(ts))
 
 
+def _paths(m, ctx, cand) -> dict:
+    return {
+        "casadi_per_cand": lambda: m.reference(ctx, cand),
+        "casadi_map": lambda: m.casadi_map(ctx, cand),
+        "numpy_batch": lambda: m.numpy_H(ctx, cand),
+        "fast_batch": lambda: m(ctx, cand),
+        "seq_scalar": lambda: [m.scalar(ctx, p) for p in cand],
+        "seq_matrix": lambda: [m.numpy_H(ctx, p[None]) for p in cand],
+        "seq_casadi_map": lambda: [m.casadi_map(ctx, p[None]) for p in cand],
+        "seq_casadi": lambda: [m.reference(ctx, p[None]) for p in cand],
+    }
+
+
 def run(n: int = 50, reps: int = 30, seed: int = 0) -> pd.DataFrame:
+    """Time every (metric, implementation); the repetitions are interleaved
+    (each repetition runs every pair once) so that load changes on a shared
+    machine hit all implementations alike and the ratios stay comparable."""
     kw, cand = make_inputs(n, seed)
     ctx = MetricContext(**kw)
     cm.jacobian_map(n), cm.jacobian_map(1)  # build the mapped Functions outside the timing
-    t_ctx = _median_ns(lambda: MetricContext(**kw)._info(), reps)
-    rows = []
+    jobs, meta = {}, {}
     for name in METRIC_NAMES:
         m = make_metric(name)
-        paths = {
-            "casadi_per_cand": lambda: m.reference(ctx, cand),
-            "casadi_map": lambda: m.casadi_map(ctx, cand),
-            "numpy_batch": lambda: m.numpy_H(ctx, cand),
-            "fast_batch": lambda: m(ctx, cand),
-            "seq_scalar": lambda: [m.scalar(ctx, p) for p in cand],
-            "seq_matrix": lambda: [m.numpy_H(ctx, p[None]) for p in cand],
-            "seq_casadi_map": lambda: [m.casadi_map(ctx, p[None]) for p in cand],
-            "seq_casadi": lambda: [m.reference(ctx, p[None]) for p in cand],
-        }
         ref = m.reference(ctx, cand)
-        for impl in IMPLEMENTATIONS:
-            vals = np.ravel(np.asarray(paths[impl](), dtype=float))
-            err = float(np.max(np.abs(vals - ref) / np.maximum(np.abs(ref), 1e-300)))
-            t = _median_ns(paths[impl], reps)
-            rows.append(
-                dict(metric=name, impl=impl, n=n, us_per_call=t / 1e3, us_per_eval=t / 1e3 / n,
-                     max_rel_diff_vs_ref=err)
-            )
+        for impl, fn in _paths(m, ctx, cand).items():
+            vals = np.ravel(np.asarray(fn(), dtype=float))  # also the warm-up
+            meta[name, impl] = float(np.max(np.abs(vals - ref) / np.maximum(np.abs(ref), 1e-300)))
+            jobs[name, impl] = fn
+    jobs["ctx", ""] = lambda: MetricContext(**kw)._info()
+    times = {k: [] for k in jobs}
+    for _ in range(reps):
+        for k, fn in jobs.items():
+            t0 = time.perf_counter_ns()
+            fn()
+            times[k].append(time.perf_counter_ns() - t0)
+    rows = []
+    for (name, impl), err in meta.items():
+        t = float(np.median(times[name, impl]))
+        rows.append(
+            dict(metric=name, impl=impl, n=n, us_per_call=t / 1e3, us_per_eval=t / 1e3 / n, max_rel_diff_vs_ref=err)
+        )
     df = pd.DataFrame(rows)
     svd = df[df.metric == "svd"].set_index("impl").us_per_call
     df["ratio_to_svd"] = df.us_per_call / df.impl.map(svd)
-    df.attrs["us_ctx"] = t_ctx / 1e3
+    df.attrs["us_ctx"] = float(np.median(times["ctx", ""])) / 1e3
     return df
 
 
