@@ -133,25 +133,43 @@ def start_state(start: str, a: int, f0, dx_true: np.ndarray, dx0: np.ndarray, P_
 def run_case(cfg: dict, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
              method: str | None = None, init_mode: str | None = None) -> dict:
     """EM-EKF for one case and variant over the given seeds; arrays in arcsec / km."""
+    return run_cases(cfg, variant, [case], seed_indices, geo, method, init_mode)[0]
+
+
+def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo: sc.Geometry | None = None,
+              method: str | None = None, init_mode: str | None = None) -> list[dict]:
+    """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
+    of the stacked filter arrays (runs are independent; each keeps its own stream)."""
     geo = geo or sc.build_geometry(cfg, variant)
     method = method or cfg["em"]["method"]
     init_mode = init_mode or cfg["initial_error"]["mode"]
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    seed_indices = list(seed_indices)
+    ns = len(seed_indices)
+    zs, e0s, Rvs, inits = [], [], [], []
+    for case in case_list:
+        Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+        rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
+        z, e0 = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), rngs)
+        zs.append(z)
+        e0s.append(e0)
+        Rvs.append(np.broadcast_to(Rvar[:, None, :], (Rvar.shape[0], ns, 3)))
+        inits.append(np.broadcast_to(sc.rad(case.init_arcsec), (ns, 3)))
+    z = np.concatenate(zs)
+    e0 = np.concatenate(e0s)
+    Rvar = np.concatenate(Rvs, axis=1)
+    if all(np.array_equal(c.sigma3_px, case_list[0].sigma3_px) for c in case_list):
+        Rvar = Rvar[:, 0]  # shared by every run: the cheaper broadcast form
+    theta = np.concatenate(inits).copy()
     win = geo.window(Rvar)
-    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
-    theta_true = sc.rad(case.truth_arcsec)
-    z, e0 = sc.simulate(geo, Rvar, theta_true, rngs)
     S = z.shape[0]
     dx0 = sc.prior_mean_deviation(geo, e0, init_mode)
     dx_true = geo.dx_true
     tz_tol = cfg["em"]["tz_tol"]
 
-    zero = np.zeros((S, 3))
-    f0 = run_filter(z, zero, dx0, geo.P0, win)
+    f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win)
     err_before = np.linalg.norm(f0.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
 
     start = sc.START_OF[variant]
-    theta = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
     windows = segment_windows(cfg)
     seg_theta, it_theta, it_ll, it_data, seg_err, seg_sig = [], [], [], [], [], []
     unobs = None
@@ -161,7 +179,7 @@ def run_case(cfg: dict, variant: str, case: Case, seed_indices, geo: sc.Geometry
                        method, tz_tol)
         theta = tr.theta[-1]
         unobs = tr.unobservable
-        used = b - cfg["segments"]["N0"] if cfg["segments"]["mode"] == "growing" else b - windows[0][0]
+        used = b - windows[0][0]
         seg_theta.append(theta)
         it_theta.extend(tr.theta)
         it_ll.extend(tr.loglik)
@@ -176,27 +194,38 @@ def run_case(cfg: dict, variant: str, case: Case, seed_indices, geo: sc.Geometry
     seg_theta_as = sc.arcsec(np.stack(seg_theta, 1))
     N = cfg["segments"]["N"]
     seg_data = np.array([(l + 1) * N for l in range(len(windows))])
-    return {
-        "variant": variant,
-        "case_id": case.case_id,
-        "seed_indices": np.asarray(list(seed_indices)),
-        "truth_arcsec": np.asarray(case.truth_arcsec, float),
-        "theta_final_arcsec": sc.arcsec(theta),
-        "theta_seg_arcsec": seg_theta_as,
-        "theta_iter_arcsec": sc.arcsec(np.stack(it_theta, 1)),
-        "loglik_iter": np.stack(it_ll, 1),
-        "iter_data_used": np.asarray(it_data),
-        "seg_data_used": seg_data,
-        "seg_pos_err_km": np.stack(seg_err, 1),
-        "seg_pos_3sig_km": np.stack(seg_sig, 1),
-        "tz_unobservable": bool(np.all(unobs[:, 0])) if unobs is not None else False,
-        "data_to_converge": data_to_converge(seg_theta_as, seg_data, cfg["em"]["converge_tol_arcsec"]),
-        "nav_err_before_km": rms_last(err_before, frac),
-        "nav_err_after_km": rms_last(err_after, frac),
-        "err_before_t_km": err_before,
-        "err_after_t_km": err_after,
-        "t_s": geo.t,
-    }
+    if cfg["segments"]["mode"] == "growing":
+        seg_data = np.array([b - windows[0][0] for (_, b) in windows])
+    conv = data_to_converge(seg_theta_as, seg_data, cfg["em"]["converge_tol_arcsec"])
+    theta_iter = sc.arcsec(np.stack(it_theta, 1))
+    ll_iter = np.stack(it_ll, 1)
+    seg_err, seg_sig = np.stack(seg_err, 1), np.stack(seg_sig, 1)
+    nb, na = rms_last(err_before, frac), rms_last(err_after, frac)
+    out = []
+    for i, case in enumerate(case_list):
+        sl = slice(i * ns, (i + 1) * ns)
+        out.append({
+            "variant": variant,
+            "case_id": case.case_id,
+            "seed_indices": np.asarray(seed_indices),
+            "truth_arcsec": np.asarray(case.truth_arcsec, float),
+            "theta_final_arcsec": sc.arcsec(theta[sl]),
+            "theta_seg_arcsec": seg_theta_as[sl],
+            "theta_iter_arcsec": theta_iter[sl],
+            "loglik_iter": ll_iter[sl],
+            "iter_data_used": np.asarray(it_data),
+            "seg_data_used": seg_data,
+            "seg_pos_err_km": seg_err[sl],
+            "seg_pos_3sig_km": seg_sig[sl],
+            "tz_unobservable": bool(np.all(unobs[sl, 0])) if unobs is not None else False,
+            "data_to_converge": conv[sl],
+            "nav_err_before_km": nb[sl],
+            "nav_err_after_km": na[sl],
+            "err_before_t_km": err_before[sl],
+            "err_after_t_km": err_after[sl],
+            "t_s": geo.t,
+        })
+    return out
 
 
 def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_samples: int,
@@ -230,26 +259,31 @@ def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_sa
     tz_tol = cfg["em"]["tz_tol"]
     theta0 = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
 
-    # reference: SQUAREM to a tight fixed point
-    ref = theta0
-    cycles = 0
-    while cycles * 3 < max(max_maps, 30):
-        tr = em_window(wz, ref, x0, P0, ww, 1, "squarem", tz_tol)
-        step = np.abs(sc.arcsec(tr.theta[-1] - ref))[:, :2].max()
-        ref = tr.theta[-1]
-        cycles += 1
+    # SQUAREM cycles from theta0 until the step is below 1e-4 arcsec: its end point is the
+    # reference theta* (the ML estimate), its history the SQUAREM convergence record
+    sq_theta, sq_ll = [], []
+    th = theta0
+    while len(sq_theta) < max(max_maps, 30):
+        tr = em_window(wz, th, x0, P0, ww, 3, "squarem", tz_tol)
+        sq_theta.extend(tr.theta)
+        sq_ll.extend(tr.loglik)
+        step = np.abs(sc.arcsec(tr.theta[-1] - th))[:, :2].max()
+        th = tr.theta[-1]
         if step < 1e-4:
             break
-    ref_as = sc.arcsec(ref)
+    ref_as = sc.arcsec(th)
+    traces = {"squarem": (sq_theta, sq_ll)}
+    tr = em_window(wz, theta0, x0, P0, ww, max_maps, "plain", tz_tol)
+    traces["plain"] = (tr.theta, tr.loglik)
 
     out = {"variant": variant, "theta_star_arcsec": ref_as, "truth_arcsec": np.asarray(case.truth_arcsec),
            "data_samples": data_samples, "max_maps": max_maps}
     for method in ("plain", "squarem"):
-        tr = em_window(wz, theta0, x0, P0, ww, max_maps, method, tz_tol)
-        hist = sc.arcsec(np.stack(tr.theta, 1))  # (S, maps, 3)
+        th_list, ll_list = traces[method]
+        hist = sc.arcsec(np.stack(th_list, 1))  # (S, maps, 3)
         dist = np.abs(hist[:, :, :2] - ref_as[:, None, :2]).max(-1)
         ok = dist <= tol_arcsec
-        maps_needed = np.full(S, max_maps + 1)
+        maps_needed = np.full(S, max(max_maps, hist.shape[1]) + 1)
         for i in range(S):
             bad = np.where(~ok[i])[0]
             last_bad = bad[-1] if bad.size else -1
@@ -260,8 +294,8 @@ def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_sa
         # stalled runs: maps still needed at the measured linear rate (extrapolation, labelled so)
         with np.errstate(divide="ignore", invalid="ignore"):
             extra = np.where(rate < 1.0, np.log(tol_arcsec / d[:, -1]) / np.log(rate), np.inf)
-        extrap = np.where(maps_needed > max_maps, dist.shape[1] + np.maximum(extra, 0.0),
+        extrap = np.where(maps_needed > hist.shape[1], dist.shape[1] + np.maximum(extra, 0.0),
                           maps_needed.astype(float))
         out[method] = {"maps_to_converge": maps_needed, "maps_extrapolated": extrap, "dist_arcsec": dist,
-                       "theta_hist_arcsec": hist, "loglik": np.stack(tr.loglik, 1), "rate_per_map": rate}
+                       "theta_hist_arcsec": hist, "loglik": np.stack(ll_list, 1), "rate_per_map": rate}
     return out

@@ -43,13 +43,20 @@ class Window:
     Phi: np.ndarray  # (n+1, 6, 6), Phi[k] = Phi_{k,k-1}; Phi[0] unused
     C: np.ndarray  # (n+1, 3, 3) A_c^i at each sample; index 0 unused
     u_ref: np.ndarray  # (n+1, 3) A_c^i (X_M - r_ref), km
-    Rvar: np.ndarray  # (n+1, 3) measurement variances, km^2
+    Rvar: np.ndarray  # (n+1, 3) or per seed (n+1, S, 3) measurement variances, km^2
     Q: np.ndarray  # (6, 6) process noise per step
 
     def slice(self, a: int, b: int) -> "Window":
         """Samples a..b (inclusive; a becomes the start sample 0)."""
         return Window(self.Phi[a:b + 1], self.C[a:b + 1], self.u_ref[a:b + 1],
                       self.Rvar[a:b + 1], self.Q)
+
+    def weights(self, S: int) -> np.ndarray:
+        """R^-1 diagonals of samples 1..n for every seed, (S, n, 3)."""
+        w = 1.0 / self.Rvar[1:]
+        if w.ndim == 2:
+            return np.broadcast_to(w, (S,) + w.shape)
+        return np.swapaxes(w, 0, 1)
 
     @property
     def n(self) -> int:

@@ -61,11 +61,11 @@ def los_moments(s: SmootherResult, win: Window) -> tuple[np.ndarray, np.ndarray]
 def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:
     """E-step statistics of eq. 23/26 for the closed-form M-step (see module docstring)."""
     m, Mom = los_moments(s, win)
-    w = 1.0 / win.Rvar[1:]  # (n,3)
+    w = win.weights(z.shape[0])  # (S,n,3)
     zz = z[:, 1:]
-    N = np.einsum("ijk,ti,inl,stjn->skl", EPS, w, EPS, Mom, optimize=True)
-    b = (np.einsum("ijk,stj,ti,sti->sk", EPS, m, w, zz, optimize=True)
-         - np.einsum("ijk,ti,stji->sk", EPS, w, Mom, optimize=True))
+    N = np.einsum("ijk,sti,inl,stjn->skl", EPS, w, EPS, Mom, optimize=True)
+    b = (np.einsum("ijk,stj,sti,sti->sk", EPS, m, w, zz, optimize=True)
+         - np.einsum("ijk,sti,stji->sk", EPS, w, Mom, optimize=True))
     return EStats(N, b)
 
 
@@ -94,9 +94,9 @@ def trace_RinvB(theta: np.ndarray, z: np.ndarray, s: SmootherResult, win: Window
     H = -np.einsum("sij,kjl->skil", A, win.C[1:])
     u = win.u_ref[1:] - np.einsum("kij,skj->ski", win.C[1:], s.xs[:, 1:, :3])
     res = z[:, 1:] - np.einsum("sij,skj->ski", A, u)
-    w = 1.0 / win.Rvar[1:]
+    w = win.weights(z.shape[0])
     HPH = np.einsum("skij,skjl,skml->skim", H, s.Ps[:, 1:, :3, :3], H)
-    return (np.einsum("ki,skii->s", w, HPH) + np.einsum("ki,ski,ski->s", w, res, res))
+    return (np.einsum("ski,skii->s", w, HPH) + np.einsum("ski,ski,ski->s", w, res, res))
 
 
 def expected_complete_loglik(theta: np.ndarray, z: np.ndarray, s: SmootherResult, win: Window,
@@ -120,7 +120,7 @@ def expected_complete_loglik(theta: np.ndarray, z: np.ndarray, s: SmootherResult
               - Phi @ s.Plag[:, k].transpose(0, 2, 1) + Phi @ s.Ps[:, k - 1] @ Phi.T)
         Aterm = Aterm + np.einsum("ij,sji->s", Qinv, Ak)
     val -= 0.5 * Aterm
-    val -= 0.5 * np.log(win.Rvar[1:]).sum()
+    val += 0.5 * np.log(win.weights(z.shape[0])).sum(axis=(1, 2))
     val -= 0.5 * trace_RinvB(theta, z, s, win)
     return val
 

@@ -64,11 +64,11 @@ def run_group(cfg: dict, variant: str, group: str, method: str, log=None) -> lis
     seeds = range(cfg["n_seeds"])
     out = []
     s = cfg["segments"]
-    for case in cases_in(cfg, group):
-        r = cases.run_case(cfg, variant, case, seeds, geo=geo, method=method)
+    clist = cases_in(cfg, group)
+    for case, r in zip(clist, cases.run_cases(cfg, variant, clist, seeds, geo=geo, method=method)):
         Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
         curve = bound_curve(cfg, geo, Rvar, case.truth_arcsec, variant)
-        used = s["L"] * s["N"] if s["mode"] == "sliding" else s["L"] * s["N"]
+        used = s["L"] * s["N"]
         r["crlb_total_arcsec"] = curve[min(used, len(curve) - 1)]
         r["crlb_window_arcsec"] = curve[min(s["N"], len(curve) - 1)]
         r.update(method=method, group=group, case=case)

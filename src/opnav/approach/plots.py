@@ -14,6 +14,14 @@ COLORS = {"plain": "C0", "squarem": "C3"}
 VCOLORS = {"literal": "C0", "prior": "C1", "roll": "C2", "reference-start": "C3"}
 
 
+def _plain_log_ticks(ax):
+    from matplotlib.ticker import LogLocator, ScalarFormatter, NullFormatter
+
+    ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(ScalarFormatter())
+    ax.yaxis.set_minor_formatter(NullFormatter())
+
+
 def _band(ax, x, y, color, label, ls="-"):
     m, s = y.mean(0), y.std(0)
     ax.plot(x, m, color=color, ls=ls, label=label)
@@ -29,8 +37,9 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
         truth = None
         for method, r in runs.items():
             th = r["theta_iter_arcsec"]
-            data = r["iter_data_used"]
-            x = np.arange(1, th.shape[1] + 1)
+            init = np.broadcast_to(np.asarray(r["case"].init_arcsec, float), (th.shape[0], 1, 3))
+            th = np.concatenate([init, th], axis=1)  # iteration 0 = the EM initial value
+            x = np.arange(th.shape[1])
             truth = r["truth_arcsec"]
             for i, ax in enumerate(axes):
                 _band(ax, x, th[:, :, i], COLORS[method], f"EM ({method})")
@@ -65,6 +74,7 @@ def fig_nav_accuracy(runs: dict, variant: str):
         ax.set_xlabel("data used (samples)")
         ax.set_ylabel("position error (km)")
         ax.set_yscale("log")
+        _plain_log_ticks(ax)
         ax.legend(fontsize=6)
         ax.set_title(f"A-F5 navigation during estimation, {variant}", fontsize=8)
         fig.tight_layout()
@@ -81,13 +91,15 @@ def fig_compensation(runs: dict, variant: str, pub: dict):
         for method, r in runs.items():
             t = r["t_s"]
             if first:
-                ax.plot(t, r["err_before_t_km"].mean(0), color="k", label="before (theta = 0)")
+                ax.plot(t, r["err_before_t_km"].mean(0), color="k", ls="--", lw=1.2, zorder=3,
+                        label="before (theta = 0)")
                 first = False
             ax.plot(t, r["err_after_t_km"].mean(0), color=COLORS[method], label=f"after, EM ({method})")
         hp = pub["headline"]
         ax.plot([t[-1]], [hp["nav_err_before_km"]], **{**figures.PUBLISHED_STYLE, "label": "published before/after"})
         ax.plot([t[-1]], [hp["nav_err_after_km"]], **{**figures.PUBLISHED_STYLE, "label": None})
         ax.set_yscale("log")
+        _plain_log_ticks(ax)
         ax.set_xlabel("time (s)")
         ax.set_ylabel("position error (km)")
         ax.legend(fontsize=6)

@@ -105,6 +105,11 @@ def build_geometry(cfg: dict, variant: str, n: int | None = None) -> Geometry:
     roll_cfg = cfg["roll"]
     roll = (camera.roll_angle(t, roll_cfg["rate_deg_s"], roll_cfg["steps_deg"],
                               roll_cfg["step_interval_s"]) if variant == "roll" else np.zeros_like(t))
+    rho = np.linalg.norm(los, axis=1)
+    disc_px = 2.0 * np.rad2deg(np.arcsin(dynamics.R_MARS_KM / rho.min())) * 3600.0 / cfg["camera"]["ifov_arcsec"]
+    if disc_px > cfg["camera"]["pixels"]:
+        raise ValueError(f"approach.camera: Mars ({disc_px:.0f} px across) does not fit the "
+                         f"{cfg['camera']['pixels']} px detector; raise camera.ifov_arcsec or the range")
     C = camera.tracking_attitude(los, roll)
     u_ref = np.einsum("kij,kj->ki", C, X_mars[:, :3] - X_ref[:, :3])
     u_true = np.einsum("kij,kj->ki", C, los)
