@@ -172,3 +172,71 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
         else:
             raise ValueError(f"{p}: only .pdf figures and .tex tables go into the manuscript")
     return "\n".join(blocks)
+
+
+# ------------------------------------------------------------ compact tables
+def _pm(mean: float, spread: float, fmt: str = "{:.3g}") -> str:
+    if mean is None or (isinstance(mean, float) and math.isnan(mean)):
+        return "--"
+    if spread is None or (isinstance(spread, float) and math.isnan(spread)):
+        return fmt.format(mean)
+    return f"{fmt.format(mean)} ± {fmt.format(spread)}"
+
+
+def _num(x: float, fmt: str = "{:.4g}") -> str:
+    return "--" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt.format(x)
+
+
+def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """A-T1 for the page: one table per scenario variant, ours beside published.
+
+    Estimates are mean ± standard deviation over the noise seeds (arcsec);
+    navigation errors before / after compensation in km.
+    """
+    import pandas as pd
+
+    out = []
+    for variant, g in df.groupby("variant", sort=False):
+        rows = []
+        for _, r in g.iterrows():
+            rows.append({
+                "group": r.get("group", ""),
+                "case": r["case_id"],
+                'truth x, y (")': f"{_num(r['truth_x_arcsec'], '{:g}')}, {_num(r['truth_y_arcsec'], '{:g}')}",
+                'est. x (")': _pm(r["est_x_mean"], r.get("est_x_std")),
+                'est. y (")': _pm(r["est_y_mean"], r.get("est_y_std")),
+                'CRLB x, y (")': f"{_num(r['crlb_x_arcsec'], '{:.3g}')}, {_num(r['crlb_y_arcsec'], '{:.3g}')}",
+                "data (samples)": _num(r["data_to_converge_samples"], "{:.0f}"),
+                "nav. before / after (km)": f"{_num(r['nav_err_before_km'], '{:.1f}')} / {_num(r['nav_err_after_km'], '{:.1f}')}",
+                'published est. x, y (")': f"{_num(r.get('pub_est_x_mean'), '{:g}')}, {_num(r.get('pub_est_y_mean'), '{:g}')}",
+                "published data": _num(r.get("pub_data_to_converge_samples"), "{:.0f}"),
+                "published nav. (km)": f"{_num(r.get('pub_nav_err_before_km'), '{:g}')} / {_num(r.get('pub_nav_err_after_km'), '{:g}')}",
+            })
+        out.append((str(variant), pd.DataFrame(rows)))
+    return out
+
+
+def compact_b_t3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """B-T3 for the page: per method final/RMS errors (mean, 3-sigma), NEES, timing."""
+    import pandas as pd
+
+    rows = []
+    for _, r in df.iterrows():
+        row = {"method": r["method"]}
+        for q, unit in (("pos", "m"), ("vel", "mps"), ("att", "deg")):
+            u = {"mps": "m/s"}.get(unit, unit)
+            row[f"final {q} ({u})"] = _pm(r[f"final_{q}_err_{unit}_mean"], r[f"final_{q}_err_{unit}_3sigma"])
+            row[f"RMS {q} ({u})"] = _pm(r[f"rms_{q}_err_{unit}_mean"], r[f"rms_{q}_err_{unit}_3sigma"])
+        if "mean_nees_pos" in df.columns:
+            row["NEES pos, vel"] = f"{_num(r['mean_nees_pos'], '{:.2f}')}, {_num(r.get('mean_nees_vel'), '{:.2f}')}"
+        row["median plan (µs)"] = _num(r["median_plan_time_us"], "{:.0f}")
+        if "metric_evals_per_call" in df.columns:
+            row["evals/call"] = _num(r["metric_evals_per_call"], "{:.0f}")
+        red = r.get("time_reduction_vs_svd_pct")
+        row["time vs SVD (%)"] = "--" if red is None or pd.isna(red) else f"{-float(red):+.1f}"
+        rows.append(row)
+    return [("", pd.DataFrame(rows))]
+
+
+#: Manuscript views of tables too wide for a page, by SPEC id.
+COMPACT_VIEWS = {"A-T1": compact_a_t1, "B-T3": compact_b_t3}

@@ -37,11 +37,13 @@ rule paper_floats:
     input:
         approach=_floats("approach"),
         landing=_floats("landing"),
+        tables_csv=[c for c in (t[:-4] + ".csv" for t in _floats("approach") + _floats("landing")) if c in _targets],
         captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
         code=src("manuscript.py"),
     output:
         approach=f"{PAPER}/floats_approach.tex",
         landing=f"{PAPER}/floats_landing.tex",
+        compact=directory(f"{PAPER}/compact"),
     params:
         paper_dir=str(PAPER_DIR),
         captions_dir=str(CAPTIONS),

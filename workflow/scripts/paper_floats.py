@@ -1,12 +1,32 @@
-"""Figure/table floats for the manuscript, one file per paper."""
+"""Figure/table floats for the manuscript, one file per paper.
 
-from opnav.manuscript import float_block
+Tables too wide for a page (ids in opnav.manuscript.COMPACT_VIEWS) are shown
+through a compact view computed from their CSV, written under compact/.
+"""
+
+from pathlib import Path
+
+import pandas as pd
+
+from opnav.manuscript import COMPACT_VIEWS, float_block, output_id
 from opnav.snakeio import script_context
-from opnav.tables import atomic_write_text
+from opnav.tables import atomic_write_text, write_table
 
 with script_context(snakemake) as log:
+    compact_dir = Path(snakemake.output.compact)
+    compact_dir.mkdir(parents=True, exist_ok=True)
     for part in ("approach", "landing"):
-        text = float_block(snakemake.input[part], snakemake.params.captions_dir,
-                           relative_to=snakemake.params.paper_dir)
+        paths = []
+        for p in map(Path, snakemake.input[part]):
+            view = COMPACT_VIEWS.get(output_id(p)) if p.suffix == ".tex" else None
+            if view is None:
+                paths.append(p)
+                continue
+            for suffix, df in view(pd.read_csv(p.with_suffix(".csv"))):
+                stem = f"{p.stem}_{suffix}" if suffix else p.stem
+                out = compact_dir / f"{stem}.tex"
+                write_table(df, [out])
+                paths.append(out)
+        text = float_block(paths, snakemake.params.captions_dir, relative_to=snakemake.params.paper_dir)
         atomic_write_text(snakemake.output[part], text or "% no outputs yet\n")
-        log.info("%s: %d floats", part, len(snakemake.input[part]))
+        log.info("%s: %d floats", part, len(paths))
