@@ -240,3 +240,25 @@ def compact_b_t3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
 
 #: Manuscript views of tables too wide for a page, by SPEC id.
 COMPACT_VIEWS = {"A-T1": compact_a_t1, "B-T3": compact_b_t3}
+
+
+def compact_a_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """A-X1 for the page: CRLB per variant beside the EM and ML estimates' RMS error."""
+    import pandas as pd
+
+    rows = []
+    for _, r in df.iterrows():
+        rows.append({
+            "variant": r["variant"],
+            'CRLB x, 1 segment (")': _num(r.get("crlb_x_window_arcsec"), "{:.3g}"),
+            'CRLB x, all data (")': _num(r.get("crlb_x_total_arcsec"), "{:.3g}"),
+            "reaches 2\"": "yes" if bool(r.get("bound_reaches_target")) else "no",
+            'EM plain RMSE x (")': _num(r.get("em_plain_rmse_x_arcsec"), "{:.3g}"),
+            'EM SQUAREM RMSE x (")': _num(r.get("em_squarem_rmse_x_arcsec"), "{:.3g}"),
+            'ML RMSE x (")': _num(r.get("mle_rmse_x_arcsec"), "{:.3g}"),
+            "EM maps plain / SQUAREM": f"{_num(r.get('maps_plain_median'), '{:.0f}')} / {_num(r.get('maps_squarem_median'), '{:.0f}')}",
+        })
+    return [("", pd.DataFrame(rows))]
+
+
+COMPACT_VIEWS["A-X1"] = compact_a_x1

@@ -207,3 +207,23 @@ def to_longtable(df: pd.DataFrame) -> str:
     return show.to_latex(index=False, longtable=True, escape=True, na_rep="--",
                          float_format=lambda x: f"{x:.4g}",
                          column_format="llp{1.2cm}rrrp{2.4cm}p{4.2cm}".replace("p{1.2cm}", "l"))
+
+
+def verdict_counts(df: pd.DataFrame) -> pd.DataFrame:
+    """Number of items per paper and verdict (the scorecard at a glance)."""
+    if df.empty:
+        return pd.DataFrame(columns=["paper", REPRODUCED, NOT_REPRODUCED, NOT_REPRODUCIBLE, "total"])
+    t = pd.crosstab(df["paper"], df["verdict"])
+    for v in (REPRODUCED, NOT_REPRODUCED, NOT_REPRODUCIBLE):
+        if v not in t.columns:
+            t[v] = 0
+    t = t[[REPRODUCED, NOT_REPRODUCED, NOT_REPRODUCIBLE]]
+    t["total"] = t.sum(axis=1)
+    return t.reset_index()
+
+
+def headline(df: pd.DataFrame, case_id: str = "T1-01") -> pd.DataFrame:
+    """The items a reader looks at first: paper A's headline case under every
+    variant, and every paper-B item."""
+    keep = (df["paper"] == "B") | df["item"].str.contains(f" {case_id}:", regex=False)
+    return df.loc[keep, ["paper", "item", "unit", "published", "ours (mean)", "ours (spread)", "verdict"]]

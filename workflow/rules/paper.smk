@@ -64,6 +64,8 @@ rule paper_scorecard:
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
         longtable=f"{PAPER}/scorecard_longtable.tex",
+        counts=f"{PAPER}/scorecard_counts.tex",
+        headline=f"{PAPER}/scorecard_headline.tex",
         json=f"{PAPER}/scorecard.json",
     log:
         f"{PAPER}/logs/paper_scorecard.log",

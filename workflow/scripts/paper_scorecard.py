@@ -20,8 +20,12 @@ with script_context(snakemake) as log:
     df = scorecard.score_rows(rows)
     write_table(df, snakemake.output.table, caption="Scorecard: published values beside ours.")
     atomic_write_text(snakemake.output.longtable, scorecard.to_longtable(df))
+    write_table(scorecard.verdict_counts(df), [snakemake.output.counts], float_format="{:.0f}")
+    write_table(scorecard.headline(df), [snakemake.output.headline])
     counts = df["verdict"].value_counts().to_dict() if len(df) else {}
     atomic_write_text(snakemake.output.json, json.dumps(
-        {"n_items": int(len(df)), "verdicts": {k: int(v) for k, v in sorted(counts.items())}},
+        {"n_items": int(len(df)), "verdicts": {k: int(v) for k, v in sorted(counts.items())},
+         "by_paper": {p: {k: int(v) for k, v in sorted(g["verdict"].value_counts().items())}
+                      for p, g in df.groupby("paper")}},
         indent=2, sort_keys=True) + "\n")
     log.info("scorecard: %d items, %s", len(df), counts)
