@@ -1,0 +1,71 @@
+"""Paper-A tables: Table-1 columns, published values beside ours, verdict text from the numbers."""
+
+import numpy as np
+import pytest
+
+from opnav import published
+from opnav.approach import cases, pipeline
+from opnav.approach import scenario as sc
+
+from approach_helpers import approach_cfg
+
+REQUIRED = ["variant", "group", "case_id", "truth_x_arcsec", "truth_y_arcsec", "truth_z_arcsec",
+            "est_x_mean", "est_x_std", "est_y_mean", "est_y_std", "crlb_x_arcsec", "crlb_y_arcsec",
+            "data_to_converge_samples", "nav_err_before_km", "nav_err_after_km"]
+
+
+@pytest.fixture(scope="module")
+def small():
+    cfg = approach_cfg(N0=20, N=20, M=2, L=2)
+    cfg["n_seeds"] = 2
+    cfg["variants"] = ["literal", "reference-start"]
+    cfg["table1_variants"] = ["literal"]
+    res = []
+    for v in cfg["variants"]:
+        for g in pipeline.groups_for(cfg, v):
+            if v == "literal" and g not in ("size", "pixel"):
+                continue
+            res += pipeline.run_group(cfg, v, g, "plain" if v == "literal" else "squarem")
+    return cfg, res
+
+
+def test_seventeen_cases_in_five_groups_match_published_ids():
+    cfg = approach_cfg()
+    cs = cases.table1_cases(cfg)
+    assert [c.case_id for c in cs] == [r["case_id"] for r in published.paper_a()["table1"]]
+    assert [c.group for c in cs] == [r["group"] for r in published.paper_a()["table1"]]
+    assert {c.group for c in cs} == set(cases.GROUPS)
+
+
+def test_table1_columns_and_published_values(small):
+    cfg, res = small
+    t1 = pipeline.table1_frame(res, published.paper_a())
+    for c in REQUIRED:
+        assert c in t1.columns
+    assert {"pub_est_x_mean", "pub_est_y_mean", "pub_nav_err_before_km", "pub_nav_err_after_km",
+            "pub_data_to_converge_samples"} <= set(t1.columns)
+    row = t1[(t1.variant == "literal") & (t1.case_id == "T1-01")].iloc[0]
+    assert row["pub_est_x_mean"] == 11.43 and row["pub_est_y_mean"] == 21.21
+    assert row["pub_nav_err_before_km"] == 79.06 and row["pub_nav_err_after_km"] == 18.43
+    assert row["crlb_x_arcsec"] > 10.0  # literal: the prior-limited bound
+    ref = t1[(t1.variant == "reference-start+squarem") & (t1.case_id == "T1-01")].iloc[0]
+    assert ref["crlb_x_arcsec"] < 1.0
+    assert abs(ref["est_x_mean"] - 10.0) < 2.0  # identifiable with the true start
+
+
+def test_verdict_text_comes_from_the_numbers(small):
+    cfg, res = small
+    t1 = pipeline.table1_frame(res, published.paper_a())
+    geo = {v: sc.build_geometry(cfg, v) for v in cfg["variants"]}
+    case = cases.headline_case(cfg)
+    curves = {v: pipeline.bound_curve(cfg, g, sc.measurement_variance(g, cfg, case.sigma3_px),
+                                      case.truth_arcsec, v) for v, g in geo.items()}
+    x1 = pipeline.crlb_rows(cfg, curves, {}, t1)
+    text = pipeline.identifiability_text(cfg, x1)
+    lit = x1[x1.variant == "literal"].iloc[0]
+    assert not lit["bound_reaches_target"]
+    assert "**literal**" in text and "CANNOT support 2 arcsec" in text
+    assert f"{lit['crlb_x_total_arcsec']:.2f}" in text
+    summ = pipeline.summary(cfg, t1, x1)
+    assert set(summ["variants"]) == {"literal", "reference-start+squarem"}
+    assert np.isfinite(summ["variants"]["literal"]["crlb_x_arcsec"])
