@@ -70,6 +70,7 @@ def planning_states(landing: dict, run_index: int = 0):
 def time_methods(scn, states, methods, reps: int, eval_path: str):
     cfg = dataclasses.replace(scn.planner, eval_path=eval_path)
     times = {m: [] for m in methods}
+    cpu = {m: [] for m in methods}
     evals = {m: [] for m in methods}
     for _ in range(reps):
         for state, visible, exclude in states:
@@ -77,8 +78,9 @@ def time_methods(scn, states, methods, reps: int, eval_path: str):
                 t0 = time.perf_counter_ns()
                 res = PL.plan(m, state, scn.camera, scn.field, visible, cfg, exclude=exclude)
                 times[m].append(time.perf_counter_ns() - t0)
+                cpu[m].append(res.cpu_ns)
                 evals[m].append(res.n_evals)
-    return times, evals
+    return times, cpu, evals
 
 
 def table(times, evals, ref="svd"):
@@ -132,11 +134,14 @@ def main(argv=None) -> int:
           f"methods interleaved per state")
     path = scn.planner.eval_path
     print(f"\n== baselines via eval_path = {path} (configured) ==")
-    t, e = time_methods(scn, states, methods, args.reps, path)
+    t, c, e = time_methods(scn, states, methods, args.reps, path)
+    print("-- wall time (perf_counter_ns) --")
     table(t, e)
+    print("-- CPU time of the thread (thread_time_ns) --")
+    table(c, e)
     if path != "closed_form":
         print("\n== baselines via eval_path = closed_form (metrics module's closed form; beyond the paper) ==")
-        t, e = time_methods(scn, states, methods, args.reps, "closed_form")
+        t, c, e = time_methods(scn, states, methods, args.reps, "closed_form")
         table(t, e)
     if args.mc:
         wall = run_mc(args.config)

@@ -6,12 +6,13 @@ LANDING = res("landing")
 rule landing_tables:
     """B-T1 and B-T2, rendered from the config."""
     input:
-        src("landing/scenario.py", "tables.py", "published.py", "data/published.yaml"),
+        src("landing/scenario.py", "landing/trajectory.py", "tables.py", "published.py",
+            "data/published.yaml"),
     output:
         t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
         t2=report_table(f"{LANDING}/B-T2_error_bounds", "B-T2", "Paper B"),
     params:
-        landing=cfg("landing", "initial_state", "mc"),
+        landing=cfg("landing", "initial_state", "mc", "duration_s", "gravity_mps2", "yaw_deg"),
     log:
         f"{LANDING}/logs/landing_tables.log",
     localrule: True

@@ -183,7 +183,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
     nees_r = np.empty(n + 1)
     nees_v = np.empty(n + 1)
     updated = np.zeros(n + 1, bool)
-    plan_ns, plan_evals, plan_t, plan_beta, plan_idx = [], [], [], [], []
+    plan_ns, plan_cpu, plan_evals, plan_t, plan_beta, plan_idx = [], [], [], [], [], []
     cur, n_obs, n_used = -1, 0, 0
     a_est = tr.a[0]
 
@@ -224,6 +224,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                            visible, scn.planner, exclude={cur} if cur >= 0 else set(),
                            rng=rng_pick)
                 plan_ns.append(res.time_ns)
+                plan_cpu.append(res.cpu_ns)
                 plan_evals.append(res.n_evals)
                 plan_t.append(k * scn.Dt)
                 plan_beta.append(res.beta)
@@ -253,7 +254,8 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         "err_rpy_deg": _wrap_deg(rpy_t - _est_rpy(tr.R_LtoB, err_th)),
         "sig_r": sig[:, 0:3], "sig_v": sig[:, 3:6], "sig_th_deg": np.degrees(sig[:, 6:9]),
         "nees_r": nees_r, "nees_v": nees_v, "updated": updated,
-        "plan_ns": np.asarray(plan_ns, np.int64), "plan_evals": np.asarray(plan_evals, np.int64),
+        "plan_ns": np.asarray(plan_ns, np.int64), "plan_cpu_ns": np.asarray(plan_cpu, np.int64),
+        "plan_evals": np.asarray(plan_evals, np.int64),
         "plan_t": np.asarray(plan_t, float), "plan_beta": np.asarray(plan_beta, float),
         "plan_index": np.asarray(plan_idx, np.int64), "n_landmarks": n_used,
         "init_error": e0,

@@ -126,8 +126,9 @@ class PlanResult:
     ground: np.ndarray         # ideal ground point, m
     objective: float           # objective at beta* (minimised)
     n_evals: int               # objective evaluations
-    time_ns: int               # wall time of the planning call
+    time_ns: int               # wall time of the planning call (perf_counter_ns)
     note: str = ""
+    cpu_ns: int = 0            # CPU time of the calling thread (thread_time_ns)
 
 
 _GRID_CACHE: dict = {}
@@ -366,6 +367,18 @@ def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
 def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
          visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
          exclude: set = frozenset(), rng: np.random.Generator | None = None) -> PlanResult:
+    """One planning call (see :func:`_plan`), with its wall time (``time_ns``,
+    ``perf_counter_ns``) and the CPU time of the calling thread (``cpu_ns``,
+    ``thread_time_ns``, insensitive to other processes on a shared machine)."""
+    c0 = time.thread_time_ns()
+    res = _plan(method, state, camera, field_, visible, cfg, exclude, rng)
+    res.cpu_ns = time.thread_time_ns() - c0
+    return res
+
+
+def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
+          visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
+          exclude: set = frozenset(), rng: np.random.Generator | None = None) -> PlanResult:
     """One planning call: choose the next unknown landmark.
 
     ``visible(points_L (n, 3)) -> bool (n,)`` says which landmarks the camera

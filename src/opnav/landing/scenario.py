@@ -17,14 +17,28 @@ def _vec(v) -> str:
     return "[" + ", ".join(f"{x:g}" for x in v) + "]"
 
 
+def derived_initial_attitude_deg(landing_cfg: dict) -> np.ndarray:
+    """Our initial (roll, pitch, yaw), deg: body +z along the guidance thrust at
+    t = 0 with the configured yaw (``opnav.landing.trajectory``)."""
+    from opnav.landing.trajectory import euler_rpy_deg, truth_states
+
+    s = landing_cfg["initial_state"]
+    tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),
+                      landing_cfg["gravity_mps2"], float(landing_cfg.get("yaw_deg", 0.0)))
+    return euler_rpy_deg(tr.R_LtoB[0])
+
+
 def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
-    """B-T1: the lander's initial state in {L} (paper Table 1), config beside published."""
+    """B-T1: the lander's initial state in {L} (paper Table 1), config beside
+    published, and the simulation's initial state (the attitude derived from the
+    guidance thrust direction)."""
     s = landing_cfg["initial_state"]
     pub = published.paper_b()["table1_initial_state"]
+    att = derived_initial_attitude_deg(landing_cfg)
     rows = [
-        ("position", "m", s["r_m"], pub["r_m"]),
-        ("velocity", "m/s", s["v_mps"], pub["v_mps"]),
-        ("attitude (roll, pitch, yaw)", "deg", s["att_deg"], pub["att_deg"]),
+        ("position", "m", s["r_m"], pub["r_m"], s["r_m"]),
+        ("velocity", "m/s", s["v_mps"], pub["v_mps"], s["v_mps"]),
+        ("attitude (roll, pitch, yaw)", "deg", s["att_deg"], pub["att_deg"], np.round(att, 2)),
     ]
     return pd.DataFrame(
         {
@@ -32,6 +46,7 @@ def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
             "unit": [r[1] for r in rows],
             "config": [_vec(r[2]) for r in rows],
             "published": [_vec(r[3]) for r in rows],
+            "simulated (ours)": [_vec(r[4]) for r in rows],
             "norm (config)": [float(np.linalg.norm(r[2])) for r in rows],
         }
     )
