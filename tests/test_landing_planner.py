@@ -72,3 +72,35 @@ def test_degenerate_geometry_falls_back_with_a_note(scn):
     vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
     res = plan("depth", st, scn.camera, scn.field, vis, scn.planner)
     assert "does not descend" in res.note and math.isnan(res.beta)
+
+
+def test_landing_site_in_view_for_the_whole_descent(scn):
+    tr = scn.truth
+    d = np.einsum("nij,nj->ni", tr.R_LtoB[:-1], -tr.r[:-1])   # site direction in {B}
+    assert scn.camera.in_view(d, margin_px=50.0).all()
+
+
+def test_camera_measurement_noise_and_behind_camera_error(scn):
+    cam = scn.camera
+    d = cam.boresight_B * 1000.0 + np.array([30.0, -20.0, 10.0])
+    rng = np.random.default_rng(0)
+    b = np.array([cam.measure(d, rng.standard_normal(2)) for _ in range(4000)])
+    u = d / np.linalg.norm(d)
+    assert np.allclose(np.linalg.norm(b, axis=1), 1.0)
+    tang = b - np.outer(b @ u, u)
+    # per-component tangential spread ~ sigma_px / f (slightly less off-axis)
+    s = np.sqrt(np.mean(np.sum(tang**2, axis=1)) / 2)
+    assert 0.8 * cam.sigma_b < s < 1.05 * cam.sigma_b
+    with pytest.raises(ValueError, match="behind the camera"):
+        cam.measure(-cam.boresight_B, np.zeros(2))
+    assert not cam.in_view(-cam.boresight_B[None])[0]
+
+
+@pytest.mark.parametrize("method", ["random", "center", "logdet", "mineig"])
+def test_beyond_paper_methods_plan_too(scn, method):
+    tr = scn.truth
+    k = 20
+    st = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3))
+    vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
+    res = plan(method, st, scn.camera, scn.field, vis, scn.planner, rng=np.random.default_rng(1))
+    assert res.index >= 0 and vis(scn.field.xyz[res.index][None])[0]

@@ -339,9 +339,23 @@ def _metric_names() -> tuple[str, ...]:
 OBJECTIVES: dict[str, Callable] = {"depth": depth_objective}
 OBJECTIVES.update({n: metric_objective(n) for n in _metric_names()})
 
-#: method name -> direct picker without search: f(candidates (k,) indices,
-#: dirs_B (k, 3), rng) -> chosen position in candidates
-PICKERS: dict[str, Callable] = {}
+def _pick_random(field_, cand, state, camera, rng) -> int:
+    """A detected landmark drawn uniformly (the run's own picker stream)."""
+    if rng is None:
+        raise ValueError("the 'random' planner needs a random generator")
+    return int(rng.integers(len(cand)))
+
+
+def _pick_center(field_, cand, state, camera, rng) -> int:
+    """The detected landmark nearest the image centre (estimated attitude)."""
+    d = (field_.xyz[cand] - state.r) @ state.R_LtoB.T
+    cosang = (d @ camera.boresight_B) / np.linalg.norm(d, axis=1)
+    return int(np.argmax(cosang))
+
+
+#: method name -> direct picker without search: f(field, candidate indices (k,),
+#: state, camera, rng) -> chosen position in the candidates (B-X1 baselines)
+PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center}
 
 
 def available_methods() -> tuple[str, ...]:
