@@ -47,14 +47,19 @@ def bound_curve(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, var
 
 
 def groups_for(cfg: dict, variant: str) -> list[str]:
-    """Case groups a variant runs: all five for ``table1_variants``, else the headline only."""
-    return list(cases.GROUPS) if variant in cfg["table1_variants"] else ["headline"]
+    """Case groups a variant runs (Snakemake jobs): the five groups (or "all" in one job when
+    ``scatter: variant``) for ``table1_variants``, else the headline case only."""
+    if variant not in cfg["table1_variants"]:
+        return ["headline"]
+    return list(cases.GROUPS) if cfg["scatter"] == "group" else ["all"]
 
 
 def cases_in(cfg: dict, group: str) -> list[cases.Case]:
     allc = cases.table1_cases(cfg)
     if group == "headline":
         return [allc[0]]
+    if group == "all":
+        return allc
     return [c for c in allc if c.group == group]
 
 
