@@ -125,6 +125,7 @@ rule landing_summary:
     params:
         methods=B_METHODS,
         yaw_ratio=0.5,
+        converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
     log:
         f"{LANDING}/logs/summary.log",
     localrule: True

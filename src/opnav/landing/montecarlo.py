@@ -150,9 +150,11 @@ def same_pick_pct(a: dict, b: dict) -> float:
     return 100.0 * sum(ka[k] == kb[k] for k in common) / len(common)
 
 
-def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | None = None
-                  ) -> pd.DataFrame:
-    """B-T3: one row per method (see the module docstring for the columns)."""
+def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | None = None,
+                  converged_pos_err_m: float = 100.0) -> pd.DataFrame:
+    """B-T3: one row per method (see the module docstring for the columns);
+    ``converged_runs_pct`` counts the runs whose final position error is below
+    ``converged_pos_err_m`` (m)."""
     methods = list(data)
     rows = []
     for m in methods:
@@ -163,6 +165,9 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
                 col = st[f"{kind}_{q}"]
                 row[f"{kind}_{q}_mean"] = float(col.mean())
                 row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
+        row["final_pos_err_m_median"] = float(st["final_pos_err_m"].median())
+        row["final_vel_err_mps_median"] = float(st["final_vel_err_mps"].median())
+        row["converged_runs_pct"] = float(100.0 * (st["final_pos_err_m"] < converged_pos_err_m).mean())
         row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
         row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
         row["landmarks_per_run"] = float(st["n_landmarks"].mean())
