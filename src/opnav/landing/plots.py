@@ -63,13 +63,15 @@ def fig_depth_error_map(uv_px, dr_m, best_idx, half_px, curve_beta_deg, curve_dr
         sc = ax.scatter(uv_px[fin, 0], uv_px[fin, 1], c=dr_m[fin], s=3, cmap="viridis",
                         norm=LogNorm(vmin=np.nanmin(dr_m[fin]), vmax=np.nanpercentile(dr_m[fin], 99)),
                         rasterized=True)
-        ax.plot(*uv_px[best_idx], marker="*", ms=12, mfc="red", mec="k", ls="none",
-                label=f"optimum ({dr_m[best_idx]:.0f} m)")
+        ax.plot(*uv_px[best_idx], marker="*", ms=12, mfc="red", mec="k", ls="none", zorder=5,
+                clip_on=False, label=f"optimum ({dr_m[best_idx]:.0f} m)")
         if opt_uv_px is not None and np.all(np.isfinite(opt_uv_px)):
-            ax.plot(*opt_uv_px, marker="+", ms=10, mew=1.5, color="k", ls="none",
-                    label="golden-section direction")
-        ax.set_xlim(-half_px, half_px)
-        ax.set_ylim(half_px, -half_px)
+            ax.plot(*opt_uv_px, marker="+", ms=12, mew=2.0, color="red", ls="none", zorder=5,
+                    clip_on=False, label="golden-section direction")
+        ax.plot([-half_px, half_px, half_px, -half_px, -half_px],
+                [-half_px, -half_px, half_px, half_px, -half_px], color="k", lw=0.6)
+        ax.set_xlim(-1.06 * half_px, 1.06 * half_px)
+        ax.set_ylim(1.06 * half_px, -1.06 * half_px)
         ax.set_aspect("equal")
         ax.set_xlabel("image u (px)")
         ax.set_ylabel("image v (px)")
