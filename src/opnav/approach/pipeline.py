@@ -227,13 +227,14 @@ def identifiability_text(cfg: dict, x1: pd.DataFrame) -> str:
                          f"{_fmt(r['em_plain_est_x_std'])} arcsec (RMS error {_fmt(r['em_plain_rmse_x_arcsec'])})")
         if "maps_plain_median" in r and not pd.isna(r.get("maps_plain_median")):
             mp = r["maps_plain_median"]
-            mp_txt = (f"more than {int(r['max_maps'])} (stalled; about {r['maps_plain_extrapolated_median']:.3g} "
-                      f"extrapolated from the measured contraction {r['plain_rate_per_map']:.5f} per iteration)"
+            mp_txt = (f"more than the {int(r['max_maps'])} run (about {r['maps_plain_extrapolated_median']:.3g} "
+                      f"extrapolated from its measured contraction factor {r['plain_rate_per_map']:.5f} per "
+                      f"iteration{'; stalled' if r['plain_rate_per_map'] > 0.999 else ''})"
                       if mp > r["max_maps"] else f"{mp:.0f}")
             extra.append(f"on one {int(r['mle_samples'])}-sample window the maximum-likelihood estimate "
                          f"(SQUAREM, {r['maps_squarem_median']:.0f} EM maps) has RMS error "
                          f"{_fmt(r['mle_rmse_x_arcsec'])} arcsec in tx against a CRLB of "
-                         f"{_fmt(r['crlb_x_at_mle_samples'])}; plain EM needs {mp_txt} iterations to get within "
+                         f"{_fmt(r['crlb_x_at_mle_samples'])}; plain EM needs {mp_txt} iteration(s) to get within "
                          f"{r['tol_arcsec']:g} arcsec of it")
         if extra:
             lines.append("  " + "; ".join(extra) + ".")
