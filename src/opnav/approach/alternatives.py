@@ -1,0 +1,327 @@
+"""A-X2: the EM-EKF against the alternatives a user would try, on the Table-1 cases (SPEC A.4).
+
+Description
+    For every Table-1 case (:func:`opnav.approach.cases.table1_cases`), scenario
+    variant and Monte-Carlo seed of the EM-EKF runs (same measurement streams
+    ``SeedSequence([base_seed, case_index, seed_index])``, same scenario
+    geometry), :func:`run_case_alternatives` runs
+
+    * the augmented EKF (:mod:`opnav.approach.augmented`), theta as constant
+      states with the config prior;
+    * batch maximum likelihood (:mod:`opnav.approach.batch_ml`), CasADi + IPOPT
+      on the exact marginal likelihood.
+
+    Both use the data of the EM's segments, samples ``N0+1 .. N0+L*N``, from
+    the state the EM's first segment starts from in that variant (``literal``:
+    the theta = 0 filter's ``X_N0, P_N0``; ``prior``/``roll``: the prior
+    propagated to ``N0``; ``reference-start``: the true state with the filter's
+    ``P_N0``, diagnostic), with theta started at the case's initial value.
+
+Written rules (shared with the EM-EKF's Table 1, :mod:`opnav.approach.cases`)
+    * *Bias error*: ``theta_hat - theta_true`` for tx and ty, arcsec; mean and
+      sample standard deviation over seeds.
+    * *Navigation error after compensation* (km): the EKF over the whole arc
+      with the method's final estimate, RMS of ``|r_hat - r_true|`` over the
+      last ``nav_error.last_fraction`` of the arc (:func:`cases.rms_last`).
+    * *Data needed*: the EM's rule (:func:`cases.data_to_converge`) applied to
+      the estimate after each ``N`` samples: for the augmented EKF its state at
+      those samples (all seeds); for batch ML the IPOPT solutions on the
+      growing windows ending every ``checkpoint_stride`` segments (and at
+      ``L N``), warm-started, for the first ``alternatives.batch_ml.checkpoint_seeds``
+      seeds (each checkpoint is a full batch solve), so its resolution is
+      ``checkpoint_stride * N`` samples.
+    * *Run time* (s per seed, wall clock, this machine): augmented EKF = the
+      filter over all seeds / S; batch ML = build of the NLP (shared by the
+      seeds of a case, includes the one-off JIT compilation) + preconditioner
+      + IPOPT on the final window, / S;
+      batch ML with checkpoints: per checkpoint seed.
+Units: arcsec, km, samples, s.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pandas as pd
+
+from . import cases
+from . import scenario as sc
+from .augmented import run_augmented
+from .batch_ml import BatchML
+from .dynamics import ARCSEC
+from .ekf import predict_only, run_filter
+
+METHOD_LABELS = {
+    "em_plain": "EM-EKF (plain)",
+    "em_squarem": "EM-EKF (SQUAREM)",
+    "augmented": "augmented EKF",
+    "batch_ml": "batch ML (IPOPT)",
+}
+
+
+def start_state(variant: str, z: np.ndarray, dx0: np.ndarray, geo: sc.Geometry, win, N0: int):
+    """State (S, 6) and covariance (S, 6, 6) at ``N0`` from which the variant's EM starts."""
+    S = z.shape[0]
+    start = sc.START_OF[variant]
+    if start == "prior":
+        x, P = predict_only(dx0, geo.P0, win.slice(0, N0))
+        return x, np.broadcast_to(P, (S, 6, 6)).copy()
+    f = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
+    if start == "filter":
+        return f.xf[:, -1], f.Pf[:, -1]
+    return np.broadcast_to(geo.dx_true[N0], (S, 6)).copy(), f.Pf[:, -1]
+
+
+def los_boresight(geo: sc.Geometry) -> np.ndarray:
+    """``u`` along the camera boresight at the reference range (n+1, 3): the linearisation
+    point of the batch-ML preconditioner (the camera tracks Mars, so the true ``u``
+    has no lateral part)."""
+    u = np.zeros_like(geo.u_ref)
+    u[:, 2] = geo.rho_ref
+    return u
+
+
+def checkpoint_samples(seg_data: np.ndarray, stride: int) -> np.ndarray:
+    """Every ``stride``-th segment end, always including the last one (samples after N0)."""
+    idx = np.arange(len(seg_data))[::-1][::stride][::-1]
+    return np.asarray(seg_data)[idx]
+
+
+class _BatchCache:
+    """BatchML objects per (checkpoints, pixel noise): the NLP depends on the geometry only."""
+
+    def __init__(self):
+        self.store = {}
+
+    def get(self, key, make):
+        if key not in self.store:
+            t = time.perf_counter()
+            self.store[key] = (make(), time.perf_counter() - t)
+        return self.store[key]
+
+
+def run_case_alternatives(cfg: dict, variant: str, case: cases.Case, seed_indices,
+                          geo: sc.Geometry, cache: _BatchCache | None = None) -> dict:
+    """Augmented EKF and batch ML for one case and variant over the given seeds."""
+    alt = cfg["alternatives"]
+    seg = cfg["segments"]
+    N0, N, L = seg["N0"], seg["N"], seg["L"]
+    cache = cache or _BatchCache()
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    win = geo.window(Rvar)
+    seeds = list(seed_indices)
+    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seeds)
+    theta_true = sc.rad(case.truth_arcsec)
+    z, e0 = sc.simulate(geo, Rvar, theta_true, rngs)
+    S = z.shape[0]
+    dx0 = sc.prior_mean_deviation(geo, e0, cfg["initial_error"]["mode"])
+    x0, P0 = start_state(variant, z, dx0, geo, win, N0)
+    wwin = win.slice(N0, N0 + L * N)
+    zw = z[:, N0:N0 + L * N + 1]
+    th0 = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
+    seg_data = np.array([(l + 1) * N for l in range(L)])
+    tol = cfg["em"]["converge_tol_arcsec"]
+    frac = cfg["nav_error"]["last_fraction"]
+    out = {"variant": variant, "case": case, "case_id": case.case_id,
+           "seed_indices": np.asarray(seeds), "truth_arcsec": np.asarray(case.truth_arcsec, float),
+           "seg_data_used": seg_data, "methods": {}}
+
+    def nav_after(theta_rad):
+        f = run_filter(z, theta_rad, dx0, geo.P0, win)
+        err = np.linalg.norm(f.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
+        return cases.rms_last(err, frac)
+
+    # (a) augmented EKF
+    a = alt["augmented"]
+    t = time.perf_counter()
+    ra = run_augmented(zw, x0, P0, th0, sc.rad(a["theta_prior_sigma_arcsec"]), wwin,
+                       q_theta=(a["theta_process_sigma_arcsec"] * ARCSEC) ** 2)
+    t_aug = (time.perf_counter() - t) / S
+    seg_th = sc.arcsec(ra.theta[:, seg_data])
+    out["methods"]["augmented"] = {
+        "theta_final_arcsec": seg_th[:, -1],
+        "theta_seg_arcsec": seg_th,
+        "sigma_final_arcsec": sc.arcsec(np.sqrt(np.diagonal(ra.P_theta[:, -1], axis1=1, axis2=2))),
+        "data_to_converge": cases.data_to_converge(seg_th, seg_data, tol),
+        "nav_err_after_km": nav_after(ra.theta[:, -1]),
+        "runtime_s_per_seed": t_aug,
+    }
+
+    # (b) batch ML: final window for every seed; growing checkpoints for the first few seeds
+    b = alt["batch_ml"]
+    sig = sc.rad(b["theta_prior_sigma_arcsec"])
+    key = (tuple(case.sigma3_px), "final")
+    bm, t_build = cache.get(key, lambda: BatchML(wwin, [L * N], sig, jit=b["jit"], tol=b["tol"]))
+    t = time.perf_counter()
+    rb = bm.solve(zw, x0, P0, th0, wwin.u_ref)
+    t_solve = time.perf_counter() - t
+    ncp = min(b["checkpoint_seeds"], S)
+    res_b = {
+        "theta_final_arcsec": sc.arcsec(rb.theta[:, -1]),
+        "grad_norm": rb.grad_norm[:, -1],
+        "ipopt_iterations": rb.iterations[:, -1],
+        "ipopt_success": rb.success[:, -1],
+        "nav_err_after_km": nav_after(rb.theta[:, -1]),
+        "runtime_s_per_seed": (t_build + t_solve) / S,
+        "runtime_build_s": t_build,
+    }
+    if ncp > 0:
+        cp = checkpoint_samples(seg_data, b["checkpoint_stride"])
+        bmc, t_build_c = cache.get((tuple(case.sigma3_px), "checkpoints"),
+                                   lambda: BatchML(wwin, cp, sig, jit=b["jit"], tol=b["tol"]))
+        t = time.perf_counter()
+        rc = bmc.solve(zw[:ncp], x0[:ncp], P0[:ncp], th0[:ncp], wwin.u_ref)
+        t_cp = time.perf_counter() - t
+        cth = sc.arcsec(rc.theta)
+        res_b.update({
+            "theta_seg_arcsec": cth,
+            "checkpoint_data_used": cp,
+            "data_to_converge": cases.data_to_converge(cth, cp, tol),
+            "checkpoint_seeds": ncp,
+            "checkpoint_max_dev_from_final_arcsec": float(
+                np.abs(cth[:, -1] - res_b["theta_final_arcsec"][:ncp])[:, :2].max()),
+            "runtime_checkpoints_s_per_seed": t_cp / ncp + t_build_c / S,
+        })
+    out["methods"]["batch_ml"] = res_b
+    return out
+
+
+def run_group_alternatives(cfg: dict, variant: str, group: str, log=None) -> list[dict]:
+    """Alternatives for every case of a Table-1 ``group`` under ``variant`` (one Snakemake job)."""
+    from .pipeline import cases_in
+
+    geo = sc.build_geometry(cfg, variant)
+    cache = _BatchCache()
+    seeds = range(cfg["n_seeds"])
+    res = []
+    for case in cases_in(cfg, group):
+        r = run_case_alternatives(cfg, variant, case, seeds, geo, cache)
+        res.append(r)
+        if log:
+            log.info("%s %s %s: aug %s ml %s", variant, group, case.case_id,
+                     np.round(r["methods"]["augmented"]["theta_final_arcsec"].mean(0), 3),
+                     np.round(r["methods"]["batch_ml"]["theta_final_arcsec"].mean(0), 3))
+    return res
+
+
+def time_em(cfg: dict, variant: str, case: cases.Case, seed_indices, geo: sc.Geometry) -> dict:
+    """Wall time per seed of the EM-EKF (:func:`cases.run_case`) for each configured EM scheme.
+
+    ``run_case`` also runs the theta = 0 and the compensated full-arc filters
+    (2 of its ``1 + M L + 1`` filter passes); the time includes them.
+    """
+    out = {}
+    S = len(list(seed_indices))
+    for m in cfg["methods"]:
+        t = time.perf_counter()
+        cases.run_case(cfg, variant, case, seed_indices, geo=geo, method=m)
+        out[f"em_{m}"] = (time.perf_counter() - t) / S
+    return out
+
+
+def _std(x):
+    return float(np.std(x, ddof=1)) if len(x) > 1 else math.nan
+
+
+def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) -> pd.DataFrame:
+    """One row per variant x method x case: error, spread, CRLB, nav error, data, run time.
+
+    ``em_results``: the EM-EKF Monte-Carlo dicts (:func:`opnav.approach.pipeline.run_group`);
+    ``em_times``: {variant: {"em_plain": s, ...}} measured on the headline case.
+    """
+    crlb = {(r["variant"], r["case_id"]): r["crlb_total_arcsec"] for r in em_results}
+    rows = []
+
+    def add(variant, case, method, truth, th, nav, data, runtime, extra=None):
+        err = th[:, :2] - truth[:2]
+        cb = crlb.get((variant, case.case_id), np.full(3, np.nan))
+        row = {
+            "variant": variant, "method": method, "method_label": METHOD_LABELS[method],
+            "group": case.group, "case_id": case.case_id,
+            "truth_x_arcsec": truth[0], "truth_y_arcsec": truth[1],
+            "n_seeds": th.shape[0],
+            "err_x_mean_arcsec": float(err[:, 0].mean()), "err_x_std_arcsec": _std(err[:, 0]),
+            "err_y_mean_arcsec": float(err[:, 1].mean()), "err_y_std_arcsec": _std(err[:, 1]),
+            "rmse_xy_arcsec": float(np.sqrt(np.mean(err**2))),
+            "crlb_x_arcsec": float(cb[0]), "crlb_y_arcsec": float(cb[1]),
+            "nav_err_after_km": float(np.mean(nav)),
+            "data_to_converge_samples": float(np.median(data)) if data is not None else math.nan,
+            "runtime_s_per_seed": runtime,
+        }
+        row.update(extra or {})
+        rows.append(row)
+
+    for r in em_results:
+        m = f"em_{r['method']}"
+        if m not in METHOD_LABELS:
+            continue
+        rt = em_times.get(r["variant"], {}).get(m, math.nan) if r["case_id"] == "T1-01" else math.nan
+        add(r["variant"], r["case"], m, np.asarray(r["truth_arcsec"], float), r["theta_final_arcsec"],
+            r["nav_err_after_km"], r["data_to_converge"], rt,
+            {"nav_err_before_km": float(np.mean(r["nav_err_before_km"]))})
+    for r in alt_results:
+        for m, d in r["methods"].items():
+            extra = {}
+            if m == "batch_ml":
+                extra = {"ipopt_max_grad_norm": float(np.max(d["grad_norm"])),
+                         "ipopt_all_success": bool(np.all(d["ipopt_success"])),
+                         "ipopt_iterations_median": float(np.median(d["ipopt_iterations"])),
+                         "runtime_checkpoints_s_per_seed": d.get("runtime_checkpoints_s_per_seed", math.nan),
+                         "data_seeds": d.get("checkpoint_seeds", 0)}
+            add(r["variant"], r["case"], m, r["truth_arcsec"], d["theta_final_arcsec"],
+                d["nav_err_after_km"], d.get("data_to_converge"), d["runtime_s_per_seed"], extra)
+    df = pd.DataFrame(rows)
+    vorder = {v: i for i, v in enumerate(sc.VARIANTS)}
+    morder = {m: i for i, m in enumerate(METHOD_LABELS)}
+    df = df.assign(_v=df["variant"].map(vorder), _m=df["method"].map(morder))
+    return df.sort_values(["_v", "_m", "case_id"], kind="stable").drop(columns=["_v", "_m"]).reset_index(drop=True)
+
+
+def summary_frame(long: pd.DataFrame) -> pd.DataFrame:
+    """A-X2 table: per variant and method, the headline case (T1-01) and all-case aggregates."""
+    rows = []
+    for (v, m), g in long.groupby(["variant", "method"], sort=False):
+        h = g[g["case_id"] == "T1-01"]
+        h = h.iloc[0] if len(h) else None
+        rows.append({
+            "variant": v, "method": METHOD_LABELS[m],
+            "n_cases": len(g), "n_seeds": int(g["n_seeds"].max()),
+            "T1-01 err_x mean": h["err_x_mean_arcsec"] if h is not None else math.nan,
+            "T1-01 err_x sd": h["err_x_std_arcsec"] if h is not None else math.nan,
+            "T1-01 err_y mean": h["err_y_mean_arcsec"] if h is not None else math.nan,
+            "T1-01 err_y sd": h["err_y_std_arcsec"] if h is not None else math.nan,
+            "T1-01 CRLB_x": h["crlb_x_arcsec"] if h is not None else math.nan,
+            "RMSE_xy all cases": float(np.sqrt(np.mean(g["rmse_xy_arcsec"] ** 2))),
+            "median sd all cases": float(np.median(np.r_[g["err_x_std_arcsec"], g["err_y_std_arcsec"]])),
+            "median CRLB all cases": float(np.median(np.r_[g["crlb_x_arcsec"], g["crlb_y_arcsec"]])),
+            "nav err after km (T1-01)": h["nav_err_after_km"] if h is not None else math.nan,
+            "nav err after km (all)": float(g["nav_err_after_km"].mean()),
+            "data needed (T1-01)": h["data_to_converge_samples"] if h is not None else math.nan,
+            "data needed (median)": float(np.nanmedian(g["data_to_converge_samples"]))
+            if g["data_to_converge_samples"].notna().any() else math.nan,
+            "run time s/seed (T1-01)": h["runtime_s_per_seed"] if h is not None else math.nan,
+        })
+    return pd.DataFrame(rows)
+
+
+def summary_json(long: pd.DataFrame, table: pd.DataFrame, cfg: dict) -> dict:
+    """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json)."""
+    out = {"segments": cfg["segments"], "alternatives": cfg["alternatives"], "variants": {}}
+    for _, r in table.iterrows():
+        key = [k for k, lab in METHOD_LABELS.items() if lab == r["method"]][0]
+        out["variants"].setdefault(r["variant"], {})[key] = {
+            "err_x_mean_arcsec": r["T1-01 err_x mean"], "err_x_sd_arcsec": r["T1-01 err_x sd"],
+            "err_y_mean_arcsec": r["T1-01 err_y mean"], "err_y_sd_arcsec": r["T1-01 err_y sd"],
+            "crlb_x_arcsec": r["T1-01 CRLB_x"],
+            "rmse_xy_all_cases_arcsec": r["RMSE_xy all cases"],
+            "nav_err_after_km": r["nav err after km (T1-01)"],
+            "data_to_converge_samples": r["data needed (T1-01)"],
+            "runtime_s_per_seed": r["run time s/seed (T1-01)"],
+        }
+    ml = long[long["method"] == "batch_ml"]
+    if len(ml):
+        out["batch_ml_max_grad_norm"] = float(ml["ipopt_max_grad_norm"].max())
+        out["batch_ml_all_success"] = bool(ml["ipopt_all_success"].all())
+    return out
