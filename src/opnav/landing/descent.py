@@ -156,8 +156,14 @@ def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
 
 
 def _att_error(R_true: np.ndarray, R_est: np.ndarray) -> np.ndarray:
-    """dtheta (rad) with R_true = Exp(-dtheta) R_est."""
-    return -Rotation.from_matrix(R_true @ R_est.T).as_rotvec()
+    """dtheta (rad) with R_true = Exp(-dtheta) R_est (log map; angles < pi/2)."""
+    D = R_true @ R_est.T
+    w = 0.5 * np.array([D[2, 1] - D[1, 2], D[0, 2] - D[2, 0], D[1, 0] - D[0, 1]])
+    s = float(np.linalg.norm(w))
+    c = 0.5 * (D[0, 0] + D[1, 1] + D[2, 2] - 1.0)
+    if s < 1e-12:
+        return -w
+    return -w * (math.atan2(s, c) / s)
 
 
 def _wrap_deg(x):

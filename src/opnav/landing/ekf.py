@@ -152,8 +152,9 @@ def nullspace(r, v, R, p) -> np.ndarray:
     """Unobservable direction (12,) of the error state with one known landmark at
     the {L} origin: a rotation of everything about the vertical through the site
     (yaw): ``[e_z x r, e_z x v, R e_z, e_z x p]`` (our body-side dtheta)."""
-    ez = np.array([0.0, 0.0, 1.0])
-    return np.concatenate([np.cross(ez, r), np.cross(ez, v), R @ ez, np.cross(ez, p)])
+    # e_z x a = [-a_y, a_x, 0]
+    return np.array([-r[1], r[0], 0.0, -v[1], v[0], 0.0, R[0, 2], R[1, 2], R[2, 2],
+                     -p[1], p[0], 0.0])
 
 
 def _boxminus(a: NavState, b: NavState) -> np.ndarray:

@@ -128,7 +128,7 @@ class PlanResult:
     n_evals: int               # objective evaluations
     time_ns: int               # wall time of the planning call (perf_counter_ns)
     note: str = ""
-    cpu_ns: int = 0            # CPU time of the calling thread (thread_time_ns)
+    cpu_ns: int = 0            # CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID)
 
 
 _GRID_CACHE: dict = {}
@@ -383,11 +383,17 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
          exclude: set = frozenset(), rng: np.random.Generator | None = None) -> PlanResult:
     """One planning call (see :func:`_plan`), with its wall time (``time_ns``,
     ``perf_counter_ns``) and the CPU time of the calling thread (``cpu_ns``,
-    ``thread_time_ns``, insensitive to other processes on a shared machine)."""
-    c0 = time.thread_time_ns()
+    CLOCK_THREAD_CPUTIME_ID, insensitive to other processes on a shared machine)."""
+    c0 = _thread_ns()
     res = _plan(method, state, camera, field_, visible, cfg, exclude, rng)
-    res.cpu_ns = time.thread_time_ns() - c0
+    res.cpu_ns = _thread_ns() - c0
     return res
+
+
+def _thread_ns() -> int:
+    """CPU time of the calling thread, ns (clock_gettime: ~0.4 us here, where
+    time.thread_time_ns costs ~5 us)."""
+    return time.clock_gettime_ns(time.CLOCK_THREAD_CPUTIME_ID)
 
 
 def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
