@@ -12,6 +12,7 @@ configfile: "config/config.yaml"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/approach.smk"
+include: "workflow/rules/approach_extra.smk"
 include: "workflow/rules/landing.smk"
 include: "workflow/rules/paper.smk"
 

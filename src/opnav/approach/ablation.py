@@ -1,0 +1,104 @@
+"""A-X3: one-value ablations of the headline case, pixel noise and EM segment length.
+
+Description
+    A user changes one config value and reruns one Snakemake target:
+
+    * ``approach.ablation.sigma3_px`` (rule ``approach_ablation_pixel``): the
+      centroid 3-sigma pixel error of the headline case (the radius error is
+      ``camera.radius_to_centroid_ratio`` times it, as in Table 1's pixel group);
+    * ``approach.ablation.segment_N`` (rule ``approach_ablation_segment``): the
+      EM segment length ``N``; the segment count becomes
+      ``L = max(1, round(L0 N0_len / N))`` so the data length ``L N`` stays
+      (nearly) that of the config, and only the EM's segmentation changes.
+
+    For every scenario variant of ``approach.ablation.variants`` and every
+    swept value it runs, on ``approach.ablation.n_seeds`` seeds (streams
+    ``SeedSequence([base_seed, 1, seed])``, the headline case's), the EM-EKF
+    of the config (:func:`opnav.approach.cases.run_case`, ``em.method``), the
+    augmented EKF (:mod:`opnav.approach.augmented`, from the same start), and
+    the Cramér-Rao bound for the data used (:func:`opnav.approach.pipeline.bound_curve`).
+
+Reported per row (arcsec): mean estimate, spread (sample sd over seeds) and
+RMS error of tx and ty, and the 1-sigma CRLB of tx and ty.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pandas as pd
+
+from . import alternatives as alt
+from . import cases
+from . import scenario as sc
+from .pipeline import bound_curve
+
+SWEEPS = {"pixel": "sigma3_px", "segment": "segment_N"}
+
+
+def sweep_configs(cfg: dict, sweep: str) -> list[tuple[float, dict, cases.Case]]:
+    """(value, config, headline case) for every value of the sweep."""
+    if sweep not in SWEEPS:
+        raise ValueError(f"unknown ablation sweep {sweep!r}; use one of {sorted(SWEEPS)}")
+    abl = cfg["ablation"]
+    base = cases.headline_case(cfg)
+    out = []
+    for v in abl[SWEEPS[sweep]]:
+        c = copy.deepcopy(cfg)
+        c["n_seeds"] = abl["n_seeds"]
+        case = base
+        if sweep == "pixel":
+            ratio = cfg["camera"]["radius_to_centroid_ratio"]
+            case = cases.Case(base.case_index, base.case_id, base.group, base.truth_arcsec,
+                              base.init_arcsec, (float(v), float(v), ratio * float(v)), base.install_deg)
+        else:
+            s = c["segments"]
+            total = s["L"] * s["N"]
+            s["N"] = int(v)
+            s["L"] = max(1, int(round(total / int(v))))
+        out.append((float(v), c, case))
+    return out
+
+
+def _row(variant, sweep, value, estimator, th, truth, crlb_xy, data_used):
+    err = th[:, :2] - truth[:2]
+    sd = th[:, :2].std(axis=0, ddof=1) if th.shape[0] > 1 else np.full(2, math.nan)
+    rmse = np.sqrt(np.mean(err**2, axis=0))
+    return {"variant": variant, "sweep": sweep, "value": value, "estimator": estimator,
+            "n_seeds": th.shape[0], "data_samples": data_used,
+            "est_x_mean": th[:, 0].mean(), "est_y_mean": th[:, 1].mean(),
+            "sd_x_arcsec": sd[0], "sd_y_arcsec": sd[1],
+            "rmse_x_arcsec": rmse[0], "rmse_y_arcsec": rmse[1],
+            "crlb_x_arcsec": crlb_xy[0], "crlb_y_arcsec": crlb_xy[1],
+            "sd_over_crlb_x": sd[0] / crlb_xy[0] if crlb_xy[0] > 0 else math.nan}
+
+
+def run_sweep(cfg: dict, sweep: str, log=None) -> pd.DataFrame:
+    """The ablation table of one sweep (module docstring)."""
+    rows = []
+    for variant in cfg["ablation"]["variants"]:
+        geo = None
+        for value, c, case in sweep_configs(cfg, sweep):
+            seg = c["segments"]
+            n_needed = seg["N0"] + seg["L"] * seg["N"]
+            if geo is None or geo.t.size - 1 != n_needed:
+                geo = sc.build_geometry(c, variant, n=n_needed)
+            seeds = range(c["n_seeds"])
+            em = cases.run_case(c, variant, case, seeds, geo=geo, method=c["em"]["method"])
+            Rvar = sc.measurement_variance(geo, c, case.sigma3_px)
+            used = seg["L"] * seg["N"]
+            curve = bound_curve(c, geo, Rvar, case.truth_arcsec, variant)
+            cb = curve[min(used, len(curve) - 1)]
+            truth = np.asarray(case.truth_arcsec, float)
+            rows.append(_row(variant, sweep, value, f"EM-EKF ({c['em']['method']})",
+                             em["theta_final_arcsec"], truth, cb, used))
+            ra = alt.run_case_alternatives(c, variant, case, seeds, geo, methods=("augmented",))
+            rows.append(_row(variant, sweep, value, "augmented EKF",
+                             ra["methods"]["augmented"]["theta_final_arcsec"], truth, cb, used))
+            if log:
+                log.info("%s %s=%g: EM sd %s aug sd %s CRLB %s", variant, sweep, value,
+                         np.round(rows[-2]["sd_x_arcsec"], 4), np.round(rows[-1]["sd_x_arcsec"], 4),
+                         np.round(cb[:2], 4))
+    return pd.DataFrame(rows)

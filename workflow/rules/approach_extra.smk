@@ -1,0 +1,102 @@
+# Paper A, beyond the paper: A-X2 (EM-EKF against the augmented EKF and batch ML)
+# and A-X3 (one-value ablations of pixel noise and segment length).
+# Uses approach.smk's names (APPROACH, A_WORK, A_CFG, A_SRC, A_MC, A_METHODS, a_groups):
+# include it after approach.smk.
+
+A_X2_SRC = A_SRC + src("approach/augmented.py", "approach/batch_ml.py", "approach/alternatives.py")
+A_X2_VARIANTS = config["approach"]["table1_variants"]
+A_X2 = {(v, g): f"{A_WORK}/x2/{v}__{g}.pkl" for v in A_X2_VARIANTS for g in a_groups(v)}
+
+
+rule approach_x2_group:
+    """Augmented EKF and batch ML (CasADi + IPOPT) on one Table-1 case group and variant,
+    same seeds as the EM-EKF Monte Carlo; the headline group also times the EM-EKF."""
+    input:
+        A_X2_SRC,
+    output:
+        f"{A_WORK}/x2/{{variant}}__{{group}}.pkl",
+    params:
+        approach=A_CFG,
+    log:
+        f"{APPROACH}/logs/x2_{{variant}}__{{group}}.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/x2_{{variant}}__{{group}}.tsv"
+    script:
+        "../scripts/approach_x2_group.py"
+
+
+rule approach_x2_tables:
+    """A-X2 table (per variant and method) and A-X2-summary.json; long form per case in work/."""
+    input:
+        x2=list(A_X2.values()),
+        mc=[A_MC[(v, g, m)] for v in A_X2_VARIANTS for g in a_groups(v) for m in A_METHODS],
+        code=src("approach/alternatives.py", "tables.py"),
+    output:
+        table=report_table(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
+        long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
+        summary=f"{APPROACH}/A-X2-summary.json",
+    params:
+        approach=A_CFG,
+        profile=config["profile"],
+    log:
+        f"{APPROACH}/logs/x2_tables.log",
+    localrule: True
+    script:
+        "../scripts/approach_x2_tables.py"
+
+
+rule approach_x2_figure:
+    """A-X2 figure: error, spread and CRLB, navigation error, data needed and run time per method."""
+    input:
+        long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
+        code=src("figures.py", "opnav.mplstyle"),
+    output:
+        fig=report_figure(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
+    log:
+        f"{APPROACH}/logs/x2_figure.log",
+    localrule: True
+    script:
+        "../scripts/approach_x2_figure.py"
+
+
+rule approach_ablation_pixel:
+    """A-X3: pixel-noise sweep (approach.ablation.sigma3_px) of the headline case per variant."""
+    input:
+        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "figures.py", "tables.py"),
+    output:
+        table=report_table(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
+        fig=report_figure(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
+    params:
+        approach=A_CFG,
+        sweep="pixel",
+    log:
+        f"{APPROACH}/logs/ablation_pixel.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/ablation_pixel.tsv"
+    script:
+        "../scripts/approach_ablation.py"
+
+
+rule approach_ablation_segment:
+    """A-X3: segment-length sweep (approach.ablation.segment_N) of the headline case per variant."""
+    input:
+        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "figures.py", "tables.py"),
+    output:
+        table=report_table(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
+        fig=report_figure(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
+    params:
+        approach=A_CFG,
+        sweep="segment",
+    log:
+        f"{APPROACH}/logs/ablation_segment.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/ablation_segment.tsv"
+    script:
+        "../scripts/approach_ablation.py"
+
+
+ALL_TARGETS.extend(rules.approach_x2_tables.output.table)
+ALL_TARGETS.append(rules.approach_x2_tables.output.summary)
+ALL_TARGETS.extend(rules.approach_x2_figure.output)
+ALL_TARGETS.extend(rules.approach_ablation_pixel.output)
+ALL_TARGETS.extend(rules.approach_ablation_segment.output)

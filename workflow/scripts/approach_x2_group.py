@@ -1,0 +1,28 @@
+"""A-X2: augmented EKF and batch ML on one Table-1 case group under one variant (one Snakemake job)."""
+
+import pickle
+from pathlib import Path
+
+from opnav.approach import alternatives as alt
+from opnav.approach import scenario as sc
+from opnav.approach.pipeline import cases_in
+from opnav.snakeio import mock_snakemake, script_context
+
+if "snakemake" not in globals():  # standalone debugging run
+    snakemake = mock_snakemake(output=["results/approach/work/x2/roll__size.pkl"],
+                               wildcards={"variant": "roll", "group": "size"})
+    snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
+
+with script_context(snakemake) as log:
+    w = snakemake.wildcards
+    cfg = snakemake.params.approach
+    res = alt.run_group_alternatives(cfg, w.variant, w.group, log=log)
+    em_times = {}
+    headline = [c for c in cases_in(cfg, w.group) if c.case_index == 1]
+    if headline:  # EM-EKF timed on the same machine and job, headline case, all seeds
+        geo = sc.build_geometry(cfg, w.variant)
+        em_times = alt.time_em(cfg, w.variant, headline[0], range(cfg["n_seeds"]), geo)
+        log.info("EM-EKF run time per seed: %s", em_times)
+    Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
+    with open(snakemake.output[0], "wb") as fh:
+        pickle.dump({"variant": w.variant, "group": w.group, "results": res, "em_times": em_times}, fh)
