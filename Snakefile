@@ -14,6 +14,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/approach.smk"
 include: "workflow/rules/approach_extra.smk"
 include: "workflow/rules/landing.smk"
+include: "workflow/rules/landing_extra.smk"
 include: "workflow/rules/paper.smk"
 
 

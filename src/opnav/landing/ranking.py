@@ -1,0 +1,210 @@
+"""Ranking of landmark-planning methods on a paired Monte Carlo (B-X1).
+
+Description
+-----------
+Every method flies the same runs: run ``i`` uses ``SeedSequence([base_seed,
+i])`` for its initial error, IMU and pixel noise (``opnav.landing.descent``),
+so per-run differences between two methods remove the run-to-run spread that
+the initial errors cause (paired design). For a per-run quantity ``x`` (e.g.
+the RMS position error norm, m) and methods ``a``, ``b`` the paired
+difference is ``d_i = x_a,i - x_b,i``; :func:`paired_difference` gives its
+mean with a two-sided paired-t interval (``mean +- t_{n-1} s_d / sqrt(n)``,
+Student's t with ``n - 1`` degrees of freedom) and a percentile bootstrap
+interval over runs, the t-test p-value, and the share of runs in which ``a``
+is lower. :func:`competition_rank` ranks with ties sharing the best rank
+(1, 2, 2, 4). :func:`ranking_table` builds the B-X1 table: per method the
+accuracy (mean and 3-sigma of final and RMS position and velocity error
+norms, NEES, landmarks used), planning time (median wall and CPU time of a planning call, us, and
+the ratio to the reference's), ranks by accuracy (mean RMS position error)
+and by time (median CPU time, which other processes on a shared machine do
+not inflate), and the paired comparison against the reference method.
+All functions are pure (no I/O).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from opnav.landing.montecarlo import per_run_stats, same_pick_pct
+
+__all__ = ["paired_t_interval", "bootstrap_mean_interval", "paired_difference",
+           "competition_rank", "ranking_table", "headline"]
+
+
+def paired_t_interval(d, level: float = 0.95) -> tuple[float, float, float, float]:
+    """Mean of the paired differences ``d`` with its two-sided paired-t
+    interval at ``level`` and the p-value of ``mean = 0``:
+    ``(mean, lo, hi, p)``. Zero spread gives the degenerate interval
+    ``(mean, mean)`` with ``p = 1`` if the mean is 0 else ``0``; fewer than two
+    differences give NaN bounds."""
+    d = np.asarray(d, float).ravel()
+    if d.size == 0 or not np.all(np.isfinite(d)):
+        raise ValueError("paired_t_interval: need finite paired differences")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"paired_t_interval: level must be in (0, 1), got {level}")
+    m = float(d.mean())
+    n = d.size
+    if n < 2:
+        return m, math.nan, math.nan, math.nan
+    s = float(d.std(ddof=1))
+    if s == 0.0:
+        return m, m, m, 1.0 if m == 0.0 else 0.0
+    se = s / math.sqrt(n)
+    q = float(stats.t.ppf(0.5 + level / 2.0, n - 1))
+    p = float(2.0 * stats.t.sf(abs(m) / se, n - 1))
+    return m, m - q * se, m + q * se, p
+
+
+def bootstrap_mean_interval(d, n_boot: int = 2000, seed: int = 0, level: float = 0.95
+                            ) -> tuple[float, float]:
+    """Percentile bootstrap interval of the mean of ``d`` (runs resampled with
+    replacement, ``n_boot`` times, generator ``default_rng(seed)``); NaN if
+    ``n_boot < 2`` or fewer than two values."""
+    d = np.asarray(d, float).ravel()
+    if n_boot < 2 or d.size < 2:
+        return math.nan, math.nan
+    rng = np.random.default_rng(seed)
+    means = d[rng.integers(0, d.size, size=(int(n_boot), d.size))].mean(axis=1)
+    a = (1.0 - level) / 2.0
+    lo, hi = np.quantile(means, [a, 1.0 - a])
+    return float(lo), float(hi)
+
+
+def paired_difference(a, b, n_boot: int = 2000, seed: int = 0, level: float = 0.95) -> dict:
+    """Paired comparison of per-run values ``a`` and ``b`` (same runs, same
+    order): ``mean`` of ``a - b``, paired-t ``t_lo``/``t_hi``/``p``, bootstrap
+    ``boot_lo``/``boot_hi``, ``a_lower_pct`` (share of runs with ``a < b``,
+    %), ``equal_pct`` (share with ``a == b``, %) and ``n``."""
+    a = np.asarray(a, float).ravel()
+    b = np.asarray(b, float).ravel()
+    if a.shape != b.shape:
+        raise ValueError(f"paired_difference: {a.size} vs {b.size} runs (must be the same runs)")
+    d = a - b
+    m, lo, hi, p = paired_t_interval(d, level)
+    blo, bhi = bootstrap_mean_interval(d, n_boot, seed, level)
+    return {"mean": m, "t_lo": lo, "t_hi": hi, "p": p, "boot_lo": blo, "boot_hi": bhi,
+            "a_lower_pct": float(100.0 * np.mean(a < b)),
+            "equal_pct": float(100.0 * np.mean(a == b)), "n": int(d.size)}
+
+
+def competition_rank(values, rtol: float = 0.0) -> np.ndarray:
+    """Ranks (1 = smallest) with ties sharing the best rank (``1, 2, 2, 4``).
+
+    Values within ``rtol`` (relative, of the larger magnitude) of the previous
+    value in sorted order tie with it; NaN ranks last (all NaN share a rank).
+    """
+    v = np.asarray(values, float).ravel()
+    if rtol < 0:
+        raise ValueError("competition_rank: rtol must be >= 0")
+    order = np.argsort(np.where(np.isnan(v), np.inf, v), kind="stable")
+    ranks = np.empty(v.size, np.int64)
+    prev = None
+    for pos, i in enumerate(order):
+        x = v[i]
+        if prev is not None:
+            px = v[prev]
+            same = (np.isnan(x) and np.isnan(px)) or (
+                not np.isnan(x) and not np.isnan(px)
+                and abs(x - px) <= rtol * max(abs(x), abs(px)))
+            if same:
+                ranks[i] = ranks[prev]
+                prev = i
+                continue
+        ranks[i] = pos + 1
+        prev = i
+    return ranks
+
+
+def _median_us(ns) -> float:
+    ns = np.asarray(ns)
+    return float(np.median(ns) / 1e3) if ns.size else math.nan
+
+
+def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int = 2000,
+                  seed: int = 0, level: float = 0.95, rtol: float = 0.0) -> pd.DataFrame:
+    """B-X1: one row per method of ``data`` (gathered Monte-Carlo dicts, same
+    runs), ranked; see the module docstring for the columns. Paired columns
+    ``d_rms_pos_vs_ref_*`` / ``d_final_pos_vs_ref_*`` are method minus
+    reference (m; negative = the method is more accurate)."""
+    if reference not in data:
+        raise ValueError(f"landing.extra.reference {reference!r} not among the methods {list(data)}")
+    st = {m: per_run_stats(d) for m, d in data.items()}
+    ref_runs = st[reference].index
+    for m, s in st.items():
+        if not s.index.equals(ref_runs):
+            raise ValueError(f"method {m!r} flew runs {list(s.index)[:5]}..., reference "
+                             f"{reference!r} flew {list(ref_runs)[:5]}...: not paired")
+    ref_cpu = _median_us(data[reference]["plan_cpu_ns"])
+    rows = []
+    for m, d in data.items():
+        s = st[m]
+        n = len(s)
+        row = {"method": m, "n_runs": n}
+        for q in ("pos_err_m", "vel_err_mps"):    # attitude: see the envelopes (yaw unobservable)
+            for kind in ("rms", "final"):
+                col = s[f"{kind}_{q}"]
+                row[f"{kind}_{q}_mean"] = float(col.mean())
+                row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if n > 1 else math.nan
+        row["final_pos_err_m_median"] = float(s["final_pos_err_m"].median())
+        row["mean_nees_pos"] = float(s["mean_nees_pos"].mean())
+        row["landmarks_per_run"] = float(s["n_landmarks"].mean())
+        row["plan_calls"] = int(len(d["plan_ns"]))
+        row["median_plan_time_us"] = _median_us(d["plan_ns"])
+        row["median_plan_cpu_us"] = _median_us(d["plan_cpu_ns"])
+        row["cpu_time_ratio_to_ref"] = row["median_plan_cpu_us"] / ref_cpu
+        for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos")):
+            pdiff = paired_difference(s[key].to_numpy(), st[reference][key].to_numpy(),
+                                      n_boot=n_boot, seed=seed, level=level)
+            for k in ("mean", "t_lo", "t_hi", "boot_lo", "boot_hi", "p"):
+                row[f"d_{name}_vs_ref_{k}"] = pdiff[k]
+            if name == "rms_pos":
+                row["ref_better_pct"] = 100.0 - pdiff["a_lower_pct"] - pdiff["equal_pct"]
+                row["equal_to_ref_pct"] = pdiff["equal_pct"]
+        row["same_pick_as_ref_pct"] = (100.0 if m == reference
+                                       else same_pick_pct(d, data[reference]))
+        lo, hi = row["d_rms_pos_vs_ref_t_lo"], row["d_rms_pos_vs_ref_t_hi"]
+        row["vs_ref"] = ("reference" if m == reference else
+                         "n/a" if math.isnan(lo) else
+                         "worse" if lo > 0 else "better" if hi < 0 else "not significant")
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    df.insert(1, "rank_accuracy", competition_rank(df["rms_pos_err_m_mean"], rtol))
+    df.insert(2, "rank_time", competition_rank(df["median_plan_cpu_us"], rtol))
+    return df.sort_values(["rank_accuracy", "rank_time", "method"], kind="stable").reset_index(drop=True)
+
+
+def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
+    """Headline numbers of a :func:`ranking_table` for the manuscript macros."""
+    def clean(x):
+        if isinstance(x, (float, np.floating)):
+            return None if math.isnan(float(x)) else float(x)
+        if isinstance(x, np.integer):
+            return int(x)
+        return x
+
+    t = df.set_index("method")
+    others = [m for m in t.index if m != reference]
+    ref = t.loc[reference]
+    best_acc = t["rms_pos_err_m_mean"].idxmin()
+    fastest = t["median_plan_cpu_us"].idxmin()
+    return {
+        "reference": reference,
+        "methods": {m: {k: clean(v) for k, v in t.loc[m].items()} for m in t.index},
+        "ranking_by_accuracy": list(t.sort_values(["rank_accuracy", "rank_time"]).index),
+        "ranking_by_time": list(t.sort_values(["rank_time", "rank_accuracy"]).index),
+        "best_accuracy_method": best_acc,
+        "fastest_method": fastest,
+        "reference_rank_accuracy": int(ref["rank_accuracy"]),
+        "reference_rank_time": int(ref["rank_time"]),
+        "n_methods": int(len(t)),
+        "n_runs": int(ref["n_runs"]),
+        "reference_more_accurate_than": [m for m in others if t.loc[m, "vs_ref"] == "worse"],
+        "reference_less_accurate_than": [m for m in others if t.loc[m, "vs_ref"] == "better"],
+        "not_significant_vs_reference": [m for m in others if t.loc[m, "vs_ref"] == "not significant"],
+        "reference_faster_than": [m for m in others
+                                  if t.loc[m, "median_plan_cpu_us"] > ref["median_plan_cpu_us"]],
+    }

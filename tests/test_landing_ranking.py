@@ -1,0 +1,197 @@
+"""B-X1 ranking / paired statistics and B-X2 ablation plumbing (paper B, beyond)."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import stats
+
+from conftest import REPO
+from opnav.config import load_config
+from opnav.landing.ablation import (SWEEPS, default_value, parse_value, sweep_table, value_label,
+                                    with_value)
+from opnav.landing.montecarlo import run_chunk
+from opnav.landing.ranking import (bootstrap_mean_interval, competition_rank, headline,
+                                   paired_difference, paired_t_interval, ranking_table)
+
+
+# ------------------------------------------------------------ paired statistics
+
+def test_paired_t_known_answer():
+    # d = 1..5: mean 3, s = sqrt(2.5), se = sqrt(0.5), t_{0.975, 4} = 2.776445
+    m, lo, hi, p = paired_t_interval([1, 2, 3, 4, 5])
+    half = 2.7764451051977987 * math.sqrt(0.5)
+    assert m == 3.0
+    assert lo == pytest.approx(3 - half, rel=1e-12)
+    assert hi == pytest.approx(3 + half, rel=1e-12)
+    # t = 3 / sqrt(0.5) = 4.2426 with 4 dof: two-sided p = 0.01324
+    assert p == pytest.approx(0.013236, abs=2e-6)
+
+
+def test_paired_t_matches_scipy_ttest_rel():
+    rng = np.random.default_rng(1)
+    a = rng.normal(10, 2, 40)
+    b = a + rng.normal(0.3, 0.5, 40)
+    m, lo, hi, p = paired_t_interval(a - b, 0.9)
+    ref = stats.ttest_rel(a, b)
+    ci = ref.confidence_interval(0.9)
+    assert (lo, hi) == pytest.approx((ci.low, ci.high), rel=1e-10)
+    assert p == pytest.approx(ref.pvalue, rel=1e-10)
+
+
+def test_paired_t_degenerate_and_errors():
+    assert paired_t_interval([2.0, 2.0, 2.0]) == (2.0, 2.0, 2.0, 0.0)
+    assert paired_t_interval([0.0, 0.0]) == (0.0, 0.0, 0.0, 1.0)
+    m, lo, hi, p = paired_t_interval([1.5])
+    assert m == 1.5 and math.isnan(lo) and math.isnan(hi)
+    with pytest.raises(ValueError):
+        paired_t_interval([])
+    with pytest.raises(ValueError):
+        paired_t_interval([1.0, np.nan])
+    with pytest.raises(ValueError, match="same runs"):
+        paired_difference([1, 2, 3], [1, 2])
+
+
+def test_pairing_removes_shared_run_spread():
+    """Large run-to-run spread shared by both methods: the paired interval is
+    narrow and excludes 0, the unpaired (Welch) one does not."""
+    rng = np.random.default_rng(3)
+    base = rng.lognormal(5, 1, 60)            # run difficulty, common to both
+    a = base + 2.0 + rng.normal(0, 0.5, 60)
+    b = base + rng.normal(0, 0.5, 60)
+    d = paired_difference(a, b, n_boot=500)
+    assert 0 < d["t_lo"] < 2.0 < d["t_hi"] < 2.6
+    assert d["boot_lo"] > 0
+    welch = stats.ttest_ind(a, b, equal_var=False)
+    assert welch.pvalue > 0.05 and d["p"] < 1e-10
+    assert d["a_lower_pct"] < 5.0 and d["equal_pct"] == 0.0
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.floats(-1e3, 1e3, allow_nan=False), min_size=3, max_size=40),
+       st.floats(-50, 50, allow_nan=False))
+def test_bootstrap_interval_shift_equivariant(d, c):
+    d = np.asarray(d)
+    lo, hi = bootstrap_mean_interval(d, 200, seed=5)
+    lo2, hi2 = bootstrap_mean_interval(d + c, 200, seed=5)
+    assert lo <= hi
+    assert d.min() - 1e-9 <= lo and hi <= d.max() + 1e-9
+    assert lo2 == pytest.approx(lo + c, abs=1e-6) and hi2 == pytest.approx(hi + c, abs=1e-6)
+
+
+# --------------------------------------------------------------------- ranking
+
+def test_competition_rank_ties():
+    assert list(competition_rank([3.0, 1.0, 2.0, 2.0])) == [4, 1, 2, 2]
+    assert list(competition_rank([5.0, 5.0, 5.0])) == [1, 1, 1]
+    assert list(competition_rank([2.0, np.nan, 1.0, np.nan])) == [2, 3, 1, 3]
+    # within the relative tolerance: a tie; outside: not
+    assert list(competition_rank([1.0, 1.0 + 1e-12, 2.0], rtol=1e-9)) == [1, 1, 3]
+    assert list(competition_rank([1.0, 1.0 + 1e-12, 2.0])) == [1, 2, 3]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.integers(0, 5), min_size=1, max_size=12))
+def test_competition_rank_property(v):
+    r = competition_rank(v)
+    v = np.asarray(v)
+    for i in range(len(v)):
+        assert r[i] == 1 + np.sum(v < v[i])       # standard competition ranking
+
+
+def _fake_mc(rms_scale, runs, plan_us, seed):
+    """A gathered Monte-Carlo dict with position errors scaled per run."""
+    rng = np.random.default_rng(seed)
+    n, k = len(runs), 5
+    err = np.ones((n, k, 3)) * np.asarray(rms_scale, float)[:, None, None]
+    z = np.zeros((n, k, 3))
+    plan_run = np.repeat(runs, 3)
+    return {"run_index": np.asarray(runs), "t": np.arange(k, dtype=float), "err_r": err, "err_v": z,
+            "err_th_deg": z, "err_rpy_deg": z, "nees_r": np.ones((n, k)), "nees_v": np.ones((n, k)),
+            "n_landmarks": np.full(n, 4), "plan_ns": np.full(3 * n, plan_us * 1e3),
+            "plan_cpu_ns": (plan_us * 1e3 * (1 + 0.01 * rng.random(3 * n))).astype(np.int64),
+            "plan_evals": np.full(3 * n, 10), "plan_run": plan_run,
+            "plan_t": np.tile([1.0, 2.0, 3.0], n), "plan_index": np.tile([1, 2, 3], n)}
+
+
+def test_ranking_table_ties_and_paired_difference():
+    runs = np.arange(6)
+    base = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    data = {"depth": _fake_mc(base, runs, 100.0, 0),
+            "svd": _fake_mc(base + 1.0, runs, 800.0, 1),
+            "gdop": _fake_mc(base + 1.0, runs, 900.0, 2),     # same errors as svd: a tie
+            "random": _fake_mc(base * 0.5, runs, 50.0, 3)}
+    df = ranking_table(data, "depth", n_boot=100)
+    t = df.set_index("method")
+    assert t.loc["random", "rank_accuracy"] == 1
+    assert t.loc["depth", "rank_accuracy"] == 2
+    assert t.loc["svd", "rank_accuracy"] == t.loc["gdop", "rank_accuracy"] == 3
+    assert list(t["rank_time"].loc[["random", "depth", "svd", "gdop"]]) == [1, 2, 3, 4]
+    # error norm = sqrt(3) * scale: svd - depth = sqrt(3) exactly in every run
+    assert t.loc["svd", "d_rms_pos_vs_ref_mean"] == pytest.approx(math.sqrt(3))
+    assert t.loc["svd", "d_rms_pos_vs_ref_t_lo"] == pytest.approx(math.sqrt(3))
+    assert t.loc["svd", "vs_ref"] == "worse" and t.loc["random", "vs_ref"] == "better"
+    assert t.loc["svd", "ref_better_pct"] == 100.0
+    assert t.loc["depth", "d_rms_pos_vs_ref_mean"] == 0.0 and t.loc["depth", "vs_ref"] == "reference"
+    assert t.loc["svd", "same_pick_as_ref_pct"] == 100.0
+    h = headline(df, "depth")
+    assert h["best_accuracy_method"] == "random" and h["fastest_method"] == "random"
+    assert h["reference_rank_accuracy"] == 2
+    assert set(h["reference_more_accurate_than"]) == {"svd", "gdop"}
+    assert h["reference_faster_than"] == ["svd", "gdop"] or set(h["reference_faster_than"]) == {"svd", "gdop"}
+
+
+def test_ranking_refuses_unpaired_runs():
+    a = _fake_mc(np.ones(3), np.arange(3), 1.0, 0)
+    b = _fake_mc(np.ones(3), np.arange(1, 4), 1.0, 0)
+    with pytest.raises(ValueError, match="not paired"):
+        ranking_table({"depth": a, "svd": b})
+    with pytest.raises(ValueError, match="reference"):
+        ranking_table({"svd": a}, reference="depth")
+
+
+# -------------------------------------------------------------------- ablation
+
+def test_ablation_value_labels_and_config_keys():
+    cfg = load_config(REPO / "config" / "config.yaml")["landing"]
+    assert value_label("fov", 60.0) == "60" and value_label("fov", 22.5) == "22.5"
+    assert value_label("obs", 3) == "3"
+    assert parse_value("fov", "60", [45.0, 60.0]) == 60.0
+    with pytest.raises(ValueError, match="landing.ablation.fov_deg"):
+        parse_value("fov", "61", [45.0, 60.0])
+    with pytest.raises(ValueError, match="unknown ablation sweep"):
+        with_value(cfg, "pixels", 1)
+    for name, (key, section, sub, _, _) in SWEEPS.items():
+        assert key in cfg["ablation"]
+        new = with_value(cfg, name, 7)
+        assert new[section][sub] == 7 and cfg[section][sub] != 7       # copy, not in place
+        assert {k: v for k, v in new.items() if k != section} == \
+            {k: v for k, v in cfg.items() if k != section}
+
+
+def test_ablation_run_at_default_value_equals_main_run():
+    """Seeds depend on the run index only: ablation run i at the configured value
+    is main Monte-Carlo run i (bit for bit); another value changes the run."""
+    cfg = load_config(REPO / "config" / "quick.yaml")["landing"]
+    main = run_chunk(cfg, "depth", [1])
+    for name in ("fov", "obs"):
+        abl = run_chunk(with_value(cfg, name, default_value(cfg, name)), "depth", [1])
+        for k in ("err_r", "err_v", "err_th_deg", "nees_r", "plan_index", "plan_t", "init_error"):
+            assert np.array_equal(main[k], abl[k]), (name, k)
+    other = run_chunk(with_value(cfg, "obs", default_value(cfg, "obs") + 2), "depth", [1])
+    assert np.array_equal(other["init_error"], main["init_error"])      # same draws (paired)
+    assert not np.array_equal(other["err_r"], main["err_r"])            # different setting
+
+
+def test_sweep_table_rows():
+    runs = np.arange(4)
+    d = {45.0: {"depth": _fake_mc(np.ones(4), runs, 100.0, 0), "svd": _fake_mc(2 * np.ones(4), runs, 900.0, 1)},
+         60.0: {"depth": _fake_mc(3 * np.ones(4), runs, 100.0, 2), "svd": _fake_mc(np.ones(4), runs, 900.0, 3)}}
+    df = sweep_table("fov", d)
+    assert list(df["fov_deg"]) == [45.0, 45.0, 60.0, 60.0]
+    assert list(df["method"]) == ["depth", "svd", "depth", "svd"]
+    assert df["final_pos_err_m_mean"].to_numpy() == pytest.approx(math.sqrt(3) * np.array([1, 2, 3, 1]))
+    assert df["final_pos_err_m_3sigma"].to_numpy() == pytest.approx(0.0)
+    assert (df["n_runs"] == 4).all() and (df["landmarks_per_run"] == 4).all()

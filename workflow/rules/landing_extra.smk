@@ -1,0 +1,119 @@
+# Paper B beyond the paper (SPEC B.4 B-X1) and one-value ablations (B-X2).
+# Included right after landing.smk: reuses its LANDING, B_SIM, B_SRC, B_METHODS and
+# its Monte-Carlo wildcard rules (an extra method is one more gathered
+# results/landing/mc/{method}.npz, same runs, same seeds).
+from opnav.landing.ablation import SWEEPS as _B_SWEEPS, value_label as _b_value_label
+
+_BX = config["landing"]["extra"]
+X1_METHODS = list(B_METHODS) + [m for m in _BX["methods"] if m not in B_METHODS]
+
+
+rule landing_x1_summary:
+    """B-X1: all methods on the paired Monte Carlo, envelopes, ranking table, summary JSON."""
+    input:
+        mc=[f"{LANDING}/mc/{m}.npz" for m in X1_METHODS],
+        code=src("landing/ranking.py", "landing/montecarlo.py", "landing/plots.py", "tables.py",
+                 "figures.py", "opnav.mplstyle"),
+    output:
+        f=report_figure(f"{LANDING}/B-X1_envelopes", "B-X1", "Paper B", "beyond"),
+        t=report_table(f"{LANDING}/B-X1_ranking", "B-X1", "Paper B"),
+        summary=f"{LANDING}/B-X1-summary.json",
+    params:
+        methods=X1_METHODS,
+        extra=canonical(config["landing"]["extra"]),
+    log:
+        f"{LANDING}/logs/x1_summary.log",
+    localrule: True
+    script:
+        "../scripts/landing_x1_summary.py"
+
+
+ALL_TARGETS.extend(rules.landing_x1_summary.output)
+
+
+# ---------------------------------------------------------------- ablations
+# Sweep "fov" changes landing.camera.fov_deg, "obs" landing.filter.obs_per_landmark
+# (opnav.landing.ablation.SWEEPS); each value flies runs 0..n_runs-1 with the main
+# Monte Carlo's seeds (run index only), scattered over (sweep, value, chunk) jobs.
+_BA = config["landing"]["ablation"]
+ABL_METHODS = list(_BA["methods"])
+ABL_VALUES = {s: {_b_value_label(s, v): v for v in _BA[_B_SWEEPS[s][0]]} for s in _B_SWEEPS}
+_na, _ka = _BA["n_runs"], _BA["runs_per_job"]
+ABL_CHUNKS = [list(range(a, min(a + _ka, _na))) for a in range(0, _na, _ka)]
+
+
+def _abl_chunks(sweep):
+    return [f"{LANDING}/ablation/{sweep}/{lab}/{m}_{i:03d}.npz"
+            for lab in ABL_VALUES[sweep] for i in range(len(ABL_CHUNKS)) for m in ABL_METHODS]
+
+
+rule landing_ablation_chunk:
+    """One ablation job: runs of every ablation method at one swept value (scatter)."""
+    input:
+        B_SRC,
+        src("landing/ablation.py"),
+    output:
+        [f"{LANDING}/ablation/{{bsweep}}/{{bvalue}}/{m}_{{bchunk}}.npz" for m in ABL_METHODS],
+    wildcard_constraints:
+        bsweep="|".join(_B_SWEEPS),
+        bvalue="[0-9][0-9.]*",
+        bchunk="[0-9]{3}",
+    params:
+        landing=B_SIM,
+        methods=ABL_METHODS,
+        value=lambda wc: ABL_VALUES[wc.bsweep][wc.bvalue],
+        runs=lambda wc: ABL_CHUNKS[int(wc.bchunk)],
+    log:
+        f"{LANDING}/logs/ablation_{{bsweep}}_{{bvalue}}_{{bchunk}}.log",
+    benchmark:
+        f"{LANDING}/benchmarks/ablation_{{bsweep}}_{{bvalue}}_{{bchunk}}.tsv"
+    script:
+        "../scripts/landing_ablation_chunk.py"
+
+
+rule landing_ablation_fov:
+    """B-X2: camera field of view swept (table + figure)."""
+    input:
+        runs=_abl_chunks("fov"),
+        code=src("landing/ablation.py", "landing/montecarlo.py", "tables.py", "figures.py",
+                 "opnav.mplstyle"),
+    output:
+        t=report_table(f"{LANDING}/B-X2_ablation_fov", "B-X2", "Paper B"),
+        f=report_figure(f"{LANDING}/B-X2_ablation_fov", "B-X2", "Paper B", "ablation"),
+    params:
+        sweep="fov",
+        values=list(ABL_VALUES["fov"].values()),
+        methods=ABL_METHODS,
+        default=config["landing"]["camera"]["fov_deg"],
+        converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
+    log:
+        f"{LANDING}/logs/ablation_fov.log",
+    localrule: True
+    script:
+        "../scripts/landing_ablation.py"
+
+
+rule landing_ablation_obs:
+    """B-X2: observations per landmark swept (table + figure)."""
+    input:
+        runs=_abl_chunks("obs"),
+        code=src("landing/ablation.py", "landing/montecarlo.py", "tables.py", "figures.py",
+                 "opnav.mplstyle"),
+    output:
+        t=report_table(f"{LANDING}/B-X2_ablation_obs", "B-X2", "Paper B"),
+        f=report_figure(f"{LANDING}/B-X2_ablation_obs", "B-X2", "Paper B", "ablation"),
+    params:
+        sweep="obs",
+        values=list(ABL_VALUES["obs"].values()),
+        methods=ABL_METHODS,
+        default=config["landing"]["filter"]["obs_per_landmark"],
+        converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
+    log:
+        f"{LANDING}/logs/ablation_obs.log",
+    localrule: True
+    script:
+        "../scripts/landing_ablation.py"
+
+
+ALL_TARGETS.extend(rules.landing_ablation_fov.output)
+ALL_TARGETS.extend(rules.landing_ablation_obs.output)

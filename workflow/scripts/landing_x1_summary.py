@@ -1,0 +1,42 @@
+"""B-X1: every planning method (paper's four + extra) on the same paired Monte
+Carlo: 3-sigma envelopes figure, ranking table with paired comparison against
+the reference (depth), and B-X1-summary.json for the manuscript macros."""
+
+import json
+
+from opnav import figures
+from opnav.landing import plots
+from opnav.landing.montecarlo import load
+from opnav.landing.ranking import headline, ranking_table
+from opnav.snakeio import mock_snakemake, script_context
+from opnav.tables import write_table
+
+if "snakemake" not in globals():  # standalone debugging run
+    _m = ["depth", "svd", "gdop", "cond", "logdet", "mineig", "random", "center"]
+    snakemake = mock_snakemake(
+        input={"mc": [f"results/landing/mc/{m}.npz" for m in _m]},
+        output={"f": ["results/landing/B-X1_envelopes.pdf", "results/landing/B-X1_envelopes.png"],
+                "t": ["results/landing/B-X1_ranking.csv"],
+                "summary": "results/landing/B-X1-summary.json"})
+    snakemake.params = type("P", (), {"methods": _m,
+                                      "extra": {"reference": "depth", "n_boot": 2000}})()
+
+with script_context(snakemake) as log:
+    methods = list(snakemake.params.methods)
+    data = {m: load(p) for m, p in zip(methods, snakemake.input.mc)}
+    ref = snakemake.params.extra["reference"]
+    n_boot = int(snakemake.params.extra["n_boot"])
+    df = ranking_table(data, reference=ref, n_boot=n_boot, seed=0)
+    write_table(df, snakemake.output.t,
+                caption=(f"B-X1: all planning methods on the same paired Monte Carlo, ranked by mean "
+                         f"RMS position error (rank_accuracy) and by median planning-call CPU time "
+                         f"(rank_time; ties share the best rank); paired differences method minus "
+                         f"{ref} of the per-run RMS and final position errors (m) with 95 % paired-t "
+                         f"and bootstrap ({n_boot} resamples) intervals."))
+    t = next(iter(data.values()))["t"]
+    figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f)
+    out = headline(df, ref)
+    out["n_boot"] = n_boot
+    with open(snakemake.output.summary, "w") as fh:
+        json.dump(out, fh, indent=2, sort_keys=True)
+    log.info("B-X1:\n%s", df.to_string())
