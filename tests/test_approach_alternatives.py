@@ -1,0 +1,213 @@
+"""A-X2 alternatives: augmented EKF and batch ML (CasADi + IPOPT) against EM and the CRLB."""
+
+import numpy as np
+import pytest
+
+from approach_helpers import small_window
+from opnav.approach import ablation, alternatives, crlb
+from opnav.approach import scenario as sc
+from opnav.approach.augmented import run_augmented
+from opnav.approach.batch_ml import BatchML
+from opnav.approach.em import em_window
+from opnav.config import load_config
+
+N_SAMPLES = 600
+TRUTH = np.array([10.0, 20.0, 10.0])
+
+
+def _cfg():
+    cfg = load_config()["approach"]
+    cfg["initial_error"]["mode"] = "sampled"  # prior mean drawn about the truth: a proper Bayesian setup
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def roll_case():
+    """Roll variant from the prior at t0, 600 samples (5 min, 30 deg of roll): theta is observable."""
+    cfg = _cfg()
+    geo = sc.build_geometry(cfg, "roll", n=N_SAMPLES)
+    Rvar = sc.measurement_variance(geo, cfg, [0.1, 0.1, 0.2])
+    win = geo.window(Rvar)
+    bound = sc.arcsec(crlb.crlb_curve(win, geo.u_true, geo.P0, sc.rad(TRUTH), 0.01)[-1])
+    return cfg, geo, win, bound
+
+
+def _data(geo, win, truth, seeds, base=11):
+    z, e0 = sc.simulate(geo, win.Rvar, sc.rad(truth), sc.seed_streams(base, 1, seeds))
+    return z, sc.prior_mean_deviation(geo, e0, "sampled")
+
+
+def test_bound_is_informative(roll_case):
+    _, _, _, bound = roll_case
+    assert bound[:2].max() < 3.0  # arcsec: a case where theta is well observable
+    assert bound[2] > 1000.0  # tz: unobservable, stays at the diffuse prior
+
+
+def test_augmented_batch_ml_and_em_agree(roll_case):
+    """All three estimators are within a few CRLB sigma of the truth; batch ML and converged EM
+    maximise the same observed-data likelihood, so they agree far more closely."""
+    _, geo, win, bound = roll_case
+    S = 3
+    z, dx0 = _data(geo, win, TRUTH, range(S))
+    th0 = np.zeros((S, 3))
+    aug = run_augmented(z, dx0, geo.P0, th0, sc.rad(100.0), win)
+    bm = BatchML(win, [win.n], sc.rad(3600.0), jit=False)
+    ml = bm.solve(z, dx0, geo.P0, th0, geo.u_ref)
+    em = em_window(z, th0, dx0, geo.P0, win, 30, "squarem")
+    est = {"augmented": sc.arcsec(aug.theta[:, -1]), "batch_ml": sc.arcsec(ml.theta[:, -1]),
+           "em": sc.arcsec(em.theta[-1])}
+    for name, th in est.items():
+        assert np.all(np.abs(th[:, :2] - TRUTH[:2]) < 4.0 * bound[:2]), name
+    assert ml.success.all()
+    np.testing.assert_allclose(est["batch_ml"][:, :2], est["em"][:, :2], atol=0.05 * bound[:2].max())
+    np.testing.assert_allclose(est["augmented"][:, :2], est["batch_ml"][:, :2], atol=1.0 * bound[:2].max())
+
+
+def test_batch_ml_solution_is_stationary_and_gradient_exact(roll_case):
+    _, geo, win, bound = roll_case
+    z, dx0 = _data(geo, win, TRUTH, [5])
+    bm = BatchML(win, [win.n // 2, win.n], sc.rad(3600.0), jit=False)
+    res = bm.solve(z, dx0, geo.P0, np.zeros(3), geo.u_ref)
+    for j in range(2):
+        p = bm.params(z[0, 1:] - geo.u_ref[1:], dx0[0], geo.P0, np.zeros(3))
+        f, g = bm.objective[j](sc.arcsec(res.theta[0, j]), p)
+        g = np.asarray(g).ravel()
+        # score in units of its own standard deviation (Fisher information ~ 1/CRLB^2): ~0
+        assert np.all(np.abs(g[:2]) * bound[:2] < 1e-5)
+        assert res.grad_norm[0, j] == pytest.approx(np.linalg.norm(g))
+    # the CasADi gradient matches central differences of the objective
+    th = np.array([3.0, -4.0, 2.0])
+    f0, g0 = bm.objective[-1](th, p)
+    h = 1e-3
+    fd = [(float(bm.objective[-1](th + h * e, p)[0]) - float(bm.objective[-1](th - h * e, p)[0])) / (2 * h)
+          for e in np.eye(3)]
+    np.testing.assert_allclose(np.asarray(g0).ravel()[:2], fd[:2], rtol=1e-5)
+
+
+def test_score_at_truth_has_zero_mean(roll_case):
+    """E[d log p(z|theta)/d theta] = 0 at the true theta (data and prior mean drawn from the model)."""
+    _, geo, win, bound = roll_case
+    S = 8
+    z, dx0 = _data(geo, win, TRUTH, range(S), base=23)
+    bm = BatchML(win, [win.n], sc.rad(1.0e6), jit=False)  # prior gradient negligible
+    scores = []
+    for s in range(S):
+        p = bm.params(z[s, 1:] - geo.u_ref[1:], dx0[s], geo.P0, np.zeros(3))
+        scores.append(np.asarray(bm.objective[0](TRUTH, p)[1]).ravel()[:2])
+    scores = np.array(scores)
+    fisher_sd = 1.0 / bound[:2]  # sd of the score = sqrt(Fisher information)
+    zstat = scores.mean(0) / (fisher_sd / np.sqrt(S))
+    assert np.all(np.abs(zstat) < 4.0)
+    assert np.all(scores.std(0) < 3.0 * fisher_sd)  # and its spread is the Fisher information's
+
+
+def test_batch_ml_zero_bias_truth(roll_case):
+    _, geo, win, bound = roll_case
+    S = 2
+    z, dx0 = _data(geo, win, np.zeros(3), range(S), base=31)
+    bm = BatchML(win, [win.n], sc.rad(3600.0), jit=False)
+    res = bm.solve(z, dx0, geo.P0, sc.rad([5.0, -5.0, 0.0]), geo.u_ref)
+    assert np.all(np.abs(sc.arcsec(res.theta[:, -1, :2])) < 4.0 * bound[:2])
+
+
+def test_jit_gives_the_same_objective(roll_case):
+    _, geo, win, _ = roll_case
+    z, dx0 = _data(geo, win, TRUTH, [0])
+    vals = []
+    for jit in (False, True):
+        bm = BatchML(win.slice(0, 100), [100], sc.rad(3600.0), jit=jit)
+        p = bm.params(z[0, 1:101] - geo.u_ref[1:101], dx0[0], geo.P0, np.zeros(3))
+        f, g = bm.objective[0](TRUTH, p)
+        vals.append(np.r_[float(f), np.asarray(g).ravel()])
+    np.testing.assert_allclose(vals[0], vals[1], rtol=1e-10)
+
+
+def test_linear_augmented_filter_attains_the_crlb():
+    """On the linear-Gaussian model the augmented Kalman filter's theta covariance equals the
+    Bayesian CRLB from the dense joint information of X_0..X_n and theta."""
+    win, rng = small_window(n=8, seed=3)
+    u_lin = win.u_ref + rng.standard_normal(win.u_ref.shape)
+    P0 = np.diag([4.0, 3.0, 2.0, 1.0, 1.0, 0.5])
+    sig = 0.05
+    z = rng.standard_normal((1, win.n + 1, 3))  # the covariance does not depend on the data
+    res = run_augmented(z, np.zeros((1, 6)), P0, np.zeros(3), sig, win, u_lin=u_lin)
+    dense = crlb.batch_crlb(win, u_lin, P0, np.zeros(3), sig)
+    np.testing.assert_allclose(np.sqrt(np.diag(res.P_theta[0, -1])), dense, rtol=1e-7)
+    # and the recursion shared with A-X1 gives the same sequence
+    rec = crlb.crlb_curve(win, u_lin, P0, np.zeros(3), sig)
+    np.testing.assert_allclose(np.sqrt(np.diagonal(res.P_theta[0], axis1=1, axis2=2)), rec, rtol=1e-7)
+
+
+def test_linear_augmented_filter_mean_is_the_gls_solution():
+    """Linear model: the filter's final theta equals the dense posterior mean (GLS)."""
+    win, rng = small_window(n=6, seed=4, q=0.05)
+    u_lin = win.u_ref.copy()
+    P0 = np.eye(6)
+    sig = 0.1
+    n = win.n
+    dim = 6 * (n + 1) + 3
+    J = np.zeros((dim, dim))
+    J[:6, :6] = np.linalg.inv(P0)
+    J[-3:, -3:] = np.eye(3) / sig**2
+    Qi = np.linalg.inv(win.Q)
+    b = np.zeros(dim)
+    z = np.full((1, n + 1, 3), np.nan)
+    from opnav.approach.camera import skew
+    for k in range(1, n + 1):
+        D = np.zeros((6, dim))
+        D[:, 6 * k:6 * k + 6] = np.eye(6)
+        D[:, 6 * (k - 1):6 * k] = -win.Phi[k]
+        J += D.T @ Qi @ D
+        M = np.zeros((3, dim))
+        M[:, 6 * k:6 * k + 3] = -win.C[k]
+        M[:, -3:] = skew(u_lin[k])
+        z[0, k] = win.u_ref[k] + rng.standard_normal(3)
+        W = np.diag(1.0 / win.Rvar[k])
+        J += M.T @ W @ M
+        b += M.T @ W @ (z[0, k] - win.u_ref[k])
+    post = np.linalg.solve(J, b)
+    res = run_augmented(z, np.zeros((1, 6)), P0, np.zeros(3), sig, win, u_lin=u_lin)
+    np.testing.assert_allclose(res.theta[0, -1], post[-3:], rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(res.xf[0, -1], post[6 * n:6 * n + 6], rtol=1e-6, atol=1e-10)
+
+
+def test_ekf_theta_covariance_approaches_the_crlb(roll_case):
+    """The (nonlinear) augmented EKF's theta covariance is close to the bound at the truth."""
+    _, geo, win, _ = roll_case
+    z, dx0 = _data(geo, win, TRUTH, [2])
+    sig = sc.rad(100.0)  # the pipeline's default prior on theta
+    res = run_augmented(z, dx0, geo.P0, np.zeros(3), sig, win)
+    bound = crlb.crlb_curve(win, geo.u_true, geo.P0, sc.rad(TRUTH), sig)[-1]
+    np.testing.assert_allclose(np.sqrt(np.diag(res.P_theta[0, -1]))[:2], bound[:2], rtol=0.05)
+
+
+def test_augmented_input_errors():
+    win, _ = small_window(n=3)
+    with pytest.raises(ValueError, match="samples"):
+        run_augmented(np.zeros((1, 2, 3)), np.zeros((1, 6)), np.eye(6), np.zeros(3), 1.0, win)
+    with pytest.raises(ValueError, match="theta_prior_sigma"):
+        run_augmented(np.zeros((1, 4, 3)), np.zeros((1, 6)), np.eye(6), np.zeros(3), 0.0, win)
+    with pytest.raises(ValueError, match="checkpoints"):
+        BatchML(win, [2, 2], 1.0, jit=False)
+
+
+def test_checkpoint_samples_keep_the_last():
+    seg = np.arange(1, 11) * 50
+    np.testing.assert_array_equal(alternatives.checkpoint_samples(seg, 4), [100, 300, 500])
+    np.testing.assert_array_equal(alternatives.checkpoint_samples(seg, 1), seg)
+    assert alternatives.checkpoint_samples(seg, 100)[-1] == 500
+
+
+def test_ablation_sweeps_change_one_value():
+    cfg = load_config()["approach"]
+    base = cfg["segments"]["L"] * cfg["segments"]["N"]
+    for value, c, case in ablation.sweep_configs(cfg, "segment"):
+        assert c["segments"]["N"] == value
+        assert abs(c["segments"]["L"] * c["segments"]["N"] - base) <= value / 2
+        assert case.sigma3_px == tuple(cfg["camera"]["sigma3_px"])
+    for value, c, case in ablation.sweep_configs(cfg, "pixel"):
+        r = cfg["camera"]["radius_to_centroid_ratio"]
+        assert case.sigma3_px == (value, value, r * value)
+        assert c["segments"] == cfg["segments"]
+    with pytest.raises(ValueError, match="sweep"):
+        ablation.sweep_configs(cfg, "nope")
