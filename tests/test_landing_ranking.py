@@ -195,3 +195,6 @@ def test_sweep_table_rows():
     assert df["final_pos_err_m_mean"].to_numpy() == pytest.approx(math.sqrt(3) * np.array([1, 2, 3, 1]))
     assert df["final_pos_err_m_3sigma"].to_numpy() == pytest.approx(0.0)
     assert (df["n_runs"] == 4).all() and (df["landmarks_per_run"] == 4).all()
+    d[60.0]["svd"]["plan_index"][:3] = -1                 # 3 of 12 plans chose nothing
+    df = sweep_table("fov", d)
+    assert list(df["no_pick_pct"]) == [0.0, 0.0, 0.0, 25.0]

@@ -28,7 +28,8 @@ PANELS = (("final_pos_err_m", "final position error (m)"),
           ("mean_nees_pos", "mean position NEES (-)"),
           ("landmarks_per_run", "landmarks used per run (-)"),
           ("median_plan_time_us", "median planning time (us)"),
-          ("median_plan_cpu_us", "median planning CPU time (us)"))
+          ("median_plan_cpu_us", "median planning CPU time (us)"),
+          ("no_pick_pct", "plans choosing no landmark (%)"))
 
 
 def figure(df, col, xlabel, methods, default):
@@ -37,7 +38,7 @@ def figure(df, col, xlabel, methods, default):
     from opnav.landing.plots import METHOD_COLORS, METHOD_LABELS
 
     with figures.style():
-        fig, axs = plt.subplots(2, 4, figsize=(figures.PAGE_WIDTH_IN, 3.6), sharex=True,
+        fig, axs = plt.subplots(3, 3, figsize=(figures.PAGE_WIDTH_IN, 5.4), sharex=True,
                                 constrained_layout=True)
         for ax, (key, ylabel) in zip(axs.ravel(), PANELS):
             for k, m in enumerate(methods):
@@ -54,7 +55,7 @@ def figure(df, col, xlabel, methods, default):
                 ax.set_yscale("log")
             ax.axvline(default, color="0.6", lw=0.6, ls=":")
             ax.set_ylabel(ylabel, fontsize="small")
-        for ax in axs[1]:
+        for ax in axs[-1]:
             ax.set_xlabel(xlabel)
         axs[0, 0].legend(loc="best", fontsize="x-small")
         return fig

@@ -13,8 +13,9 @@ config key it changes; :func:`with_value` returns the modified config;
 (value, method) with the B-T3 statistics (``montecarlo.summary_table``):
 final and RMS position (m) and velocity (m/s) error norms as mean and 3-sigma
 (three sample standard deviations over the runs), mean position/velocity NEES,
-landmarks used per run, median planning-call wall/CPU time (us) and planning
-calls.
+landmarks used per run, median planning-call wall/CPU time (us), planning
+calls and the share of them that chose no landmark (%, the planner's ideal
+point had no detected landmark among its nearest, ``opnav.landing.planner``).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ ABLATION_COLUMNS = (
     "final_pos_err_m_mean", "final_pos_err_m_3sigma", "rms_pos_err_m_mean", "rms_pos_err_m_3sigma",
     "final_vel_err_mps_mean", "final_vel_err_mps_3sigma", "rms_vel_err_mps_mean",
     "rms_vel_err_mps_3sigma", "final_pos_err_m_median", "converged_runs_pct",
-    "mean_nees_pos", "mean_nees_vel", "landmarks_per_run", "plan_calls",
+    "mean_nees_pos", "mean_nees_vel", "landmarks_per_run", "plan_calls", "no_pick_pct",
     "median_plan_time_us", "median_plan_cpu_us",
 )
 
@@ -97,6 +98,8 @@ def sweep_table(name: str, data: dict[float | int, dict[str, dict]],
         for rec in df.to_dict("records"):
             row = {col: value, "method": rec["method"]}
             row.update({k: rec.get(k, math.nan) for k in ABLATION_COLUMNS})
+            idx = np.asarray(data[value][rec["method"]]["plan_index"])
+            row["no_pick_pct"] = float(100.0 * np.mean(idx < 0)) if idx.size else math.nan
             rows.append(row)
     out = pd.DataFrame(rows)
     out["n_runs"] = out["n_runs"].astype(np.int64)

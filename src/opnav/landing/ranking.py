@@ -14,7 +14,7 @@ interval over runs, the t-test p-value, and the share of runs in which ``a``
 is lower. :func:`competition_rank` ranks with ties sharing the best rank
 (1, 2, 2, 4). :func:`ranking_table` builds the B-X1 table: per method the
 accuracy (mean and 3-sigma of final and RMS position and velocity error
-norms, NEES, landmarks used), planning time (median wall and CPU time of a planning call, us, and
+norms, NEES, landmarks used, share of planning calls that chose no landmark), planning time (median wall and CPU time of a planning call, us, and
 the ratio to the reference's), ranks by accuracy (mean RMS position error)
 and by time (median CPU time, which other processes on a shared machine do
 not inflate), and the paired comparison against the reference method.
@@ -153,6 +153,8 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
         row["mean_nees_pos"] = float(s["mean_nees_pos"].mean())
         row["landmarks_per_run"] = float(s["n_landmarks"].mean())
         row["plan_calls"] = int(len(d["plan_ns"]))
+        idx = np.asarray(d["plan_index"])
+        row["no_pick_pct"] = float(100.0 * np.mean(idx < 0)) if idx.size else math.nan
         row["median_plan_time_us"] = _median_us(d["plan_ns"])
         row["median_plan_cpu_us"] = _median_us(d["plan_cpu_ns"])
         row["cpu_time_ratio_to_ref"] = row["median_plan_cpu_us"] / ref_cpu
