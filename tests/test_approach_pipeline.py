@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from opnav import published
-from opnav.approach import cases, pipeline
+from opnav.approach import cases, pipeline, report
 from opnav.approach import scenario as sc
 
 from approach_helpers import approach_cfg
@@ -39,7 +39,7 @@ def test_seventeen_cases_in_five_groups_match_published_ids():
 
 def test_table1_columns_and_published_values(small):
     cfg, res = small
-    t1 = pipeline.table1_frame(res, published.paper_a())
+    t1 = report.table1_frame(res, published.paper_a())
     for c in REQUIRED:
         assert c in t1.columns
     assert {"pub_est_x_mean", "pub_est_y_mean", "pub_nav_err_before_km", "pub_nav_err_after_km",
@@ -55,17 +55,17 @@ def test_table1_columns_and_published_values(small):
 
 def test_verdict_text_comes_from_the_numbers(small):
     cfg, res = small
-    t1 = pipeline.table1_frame(res, published.paper_a())
+    t1 = report.table1_frame(res, published.paper_a())
     geo = {v: sc.build_geometry(cfg, v) for v in cfg["variants"]}
     case = cases.headline_case(cfg)
     curves = {v: pipeline.bound_curve(cfg, g, sc.measurement_variance(g, cfg, case.sigma3_px),
                                       case.truth_arcsec, v) for v, g in geo.items()}
-    x1 = pipeline.crlb_rows(cfg, curves, {}, t1)
-    text = pipeline.identifiability_text(cfg, x1)
+    x1 = report.crlb_rows(cfg, curves, {}, t1)
+    text = report.identifiability_text(cfg, x1)
     lit = x1[x1.variant == "literal"].iloc[0]
     assert not lit["bound_reaches_target"]
     assert "**literal**" in text and "CANNOT support 2 arcsec" in text
     assert f"{lit['crlb_x_total_arcsec']:.2f}" in text
-    summ = pipeline.summary(cfg, t1, x1)
+    summ = report.summary(cfg, t1, x1)
     assert set(summ["variants"]) == {"literal", "reference-start+squarem"}
     assert np.isfinite(summ["variants"]["literal"]["crlb_x_arcsec"])

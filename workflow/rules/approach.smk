@@ -86,7 +86,7 @@ rule approach_tables:
         mc=list(A_MC.values()),
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
-        code=src("approach/pipeline.py", "tables.py", "published.py", "data/published.yaml"),
+        code=src("approach/report.py", "tables.py", "published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
         x1=report_table(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),

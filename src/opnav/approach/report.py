@@ -1,0 +1,220 @@
+"""Paper-A reporting: Table 1 in long form, the A-X1 table and verdict, the summary JSON.
+
+Pure functions of the simulation results (:mod:`opnav.approach.pipeline`);
+editing this module reruns only the table rules, never the Monte Carlo.
+Units: arcsec, km, samples.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from . import cases
+from . import scenario as sc
+
+
+def variant_label(variant: str, method: str) -> str:
+    """Row label: the scenario name, with '+squarem' for the accelerated EM."""
+    return variant if method == "plain" else f"{variant}+squarem"
+
+
+def table1_frame(results: list[dict], published: dict, profile: str = "") -> pd.DataFrame:
+    """A-T1 long form: one row per case x variant x EM scheme, published values beside."""
+    pub = {r["case_id"]: r for r in published["table1"]}
+    rows = []
+    for r in results:
+        c: cases.Case = r["case"]
+        th = r["theta_final_arcsec"]
+        truth = np.asarray(c.truth_arcsec)
+        p = pub.get(c.case_id, {})
+        rows.append({
+            "variant": variant_label(r["variant"], r["method"]),
+            "scenario": r["variant"],
+            "method": r["method"],
+            "group": c.group,
+            "case_id": c.case_id,
+            "truth_x_arcsec": truth[0], "truth_y_arcsec": truth[1], "truth_z_arcsec": truth[2],
+            "init_x_arcsec": c.init_arcsec[0], "init_y_arcsec": c.init_arcsec[1],
+            "pixel_sigma3_px": c.sigma3_px[0], "install_deg": c.install_deg,
+            "n_seeds": th.shape[0],
+            "est_x_mean": th[:, 0].mean(), "est_x_std": th[:, 0].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "est_y_mean": th[:, 1].mean(), "est_y_std": th[:, 1].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "rmse_x_arcsec": float(np.sqrt(np.mean((th[:, 0] - truth[0]) ** 2))),
+            "rmse_y_arcsec": float(np.sqrt(np.mean((th[:, 1] - truth[1]) ** 2))),
+            "crlb_x_arcsec": r["crlb_total_arcsec"][0], "crlb_y_arcsec": r["crlb_total_arcsec"][1],
+            "crlb_window_x_arcsec": r["crlb_window_arcsec"][0],
+            "tz_observable": not r["tz_unobservable"],
+            "data_to_converge_samples": float(np.median(r["data_to_converge"])),
+            "nav_err_before_km": r["nav_err_before_km"].mean(),
+            "nav_err_before_km_std": r["nav_err_before_km"].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "nav_err_after_km": r["nav_err_after_km"].mean(),
+            "nav_err_after_km_std": r["nav_err_after_km"].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "pub_est_x_mean": p.get("est_x_arcsec", math.nan),
+            "pub_est_y_mean": p.get("est_y_arcsec", math.nan),
+            "pub_data_to_converge_samples": p.get("data_to_converge_samples", math.nan),
+            "pub_nav_err_before_km": p.get("nav_err_before_km", math.nan),
+            "pub_nav_err_after_km": p.get("nav_err_after_km", math.nan),
+        })
+    df = pd.DataFrame(rows)
+    order = {v: i for i, v in enumerate(sc.VARIANTS)}
+    df["_v"] = df["scenario"].map(order)
+    df = df.sort_values(["_v", "method", "case_id"], kind="stable").drop(columns="_v").reset_index(drop=True)
+    return df
+
+
+COMPACT_COLUMNS = {
+    "variant": "variant", "case_id": "case", "truth_x_arcsec": "truth x", "truth_y_arcsec": "truth y",
+    "est_x_mean": "est x", "est_x_std": "sd x", "pub_est_x_mean": "pub x",
+    "est_y_mean": "est y", "est_y_std": "sd y", "pub_est_y_mean": "pub y",
+    "crlb_x_arcsec": "CRLB x", "data_to_converge_samples": "conv", "pub_data_to_converge_samples": "pub conv",
+    "nav_err_before_km": "before km", "pub_nav_err_before_km": "pub before",
+    "nav_err_after_km": "after km", "pub_nav_err_after_km": "pub after",
+}
+
+
+def table1_compact(t1: pd.DataFrame) -> pd.DataFrame:
+    """The Table-1 columns that fit a page (LaTeX/Markdown); the CSV keeps them all."""
+    return t1[list(COMPACT_COLUMNS)].rename(columns=COMPACT_COLUMNS)
+
+
+def crlb_rows(cfg: dict, curves: dict, conv: dict, t1: pd.DataFrame) -> pd.DataFrame:
+    """A-X1 table: the bound per variant beside the EM estimates' spread and EM iterations."""
+    s = cfg["segments"]
+    target = cfg["accuracy_target_arcsec"]
+    cs = cfg["convergence_study"]
+    rows = []
+    for v, curve in curves.items():
+        d_total = min(s["L"] * s["N"], len(curve) - 1)
+        row = {
+            "variant": v,
+            "crlb_x_window_arcsec": curve[min(s["N"], len(curve) - 1), 0],
+            "crlb_x_250_arcsec": curve[min(250, len(curve) - 1), 0],
+            "crlb_x_total_arcsec": curve[d_total, 0],
+            "crlb_y_total_arcsec": curve[d_total, 1],
+            "total_samples": d_total,
+            "tz_observable": bool(curve[-1, 2] < 0.5 * sc.arcsec(cfg["crlb"]["theta_prior_sigma_rad"])),
+            "bound_reaches_target": bool(curve[d_total, :2].max() <= target),
+            "samples_to_target": _first_below(curve[:, :2].max(1), target),
+        }
+        h = t1[(t1["scenario"] == v) & (t1["case_id"] == "T1-01")]
+        for _, r in h.iterrows():
+            tag = r["method"]
+            row[f"em_{tag}_est_x_mean"] = r["est_x_mean"]
+            row[f"em_{tag}_est_x_std"] = r["est_x_std"]
+            row[f"em_{tag}_rmse_x_arcsec"] = r["rmse_x_arcsec"]
+        c = conv.get(v)
+        if c is not None:
+            ts, tr = c["theta_star_arcsec"], c["truth_arcsec"]
+            row["mle_samples"] = c["data_samples"]
+            row["crlb_x_at_mle_samples"] = curve[min(c["data_samples"], len(curve) - 1), 0]
+            row["mle_x_mean"] = ts[:, 0].mean()
+            row["mle_x_std"] = ts[:, 0].std(ddof=1) if ts.shape[0] > 1 else math.nan
+            row["mle_rmse_x_arcsec"] = float(np.sqrt(np.mean((ts[:, 0] - tr[0]) ** 2)))
+            row["mle_rmse_y_arcsec"] = float(np.sqrt(np.mean((ts[:, 1] - tr[1]) ** 2)))
+            row["maps_plain_median"] = float(np.median(c["plain"]["maps_to_converge"]))
+            row["maps_plain_extrapolated_median"] = float(np.median(c["plain"]["maps_extrapolated"]))
+            row["plain_rate_per_map"] = float(np.median(c["plain"]["rate_per_map"]))
+            row["maps_squarem_median"] = float(np.median(c["squarem"]["maps_to_converge"]))
+            row["max_maps"] = c["max_maps"]
+            row["tol_arcsec"] = cs["tol_arcsec"]
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _first_below(values: np.ndarray, target: float) -> float:
+    """First data length whose bound is at or below ``target`` (NaN if never)."""
+    idx = np.nonzero(values <= target)[0]
+    return float(idx[0]) if idx.size else math.nan
+
+
+def _fmt(x, nd=2):
+    return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
+
+
+def identifiability_text(cfg: dict, x1: pd.DataFrame) -> str:
+    """Plain-language A-X1 verdict, generated from the numbers of the A-X1 table."""
+    target = cfg["accuracy_target_arcsec"]
+    s = cfg["segments"]
+    lines = ["# A-X1: what the data can tell about the camera misalignment", "",
+             f"Profile segments: N0 = {s['N0']}, N = {s['N']}, M = {s['M']}, L = {s['L']} ({s['mode']}); "
+             f"the paper claims an accuracy better than {target:g} arcsec (published).", ""]
+    for _, r in x1.iterrows():
+        v = r["variant"]
+        diag = " (DIAGNOSTIC: the E-step reference is the true state, which the measurements do not provide)" \
+            if v == "reference-start" else ""
+        b = r["crlb_x_total_arcsec"]
+        verdict = "CAN" if r["bound_reaches_target"] else "CANNOT"
+        need = r.get("samples_to_target")
+        need_txt = (f" The bound falls below {target:g} arcsec after {int(need)} samples."
+                    if need is not None and not pd.isna(need) else "")
+        why = {
+            "literal": "the camera looks at Mars without turning, so a misalignment shifts the Mars vector "
+                       "sideways by about rho*theta, which the data cannot tell from a lateral position error; "
+                       "only the 100 km prior separates them (100 km / 1e6 km is about 20 arcsec). The literal "
+                       "EM start X_N0 from the theta = 0 filter has already absorbed the offset",
+            "prior": "the same geometry: the lateral offset rho*theta looks like a position error, and the "
+                     "prior (100 km, 0.1 km/s) only bounds theta to about 100 km / 1e6 km",
+            "roll": "turning the camera about its boresight turns the misalignment's offset in inertial space "
+                    "while a position error stays fixed, so the data separate the two",
+            "reference-start": "knowing the true start state removes the position ambiguity",
+        }.get(v, "")
+        lines.append(f"* **{v}**{diag}: CRLB(tx) = {_fmt(b)} arcsec after {int(r['total_samples'])} samples "
+                     f"(per {s['N']}-sample segment: {_fmt(r['crlb_x_window_arcsec'])} arcsec). "
+                     f"The information in this variant's data and prior {verdict} support {target:g} arcsec: "
+                     f"{why}.{need_txt}")
+        extra = []
+        if "em_plain_est_x_mean" in r and not pd.isna(r.get("em_plain_est_x_mean")):
+            extra.append(f"plain EM (paper's segments) ends at tx = {_fmt(r['em_plain_est_x_mean'])} +- "
+                         f"{_fmt(r['em_plain_est_x_std'])} arcsec (RMS error {_fmt(r['em_plain_rmse_x_arcsec'])})")
+        if "maps_plain_median" in r and not pd.isna(r.get("maps_plain_median")):
+            mp = r["maps_plain_median"]
+            mp_txt = (f"more than the {int(r['max_maps'])} run (about {r['maps_plain_extrapolated_median']:.3g} "
+                      f"extrapolated from its measured contraction factor {r['plain_rate_per_map']:.5f} per "
+                      f"iteration{'; stalled' if r['plain_rate_per_map'] > 0.999 else ''})"
+                      if mp > r["max_maps"] else f"{mp:.0f}")
+            extra.append(f"on one {int(r['mle_samples'])}-sample window the maximum-likelihood estimate "
+                         f"(SQUAREM, {r['maps_squarem_median']:.0f} EM maps) has RMS error "
+                         f"{_fmt(r['mle_rmse_x_arcsec'])} arcsec in tx against a CRLB of "
+                         f"{_fmt(r['crlb_x_at_mle_samples'])}; plain EM needs {mp_txt} iteration(s) to get within "
+                         f"{r['tol_arcsec']:g} arcsec of it")
+        if extra:
+            lines.append("  " + "; ".join(extra) + ".")
+        if not r["tz_observable"]:
+            lines.append("  tz (roll about the boresight) is unobservable: its bound stays at the diffuse prior.")
+    lines += ["", "Any published accuracy finer than a variant's CRLB cannot come from an unbiased estimator "
+              "using that variant's measurements and prior; a match there would be luck or extra information."]
+    return "\n".join(lines) + "\n"
+
+
+def summary(cfg: dict, t1: pd.DataFrame, x1: pd.DataFrame) -> dict:
+    """Headline numbers per variant and EM scheme for the manuscript macros."""
+    out = {"profile_segments": cfg["segments"], "accuracy_target_arcsec": cfg["accuracy_target_arcsec"],
+           "variants": {}}
+    for _, r in t1[t1["case_id"] == "T1-01"].iterrows():
+        x = x1[x1["variant"] == r["scenario"]]
+        x = x.iloc[0] if len(x) else {}
+        out["variants"][r["variant"]] = {
+            "scenario": r["scenario"], "method": r["method"],
+            "est_x_mean": r["est_x_mean"], "est_x_std": r["est_x_std"],
+            "est_y_mean": r["est_y_mean"], "est_y_std": r["est_y_std"],
+            "crlb_x_arcsec": r["crlb_x_arcsec"], "crlb_y_arcsec": r["crlb_y_arcsec"],
+            "data_to_converge_samples": r["data_to_converge_samples"],
+            "nav_err_before_km": r["nav_err_before_km"], "nav_err_after_km": r["nav_err_after_km"],
+            "iterations_plain_median": _num(x, "maps_plain_median"),
+            "iterations_plain_extrapolated_median": _num(x, "maps_plain_extrapolated_median"),
+            "iterations_squarem_median": _num(x, "maps_squarem_median"),
+            "mle_rmse_x_arcsec": _num(x, "mle_rmse_x_arcsec"),
+            "bound_reaches_target": bool(x["bound_reaches_target"]) if len(x) else None,
+        }
+    return out
+
+
+def _num(row, key):
+    try:
+        v = float(row[key])
+    except (KeyError, TypeError, ValueError):
+        return None
+    return None if math.isnan(v) else (v if math.isfinite(v) else None)
