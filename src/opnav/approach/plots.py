@@ -15,17 +15,25 @@ VCOLORS = {"literal": "C0", "prior": "C1", "roll": "C2", "reference-start": "C3"
 
 
 def _plain_log_ticks(ax):
-    from matplotlib.ticker import LogLocator, ScalarFormatter, NullFormatter
+    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
     ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    ax.yaxis.set_major_formatter(ScalarFormatter())
+    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
     ax.yaxis.set_minor_formatter(NullFormatter())
 
 
 def _band(ax, x, y, color, label, ls="-"):
+    """Mean and +-1 sd over seeds (linear axes)."""
     m, s = y.mean(0), y.std(0)
     ax.plot(x, m, color=color, ls=ls, label=label)
     ax.fill_between(x, m - s, m + s, color=color, alpha=0.2, lw=0)
+
+
+def _band_log(ax, x, y, color, label, ls="-"):
+    """Median and 16-84 % band over seeds (log axes: stays positive)."""
+    lo, med, hi = np.percentile(y, [16, 50, 84], axis=0)
+    ax.plot(x, med, color=color, ls=ls, label=label)
+    ax.fill_between(x, lo, hi, color=color, alpha=0.2, lw=0)
 
 
 def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
@@ -64,14 +72,14 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
 
 
 def fig_nav_accuracy(runs: dict, variant: str):
-    """A-F5: position error at each segment end during the estimation (mean +- sd) and filter 3-sigma."""
+    """A-F5: position error at each segment end during the estimation (median, 16-84 %) and filter 3-sigma."""
     import matplotlib.pyplot as plt
 
     with figures.style():
         fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.6))
         for method, r in runs.items():
             d = r["seg_data_used"]
-            _band(ax, d, r["seg_pos_err_km"], COLORS[method], f"|r error|, EM ({method})")
+            _band_log(ax, d, r["seg_pos_err_km"], COLORS[method], f"|r error| median, EM ({method})")
             ax.plot(d, r["seg_pos_3sig_km"].mean(0), color=COLORS[method], ls=":", label=f"3-sigma ({method})")
         ax.set_xlabel("data used (samples)")
         ax.set_ylabel("position error (km)")
