@@ -17,18 +17,19 @@ def test_macro_names_are_letters_only(parts):
 def test_macros_flatten_and_format():
     m = macros_from_summary({"literal": {"est_x": 11.4321, "n_seeds": 20, "note": "a_b"},
                              "crlb": [1.5, 250.0]}, "A")
-    assert m["ALiteralEstX"] == "11.4"
+    assert m["ALiteralEstX"] == "11.43"
     assert m["ALiteralNSeeds"] == "20"
     assert m["ALiteralNote"] == r"a\_b"
-    assert m["ACrlbOne"] == "1.50" and m["ACrlbTwo"] == "250"
+    assert m["ACrlbOne"] == "1.5" and m["ACrlbTwo"] == "250"
     text = render_macros(m)
     assert text.splitlines() == sorted(text.splitlines())
-    assert r"\newcommand{\ALiteralEstX}{11.4}" in text
+    assert r"\newcommand{\ALiteralEstX}{11.43}" in text
 
 
 def test_format_number_ranges():
-    assert format_number(79.06) == "79.1"
-    assert format_number(18.43) == "18.4"
+    assert format_number(79.06) == "79.06"
+    assert format_number(18.43) == "18.43"
+    assert format_number(50.0) == "50"
     assert format_number(1234.5) == "1{,}234"
     assert format_number(0.0123) == "0.0123"
     assert format_number(2.5e-6) == r"2.50\times10^{-6}"

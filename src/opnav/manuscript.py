@@ -34,7 +34,7 @@ def macro_name(parts: Iterable[str]) -> str:
 
 
 def format_number(x: float) -> str:
-    """Numbers as a reader wants them in running text (3-4 significant digits)."""
+    """Numbers as a reader wants them in running text: 4 significant digits, no exponent above 1e-3."""
     if isinstance(x, bool):
         return "yes" if x else "no"
     if isinstance(x, int):
@@ -46,16 +46,10 @@ def format_number(x: float) -> str:
     ax = abs(x)
     if ax >= 1000:
         return f"{x:,.0f}".replace(",", "{,}")
-    if ax >= 100:
-        return f"{x:.0f}"
-    if ax >= 10:
-        return f"{x:.1f}"
-    if ax >= 1:
-        return f"{x:.2f}"
     if ax == 0:
         return "0"
     if ax >= 1e-3:
-        return f"{x:.3g}"
+        return f"{x:.4g}"
     m, e = f"{x:.2e}".split("e")
     return rf"{m}\times10^{{{int(e)}}}"
 

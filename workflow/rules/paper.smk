@@ -19,7 +19,12 @@ def _floats(part):
 
 SUMMARIES = {
     k: p
-    for k, p in {"A": res("approach", "A-summary.json"), "B": res("landing", "B-summary.json")}.items()
+    for k, p in {
+        "A": res("approach", "A-summary.json"),
+        "B": res("landing", "B-summary.json"),
+        "AX2": res("approach", "A-X2-summary.json"),
+        "BX1": res("landing", "B-X1-summary.json"),
+    }.items()
     if p in _targets
 }
 SCORE_INPUTS = {
