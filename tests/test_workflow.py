@@ -74,6 +74,9 @@ def test_quick_profile_end_to_end(workdir):
                               "--configfile", "config/quick.yaml")
         assert again.returncode == 0, again.stderr[-3000:]
         assert pdf.read_bytes() == first
+        # every number the text quotes was written by a rule
+        log = (workdir / "results" / "paper" / "logs" / "paper_pdf.log").read_text()
+        assert "opnav-missing-macro" not in log, log[-2000:]
     # the Snakemake report, with a caption for every figure and table
     rep = run_snakemake(workdir, "--cores", "1", "--configfile", "config/quick.yaml",
                         "--report", "results/report.html")

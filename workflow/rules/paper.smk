@@ -84,7 +84,8 @@ rule paper_macros:
     input:
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         scorecard=rules.paper_scorecard.output.json,
-        code=src("manuscript.py"),
+        published=src("data/published.yaml"),
+        code=src("manuscript.py", "published.py"),
     output:
         f"{PAPER}/macros.tex",
     params:

@@ -2,6 +2,7 @@
 
 import json
 
+from opnav import published
 from opnav.manuscript import macros_from_summary, render_macros
 from opnav.snakeio import script_context
 from opnav.tables import atomic_write_text
@@ -15,6 +16,8 @@ with script_context(snakemake) as log:
     sc = json.loads(open(snakemake.input.scorecard).read())
     macros.update(macros_from_summary(sc, "Score"))
     macros.update(macros_from_summary({"profile": snakemake.params.profile}, "Run"))
+    # the papers' published values (labelled "Pub" in every macro name)
+    macros.update(macros_from_summary(published.load(), "Pub"))
     # the configured model parameters, so the manuscript quotes them from the config
     macros.update(macros_from_summary(snakemake.params.config, "Cfg"))
     atomic_write_text(snakemake.output[0], render_macros(

@@ -1,6 +1,7 @@
 """Build the manuscript PDF with latexmk, reproducibly (fixed SOURCE_DATE_EPOCH)."""
 
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -21,4 +22,7 @@ with script_context(snakemake) as log:
     log.info(proc.stdout[-20000:])
     if proc.returncode != 0:
         raise RuntimeError(f"latexmk failed (exit {proc.returncode}); see {build}/main.log")
+    missing = sorted(set(re.findall(r"opnav-missing-macro (\w+)", (build / "main.log").read_text(errors="replace"))))
+    if missing:
+        log.warning("opnav-missing-macro: the manuscript quotes numbers no rule wrote: %s", ", ".join(missing))
     shutil.copyfile(build / "main.pdf", out)
