@@ -27,7 +27,7 @@ with script_context(snakemake) as log:
         import matplotlib.pyplot as plt
 
         variants = list(dict.fromkeys(df["variant"]))
-        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.8), sharex=True)
+        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.6), sharex=True)
         for ax, axis in zip(axes, ("x", "y")):
             for i, v in enumerate(variants):
                 d = df[df["variant"] == v]
@@ -39,14 +39,18 @@ with script_context(snakemake) as log:
                         label=f"{v}: EM-EKF RMSE")
                 ax.plot(au["value"], au[f"sd_{axis}_arcsec"], "s--", color=col, ms=3,
                         label=f"{v}: augmented EKF spread")
-                ax.plot(em["value"], em[f"crlb_{axis}_arcsec"], "-", color="k" if i == 0 else "0.5", lw=1.5,
+                ax.plot(au["value"], au[f"rmse_{axis}_arcsec"], "s:", color=col, ms=4, mfc="none",
+                        label=f"{v}: augmented EKF RMSE")
+                ax.plot(em["value"], em[f"crlb_{axis}_arcsec"], "-", color="k" if i == 0 else "0.55", lw=1.5,
                         label=f"{v}: CRLB")
             ax.set_yscale("log")
-            if sweep == "segment" or np.all(df["value"] > 0):
+            if np.all(df["value"] > 0):
                 ax.set_xscale("log")
             ax.set_xlabel(XLABEL[sweep])
             ax.set_ylabel(f"t{axis}: spread, RMSE, CRLB (arcsec)")
-        axes[1].legend(fontsize="x-small", ncol=1, loc="best")
-        fig.tight_layout()
+        h, lab = axes[0].get_legend_handles_labels()
+        fig.legend(h, lab, loc="lower center", ncol=len(variants) * 2 if len(variants) < 3 else 5,
+                   fontsize="x-small", frameon=False)
+        fig.tight_layout(rect=(0, 0.2, 1, 1))
         figures.save(fig, snakemake.output.fig)
     log.info("A-X3 %s: %d rows", sweep, len(df))
