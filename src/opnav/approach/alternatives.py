@@ -326,6 +326,10 @@ def summary_json(long: pd.DataFrame, table: pd.DataFrame, cfg: dict) -> dict:
             "data_to_converge_samples": r["data needed (T1-01)"],
             "runtime_s_per_seed": r["run time s/seed (T1-01)"],
         }
+    if "nav_err_before_km" in long:
+        nb = long[long["case_id"] == "T1-01"].dropna(subset=["nav_err_before_km"])
+        out["nav_err_before_km"] = {v: float(g["nav_err_before_km"].iloc[0])
+                                    for v, g in nb.groupby("variant", sort=False)}
     ml = long[long["method"] == "batch_ml"]
     if len(ml):
         out["batch_ml_max_grad_norm"] = float(ml["ipopt_max_grad_norm"].max())
