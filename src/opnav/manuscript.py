@@ -256,3 +256,82 @@ def compact_a_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
 
 
 COMPACT_VIEWS["A-X1"] = compact_a_x1
+
+
+def compact_a_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """A-X2 for the page: EM-EKF vs augmented EKF vs batch ML, headline case and all cases."""
+    import pandas as pd
+
+    rows = []
+    for _, r in df.iterrows():
+        rows.append({
+            "variant": r["variant"], "method": r["method"],
+            'T1-01 error x (")': _pm(r.get("T1-01 err_x mean"), r.get("T1-01 err_x sd")),
+            'T1-01 error y (")': _pm(r.get("T1-01 err_y mean"), r.get("T1-01 err_y sd")),
+            'CRLB x (")': _num(r.get("T1-01 CRLB_x"), "{:.3g}"),
+            'RMSE all cases (")': _num(r.get("RMSE_xy all cases"), "{:.3g}"),
+            "nav. after (km)": _num(r.get("nav err after km (T1-01)"), "{:.1f}"),
+            "data (samples)": _num(r.get("data needed (T1-01)"), "{:.0f}"),
+            "time (s/seed)": _num(r.get("run time s/seed (T1-01)"), "{:.3f}"),
+        })
+    return [("", pd.DataFrame(rows))]
+
+
+def compact_a_x3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """A-X3 for the page: estimate spread and error against the CRLB over the swept value."""
+    import pandas as pd
+
+    rows = []
+    for _, r in df.iterrows():
+        rows.append({
+            "variant": r["variant"], str(r.get("sweep", "value")): _num(r["value"], "{:g}"),
+            "estimator": r["estimator"],
+            'sd x (")': _num(r.get("sd_x_arcsec"), "{:.3g}"),
+            'RMSE x (")': _num(r.get("rmse_x_arcsec"), "{:.3g}"),
+            'CRLB x (")': _num(r.get("crlb_x_arcsec"), "{:.3g}"),
+            "sd / CRLB": _num(r.get("sd_over_crlb_x"), "{:.3g}"),
+        })
+    return [("", pd.DataFrame(rows))]
+
+
+def compact_b_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """B-X1 for the page: every selection rule ranked, paired difference against depth."""
+    import pandas as pd
+
+    rows = []
+    for _, r in df.iterrows():
+        lo, hi = r.get("d_rms_pos_vs_ref_boot_lo"), r.get("d_rms_pos_vs_ref_boot_hi")
+        rows.append({
+            "method": r["method"],
+            "rank acc., time": f"{_num(r.get('rank_accuracy'), '{:.0f}')}, {_num(r.get('rank_time'), '{:.0f}')}",
+            "RMS pos (m)": _pm(r.get("rms_pos_err_m_mean"), r.get("rms_pos_err_m_3sigma")),
+            "final pos (m)": _pm(r.get("final_pos_err_m_mean"), r.get("final_pos_err_m_3sigma")),
+            "final vel (m/s)": _pm(r.get("final_vel_err_mps_mean"), r.get("final_vel_err_mps_3sigma")),
+            "NEES pos": _num(r.get("mean_nees_pos"), "{:.2f}"),
+            "median plan (µs)": _num(r.get("median_plan_time_us"), "{:.0f}"),
+            "RMS pos minus depth (m), 95 % CI": f"{_num(r.get('d_rms_pos_vs_ref_mean'), '{:.3g}')} [{_num(lo, '{:.3g}')}, {_num(hi, '{:.3g}')}]",
+            "same pick (%)": _num(r.get("same_pick_as_ref_pct"), "{:.1f}"),
+        })
+    return [("", pd.DataFrame(rows))]
+
+
+def compact_b_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """B-X2 for the page: accuracy, consistency and timing over the swept value."""
+    import pandas as pd
+
+    swept = df.columns[0]
+    rows = []
+    for _, r in df.iterrows():
+        rows.append({
+            swept: _num(r[swept], "{:g}"), "method": r["method"],
+            "final pos (m)": _pm(r.get("final_pos_err_m_mean"), r.get("final_pos_err_m_3sigma")),
+            "RMS pos (m)": _pm(r.get("rms_pos_err_m_mean"), r.get("rms_pos_err_m_3sigma")),
+            "final vel (m/s)": _pm(r.get("final_vel_err_mps_mean"), r.get("final_vel_err_mps_3sigma")),
+            "NEES pos, vel": f"{_num(r.get('mean_nees_pos'), '{:.2f}')}, {_num(r.get('mean_nees_vel'), '{:.2f}')}",
+            "landmarks": _num(r.get("landmarks_per_run"), "{:.1f}"),
+            "median plan (µs)": _num(r.get("median_plan_time_us"), "{:.0f}"),
+        })
+    return [("", pd.DataFrame(rows))]
+
+
+COMPACT_VIEWS.update({"A-X2": compact_a_x2, "A-X3": compact_a_x3, "B-X1": compact_b_x1, "B-X2": compact_b_x2})
