@@ -198,3 +198,24 @@ def test_sweep_table_rows():
     d[60.0]["svd"]["plan_index"][:3] = -1                 # 3 of 12 plans chose nothing
     df = sweep_table("fov", d)
     assert list(df["no_pick_pct"]) == [0.0, 0.0, 0.0, 25.0]
+
+
+def test_headline_feeds_manuscript_macros():
+    """B-X1-summary.json flattens into distinct LaTeX macros (no collisions)."""
+    import json
+
+    from opnav.manuscript import macros_from_summary
+
+    runs = np.arange(5)
+    data = {"depth": _fake_mc(np.arange(1.0, 6.0), runs, 100.0, 0),
+            "svd": _fake_mc(np.arange(1.0, 6.0) * (1 + 1e-5), runs, 800.0, 1),
+            "logdet": _fake_mc(np.arange(2.0, 7.0), runs, 900.0, 2)}
+    df = ranking_table(data, "depth", n_boot=50, rtol=1e-3)
+    t = df.set_index("method")
+    assert t.loc["svd", "rank_accuracy"] == t.loc["depth", "rank_accuracy"] == 1   # within 0.1 %
+    h = json.loads(json.dumps(headline(df, "depth")))
+    macros = macros_from_summary(h, "BXone")
+    assert macros and all(k.isalpha() for k in macros)
+    # svd is 1e-5 worse in EVERY run: a shared rank (tolerance) but a significant paired difference
+    assert h["reference_more_accurate_than_text"] == "svd, logdet"
+    assert h["reference_less_accurate_than_text"] == "none"

@@ -193,7 +193,7 @@ def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
     ref = t.loc[reference]
     best_acc = t["rms_pos_err_m_mean"].idxmin()
     fastest = t["median_plan_cpu_us"].idxmin()
-    return {
+    out = {
         "reference": reference,
         "methods": {m: {k: clean(v) for k, v in t.loc[m].items()} for m in t.index},
         "ranking_by_accuracy": list(t.sort_values(["rank_accuracy", "rank_time"]).index),
@@ -210,3 +210,7 @@ def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
         "reference_faster_than": [m for m in others
                                   if t.loc[m, "median_plan_cpu_us"] > ref["median_plan_cpu_us"]],
     }
+    for k in ("ranking_by_accuracy", "ranking_by_time", "reference_more_accurate_than",
+              "reference_less_accurate_than", "not_significant_vs_reference", "reference_faster_than"):
+        out[f"{k}_text"] = ", ".join(out[k]) if out[k] else "none"
+    return out
