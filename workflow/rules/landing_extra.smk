@@ -21,6 +21,7 @@ rule landing_x1_summary:
     params:
         methods=X1_METHODS,
         extra=canonical(config["landing"]["extra"]),
+        converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
     log:
         f"{LANDING}/logs/x1_summary.log",
     localrule: True

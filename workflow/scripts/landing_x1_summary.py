@@ -20,7 +20,8 @@ if "snakemake" not in globals():  # standalone debugging run
                 "summary": "results/landing/B-X1-summary.json"})
     snakemake.params = type("P", (), {"methods": _m,
                                       "extra": {"reference": "depth", "n_boot": 2000,
-                                                "tie_rtol": 1e-3}})()
+                                                "tie_rtol": 1e-3},
+                                      "converged_pos_err_m": 100.0})()
 
 with script_context(snakemake) as log:
     methods = list(snakemake.params.methods)
@@ -28,14 +29,17 @@ with script_context(snakemake) as log:
     ref = snakemake.params.extra["reference"]
     n_boot = int(snakemake.params.extra["n_boot"])
     rtol = float(snakemake.params.extra["tie_rtol"])
-    df = ranking_table(data, reference=ref, n_boot=n_boot, seed=0, rtol=rtol)
+    conv = float(snakemake.params.converged_pos_err_m)
+    df = ranking_table(data, reference=ref, n_boot=n_boot, seed=0, rtol=rtol,
+                       converged_pos_err_m=conv)
     write_table(df, snakemake.output.t,
                 caption=(f"B-X1: all planning methods on the same paired Monte Carlo, ranked by mean "
                          f"RMS position error (rank_accuracy) and by median planning-call CPU time "
                          f"(rank_time; methods within {100 * rtol:g} % of each other share the best "
                          f"rank); paired differences method minus "
                          f"{ref} of the per-run RMS and final position errors (m) with 95 % paired-t "
-                         f"and bootstrap ({n_boot} resamples) intervals."))
+                         f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
+                         f"error below {conv:g} m."))
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f)
     out = headline(df, ref)

@@ -125,11 +125,14 @@ def _median_us(ns) -> float:
 
 
 def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int = 2000,
-                  seed: int = 0, level: float = 0.95, rtol: float = 0.0) -> pd.DataFrame:
+                  seed: int = 0, level: float = 0.95, rtol: float = 0.0,
+                  converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-X1: one row per method of ``data`` (gathered Monte-Carlo dicts, same
     runs), ranked; see the module docstring for the columns. Paired columns
     ``d_rms_pos_vs_ref_*`` / ``d_final_pos_vs_ref_*`` are method minus
-    reference (m; negative = the method is more accurate)."""
+    reference (m; negative = the method is more accurate); ``converged_runs_pct``
+    counts runs whose final position error is below ``converged_pos_err_m`` (m),
+    as in B-T3."""
     if reference not in data:
         raise ValueError(f"landing.extra.reference {reference!r} not among the methods {list(data)}")
     st = {m: per_run_stats(d) for m, d in data.items()}
@@ -150,6 +153,7 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
                 row[f"{kind}_{q}_mean"] = float(col.mean())
                 row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if n > 1 else math.nan
         row["final_pos_err_m_median"] = float(s["final_pos_err_m"].median())
+        row["converged_runs_pct"] = float(100.0 * (s["final_pos_err_m"] < converged_pos_err_m).mean())
         row["mean_nees_pos"] = float(s["mean_nees_pos"].mean())
         row["landmarks_per_run"] = float(s["n_landmarks"].mean())
         row["plan_calls"] = int(len(d["plan_ns"]))
