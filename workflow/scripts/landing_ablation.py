@@ -45,13 +45,15 @@ def figure(df, col, xlabel, methods, default):
                 d = df[df["method"] == m].sort_values(col)
                 c = METHOD_COLORS.get(m, f"C{k}")
                 lab = METHOD_LABELS.get(m, m)
+                # earlier methods drawn wider underneath, so identical curves stay visible
+                w = 1.0 + 1.2 * (len(methods) - 1 - k)
                 if f"{key}_mean" in d:
-                    ax.plot(d[col], d[f"{key}_mean"], "o-", color=c, ms=3, lw=1.0, label=f"{lab} mean")
-                    ax.plot(d[col], d[f"{key}_3sigma"], "s--", color=c, ms=2.5, lw=0.8,
+                    ax.plot(d[col], d[f"{key}_mean"], "o-", color=c, ms=2 + w, lw=w, label=f"{lab} mean")
+                    ax.plot(d[col], d[f"{key}_3sigma"], "s--", color=c, ms=1.5 + w, lw=0.8 * w,
                             label=f"{lab} 3-sigma")
                 else:
-                    ax.plot(d[col], d[key], "o-", color=c, ms=3, lw=1.0, label=lab)
-            if key.startswith(("final_", "rms_", "median_")):
+                    ax.plot(d[col], d[key], "o-", color=c, ms=2 + w, lw=w, label=lab)
+            if key.startswith(("final_", "rms_", "median_", "mean_nees")):
                 ax.set_yscale("log")
             ax.axvline(default, color="0.6", lw=0.6, ls=":")
             ax.set_ylabel(ylabel, fontsize="small")
