@@ -104,3 +104,18 @@ def test_beyond_paper_methods_plan_too(scn, method):
     vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
     res = plan(method, st, scn.camera, scn.field, vis, scn.planner, rng=np.random.default_rng(1))
     assert res.index >= 0 and vis(scn.field.xyz[res.index][None])[0]
+
+
+def test_pick_nearest_widens_until_a_detected_landmark():
+    """The optimum may fall outside the true image: the pick is then the
+    nearest *detected* landmark, never 'no landmark' while one is detected."""
+    from opnav.landing.landmarks import make_field
+    from opnav.landing.planner import _pick_nearest
+
+    field = make_field(1000.0, 500, seed=3)
+    point = np.array([0.0, 0.0, 0.0])
+    far = np.argsort(np.hypot(*field.xyz[:, :2].T))[200]          # the 201st nearest
+    visible = lambda p: np.isin(np.arange(len(field.xyz)), [far])[  # noqa: E731
+        [int(np.flatnonzero((field.xyz == q).all(axis=1))[0]) for q in p]]
+    assert _pick_nearest(field, point, visible, knn=16, exclude=set()) == far
+    assert _pick_nearest(field, point, lambda p: np.zeros(len(p), bool), 16, set()) == -1

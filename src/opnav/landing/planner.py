@@ -366,16 +366,28 @@ def available_methods() -> tuple[str, ...]:
 
 def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
                   exclude: set) -> int:
-    """The detected landmark nearest (horizontally) to ``point`` among its
-    ``knn`` nearest landmarks, -1 if none of them is detected."""
-    idx = field_.nearest(point, knn)
-    for e in exclude:
-        idx = idx[idx != e]
-    if idx.size:
-        vis = visible(field_.xyz[idx])
-        if vis.any():
-            return int(idx[np.argmax(vis)])
-    return -1
+    """The detected landmark nearest (horizontally) to ``point``; -1 only if
+    the camera detects no landmark at all (paper B sec. 2.2: "the visible
+    landmark nearest to the optimum").
+
+    The KD-tree is asked for the ``knn`` nearest landmarks first; when none of
+    them is detected (the optimum, planned from the *estimated* pose, may fall
+    just outside the *true* image) the query widens by a factor of 4 until a
+    detected landmark is found or the whole field has been searched.
+    """
+    n_field = len(field_.xyz)
+    k = max(int(knn), 1)
+    while True:
+        idx = field_.nearest(point, k)
+        for e in exclude:
+            idx = idx[idx != e]
+        if idx.size:
+            vis = visible(field_.xyz[idx])
+            if vis.any():
+                return int(idx[np.argmax(vis)])
+        if k >= n_field:
+            return -1
+        k = min(4 * k, n_field)
 
 
 def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
