@@ -240,7 +240,14 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
             if cam.in_view(d_site[None])[0]:
                 meas.append((cam.measure(d_site, noise_px[k, 0]), p_site))
             still = cur >= 0 and visible(scn.field.xyz[cur][None], 0.0)[0]
-            if cur < 0 or n_obs >= scn.obs_per_landmark or not still:
+            need_new = cur < 0 or n_obs >= scn.obs_per_landmark or not still
+            if need_new and not _detects_other(visible(scn.field.xyz), cur):
+                # the image holds no other landmark (e.g. low altitude): nothing to
+                # choose, so no planning call; keep the current one while it is seen
+                need_new = False
+                if not still:
+                    cur, n_obs = -1, 0
+            if need_new:
                 res = plan(method, PlanState(st.r, st.v, a_est, st.R, st.P), cam, scn.field,
                            visible, scn.planner, exclude={cur} if cur >= 0 else set(),
                            rng=rng_pick)
@@ -259,7 +266,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                         n_obs, n_used = 1, n_used + 1
                     except ValueError:
                         cur = -1
-            else:
+            elif cur >= 0:
                 b = cam.measure(R_t @ (scn.field.xyz[cur] - r_t), noise_px[k, 1])
                 meas.append((b, None))
                 n_obs += 1
@@ -281,6 +288,12 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         "plan_index": np.asarray(plan_idx, np.int64), "n_landmarks": n_used,
         "init_error": e0,
     }
+
+
+def _detects_other(detected: np.ndarray, cur: int) -> bool:
+    """True if the camera detects a landmark other than ``cur`` (the image's
+    feature list, from the truth pose: the same for every planning method)."""
+    return bool(detected.sum() - (detected[cur] if cur >= 0 else 0) > 0)
 
 
 def _est_rpy(R_true: np.ndarray, dth: np.ndarray) -> np.ndarray:
