@@ -94,3 +94,30 @@ def write_table(df: pd.DataFrame, paths: Iterable[str | Path] | str | Path,
         atomic_write_text(p, text)
         written.append(p)
     return written
+
+
+def json_ready(x):
+    """``x`` with numpy scalars as Python numbers and NaN/inf as ``None`` (valid JSON)."""
+    import math
+
+    import numpy as np
+
+    if isinstance(x, dict):
+        return {str(k): json_ready(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_ready(v) for v in x]
+    if isinstance(x, (np.floating, float)):
+        x = float(x)
+        return x if math.isfinite(x) else None
+    if isinstance(x, (np.integer,)):
+        return int(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    return x
+
+
+def write_json(path: str | Path, obj) -> None:
+    """Write ``obj`` as sorted, indented JSON (via :func:`json_ready`), atomically."""
+    import json
+
+    atomic_write_text(path, json.dumps(json_ready(obj), indent=2, sort_keys=True) + "\n")

@@ -1,33 +1,15 @@
 """A-T1 (Table 1 beside the published values), A-X1 table + verdict text, A-summary.json."""
 
-import json
-import math
 import pickle
 
-import numpy as np
 
 from opnav import published
-from opnav.approach import pipeline, report
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import atomic_write_text, write_table
+from opnav.approach import report
+from opnav.snakeio import script_context
+from opnav.tables import atomic_write_text, write_json, write_table
 
 if "snakemake" not in globals():  # standalone debugging run
     raise SystemExit("run through snakemake (needs the gathered Monte-Carlo pickles)")
-
-
-def _clean(x):
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        x = float(x)
-        return x if math.isfinite(x) else None
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
 
 
 with script_context(snakemake) as log:
@@ -55,5 +37,5 @@ with script_context(snakemake) as log:
     atomic_write_text(snakemake.output.verdict, report.identifiability_text(cfg, x1))
     summ = report.summary(cfg, t1, x1)
     summ["profile"] = snakemake.params.profile
-    atomic_write_text(snakemake.output.summary, json.dumps(_clean(summ), indent=2, sort_keys=True) + "\n")
+    write_json(snakemake.output.summary, summ)
     log.info("wrote %d Table-1 rows", len(t1))

@@ -1,32 +1,14 @@
 """A-X2 table (EM-EKF vs augmented EKF vs batch ML), long form per case, A-X2-summary.json."""
 
-import json
-import math
 import pickle
 
-import numpy as np
 
 from opnav.approach import alternatives as alt
 from opnav.snakeio import script_context
-from opnav.tables import atomic_write_text, write_table
+from opnav.tables import write_json, write_table
 
 if "snakemake" not in globals():  # standalone debugging run
     raise SystemExit("run through snakemake (needs the A-X2 and EM-EKF Monte-Carlo pickles)")
-
-
-def _clean(x):
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        x = float(x)
-        return x if math.isfinite(x) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
 
 
 with script_context(snakemake) as log:
@@ -52,5 +34,5 @@ with script_context(snakemake) as log:
                         "data needed in samples, run time in s per Monte-Carlo seed.")
     summ = alt.summary_json(long, table, cfg)
     summ["profile"] = snakemake.params.profile
-    atomic_write_text(snakemake.output.summary, json.dumps(_clean(summ), indent=2, sort_keys=True) + "\n")
+    write_json(snakemake.output.summary, summ)
     log.info("A-X2: %d long rows, %d table rows", len(long), len(table))

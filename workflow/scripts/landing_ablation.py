@@ -5,7 +5,6 @@ the swept value, per method."""
 from collections import defaultdict
 from pathlib import Path
 
-import numpy as np
 
 from opnav import figures
 from opnav.landing.ablation import SWEEPS, parse_value, sweep_table

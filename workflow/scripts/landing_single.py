@@ -2,7 +2,6 @@
 
 import json
 
-import numpy as np
 
 from opnav import figures
 from opnav.landing import plots

@@ -4,12 +4,11 @@ and results/landing/B-summary.json (headline numbers for the manuscript)."""
 import json
 import math
 
-import numpy as np
 
 from opnav import published
 from opnav.landing.montecarlo import load, summary_table
 from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_table
+from opnav.tables import write_json, write_table
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(
@@ -18,14 +17,6 @@ if "snakemake" not in globals():  # standalone debugging run
         output={"t3": ["results/landing/B-T3_summary.csv"], "summary": "results/landing/B-summary.json"})
     snakemake.params = type("P", (), {"methods": ["depth", "svd", "gdop", "cond"],
                                       "yaw_ratio": 0.5, "converged_pos_err_m": 100.0})()
-
-
-def _clean(x):
-    if isinstance(x, (float, np.floating)):
-        return None if math.isnan(float(x)) else float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    return x
 
 
 with script_context(snakemake) as log:
@@ -50,8 +41,8 @@ with script_context(snakemake) as log:
     converges = s_last < ratio * s_first
     out = {
         "single": single,
-        "methods": {r["method"]: {k: _clean(v) for k, v in r.items()} for r in df.to_dict("records")},
-        "time_reduction_vs_svd_pct": _clean(df.set_index("method").get("time_reduction_vs_svd_pct",
+        "methods": {r["method"]: dict(r) for r in df.to_dict("records")},
+        "time_reduction_vs_svd_pct": (df.set_index("method").get("time_reduction_vs_svd_pct",
                                                                       {}).get("depth", math.nan))
         if "svd" in data and "depth" in data else None,
         "published_time_reduction_vs_svd_pct": pub["depth_time_reduction_vs_svd_pct"],
@@ -62,6 +53,5 @@ with script_context(snakemake) as log:
                        f"({'below' if converges else 'not below'} {ratio:.0%} of the start)"),
         "n_runs": int(yaw.shape[0]),
     }
-    with open(snakemake.output.summary, "w") as fh:
-        json.dump(out, fh, indent=2, sort_keys=True)
+    write_json(snakemake.output.summary, out)
     log.info("B-T3:\n%s", df.to_string())

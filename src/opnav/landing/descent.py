@@ -51,7 +51,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from opnav.landing import ekf, imu
 from opnav.landing.camera import Camera, camera_from_config
