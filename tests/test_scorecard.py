@@ -78,3 +78,9 @@ def test_rows_paper_b_timing_and_same_accuracy():
     df = score_rows(rows_paper_b(t3, {}, {"depth_time_reduction_vs_svd_pct": 29.03}))
     assert df.loc[0, "verdict"] == NOT_REPRODUCED                 # 80 % vs 29.03 %
     assert df.loc[1, "verdict"] == NOT_REPRODUCED                 # -23 % is not "almost the same"
+
+
+def test_wide_band_does_not_count_as_reproduced():
+    # 30.9 +- 11.9 "contains" 11.43 only because the runs scatter widely
+    v = judge(11.43, 30.94, spread=11.93, unit="arcsec")
+    assert v.verdict == NOT_REPRODUCED and "wide" in v.reason

@@ -9,7 +9,11 @@ our Monte-Carlo seeds), with the difference and a verdict:
     with ``K_SPREAD = 2`` (about a 95 % band of our run-to-run spread),
     ``REL_TOL = 0.10`` (10 % of the published value) and ``abs_tol`` a
     per-quantity floor for values published with few digits (0.5 arcsec for
-    bias estimates, 1 sample-segment for data lengths; 0 otherwise).
+    bias estimates; 0 otherwise), *and* our band is narrow enough to mean
+    something: ``K_SPREAD * spread <= max(MAX_BAND_REL * |published|, abs_tol)``
+    with ``MAX_BAND_REL = 0.5``. A published value that falls inside a band wider
+    than that is only "consistent because our runs scatter widely" and is
+    scored *not reproduced*, with that reason.
 ``not reproducible under stated assumptions``
     Not reproduced, and the information bound says it cannot be: the published
     accuracy |published - truth| is finer than the Cramér-Rao 1-sigma bound of
@@ -31,6 +35,7 @@ import pandas as pd
 
 K_SPREAD = 2.0
 REL_TOL = 0.10
+MAX_BAND_REL = 0.5
 
 REPRODUCED = "reproduced"
 NOT_REPRODUCED = "not reproduced"
@@ -57,6 +62,10 @@ def judge(published: float, ours: float, spread: float | None = None, abs_tol: f
     tol = tolerance(published, spread, abs_tol)
     diff = ours - published
     u = f" {unit}" if unit else ""
+    band = 0.0 if spread is None or math.isnan(spread) else K_SPREAD * abs(spread)
+    if abs(diff) <= tol and band > max(MAX_BAND_REL * abs(published), abs_tol):
+        return Verdict(NOT_REPRODUCED, f"inside our band only because it is wide: 2 sd = {band:.3g}{u} "
+                                       f"> {100 * MAX_BAND_REL:.0f} % of the published value")
     if abs(diff) <= tol:
         return Verdict(REPRODUCED, f"|diff| {abs(diff):.3g}{u} within tolerance {tol:.3g}{u}")
     if truth is not None and crlb is not None and not math.isnan(crlb):
