@@ -127,9 +127,12 @@ def output_variant(path: str | Path) -> str:
 
 
 def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_to: str | Path,
-                width: str = r"\linewidth") -> str:
+                width: str | None = None) -> str:
     """Figure floats for PDFs and table floats for ``.tex`` tables, in the given order.
 
+    Figures keep their natural size (the shared style draws them at column
+    or page width, so fonts read at 8 pt), shrunk only if wider than the text;
+    ``width`` forces a width instead.
     ``relative_to`` is the directory LaTeX resolves paths from; paths are
     written relative to it with forward slashes, so the output does not depend
     on where the checkout lives.
@@ -151,8 +154,10 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
         if p.suffix == ".pdf":
             blocks.append(
                 "\\begin{figure}[htbp]\n  \\centering\n"
-                f"  \\includegraphics[width={width}]{{{rel}}}\n"
-                f"  \\caption[{short}]{{\\textbf{{{short}.}} {caption}}}\n"
+                + (f"  \\includegraphics[width={width}]{{{rel}}}\n" if width else
+                   "  \\resizebox{\\ifdim\\width>\\linewidth\\linewidth\\else\\width\\fi}{!}"
+                   f"{{\\includegraphics{{{rel}}}}}\n")
+                + f"  \\caption[{short}]{{\\textbf{{{short}.}} {caption}}}\n"
                 f"  \\label{{fig:{label}}}\n\\end{{figure}}\n"
             )
         elif p.suffix == ".tex":
