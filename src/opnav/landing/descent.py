@@ -231,7 +231,8 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         if k < n and st.r[2] > scn.min_update_alt:
             r_t, R_t = tr.r[k], tr.R_LtoB[k]
 
-            def visible(pts, margin=scn.planner.margin_px):
+            def visible(pts, margin=scn.planner.margin_px, r_t=r_t, R_t=R_t):
+                # pose bound now (not late-bound), so a stored closure stays this image's
                 return cam.in_view((np.asarray(pts) - r_t) @ R_t.T, margin)
 
             meas = []
