@@ -145,26 +145,9 @@ def test_linear_augmented_filter_mean_is_the_gls_solution():
     P0 = np.eye(6)
     sig = 0.1
     n = win.n
-    dim = 6 * (n + 1) + 3
-    J = np.zeros((dim, dim))
-    J[:6, :6] = np.linalg.inv(P0)
-    J[-3:, -3:] = np.eye(3) / sig**2
-    Qi = np.linalg.inv(win.Q)
-    b = np.zeros(dim)
     z = np.full((1, n + 1, 3), np.nan)
-    from opnav.approach.camera import skew
-    for k in range(1, n + 1):
-        D = np.zeros((6, dim))
-        D[:, 6 * k:6 * k + 6] = np.eye(6)
-        D[:, 6 * (k - 1):6 * k] = -win.Phi[k]
-        J += D.T @ Qi @ D
-        M = np.zeros((3, dim))
-        M[:, 6 * k:6 * k + 3] = -win.C[k]
-        M[:, -3:] = skew(u_lin[k])
-        z[0, k] = win.u_ref[k] + rng.standard_normal(3)
-        W = np.diag(1.0 / win.Rvar[k])
-        J += M.T @ W @ M
-        b += M.T @ W @ (z[0, k] - win.u_ref[k])
+    z[0, 1:] = win.u_ref[1:] + rng.standard_normal((n, 3))
+    J, b = crlb.dense_information(win, P0, -win.C, crlb.theta_sensitivity(u_lin), sig, y=z[0] - win.u_ref)
     post = np.linalg.solve(J, b)
     res = run_augmented(z, np.zeros((1, 6)), P0, np.zeros(3), sig, win, u_lin=u_lin)
     np.testing.assert_allclose(res.theta[0, -1], post[-3:], rtol=1e-6, atol=1e-12)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from opnav.approach import ekf, smoother
+from opnav.approach import crlb, ekf, smoother
 from opnav.approach.camera import misalignment_small
 
 from approach_helpers import small_window
@@ -11,27 +11,11 @@ from approach_helpers import small_window
 
 def _dense_posterior(z, theta, x0, P0, win):
     """Mean and covariance of X_0..X_n given z, from the joint information matrix."""
-    n = win.n
-    dim = 6 * (n + 1)
-    J = np.zeros((dim, dim))
-    h = np.zeros(dim)
-    P0i = np.linalg.inv(P0)
-    J[:6, :6] += P0i
-    h[:6] += P0i @ x0
-    Qi = np.linalg.inv(win.Q)
     A = misalignment_small(theta)
-    for k in range(1, n + 1):
-        D = np.zeros((6, dim))
-        D[:, 6 * k:6 * k + 6] = np.eye(6)
-        D[:, 6 * (k - 1):6 * k] = -win.Phi[k]
-        J += D.T @ Qi @ D
-        M = np.zeros((3, dim))
-        M[:, 6 * k:6 * k + 3] = -A @ win.C[k]
-        W = np.diag(1.0 / win.Rvar[k])
-        J += M.T @ W @ M
-        h += M.T @ W @ (z[k] - A @ win.u_ref[k])
+    Hx = np.stack([-A @ C for C in win.C])
+    J, h = crlb.dense_information(win, P0, Hx, y=z - win.u_ref @ A.T, x0=x0)
     cov = np.linalg.inv(J)
-    return (cov @ h).reshape(n + 1, 6), cov
+    return (cov @ h).reshape(win.n + 1, 6), cov
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -71,25 +71,52 @@ def crlb_curve(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.n
     return out
 
 
-def batch_crlb(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.ndarray,
-               sigma_theta: float = 1.0) -> np.ndarray:
-    """Same bound at n from the dense joint information of ``X_0..X_n, theta`` (3,), rad."""
+def dense_information(win: Window, P0: np.ndarray, Hx: np.ndarray, Ht: np.ndarray | None = None,
+                      sigma_theta: float | None = None, y: np.ndarray | None = None,
+                      x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Joint information of ``X_0..X_n`` (and ``theta``) of the linear-Gaussian model
+
+    ``X_0 ~ N(x0, P0)``, ``X_k = Phi_k X_{k-1} + w_k`` (``w ~ N(0, Q)``),
+    ``y_k = Hx[k] r_k + Ht[k] theta + v_k`` (``v ~ N(0, diag Rvar[k])``), k = 1..n,
+    with ``theta ~ N(0, sigma_theta^2 I)`` when ``Ht`` is given (appended last).
+
+    Returns ``(J, h)``: the information matrix and linear term, so the posterior
+    is ``N(J^-1 h, J^-1)`` (``h`` is zero where ``y``/``x0`` are not given).
+    The dense reference for the recursive bound and the smoother tests.
+    """
     n = win.n
-    dim = 6 * (n + 1) + 3
+    n_th = 0 if Ht is None else 3
+    dim = 6 * (n + 1) + n_th
     J = np.zeros((dim, dim))
-    J[:6, :6] += np.linalg.inv(P_start)
-    J[-3:, -3:] += np.eye(3) / sigma_theta**2
+    h = np.zeros(dim)
+    P0i = np.linalg.inv(P0)
+    J[:6, :6] += P0i
+    if x0 is not None:
+        h[:6] += P0i @ x0
+    if n_th:
+        J[-3:, -3:] += np.eye(3) / sigma_theta**2
     Qi = np.linalg.inv(win.Q)
-    A = misalignment_small(theta)
-    Us = theta_sensitivity(u_true)
     for k in range(1, n + 1):
         D = np.zeros((6, dim))
         D[:, 6 * k:6 * k + 6] = np.eye(6)
         D[:, 6 * (k - 1):6 * k] = -win.Phi[k]
         J += D.T @ Qi @ D
         M = np.zeros((3, dim))
-        M[:, 6 * k:6 * k + 3] = -A @ win.C[k]
-        M[:, -3:] = Us[k]
-        J += M.T @ np.diag(1.0 / win.Rvar[k]) @ M
+        M[:, 6 * k:6 * k + 3] = Hx[k]
+        if n_th:
+            M[:, -3:] = Ht[k]
+        W = np.diag(1.0 / win.Rvar[k])
+        J += M.T @ W @ M
+        if y is not None:
+            h += M.T @ W @ y[k]
+    return J, h
+
+
+def batch_crlb(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.ndarray,
+               sigma_theta: float = 1.0) -> np.ndarray:
+    """Same bound at n from the dense joint information of ``X_0..X_n, theta`` (3,), rad."""
+    A = misalignment_small(theta)
+    Hx = np.stack([-A @ C for C in win.C])
+    J, _ = dense_information(win, P_start, Hx, theta_sensitivity(u_true), sigma_theta)
     cov = np.linalg.inv(J)
     return np.sqrt(np.diag(cov)[-3:])
