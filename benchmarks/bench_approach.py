@@ -12,7 +12,6 @@ results directory (in a temporary copy of the workflow).
 from __future__ import annotations
 
 import argparse
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -20,6 +19,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from opnav.snakeio import copy_workflow
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -51,13 +52,7 @@ def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int =
 
 def workflow_timing(configfile: str | None = None) -> float:
     with tempfile.TemporaryDirectory() as d:
-        dst = Path(d)
-        for name in ("Snakefile", "config", "workflow", "src", "paper", "profiles"):
-            p = REPO / name
-            if p.is_dir():
-                shutil.copytree(p, dst / name, ignore=shutil.ignore_patterns("__pycache__", "*.pdf"))
-            elif p.exists():
-                shutil.copy2(p, dst / name)
+        dst = copy_workflow(REPO, Path(d))
         targets = ["results/approach/A-T1_table1.csv", "results/approach/A-X1_crlb.pdf"] + [
             f"results/approach/A-F4_bias_estimate_{v}.pdf" for v in ("literal", "prior", "roll", "reference-start")]
         cmd = [sys.executable, "-m", "snakemake", "--cores", "2", *targets]

@@ -1,23 +1,18 @@
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from opnav.snakeio import copy_workflow as _copy_workflow
+
 REPO = Path(__file__).resolve().parents[1]
 
 
 def copy_workflow(dst: Path) -> Path:
     """Copy what the workflow needs (not results/ or .snakemake/) into ``dst``."""
-    for name in ("Snakefile", "config", "workflow", "src", "paper", "profiles"):
-        p = REPO / name
-        if p.is_dir():
-            shutil.copytree(p, dst / name, ignore=shutil.ignore_patterns("__pycache__", "*.pdf"))
-        elif p.exists():
-            shutil.copy2(p, dst / name)
-    return dst
+    return _copy_workflow(REPO, dst)
 
 
 def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.CompletedProcess:

@@ -68,3 +68,21 @@ class _Named(list):
         super().__init__(items)
         for k, v in names.items():
             setattr(self, k, v)
+
+
+#: What a copy of the workflow needs (not results/ or .snakemake/).
+WORKFLOW_PARTS = ("Snakefile", "config", "workflow", "src", "paper", "profiles")
+
+
+def copy_workflow(repo: Path, dst: Path) -> Path:
+    """Copy the workflow of checkout ``repo`` into ``dst`` (for tests and benchmarks
+    that run snakemake in a scratch directory)."""
+    import shutil
+
+    for name in WORKFLOW_PARTS:
+        p = Path(repo) / name
+        if p.is_dir():
+            shutil.copytree(p, Path(dst) / name, ignore=shutil.ignore_patterns("__pycache__", "*.pdf"))
+        elif p.exists():
+            shutil.copy2(p, Path(dst) / name)
+    return Path(dst)
