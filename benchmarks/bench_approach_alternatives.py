@@ -35,7 +35,7 @@ def main(argv=None) -> int:
     ap.add_argument("--cases", nargs="*", default=["T1-01", "T1-09", "T1-12"], help="case ids")
     ap.add_argument("--variants", nargs="*", default=["literal", "roll"])
     args = ap.parse_args(argv)
-    cfg = load_config(REPO / "config" / ("quick.yaml" if args.quick else "config.yaml"))["approach"]
+    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if args.quick else [])["approach"]
     S = args.seeds or cfg["n_seeds"]
     seeds = range(S)
     allc = {c.case_id: c for c in cases.table1_cases(cfg)}

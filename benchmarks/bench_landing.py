@@ -127,7 +127,7 @@ def main(argv=None) -> int:
     ap.add_argument("--methods", default=None, help="comma list (default landing.mc.methods)")
     ap.add_argument("--mc", action="store_true", help="also time the full Monte Carlo (--cores 2)")
     args = ap.parse_args(argv)
-    landing = copy.deepcopy(load_config(args.config)["landing"])
+    landing = copy.deepcopy(load_config(overlays=[args.config] if args.config else [])["landing"])
     methods = args.methods.split(",") if args.methods else list(landing["mc"]["methods"])
     scn, states = planning_states(landing)
     print(f"{len(states)} planning states from run 0 (depth), {args.reps} rounds, "

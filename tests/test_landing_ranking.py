@@ -174,7 +174,7 @@ def test_ablation_value_labels_and_config_keys():
 def test_ablation_run_at_default_value_equals_main_run():
     """Seeds depend on the run index only: ablation run i at the configured value
     is main Monte-Carlo run i (bit for bit); another value changes the run."""
-    cfg = load_config(REPO / "config" / "quick.yaml")["landing"]
+    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"])["landing"]
     main = run_chunk(cfg, "depth", [1])
     for name in ("fov", "obs"):
         abl = run_chunk(with_value(cfg, name, default_value(cfg, name)), "depth", [1])

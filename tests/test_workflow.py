@@ -7,10 +7,11 @@ import pytest
 import yaml
 
 from conftest import REPO, run_snakemake
+from opnav.config import load_config
 
 
 def _write_bad(workdir: Path, mutate) -> Path:
-    cfg = yaml.safe_load((REPO / "config" / "quick.yaml").read_text())
+    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"])
     mutate(cfg)
     path = workdir / "bad.yaml"
     path.write_text(yaml.safe_dump(cfg))
@@ -42,18 +43,24 @@ def test_dry_run_succeeds(workdir, configfile):
     assert proc.returncode == 0, proc.stderr[-3000:]
 
 
-def test_configs_have_the_same_keys():
-    def keys(d, prefix=""):
-        out = set()
-        for k, v in d.items():
-            out.add(prefix + k)
-            if isinstance(v, dict):
-                out |= keys(v, prefix + k + ".")
-        return out
-
+def test_quick_profile_is_a_valid_overlay_of_only_changed_keys():
+    """quick.yaml holds only keys of config.yaml whose values it changes, and the
+    merged result validates (so the overlay cannot drift from the schema)."""
     full = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
     quick = yaml.safe_load((REPO / "config" / "quick.yaml").read_text())
-    assert keys(full) == keys(quick)
+
+    def check(f, q, prefix=""):
+        for k, v in q.items():
+            assert k in f, f"quick.yaml key {prefix + k} is not in config.yaml"
+            if isinstance(v, dict):
+                check(f[k], v, prefix + k + ".")
+            else:
+                assert v != f[k], f"quick.yaml key {prefix + k} repeats the full value"
+
+    check(full, quick)
+    merged = load_config(overlays=[REPO / "config" / "quick.yaml"])
+    assert merged["profile"] == "quick"
+    assert merged["landing"]["mc"]["bounds"] == load_config()["landing"]["mc"]["bounds"]
 
 
 @pytest.mark.slow

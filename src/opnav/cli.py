@@ -30,7 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"opnav {__version__}")
     parser.add_argument("--config", default=None,
-                        help="config file (default: config/config.yaml of the checkout)")
+                        help="config overlay on config/config.yaml of the checkout (e.g. config/quick.yaml)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for part in PARTS:
         try:

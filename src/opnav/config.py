@@ -1,7 +1,7 @@
 """Configuration: load a YAML config, validate it against the project schema.
 
-The schema (``workflow/schemas/config.schema.yaml`` and the section files it
-references) is the single source of defaults, types and ranges. Snakemake
+The schema (``opnav/schemas/config.schema.yaml``, shipped with the package, and
+the section files it references) is the single source of defaults, types and ranges. Snakemake
 validates with :func:`snakemake.utils.validate`; the command-line tools use
 :func:`load_config`, which applies the same schema with the same defaults so a
 CLI run and a pipeline run see the same parameters.
@@ -45,14 +45,18 @@ def describe_validation_error(exc: BaseException) -> str:
     return f"invalid {where}: {reason}"
 
 
+#: The project schema, shipped as package data.
+SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "config.schema.yaml"
+
+
 def repo_root(start: Path | None = None) -> Path:
-    """The checkout that holds ``workflow/schemas`` (searching upwards from ``start``)."""
+    """The checkout that holds ``config/config.yaml`` (searching upwards from ``start``)."""
     here = (start or Path.cwd()).resolve()
     for cand in [here, *here.parents, Path(__file__).resolve().parents[2]]:
-        if (cand / "workflow" / "schemas" / "config.schema.yaml").is_file():
+        if (cand / "config" / "config.yaml").is_file() and (cand / "Snakefile").is_file():
             return cand
     raise ConfigError(
-        "cannot find workflow/schemas/config.schema.yaml: run from the opnav-repro checkout"
+        "cannot find config/config.yaml: run from the opnav-repro checkout or pass --config"
     )
 
 
@@ -102,13 +106,15 @@ def validate_config(config: dict, schema_path: Path) -> dict:
 
 
 def load_config(path: str | Path | None = None, overlays: list[str | Path] = ()) -> dict:
-    """Read ``config/config.yaml`` (or ``path``), merge overlays, validate, return.
+    """Read ``path`` (default: the checkout's ``config/config.yaml``), merge the
+    ``overlays`` in order (nested keys merged, as ``snakemake --configfile``
+    does), validate, return.
 
+    ``config/quick.yaml`` is an overlay: ``load_config(overlays=[quick])``.
     Raises :class:`ConfigError` naming the file if it is missing, or the key if
     a value is invalid.
     """
-    root = repo_root(Path(path).parent if path else None)
-    files = [Path(path) if path else root / "config" / "config.yaml", *map(Path, overlays)]
+    files = [Path(path) if path else repo_root() / "config" / "config.yaml", *map(Path, overlays)]
     config: dict = {}
     for f in files:
         if not f.is_file():
@@ -117,7 +123,7 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = ())
         if not isinstance(data, dict):
             raise ConfigError(f"config file {f} must hold a mapping at the top level")
         _merge(config, data)
-    return validate_config(config, root / "workflow" / "schemas" / "config.schema.yaml")
+    return validate_config(config, SCHEMA_PATH)
 
 
 def _merge(base: dict, new: dict) -> None:

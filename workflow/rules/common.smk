@@ -9,7 +9,7 @@ sys.path.insert(0, str(Path(workflow.basedir) / "src"))
 from opnav.config import ConfigError, describe_validation_error  # noqa: E402
 
 try:
-    validate(config, "../schemas/config.schema.yaml", set_default=True)
+    validate(config, "../../src/opnav/schemas/config.schema.yaml", set_default=True)
 except WorkflowError as exc:
     raise ConfigError(describe_validation_error(exc)) from None
 

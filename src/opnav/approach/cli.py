@@ -38,7 +38,7 @@ def run(args) -> int:
     from .cases import Case, run_case
     from .pipeline import bound_curve
 
-    cfg = load_config(args.config)["approach"]
+    cfg = load_config(overlays=[args.config] if args.config else [])["approach"]
     for k in ("N0", "N", "M", "L"):
         v = getattr(args, k)
         if v is not None:

@@ -19,7 +19,7 @@ def _run(args) -> int:
     from opnav.landing.descent import build_scenario, run_descent, summarize_run
     from opnav.landing.planner import available_methods
 
-    cfg = load_config(args.config)["landing"]
+    cfg = load_config(overlays=[args.config] if args.config else [])["landing"]
     if args.method not in available_methods():
         raise SystemExit(f"opnav landing: unknown --method {args.method!r}; "
                          f"available: {', '.join(available_methods())}")
