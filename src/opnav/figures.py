@@ -10,8 +10,6 @@ this module: plotting lives in ``workflow/scripts`` and here only.
 from __future__ import annotations
 
 import contextlib
-import os
-import tempfile
 from pathlib import Path
 from typing import Iterable, Iterator
 
@@ -19,6 +17,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from opnav.tables import atomic_target  # noqa: E402
 
 STYLE = Path(__file__).with_name("opnav.mplstyle")
 
@@ -57,14 +57,8 @@ def save(fig: "matplotlib.figure.Figure", paths: Iterable[str | Path] | str | Pa
                 meta = {"Software": None}
             else:
                 meta = {}
-            fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.stem}.", suffix=p.suffix)
-            os.close(fd)
-            try:
+            with atomic_target(p) as tmp:
                 fig.savefig(tmp, format=fmt, metadata=meta)
-                os.replace(tmp, p)
-            except BaseException:
-                Path(tmp).unlink(missing_ok=True)
-                raise
             out.append(p)
     finally:
         plt.close(fig)
