@@ -10,9 +10,11 @@ on how runs are grouped into Snakemake jobs. :func:`run_chunk` flies a list of
 run indices and stacks the per-run arrays; :func:`gather` concatenates chunks
 in run order; :func:`summary_table` builds B-T3.
 
-Statistics (per method, over the runs): final and RMS (over time) error norms
-of position (m), velocity (m/s) and attitude (deg, small-angle ``dtheta``),
-each as mean and ``3 sigma`` (three sample standard deviations); the median
+Statistics (per method, over the runs): final (touchdown) and RMS (over time)
+error norms of position (m), velocity (m/s) and attitude (deg, small-angle
+``dtheta``), each as mean and ``3 sigma`` (three sample standard deviations),
+and the position and velocity error at the last vision update (``lastvis_``:
+the filter then coasts on the IMU to touchdown); the median
 wall time of a planning call over every planning call of every run (us), the
 median objective evaluations per call; the depth method's time reduction
 against each baseline ``100 (1 - median_depth / median_baseline)`` (%), with a
@@ -36,7 +38,7 @@ __all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stat
 
 _PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index")
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
-           "nees_r", "nees_v")
+           "sig_yaw_deg", "nees_r", "nees_v", "updated")
 
 
 def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
@@ -106,11 +108,20 @@ def per_run_stats(data: dict) -> pd.DataFrame:
     for key, name in (("err_r", "pos_err_m"), ("err_v", "vel_err_mps"), ("err_th_deg", "att_err_deg")):
         nrm = np.linalg.norm(data[key], axis=2)
         rows[f"final_{name}"] = nrm[:, -1]
+        if "updated" in data:      # at the last vision update (then the IMU-only coast)
+            rows[f"lastvis_{name}"] = nrm[np.arange(len(nrm)), _last_update(data["updated"])]
         rows[f"rms_{name}"] = np.sqrt(np.mean(nrm**2, axis=1))
     rows["mean_nees_pos"] = data["nees_r"].mean(axis=1)
     rows["mean_nees_vel"] = data["nees_v"].mean(axis=1)
     rows["n_landmarks"] = data["n_landmarks"]
     return pd.DataFrame(rows, index=pd.Index(data["run_index"], name="run"))
+
+
+def _last_update(updated: np.ndarray) -> np.ndarray:
+    """Per run, the index of the last filter time with a vision update (0 if none)."""
+    u = np.asarray(updated, bool)
+    last = u.shape[1] - 1 - np.argmax(u[:, ::-1], axis=1)
+    return np.where(u.any(axis=1), last, 0)
 
 
 def _median_us(ns: np.ndarray) -> float:
@@ -167,6 +178,12 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
                 row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
         row["final_pos_err_m_median"] = float(st["final_pos_err_m"].median())
         row["final_vel_err_mps_median"] = float(st["final_vel_err_mps"].median())
+        if "lastvis_pos_err_m" in st:   # at the last vision update, before the IMU-only coast
+            for q in ("pos_err_m", "vel_err_mps"):
+                col = st[f"lastvis_{q}"]
+                row[f"lastvis_{q}_mean"] = float(col.mean())
+                row[f"lastvis_{q}_median"] = float(col.median())
+                row[f"lastvis_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
         row["converged_runs_pct"] = float(100.0 * (st["final_pos_err_m"] < converged_pos_err_m).mean())
         row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
         row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
