@@ -65,11 +65,22 @@ def _validator(schema_path: Path):
     from jsonschema import Draft202012Validator
     from referencing import Registry, Resource
 
+    from referencing.jsonschema import DRAFT202012
+
+    def load(path: Path) -> dict:
+        # Without "$schema" the extended class below (which fills defaults) is
+        # kept for referenced section files too: jsonschema otherwise switches
+        # to the plain Draft 2020-12 validator for every schema naming its
+        # dialect, and nested sections were never filled.
+        contents = yaml.safe_load(path.read_text())
+        contents.pop("$schema", None)
+        return contents
+
     def retrieve(uri: str) -> Resource:
         path = Path(uri.removeprefix("file://"))
-        return Resource.from_contents(yaml.safe_load(path.read_text()))
+        return Resource.from_contents(load(path), default_specification=DRAFT202012)
 
-    schema = yaml.safe_load(schema_path.read_text())
+    schema = load(schema_path)
     schema["$id"] = schema_path.resolve().as_uri()
     registry = Registry(retrieve=retrieve)
 
@@ -106,7 +117,9 @@ def validate_config(config: dict, schema_path: Path) -> dict:
 
 
 def load_config(path: str | Path | None = None, overlays: list[str | Path] = ()) -> dict:
-    """Read ``path`` (default: the checkout's ``config/config.yaml``), merge the
+    """Read ``path`` (default: the checkout's ``config/config.yaml``, or, for an
+    installed package run outside a checkout, nothing: the schema's defaults,
+    which a test keeps equal to ``config/config.yaml``), merge the
     ``overlays`` in order (nested keys merged, as ``snakemake --configfile``
     does), validate, return.
 
@@ -114,7 +127,12 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = ())
     Raises :class:`ConfigError` naming the file if it is missing, or the key if
     a value is invalid.
     """
-    files = [Path(path) if path else repo_root() / "config" / "config.yaml", *map(Path, overlays)]
+    if path is None:
+        try:
+            path = repo_root() / "config" / "config.yaml"
+        except ConfigError:
+            path = None  # installed without a checkout: the schema defaults alone
+    files = [*([Path(path)] if path is not None else []), *map(Path, overlays)]
     config: dict = {}
     for f in files:
         if not f.is_file():

@@ -1,0 +1,82 @@
+"""``pip install .`` (not editable) gives a working ``opnav`` without the checkout.
+
+Builds a wheel from a copy of the sources, installs it into a temporary venv
+that sees the already-installed dependencies (``--system-site-packages``,
+``--no-deps``, ``--no-build-isolation``: no network), and runs the installed
+command from a folder outside any checkout, where only package data can supply
+the schemas, defaults, published values and figure style.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+
+import pytest
+
+from conftest import REPO
+
+pytestmark = pytest.mark.slow
+
+
+def _run(cmd, cwd, env):
+    return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("wheel")
+    src = tmp / "src-copy"
+    src.mkdir()
+    for name in ["pyproject.toml", "README.md", "LICENSE"]:
+        if (REPO / name).exists():
+            shutil.copy2(REPO / name, src / name)
+    shutil.copytree(REPO / "src", src / "src",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    wheels = tmp / "dist"
+    r = _run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "--no-build-isolation",
+              "-w", str(wheels), "-q"], tmp, env)
+    assert r.returncode == 0, r.stderr
+    (wheel,) = wheels.glob("opnav_repro-*.whl")
+    venv = tmp / "venv"
+    r = _run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], tmp, env)
+    assert r.returncode == 0, r.stderr
+    bindir = venv / ("Scripts" if os.name == "nt" else "bin")
+    r = _run([str(bindir / "python"), "-m", "pip", "install", "-q", "--no-deps", "--no-index",
+              "--force-reinstall", str(wheel)], tmp, env)
+    assert r.returncode == 0, r.stderr
+    outside = tmp / "elsewhere"
+    outside.mkdir()
+    return dict(wheel=wheel, bin=bindir, cwd=outside, env=env)
+
+
+def test_wheel_ships_its_package_data(installed):
+    names = set(zipfile.ZipFile(installed["wheel"]).namelist())
+    for f in ["opnav/schemas/config.schema.yaml", "opnav/schemas/approach.schema.yaml",
+              "opnav/schemas/landing.schema.yaml", "opnav/data/published.yaml",
+              "opnav/opnav.mplstyle"]:
+        assert f in names
+
+
+def test_installed_cli_runs_outside_a_checkout(installed):
+    env, cwd, bindir = installed["env"], installed["cwd"], installed["bin"]
+    r = _run([str(bindir / "python"), "-c", "import opnav; print(opnav.__file__)"], cwd, env)
+    assert str(installed["bin"].parent) in r.stdout, r.stdout + r.stderr  # the venv's copy
+    r = _run([str(bindir / "opnav"), "--help"], cwd, env)
+    assert r.returncode == 0 and "approach" in r.stdout and "landing" in r.stdout, r.stderr
+    r = _run([str(bindir / "opnav"), "landing", "--method", "depth", "--seed", "0"], cwd, env)
+    assert r.returncode == 0, r.stderr
+    installed_out = json.loads(r.stdout)
+    # The installed command uses the schema defaults; the checkout's uses
+    # config/config.yaml: the same descent, the same numbers.
+    here = subprocess.run([sys.executable, "-m", "opnav.cli", "landing", "--method", "depth",
+                           "--seed", "0"], cwd=REPO, capture_output=True, text=True,
+                          env=dict(env, PYTHONPATH=str(REPO / "src")), timeout=300)
+    assert here.returncode == 0, here.stderr
+    checkout_out = json.loads(here.stdout)
+    drop = {"median_plan_time_us"}  # a clock
+    assert {k: v for k, v in installed_out.items() if k not in drop} == \
+        {k: v for k, v in checkout_out.items() if k not in drop}
