@@ -1,4 +1,5 @@
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -26,3 +27,28 @@ def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.Comp
 @pytest.fixture()
 def workdir(tmp_path: Path) -> Path:
     return copy_workflow(tmp_path)
+
+
+@pytest.fixture(scope="session")
+def quick_results(tmp_path_factory) -> Path:
+    """A scratch copy of the workflow after one complete quick-profile run (shared by
+    the end-to-end test and the dry-run tests that need recorded provenance)."""
+    wd = copy_workflow(tmp_path_factory.mktemp("quick"))
+    proc = run_snakemake(wd, "--cores", "2", "--configfile", "config/quick.yaml")
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
+    return wd
+
+
+def dry_run_jobs(cwd: Path, *args: str) -> list[tuple[str, dict]]:
+    """The jobs ``snakemake -n`` lists, as (rule, wildcards) pairs."""
+    proc = run_snakemake(cwd, "-n", "--cores", "1", *args)
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
+    jobs = []
+    for block in re.split(r"\n(?=(?:local)?rule \w+:\n)", proc.stdout):
+        m = re.match(r"(?:local)?rule (\w+):\n", block.lstrip("\n"))
+        if not m:
+            continue
+        wc = re.search(r"^    wildcards: (.*)$", block, re.M)
+        pairs = dict(kv.split("=", 1) for kv in wc.group(1).split(", ")) if wc else {}
+        jobs.append((m.group(1), pairs))
+    return jobs

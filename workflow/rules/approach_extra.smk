@@ -1,10 +1,20 @@
 # Paper A, beyond the paper: A-X2 (EM-EKF against the augmented EKF and batch ML)
 # and A-X3 (one-value ablations of pixel noise and segment length).
-# Uses approach.smk's names (APPROACH, A_WORK, A_CFG, A_SRC, A_MC, A_METHODS, a_groups):
+# Uses approach.smk's names (APPROACH, A_WORK, A_SCENARIO, A_EM, A_SRC, A_MC, A_METHODS, a_groups):
 # include it after approach.smk.
 
 A_X2_SRC = A_SRC + src("approach/augmented.py", "approach/batch_ml.py", "approach/alternatives.py")
 A_X2_VARIANTS = config["approach"]["table1_variants"]
+
+
+def a_ablation_cfg(values_key):
+    """The keys an A-X3 sweep reads: scenario, EM, augmented EKF and its own values only."""
+    c = cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives")
+    abl = config["approach"]["ablation"]
+    c["ablation"] = canonical({k: abl[k] for k in ("variants", "n_seeds", values_key)})
+    return c
+
+
 A_X2 = {(v, g): f"{A_WORK}/x2/{v}__{g}.pkl" for v in A_X2_VARIANTS for g in a_groups(v)}
 
 
@@ -16,7 +26,7 @@ rule approach_x2_group:
     output:
         f"{A_WORK}/x2/{{variant}}__{{group}}.pkl",
     params:
-        approach=A_CFG,
+        approach=cfg("approach", *A_EM, "alternatives", "methods"),
     log:
         f"{APPROACH}/logs/x2_{{variant}}__{{group}}.log",
     benchmark:
@@ -36,7 +46,7 @@ rule approach_x2_tables:
         long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
         summary=f"{APPROACH}/A-X2-summary.json",
     params:
-        approach=A_CFG,
+        approach=cfg("approach", "segments", "alternatives"),
         profile=config["profile"],
     log:
         f"{APPROACH}/logs/x2_tables.log",
@@ -67,7 +77,7 @@ rule approach_ablation_pixel:
         table=report_table(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
         fig=report_figure(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
     params:
-        approach=A_CFG,
+        approach=a_ablation_cfg("sigma3_px"),
         sweep="pixel",
     log:
         f"{APPROACH}/logs/ablation_pixel.log",
@@ -85,7 +95,7 @@ rule approach_ablation_segment:
         table=report_table(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
         fig=report_figure(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
     params:
-        approach=A_CFG,
+        approach=a_ablation_cfg("segment_N"),
         sweep="segment",
     log:
         f"{APPROACH}/logs/ablation_segment.log",

@@ -29,9 +29,14 @@ ALL_TARGETS.extend(rules.landing_tables.output)
 # A new planning method is a new name in landing.mc.methods (table-driven
 # dispatch in opnav.landing.planner). Wildcards are named bmethod/bchunk so the
 # other parts' global wildcard constraints do not apply.
+# Chunks are kept (not temp) and named by their run indices (montecarlo.chunk_label):
+# a run's random stream depends on its index only, so raising landing.mc.n_runs flies
+# only the new runs, and no chunk's params mention n_runs.
+from opnav.landing.montecarlo import CHUNK_PATTERN, chunk_label, chunk_runs, chunks as mc_chunks
+
 B_METHODS = list(config["landing"]["mc"]["methods"])
-_n, _k = config["landing"]["mc"]["n_runs"], config["landing"]["mc"]["runs_per_job"]
-B_CHUNKS = [list(range(a, min(a + _k, _n))) for a in range(0, _n, _k)]  # = montecarlo.chunks
+B_CHUNKS = [chunk_label(c) for c in mc_chunks(config["landing"]["mc"]["n_runs"],
+                                               config["landing"]["mc"]["runs_per_job"])]
 B_SIM = cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg", "imu", "camera",
             "landmarks", "filter", "planner")
 B_SIM["mc"] = canonical({k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")})
@@ -47,13 +52,13 @@ rule landing_mc_chunk:
     input:
         B_SRC,
     output:
-        temp(f"{LANDING}/mc/chunks/{{bmethod}}/{{bchunk}}.npz"),
+        f"{LANDING}/mc/chunks/{{bmethod}}/{{bchunk}}.npz",
     wildcard_constraints:
         bmethod="[a-z][a-z0-9_-]*",
-        bchunk="[0-9]{3}",
+        bchunk=CHUNK_PATTERN,
     params:
         landing=B_SIM,
-        runs=lambda wc: B_CHUNKS[int(wc.bchunk)],
+        runs=lambda wc: chunk_runs(wc.bchunk),
     log:
         f"{LANDING}/logs/mc_{{bmethod}}_chunk{{bchunk}}.log",
     benchmark:
@@ -65,7 +70,7 @@ rule landing_mc_chunk:
 rule landing_mc_gather:
     """All runs of one method, in run order (gather)."""
     input:
-        lambda wc: [f"{LANDING}/mc/chunks/{wc.bmethod}/{i:03d}.npz" for i in range(len(B_CHUNKS))],
+        lambda wc: [f"{LANDING}/mc/chunks/{wc.bmethod}/{c}.npz" for c in B_CHUNKS],
     output:
         f"{LANDING}/mc/{{bmethod}}.npz",
     wildcard_constraints:

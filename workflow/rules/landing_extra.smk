@@ -39,13 +39,12 @@ ALL_TARGETS.extend(rules.landing_x1_summary.output)
 _BA = config["landing"]["ablation"]
 ABL_METHODS = list(_BA["methods"])
 ABL_VALUES = {s: {_b_value_label(s, v): v for v in _BA[_B_SWEEPS[s][0]]} for s in _B_SWEEPS}
-_na, _ka = _BA["n_runs"], _BA["runs_per_job"]
-ABL_CHUNKS = [list(range(a, min(a + _ka, _na))) for a in range(0, _na, _ka)]
+ABL_CHUNKS = [chunk_label(c) for c in mc_chunks(_BA["n_runs"], _BA["runs_per_job"])]
 
 
 def _abl_chunks(sweep):
-    return [f"{LANDING}/ablation/{sweep}/{lab}/{m}_{i:03d}.npz"
-            for lab in ABL_VALUES[sweep] for i in range(len(ABL_CHUNKS)) for m in ABL_METHODS]
+    return [f"{LANDING}/ablation/{sweep}/{lab}/{m}_{c}.npz"
+            for lab in ABL_VALUES[sweep] for c in ABL_CHUNKS for m in ABL_METHODS]
 
 
 rule landing_ablation_chunk:
@@ -58,12 +57,12 @@ rule landing_ablation_chunk:
     wildcard_constraints:
         bsweep="|".join(_B_SWEEPS),
         bvalue="[0-9][0-9.]*",
-        bchunk="[0-9]{3}",
+        bchunk=CHUNK_PATTERN,
     params:
         landing=B_SIM,
         methods=ABL_METHODS,
         value=lambda wc: ABL_VALUES[wc.bsweep][wc.bvalue],
-        runs=lambda wc: ABL_CHUNKS[int(wc.bchunk)],
+        runs=lambda wc: chunk_runs(wc.bchunk),
     log:
         f"{LANDING}/logs/ablation_{{bsweep}}_{{bvalue}}_{{bchunk}}.log",
     benchmark:

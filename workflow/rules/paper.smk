@@ -90,7 +90,10 @@ rule paper_macros:
         f"{PAPER}/macros.tex",
     params:
         profile=config["profile"],
-        config=canonical({k: config[k] for k in ("approach", "landing")}),
+        # the model configuration the text may quote (\Cfg... macros); ablation and study
+        # values are reported by their own outputs, so editing one reruns no macro
+        config=canonical({k: {kk: vv for kk, vv in config[k].items() if kk != "ablation"}
+                          for k in ("approach", "landing")}),
     log:
         f"{PAPER}/logs/paper_macros.log",
     localrule: True

@@ -6,8 +6,8 @@ from opnav.landing.montecarlo import run_chunk, save
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/landing/ablation/fov/60/depth_000.npz"],
-                               wildcards={"bsweep": "fov", "bvalue": "60", "bchunk": "000"})
+    snakemake = mock_snakemake(output=["results/landing/ablation/fov/60/depth_r0000-0001.npz"],
+                               wildcards={"bsweep": "fov", "bvalue": "60", "bchunk": "r0000-0001"})
     snakemake.params = type("P", (), {"landing": snakemake.config["landing"], "runs": [0, 1],
                                       "methods": ["depth"], "value": 60.0})()
 

@@ -4,7 +4,7 @@ from opnav.landing.montecarlo import gather, load, save
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(input=["results/landing/mc/chunks/depth/000.npz"],
+    snakemake = mock_snakemake(input=["results/landing/mc/chunks/depth/r0000-0001.npz"],
                                output=["results/landing/mc/depth.npz"], wildcards={"bmethod": "depth"})
 
 with script_context(snakemake) as log:

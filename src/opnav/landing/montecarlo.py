@@ -26,6 +26,7 @@ inflate.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,8 @@ import pandas as pd
 from opnav.landing.descent import build_scenario, run_descent
 
 __all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
-           "time_reduction", "chunks", "same_pick_pct"]
+           "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
+           "same_pick_pct"]
 
 _PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index")
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
@@ -46,6 +48,31 @@ def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
     if n_runs < 1 or runs_per_job < 1:
         raise ValueError("landing.mc.n_runs and runs_per_job must be >= 1")
     return [list(range(a, min(a + runs_per_job, n_runs))) for a in range(0, n_runs, runs_per_job)]
+
+
+def chunk_label(run_indices) -> str:
+    """A chunk's name from its (consecutive) run indices: ``[4, 5]`` -> ``"r0004-0005"``.
+
+    Chunk files are named by the runs they hold, not by their position, so
+    raising ``n_runs`` keeps every full chunk (same name, same runs) and only
+    the new runs (and a formerly partial last chunk) are flown.
+    """
+    runs = [int(i) for i in run_indices]
+    if not runs or runs != list(range(runs[0], runs[0] + len(runs))):
+        raise ValueError(f"a chunk holds consecutive run indices, got {runs}")
+    return f"r{runs[0]:04d}-{runs[-1]:04d}"
+
+
+def chunk_runs(label: str) -> list[int]:
+    """The run indices of a :func:`chunk_label` (inverse)."""
+    m = re.fullmatch(r"r(\d{4,})-(\d{4,})", label)
+    if not m or int(m.group(2)) < int(m.group(1)):
+        raise ValueError(f"not a Monte-Carlo chunk label: {label!r} (expected e.g. 'r0000-0024')")
+    return list(range(int(m.group(1)), int(m.group(2)) + 1))
+
+
+#: Snakemake wildcard pattern of :func:`chunk_label`.
+CHUNK_PATTERN = r"r[0-9]+-[0-9]+"
 
 
 def run_chunk(landing_cfg: dict, method: str, run_indices) -> dict:
