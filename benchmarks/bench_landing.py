@@ -55,9 +55,10 @@ def planning_states(landing: dict, run_index: int = 0):
     captured = []
     orig = D.plan
 
-    def spy(method, state, camera, field, visible, cfg, exclude=frozenset(), rng=None):
-        captured.append((state, visible, set(exclude)))
-        return orig(method, state, camera, field, visible, cfg, exclude=exclude, rng=rng)
+    def spy(method, state, camera, field, visible, cfg, exclude=frozenset(), rng=None, detected=None):
+        captured.append((state, visible, set(exclude), detected))
+        return orig(method, state, camera, field, visible, cfg, exclude=exclude, rng=rng,
+                    detected=detected)
 
     D.plan = spy
     try:
@@ -73,10 +74,11 @@ def time_methods(scn, states, methods, reps: int, eval_path: str):
     cpu = {m: [] for m in methods}
     evals = {m: [] for m in methods}
     for _ in range(reps):
-        for state, visible, exclude in states:
+        for state, visible, exclude, detected in states:
             for m in methods:
                 t0 = time.perf_counter_ns()
-                res = PL.plan(m, state, scn.camera, scn.field, visible, cfg, exclude=exclude)
+                res = PL.plan(m, state, scn.camera, scn.field, visible, cfg, exclude=exclude,
+                              detected=detected)
                 times[m].append(time.perf_counter_ns() - t0)
                 cpu[m].append(res.cpu_ns)
                 evals[m].append(res.n_evals)

@@ -61,8 +61,12 @@ def test_plan_picks_a_detected_landmark_near_the_optimum(scn, method):
     assert res.index >= 0 and res.index != 123
     assert vis(scn.field.xyz[res.index][None])[0]
     assert np.isfinite(res.beta) and res.n_evals > 10 and res.time_ns > 0
-    assert np.linalg.norm(scn.field.xyz[res.index, :2] - res.ground[:2]) < 500.0
     assert abs(res.ground[2]) < 1e-6
+    if res.edge:   # optimum outside the image: the best detected landmark by the metric
+        assert res.pick_ratio == pytest.approx(1.0, rel=1e-9)
+    else:          # interior optimum: the detected landmark nearest to it
+        assert np.linalg.norm(scn.field.xyz[res.index, :2] - res.ground[:2]) < 500.0
+        assert res.pick_ratio >= 1.0
 
 
 def test_degenerate_geometry_falls_back_with_a_note(scn):
@@ -119,3 +123,104 @@ def test_pick_nearest_widens_until_a_detected_landmark():
         [int(np.flatnonzero((field.xyz == q).all(axis=1))[0]) for q in p]]
     assert _pick_nearest(field, point, visible, knn=16, exclude=set()) == far
     assert _pick_nearest(field, point, lambda p: np.zeros(len(p), bool), 16, set()) == -1
+
+
+def _image_grid_field(scn, k, n=3, inset_px=60.0):
+    """Landmarks on the ground under an n x n grid of pixels spanning the image
+    (truth pose at step k), and their pixel coordinates."""
+    from scipy.spatial import cKDTree
+
+    from opnav.landing.landmarks import LandmarkField
+
+    cam, r, R = scn.camera, scn.truth.r[k], scn.truth.R_LtoB[k]
+    g = np.linspace(-(cam.half_px - inset_px), cam.half_px - inset_px, n)
+    uu, vv = np.meshgrid(g, g)
+    c = np.stack([uu.ravel(), vv.ravel(), np.full(uu.size, cam.focal_px)], 1)
+    d_L = (c @ cam.R_BtoC) @ R                  # camera -> body -> {L}
+    pts = r + (-r[2] / d_L[:, 2])[:, None] * d_L
+    return LandmarkField(pts, cKDTree(pts[:, :2])), c[:, :2]
+
+
+def _reference_objective(method, st, scn, pts):
+    """Each landmark scored independently of the planner's code: the depth error
+    of eq. 23-25 at the landmark, or the metric by one CasADi Jacobian and an
+    explicit SVD / information per landmark (minimised: negated)."""
+    from opnav.landing.depth_error import depth_error_at_landmarks, error_radius
+    from opnav.landing.metrics import MetricContext, make_metric
+
+    if method == "depth":
+        r_e = error_radius(st.P[3:6, 3:6], scn.planner.t_s, scn.planner.n_sigma_v)
+        return depth_error_at_landmarks(st.r, st.v, st.a, pts, scn.planner.t_s, r_e)
+    ctx = MetricContext(r_L=st.r, v_L=st.v, R_LtoB=st.R_LtoB, p_known_L=np.zeros(3), P=st.P,
+                        R_meas=scn.camera.sigma_b**2 * np.eye(6),
+                        boresight_B=scn.camera.boresight_B)
+    return -make_metric(method).reference(ctx, pts)
+
+
+@pytest.mark.parametrize("method", [m for m in OBJECTIVES if m != "mineig"])
+def test_edge_optimum_picks_the_best_detected_landmark_at_a_corner(scn, method):
+    """Site-tilt camera at t = 1 s: every metric's in-plane optimum lies beyond
+    an end of the visible interval. The landmarks sit under a 3 x 3 pixel grid;
+    the best of them (independent reference scoring) is chosen, for the paper's
+    four metrics that is an image corner, and the old rule (landmark nearest
+    to the in-plane optimum's ground point) would have chosen another one.
+    (mineig's optimum is inside the interval here: the nearest rule applies.)"""
+    k = 1
+    tr = scn.truth
+    field, uv = _image_grid_field(scn, k)
+    st = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k],
+                   np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3))
+    vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
+    assert vis(field.xyz).all()
+    res = plan(method, st, scn.camera, field, vis, scn.planner)
+    assert res.edge
+    ref = _reference_objective(method, st, scn, field.xyz)
+    assert res.index == int(np.argmin(ref))
+    assert res.pick_ratio == pytest.approx(1.0, rel=1e-9)
+    if method in ("depth", "svd", "gdop", "cond"):
+        half = scn.camera.half_px
+        assert np.all(np.abs(uv[res.index]) > 0.8 * half), "best landmark not at a corner"
+        from opnav.landing.planner import _pick_nearest
+        assert _pick_nearest(field, res.ground, vis, 16, set()) != res.index
+
+
+def test_pick_ratio_records_how_far_the_pick_is_from_the_best(scn):
+    """The diagnostic ratio is the picked landmark's metric over the best
+    detected one's: >= 1, and equal to the reference scores' ratio."""
+    k = 60
+    tr = scn.truth
+    field, _ = _image_grid_field(scn, k, n=7)
+    st = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k],
+                   np.diag([1e2] * 3 + [0.1] * 3 + [1e-4] * 3 + [1e4] * 3))
+    vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
+    for method in ("depth", "svd"):
+        res = plan(method, st, scn.camera, field, vis, scn.planner)
+        ref = _reference_objective(method, st, scn, field.xyz)
+        want = (ref[res.index] / ref.min()) if method == "depth" else (ref.min() / ref[res.index])
+        assert res.pick_ratio >= 1.0
+        assert res.pick_ratio == pytest.approx(want, rel=1e-7)
+
+
+def test_depth_batch_matches_the_paper_formula_at_landmarks(scn):
+    """The planner's vectorised depth error at landmarks equals eq. 23-25 via
+    the triangle angles (depth_error_at_landmarks), and its in-plane scalar
+    objective at the landmarks that lie in the plane."""
+    from opnav.landing.depth_error import depth_error_at_landmarks, error_radius
+    from opnav.landing.planner import depth_objective
+
+    tr = scn.truth
+    for k in (1, 50, 150):
+        P = np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3)
+        st = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], P)
+        geom = plane_geometry(st.r, st.v)
+        f = depth_objective(st, geom, scn.planner)
+        pts = scn.field.xyz[::7]
+        r_e = error_radius(P[3:6, 3:6], scn.planner.t_s, scn.planner.n_sigma_v)
+        want = depth_error_at_landmarks(st.r, st.v, st.a, pts, scn.planner.t_s, r_e)
+        np.testing.assert_allclose(f.batch(pts), want, rtol=1e-8)
+        from opnav.landing.depth_error import ground_point
+        betas = np.linspace(-1.0, 0.5, 13)
+        betas = betas[betas != 0]
+        g = ground_point(betas, geom)
+        ok = np.all(np.isfinite(g), axis=1)
+        np.testing.assert_allclose(f.batch(g[ok]), [f(b) for b in betas[ok]], rtol=1e-8)

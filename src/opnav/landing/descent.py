@@ -32,7 +32,7 @@ error stays near 1-2 deg); ``iterations`` (default 3) relinearises each
 bearing update at the iterate (iterated EKF), the Jacobian projected on the
 complement of the unobservable direction at the prior, so the constraint
 holds in every iteration (without the projection the yaw 1-sigma collapses);
-``meas_noise_scale`` (default 6) is the ratio of the filter's bearing-noise
+``meas_noise_scale`` (default 5) is the ratio of the filter's bearing-noise
 model to the true pixel noise. With the Table 2 initial errors (1 km, 10 m/s,
 2 deg) the second-order terms of the bearings exceed the 0.5-pixel noise
 at the first landmark triangulations, and the filter with the true noise is
@@ -213,6 +213,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
     nees_v = np.empty(n + 1)
     updated = np.zeros(n + 1, bool)
     plan_ns, plan_cpu, plan_evals, plan_t, plan_beta, plan_idx = [], [], [], [], [], []
+    plan_edge, plan_ratio = [], []
     cur, n_obs, n_used = -1, 0, 0
     a_est = tr.a[0]
 
@@ -251,7 +252,8 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                 meas.append((cam.measure(d_site, noise_px[k, 0]), p_site))
             still = cur >= 0 and visible(scn.field.xyz[cur][None], 0.0)[0]
             need_new = cur < 0 or n_obs >= scn.obs_per_landmark or not still
-            if need_new and not _detects_other(visible(scn.field.xyz), cur):
+            det = visible(scn.field.xyz) if need_new else None   # the image's feature list
+            if need_new and not _detects_other(det, cur):
                 # the image holds no other landmark (e.g. low altitude): nothing to
                 # choose, so no planning call; keep the current one while it is seen
                 need_new = False
@@ -260,13 +262,15 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
             if need_new:
                 res = plan(method, PlanState(st.r, st.v, a_est, st.R, st.P), cam, scn.field,
                            visible, scn.planner, exclude={cur} if cur >= 0 else set(),
-                           rng=rng_pick)
+                           rng=rng_pick, detected=np.flatnonzero(det))
                 plan_ns.append(res.time_ns)
                 plan_cpu.append(res.cpu_ns)
                 plan_evals.append(res.n_evals)
                 plan_t.append(k * scn.Dt)
                 plan_beta.append(res.beta)
                 plan_idx.append(res.index)
+                plan_edge.append(res.edge)
+                plan_ratio.append(res.pick_ratio)
                 cur, n_obs = res.index, 0
                 if cur >= 0:
                     b = cam.measure(R_t @ (scn.field.xyz[cur] - r_t), noise_px[k, 1])
@@ -300,6 +304,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         "plan_evals": np.asarray(plan_evals, np.int64),
         "plan_t": np.asarray(plan_t, float), "plan_beta": np.asarray(plan_beta, float),
         "plan_index": np.asarray(plan_idx, np.int64), "n_landmarks": n_used,
+        "plan_edge": np.asarray(plan_edge, bool), "plan_ratio": np.asarray(plan_ratio, float),
         "init_error": e0,
     }
 

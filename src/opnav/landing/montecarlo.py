@@ -36,9 +36,10 @@ from opnav.landing.descent import build_scenario, run_descent
 
 __all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
            "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
-           "same_pick_pct"]
+           "same_pick_pct", "pick_quality"]
 
-_PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index")
+_PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index", "plan_edge",
+         "plan_ratio")
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
            "sig_yaw_deg", "nees_r", "nees_v", "updated")
 
@@ -177,6 +178,21 @@ def time_reduction(a: dict, b: dict, n_boot: int = 200, seed: int = 0, key: str 
     return red, float(np.std(vals, ddof=1))
 
 
+def pick_quality(d: dict) -> dict:
+    """Per method: share of planning calls whose in-plane optimum fell on an end
+    of the visible interval (edge rule, %), and the median / max over calls of
+    the picked landmark's metric over the best detected landmark's (1 = best)."""
+    out = {"edge_calls_pct": math.nan, "pick_ratio_median": math.nan, "pick_ratio_max": math.nan}
+    if "plan_edge" in d and len(d["plan_edge"]):
+        out["edge_calls_pct"] = float(100.0 * np.mean(d["plan_edge"]))
+    r = np.asarray(d.get("plan_ratio", []), float)
+    r = r[np.isfinite(r)]
+    if r.size:
+        out["pick_ratio_median"] = float(np.median(r))
+        out["pick_ratio_max"] = float(r.max())
+    return out
+
+
 def same_pick_pct(a: dict, b: dict) -> float:
     """Percentage of planning calls (matched by run and time) at which two
     methods chose the same landmark."""
@@ -220,6 +236,7 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
         ev = data[m]["plan_evals"]
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
+        row.update(pick_quality(data[m]))
         if m != methods[0]:
             row[f"same_pick_as_{methods[0]}_pct"] = same_pick_pct(data[m], data[methods[0]])
         for b in methods:

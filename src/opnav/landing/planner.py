@@ -129,6 +129,10 @@ class PlanResult:
     time_ns: int               # wall time of the planning call (perf_counter_ns)
     note: str = ""
     cpu_ns: int = 0            # CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID)
+    edge: bool = False         # in-plane optimum on an end of the visible interval:
+                               # the detected landmarks were scored directly
+    pick_ratio: float = math.nan  # picked landmark's metric / best detected one's (>= 1;
+                                  # 1 = the best detected landmark), outside the timed path
 
 
 _GRID_CACHE: dict = {}
@@ -258,7 +262,41 @@ def depth_objective(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, *
             return inf
         return k * rks / sb                                       # eq. 23-24: 2 r_e / sin(theta)
 
+    C, v_hat = geom.C, geom.v_hat
+
+    def batch(points: np.ndarray) -> np.ndarray:
+        """The same depth error (m) at ground points (n, 3), vectorised: for a
+        given landmark the depth of eq. 25 is its range |p - C| (the law of
+        sines only serves the in-plane parametrisation), so
+        dr = 2 r_e |r^(k+s)| / (b sin beta) (eq. 23-24); +inf at beta = 0."""
+        lc = np.asarray(points, float) - C
+        rho = np.sqrt(np.einsum("ij,ij->i", lc, lc))
+        cb = np.clip((lc @ v_hat) / rho, -1.0, 1.0)
+        sb_ = np.sqrt(1.0 - cb * cb)
+        rk = np.sqrt(np.maximum(b2 + rho * rho - 2.0 * b * rho * cb, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = k * rk / sb_
+        return np.where((sb_ > 0) & (points[:, 2] < C[2]), out, np.inf)
+
+    f.batch = batch
+    f.ratio = _ratio_positive
     return f
+
+
+def _ratio_positive(f_pick: float, f_best: float) -> float:
+    """Picked / best for a positive objective that is minimised (>= 1)."""
+    return f_pick / f_best
+
+
+def _ratio_negated(f_pick: float, f_best: float) -> float:
+    """Best / picked metric for a positive metric m maximised, f = -m (>= 1)."""
+    return f_best / f_pick
+
+
+def _ratio_log(f_pick: float, f_best: float) -> float:
+    """Ratio of the metric's exponentials for a log metric maximised, f = -log m
+    (log det: the ratio of the determinants, >= 1)."""
+    return math.exp(f_pick - f_best)
 
 
 _METRIC_CACHE: dict = {}
@@ -306,22 +344,33 @@ def metric_objective(name: str) -> Callable:
                             R_meas=(sigma_b**2) * np.eye(6), boresight_B=camera.boresight_B)
         ground = _ground_fn(geom)
         path = cfg.eval_path
+        # batch scoring of landmarks (edge rule): the same computation as the search's
+        # path, vectorised: closed-form singular values, or H for all + batched LAPACK
+        batch_call = {"closed_form": m.__call__, "casadi_map": m.casadi_map}.get(path, m.numpy_H)
+
+        def batch(points: np.ndarray) -> np.ndarray:
+            return -batch_call(ctx, np.asarray(points, float))
+
         if path in ("matrix_scalar", "closed_form"):
             call1 = m.matrix_scalar if path == "matrix_scalar" else m.scalar
 
             def f(beta: float) -> float:
                 p = ground(beta)
                 return math.inf if p is None else -call1(ctx, p)
-            return f
-        call = {"numpy_H": m.numpy_H, "reference": m.reference, "casadi_map": m.casadi_map}.get(path)
-        if call is None:
-            raise ValueError(f"landing.planner.eval_path: unknown {path!r}")
+        else:
+            call = {"numpy_H": m.numpy_H, "reference": m.reference,
+                    "casadi_map": m.casadi_map}.get(path)
+            if call is None:
+                raise ValueError(f"landing.planner.eval_path: unknown {path!r}")
 
-        def f(beta: float) -> float:
-            p = ground(beta)
-            if p is None:
-                return math.inf
-            return -float(call(ctx, np.array([p]))[0])
+            def f(beta: float) -> float:
+                p = ground(beta)
+                if p is None:
+                    return math.inf
+                return -float(call(ctx, np.array([p]))[0])
+        f.batch = batch
+        f.ratio = _ratio_log if name == "logdet" else _ratio_negated
+        f.diagnostic = lambda points: -m(ctx, np.asarray(points, float))   # fastest, same values
         return f
 
     return build
@@ -392,13 +441,31 @@ def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
 
 def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
          visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
-         exclude: set = frozenset(), rng: np.random.Generator | None = None) -> PlanResult:
+         exclude: set = frozenset(), rng: np.random.Generator | None = None,
+         detected: np.ndarray | None = None) -> PlanResult:
     """One planning call (see :func:`_plan`), with its wall time (``time_ns``,
     ``perf_counter_ns``) and the CPU time of the calling thread (``cpu_ns``,
-    CLOCK_THREAD_CPUTIME_ID, insensitive to other processes on a shared machine)."""
+    CLOCK_THREAD_CPUTIME_ID, insensitive to other processes on a shared machine).
+
+    ``detected``: field indices of the landmarks the image holds (the feature
+    detector's list, the same for every method); computed from ``visible`` if
+    not given. Building it is not planning work, so it stays outside the timed
+    path, as does the diagnostic ``pick_ratio`` (every detected landmark scored
+    by the method's own metric, fastest path)."""
+    if detected is None:
+        detected = np.flatnonzero(visible(field_.xyz))
+    cand = np.sort(np.asarray(detected, np.int64))
+    if exclude:
+        cand = cand[~np.isin(cand, np.fromiter(exclude, np.int64))]
     c0 = _thread_ns()
-    res = _plan(method, state, camera, field_, visible, cfg, exclude, rng)
+    res, fun = _plan(method, state, camera, field_, visible, cfg, exclude, rng, cand)
     res.cpu_ns = _thread_ns() - c0
+    if fun is not None and res.index >= 0 and cand.size:
+        vals = getattr(fun, "diagnostic", fun.batch)(field_.xyz[cand])
+        fin = np.isfinite(vals)
+        if fin.any():
+            f_pick = vals[np.searchsorted(cand, res.index)] if res.index in cand else math.nan
+            res.pick_ratio = float(fun.ratio(f_pick, float(vals[fin].min())))
     return res
 
 
@@ -410,31 +477,38 @@ def _thread_ns() -> int:
 
 def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
           visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
-          exclude: set = frozenset(), rng: np.random.Generator | None = None) -> PlanResult:
-    """One planning call: choose the next unknown landmark.
+          exclude: set, rng: np.random.Generator | None, cand: np.ndarray):
+    """One planning call: choose the next unknown landmark; returns the
+    :class:`PlanResult` and the objective used (None for direct pickers).
 
     ``visible(points_L (n, 3)) -> bool (n,)`` says which landmarks the camera
-    actually detects (truth pose; the same for every method). ``exclude``
-    holds field indices not to choose (the current landmark). If the planning
-    geometry is degenerate (velocity not descending, zero velocity) or no
-    interval is visible, the detected landmark nearest to the image centre is
-    chosen and ``note`` says why (never a silent NaN).
+    actually detects (truth pose; the same for every method); ``cand`` (sorted
+    field indices) are the detected landmarks less ``exclude`` (the current
+    landmark). If the planning geometry is degenerate (velocity not
+    descending, zero velocity) or no interval is visible, the detected
+    landmark nearest to the image centre is chosen and ``note`` says why
+    (never a silent NaN).
+
+    Edge rule (one rule for every metric): when the in-plane golden-section
+    optimum lies on an end of its visible sub-interval (within ``tol_rad``),
+    the metric's optimum is outside the image, the landmark nearest to that
+    end need not be the best one in the image (it may sit at a corner), so
+    every detected landmark is scored directly by the same metric
+    (vectorised, ``objective.batch``) and the best is chosen (first index on
+    ties); ``edge`` says so and the evaluations are counted.
     """
     t0 = time.perf_counter_ns()
     if method in PICKERS:
-        vis = visible(field_.xyz)
-        for i in exclude:
-            vis[i] = False
-        cand = np.flatnonzero(vis)
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
-                          math.nan, 0, time.perf_counter_ns() - t0)
+                          math.nan, 0, time.perf_counter_ns() - t0), None
     build = OBJECTIVES.get(method)
     if build is None:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
     note = ""
-    best = (math.inf, math.nan)
+    best = (math.inf, math.nan, math.nan, math.nan)       # f, beta, interval ends
     n = 0
+    fun = None
     try:
         geom = plane_geometry(state.r, state.v)
         intervals = visible_intervals(geom, state.R_LtoB, camera, cfg.n_grid, cfg.margin_px)
@@ -444,7 +518,7 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
                 x, fx, k = golden_section(fun, a, b, cfg.tol_rad)
                 n += k
                 if fx < best[0] or math.isnan(best[1]):
-                    best = (fx, x)
+                    best = (fx, x, a, b)
         else:
             note = "no visible interval"
     except ValueError as exc:
@@ -457,7 +531,17 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
             -(state.R_LtoB.T @ camera.boresight_B)[2], 1e-3)
         k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
         return PlanResult(method, k, math.nan, point, math.nan, n, time.perf_counter_ns() - t0,
-                          note or "no finite objective")
-    point = np.array(_ground_fn(geom)(best[1]))
-    k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
-    return PlanResult(method, k, best[1], point, best[0], n, time.perf_counter_ns() - t0, note)
+                          note or "no finite objective"), fun
+    fx, x, a, b = best
+    point = np.array(_ground_fn(geom)(x))
+    edge = min(x - a, b - x) <= cfg.tol_rad
+    k = -1
+    if edge and cand.size:
+        vals = fun.batch(field_.xyz[cand])
+        n += int(cand.size)
+        if np.isfinite(vals).any():
+            k = int(cand[int(np.argmin(np.where(np.isfinite(vals), vals, np.inf)))])
+    if k < 0:
+        k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
+    return PlanResult(method, k, x, point, fx, n, time.perf_counter_ns() - t0, note,
+                      edge=bool(edge)), fun
