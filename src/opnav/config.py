@@ -9,6 +9,8 @@ CLI run and a pipeline run see the same parameters.
 
 from __future__ import annotations
 
+import functools
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -60,11 +62,24 @@ def repo_root(start: Path | None = None) -> Path:
     )
 
 
+def _is_integer(checker, instance) -> bool:
+    """JSON-schema ``integer``: a Python int only (``3.0`` is refused, so a value
+    that passes validation works in ``range()`` inside a rule)."""
+    return isinstance(instance, int) and not isinstance(instance, bool)
+
+
+def _is_number(checker, instance) -> bool:
+    """JSON-schema ``number``: a finite int or float (NaN passes every
+    ``minimum`` comparison and inf every key without a ``maximum``)."""
+    return (isinstance(instance, (int, float)) and not isinstance(instance, bool)
+            and math.isfinite(instance))
+
+
+@functools.lru_cache(maxsize=8)
 def _validator(schema_path: Path):
     import jsonschema
-    from jsonschema import Draft202012Validator
+    from jsonschema import Draft202012Validator, ValidationError
     from referencing import Registry, Resource
-
     from referencing.jsonschema import DRAFT202012
 
     def load(path: Path) -> dict:
@@ -86,6 +101,7 @@ def _validator(schema_path: Path):
 
     base = Draft202012Validator
     validate_props = base.VALIDATORS["properties"]
+    validate_type = base.VALIDATORS["type"]
 
     def set_defaults(validator, properties, instance, schema):
         if isinstance(instance, dict):
@@ -94,8 +110,42 @@ def _validator(schema_path: Path):
                     instance[prop] = _copy(sub["default"])
         yield from validate_props(validator, properties, instance, schema)
 
-    cls = jsonschema.validators.extend(base, {"properties": set_defaults})
+    def strict_type(validator, types, instance, schema):
+        errors = list(validate_type(validator, types, instance, schema))
+        wanted = [types] if isinstance(types, str) else list(types)
+        if errors and isinstance(instance, float) and {"number", "integer"} & set(wanted):
+            if not math.isfinite(instance):
+                yield ValidationError(f"{instance} is not a finite number (NaN and infinity are refused)")
+                return
+            if "integer" in wanted and instance.is_integer():
+                yield ValidationError(f"{instance!r} is not an integer (write {int(instance)})")
+                return
+        yield from errors
+
+    checker = base.TYPE_CHECKER.redefine_many({"integer": _is_integer, "number": _is_number})
+    cls = jsonschema.validators.extend(base, {"properties": set_defaults, "type": strict_type},
+                                       type_checker=checker)
     return cls(schema, registry=registry)
+
+
+def non_finite_keys(value: Any, path: tuple = ()) -> list[str]:
+    """Dotted keys of every NaN or infinite number anywhere in ``value`` (a
+    config mapping), whatever the schema says of the key; list items are named
+    ``key[i]``."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return [_dotted(path)]
+    if isinstance(value, dict):
+        return [k for n, v in value.items() for k in non_finite_keys(v, (*path, str(n)))]
+    if isinstance(value, (list, tuple)):
+        return [k for i, v in enumerate(value) for k in non_finite_keys(v, (*path, i))]
+    return []
+
+
+def _dotted(path) -> str:
+    out = ""
+    for p in path:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out
 
 
 def _copy(value: Any) -> Any:
@@ -104,16 +154,42 @@ def _copy(value: Any) -> Any:
     return copy.deepcopy(value)
 
 
-def validate_config(config: dict, schema_path: Path) -> dict:
-    """Validate ``config`` in place (filling defaults); raise :class:`ConfigError`."""
+def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: bool = True,
+                    root: str | Path | None = None) -> dict:
+    """Validate ``config`` in place (filling defaults); raise :class:`ConfigError`
+    with one line per problem, each naming its key.
+
+    Three layers, all before any job runs: every number anywhere must be finite
+    (:func:`non_finite_keys`); the JSON schema (integer keys take ints only);
+    and, with ``physics``, the cross-key consistency checks of
+    :func:`opnav.checks.config_problems` (durations, rates, geometry, method
+    names, ...; ``root`` is the checkout that ``results_dir`` is relative to).
+    """
+    bad = non_finite_keys(config)
+    lines = [f"invalid config key '{k}': {_at(config, k)} is not a finite number "
+             "(NaN and infinity are refused)" for k in bad]
     validator = _validator(schema_path)
-    errors = sorted(validator.iter_errors(config), key=lambda e: list(e.absolute_path))
-    if errors:
-        err = errors[0]
-        key = ".".join(str(p) for p in err.absolute_path)
-        where = f"config key '{key}'" if key else "config (top level)"
-        raise ConfigError(f"invalid {where}: {err.message}")
+    for err in sorted(validator.iter_errors(config), key=lambda e: [str(p) for p in e.absolute_path]):
+        key = _dotted(err.absolute_path)
+        if key not in bad:
+            where = f"config key '{key}'" if key else "config (top level)"
+            lines.append(f"invalid {where}: {err.message}")
+    if lines:
+        raise ConfigError("\n".join(dict.fromkeys(lines)))
+    if physics:
+        from opnav.checks import config_problems
+
+        problems = config_problems(config, root)
+        if problems:
+            raise ConfigError("\n".join(problems))
     return config
+
+
+def _at(config: dict, dotted: str):
+    node: Any = config
+    for part in re.findall(r"[^.\[\]]+|\[\d+\]", dotted):
+        node = node[int(part[1:-1])] if part.startswith("[") else node[part]
+    return node
 
 
 def load_config(path: str | Path | None = None, overlays: list[str | Path] = ()) -> dict:

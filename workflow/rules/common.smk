@@ -2,16 +2,13 @@
 import sys
 from pathlib import Path
 
-from snakemake.utils import validate
-from snakemake.exceptions import WorkflowError
-
 sys.path.insert(0, str(Path(workflow.basedir) / "src"))
-from opnav.config import ConfigError, describe_validation_error  # noqa: E402
+from opnav.config import validate_config  # noqa: E402
 
-try:
-    validate(config, "../../src/opnav/schemas/config.schema.yaml", set_default=True)
-except WorkflowError as exc:
-    raise ConfigError(describe_validation_error(exc)) from None
+# The schema (defaults filled in place, finite numbers, strict integers) and the
+# cross-key physics checks of opnav.checks, before any job: the same function
+# the `opnav` CLI uses. A ConfigError lists one line per problem, naming the key.
+validate_config(config, root=workflow.basedir)
 
 RESULTS = config["results_dir"]
 

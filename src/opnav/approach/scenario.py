@@ -87,6 +87,12 @@ def n_samples(cfg: dict) -> int:
     return s["N0"] + s["L"] * s["N"]
 
 
+def mars_disc_px(range_km: float, ifov_arcsec: float) -> float:
+    """Apparent diameter of Mars, px, seen from ``range_km`` (km, > Mars radius)
+    with pixels of ``ifov_arcsec`` arcsec."""
+    return 2.0 * np.rad2deg(np.arcsin(dynamics.R_MARS_KM / range_km)) * 3600.0 / ifov_arcsec
+
+
 def build_geometry(cfg: dict, variant: str, n: int | None = None) -> Geometry:
     """Truth, reference with STMs, attitude of ``variant`` (see module docstring)."""
     if variant not in VARIANTS:
@@ -106,7 +112,7 @@ def build_geometry(cfg: dict, variant: str, n: int | None = None) -> Geometry:
     roll = (camera.roll_angle(t, roll_cfg["rate_deg_s"], roll_cfg["steps_deg"],
                               roll_cfg["step_interval_s"]) if variant == "roll" else np.zeros_like(t))
     rho = np.linalg.norm(los, axis=1)
-    disc_px = 2.0 * np.rad2deg(np.arcsin(dynamics.R_MARS_KM / rho.min())) * 3600.0 / cfg["camera"]["ifov_arcsec"]
+    disc_px = mars_disc_px(rho.min(), cfg["camera"]["ifov_arcsec"])
     if disc_px > cfg["camera"]["pixels"]:
         raise ValueError(f"approach.camera: Mars ({disc_px:.0f} px across) does not fit the "
                          f"{cfg['camera']['pixels']} px detector; raise camera.ifov_arcsec or the range")

@@ -1,0 +1,301 @@
+"""Config-time physics and consistency checks, run before any job.
+
+Description
+-----------
+The JSON schema checks each key alone (type, range); :func:`config_problems`
+checks what only several keys together decide, so that a config that would
+crash, hang or quietly produce garbage inside a job is refused at once, with
+one line per problem naming the keys:
+
+* paper A: the arc and roll-step durations versus ``approach.dt_s``; the
+  approach direction non-zero and not along the ecliptic pole (the aim-offset
+  direction is ``v_inf_dir x z``); the arc starting outside Mars and not
+  hitting it; Mars (at its closest along the arc, two-body Mars-centred
+  hyperbola) fitting the detector; the truth misalignment keeping Mars on the
+  detector; ``table1_variants`` inside ``variants``; memory bounds (data
+  length, seeds x samples);
+* paper B: ``duration_s`` a multiple of ``filter.dt_s``, ``imu.rate_hz x
+  filter.dt_s`` an integer; the lander above ground (and above the
+  measurement-cut-off altitude) and its nominal guidance trajectory not
+  through the ground; the landing site in the configured camera's view at the
+  start and while the filter measures (for every swept field of view too);
+  every method name known to :func:`opnav.landing.planner.available_methods`
+  (the planner's own registry); the B-X1 reference among the flown methods;
+  the B-F5 instant inside the descent on a filter step; memory bounds;
+* both: ``results_dir`` non-empty and outside the checkout's tracked folders.
+
+Use: :func:`opnav.config.validate_config` calls :func:`config_problems` after
+the schema (Snakefile validation and the ``opnav`` CLI both go through it).
+Every check reads the package's own models (camera, guidance, constants), so
+it follows them when they change. Units as in the config.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["config_problems", "approach_problems", "landing_problems", "results_dir_problems",
+           "TRACKED_DIRS", "MAX_APPROACH_SAMPLES", "MAX_APPROACH_SEED_SAMPLES",
+           "MAX_LANDING_IMU_SAMPLES", "MAX_LANDING_RUN_STEPS"]
+
+#: Memory bounds. An approach arc of n samples keeps n one-step STMs (6x6) per
+#: geometry and (seeds x n) filter states and covariances per batch.
+MAX_APPROACH_SAMPLES = 200_000
+MAX_APPROACH_SEED_SAMPLES = 2_000_000
+#: A descent keeps its truth at every IMU sample; a Monte Carlo keeps per-run
+#: histories of every filter step.
+MAX_LANDING_IMU_SAMPLES = 1_000_000
+MAX_LANDING_RUN_STEPS = 5_000_000
+
+#: Folders of the checkout that hold tracked files: results_dir may not be
+#: (inside) one of them, nor the checkout itself.
+TRACKED_DIRS = ("paper", "src", "config", "workflow", "profiles", "tests", "benchmarks", ".git",
+                ".snakemake")
+
+
+def _multiple(value: float, step: float, tol: float = 1e-9) -> bool:
+    k = round(value / step)
+    return k >= 1 and abs(k * step - value) <= tol * max(1.0, abs(value))
+
+
+def _duplicates(items) -> list:
+    seen, dup = set(), []
+    for x in items:
+        if x in seen and x not in dup:
+            dup.append(x)
+        seen.add(x)
+    return dup
+
+
+def config_problems(config: dict, root: str | Path | None = None) -> list[str]:
+    """Every problem of a schema-valid ``config`` (defaults filled), one line each,
+    naming the key(s). ``root`` is the checkout (default: the working directory)."""
+    out = results_dir_problems(config.get("results_dir", "results"), root)
+    if "approach" in config:
+        out += approach_problems(config["approach"])
+    if "landing" in config:
+        out += landing_problems(config["landing"])
+    return out
+
+
+def results_dir_problems(results_dir: str, root: str | Path | None = None) -> list[str]:
+    """``results_dir`` must be non-empty, not the checkout and not inside a tracked folder."""
+    if not str(results_dir).strip():
+        return ["invalid config key 'results_dir': empty (generated files would land in the checkout)"]
+    base = Path(root or Path.cwd()).resolve()
+    p = Path(results_dir)
+    p = (p if p.is_absolute() else base / p).resolve()
+    if p == base:
+        return [f"invalid config key 'results_dir': {results_dir!r} is the checkout itself"]
+    for d in TRACKED_DIRS:
+        t = base / d
+        if p == t or t in p.parents:
+            return [f"invalid config key 'results_dir': {results_dir!r} is inside the tracked "
+                    f"folder {d}/ (choose e.g. 'results')"]
+    return []
+
+
+# --------------------------------------------------------------------- paper A
+
+def _approach_min_range_km(a: dict, T: float) -> tuple[float, float]:
+    """(range at t0, closest range over [0, T]) of the Mars-centred two-body
+    hyperbola that :func:`opnav.approach.scenario.initial_truth` starts, km.
+    (The Sun's tide over an approach arc moves it by far less than Mars' radius.)"""
+    from opnav.approach import dynamics, scenario
+
+    X = scenario.initial_truth(a) - dynamics.kepler_state(
+        dynamics.KeplerElements.from_config(a["mars_elements"]), 0.0)
+    r, v = X[:3], X[3:]
+    mu = dynamics.MU_MARS
+    rn, vn = float(np.linalg.norm(r)), float(np.linalg.norm(v))
+    h = float(np.linalg.norm(np.cross(r, v)))
+    energy = vn ** 2 / 2 - mu / rn
+    if energy <= 0:                                  # cannot happen with v_inf > 0
+        return rn, min(rn, h ** 2 / mu / 2)
+    sma = mu / (2 * energy)                          # |a| of the hyperbola
+    ecc = math.sqrt(1 + 2 * energy * h ** 2 / mu ** 2)
+    rp = sma * (ecc - 1)
+    if float(np.dot(r, v)) >= 0:                     # receding: closest now
+        return rn, rn
+    F0 = math.acosh(max(1.0, (1 + rn / sma) / ecc))
+    t_peri = (ecc * math.sinh(F0) - F0) / math.sqrt(mu / sma ** 3)
+    if t_peri <= T:
+        return rn, rp
+    # still approaching at T: range at T from the hyperbolic Kepler equation
+    M = (ecc * math.sinh(F0) - F0) - math.sqrt(mu / sma ** 3) * T
+    F = math.asinh(M / ecc)
+    for _ in range(60):
+        F -= (ecc * math.sinh(F) - F - M) / (ecc * math.cosh(F) - 1)
+    return rn, sma * (ecc * math.cosh(F) - 1)
+
+
+def approach_problems(a: dict) -> list[str]:
+    """Cross-key problems of the ``approach`` section (see module docstring)."""
+    from opnav.approach import dynamics, scenario
+
+    out: list[str] = []
+    k = "invalid config key 'approach."
+    dt = a["dt_s"]
+    s = a["segments"]
+    n = scenario.n_samples(a)
+    if n > MAX_APPROACH_SAMPLES:
+        out.append(f"{k}segments': N0 + L*N = {n} samples exceeds the limit "
+                   f"{MAX_APPROACH_SAMPLES} (memory)")
+    for key, seeds, samples in (("n_seeds", a["n_seeds"], n),
+                                ("convergence_study", a["convergence_study"]["n_seeds"],
+                                 s["N0"] + a["convergence_study"]["data_samples"]),
+                                ("ablation.n_seeds", a["ablation"]["n_seeds"], n)):
+        if seeds * samples > MAX_APPROACH_SEED_SAMPLES:
+            out.append(f"{k}{key}': {seeds} seeds x {samples} samples exceeds the limit "
+                       f"{MAX_APPROACH_SEED_SAMPLES} (memory)")
+    if s["N0"] + a["convergence_study"]["data_samples"] > MAX_APPROACH_SAMPLES:
+        out.append(f"{k}convergence_study.data_samples': N0 + data_samples exceeds the limit "
+                   f"{MAX_APPROACH_SAMPLES} (memory)")
+    roll = a["roll"]
+    if roll["steps_deg"] and not _multiple(roll["step_interval_s"], dt):
+        out.append(f"{k}roll.step_interval_s': {roll['step_interval_s']} s is not a multiple of "
+                   f"approach.dt_s = {dt} s")
+    for key in ("variants", "table1_variants", "methods", "ablation.variants",
+                "ablation.sigma3_px", "ablation.segment_N"):
+        node = a
+        for part in key.split("."):
+            node = node[part]
+        dup = _duplicates(node)
+        if dup:
+            out.append(f"{k}{key}': duplicated {', '.join(map(str, dup))}")
+    extra = [v for v in a["table1_variants"] if v not in a["variants"]]
+    if extra:
+        out.append(f"{k}table1_variants': {', '.join(extra)} not in approach.variants "
+                   f"({', '.join(a['variants'])})")
+    g = a["geometry"]
+    d = np.asarray(g["v_inf_dir"], float)
+    dn = float(np.linalg.norm(d))
+    if dn == 0:
+        out.append(f"{k}geometry.v_inf_dir': the approach direction is zero")
+        return out
+    if float(np.linalg.norm(np.cross(d / dn, [0.0, 0.0, 1.0]))) < 1e-6:
+        out.append(f"{k}geometry.v_inf_dir': {list(g['v_inf_dir'])} is along the ecliptic pole "
+                   "(the aim-offset direction v_inf_dir x z is undefined)")
+        return out
+    if g["range_km"] <= dynamics.R_MARS_KM:
+        out.append(f"{k}geometry.range_km': the arc starts inside Mars "
+                   f"({g['range_km']} km <= Mars radius {dynamics.R_MARS_KM} km)")
+        return out
+    T = dt * max(n, s["N0"] + a["convergence_study"]["data_samples"])
+    _, rmin = _approach_min_range_km(a, T)
+    if rmin <= dynamics.R_MARS_KM:
+        out.append(f"{k}geometry': the arc hits Mars within its {T:g} s (closest range "
+                   f"{rmin:.0f} km <= {dynamics.R_MARS_KM} km); raise geometry.aim_offset_km "
+                   "or range_km, or shorten the arc")
+        return out
+    cam = a["camera"]
+    disc = scenario.mars_disc_px(rmin, cam["ifov_arcsec"])
+    if disc > cam["pixels"]:
+        out.append(f"{k}camera': Mars ({disc:.0f} px across at its closest, {rmin:.0f} km) does "
+                   f"not fit the {cam['pixels']} px detector; raise camera.ifov_arcsec or "
+                   "geometry.range_km")
+    half_fov = cam["pixels"] * cam["ifov_arcsec"] / 2.0
+    for key in ("truth_bias_arcsec", "theta_init_arcsec"):
+        off = math.hypot(a[key][0], a[key][1])
+        if off >= half_fov:
+            out.append(f"{k}{key}': a misalignment of {off:g} arcsec (x, y) puts Mars off the "
+                       f"detector (half field of view {half_fov:g} arcsec)")
+    return out
+
+
+# --------------------------------------------------------------------- paper B
+
+def landing_problems(c: dict) -> list[str]:
+    """Cross-key problems of the ``landing`` section (see module docstring)."""
+    from opnav.landing.camera import camera_from_config
+    from opnav.landing.planner import available_methods
+    from opnav.landing.trajectory import truth_states
+
+    out: list[str] = []
+    k = "invalid config key 'landing."
+    T, Dt, rate = c["duration_s"], c["filter"]["dt_s"], c["imu"]["rate_hz"]
+    if not _multiple(T, Dt):
+        out.append(f"{k}duration_s': {T} s is not a multiple of landing.filter.dt_s = {Dt} s")
+    if not _multiple(rate * Dt, 1.0):
+        out.append(f"{k}imu.rate_hz': rate_hz x filter.dt_s = {rate} x {Dt} = {rate * Dt:g} "
+                   "is not a positive integer")
+    n_steps = max(1, round(T / Dt))
+    if T * rate > MAX_LANDING_IMU_SAMPLES:
+        out.append(f"{k}imu.rate_hz': duration_s x rate_hz = {T * rate:.0f} IMU samples exceeds "
+                   f"the limit {MAX_LANDING_IMU_SAMPLES} (memory)")
+    for key, runs in (("mc.n_runs", c["mc"]["n_runs"]), ("ablation.n_runs", c["ablation"]["n_runs"])):
+        if runs * n_steps > MAX_LANDING_RUN_STEPS:
+            out.append(f"{k}{key}': {runs} runs x {n_steps} filter steps exceeds the limit "
+                       f"{MAX_LANDING_RUN_STEPS} (memory)")
+    f5 = c["figures"]["f5_time_s"]
+    if not (0 <= f5 < T) or (f5 > 0 and not _multiple(f5, Dt)):
+        out.append(f"{k}figures.f5_time_s': {f5} s must be a filter step "
+                   f"(multiple of filter.dt_s = {Dt} s) in [0, duration_s = {T} s)")
+
+    known = available_methods()
+    lists = {"mc.methods": c["mc"]["methods"], "extra.methods": c["extra"]["methods"],
+             "ablation.methods": c["ablation"]["methods"], "extra.reference": [c["extra"]["reference"]],
+             "single.method": [c["single"]["method"]]}
+    for key, names in lists.items():
+        bad = [m for m in names if m not in known]
+        if bad:
+            out.append(f"{k}{key}': unknown planning method {', '.join(map(repr, bad))} "
+                       f"(known: {', '.join(known)})")
+        dup = _duplicates(names)
+        if dup:
+            out.append(f"{k}{key}': duplicated {', '.join(dup)}")
+    for key in ("ablation.fov_deg", "ablation.obs_per_landmark"):
+        dup = _duplicates(c["ablation"][key.split(".")[1]])
+        if dup:
+            out.append(f"{k}{key}': duplicated {', '.join(map(str, dup))}")
+    flown = list(c["mc"]["methods"]) + list(c["extra"]["methods"])
+    if c["extra"]["reference"] not in flown:
+        out.append(f"{k}extra.reference': {c['extra']['reference']!r} is not flown "
+                   "(not in landing.mc.methods or landing.extra.methods)")
+
+    r0 = np.asarray(c["initial_state"]["r_m"], float)
+    alt_min = c["filter"]["min_update_altitude_m"]
+    if r0[2] <= 0:
+        out.append(f"{k}initial_state.r_m': the lander starts at altitude {r0[2]:g} m, "
+                   "not above the ground z = 0")
+        return out
+    if r0[2] <= alt_min:
+        out.append(f"{k}initial_state.r_m': the lander starts at {r0[2]:g} m, not above "
+                   f"filter.min_update_altitude_m = {alt_min:g} m (no measurement would be taken)")
+    if out or not _multiple(T, Dt):
+        return out
+    t = Dt * np.arange(n_steps + 1)
+    try:
+        tr = truth_states(t, r0, c["initial_state"]["v_mps"], T, c["gravity_mps2"], c["yaw_deg"])
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        return [*out, f"{k}initial_state': the nominal guidance trajectory is undefined: {exc}"]
+    below = np.nonzero(tr.r[:-1, 2] < 0)[0]
+    if below.size:
+        out.append(f"{k}initial_state': the nominal guidance trajectory goes below ground at "
+                   f"t = {t[below[0]]:g} s (initial_state.r_m / v_mps / duration_s)")
+        return out
+    measuring = tr.r[:, 2] > alt_min                 # where the filter takes bearings
+    to_site_B = np.einsum("kij,kj->ki", tr.R_LtoB, -tr.r)
+    fovs = [c["camera"]["fov_deg"], *c["ablation"]["fov_deg"]]
+    for i, fov in enumerate(dict.fromkeys(fovs)):
+        key = "camera" if i == 0 else "ablation.fov_deg"
+        try:
+            cam = camera_from_config({**c["camera"], "fov_deg": fov})
+        except ValueError as exc:
+            out.append(f"{k}{key}': {exc}")
+            continue
+        seen = cam.in_view(to_site_B)
+        if i > 0 and any(f"{k}camera'" in line for line in out):
+            break                                    # the configured camera already fails
+        if not seen[0]:
+            out.append(f"{k}{key}': the landing site is not in the camera's view at t = 0 "
+                       f"(fov_deg {fov:g}, tilt_deg {c['camera']['tilt_deg']:g}, "
+                       f"tilt_azimuth_deg {c['camera']['tilt_azimuth_deg']:g})")
+        elif not np.all(seen[measuring]):
+            t_out = t[np.nonzero(measuring & ~seen)[0][0]]
+            out.append(f"{k}{key}': the landing site leaves the camera's view at t = {t_out:g} s "
+                       f"of the nominal descent (fov_deg {fov:g})")
+    return out
