@@ -49,3 +49,19 @@ def test_float_block_uses_caption_and_relative_path(tmp_path: Path):
     assert "../results/approach/A-F4_bias_estimate_roll.pdf" in tex
     assert "Bias estimate vs iteration, arcsec." in tex
     assert "A-F4 (bias estimate roll)" in tex
+
+
+def test_every_file_the_manuscript_names_exists():
+    """Paths in \\texttt{...} are files of the repository (or of results/,
+    which the pipeline writes): no pointer to a file a reader cannot open."""
+    import re
+
+    from conftest import REPO
+
+    named = set()
+    for tex in (REPO / "paper").rglob("*.tex"):
+        named |= set(re.findall(r"\\texttt\{([^}\\]*/[^}\\]*|[^}\\]*\.(?:md|py|yaml|lock|cff))\}",
+                                tex.read_text()))
+    assert named, "no file names found: the pattern is broken"
+    missing = [n for n in sorted(named) if not n.startswith("results/") and not (REPO / n).exists()]
+    assert missing == []

@@ -3,6 +3,8 @@
 import os
 import shutil
 
+from opnav import provenance
+
 PAPER = res("paper")
 PAPER_DIR = Path(workflow.basedir) / "paper"
 CAPTIONS = Path(workflow.basedir) / "workflow" / "report"
@@ -101,7 +103,27 @@ rule paper_macros:
         "../scripts/paper_macros.py"
 
 
-PAPER_INPUTS = [rules.paper_floats.output, rules.paper_macros.output, rules.paper_scorecard.output]
+rule provenance:
+    """Python, package versions and git commit of this run (opnav.provenance);
+    collected when the workflow is parsed, so a new commit or upgrade reruns it."""
+    input:
+        code=src("provenance.py"),
+    output:
+        csv=report(res("provenance.csv"), caption=_caption("provenance"), category="Provenance"),
+        md=res("provenance.md"),
+        json=res("provenance.json"),
+        tex=f"{PAPER}/provenance.tex",
+    params:
+        info=provenance.collect(workflow.basedir),
+    log:
+        f"{PAPER}/logs/provenance.log",
+    localrule: True
+    script:
+        "../scripts/provenance.py"
+
+
+PAPER_INPUTS = [rules.paper_floats.output, rules.paper_macros.output, rules.paper_scorecard.output,
+                rules.provenance.output]
 ALL_TARGETS.extend(PAPER_INPUTS)
 
 LATEX_HINT = (

@@ -1,0 +1,17 @@
+"""results/provenance.{csv,md,json} and results/paper/provenance.tex: the
+Python, package versions and git commit of this run (opnav.provenance)."""
+
+import pandas as pd
+
+from opnav import provenance
+from opnav.snakeio import script_context
+from opnav.tables import atomic_write_text, write_json, write_table
+
+with script_context(snakemake) as log:
+    info = dict(snakemake.params.info)
+    df = pd.DataFrame(provenance.rows(info), columns=["item", "version"])
+    write_table(df, [snakemake.output.csv, snakemake.output.md],
+                caption="Software environment and commit of this run")
+    write_json(snakemake.output.json, info)
+    atomic_write_text(snakemake.output.tex, provenance.latex_macros(info))
+    log.info("provenance: %s", info)
