@@ -171,3 +171,118 @@ def test_snakefile_refuses_before_any_job(tmp_path):
     assert "approach.dt_s" in out and "landing.mc.runs_per_job" in out, out
     assert "Traceback" not in out
     assert not (wd / "results").exists()
+
+
+# ------------------------------------------------------------------ the CLI
+
+def _write(tmp_path, name, text):
+    p = tmp_path / name
+    p.write_text(text)
+    return str(p)
+
+
+# (argv, text stderr must contain: the flag or the file/key); {tmp} is tmp_path
+BAD_CLI = [
+    (["approach", "--bias", "nan", "0", "0"], "--bias"),
+    (["approach", "--bias", "0", "inf", "0"], "--bias"),
+    (["approach", "--bias", "1e9", "0", "0"], "--bias"),
+    (["approach", "--bias", "6000", "0", "0"], "--bias"),
+    (["approach", "--bias", "1", "2"], "--bias"),
+    (["approach", "--init", "-inf", "0", "0"], "--init"),
+    (["approach", "--init", "0", "50000", "0"], "--init"),
+    (["approach", "--pixel-sigma", "nan"], "--pixel-sigma"),
+    (["approach", "--pixel-sigma", "0"], "--pixel-sigma"),
+    (["approach", "--pixel-sigma", "1e6"], "--pixel-sigma"),
+    (["approach", "--N", "3.0"], "--N"),
+    (["approach", "--N", "1"], "--N"),
+    (["approach", "--N0", "0"], "--N0"),
+    (["approach", "--M", "5000"], "--M"),
+    (["approach", "--L", "-3"], "--L"),
+    (["approach", "--N", "100000", "--L", "10000"], "--N"),
+    (["approach", "--seeds", "0"], "--seeds"),
+    (["approach", "--seeds", "1001"], "--seeds"),
+    (["approach", "--seeds", "2.5"], "--seeds"),
+    (["approach", "--seed", "-1"], "--seed"),
+    (["approach", "--variant", "nope"], "--variant"),
+    (["approach", "--method", "fast"], "--method"),
+    (["approach", "--mode", "zigzag"], "--mode"),
+    (["landing", "--method", "foo"], "--method"),
+    (["landing", "--method", ""], "--method"),
+    (["landing", "--seed", "-1"], "--seed"),
+    (["landing", "--seed", "1.5"], "--seed"),
+    (["landing", "--seed", "abc"], "--seed"),
+    (["landing", "--nosuch"], "--nosuch"),
+    (["--config", "{tmp}/missing.yaml", "approach"], "missing.yaml"),
+    (["--config", "{tmp}/broken.yaml", "landing"], "broken.yaml"),
+    (["--config", "{tmp}/nan.yaml", "approach"], "approach.dt_s"),
+    (["--config", "{tmp}/tilt.yaml", "landing"], "landing.camera"),
+]
+
+
+@pytest.fixture()
+def no_work(monkeypatch):
+    """Any simulation started fails the test: refusal must come first."""
+    import opnav.approach.cases as cases
+    import opnav.approach.scenario as scenario
+    import opnav.landing.descent as descent
+
+    def forbidden(*a, **k):
+        raise AssertionError("work started before the input was refused")
+
+    for mod, name in ((cases, "run_case"), (scenario, "build_geometry"),
+                      (descent, "build_scenario"), (descent, "run_descent")):
+        monkeypatch.setattr(mod, name, forbidden)
+
+
+@pytest.mark.parametrize("argv,named", BAD_CLI, ids=[" ".join(a) for a, _ in BAD_CLI])
+def test_bad_cli_refused_naming_flag(argv, named, tmp_path, capsys, no_work):
+    from opnav.cli import EXIT_USER, main
+
+    _write(tmp_path, "broken.yaml", "approach: {dt_s: [1, 2\n")
+    _write(tmp_path, "nan.yaml", "approach: {dt_s: .nan}\n")
+    _write(tmp_path, "tilt.yaml", "landing: {camera: {tilt_deg: 0}}\n")
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    try:
+        rc = main(argv)
+    except SystemExit as exc:          # argparse's own refusals
+        rc = exc.code
+    cap = capsys.readouterr()
+    assert rc == EXIT_USER, (rc, cap.err)
+    assert named in cap.err, cap.err
+    assert cap.out == ""
+    assert "Traceback" not in cap.err
+    assert all(line.startswith("opnav") for line in cap.err.strip().splitlines()), cap.err
+
+
+def test_numerical_failure_is_one_line(monkeypatch, capsys):
+    import numpy as np
+
+    import opnav.landing.descent as descent
+    from opnav.cli import EXIT_NUMERICAL, main
+
+    def singular(*a, **k):
+        raise np.linalg.LinAlgError("Matrix is not positive definite")
+
+    monkeypatch.setattr(descent, "run_descent", singular)
+    assert main(["landing"]) == EXIT_NUMERICAL
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not positive definite" in err[0]
+
+
+def test_json_output_is_strict():
+    """NaN and infinities (also numpy's) are written as null: valid JSON."""
+    import json
+
+    import numpy as np
+
+    from opnav.cli import _finite_or_none
+
+    obj = {"a": float("nan"), "b": [float("inf"), 1.5], "c": np.float64("nan"), "d": np.array([1.0, np.nan]),
+           "e": "nan", "f": 3}
+    text = json.dumps(_finite_or_none(obj), allow_nan=False)
+
+    def refuse(c):
+        raise ValueError(c)
+
+    back = json.loads(text, parse_constant=refuse)
+    assert back == {"a": None, "b": [None, 1.5], "c": None, "d": [1.0, None], "e": "nan", "f": 3}

@@ -144,6 +144,7 @@ def approach_problems(a: dict) -> list[str]:
     if n > MAX_APPROACH_SAMPLES:
         out.append(f"{k}segments': N0 + L*N = {n} samples exceeds the limit "
                    f"{MAX_APPROACH_SAMPLES} (memory)")
+        return out
     for key, seeds, samples in (("n_seeds", a["n_seeds"], n),
                                 ("convergence_study", a["convergence_study"]["n_seeds"],
                                  s["N0"] + a["convergence_study"]["data_samples"]),
@@ -154,6 +155,8 @@ def approach_problems(a: dict) -> list[str]:
     if s["N0"] + a["convergence_study"]["data_samples"] > MAX_APPROACH_SAMPLES:
         out.append(f"{k}convergence_study.data_samples': N0 + data_samples exceeds the limit "
                    f"{MAX_APPROACH_SAMPLES} (memory)")
+    if out:
+        return out
     roll = a["roll"]
     if roll["steps_deg"] and not _multiple(roll["step_interval_s"], dt):
         out.append(f"{k}roll.step_interval_s': {roll['step_interval_s']} s is not a multiple of "

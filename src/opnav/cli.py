@@ -2,24 +2,120 @@
 
 Subcommands are contributed by the subpackages: a module ``opnav.<part>.cli``
 that defines ``register(subparsers)`` adds its own (``opnav approach``,
-``opnav landing``). Each prints a JSON summary to stdout.
+``opnav landing``). Each prints a JSON summary to stdout (:func:`print_json`:
+valid JSON, a non-finite number written as ``null``).
+
+Errors are one line each on stderr, no traceback. Exit codes: 0 success;
+:data:`EXIT_USER` (2) for every user error (a bad flag or config value, an
+unreadable or invalid YAML file, a missing file); :data:`EXIT_NUMERICAL` (3)
+when a computation fails on inputs that passed every check. Every flag that
+sets a config value goes through the same schema and physics checks as the
+config (:func:`with_flags`), so the errors name the flag and the limit.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import json
+import math
+import re
 import sys
+from typing import Any
 
 from opnav import __version__
-from opnav.config import ConfigError
+from opnav.config import ConfigError, validate_config
+
+#: Exit code of every user error (argparse's own code for a bad flag).
+EXIT_USER = 2
+#: Exit code of a numerical failure on inputs that passed every check.
+EXIT_NUMERICAL = 3
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage block)."""
+
+    def error(self, message: str):  # noqa: D102
+        self.exit(EXIT_USER, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite number (``nan``, ``inf`` refused)."""
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(x):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return x
+
+
+def integer(text: str) -> int:
+    """argparse type: an integer written as one (``3.0`` refused, as in the config)."""
+    try:
+        return int(text, 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+
+
+def _set(config: dict, dotted: str, value: Any) -> None:
+    *parents, last = dotted.split(".")
+    node = config
+    for p in parents:
+        node = node.setdefault(p, {})
+    node[last] = value
+
+
+_KEY_RE = re.compile(r"config key '([^'\[]+)")
+
+
+def with_flags(config: dict, flags: dict[str, tuple[str, Any]]) -> dict:
+    """Set config keys from command-line flags and validate the result.
+
+    ``flags`` maps a dotted config key to ``(flag, value)``; ``None`` values are
+    skipped. The whole config is validated again (schema limits and the physics
+    checks of :mod:`opnav.checks`), and every error line about a flag's key (or
+    a parent or child of it) is prefixed with the flag. Raises
+    :class:`~opnav.config.ConfigError`.
+    """
+    given = {k: fv for k, fv in flags.items() if fv[1] is not None}
+    for key, (_, value) in given.items():
+        _set(config, key, value)
+    try:
+        return validate_config(config)
+    except ConfigError as exc:
+        lines = []
+        for line in str(exc).splitlines():
+            m = _KEY_RE.search(line)
+            bad = m.group(1) if m else ""
+            names = [flag for key, (flag, _) in given.items()
+                     if bad and (bad == key or key.startswith(bad + ".") or bad.startswith(key + "."))]
+            lines.append(f"{'/'.join(dict.fromkeys(names))}: {line}" if names else line)
+        raise ConfigError("\n".join(lines)) from None
+
+
+def _finite_or_none(value: Any) -> Any:
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_or_none(v) for v in value]
+    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):  # numpy arrays/scalars
+        return _finite_or_none(value.tolist())
+    return value
+
+
+def print_json(obj: Any, **kw) -> None:
+    """Print ``obj`` as strict JSON (NaN and infinities written as ``null``)."""
+    print(json.dumps(_finite_or_none(obj), allow_nan=False, **kw))
 
 #: Subpackages that may contribute a subcommand, in help order.
 PARTS = ("approach", "landing")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="opnav",
         description=(
             "Reproducible Mars optical navigation: EM-EKF camera-misalignment "
@@ -27,6 +123,8 @@ def build_parser() -> argparse.ArgumentParser:
             "for powered descent (paper B). The full pipeline runs with "
             "`snakemake --cores 2`; these subcommands run single cases."
         ),
+        epilog=f"Exit codes: 0 ok, {EXIT_USER} bad input (flag, config value or file), "
+               f"{EXIT_NUMERICAL} numerical failure.",
     )
     parser.add_argument("--version", action="version", version=f"opnav {__version__}")
     parser.add_argument("--config", default=None,
@@ -49,11 +147,21 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 0
+    import numpy as np
+
     try:
         return int(args.func(args) or 0)
     except ConfigError as exc:
-        print(f"opnav: {exc}", file=sys.stderr)
-        return 2
+        for line in str(exc).splitlines():
+            print(f"opnav: error: {line}", file=sys.stderr)
+        return EXIT_USER
+    except OSError as exc:
+        print(f"opnav: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
+        return EXIT_USER
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        msg = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"opnav: numerical failure ({type(exc).__name__}): {msg}", file=sys.stderr)
+        return EXIT_NUMERICAL
 
 
 if __name__ == "__main__":  # pragma: no cover

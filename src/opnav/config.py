@@ -213,11 +213,21 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = ())
     for f in files:
         if not f.is_file():
             raise ConfigError(f"config file not found: {f}")
-        data = yaml.safe_load(f.read_text()) or {}
+        try:
+            data = yaml.safe_load(f.read_text()) or {}
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ConfigError(f"config file {f} cannot be read: {exc}") from None
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
+            what = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+            raise ConfigError(f"config file {f} is not valid YAML{where}: {what}") from None
         if not isinstance(data, dict):
             raise ConfigError(f"config file {f} must hold a mapping at the top level")
         _merge(config, data)
-    return validate_config(config, SCHEMA_PATH)
+    # results_dir is relative to the checkout that holds config/config.yaml
+    root = Path(path).resolve().parents[1] if path is not None and Path(path).parent.name == "config" else None
+    return validate_config(config, SCHEMA_PATH, root=root)
 
 
 def _merge(base: dict, new: dict) -> None:

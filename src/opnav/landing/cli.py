@@ -10,37 +10,36 @@ of the Monte Carlo for that method exactly.
 
 from __future__ import annotations
 
-import json
-import math
 
 
 def _run(args) -> int:
+    from opnav.cli import print_json, with_flags
     from opnav.config import load_config
     from opnav.landing.descent import build_scenario, run_descent, summarize_run
-    from opnav.landing.planner import available_methods
 
-    cfg = load_config(overlays=[args.config] if args.config else [])["landing"]
-    if args.method not in available_methods():
-        raise SystemExit(f"opnav landing: unknown --method {args.method!r}; "
-                         f"available: {', '.join(available_methods())}")
-    if args.seed < 0:
-        raise SystemExit("opnav landing: --seed must be >= 0")
+    config = load_config(overlays=[args.config] if args.config else [])
+    # the planner's registry and the seed's limits are checked as the config's
+    # landing.single.method / run_index (opnav.checks), naming the flag
+    cfg = with_flags(config, {"landing.single.method": ("--method", args.method),
+                              "landing.single.run_index": ("--seed", args.seed)})["landing"]
     scn = build_scenario(cfg)
     run = run_descent(scn, args.method, args.seed)
     s = summarize_run(run)
-    s = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in s.items()}
     s.update(method=args.method, seed=args.seed,
              final_pos_err_m_xyz=[round(float(x), 4) for x in run["err_r"][-1]],
              final_vel_err_mps_xyz=[round(float(x), 5) for x in run["err_v"][-1]],
              final_rpy_err_deg=[round(float(x), 5) for x in run["err_rpy_deg"][-1]])
-    print(json.dumps(s, indent=2, sort_keys=True))
+    print_json(s, indent=2, sort_keys=True)
     return 0
 
 
 def register(subparsers) -> None:
+    from opnav.cli import integer
+
     p = subparsers.add_parser("landing", help="fly one Mars powered descent (paper B)",
                               description=__doc__.split("\n\n")[0])
     p.add_argument("--method", default="depth",
-                   help="landmark planner: depth, svd, gdop, cond, logdet, mineig (default depth)")
-    p.add_argument("--seed", type=int, default=0, help="Monte-Carlo run index (default 0)")
+                   help="landmark planner, a name of opnav.landing.planner.available_methods() "
+                        "(depth, svd, gdop, cond, ...; default depth)")
+    p.add_argument("--seed", type=integer, default=0, help="Monte-Carlo run index (>= 0, default 0)")
     p.set_defaults(func=_run)
