@@ -97,3 +97,35 @@ def test_slurm_profile_dry_run(workdir):
     proc = run_snakemake(workdir, "-n", "--profile", "profiles/slurm", "--configfile", "config/quick.yaml")
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "Job stats" in proc.stdout
+
+
+def test_slurm_workflow_profile_dry_run_account_and_measured_resources(workdir):
+    """README's cluster command: account and partition from the command line
+    (no tracked file edited); each cluster rule gets its measured resources."""
+    import re
+
+    import yaml
+
+    pytest.importorskip("snakemake_executor_plugin_slurm")
+    profile = yaml.safe_load((workdir / "profiles" / "slurm" / "config.yaml").read_text())
+    assert "slurm_account" not in str(profile.get("default-resources", ""))
+    set_res = profile["set-resources"]
+    proc = run_snakemake(workdir, "-n", "--workflow-profile", "profiles/slurm",
+                         "--default-resources", "slurm_account=acct42", "slurm_partition=part7",
+                         "--configfile", "config/quick.yaml")
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    jobs = re.split(r"\n(?=(?:local)?rule \w+:)", proc.stdout)
+    seen = set()
+    for block in jobs:
+        m = re.match(r"(?:local)?rule (\w+):", block)
+        res = re.search(r"resources: (.*)", block)
+        if not m or not res:
+            continue
+        rule, res = m.group(1), res.group(1)
+        seen.add(rule)
+        assert "slurm_account=acct42" in res and "slurm_partition=part7" in res, res
+        if rule in set_res:
+            assert f"runtime={set_res[rule]['runtime']}" in res, (rule, res)
+            assert f"mem_mb={set_res[rule]['mem_mb']}" in res, (rule, res)
+    assert set(set_res) <= seen, f"set-resources for rules not in the workflow: {set(set_res) - seen}"
+    assert {"landing_mc_chunk", "approach_mc"} <= seen

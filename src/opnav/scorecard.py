@@ -256,9 +256,21 @@ def to_longtable(df: pd.DataFrame) -> str:
     if df.empty:
         return "% scorecard: no published numbers compared yet\n"
     show = df.drop(columns=["difference"]).rename(columns={"ours (mean)": "ours", "ours (spread)": "spread"})
-    return show.to_latex(index=False, longtable=True, escape=True, na_rep="--",
-                         float_format=lambda x: f"{x:.4g}",
-                         column_format="llp{1.2cm}rrrp{2.4cm}p{4.2cm}".replace("p{1.2cm}", "l"))
+    tex = show.to_latex(index=False, longtable=True, escape=True, na_rep="--",
+                        float_format=lambda x: f"{x:.4g}", column_format=LONGTABLE_COLUMNS)
+    # long snake_case names may break after an underscore (else they overrun their column)
+    return tex.replace(r"\_", r"\_\allowbreak{}")
+
+
+def _wrap(width: str) -> str:
+    return rf">{{\raggedright\arraybackslash}}p{{{width}\linewidth}}"
+
+
+#: Longtable columns (paper, item, unit, published, ours, spread, verdict,
+#: reason): the three text columns wrap within fixed shares of the line width,
+#: so the table fits the page whatever the item names (with the manuscript's
+#: 3 pt column separation: 0.55 of the width in text, 5 short columns beside).
+LONGTABLE_COLUMNS = "l" + _wrap("0.22") + "lrrr" + _wrap("0.12") + _wrap("0.21")
 
 
 def verdict_counts(df: pd.DataFrame) -> pd.DataFrame:

@@ -40,7 +40,7 @@ def canonical(value):
 
 
 def cfg(section, *keys):
-    """The config values a rule depends on, canonical, for its `params:`:
+    """The config values that a rule's params hold, sorted (canonical); e.g.
     cfg("landing", "mc", "initial_state") -> {"initial_state": ..., "mc": ...}."""
     sec = config[section]
     return canonical({k: sec[k] for k in keys} if keys else sec)

@@ -137,7 +137,7 @@ HAVE_LATEX = shutil.which("latexmk") is not None and shutil.which("pdflatex") is
 rule paper_pdf:
     """The manuscript, built reproducibly (SOURCE_DATE_EPOCH) with latexmk."""
     input:
-        tex=[str(PAPER_DIR / "main.tex"), *sorted(str(p) for p in (PAPER_DIR / "sections").glob("*.tex"))],
+        tex=sorted(str(p) for p in PAPER_DIR.rglob("*.tex")),
         generated=PAPER_INPUTS,
         results=[t for t in _targets if t.endswith((".pdf", ".tex"))],
     output:
