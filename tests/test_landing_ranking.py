@@ -219,3 +219,23 @@ def test_headline_feeds_manuscript_macros():
     # svd is 1e-5 worse in EVERY run: a shared rank (tolerance) but a significant paired difference
     assert h["reference_more_accurate_than_text"] == "svd, logdet"
     assert h["reference_less_accurate_than_text"] == "none"
+
+
+def test_tied_order_is_by_method_name_not_timing():
+    """B-X1 rebuilt with the same errors but other timings (as every rebuild has):
+    the same table order and headline orders, ties listed by method name."""
+    runs = np.arange(6)
+    base = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+
+    def build(times):
+        data = {m: _fake_mc(base + (0.0 if m in ("depth", "svd", "cond") else 1.0), runs, times[m], i)
+                for i, m in enumerate(["svd", "depth", "mineig", "cond", "gdop"])}
+        df = ranking_table(data, "depth", n_boot=20, rtol=1e-3)
+        return df, headline(df, "depth")
+
+    df1, h1 = build({"svd": 900.0, "depth": 100.0, "mineig": 50.0, "cond": 400.0, "gdop": 60.0})
+    df2, h2 = build({"svd": 10.0, "depth": 700.0, "mineig": 800.0, "cond": 5.0, "gdop": 900.0})
+    assert list(df1["method"]) == list(df2["method"]) == ["cond", "depth", "svd", "gdop", "mineig"]
+    assert h1["ranking_by_accuracy"] == h2["ranking_by_accuracy"] == list(df1["method"])
+    assert h1["best_accuracy_method"] == h2["best_accuracy_method"] == "cond"
+    assert h1["reference_more_accurate_than_text"] == h2["reference_more_accurate_than_text"] == "gdop, mineig"

@@ -12,7 +12,8 @@ mean with a two-sided paired-t interval (``mean +- t_{n-1} s_d / sqrt(n)``,
 Student's t with ``n - 1`` degrees of freedom) and a percentile bootstrap
 interval over runs, the t-test p-value, and the share of runs in which ``a``
 is lower. :func:`competition_rank` ranks with ties sharing the best rank
-(1, 2, 2, 4). :func:`ranking_table` builds the B-X1 table: per method the
+(1, 2, 2, 4); methods that share a rank are listed by name, never by a
+timing. :func:`ranking_table` builds the B-X1 table: per method the
 accuracy (mean and 3-sigma of final and RMS position and velocity error
 norms, NEES, landmarks used, share of planning calls that chose no landmark), planning time (median wall and CPU time of a planning call, us, and
 the ratio to the reference's), ranks by accuracy (mean RMS position error)
@@ -180,7 +181,8 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
     df = pd.DataFrame(rows)
     df.insert(1, "rank_accuracy", competition_rank(df["rms_pos_err_m_mean"], rtol))
     df.insert(2, "rank_time", competition_rank(df["median_plan_cpu_us"], rtol))
-    return df.sort_values(["rank_accuracy", "rank_time", "method"], kind="stable").reset_index(drop=True)
+    # ties broken by method name, never by a timing (identical rebuilds, same order)
+    return df.sort_values(["rank_accuracy", "method"], kind="stable").reset_index(drop=True)
 
 
 def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
@@ -195,15 +197,17 @@ def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
     t = df.set_index("method")
     others = [m for m in t.index if m != reference]
     ref = t.loc[reference]
-    best_acc = t["rms_pos_err_m_mean"].idxmin()
-    fastest = t["median_plan_cpu_us"].idxmin()
+    # orders: by rank, ties by method name (never by the other ranking: timings
+    # change from build to build)
+    by_acc = list(t.reset_index().sort_values(["rank_accuracy", "method"], kind="stable")["method"])
+    by_time = list(t.reset_index().sort_values(["rank_time", "method"], kind="stable")["method"])
     out = {
         "reference": reference,
         "methods": {m: {k: clean(v) for k, v in t.loc[m].items()} for m in t.index},
-        "ranking_by_accuracy": list(t.sort_values(["rank_accuracy", "rank_time"]).index),
-        "ranking_by_time": list(t.sort_values(["rank_time", "rank_accuracy"]).index),
-        "best_accuracy_method": best_acc,
-        "fastest_method": fastest,
+        "ranking_by_accuracy": by_acc,
+        "ranking_by_time": by_time,
+        "best_accuracy_method": by_acc[0],
+        "fastest_method": by_time[0],
         "reference_rank_accuracy": int(ref["rank_accuracy"]),
         "reference_rank_time": int(ref["rank_time"]),
         "n_methods": int(len(t)),

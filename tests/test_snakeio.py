@@ -1,0 +1,61 @@
+"""Job plumbing that users meet when something goes wrong: a failing job's
+traceback lands in its rule's log; a truncated intermediate is reported with its
+name and the command that rebuilds it."""
+
+import numpy as np
+import pytest
+
+from opnav.landing import montecarlo
+from opnav.snakeio import CorruptIntermediate, load_pickle, mock_snakemake, save_pickle, script_context
+
+
+def test_failing_job_writes_traceback_to_its_log(tmp_path):
+    log = tmp_path / "logs" / "job.log"
+    smk = mock_snakemake(log=[str(log)], config={})
+    smk.rule = "demo_rule"
+    with pytest.raises(SystemExit) as err:
+        with script_context(smk) as logger:
+            logger.info("starting")
+            raise np.linalg.LinAlgError("Matrix is not positive definite")
+    msg = str(err.value.code)
+    assert msg.startswith("demo_rule failed: LinAlgError: Matrix is not positive definite")
+    assert str(log) in msg and "\n" not in msg
+    text = log.read_text()
+    assert "starting" in text and "Traceback" in text and "LinAlgError" in text
+
+
+def test_interrupt_is_not_swallowed(tmp_path):
+    smk = mock_snakemake(log=[str(tmp_path / "x.log")], config={})
+    with pytest.raises(KeyboardInterrupt):
+        with script_context(smk):
+            raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize("cut", [0, 10, -20])
+def test_truncated_intermediates_are_named(tmp_path, cut):
+    npz, pkl = tmp_path / "chunk.npz", tmp_path / "mc.pkl"
+    montecarlo.save(npz, {"x": np.arange(50.0)}, "depth")
+    save_pickle(pkl, {"x": np.arange(50.0)})
+    assert montecarlo.load(npz)["x"][-1] == 49.0 and load_pickle(pkl)["x"][-1] == 49.0
+    for path, loader in ((npz, montecarlo.load), (pkl, load_pickle)):
+        data = path.read_bytes()
+        path.write_bytes(data[:cut] if cut else b"")
+        with pytest.raises(CorruptIntermediate) as err:
+            loader(path)
+        assert str(path) in str(err.value) and f"snakemake --cores 2 --force {path}" in str(err.value)
+
+
+def test_atomic_writers_leave_no_partial_file(tmp_path, monkeypatch):
+    """A writer that dies mid-way leaves neither a partial output nor a temporary file."""
+    import pickle
+
+    def die(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pickle, "dump", die)
+    with pytest.raises(KeyboardInterrupt):
+        save_pickle(tmp_path / "a.pkl", {"x": 1})
+    monkeypatch.setattr(np, "savez_compressed", die)
+    with pytest.raises(KeyboardInterrupt):
+        montecarlo.save(tmp_path / "b.npz", {"x": np.zeros(3)}, "depth")
+    assert list(tmp_path.iterdir()) == []
