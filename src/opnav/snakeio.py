@@ -1,7 +1,8 @@
 """Glue for the thin ``workflow/scripts`` wrappers.
 
 :func:`script_context` sends stderr/stdout and the ``logging`` module to the
-rule's log file; :func:`mock_snakemake` builds a stand-in ``snakemake`` object
+rule's log file, and a failing job's traceback too (Snakemake then shows one
+line naming the log); :func:`mock_snakemake` builds a stand-in ``snakemake`` object
 so a script can be run by hand for debugging, e.g.::
 
     python workflow/scripts/landing_tables.py   # uses mock_snakemake defaults
@@ -19,7 +20,11 @@ from typing import Iterator
 
 @contextlib.contextmanager
 def script_context(snakemake) -> Iterator[logging.Logger]:
-    """Redirect output to ``snakemake.log[0]`` (if any) and yield a logger."""
+    """Redirect output to ``snakemake.log[0]`` (if any) and yield a logger.
+
+    An exception inside the block is logged with its traceback to the log file
+    and turned into ``SystemExit("<rule> failed: <error> (traceback in <log>)")``.
+    """
     log_path = snakemake.log[0] if len(getattr(snakemake, "log", [])) else None
     logger = logging.getLogger("opnav")
     if log_path is None:
@@ -36,6 +41,13 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         sys.stderr = sys.stdout = fh
         try:
             yield logger
+        except Exception as exc:
+            # the traceback goes to the rule's log; Snakemake shows one line naming it
+            logger.error("job failed", exc_info=True)
+            fh.flush()
+            rule = getattr(snakemake, "rule", None) or Path(sys.argv[0]).stem or "job"
+            what = " ".join(f"{type(exc).__name__}: {exc}".split())
+            raise SystemExit(f"{rule} failed: {what} (traceback in {log_path})") from None
         finally:
             sys.stderr, sys.stdout = old_err, old_out
             logger.removeHandler(handler)
@@ -59,6 +71,44 @@ def mock_snakemake(input=None, output=None, params=None, log=None, wildcards=Non
     return SimpleNamespace(input=ns(input), output=ns(output), params=ns(params),
                            log=ns(log), wildcards=ns(wildcards), threads=threads,
                            config=config)
+
+
+class CorruptIntermediate(ValueError):
+    """An intermediate file is truncated or unreadable; the message names it and
+    the command that rebuilds it."""
+
+
+def corrupt_intermediate(path, exc: BaseException) -> CorruptIntermediate:
+    """The error for an unreadable intermediate ``path`` (raise it ``from exc``)."""
+    why = " ".join(f"{type(exc).__name__}: {exc}".split())
+    return CorruptIntermediate(
+        f"intermediate file {path} is truncated or corrupt ({why}); rebuild it with "
+        f"`snakemake --cores 2 --force {path}` (plus your --configfile options), then rerun")
+
+
+def save_pickle(path, obj) -> None:
+    """Pickle ``obj`` to ``path`` atomically (complete or absent)."""
+    import pickle
+
+    from opnav.tables import atomic_target
+
+    with atomic_target(path) as tmp, open(tmp, "wb") as fh:
+        pickle.dump(obj, fh)
+
+
+def load_pickle(path):
+    """Unpickle an intermediate; a truncated or corrupt file raises
+    :class:`CorruptIntermediate` naming it."""
+    import pickle
+
+    try:
+        with open(path, "rb") as fh:
+            return pickle.load(fh)
+    except FileNotFoundError:
+        raise
+    except (EOFError, pickle.UnpicklingError, ValueError, TypeError, AttributeError, ImportError,
+            IndexError, KeyError, OSError) as exc:
+        raise corrupt_intermediate(path, exc) from exc
 
 
 class _Named(list):

@@ -1,10 +1,9 @@
 """Plain EM vs SQUAREM iterations to the maximum-likelihood estimate (headline case, one window)."""
 
-import pickle
 from pathlib import Path
 
 from opnav.approach.cases import convergence_study, headline_case
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(output=["results/approach/work/conv/roll.pkl"], wildcards={"variant": "roll"})
@@ -19,5 +18,4 @@ with script_context(snakemake) as log:
     log.info("theta* mean %s; maps plain %s squarem %s", res["theta_star_arcsec"].mean(0),
              res["plain"]["maps_to_converge"], res["squarem"]["maps_to_converge"])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
-    with open(snakemake.output[0], "wb") as fh:
-        pickle.dump(res, fh)
+    save_pickle(snakemake.output[0], res)

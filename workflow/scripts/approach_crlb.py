@@ -1,12 +1,11 @@
 """CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case)."""
 
-import pickle
 from pathlib import Path
 
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
 from opnav.approach.pipeline import bound_curve
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(output=["results/approach/work/crlb.pkl"])
@@ -22,5 +21,4 @@ with script_context(snakemake) as log:
         curves[v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v)
         log.info("%s: CRLB at end %s arcsec", v, curves[v][-1])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
-    with open(snakemake.output[0], "wb") as fh:
-        pickle.dump(curves, fh)
+    save_pickle(snakemake.output[0], curves)

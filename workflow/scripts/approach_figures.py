@@ -1,16 +1,14 @@
 """A-F4, A-F5, A-F6 for the headline case (T1-01) of one scenario variant."""
 
-import pickle
 
 from opnav import figures, published
 from opnav.approach import plots
-from opnav.snakeio import script_context
+from opnav.snakeio import load_pickle, script_context
 
 with script_context(snakemake) as log:
     runs = {}
     for p in snakemake.input.mc:
-        with open(p, "rb") as fh:
-            for r in pickle.load(fh):
+        for r in load_pickle(p):
                 if r["case_id"] == "T1-01":
                     runs[r["method"]] = r
     v = snakemake.wildcards.variant

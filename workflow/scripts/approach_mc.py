@@ -1,10 +1,9 @@
 """Monte Carlo of one Table-1 case group under one scenario variant and EM scheme."""
 
-import pickle
 from pathlib import Path
 
 from opnav.approach.pipeline import run_group
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(output=["results/approach/work/mc/literal__size__plain.pkl"],
@@ -15,5 +14,4 @@ with script_context(snakemake) as log:
     w = snakemake.wildcards
     res = run_group(snakemake.params.approach, w.variant, w.group, w.method, log=log)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
-    with open(snakemake.output[0], "wb") as fh:
-        pickle.dump(res, fh)
+    save_pickle(snakemake.output[0], res)

@@ -1,11 +1,10 @@
 """A-T1 (Table 1 beside the published values), A-X1 table + verdict text, A-summary.json."""
 
-import pickle
 
 
 from opnav import published
 from opnav.approach import report
-from opnav.snakeio import script_context
+from opnav.snakeio import load_pickle, script_context
 from opnav.tables import atomic_write_text, write_json, write_table
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -16,15 +15,12 @@ with script_context(snakemake) as log:
     cfg = snakemake.params.approach
     results = []
     for p in snakemake.input.mc:
-        with open(p, "rb") as fh:
-            results.extend(pickle.load(fh))
+        results.extend(load_pickle(p))
     conv = {}
     for p in snakemake.input.conv:
-        with open(p, "rb") as fh:
-            c = pickle.load(fh)
+        c = load_pickle(p)
         conv[c["variant"]] = c
-    with open(snakemake.input.crlb, "rb") as fh:
-        curves = pickle.load(fh)
+    curves = load_pickle(snakemake.input.crlb)
     pub = published.paper_a()
     t1 = report.table1_frame(results, pub, snakemake.params.profile)
     csv, tex, md = snakemake.output.t1

@@ -1,21 +1,18 @@
 """A-X1 figure: the CRLB per variant beside the EM estimates; EM iterations plain vs SQUAREM."""
 
-import pickle
 
 import pandas as pd
 
 from opnav import figures
 from opnav.approach import plots
-from opnav.snakeio import script_context
+from opnav.snakeio import load_pickle, script_context
 
 with script_context(snakemake) as log:
     cfg = snakemake.params.approach
-    with open(snakemake.input.crlb, "rb") as fh:
-        curves = pickle.load(fh)
+    curves = load_pickle(snakemake.input.crlb)
     conv = {}
     for p in snakemake.input.conv:
-        with open(p, "rb") as fh:
-            c = pickle.load(fh)
+        c = load_pickle(p)
         conv[c["variant"]] = c
     x1 = pd.read_csv(snakemake.input.x1)
     fig = plots.fig_crlb(curves, conv, x1, cfg["accuracy_target_arcsec"], cfg["segments"]["N0"])

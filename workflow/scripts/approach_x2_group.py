@@ -1,12 +1,11 @@
 """A-X2: augmented EKF and batch ML on one Table-1 case group under one variant (one Snakemake job)."""
 
-import pickle
 from pathlib import Path
 
 from opnav.approach import alternatives as alt
 from opnav.approach import scenario as sc
 from opnav.approach.pipeline import cases_in
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(output=["results/approach/work/x2/roll__size.pkl"],
@@ -24,5 +23,4 @@ with script_context(snakemake) as log:
         em_times = alt.time_em(cfg, w.variant, headline[0], range(cfg["n_seeds"]), geo)
         log.info("EM-EKF run time per seed: %s", em_times)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
-    with open(snakemake.output[0], "wb") as fh:
-        pickle.dump({"variant": w.variant, "group": w.group, "results": res, "em_times": em_times}, fh)
+    save_pickle(snakemake.output[0], {"variant": w.variant, "group": w.group, "results": res, "em_times": em_times})

@@ -1,10 +1,9 @@
 """A-X2 table (EM-EKF vs augmented EKF vs batch ML), long form per case, A-X2-summary.json."""
 
-import pickle
 
 
 from opnav.approach import alternatives as alt
-from opnav.snakeio import script_context
+from opnav.snakeio import load_pickle, script_context
 from opnav.tables import write_json, write_table
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -15,16 +14,14 @@ with script_context(snakemake) as log:
     cfg = snakemake.params.approach
     alt_res, em_times = [], {}
     for p in snakemake.input.x2:
-        with open(p, "rb") as fh:
-            d = pickle.load(fh)
+        d = load_pickle(p)
         alt_res.extend(d["results"])
         if d["em_times"]:
             em_times[d["variant"]] = d["em_times"]
     em_res = []
     variants = {r["variant"] for r in alt_res}
     for p in snakemake.input.mc:
-        with open(p, "rb") as fh:
-            em_res.extend(r for r in pickle.load(fh) if r["variant"] in variants)
+        em_res.extend(r for r in load_pickle(p) if r["variant"] in variants)
     long = alt.long_frame(alt_res, em_res, em_times)
     long.to_csv(snakemake.output.long, index=False)
     table = alt.summary_frame(long)

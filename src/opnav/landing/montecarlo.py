@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -94,16 +93,26 @@ def run_chunk(landing_cfg: dict, method: str, run_indices) -> dict:
 
 def save(path, data: dict, method: str) -> None:
     """Write a chunk or gathered result (``.npz``, atomically)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.npz")
-    np.savez_compressed(tmp, method=np.array(method), **data)
-    tmp.replace(path)
+    from opnav.tables import atomic_target
+
+    with atomic_target(path) as tmp:
+        np.savez_compressed(tmp, method=np.array(method), **data)
 
 
 def load(path) -> dict:
-    with np.load(path, allow_pickle=False) as z:
-        return {k: z[k] for k in z.files}
+    """Read a :func:`save` file; a truncated or corrupt one raises
+    :class:`opnav.snakeio.CorruptIntermediate` naming it and its rebuild command."""
+    import zipfile
+
+    from opnav.snakeio import corrupt_intermediate
+
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise
+    except (zipfile.BadZipFile, EOFError, ValueError, OSError, KeyError) as exc:
+        raise corrupt_intermediate(path, exc) from exc
 
 
 def gather(parts: list[dict]) -> dict:
