@@ -275,11 +275,11 @@ def test_json_output_is_strict():
 
     import numpy as np
 
-    from opnav.cli import _finite_or_none
+    from opnav.tables import json_ready
 
     obj = {"a": float("nan"), "b": [float("inf"), 1.5], "c": np.float64("nan"), "d": np.array([1.0, np.nan]),
            "e": "nan", "f": 3}
-    text = json.dumps(_finite_or_none(obj), allow_nan=False)
+    text = json.dumps(json_ready(obj), allow_nan=False)
 
     def refuse(c):
         raise ValueError(c)

@@ -65,3 +65,30 @@ def test_every_file_the_manuscript_names_exists():
     assert named, "no file names found: the pattern is broken"
     missing = [n for n in sorted(named) if not n.startswith("results/") and not (REPO / n).exists()]
     assert missing == []
+
+
+def test_no_nan_text_reaches_the_manuscript():
+    """Missing values read as a dash, whatever their type: macros, compact views, tables."""
+    import re
+
+    import numpy as np
+    import pandas as pd
+
+    from opnav.manuscript import COMPACT_VIEWS, macros_from_summary, render_macros
+    from opnav.tables import to_latex, to_markdown
+
+    nanword = re.compile(r"(?<![A-Za-z])(nan|inf|<NA>)(?![A-Za-z])", re.IGNORECASE)
+    summary = {"a": float("nan"), "b": np.float32("nan"), "c": "nan", "d": [None, np.nan],
+               "e": "best: nan m", "f": np.float64(2.5), "g": np.int64(3), "h": float("inf")}
+    text = render_macros(macros_from_summary(summary, "T"))
+    assert not nanword.search(text), text
+    assert r"\newcommand{\TF}{2.5}" in text and r"\newcommand{\TG}{3}" in text
+    row = {"method": "depth", "rank_accuracy": 1, "rank_time": np.nan, "rms_pos_err_m_mean": np.nan,
+           "rms_pos_err_m_3sigma": np.nan, "final_pos_err_m_mean": 3.0, "final_pos_err_m_3sigma": np.inf,
+           "mean_nees_pos": pd.NA, "median_plan_time_us": np.float32("nan")}
+    for _, df in COMPACT_VIEWS["B-X1"](pd.DataFrame([row])):
+        for out in (to_latex(df), to_markdown(df)):
+            assert not nanword.search(out), out
+    df = pd.DataFrame({"x": [1.0, np.nan, np.inf], "s": ["a", None, "b"]})
+    for out in (to_latex(df), to_markdown(df)):
+        assert not nanword.search(out), out

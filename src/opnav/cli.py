@@ -94,21 +94,11 @@ def with_flags(config: dict, flags: dict[str, tuple[str, Any]]) -> dict:
         raise ConfigError("\n".join(lines)) from None
 
 
-def _finite_or_none(value: Any) -> Any:
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _finite_or_none(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite_or_none(v) for v in value]
-    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):  # numpy arrays/scalars
-        return _finite_or_none(value.tolist())
-    return value
-
-
 def print_json(obj: Any, **kw) -> None:
     """Print ``obj`` as strict JSON (NaN and infinities written as ``null``)."""
-    print(json.dumps(_finite_or_none(obj), allow_nan=False, **kw))
+    from opnav.tables import json_ready
+
+    print(json.dumps(json_ready(obj), allow_nan=False, **kw))
 
 #: Subpackages that may contribute a subcommand, in help order.
 PARTS = ("approach", "landing")
@@ -155,9 +145,14 @@ def main(argv: list[str] | None = None) -> int:
         for line in str(exc).splitlines():
             print(f"opnav: error: {line}", file=sys.stderr)
         return EXIT_USER
+    except BrokenPipeError:                      # e.g. `opnav landing | head`
+        return 0
     except OSError as exc:
         print(f"opnav: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
         return EXIT_USER
+    except KeyboardInterrupt:
+        print("opnav: interrupted", file=sys.stderr)
+        return 130
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         msg = " ".join(str(exc).split()) or type(exc).__name__
         print(f"opnav: numerical failure ({type(exc).__name__}): {msg}", file=sys.stderr)

@@ -11,11 +11,21 @@
 from __future__ import annotations
 
 import math
+import numbers
 import re
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 _DIGITS = ["Zero", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine"]
+
+
+def np_bool_types() -> tuple:
+    try:
+        import numpy as np
+
+        return (np.bool_,)
+    except ImportError:  # pragma: no cover
+        return ()
 
 
 def macro_name(parts: Iterable[str]) -> str:
@@ -33,16 +43,45 @@ def macro_name(parts: Iterable[str]) -> str:
     return name
 
 
+#: What a missing value reads as in the manuscript (never "nan").
+MISSING = "--"
+_NAN_WORD = re.compile(r"(?<![A-Za-z])(?:nan|<NA>|NaT)(?![A-Za-z])", re.IGNORECASE)
+
+
+def is_missing(x: Any) -> bool:
+    """None, NaN (any float type), pandas' NA/NaT, or the text ``nan``."""
+    if x is None:
+        return True
+    if isinstance(x, str):
+        return x.strip().lower() in ("nan", "<na>", "nat", "none", "")
+    if isinstance(x, numbers.Real) and not isinstance(x, bool):
+        return math.isnan(float(x))
+    try:
+        import pandas as pd
+
+        return bool(pd.isna(x)) if pd.api.types.is_scalar(x) else False
+    except (ImportError, TypeError, ValueError):
+        return False
+
+
+def no_nan_text(text: str) -> str:
+    """``text`` with every standalone ``nan`` / ``<NA>`` / ``NaT`` token replaced by
+    :data:`MISSING` (a last guard for strings formatted upstream)."""
+    return _NAN_WORD.sub(MISSING, text)
+
+
 def format_number(x: float) -> str:
-    """Numbers as a reader wants them in running text: 4 significant digits, no exponent above 1e-3."""
-    if isinstance(x, bool):
+    """Numbers as a reader wants them in running text: 4 significant digits, no
+    exponent above 1e-3; a missing value (None, NaN) reads as :data:`MISSING`."""
+    if isinstance(x, (bool, np_bool_types())):
         return "yes" if x else "no"
-    if isinstance(x, int):
-        return f"{x:,}".replace(",", "{,}")
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "--"
+    if isinstance(x, numbers.Integral):
+        return f"{int(x):,}".replace(",", "{,}")
+    if is_missing(x):
+        return MISSING
+    x = float(x)
     if math.isinf(x):
-        return r"\infty" if x > 0 else r"-\infty"
+        return r"$\infty$" if x > 0 else r"$-\infty$"
     ax = abs(x)
     if ax >= 1000:
         return f"{x:,.0f}".replace(",", "{,}")
@@ -80,12 +119,10 @@ def macros_from_summary(summary: Mapping[str, Any], prefix: str) -> dict[str, st
             name = macro_name([prefix, *parts])
             if name in out:
                 raise ValueError(f"macro {name} defined twice")
-            if isinstance(node, (int, float)) and not isinstance(node, bool) or node is None:
-                out[name] = format_number(node)
-            elif isinstance(node, bool):
+            if node is None or isinstance(node, (numbers.Real, bool, *np_bool_types())):
                 out[name] = format_number(node)
             else:
-                out[name] = latex_escape(str(node))
+                out[name] = no_nan_text(latex_escape(str(node)))
 
     walk(summary, [])
     return out
@@ -175,15 +212,17 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
 
 # ------------------------------------------------------------ compact tables
 def _pm(mean: float, spread: float, fmt: str = "{:.3g}") -> str:
-    if mean is None or (isinstance(mean, float) and math.isnan(mean)):
-        return "--"
-    if spread is None or (isinstance(spread, float) and math.isnan(spread)):
+    if is_missing(mean) or not math.isfinite(float(mean)):
+        return MISSING
+    if is_missing(spread) or not math.isfinite(float(spread)):
         return fmt.format(mean)
     return f"{fmt.format(mean)} ± {fmt.format(spread)}"
 
 
 def _num(x: float, fmt: str = "{:.4g}") -> str:
-    return "--" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt.format(x)
+    if is_missing(x) or (isinstance(x, numbers.Real) and not math.isfinite(float(x))):
+        return MISSING
+    return fmt.format(x)
 
 
 def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:

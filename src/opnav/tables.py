@@ -7,6 +7,8 @@ file is either complete or absent (written to a temporary name, then renamed).
 
 from __future__ import annotations
 
+import math
+
 import os
 import tempfile
 from contextlib import contextmanager
@@ -70,7 +72,7 @@ def to_latex(df: pd.DataFrame, caption: str | None = None, label: str | None = N
     body = df.to_latex(
         index=False,
         escape=True,
-        float_format=lambda x: float_format.format(x),
+        float_format=lambda x: float_format.format(x) if math.isfinite(x) else "--",
         na_rep="--",
         column_format="l" * df.shape[1],
     )
@@ -87,7 +89,10 @@ def to_markdown(df: pd.DataFrame, caption: str | None = None, float_format: str 
     fmt = df.copy()
     for c in fmt.columns:
         if pd.api.types.is_float_dtype(fmt[c]):
-            fmt[c] = [("--" if pd.isna(x) else float_format.format(x)) for x in fmt[c]]
+            fmt[c] = [("--" if not math.isfinite(x) else float_format.format(x)) for x in fmt[c]]
+        else:
+            fmt[c] = [("--" if x is None or (pd.api.types.is_scalar(x) and pd.isna(x)) else x)
+                      for x in fmt[c]]
     md = fmt.to_markdown(index=False)
     return (f"{caption}\n\n{md}\n" if caption else md + "\n")
 
@@ -129,6 +134,8 @@ def json_ready(x):
         return {str(k): json_ready(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [json_ready(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return json_ready(x.tolist())
     if isinstance(x, (np.floating, float)):
         x = float(x)
         return x if math.isfinite(x) else None
