@@ -93,6 +93,11 @@ BAD_CONFIGS = [
     ("landing: {single: {method: foo}}", "landing.single.method"),
     ("landing: {ablation: {methods: [depth, xyz]}}", "landing.ablation.methods"),
     ("landing: {extra: {methods: [], reference: logdet}}", "landing.extra.reference"),
+    ("landing: {extra: {n_boot: 1}}", "landing.extra.n_boot"),
+    ("approach: {mars_elements: {a_au: 1.0e-9}}", "approach.mars_elements.a_au"),
+    ("landing: {gravity_mps2: [0, 0, 0]}", "landing.initial_state"),
+    ("landing: {filter: {min_update_altitude_m: 100000}}", "landing.initial_state.r_m"),
+    ("approach: {base_seed: true}", "approach.base_seed"),
     # where outputs go
     ("results_dir: ''", "results_dir"),
     ("results_dir: '.'", "results_dir"),

@@ -70,10 +70,12 @@ def _duplicates(items) -> list:
     return dup
 
 
-def config_problems(config: dict, root: str | Path | None = None) -> list[str]:
+def config_problems(config: dict, root: str | Path | None = None,
+                    workdir: str | Path | None = None) -> list[str]:
     """Every problem of a schema-valid ``config`` (defaults filled), one line each,
-    naming the key(s). ``root`` is the checkout (default: the working directory)."""
-    out = results_dir_problems(config.get("results_dir", "results"), root)
+    naming the key(s). ``root`` is the checkout (default: the working directory),
+    ``workdir`` where relative outputs go (default: ``root``)."""
+    out = results_dir_problems(config.get("results_dir", "results"), root, workdir)
     if "approach" in config:
         out += approach_problems(config["approach"])
     if "landing" in config:
@@ -81,13 +83,17 @@ def config_problems(config: dict, root: str | Path | None = None) -> list[str]:
     return out
 
 
-def results_dir_problems(results_dir: str, root: str | Path | None = None) -> list[str]:
-    """``results_dir`` must be non-empty, not the checkout and not inside a tracked folder."""
+def results_dir_problems(results_dir: str, root: str | Path | None = None,
+                         workdir: str | Path | None = None) -> list[str]:
+    """``results_dir`` must be non-empty, not the checkout ``root`` (default: the
+    working directory) and not inside one of its tracked folders; a relative
+    ``results_dir`` is taken from ``workdir`` (where Snakemake writes; default
+    ``root``)."""
     if not str(results_dir).strip():
         return ["invalid config key 'results_dir': empty (generated files would land in the checkout)"]
     base = Path(root or Path.cwd()).resolve()
     p = Path(results_dir)
-    p = (p if p.is_absolute() else base / p).resolve()
+    p = (p if p.is_absolute() else Path(workdir or base) / p).resolve()
     if p == base:
         return [f"invalid config key 'results_dir': {results_dir!r} is the checkout itself"]
     for d in TRACKED_DIRS:
@@ -254,6 +260,8 @@ def landing_problems(c: dict) -> list[str]:
         dup = _duplicates(c["ablation"][key.split(".")[1]])
         if dup:
             out.append(f"{k}{key}': duplicated {', '.join(map(str, dup))}")
+    if c["extra"]["n_boot"] == 1:
+        out.append(f"{k}extra.n_boot': 1 resample gives no interval; use 0 (paired t only) or >= 2")
     flown = list(c["mc"]["methods"]) + list(c["extra"]["methods"])
     if c["extra"]["reference"] not in flown:
         out.append(f"{k}extra.reference': {c['extra']['reference']!r} is not flown "

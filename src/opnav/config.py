@@ -155,7 +155,7 @@ def _copy(value: Any) -> Any:
 
 
 def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: bool = True,
-                    root: str | Path | None = None) -> dict:
+                    root: str | Path | None = None, workdir: str | Path | None = None) -> dict:
     """Validate ``config`` in place (filling defaults); raise :class:`ConfigError`
     with one line per problem, each naming its key.
 
@@ -163,7 +163,8 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
     (:func:`non_finite_keys`); the JSON schema (integer keys take ints only);
     and, with ``physics``, the cross-key consistency checks of
     :func:`opnav.checks.config_problems` (durations, rates, geometry, method
-    names, ...; ``root`` is the checkout that ``results_dir`` is relative to).
+    names, ...; ``root`` is the checkout, ``workdir`` where a relative
+    ``results_dir`` lands, default ``root``).
     """
     bad = non_finite_keys(config)
     lines = [f"invalid config key '{k}': {_at(config, k)} is not a finite number "
@@ -179,7 +180,7 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
     if physics:
         from opnav.checks import config_problems
 
-        problems = config_problems(config, root)
+        problems = config_problems(config, root, workdir)
         if problems:
             raise ConfigError("\n".join(problems))
     return config

@@ -3,12 +3,15 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(workflow.basedir) / "src"))
-from opnav.config import validate_config  # noqa: E402
+from opnav.config import ConfigError, validate_config  # noqa: E402
 
 # The schema (defaults filled in place, finite numbers, strict integers) and the
 # cross-key physics checks of opnav.checks, before any job: the same function
 # the `opnav` CLI uses. A ConfigError lists one line per problem, naming the key.
-validate_config(config, root=workflow.basedir)
+try:
+    validate_config(config, root=workflow.basedir, workdir=Path.cwd())
+except ConfigError as exc:
+    sys.exit(f"ConfigError (no job was run):\n{exc}")
 
 RESULTS = config["results_dir"]
 
