@@ -74,6 +74,8 @@ BAD_CONFIGS = [
     ("approach: {segments: {N: 100000, L: 10000}}", "approach.segments"),
     ("approach: {n_seeds: 1000, segments: {N0: 10000}}", "approach.n_seeds"),
     ("approach: {roll: {steps_deg: [0, 90], step_interval_s: 100.3}}", "approach.roll.step_interval_s"),
+    ("approach: {prior_sigma: {r_km: 1.0e-300}}", "approach.prior_sigma.r_km"),
+    ("approach: {initial_error: {r_km: [1.0e+9, 0, 0]}}", "approach.initial_error.r_km[0]"),
     # physics of paper B
     ("landing: {duration_s: 197.5}", "landing.duration_s"),
     ("landing: {filter: {dt_s: 0.7}}", "landing.duration_s"),
@@ -125,6 +127,8 @@ def test_bad_config_refused_naming_key(overlay, key):
 
 def test_quick_and_full_profiles_pass():
     validate_config(_overlaid("{}"), root=REPO)
+    # a slow, nearly parabolic approach that does not reach Mars is legal
+    validate_config(_overlaid("approach: {geometry: {v_inf_kms: 1.0e-9}}"), root=REPO)
     validate_config(yaml.safe_load((REPO / "config" / "config.yaml").read_text()), root=REPO)
 
 

@@ -59,3 +59,18 @@ def test_atomic_writers_leave_no_partial_file(tmp_path, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         montecarlo.save(tmp_path / "b.npz", {"x": np.zeros(3)}, "depth")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_chunk_names_cover_any_number_of_chunks():
+    """More than 999 chunks (and run indices past 9999) still match the rules' wildcard."""
+    import re
+
+    from opnav.landing.montecarlo import CHUNK_PATTERN, chunk_label, chunk_runs, chunks
+
+    parts = chunks(12_345, 1)
+    assert len(parts) == 12_345
+    labels = [chunk_label(c) for c in parts]
+    assert len(set(labels)) == len(labels)
+    for c, lab in zip(parts[::997] + parts[-2:], labels[::997] + labels[-2:]):
+        assert re.fullmatch(CHUNK_PATTERN, lab), lab
+        assert chunk_runs(lab) == list(c)

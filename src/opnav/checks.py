@@ -106,36 +106,40 @@ def results_dir_problems(results_dir: str, root: str | Path | None = None,
 
 # --------------------------------------------------------------------- paper A
 
-def _approach_min_range_km(a: dict, T: float) -> tuple[float, float]:
-    """(range at t0, closest range over [0, T]) of the Mars-centred two-body
-    hyperbola that :func:`opnav.approach.scenario.initial_truth` starts, km.
-    (The Sun's tide over an approach arc moves it by far less than Mars' radius.)"""
+def _approach_min_range_km(a: dict, T: float) -> float:
+    """Closest range to Mars over [0, T] (s) of the arc that
+    :func:`opnav.approach.scenario.initial_truth` starts, km: the Mars-centred
+    two-body motion (DOP853), stopped at the surface if it gets there. (The
+    Sun's tide over an approach arc moves it by far less than Mars' radius.)"""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import minimize_scalar
+
     from opnav.approach import dynamics, scenario
 
-    X = scenario.initial_truth(a) - dynamics.kepler_state(
+    X0 = scenario.initial_truth(a) - dynamics.kepler_state(
         dynamics.KeplerElements.from_config(a["mars_elements"]), 0.0)
-    r, v = X[:3], X[3:]
     mu = dynamics.MU_MARS
-    rn, vn = float(np.linalg.norm(r)), float(np.linalg.norm(v))
-    h = float(np.linalg.norm(np.cross(r, v)))
-    energy = vn ** 2 / 2 - mu / rn
-    if energy <= 0:                                  # cannot happen with v_inf > 0
-        return rn, min(rn, h ** 2 / mu / 2)
-    sma = mu / (2 * energy)                          # |a| of the hyperbola
-    ecc = math.sqrt(1 + 2 * energy * h ** 2 / mu ** 2)
-    rp = sma * (ecc - 1)
-    if float(np.dot(r, v)) >= 0:                     # receding: closest now
-        return rn, rn
-    F0 = math.acosh(max(1.0, (1 + rn / sma) / ecc))
-    t_peri = (ecc * math.sinh(F0) - F0) / math.sqrt(mu / sma ** 3)
-    if t_peri <= T:
-        return rn, rp
-    # still approaching at T: range at T from the hyperbolic Kepler equation
-    M = (ecc * math.sinh(F0) - F0) - math.sqrt(mu / sma ** 3) * T
-    F = math.asinh(M / ecc)
-    for _ in range(60):
-        F -= (ecc * math.sinh(F) - F - M) / (ecc * math.cosh(F) - 1)
-    return rn, sma * (ecc * math.cosh(F) - 1)
+
+    def rhs(t, X):
+        r = X[:3]
+        return np.concatenate([X[3:], -mu * r / np.linalg.norm(r) ** 3])
+
+    def surface(t, X):
+        return np.linalg.norm(X[:3]) - dynamics.R_MARS_KM
+
+    surface.terminal = True
+    sol = solve_ivp(rhs, (0.0, T), X0, method="DOP853", rtol=1e-10, atol=1e-6,
+                    dense_output=True, events=surface)
+    if sol.status == 1:                              # reached the surface
+        return dynamics.R_MARS_KM
+    rng = np.linalg.norm(sol.y[:3], axis=0)
+    i = int(np.argmin(rng))
+    lo, hi = sol.t[max(i - 1, 0)], sol.t[min(i + 1, len(sol.t) - 1)]
+    if hi <= lo:
+        return float(rng[i])
+    best = minimize_scalar(lambda t: np.linalg.norm(sol.sol(t)[:3]), bounds=(lo, hi),
+                           method="bounded", options={"xatol": 1e-6 * max(T, 1.0)})
+    return float(min(rng[i], best.fun))
 
 
 def approach_problems(a: dict) -> list[str]:
@@ -194,11 +198,10 @@ def approach_problems(a: dict) -> list[str]:
                    f"({g['range_km']} km <= Mars radius {dynamics.R_MARS_KM} km)")
         return out
     T = dt * max(n, s["N0"] + a["convergence_study"]["data_samples"])
-    _, rmin = _approach_min_range_km(a, T)
+    rmin = _approach_min_range_km(a, T)
     if rmin <= dynamics.R_MARS_KM:
-        out.append(f"{k}geometry': the arc hits Mars within its {T:g} s (closest range "
-                   f"{rmin:.0f} km <= {dynamics.R_MARS_KM} km); raise geometry.aim_offset_km "
-                   "or range_km, or shorten the arc")
+        out.append(f"{k}geometry': the arc reaches Mars' surface within its {T:g} s "
+                   "(dt_s x samples); raise geometry.aim_offset_km or range_km, or shorten the arc")
         return out
     cam = a["camera"]
     disc = scenario.mars_disc_px(rmin, cam["ifov_arcsec"])
