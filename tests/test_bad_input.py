@@ -89,6 +89,8 @@ BAD_CONFIGS = [
     ("landing: {figures: {f5_time_s: 500}}", "landing.figures.f5_time_s"),
     ("landing: {figures: {f5_time_s: 1.5}}", "landing.figures.f5_time_s"),
     ("landing: {mc: {n_runs: 100000}}", "landing.mc.n_runs"),
+    ("landing: {mc: {bounds: {r_m: 100000}}}", "landing.mc.bounds.r_m"),
+    ("landing: {planner: {margin_px: 10000}}", "landing.planner.margin_px"),
     # method names: the planner's registry
     ("landing: {mc: {methods: [depth, nosuch]}}", "landing.mc.methods"),
     ("landing: {extra: {reference: gdopp}}", "landing.extra.reference"),

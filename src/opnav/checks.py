@@ -16,8 +16,9 @@ one line per problem naming the keys:
   length, seeds x samples);
 * paper B: ``duration_s`` a multiple of ``filter.dt_s``, ``imu.rate_hz x
   filter.dt_s`` an integer; the lander above ground (and above the
-  measurement-cut-off altitude) and its nominal guidance trajectory not
-  through the ground; the landing site in the configured camera's view at the
+  measurement-cut-off altitude, and above its initial position errors) and its
+  nominal guidance trajectory not through the ground; a planning margin that
+  leaves part of the detector; the landing site in the configured camera's view at the
   start and while the filter measures (for every swept field of view too);
   every method name known to :func:`opnav.landing.planner.available_methods`
   (the planner's own registry); the B-X1 reference among the flown methods;
@@ -156,7 +157,7 @@ def approach_problems(a: dict) -> list[str]:
                    f"{MAX_APPROACH_SAMPLES} (memory)")
         return out
     for key, seeds, samples in (("n_seeds", a["n_seeds"], n),
-                                ("convergence_study", a["convergence_study"]["n_seeds"],
+                                ("convergence_study.n_seeds", a["convergence_study"]["n_seeds"],
                                  s["N0"] + a["convergence_study"]["data_samples"]),
                                 ("ablation.n_seeds", a["ablation"]["n_seeds"], n)):
         if seeds * samples > MAX_APPROACH_SEED_SAMPLES:
@@ -276,6 +277,13 @@ def landing_problems(c: dict) -> list[str]:
         out.append(f"{k}initial_state.r_m': the lander starts at altitude {r0[2]:g} m, "
                    "not above the ground z = 0")
         return out
+    if c["mc"]["bounds"]["r_m"] >= r0[2]:
+        out.append(f"{k}mc.bounds.r_m': initial position errors up to {c['mc']['bounds']['r_m']:g} m "
+                   f"would start estimates below the ground (the lander starts at {r0[2]:g} m)")
+    half = c["camera"]["pixels"] / 2.0
+    if c["planner"]["margin_px"] >= half:
+        out.append(f"{k}planner.margin_px': {c['planner']['margin_px']:g} px leaves no part of the "
+                   f"{c['camera']['pixels']} px detector to plan landmarks in (must be < {half:g})")
     if r0[2] <= alt_min:
         out.append(f"{k}initial_state.r_m': the lander starts at {r0[2]:g} m, not above "
                    f"filter.min_update_altitude_m = {alt_min:g} m (no measurement would be taken)")
