@@ -26,6 +26,7 @@ SUMMARIES = {
         "B": res("landing", "B-summary.json"),
         "AX2": res("approach", "A-X2-summary.json"),
         "BX1": res("landing", "B-X1-summary.json"),
+        "AP1": res("approach", "A-P1-summary.json"),
     }.items()
     if p in _targets
 }

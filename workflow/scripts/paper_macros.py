@@ -9,7 +9,7 @@ from opnav.tables import atomic_write_text
 
 with script_context(snakemake) as log:
     macros = {}
-    for key in ("A", "B", "AX2", "BX1"):
+    for key in ("A", "B", "AX2", "BX1", "AP1"):
         name = f"summary_{key}"
         if name in snakemake.input.keys():
             macros.update(macros_from_summary(json.loads(open(snakemake.input[name]).read()), key))

@@ -1,0 +1,510 @@
+"""A-P1: Basilisk's pixel/line-bias UKF as a peer on paper A's measurements (issue 12).
+
+Description
+    Basilisk (AVSLab, ``bsk`` on PyPI) ships the flight-software module
+    ``fswAlgorithms.pixelLineBiasUKF``: a square-root UKF (Wan & van der Merwe)
+    with 9 states, the spacecraft position and velocity relative to the planet
+    in an inertial frame N and a bias ``b`` of the planet's image (pixel, line,
+    apparent radius, px). Nobody here wrote it; running it on the *same*
+    measurements as the EM-EKF, the augmented EKF and batch ML gives an
+    independent reading of paper A's misalignment.
+
+    Module conventions (read from its source, ``src/fswAlgorithms/
+    opticalNavigation/pixelLineBiasUKF/pixelLineBiasUKF.c``, Basilisk 2.12):
+
+    * Units: messages and ``stateInit`` / ``covarInit`` in m, m/s (and px for
+      the bias); internally km, km/s. ``qNoise`` is used unconverted, i.e. in
+      km^2, (km/s)^2, px^2 per time update. The output covariance is scaled
+      back by 1e6 in its position/velocity rows only.
+    * Dynamics: two-body about the planet (``MU_MARS = 42828.314`` km^3/s^2 for
+      planet id 2), RK4 over each time update; ``b' = 0``.
+    * Measurement of sigma point ``(r_N, b)``: ``r_C = [CB][BN] r_N`` with
+      ``[CB] = MRP2C(sigma_CB)`` (camera config message) and ``[BN] =
+      MRP2C(sigma_BN)`` (attitude message); ``pixel = -r_C,x / r_C,z / X +
+      res_x/2 - 0.5 - b_1``, ``line = -r_C,y / r_C,z / Y + res_y/2 - 0.5 - b_2``,
+      ``radius = tan(asin(REQ_MARS / |r|)) / X - b_3``, with the pixel pitch
+      ``X = 2 tan(FOV res_x / res_y / 2) / res_x`` (``Y`` with FOV along y) and
+      ``REQ_MARS = 3396.19`` km.
+    * The observation vector has 6 entries: the circle (pixel, line, radius)
+      and a pseudo-measurement of the bias, ``round(h(x_hat) - circle)``, with
+      the circle's 3x3 ``uncertainty`` (px^2, a covariance) as noise for both.
+    * After every measurement update the three bias states are rounded to
+      whole pixels (``state[6..8] = round(...)``).
+    * UKF constants recommended by its user guide: alpha = 0.02, beta = 2,
+      kappa = 0.
+
+    Conversion of paper A's data (:func:`circles_from_los`): the measurement
+    ``z_k`` of the pipeline is Mars' position in the *measured* camera frame,
+    km. With the camera attitude the spacecraft believes (the calibrated frame
+    ``A_c^i``, sent as ``sigma_BN`` of the body attitude ``A_b^i`` and
+    ``sigma_CB`` of the installation ``A_c^b``), the module's model maps the
+    true Mars-relative position to the noise-free circle of a perfectly
+    aligned camera; ``z_k`` goes through the same pinhole formulas with the
+    module's Mars radius, so the UKF reads exactly the information the other
+    estimators read. The camera's field of view is set so that ``X`` equals
+    the pipeline's IFOV. The circle noise (px^2) is the pipeline's km-level
+    variance mapped through the same formulas to first order.
+
+    Bias parameterisation: a misalignment ``theta`` (camera frame, paper eq. 5)
+    moves Mars' image by ``-theta_y / X`` px in pixel and ``+theta_x / Y`` px in
+    line (:func:`bias_px_from_theta`); the module's bias is measured minus
+    modelled, so ``theta_x = -b_line Y``... see :func:`theta_from_bias_px` for
+    the exact signs (pinned by a test against the module's own model).
+
+Two-body approximation
+    The module has no Sun. :func:`two_body_check` computes the Sun's tidal
+    acceleration relative to Mars along the truth arc and the position error
+    a pure two-body propagation makes over the arc; the caption and the
+    manuscript quote both numbers.
+
+Units: km, km/s, s, rad inside; px for the circle; arcsec in outputs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.spatial.transform import Rotation
+
+from . import camera
+from . import scenario as sc
+from .dynamics import ARCSEC, MU_MARS, MU_SUN
+
+#: Basilisk's constants for planet id 2 (astroConstants.h): the module's Mars.
+BSK_REQ_MARS_KM = 3396.19
+BSK_MU_MARS = 42828.314
+BSK_PLANET_ID_MARS = 2
+
+
+def have_basilisk() -> bool:
+    """True when ``Basilisk.fswAlgorithms.pixelLineBiasUKF`` can be imported."""
+    try:
+        from Basilisk.fswAlgorithms import pixelLineBiasUKF  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+# ----------------------------------------------------------------- camera
+@dataclass(frozen=True)
+class PeerCamera:
+    """The pipeline's camera in the module's parameters."""
+
+    resolution: int  # px, square detector
+    fov_rad: float  # edge to edge, along y
+    pitch: float  # X = Y = 2 tan(fov/2) / resolution (tangent of one pixel)
+
+    @classmethod
+    def from_config(cls, cam_cfg: dict) -> "PeerCamera":
+        """FOV chosen so that one pixel spans the pipeline's IFOV at the image centre."""
+        res = int(cam_cfg["pixels"])
+        pitch = np.tan(cam_cfg["ifov_arcsec"] * ARCSEC)
+        fov = 2.0 * np.arctan(0.5 * res * pitch)
+        return cls(res, float(fov), float(2.0 * np.tan(fov / 2.0) / res))
+
+    @property
+    def centre(self) -> float:
+        """Pixel coordinate of the optical axis in the module's convention."""
+        return self.resolution / 2 - 0.5
+
+
+def circles_from_los(z_km: np.ndarray, cam: PeerCamera) -> np.ndarray:
+    """Circle (pixel, line, radius) in px (..., 3) of Mars at ``z_km`` (..., 3), camera frame.
+
+    The module's pinhole model (module docstring) applied to the Mars vector
+    ``z = -r_C``: ``pixel = -z_x / z_z / X + c``, ``line = -z_y / z_z / X + c``,
+    ``radius = tan(asin(REQ_MARS / |z|)) / X``.
+    """
+    z = np.asarray(z_km, float)
+    rho = np.linalg.norm(z, axis=-1)
+    px = -z[..., 0] / z[..., 2] / cam.pitch + cam.centre
+    ln = -z[..., 1] / z[..., 2] / cam.pitch + cam.centre
+    rad = np.tan(np.arcsin(BSK_REQ_MARS_KM / rho)) / cam.pitch
+    return np.stack([px, ln, rad], axis=-1)
+
+
+def circle_variance(z_km: np.ndarray, Rvar_km2: np.ndarray, cam: PeerCamera) -> np.ndarray:
+    """Circle noise variances (..., 3), px^2, from the pipeline's km^2 variances (first order).
+
+    Lateral: ``sigma_px = sigma_x / (z_z X)``; radius: ``|d radius / d rho| sigma_rho``
+    with ``d radius / d rho = -R / (X rho^2 cos^3(alpha))``, ``sin(alpha) = R / rho``.
+    """
+    z = np.asarray(z_km, float)
+    rho = np.linalg.norm(z, axis=-1)
+    sa = BSK_REQ_MARS_KM / rho
+    ca = np.sqrt(1.0 - sa**2)
+    drad = BSK_REQ_MARS_KM / (cam.pitch * rho**2 * ca**3)
+    R = np.asarray(Rvar_km2, float)
+    return np.stack([R[..., 0] / (z[..., 2] * cam.pitch) ** 2,
+                     R[..., 1] / (z[..., 2] * cam.pitch) ** 2,
+                     R[..., 2] * drad**2], axis=-1)
+
+
+def bias_px_from_theta(theta_rad: np.ndarray, cam: PeerCamera) -> np.ndarray:
+    """The module's (pixel, line) bias (..., 2) that a small misalignment ``theta`` causes.
+
+    ``z = A_m u ~ u - theta x u`` with ``u`` on the boresight moves Mars by
+    ``(-theta_y rho, +theta_x rho)`` laterally, i.e. the circle by
+    ``(+theta_y / X, -theta_x / X)`` px; the module models ``circle = h - b``.
+    """
+    th = np.asarray(theta_rad, float)
+    return np.stack([-th[..., 1], th[..., 0]], axis=-1) / cam.pitch
+
+
+def theta_from_bias_px(b_px: np.ndarray, cam: PeerCamera) -> np.ndarray:
+    """Inverse of :func:`bias_px_from_theta`: (tx, ty) in rad (..., 2) from (b_pixel, b_line)."""
+    b = np.asarray(b_px, float)
+    return np.stack([b[..., 1], -b[..., 0]], axis=-1) * cam.pitch
+
+
+def mrp_from_dcm(C: np.ndarray) -> np.ndarray:
+    """MRP (..., 3) of the direction cosine matrix ``C`` = [BN] (maps N components to B),
+    shadow set chosen so that |sigma| <= 1 (Basilisk's ``C2MRP`` convention)."""
+    # [BN] is the passive matrix of the rotation that takes N's axes onto B's: R = C^T
+    s = Rotation.from_matrix(np.swapaxes(np.asarray(C, float), -1, -2)).as_mrp()
+    return s
+
+
+# ------------------------------------------------------------ two-body check
+def two_body_check(geo: sc.Geometry) -> dict:
+    """What the module's two-body (Mars only) dynamics neglect along the truth arc.
+
+    ``sun_tidal_kms2``: |a_Sun(r_sc) - a_Sun(r_Mars)| at the start (the
+    indirect term cancels Mars' own heliocentric acceleration), and its maximum
+    over the arc; ``two_body_pos_err_km``: max |r_2body - r_true| (Mars-centred)
+    of a two-body propagation from the true state at t0 over the arc.
+    """
+    r_rel = geo.X_true[:, :3] - geo.X_mars[:, :3]
+
+    def a_sun(r):
+        return -MU_SUN * r / np.linalg.norm(r, axis=-1, keepdims=True) ** 3
+
+    tidal = np.linalg.norm(a_sun(geo.X_true[:, :3]) - a_sun(geo.X_mars[:, :3]), axis=-1)
+
+    def f(t, X):
+        r = X[:3]
+        return np.concatenate([X[3:], -MU_MARS * r / np.linalg.norm(r) ** 3])
+
+    X0 = geo.X_true[0] - geo.X_mars[0]
+    sol = solve_ivp(f, (geo.t[0], geo.t[-1]), X0, method="DOP853", t_eval=geo.t, rtol=1e-13, atol=1e-9)
+    err = np.linalg.norm(sol.y[:3].T - r_rel, axis=-1)
+    return {"sun_tidal_kms2_start": float(tidal[0]), "sun_tidal_kms2_max": float(tidal.max()),
+            "range_km_start": float(np.linalg.norm(r_rel[0])),
+            "arc_s": float(geo.t[-1] - geo.t[0]),
+            "two_body_pos_err_km": float(err.max()),
+            "mu_mars_relative_difference": float(abs(BSK_MU_MARS - MU_MARS) / MU_MARS)}
+
+
+# ------------------------------------------------------------------ the UKF
+@dataclass(frozen=True)
+class UKFSettings:
+    """Tuning of the peer (config ``approach.peers.basilisk``)."""
+
+    alpha: float = 0.02
+    beta: float = 2.0
+    kappa: float = 0.0
+    bias_prior_sigma_px: float = 10.0  # pixel and line
+    radius_bias_prior_sigma_px: float = 10.0
+    bias_process_sigma_px: float = 1e-6  # per time update; > 0 (the module's Cholesky of qNoise)
+
+    @classmethod
+    def from_config(cls, c: dict, cam: PeerCamera) -> "UKFSettings":
+        return cls(alpha=c["alpha"], beta=c["beta"], kappa=c["kappa"],
+                   bias_prior_sigma_px=c["bias_prior_sigma_arcsec"] * ARCSEC / cam.pitch,
+                   radius_bias_prior_sigma_px=c["radius_bias_prior_sigma_px"],
+                   bias_process_sigma_px=c["bias_process_sigma_px"])
+
+
+@dataclass
+class UKFRun:
+    """Output of the module per sample (index 0 = the prior at t0)."""
+
+    state: np.ndarray  # (n+1, 9) km, km/s, px (converted from the module's m)
+    covar: np.ndarray  # (n+1, 9, 9) km^2..., px^2
+    postfit: np.ndarray  # (n+1, 6) px
+
+
+def run_ukf(circles: np.ndarray, circle_var: np.ndarray, t_s: np.ndarray, sigma_BN: np.ndarray,
+            sigma_CB: np.ndarray, cam: PeerCamera, x0_km: np.ndarray, P0_km: np.ndarray,
+            Q_km: np.ndarray, settings: UKFSettings, steps: int | None = None) -> UKFRun:
+    """Run Basilisk's pixelLineBiasUKF over the samples 1..n (sample 0 is the prior).
+
+    circles (n+1, 3) px; circle_var (n+1, 3) px^2; t_s (n+1,) s from t0 = 0;
+    sigma_BN (n+1, 3) body attitude MRPs; sigma_CB (3,) camera-on-body MRP;
+    x0_km (6,) Mars-centred prior mean (km, km/s); P0_km (6, 6); Q_km (6, 6)
+    per step. The bias starts at 0 with the settings' prior.
+    """
+    from Basilisk.architecture import messaging
+    from Basilisk.fswAlgorithms import pixelLineBiasUKF
+    from Basilisk.utilities import SimulationBaseClass
+
+    n = len(t_s) - 1 if steps is None else min(steps, len(t_s) - 1)
+    # the module runs inside a Basilisk simulation (which wires its logger; a bare
+    # UpdateState() call crashes); one task step per measurement time
+    sim = SimulationBaseClass.SimBaseClass()
+    dt_ns = int(round((t_s[1] - t_s[0]) * 1e9))
+    sim.CreateNewProcess("opnav").addTask(sim.CreateNewTask("peer", dt_ns))
+    m = pixelLineBiasUKF.pixelLineBiasUKF()
+    sim.AddModelToTask("peer", m)
+    m.ModelTag = "opnavPeerUKF"
+    m.planetIdInit = BSK_PLANET_ID_MARS
+    m.alpha, m.beta, m.kappa = settings.alpha, settings.beta, settings.kappa
+    m.stateInit = (np.asarray(x0_km, float) * 1e3).tolist() + [0.0, 0.0, 0.0]
+    P = np.zeros((9, 9))
+    P[:6, :6] = np.asarray(P0_km, float) * 1e6
+    P[6:, 6:] = np.diag([settings.bias_prior_sigma_px**2] * 2 + [settings.radius_bias_prior_sigma_px**2])
+    m.covarInit = P.ravel().tolist()
+    Q = np.zeros((9, 9))
+    Q[:6, :6] = Q_km
+    Q[6:, 6:] = settings.bias_process_sigma_px**2 * np.eye(3)
+    m.qNoise = Q.ravel().tolist()
+
+    camp = messaging.CameraConfigMsgPayload()
+    camp.fieldOfView = cam.fov_rad
+    camp.resolution = [cam.resolution, cam.resolution]
+    camp.sigma_CB = list(map(float, sigma_CB))
+    cam_msg = messaging.CameraConfigMsg().write(camp)
+    att_msg = messaging.NavAttMsg()
+    circ_msg = messaging.OpNavCirclesMsg()
+    m.cameraConfigInMsg.subscribeTo(cam_msg)
+    m.attInMsg.subscribeTo(att_msg)
+    m.circlesInMsg.subscribeTo(circ_msg)
+    out = m.filtDataOutMsg
+
+    state = np.full((n + 1, 9), np.nan)
+    covar = np.full((n + 1, 9, 9), np.nan)
+    post = np.full((n + 1, 6), np.nan)
+    state[0] = np.r_[x0_km, 0.0, 0.0, 0.0]
+    covar[0] = P
+    covar[0, :6, :6] = P0_km
+    sim.InitializeSimulation()  # Reset at t = 0; no measurement yet
+    scale = np.ones(9)
+    scale[:6] = 1e-3  # m -> km (the module's output message)
+    cscale = np.ones((9, 9))
+    cscale[:6, :] = 1e-6  # rows 0..5 are scaled by the module (and the first 6 of row 6)
+    cscale[6, :6] = 1e-6
+    for k in range(1, n + 1):
+        tns = int(round(t_s[k] * 1e9))
+        att = messaging.NavAttMsgPayload()
+        att.sigma_BN = list(map(float, sigma_BN[k]))
+        att_msg.write(att, tns)
+        c = messaging.OpNavCirclesMsgPayload()
+        c.valid = 1
+        c.timeTag = tns
+        c.planetIds = [BSK_PLANET_ID_MARS]
+        c.circlesCenters = [float(circles[k, 0]), float(circles[k, 1])]
+        c.circlesRadii = [float(circles[k, 2])]
+        c.uncertainty = np.diag(circle_var[k]).ravel().tolist()
+        circ_msg.write(c, tns)
+        sim.ConfigureStopTime(tns)
+        sim.ExecuteSimulation()
+        o = out.read()
+        state[k] = np.asarray(o.state, float) * scale
+        covar[k] = np.asarray(o.covar, float).reshape(9, 9) * cscale
+        post[k] = np.asarray(o.postFitRes, float)
+    return UKFRun(state, covar, post)
+
+
+# --------------------------------------------------------- A-P1 on paper A's data
+def peer_settings(cfg: dict) -> tuple[PeerCamera, UKFSettings]:
+    """The module's camera and tuning from the approach config section."""
+    cam = PeerCamera.from_config(cfg["camera"])
+    return cam, UKFSettings.from_config(cfg["peers"]["basilisk"], cam)
+
+
+def ukf_inputs(geo: sc.Geometry, install_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """Attitude inputs: body ``sigma_BN`` per sample (n+1, 3) and camera ``sigma_CB`` (3,).
+
+    The spacecraft knows the calibrated camera frame ``A_c^i`` (with the roll of the
+    variant) and the installation ``A_c^b = rot_x(install)``; the body attitude is
+    ``A_b^i = A_c^b^T A_c^i``, so the module's ``[CB][BN]`` is ``A_c^i`` again.
+    """
+    A_b_i = camera.body_attitude(geo.C, install_deg)
+    return mrp_from_dcm(A_b_i), mrp_from_dcm(camera.rot_x(np.deg2rad(install_deg)))
+
+
+def run_peer(cfg: dict, variant: str, case, seed_indices, truth_arcsec=None,
+             geo: sc.Geometry | None = None, steps: int | None = None, stride: int = 10,
+             start: str = "prior") -> dict:
+    """The peer UKF on the measurements of ``case`` (same streams as the EM-EKF) per seed.
+
+    ``truth_arcsec`` overrides the case's truth (the bias-free sanity case uses
+    zeros with the same noise). ``start="truth"`` puts the prior mean on the true
+    state (prior covariance unchanged): a diagnostic, like the EM-EKF's
+    reference-start, of what the module does when the position is known. Returns per seed the final (tx, ty) estimate and
+    its 3-sigma in arcsec, the radius bias (px), the final and RMS position error
+    (km) and, every ``stride`` samples, the estimate history for the figure.
+    """
+    geo = geo or sc.build_geometry(cfg, variant)
+    cam, settings = peer_settings(cfg)
+    truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    seeds = list(seed_indices)
+    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seeds)
+    z, e0 = sc.simulate(geo, Rvar, sc.rad(truth), rngs)
+    dx0 = sc.prior_mean_deviation(geo, e0, cfg["initial_error"]["mode"])
+    sBN, sCB = ukf_inputs(geo, case.install_deg)
+    r_true = geo.X_true[:, :3] - geo.X_mars[:, :3]
+    est, sig3, rad_b, pos_fin, pos_rms, hist, hist_sig = [], [], [], [], [], [], []
+    for s in range(z.shape[0]):
+        x0 = (geo.X_true[0] if start == "truth" else geo.X_ref[0] + dx0[s]) - geo.X_mars[0]
+        run = run_ukf(circles_from_los(z[s], cam), circle_variance(z[s], Rvar, cam), geo.t, sBN, sCB,
+                      cam, x0, geo.P0, geo.Q, settings, steps=steps)
+        n = run.state.shape[0] - 1
+        th = sc.arcsec(theta_from_bias_px(run.state[:, 6:8], cam))  # (n+1, 2)
+        sd_px = np.sqrt(np.diagonal(run.covar[:, 6:8, 6:8], axis1=1, axis2=2))
+        sd = sc.arcsec(sd_px[:, ::-1] * cam.pitch)  # tx from the line bias, ty from the pixel bias
+        est.append(th[-1])
+        sig3.append(3.0 * sd[-1])
+        rad_b.append(run.state[-1, 8])
+        e = np.linalg.norm(run.state[:, :3] - r_true[:n + 1], axis=-1)
+        pos_fin.append(e[-1])
+        pos_rms.append(np.sqrt(np.mean(e[1:] ** 2)))
+        hist.append(th[1::stride])  # from the first measurement (index 0: the prior)
+        hist_sig.append(3.0 * sd[1::stride])
+    n = len(geo.t) - 1 if steps is None else min(steps, len(geo.t) - 1)
+    return {"variant": variant, "case_id": case.case_id, "seed_indices": np.asarray(seeds), "start": start,
+            "truth_arcsec": truth, "theta_final_arcsec": np.stack(est), "sigma3_final_arcsec": np.stack(sig3),
+            "radius_bias_px": np.asarray(rad_b), "pos_err_final_km": np.asarray(pos_fin),
+            "pos_err_rms_km": np.asarray(pos_rms), "t_hist_s": geo.t[1:n + 1:stride],
+            "theta_hist_arcsec": np.stack(hist), "sigma3_hist_arcsec": np.stack(hist_sig),
+            "truth_bias_px": bias_px_from_theta(sc.rad(truth[:2].tolist() + [0.0]), cam)}
+
+
+def peer_bound(cfg: dict, geo: sc.Geometry, case, truth_arcsec=None) -> np.ndarray:
+    """1-sigma CRLB (tx, ty, tz) in arcsec on the peer's information: every sample from t0
+    with the prior ``P_X0`` and the peer's bias prior (the EM-EKF's ``literal`` set)."""
+    from .crlb import crlb_curve
+
+    cam, settings = peer_settings(cfg)
+    truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    sig = settings.bias_prior_sigma_px * cam.pitch
+    return sc.arcsec(crlb_curve(geo.window(Rvar), geo.u_true, geo.P0, sc.rad(truth), sig)[-1])
+
+
+#: The A-P1 runs per variant: (name, truth override, prior-mean rule).
+RUNS = (("headline", None, "prior"), ("bias_free", np.zeros(3), "prior"), ("truth_start", None, "truth"))
+RUN_LABELS = {"headline": "headline case", "bias_free": "zero misalignment (sanity)",
+              "truth_start": "prior mean at the truth (diagnostic)"}
+
+
+def run_variant(cfg: dict, variant: str, log=None) -> dict:
+    """A-P1 simulation job: the headline case and the bias-free sanity case of ``variant``."""
+    from .cases import headline_case
+
+    geo = sc.build_geometry(cfg, variant)
+    case = headline_case(cfg)
+    seeds = range(cfg["n_seeds"])
+    out = {"variant": variant, "two_body": two_body_check(geo), "runs": {}}
+    for name, truth, start in RUNS:
+        r = run_peer(cfg, variant, case, seeds, truth_arcsec=truth, geo=geo, start=start)
+        r["crlb_peer_arcsec"] = peer_bound(cfg, geo, case, truth)
+        out["runs"][name] = r
+        if log:
+            log.info("A-P1 %s %s: UKF (tx, ty) %s +- %s arcsec (3 sigma, seed mean); truth %s",
+                     variant, name, np.round(r["theta_final_arcsec"].mean(0), 3),
+                     np.round(r["sigma3_final_arcsec"].mean(0), 4), r["truth_arcsec"][:2])
+    return out
+
+
+# ------------------------------------------------------------ A-P1 table
+def _row(variant, method, run, truth, th, own3=None, crlb3=None, n_seeds=None) -> dict:
+    """One table row: seed mean and sd of (tx, ty), own 3-sigma, CRLB 3-sigma, coverage."""
+    th = np.asarray(th, float)[:, :2]
+    err = th - np.asarray(truth, float)[:2]
+    sd = th.std(0, ddof=1) if len(th) > 1 else np.full(2, np.nan)
+    row = {"variant": variant, "estimator": method, "run": run,
+           "truth_x_arcsec": float(truth[0]), "truth_y_arcsec": float(truth[1]), "n_seeds": len(th),
+           "est_x_mean_arcsec": float(th[:, 0].mean()), "est_x_sd_arcsec": float(sd[0]),
+           "est_y_mean_arcsec": float(th[:, 1].mean()), "est_y_sd_arcsec": float(sd[1]),
+           "rmse_xy_arcsec": float(np.sqrt(np.mean(err**2)))}
+    if own3 is not None:
+        own3 = np.asarray(own3, float)[:, :2]
+        row.update(own_3sigma_x_arcsec=float(np.median(own3[:, 0])), own_3sigma_y_arcsec=float(np.median(own3[:, 1])),
+                   within_own_3sigma=float(np.mean(np.all(np.abs(err) <= own3, axis=1))))
+    else:
+        row.update(own_3sigma_x_arcsec=np.nan, own_3sigma_y_arcsec=np.nan, within_own_3sigma=np.nan)
+    c = np.full(2, np.nan) if crlb3 is None else np.asarray(crlb3, float)[:2]
+    row.update(crlb_3sigma_x_arcsec=float(c[0]), crlb_3sigma_y_arcsec=float(c[1]),
+               within_crlb_3sigma=float(np.mean(np.all(np.abs(err) <= c, axis=1))) if crlb3 is not None else np.nan)
+    return row
+
+
+def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id: str = "T1-01"):
+    """A-P1 table: per variant, the EM-EKF (each scheme), augmented EKF, batch ML and the
+    peer UKF (headline, zero-misalignment sanity, truth-start diagnostic), arcsec.
+
+    ``peer``: :func:`run_variant` outputs; ``em``: EM-EKF Monte-Carlo dicts
+    (:func:`opnav.approach.pipeline.run_group`); ``alt``: A-X2 dicts
+    (:func:`opnav.approach.alternatives.run_case_alternatives`). The CRLB of the
+    paper's estimators is their variant's bound on the segment data
+    (``crlb_total_arcsec``); the peer's is :func:`peer_bound` on all data from t0.
+    """
+    import pandas as pd
+
+    from .alternatives import METHOD_LABELS
+
+    rows = []
+    for p in peer:
+        v = p["variant"]
+        ems = [r for r in em if r["variant"] == v and r["case_id"] == case_id]
+        bound = 3.0 * np.asarray(ems[0]["crlb_total_arcsec"], float) if ems else None
+        for r in ems:
+            rows.append(_row(v, METHOD_LABELS.get(f"em_{r['method']}", r["method"]), "headline case",
+                             r["truth_arcsec"], r["theta_final_arcsec"], None, bound))
+        for a in (a for a in alt if a["variant"] == v and a["case_id"] == case_id):
+            for m, d in a["methods"].items():
+                own = 3.0 * d["sigma_final_arcsec"] if "sigma_final_arcsec" in d else None
+                rows.append(_row(v, METHOD_LABELS[m], "headline case", a["truth_arcsec"],
+                                 d["theta_final_arcsec"], own, bound))
+        for name, r in p["runs"].items():
+            rows.append(_row(v, "Basilisk pixelLineBiasUKF", RUN_LABELS[name], r["truth_arcsec"],
+                             r["theta_final_arcsec"], r["sigma3_final_arcsec"], 3.0 * r["crlb_peer_arcsec"]))
+    return pd.DataFrame(rows)
+
+
+def summary(table, peer: list[dict]) -> dict:
+    """Numbers for the manuscript macros (A-P1-summary.json)."""
+    keys = {"EM-EKF (plain)": "em_plain", "EM-EKF (SQUAREM)": "em_squarem", "augmented EKF": "augmented",
+            "batch ML (IPOPT)": "batch_ml"}
+    run_keys = {lab: k for k, lab in RUN_LABELS.items()}
+    out = {"ran": True, "variants": {}}
+    for _, r in table.iterrows():
+        k = keys.get(r["estimator"]) or "ukf_" + run_keys[r["run"]]
+        out["variants"].setdefault(r["variant"], {})[k] = {
+            c: r[c] for c in ("est_x_mean_arcsec", "est_x_sd_arcsec", "est_y_mean_arcsec", "est_y_sd_arcsec",
+                              "own_3sigma_x_arcsec", "own_3sigma_y_arcsec", "within_own_3sigma",
+                              "crlb_3sigma_x_arcsec", "crlb_3sigma_y_arcsec", "rmse_xy_arcsec")}
+    for p in peer:
+        v = out["variants"].setdefault(p["variant"], {})
+        h = p["runs"]["headline"]
+        v["ukf_pos_err_final_km"] = float(np.mean(h["pos_err_final_km"]))
+        v["ukf_truth_bias_pixel_px"], v["ukf_truth_bias_line_px"] = map(float, h["truth_bias_px"])
+        b = p["runs"]["bias_free"]
+        v["ukf_bias_free_within_own_3sigma_all"] = bool(np.all(
+            np.abs(b["theta_final_arcsec"]) <= b["sigma3_final_arcsec"]))
+    tb = peer[0]["two_body"]
+    out["two_body"] = tb
+    out["n_seeds"] = int(table["n_seeds"].max())
+    return out
+
+
+def seed_frame(peer: list[dict]):
+    """Per seed and run: the peer's final (tx, ty), its 3-sigma and the position error (long CSV)."""
+    import pandas as pd
+
+    rows = []
+    for p in peer:
+        for name, r in p["runs"].items():
+            for i, s in enumerate(r["seed_indices"]):
+                rows.append({"variant": p["variant"], "run": name, "seed": int(s),
+                             "truth_x_arcsec": r["truth_arcsec"][0], "truth_y_arcsec": r["truth_arcsec"][1],
+                             "est_x_arcsec": r["theta_final_arcsec"][i, 0], "est_y_arcsec": r["theta_final_arcsec"][i, 1],
+                             "sigma3_x_arcsec": r["sigma3_final_arcsec"][i, 0],
+                             "sigma3_y_arcsec": r["sigma3_final_arcsec"][i, 1],
+                             "radius_bias_px": r["radius_bias_px"][i],
+                             "pos_err_final_km": r["pos_err_final_km"][i], "pos_err_rms_km": r["pos_err_rms_km"][i]})
+    return pd.DataFrame(rows)

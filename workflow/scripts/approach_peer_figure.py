@@ -1,0 +1,27 @@
+"""A-P1 figure: the peer UKF's (tx, ty) over the arc with its own 3 sigma, against the others' end values."""
+
+import pickle
+
+import pandas as pd
+
+from opnav import figures
+from opnav.approach import peer_plots
+from opnav.snakeio import mock_snakemake, script_context
+
+if "snakemake" not in globals():  # standalone debugging run
+    snakemake = mock_snakemake(input={"peer": ["results/approach/work/peers/literal.pkl",
+                                               "results/approach/work/peers/roll.pkl"],
+                                      "table": "results/approach/A-P1_peer_ukf.csv"},
+                               output={"fig": ["results/approach/A-P1_peer_ukf.pdf",
+                                               "results/approach/A-P1_peer_ukf.png"]})
+
+with script_context(snakemake) as log:
+    peer = []
+    for p in snakemake.input.peer:
+        with open(p, "rb") as fh:
+            peer.append(pickle.load(fh))
+    table = pd.read_csv(snakemake.input.table)
+    with figures.style():
+        fig = peer_plots.peer_figure(peer, table)
+        figures.save(fig, snakemake.output.fig)
+    log.info("A-P1 figure: %d variants", len(peer))

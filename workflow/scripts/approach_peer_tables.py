@@ -1,0 +1,31 @@
+"""A-P1 table and summary: the peer UKF beside the EM-EKF, augmented EKF, batch ML and the CRLB."""
+
+import pickle
+
+from opnav.approach import peers
+from opnav.snakeio import script_context
+from opnav.tables import write_json, write_table
+
+if "snakemake" not in globals():  # standalone debugging run
+    raise SystemExit("run through snakemake (needs the A-P1, A-X2 and EM-EKF pickles)")
+
+
+def load(paths):
+    out = []
+    for p in paths:
+        with open(p, "rb") as fh:
+            d = pickle.load(fh)
+        out.extend(d if isinstance(d, list) else d.get("results", [d]))
+    return out
+
+
+with script_context(snakemake) as log:
+    peer = load(snakemake.input.peer)
+    table = peers.comparison_frame(peer, load(snakemake.input.mc), load(snakemake.input.x2))
+    write_table(table, snakemake.output.table,
+                caption="A-P1: Basilisk's pixelLineBiasUKF on paper A's measurements beside the EM-EKF, "
+                        "the augmented EKF, batch ML and the Cramer-Rao bound (headline case; arcsec; "
+                        "mean and sd over seeds, own 3-sigma: median of the estimator's covariance).")
+    peers.seed_frame(peer).to_csv(snakemake.output.long, index=False)
+    write_json(snakemake.output.summary, peers.summary(table, peer))
+    log.info("A-P1: %d rows", len(table))
