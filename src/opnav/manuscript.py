@@ -379,3 +379,23 @@ def compact_b_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
 
 
 COMPACT_VIEWS.update({"A-X2": compact_a_x2, "A-X3": compact_a_x3, "B-X1": compact_b_x1, "B-X2": compact_b_x2})
+
+
+def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+    """A-P1 for the page: the peer UKF beside the paper's estimators, estimate, own 3-sigma, bound."""
+    import pandas as pd
+
+    rows = []
+    for _, r in df.iterrows():
+        rows.append({
+            "variant": r["variant"], "estimator": r["estimator"], "run": r["run"],
+            'tx (")': _pm(r.get("est_x_mean_arcsec"), r.get("est_x_sd_arcsec")),
+            'ty (")': _pm(r.get("est_y_mean_arcsec"), r.get("est_y_sd_arcsec")),
+            'own 3σ x (")': _num(r.get("own_3sigma_x_arcsec"), "{:.3g}"),
+            "truth in own 3σ": str(r.get("within_own_3sigma_text", "--")),
+            'CRLB 3σ x (")': _num(r.get("crlb_3sigma_x_arcsec"), "{:.3g}"),
+        })
+    return [("", pd.DataFrame(rows))]
+
+
+COMPACT_VIEWS["A-P1"] = compact_a_p1
