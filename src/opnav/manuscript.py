@@ -391,9 +391,9 @@ def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
             "variant": r["variant"], "estimator": r["estimator"], "run": r["run"],
             'tx (")': _pm(r.get("est_x_mean_arcsec"), r.get("est_x_sd_arcsec")),
             'ty (")': _pm(r.get("est_y_mean_arcsec"), r.get("est_y_sd_arcsec")),
-            'own 3σ x (")': _num(r.get("own_3sigma_x_arcsec"), "{:.3g}"),
-            "truth in own 3σ": str(r.get("within_own_3sigma_text", "--")),
-            'CRLB 3σ x (")': _num(r.get("crlb_3sigma_x_arcsec"), "{:.3g}"),
+            'own 3-sigma x (")': _num(r.get("own_3sigma_x_arcsec"), "{:.3g}"),
+            "truth in own 3-sigma": str(r.get("within_own_3sigma_text", "--")),
+            '3 CRLB x (")': _num(r.get("crlb_3sigma_x_arcsec"), "{:.3g}"),
         })
     return [("", pd.DataFrame(rows))]
 
