@@ -232,3 +232,30 @@ def test_basilisk_bias_free_sanity_roll(start):
         assert not inside.any()
         # the spurious bias is the prior position error seen from the range, in whole pixels
         assert np.all(np.abs(r["theta_final_arcsec"]) <= 3 * 100 / 1e6 / sc.rad(1.0))
+
+
+# ------------------------------------------------------------ workflow
+def test_peer_variants_outside_table1_variants_are_refused():
+    from opnav.checks import approach_problems
+
+    cfg = approach_cfg()
+    cfg["peers"]["variants"] = ["prior", "roll"]
+    probs = approach_problems(cfg)
+    assert any("approach.peers.variants'" in p and "prior" in p for p in probs), probs
+
+
+def test_without_basilisk_the_workflow_skips_a_p1_with_one_line(workdir):
+    """Basilisk hidden (None in sys.modules, as `import` treats it): the dry run still plans
+    everything else, no A-P1 job, and says so in one line."""
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.modules['Basilisk'] = None; from snakemake.cli import main; "
+            "sys.argv = ['snakemake', '-n', '--cores', '1', '--configfile', 'config/quick.yaml']; main()")
+    env = dict(__import__("os").environ, PYTHONPATH=str(workdir / "src"))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=workdir, capture_output=True, text=True, env=env)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, out[-3000:]
+    lines = [ln for ln in out.splitlines() if "skipping A-P1" in ln]
+    assert len(lines) == 1 and "pip install" in lines[0], lines
+    assert "approach_peer_ukf" not in proc.stdout and "approach_tables" in proc.stdout

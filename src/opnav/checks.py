@@ -12,7 +12,8 @@ one line per problem naming the keys:
   direction is ``v_inf_dir x z``); the arc starting outside Mars and not
   hitting it; Mars (at its closest along the arc, two-body Mars-centred
   hyperbola) fitting the detector; the truth misalignment keeping Mars on the
-  detector; ``table1_variants`` inside ``variants``; memory bounds (data
+  detector; ``table1_variants`` inside ``variants`` and ``peers.variants``
+  inside ``table1_variants``; memory bounds (data
   length, seeds x samples);
 * paper B: ``duration_s`` a multiple of ``filter.dt_s``, ``imu.rate_hz x
   filter.dt_s`` an integer; the lander above ground (and above the
@@ -184,6 +185,14 @@ def approach_problems(a: dict) -> list[str]:
     if extra:
         out.append(f"{k}table1_variants': {', '.join(extra)} not in approach.variants "
                    f"({', '.join(a['variants'])})")
+    peers = a.get("peers", {}).get("variants", [])
+    extra = [v for v in peers if v not in a["table1_variants"]]
+    if extra:  # A-P1 sets the peer beside the A-X2 results of those variants
+        out.append(f"{k}peers.variants': {', '.join(extra)} not in approach.table1_variants "
+                   f"({', '.join(a['table1_variants'])})")
+    dup = _duplicates(peers)
+    if dup:
+        out.append(f"{k}peers.variants': duplicated {', '.join(map(str, dup))}")
     g = a["geometry"]
     d = np.asarray(g["v_inf_dir"], float)
     dn = float(np.linalg.norm(d))

@@ -4,12 +4,9 @@
 # defined and one line says so; everything else still runs.
 import importlib.util
 
-A_P1_VARIANTS = config["approach"]["peers"]["variants"]
-_bad = [v for v in A_P1_VARIANTS if v not in config["approach"]["table1_variants"]]
-if _bad:
-    raise ConfigError(f"invalid config key 'approach.peers.variants': {_bad} not in approach.table1_variants "
-                      "(A-P1 sets the peer beside the A-X2 results of those variants)")
-HAVE_BSK = importlib.util.find_spec("Basilisk") is not None
+A_P1_VARIANTS = config["approach"]["peers"]["variants"]  # inside table1_variants (opnav.checks)
+# found without importing it (parse time); a None in sys.modules marks it absent, as for import
+HAVE_BSK = sys.modules.get("Basilisk", True) is not None and importlib.util.find_spec("Basilisk") is not None
 
 
 if HAVE_BSK:

@@ -78,13 +78,6 @@ BSK_MU_MARS = 42828.314
 BSK_PLANET_ID_MARS = 2
 
 
-def have_basilisk() -> bool:
-    """True when ``Basilisk.fswAlgorithms.pixelLineBiasUKF`` can be imported."""
-    try:
-        from Basilisk.fswAlgorithms import pixelLineBiasUKF  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 # ----------------------------------------------------------------- camera
