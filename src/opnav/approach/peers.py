@@ -46,16 +46,17 @@ Description
     variance mapped through the same formulas to first order.
 
     Bias parameterisation: a misalignment ``theta`` (camera frame, paper eq. 5)
-    moves Mars' image by ``-theta_y / X`` px in pixel and ``+theta_x / Y`` px in
-    line (:func:`bias_px_from_theta`); the module's bias is measured minus
-    modelled, so ``theta_x = -b_line Y``... see :func:`theta_from_bias_px` for
-    the exact signs (pinned by a test against the module's own model).
+    moves Mars' image by ``+theta_y / X`` px in pixel and ``-theta_x / X`` px in
+    line; the module models ``circle = h - b``, so ``b = (-theta_y, +theta_x) / X``
+    (:func:`bias_px_from_theta`) and ``theta_x = b_line X``, ``theta_y = -b_pixel X``
+    (:func:`theta_from_bias_px`); both pinned by tests, one against the module's
+    own measurement model.
 
 Two-body approximation
     The module has no Sun. :func:`two_body_check` computes the Sun's tidal
     acceleration relative to Mars along the truth arc and the position error
-    a pure two-body propagation makes over the arc; the caption and the
-    manuscript quote both numbers.
+    a pure two-body propagation makes over the arc (A-P1-summary.json,
+    ``two_body``); the manuscript quotes both numbers.
 
 Units: km, km/s, s, rad inside; px for the circle; arcsec in outputs.
 """
