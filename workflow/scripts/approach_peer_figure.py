@@ -1,12 +1,10 @@
 """A-P1 figure: the peer UKF's (tx, ty) over the arc with its own 3 sigma, against the others' end values."""
 
-import pickle
-
 import pandas as pd
 
 from opnav import figures
 from opnav.approach import peer_plots
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import load_pickle, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(input={"peer": ["results/approach/work/peers/literal.pkl",
@@ -16,10 +14,7 @@ if "snakemake" not in globals():  # standalone debugging run
                                                "results/approach/A-P1_peer_ukf.png"]})
 
 with script_context(snakemake) as log:
-    peer = []
-    for p in snakemake.input.peer:
-        with open(p, "rb") as fh:
-            peer.append(pickle.load(fh))
+    peer = [load_pickle(p) for p in snakemake.input.peer]
     table = pd.read_csv(snakemake.input.table)
     with figures.style():
         fig = peer_plots.peer_figure(peer, table)

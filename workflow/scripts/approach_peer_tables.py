@@ -1,9 +1,7 @@
 """A-P1 table and summary: the peer UKF beside the EM-EKF, augmented EKF, batch ML and the CRLB."""
 
-import pickle
-
 from opnav.approach import peers
-from opnav.snakeio import script_context
+from opnav.snakeio import load_pickle, script_context
 from opnav.tables import write_json, write_table
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -13,8 +11,7 @@ if "snakemake" not in globals():  # standalone debugging run
 def load(paths):
     out = []
     for p in paths:
-        with open(p, "rb") as fh:
-            d = pickle.load(fh)
+        d = load_pickle(p)
         out.extend(d if isinstance(d, list) else d.get("results", [d]))
     return out
 

@@ -1,10 +1,9 @@
 """A-P1: Basilisk's pixelLineBiasUKF on one variant's headline-case measurements (one Snakemake job)."""
 
-import pickle
 from pathlib import Path
 
 from opnav.approach.peers import run_variant
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
     snakemake = mock_snakemake(output=["results/approach/work/peers/roll.pkl"], wildcards={"variant": "roll"})
@@ -13,5 +12,4 @@ if "snakemake" not in globals():  # standalone debugging run
 with script_context(snakemake) as log:
     res = run_variant(snakemake.params.approach, snakemake.wildcards.variant, log=log)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
-    with open(snakemake.output[0], "wb") as fh:
-        pickle.dump(res, fh)
+    save_pickle(snakemake.output[0], res)
