@@ -2,6 +2,10 @@
 #   snakemake --cores 2                               full reproduction
 #   snakemake --cores 2 --configfile config/quick.yaml   tiny profile
 # No science here: rules live in workflow/rules/, science in src/opnav/.
+# `snakemake --lint` reports one item, on purpose: "Specify a conda environment
+# or container for each rule". There is no conda here (`--sdm conda` does not
+# work on the target machines); every rule runs in the one Python environment
+# pinned by requirements.lock, whose versions rule `provenance` records.
 from snakemake.utils import min_version
 
 min_version("9.0")

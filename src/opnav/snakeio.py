@@ -136,3 +136,75 @@ def copy_workflow(repo: Path, dst: Path) -> Path:
         elif p.exists():
             shutil.copy2(p, Path(dst) / name)
     return Path(dst)
+
+
+def _literal(text: str):
+    import ast
+
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
+        return text
+
+
+def _short(value, width: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _leaf_diff(old, new, path: str = "") -> list[str]:
+    if isinstance(old, dict) and isinstance(new, dict):
+        out = []
+        for k in sorted(set(old) | set(new), key=str):
+            p = f"{path}.{k}" if path else str(k)
+            if k not in old:
+                out.append(f"{p}: (new) {_short(new[k])}")
+            elif k not in new:
+                out.append(f"{p}: {_short(old[k])} (removed)")
+            else:
+                out += _leaf_diff(old[k], new[k], p)
+        return out
+    return [] if old == new else [f"{path or 'value'}: {_short(old)} -> {_short(new)}"]
+
+
+def params_change_text(only_old, only_new, limit: int = 8) -> str:
+    """What changed between a job's recorded and current ``params:``, key by key.
+
+    Snakemake records each param value as its ``repr``; its own reason text
+    prints every changed value whole, before and after (a config section,
+    tens of kB per job). Here each new value is paired with the recorded one
+    sharing most keys, and only the differing leaves are listed
+    (``mc.runs_per_job: 2 -> 1``), at most ``limit`` of them.
+    """
+    old = [_literal(s) for s in sorted(only_old, key=str)]
+    new = [_literal(s) for s in sorted(only_new, key=str)]
+    lines = []
+    for n in new:
+        def overlap(o):
+            return len(set(o) & set(n)) if isinstance(o, dict) and isinstance(n, dict) else -1
+        if old:
+            o = max(old, key=overlap)
+            old.remove(o)
+            lines += _leaf_diff(o, n)
+        else:
+            lines.append(f"new param {_short(n)}")
+    lines += [f"param removed: {_short(o)}" for o in old]
+    more = f" (and {len(lines) - limit} more)" if len(lines) > limit else ""
+    return "; ".join(lines[:limit]) + more
+
+
+def compact_params_change_reasons() -> None:
+    """Make Snakemake's "Params have changed" job reasons name the changed keys
+    (:func:`params_change_text`) instead of dumping the values whole. Called by
+    ``workflow/rules/common.smk``; a no-op if Snakemake's internals move."""
+    try:
+        from snakemake.persistence import ParamsChange
+    except ImportError:  # pragma: no cover
+        return
+
+    def __str__(self):
+        if not self:
+            return "No params change"
+        return params_change_text(self.only_old, self.only_new)
+
+    ParamsChange.__str__ = __str__

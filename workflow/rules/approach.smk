@@ -19,19 +19,8 @@ A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/ekf.py", "ap
             "approach/pipeline.py")
 
 
-def a_groups(variant):
-    if variant not in config["approach"]["table1_variants"]:
-        return ["headline"]
-    return A_GROUPS if config["approach"]["scatter"] == "group" else ["all"]
-
-
 A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
         for v in A_VARIANTS for g in a_groups(v) for m in A_METHODS}
-
-
-def a_headline_mc(wildcards):
-    g = a_groups(wildcards.variant)[0]  # the group holding T1-01
-    return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS]
 
 
 wildcard_constraints:

@@ -7,14 +7,6 @@ A_X2_SRC = A_SRC + src("approach/augmented.py", "approach/batch_ml.py", "approac
 A_X2_VARIANTS = config["approach"]["table1_variants"]
 
 
-def a_ablation_cfg(values_key):
-    """The keys an A-X3 sweep reads: scenario, EM, augmented EKF and its own values only."""
-    c = cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives")
-    abl = config["approach"]["ablation"]
-    c["ablation"] = canonical({k: abl[k] for k in ("variants", "n_seeds", values_key)})
-    return c
-
-
 A_X2 = {(v, g): f"{A_WORK}/x2/{v}__{g}.pkl" for v in A_X2_VARIANTS for g in a_groups(v)}
 
 

@@ -4,6 +4,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(workflow.basedir) / "src"))
 from opnav.config import ConfigError, validate_config  # noqa: E402
+from opnav.snakeio import compact_params_change_reasons  # noqa: E402
+
+# "Params have changed" reasons name the changed keys, not whole config sections.
+compact_params_change_reasons()
 
 # The schema (defaults filled in place, finite numbers, strict integers) and the
 # cross-key physics checks of opnav.checks, before any job: the same function
@@ -77,3 +81,43 @@ def report_figure(stem, caption_id, category, subcategory=None):
     pdf, png = figure_outputs(stem)
     kw = {"subcategory": subcategory} if subcategory else {}
     return [pdf, report(png, caption=_caption(caption_id), category=category, **kw)]
+
+
+# Helpers of the rule files, kept here so no .smk file mixes rules and functions
+# (snakemake --lint). They read globals those files define, at call time.
+
+
+# approach.smk
+def a_groups(variant):
+    if variant not in config["approach"]["table1_variants"]:
+        return ["headline"]
+    return A_GROUPS if config["approach"]["scatter"] == "group" else ["all"]
+
+
+# approach.smk
+def a_headline_mc(wildcards):
+    g = a_groups(wildcards.variant)[0]  # the group holding T1-01
+    return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS]
+
+
+# approach_extra.smk
+def a_ablation_cfg(values_key):
+    """The keys an A-X3 sweep reads: scenario, EM, augmented EKF and its own values only."""
+    c = cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives")
+    abl = config["approach"]["ablation"]
+    c["ablation"] = canonical({k: abl[k] for k in ("variants", "n_seeds", values_key)})
+    return c
+
+
+# landing_extra.smk
+def _abl_chunks(sweep):
+    return [f"{LANDING}/ablation/{sweep}/{lab}/{m}_{c}.npz"
+            for lab in ABL_VALUES[sweep] for c in ABL_CHUNKS for m in ABL_METHODS]
+
+
+# paper.smk
+def _floats(part):
+    """The part's final figures (PDF) and tables (.tex), in id order."""
+    prefix = str(Path(RESULTS, part)) + os.sep
+    keep = [t for t in _targets if t.startswith(prefix) and t.endswith((".pdf", ".tex"))]
+    return sorted(keep, key=lambda p: (Path(p).stem.split("_")[0][2:3] != "T", Path(p).stem))

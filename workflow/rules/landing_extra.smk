@@ -42,11 +42,6 @@ ABL_VALUES = {s: {_b_value_label(s, v): v for v in _BA[_B_SWEEPS[s][0]]} for s i
 ABL_CHUNKS = [chunk_label(c) for c in mc_chunks(_BA["n_runs"], _BA["runs_per_job"])]
 
 
-def _abl_chunks(sweep):
-    return [f"{LANDING}/ablation/{sweep}/{lab}/{m}_{c}.npz"
-            for lab in ABL_VALUES[sweep] for c in ABL_CHUNKS for m in ABL_METHODS]
-
-
 rule landing_ablation_chunk:
     """One ablation job: runs of every ablation method at one swept value (scatter)."""
     input:

@@ -12,13 +12,6 @@ CAPTIONS = Path(workflow.basedir) / "workflow" / "report"
 _targets = [str(t) for t in ALL_TARGETS]
 
 
-def _floats(part):
-    """The part's final figures (PDF) and tables (.tex), in id order."""
-    prefix = str(Path(RESULTS, part)) + os.sep
-    keep = [t for t in _targets if t.startswith(prefix) and t.endswith((".pdf", ".tex"))]
-    return sorted(keep, key=lambda p: (Path(p).stem.split("_")[0][2:3] != "T", Path(p).stem))
-
-
 SUMMARIES = {
     k: p
     for k, p in {
@@ -54,7 +47,7 @@ rule paper_floats:
         compact=directory(f"{PAPER}/compact"),
     params:
         paper_dir=str(PAPER_DIR),
-        captions_dir=str(CAPTIONS),
+        captions_dir=lambda wildcards, input: str(Path(input.captions[0]).parent),
     log:
         f"{PAPER}/logs/paper_floats.log",
     localrule: True
@@ -138,13 +131,14 @@ HAVE_LATEX = shutil.which("latexmk") is not None and shutil.which("pdflatex") is
 rule paper_pdf:
     """The manuscript, built reproducibly (SOURCE_DATE_EPOCH) with latexmk."""
     input:
+        main=str(PAPER_DIR / "main.tex"),
         tex=sorted(str(p) for p in PAPER_DIR.rglob("*.tex")),
         generated=PAPER_INPUTS,
         results=[t for t in _targets if t.endswith((".pdf", ".tex"))],
     output:
         f"{PAPER}/main.pdf",
     params:
-        paper_dir=str(PAPER_DIR),
+        paper_dir=lambda wildcards, input: str(Path(input.main).parent),
         build=f"{PAPER}/build",
     log:
         f"{PAPER}/logs/paper_pdf.log",
