@@ -128,17 +128,20 @@ def _validator(schema_path: Path):
     return cls(schema, registry=registry)
 
 
-def non_finite_keys(value: Any, path: tuple = ()) -> list[str]:
-    """Dotted keys of every NaN or infinite number anywhere in ``value`` (a
-    config mapping), whatever the schema says of the key; list items are named
-    ``key[i]``."""
+def non_finite_keys(value: Any, path: tuple = ()) -> dict[str, float]:
+    """``{dotted key: value}`` of every NaN or infinite number anywhere in
+    ``value`` (a config mapping), whatever the schema says of the key; list
+    items are named ``key[i]``."""
     if isinstance(value, float) and not math.isfinite(value):
-        return [_dotted(path)]
+        return {_dotted(path): value}
+    out: dict[str, float] = {}
     if isinstance(value, dict):
-        return [k for n, v in value.items() for k in non_finite_keys(v, (*path, str(n)))]
-    if isinstance(value, (list, tuple)):
-        return [k for i, v in enumerate(value) for k in non_finite_keys(v, (*path, i))]
-    return []
+        for n, v in value.items():
+            out.update(non_finite_keys(v, (*path, str(n))))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            out.update(non_finite_keys(v, (*path, i)))
+    return out
 
 
 def _dotted(path) -> str:
@@ -167,8 +170,8 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
     ``results_dir`` lands, default ``root``).
     """
     bad = non_finite_keys(config)
-    lines = [f"invalid config key '{k}': {_at(config, k)} is not a finite number "
-             "(NaN and infinity are refused)" for k in bad]
+    lines = [f"invalid config key '{k}': {v} is not a finite number "
+             "(NaN and infinity are refused)" for k, v in bad.items()]
     validator = _validator(schema_path)
     for err in sorted(validator.iter_errors(config), key=lambda e: [str(p) for p in e.absolute_path]):
         key = _dotted(err.absolute_path)
@@ -184,13 +187,6 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
         if problems:
             raise ConfigError("\n".join(problems))
     return config
-
-
-def _at(config: dict, dotted: str):
-    node: Any = config
-    for part in re.findall(r"[^.\[\]]+|\[\d+\]", dotted):
-        node = node[int(part[1:-1])] if part.startswith("[") else node[part]
-    return node
 
 
 def load_config(path: str | Path | None = None, overlays: list[str | Path] = ()) -> dict:
