@@ -50,14 +50,17 @@ def test_landing_ablation_value_edit_lists_only_that_value(quick_results):
 
 
 def test_raising_n_runs_flies_only_the_new_runs(quick_results):
-    """Quick profile: 4 runs in chunks of 2; 6 runs adds chunk r0004-0005 per method
-    and nothing else is flown again (each run's stream depends on its index only)."""
+    """Quick profile: 4 runs in chunks of 2; 6 runs adds chunk r0004-0005 per camera
+    scenario and method and nothing else is flown again (each run's stream depends
+    on its index only)."""
     cfg = yaml.safe_load((quick_results / "config" / "quick.yaml").read_text())
     assert cfg["landing"]["mc"] == {"n_runs": 4, "runs_per_job": 2}
     jobs = _edit(quick_results, {"landing": {"mc": {"n_runs": 6}}})
     chunks = [w for r, w in jobs if r == "landing_mc_chunk"]
     assert chunks and {w["bchunk"] for w in chunks} == {"r0004-0005"}, chunks
     methods = {w["bmethod"] for w in chunks}
-    assert len(chunks) == len(methods) >= 4
+    # one new chunk per (camera scenario, method), every scenario
+    assert len(chunks) == len({(w["bscn"], w["bmethod"]) for w in chunks}) == 2 * len(methods)
+    assert {w["bscn"] for w in chunks} == {"site-tilt", "interior"} and len(methods) >= 4
     assert {w["bmethod"] for r, w in jobs if r == "landing_mc_gather"} == methods
     assert not {r for r, _ in jobs} & {"landing_ablation_chunk", "landing_single", "approach_mc"}

@@ -452,3 +452,58 @@ def test_paper_baselines_rank_identically_in_descent_geometry():
     orders = [np.argsort(make_metric(n)(ctx, cand)) for n in H_METRICS]
     np.testing.assert_array_equal(orders[0], orders[1])
     np.testing.assert_array_equal(orders[0], orders[2])
+
+
+def _descent_ctx_and_candidates(k=20, n=300, seed=3):
+    from opnav.config import load_config
+    from opnav.landing.descent import build_scenario
+    from opnav.landing.metrics import MetricContext
+
+    scn = build_scenario(load_config()["landing"])
+    tr = scn.truth
+    P = np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3)
+    A = np.random.default_rng(seed).normal(size=(12, 12)) * 0.05
+    P = P + np.sqrt(np.outer(np.diag(P), np.diag(P))) * (A @ A.T) / 12   # correlated, SPD
+    ctx = MetricContext(r_L=tr.r[k], v_L=tr.v[k], R_LtoB=tr.R_LtoB[k], p_known_L=np.zeros(3), P=P,
+                        R_meas=scn.camera.sigma_b**2 * np.eye(6), boresight_B=scn.camera.boresight_B)
+    vis = scn.camera.in_view((scn.field.xyz - tr.r[k]) @ tr.R_LtoB[k].T)
+    return ctx, scn.field.xyz[vis][:n]
+
+
+def test_whitened_metrics_agree_across_paths_and_with_a_dense_reference():
+    """svd_w / gdop_w / cond_w: batch, scalar, matrix and CasADi paths agree, and
+    equal the singular values of R^-1/2 H P^1/2 with P^1/2 a symmetric root."""
+    from scipy.linalg import sqrtm
+
+    from opnav.landing import casadi_model as cm
+    from opnav.landing.metrics import make_metric
+
+    ctx, cand = _descent_ctx_and_candidates(n=25)
+    S = np.real(sqrtm(ctx.P))
+    Rm12 = np.real(sqrtm(np.linalg.inv(ctx.R_meas)))
+    for name in ("svd_w", "gdop_w", "cond_w"):
+        m = make_metric(name)
+        batch = m(ctx, cand)
+        np.testing.assert_allclose([m.scalar(ctx, p) for p in cand], batch, rtol=1e-9)
+        np.testing.assert_allclose(m.reference(ctx, cand[:5]), batch[:5], rtol=1e-9)
+        s_ref = []
+        for p in cand[:5]:
+            H = cm.jacobian_function()(ctx.r_L, ctx.v_L, ctx.p_known_L, p, ctx.R_LtoB).full()
+            s = np.linalg.svd(Rm12 @ H @ S, compute_uv=False)[:4]
+            s_ref.append({"svd_w": s[-1], "cond_w": s[-1] / s[0], "gdop_w": 1 / np.sum(s**-2.0)}[name])
+        np.testing.assert_allclose(batch[:5], s_ref, rtol=1e-8)
+
+
+def test_paper_baselines_rank_identically_and_whitened_ones_do_not():
+    """On H the three baselines order the candidates the same way (the 1/range
+    block sets sigma_min); whitened by the prior and the noise they disagree."""
+    from scipy.stats import spearmanr
+
+    from opnav.landing.metrics import make_metric
+
+    ctx, cand = _descent_ctx_and_candidates()
+    sc = {n: make_metric(n)(ctx, cand) for n in ("svd", "gdop", "cond", "svd_w", "gdop_w", "cond_w")}
+    assert spearmanr(sc["svd"], sc["gdop"])[0] > 0.999999
+    assert spearmanr(sc["svd"], sc["cond"])[0] > 0.999999
+    assert spearmanr(sc["svd_w"], sc["cond_w"])[0] < 0.99
+    assert spearmanr(sc["svd"], sc["svd_w"])[0] < 0.99

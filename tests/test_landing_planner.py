@@ -224,3 +224,52 @@ def test_depth_batch_matches_the_paper_formula_at_landmarks(scn):
         g = ground_point(betas, geom)
         ok = np.all(np.isfinite(g), axis=1)
         np.testing.assert_allclose(f.batch(g[ok]), [f(b) for b in betas[ok]], rtol=1e-8)
+
+
+def _unconstrained_inside(state, camera, cfg):
+    """Is the in-plane depth-error optimum over the whole ground arc strictly
+    inside the visible interval (estimated state, planning margin)?"""
+    from opnav.landing.planner import depth_objective, golden_section
+
+    geom = plane_geometry(state.r, state.v)
+    f = depth_objective(state, geom, cfg)
+    opts = [golden_section(f, lo, hi, cfg.tol_rad)[:2]
+            for lo, hi in ((-(math.pi - geom.gamma) + 1e-6, -1e-9), (1e-9, geom.gamma - 1e-6))]
+    b = min(opts, key=lambda o: o[1])[0]
+    ivs = visible_intervals(geom, state.R_LtoB, camera, cfg.n_grid, cfg.margin_px)
+    return any(lo + cfg.tol_rad < b < hi - cfg.tol_rad for lo, hi in ivs)
+
+
+@pytest.mark.parametrize("scenario, inside", [("interior", True), ("site-tilt", False)])
+def test_camera_scenario_puts_the_depth_optimum_inside_or_outside_the_image(scenario, inside,
+                                                                            monkeypatch):
+    """Seeded descent of each configured camera scenario: at every planning
+    instant the depth optimum is strictly inside the visible interval (interior)
+    or outside it (site-tilt, where every metric's search ends on an edge)."""
+    from opnav.landing import descent as D
+    from opnav.landing.scenario import camera_scenarios
+
+    cfg = camera_scenarios(load_config()["landing"])[scenario]
+    scn_ = D.build_scenario(cfg)
+    seen = []
+    orig = D.plan
+
+    def spy(method, state, camera, *a, **k):
+        res = orig(method, state, camera, *a, **k)
+        seen.append((_unconstrained_inside(state, camera, scn_.planner), res.edge))
+        return res
+
+    monkeypatch.setattr(D, "plan", spy)
+    D.run_descent(scn_, "depth", 2)
+    assert len(seen) > 30
+    assert all(s[0] == inside for s in seen), [i for i, s in enumerate(seen) if s[0] != inside]
+    assert all(s[1] != inside for s in seen)       # the edge rule fires exactly when outside
+
+
+def test_unknown_headline_scenario_is_refused():
+    from opnav.landing.scenario import camera_scenarios
+
+    cfg = load_config()["landing"]
+    cfg = {**cfg, "headline_scenario": "nope"}
+    with pytest.raises(ValueError, match="landing.headline_scenario"):
+        camera_scenarios(cfg)

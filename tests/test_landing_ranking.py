@@ -239,3 +239,28 @@ def test_tied_order_is_by_method_name_not_timing():
     assert h1["ranking_by_accuracy"] == h2["ranking_by_accuracy"] == list(df1["method"])
     assert h1["best_accuracy_method"] == h2["best_accuracy_method"] == "cond"
     assert h1["reference_more_accurate_than_text"] == h2["reference_more_accurate_than_text"] == "gdop, mineig"
+
+
+def _calls_data(runs, times, idx, beta, err):
+    """A hand-made gathered result: planning calls and per-run error tracks."""
+    n = len(err)
+    e = np.zeros((n, 3, 3))
+    e[:, :, 0] = np.asarray(err, float)[:, None]
+    return {"run_index": np.arange(n), "plan_run": np.asarray(runs), "plan_t": np.asarray(times, float),
+            "plan_index": np.asarray(idx), "plan_beta": np.asarray(beta, float),
+            "err_r": e, "err_v": e, "err_th_deg": e, "nees_r": np.ones((n, 3)), "nees_v": np.ones((n, 3)),
+            "n_landmarks": np.ones(n, int)}
+
+
+def test_pair_comparison_on_hand_made_calls():
+    from opnav.landing.ranking import pair_comparison
+
+    a = _calls_data([0, 0, 1, 1], [1, 4, 1, 4], [5, 6, 7, 8], [0.1, 0.2, 0.3, 0.4], [1.0, 2.0])
+    b = _calls_data([0, 0, 1, 1], [1, 4, 1, 4], [5, 9, 7, 9], [0.1, 0.25, 0.3, 0.5], [2.0, 4.0])
+    pc = pair_comparison(a, b)
+    assert pc["same_pick_pct"] == pytest.approx(50.0)
+    # |dbeta| = 0, 0.05, 0, 0.1 rad: median 0.025 rad
+    assert pc["median_abs_dbeta_deg"] == pytest.approx(np.degrees(0.025))
+    assert pc["d_final_pos_m"] == pytest.approx(-1.5)          # (1-2 + 2-4) / 2
+    assert pc["d_final_pos_rel_pct"] == pytest.approx(-50.0)    # of b's mean 3 m
+    assert pc["d_final_pos_lo_m"] < -1.5 < pc["d_final_pos_hi_m"]

@@ -12,7 +12,8 @@ rule landing_tables:
         t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
         t2=report_table(f"{LANDING}/B-T2_error_bounds", "B-T2", "Paper B"),
     params:
-        landing=cfg("landing", "initial_state", "mc", "duration_s", "gravity_mps2", "yaw_deg"),
+        landing=cfg("landing", "initial_state", "mc", "duration_s", "gravity_mps2", "yaw_deg",
+                    "terminal_accel_mps2"),
     log:
         f"{LANDING}/logs/landing_tables.log",
     localrule: True
@@ -34,111 +35,176 @@ ALL_TARGETS.extend(rules.landing_tables.output)
 # only the new runs, and no chunk's params mention n_runs.
 from opnav.landing.montecarlo import CHUNK_PATTERN, chunk_label, chunk_runs, chunks as mc_chunks
 
+from opnav.landing.scenario import camera_scenarios, headline_scenario
+
+try:
+    B_SCENARIO_CFG = camera_scenarios(config["landing"])
+    B_HEADLINE = headline_scenario(config["landing"])
+except ValueError as exc:
+    raise ConfigError(str(exc)) from None
+# Camera scenarios (landing.scenarios): each flies its own Monte Carlo under
+# results/landing/mc/{bscn}/ and gets its own B-F5, B-F6, B-F7, B-T3, B-X1 (file
+# stems end in _{bscn}, as paper A's variants); B-summary.json gathers them all,
+# the headline scenario's numbers also at its top level.
+B_SCENARIOS = list(B_SCENARIO_CFG)
 B_METHODS = list(config["landing"]["mc"]["methods"])
 B_CHUNKS = [chunk_label(c) for c in mc_chunks(config["landing"]["mc"]["n_runs"],
                                                config["landing"]["mc"]["runs_per_job"])]
-B_SIM = cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg", "imu", "camera",
-            "landmarks", "filter", "planner")
-B_SIM["mc"] = canonical({k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")})
+_B_SIM_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu", "camera",
+               "landmarks", "filter", "planner")
+B_SIMS = {s: canonical({**{k: c[k] for k in _B_SIM_KEYS},
+                        "mc": {k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")}})
+          for s, c in B_SCENARIO_CFG.items()}
+B_SIM = B_SIMS[B_HEADLINE]          # the headline scenario (B-X2 ablations)
 B_SRC = src("landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
             "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
             "landing/planner.py", "landing/descent.py", "landing/montecarlo.py",
             "landing/metrics.py", "landing/casadi_model.py")
-B_MC = {m: f"{LANDING}/mc/{m}.npz" for m in B_METHODS}
+B_SCN_RE = "|".join(B_SCENARIOS)
+
+
+def b_mc(scn, methods):
+    return [f"{LANDING}/mc/{scn}/{m}.npz" for m in methods]
 
 
 rule landing_mc_chunk:
-    """One Monte-Carlo job: runs of one planning method (scatter)."""
+    """One Monte-Carlo job: runs of one planning method in one camera scenario (scatter)."""
     input:
         B_SRC,
     output:
-        f"{LANDING}/mc/chunks/{{bmethod}}/{{bchunk}}.npz",
+        f"{LANDING}/mc/{{bscn}}/chunks/{{bmethod}}/{{bchunk}}.npz",
     wildcard_constraints:
+        bscn=B_SCN_RE,
         bmethod="[a-z][a-z0-9_-]*",
         bchunk=CHUNK_PATTERN,
     params:
-        landing=B_SIM,
+        landing=lambda wc: B_SIMS[wc.bscn],
         runs=lambda wc: chunk_runs(wc.bchunk),
     log:
-        f"{LANDING}/logs/mc_{{bmethod}}_chunk{{bchunk}}.log",
+        f"{LANDING}/logs/mc_{{bscn}}_{{bmethod}}_chunk{{bchunk}}.log",
     benchmark:
-        f"{LANDING}/benchmarks/mc_{{bmethod}}_chunk{{bchunk}}.tsv"
+        f"{LANDING}/benchmarks/mc_{{bscn}}_{{bmethod}}_chunk{{bchunk}}.tsv"
     script:
         "../scripts/landing_mc_chunk.py"
 
 
 rule landing_mc_gather:
-    """All runs of one method, in run order (gather)."""
+    """All runs of one method in one scenario, in run order (gather)."""
     input:
-        lambda wc: [f"{LANDING}/mc/chunks/{wc.bmethod}/{c}.npz" for c in B_CHUNKS],
+        lambda wc: [f"{LANDING}/mc/{wc.bscn}/chunks/{wc.bmethod}/{c}.npz" for c in B_CHUNKS],
     output:
-        f"{LANDING}/mc/{{bmethod}}.npz",
+        f"{LANDING}/mc/{{bscn}}/{{bmethod}}.npz",
     wildcard_constraints:
+        bscn=B_SCN_RE,
         bmethod="[a-z][a-z0-9_-]*",
     log:
-        f"{LANDING}/logs/mc_{{bmethod}}_gather.log",
+        f"{LANDING}/logs/mc_{{bscn}}_{{bmethod}}_gather.log",
     localrule: True
     script:
         "../scripts/landing_mc_gather.py"
 
 
+rule landing_true_states:
+    """B-F4: the truth trajectory (the same in every camera scenario)."""
+    input:
+        src("landing/trajectory.py", "landing/plots.py", "figures.py", "opnav.mplstyle"),
+    output:
+        f4=report_figure(f"{LANDING}/B-F4_true_states", "B-F4", "Paper B"),
+    params:
+        landing=cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg",
+                    "terminal_accel_mps2"),
+    log:
+        f"{LANDING}/logs/true_states.log",
+    localrule: True
+    script:
+        "../scripts/landing_true_states.py"
+
+
 rule landing_single:
-    """The headline single descent, B-F4 (true states) and B-F5 (depth-error map)."""
+    """The single descent of one scenario and B-F5 (depth-error maps)."""
     input:
         B_SRC,
         src("landing/plots.py", "figures.py", "opnav.mplstyle"),
     output:
-        summary=f"{LANDING}/single/summary.json",
-        f4=report_figure(f"{LANDING}/B-F4_true_states", "B-F4", "Paper B"),
-        f5=report_figure(f"{LANDING}/B-F5_depth_error_map", "B-F5", "Paper B"),
+        summary=f"{LANDING}/single/summary_{{bscn}}.json",
+        f5=report_figure(f"{LANDING}/B-F5_depth_error_map_{{bscn}}", "B-F5", "Paper B", "{bscn}"),
+    wildcard_constraints:
+        bscn=B_SCN_RE,
     params:
-        landing=canonical({**B_SIM, "single": config["landing"]["single"],
-                           "figures": config["landing"]["figures"]}),
+        landing=lambda wc: canonical({**B_SIMS[wc.bscn], "single": config["landing"]["single"],
+                                      "figures": config["landing"]["figures"]}),
     log:
-        f"{LANDING}/logs/single.log",
+        f"{LANDING}/logs/single_{{bscn}}.log",
     script:
         "../scripts/landing_single.py"
 
 
 rule landing_mc_figures:
-    """B-F6 (3-sigma envelopes per axis) and B-F7 (planning-time box plots)."""
+    """B-F6 (3-sigma envelopes per axis) and B-F7 (planning-time box plots) of one scenario."""
     input:
-        mc=[B_MC[m] for m in B_METHODS],
+        mc=lambda wc: b_mc(wc.bscn, B_METHODS),
         code=src("landing/plots.py", "landing/montecarlo.py", "figures.py", "opnav.mplstyle",
                  "published.py", "data/published.yaml"),
     output:
-        f6=report_figure(f"{LANDING}/B-F6_nav_error_envelopes", "B-F6", "Paper B"),
-        f7=report_figure(f"{LANDING}/B-F7_planning_time", "B-F7", "Paper B"),
+        f6=report_figure(f"{LANDING}/B-F6_nav_error_envelopes_{{bscn}}", "B-F6", "Paper B", "{bscn}"),
+        f7=report_figure(f"{LANDING}/B-F7_planning_time_{{bscn}}", "B-F7", "Paper B", "{bscn}"),
+    wildcard_constraints:
+        bscn=B_SCN_RE,
     params:
         methods=B_METHODS,
+        eval_path=config["landing"]["planner"]["eval_path"],
     log:
-        f"{LANDING}/logs/mc_figures.log",
+        f"{LANDING}/logs/mc_figures_{{bscn}}.log",
     localrule: True
     script:
         "../scripts/landing_mc_figures.py"
 
 
 rule landing_summary:
-    """B-T3 beside the published 29.03 %, and B-summary.json for the manuscript."""
+    """B-T3 of one scenario beside the published 29.03 %, and its summary JSON."""
     input:
-        mc=[B_MC[m] for m in B_METHODS],
-        single=rules.landing_single.output.summary,
-        code=src("landing/montecarlo.py", "tables.py", "published.py", "data/published.yaml"),
+        mc=lambda wc: b_mc(wc.bscn, B_METHODS),
+        single=f"{LANDING}/single/summary_{{bscn}}.json",
+        code=src("landing/montecarlo.py", "landing/scenario.py", "tables.py", "published.py",
+                 "data/published.yaml"),
     output:
-        t3=report_table(f"{LANDING}/B-T3_summary", "B-T3", "Paper B"),
-        summary=f"{LANDING}/B-summary.json",
+        t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),
+        summary=f"{LANDING}/summaries/B-summary_{{bscn}}.json",
+    wildcard_constraints:
+        bscn=B_SCN_RE,
     params:
         methods=B_METHODS,
         yaw_ratio=0.5,
         converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
+        eval_path=config["landing"]["planner"]["eval_path"],
+        landing=cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg",
+                    "terminal_accel_mps2"),
     log:
-        f"{LANDING}/logs/summary.log",
+        f"{LANDING}/logs/summary_{{bscn}}.log",
     localrule: True
     script:
         "../scripts/landing_summary.py"
 
 
-ALL_TARGETS.extend(rules.landing_single.output.f4)
-ALL_TARGETS.extend(rules.landing_single.output.f5)
-ALL_TARGETS.extend(rules.landing_mc_figures.output)
-ALL_TARGETS.extend(rules.landing_summary.output)
+rule landing_summary_all:
+    """B-summary.json: every scenario's summary, the headline's also at the top level."""
+    input:
+        parts=expand(f"{LANDING}/summaries/B-summary_{{bscn}}.json", bscn=B_SCENARIOS),
+    output:
+        f"{LANDING}/B-summary.json",
+    params:
+        scenarios=B_SCENARIOS,
+        headline=B_HEADLINE,
+        cameras={s: canonical(c["camera"]) for s, c in B_SCENARIO_CFG.items()},
+    log:
+        f"{LANDING}/logs/summary_all.log",
+    localrule: True
+    script:
+        "../scripts/landing_combine.py"
+
+
+ALL_TARGETS.extend(rules.landing_true_states.output)
+ALL_TARGETS.extend(expand(rules.landing_single.output.f5, bscn=B_SCENARIOS))
+ALL_TARGETS.extend(expand(rules.landing_mc_figures.output, bscn=B_SCENARIOS))
+ALL_TARGETS.extend(expand(rules.landing_summary.output.t3, bscn=B_SCENARIOS))
+ALL_TARGETS.extend(rules.landing_summary_all.output)

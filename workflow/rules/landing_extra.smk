@@ -1,7 +1,8 @@
 # Paper B beyond the paper (SPEC B.4 B-X1) and one-value ablations (B-X2).
-# Included right after landing.smk: reuses its LANDING, B_SIM, B_SRC, B_METHODS and
-# its Monte-Carlo wildcard rules (an extra method is one more gathered
-# results/landing/mc/{method}.npz, same runs, same seeds).
+# Included right after landing.smk: reuses its LANDING, B_SIM(S), B_SRC, B_METHODS,
+# B_SCENARIOS and its Monte-Carlo wildcard rules (an extra method is one more gathered
+# results/landing/mc/{scenario}/{method}.npz, same runs, same seeds). The ablations
+# run in the headline scenario (B_SIM).
 from opnav.landing.ablation import SWEEPS as _B_SWEEPS, value_label as _b_value_label
 
 _BX = config["landing"]["extra"]
@@ -9,27 +10,48 @@ X1_METHODS = list(B_METHODS) + [m for m in _BX["methods"] if m not in B_METHODS]
 
 
 rule landing_x1_summary:
-    """B-X1: all methods on the paired Monte Carlo, envelopes, ranking table, summary JSON."""
+    """B-X1 of one scenario: all methods on the paired Monte Carlo, envelopes, ranking, JSON."""
     input:
-        mc=[f"{LANDING}/mc/{m}.npz" for m in X1_METHODS],
+        mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
         code=src("landing/ranking.py", "landing/montecarlo.py", "landing/plots.py", "tables.py",
                  "figures.py", "opnav.mplstyle"),
     output:
-        f=report_figure(f"{LANDING}/B-X1_envelopes", "B-X1", "Paper B", "beyond"),
-        t=report_table(f"{LANDING}/B-X1_ranking", "B-X1", "Paper B"),
-        summary=f"{LANDING}/B-X1-summary.json",
+        f=report_figure(f"{LANDING}/B-X1_envelopes_{{bscn}}", "B-X1", "Paper B", "beyond"),
+        t=report_table(f"{LANDING}/B-X1_ranking_{{bscn}}", "B-X1", "Paper B"),
+        summary=f"{LANDING}/summaries/B-X1-summary_{{bscn}}.json",
+    wildcard_constraints:
+        bscn=B_SCN_RE,
     params:
         methods=X1_METHODS,
         extra=canonical(config["landing"]["extra"]),
         converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
     log:
-        f"{LANDING}/logs/x1_summary.log",
+        f"{LANDING}/logs/x1_summary_{{bscn}}.log",
     localrule: True
     script:
         "../scripts/landing_x1_summary.py"
 
 
-ALL_TARGETS.extend(rules.landing_x1_summary.output)
+rule landing_x1_summary_all:
+    """B-X1-summary.json: every scenario's B-X1 summary, the headline's also at the top level."""
+    input:
+        parts=expand(f"{LANDING}/summaries/B-X1-summary_{{bscn}}.json", bscn=B_SCENARIOS),
+    output:
+        f"{LANDING}/B-X1-summary.json",
+    params:
+        scenarios=B_SCENARIOS,
+        headline=B_HEADLINE,
+        cameras={s: canonical(c["camera"]) for s, c in B_SCENARIO_CFG.items()},
+    log:
+        f"{LANDING}/logs/x1_summary_all.log",
+    localrule: True
+    script:
+        "../scripts/landing_combine.py"
+
+
+ALL_TARGETS.extend(expand(rules.landing_x1_summary.output.f, bscn=B_SCENARIOS))
+ALL_TARGETS.extend(expand(rules.landing_x1_summary.output.t, bscn=B_SCENARIOS))
+ALL_TARGETS.extend(rules.landing_x1_summary_all.output)
 
 
 # ---------------------------------------------------------------- ablations

@@ -27,7 +27,7 @@ SCORE_INPUTS = {
     k: p
     for k, p in {
         "a_table1": res("approach", "A-T1_table1.csv"),
-        "b_summary_table": res("landing", "B-T3_summary.csv"),
+        "b_summary_table": res("landing", f"B-T3_summary_{B_HEADLINE}.csv"),
     }.items()
     if p in _targets
 }

@@ -4,7 +4,7 @@ from opnav.landing.montecarlo import run_chunk, save
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/landing/mc/chunks/depth/r0000-0001.npz"],
+    snakemake = mock_snakemake(output=["results/landing/mc/site-tilt/chunks/depth/r0000-0001.npz"],
                                wildcards={"bmethod": "depth", "bchunk": "r0000-0001"})
     snakemake.params = type("P", (), {"landing": snakemake.config["landing"], "runs": [0, 1]})()
 

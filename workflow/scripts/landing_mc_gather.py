@@ -4,8 +4,8 @@ from opnav.landing.montecarlo import gather, load, save
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(input=["results/landing/mc/chunks/depth/r0000-0001.npz"],
-                               output=["results/landing/mc/depth.npz"], wildcards={"bmethod": "depth"})
+    snakemake = mock_snakemake(input=["results/landing/mc/site-tilt/chunks/depth/r0000-0001.npz"],
+                               output=["results/landing/mc/site-tilt/depth.npz"], wildcards={"bmethod": "depth", "bscn": "site-tilt"})
 
 with script_context(snakemake) as log:
     data = gather([load(p) for p in snakemake.input])

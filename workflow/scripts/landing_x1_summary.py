@@ -14,10 +14,10 @@ from opnav.tables import write_table
 if "snakemake" not in globals():  # standalone debugging run
     _m = ["depth", "svd", "gdop", "cond", "logdet", "mineig", "random", "center"]
     snakemake = mock_snakemake(
-        input={"mc": [f"results/landing/mc/{m}.npz" for m in _m]},
-        output={"f": ["results/landing/B-X1_envelopes.pdf", "results/landing/B-X1_envelopes.png"],
-                "t": ["results/landing/B-X1_ranking.csv"],
-                "summary": "results/landing/B-X1-summary.json"})
+        input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in _m]},
+        output={"f": ["results/landing/B-X1_envelopes_site-tilt.pdf", "results/landing/B-X1_envelopes_site-tilt.png"],
+                "t": ["results/landing/B-X1_ranking_site-tilt.csv"],
+                "summary": "results/landing/summaries/B-X1-summary_site-tilt.json"})
     snakemake.params = type("P", (), {"methods": _m,
                                       "extra": {"reference": "depth", "n_boot": 2000,
                                                 "tie_rtol": 1e-3},

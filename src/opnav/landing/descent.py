@@ -62,7 +62,7 @@ import numpy as np
 from opnav.landing import ekf, imu
 from opnav.landing.camera import Camera, camera_from_config
 from opnav.landing.landmarks import LandmarkField, make_field
-from opnav.landing.planner import PlannerConfig, PlanState, plan
+from opnav.landing.planner import OBJECTIVES, PlannerConfig, PlanState, alternative_path, plan
 from opnav.landing.trajectory import Truth, euler_rpy_deg, truth_states
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "initial_error", "summarize_run",
@@ -86,6 +86,7 @@ class Scenario:
     camera: Camera
     field: LandmarkField
     planner: PlannerConfig
+    planner_alt: PlannerConfig  # the same on the alternative metric evaluation path (timing)
     obs_per_landmark: int
     depth_sigma_frac: float
     min_update_alt: float
@@ -113,7 +114,7 @@ def _scenario_from_json(text: str) -> Scenario:
     s0 = c["initial_state"]
     yaw = float(c.get("yaw_deg", 0.0))
     t_imu = np.arange(n_steps * n_sub + 1) * dt
-    tr_imu = truth_states(t_imu, s0["r_m"], s0["v_mps"], T, g, yaw)
+    tr_imu = truth_states(t_imu, s0["r_m"], s0["v_mps"], T, g, yaw, c.get("terminal_accel_mps2"))
     tr = Truth(t=tr_imu.t[::n_sub], r=tr_imu.r[::n_sub], v=tr_imu.v[::n_sub],
                a=tr_imu.a[::n_sub], R_LtoB=tr_imu.R_LtoB[::n_sub])
     f, w = imu.synthesize(tr_imu.v, tr_imu.R_LtoB, dt, g)
@@ -130,7 +131,7 @@ def _scenario_from_json(text: str) -> Scenario:
                     n_steps=n_steps, Q=ekf.process_noise(sa, sw, dt, n_sub), sigma_a=sa, sigma_w=sw,
                     camera=camera_from_config(c["camera"]),
                     field=make_field(float(lm["half_width_m"]), int(lm["count"]), int(lm["seed"])),
-                    planner=pcfg, obs_per_landmark=int(fl["obs_per_landmark"]),
+                    planner=pcfg, planner_alt=alternative_path(pcfg), obs_per_landmark=int(fl["obs_per_landmark"]),
                     depth_sigma_frac=float(fl["depth_sigma_frac"]),
                     min_update_alt=float(fl["min_update_altitude_m"]),
                     oc=bool(fl["observability_constrained"]),
@@ -140,7 +141,7 @@ def _scenario_from_json(text: str) -> Scenario:
                     base_seed=int(c["mc"]["base_seed"]))
 
 
-_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "imu", "camera", "landmarks",
+_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu", "camera", "landmarks",
          "filter", "planner", "mc")
 
 
@@ -213,7 +214,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
     nees_v = np.empty(n + 1)
     updated = np.zeros(n + 1, bool)
     plan_ns, plan_cpu, plan_evals, plan_t, plan_beta, plan_idx = [], [], [], [], [], []
-    plan_edge, plan_ratio = [], []
+    plan_edge, plan_ratio, plan_ns_alt, plan_cpu_alt = [], [], [], []
     cur, n_obs, n_used = -1, 0, 0
     a_est = tr.a[0]
 
@@ -228,6 +229,12 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         nees_v[k] = ev @ np.linalg.solve(st.P[3:6, 3:6], ev)
 
     record(0)
+    # the planner's metric contexts skip validation (timed path): validate the
+    # descent's inputs once, here, with the same kinds of values
+    from opnav.landing.metrics import MetricContext
+
+    MetricContext(r_L=st.r, v_L=st.v, R_LtoB=st.R, p_known_L=np.asarray(scn.planner.p_known, float),
+                  P=st.P, R_meas=scn.camera.sigma_b**2 * np.eye(6), boresight_B=cam.boresight_B)
     # observability constraint (OC-EKF): unobservable direction at the prior
     N = ekf.nullspace(st.r, st.v, st.R, st.p)
     C_prior = st.R
@@ -265,6 +272,17 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                            rng=rng_pick, detected=np.flatnonzero(det))
                 plan_ns.append(res.time_ns)
                 plan_cpu.append(res.cpu_ns)
+                if method in OBJECTIVES and method != "depth":
+                    # the same call on the alternative evaluation path (closed-form
+                    # singular values vs H + LAPACK): timing only, same pick
+                    alt = plan(method, PlanState(st.r, st.v, a_est, st.R, st.P), cam, scn.field,
+                               visible, scn.planner_alt, exclude={cur} if cur >= 0 else set(),
+                               rng=None, detected=np.flatnonzero(det), diagnose=False)
+                    plan_ns_alt.append(alt.time_ns)
+                    plan_cpu_alt.append(alt.cpu_ns)
+                else:
+                    plan_ns_alt.append(res.time_ns)
+                    plan_cpu_alt.append(res.cpu_ns)
                 plan_evals.append(res.n_evals)
                 plan_t.append(k * scn.Dt)
                 plan_beta.append(res.beta)
@@ -305,6 +323,8 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         "plan_t": np.asarray(plan_t, float), "plan_beta": np.asarray(plan_beta, float),
         "plan_index": np.asarray(plan_idx, np.int64), "n_landmarks": n_used,
         "plan_edge": np.asarray(plan_edge, bool), "plan_ratio": np.asarray(plan_ratio, float),
+        "plan_ns_alt": np.asarray(plan_ns_alt, np.int64),
+        "plan_cpu_ns_alt": np.asarray(plan_cpu_alt, np.int64),
         "init_error": e0,
     }
 
@@ -390,13 +410,39 @@ def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
         if fx < best_f:
             best_b, best_f = x, fx
     opt_uv = np.full(2, np.nan)
+    opt_xy = np.full(2, np.nan)
     if math.isfinite(best_b):
         g = ground_point(best_b, geom)[0]
+        opt_xy = g[:2]
         d = cam.R_BtoC @ (R @ (g - r))
         if d[2] > 0:
             opt_uv = cam.focal_px * d[:2] / d[2]
+    # the whole field (no image constraint): every landmark's depth error and the
+    # unconstrained in-plane optimum (golden section over the whole ground arc)
+    dr_all = depth_error_at_landmarks(r, v, a, scn.field.xyz, scn.Dt, r_e)
+    fin = np.isfinite(dr_all)
+    best_all = int(np.argmin(np.where(fin, dr_all, np.inf)))
+    unc = []
+    for lo, hi in ((-(math.pi - geom.gamma) + 1e-6, -1e-9), (1e-9, geom.gamma - 1e-6)):
+        unc.append(golden_section(lambda bb: float(signed_depth_error(bb, geom, b, r_e)), lo, hi,
+                                  scn.planner.tol_rad)[:2])
+    unc_b, unc_f = min(unc, key=lambda x: x[1])
+    # image footprint on the ground: the four detector corners' lines of sight
+    hp = cam.half_px
+    corners = np.array([[-hp, -hp], [hp, -hp], [hp, hp], [-hp, hp]], float)
+    rays = np.column_stack([corners, np.full(4, cam.focal_px)]) @ cam.R_BtoC @ R
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tcut = np.where(rays[:, 2] < 0, -r[2] / rays[:, 2], np.nan)
+    footprint = (r + tcut[:, None] * rays)[:, :2]
     return {"time_s": k * scn.Dt, "uv_px": uv, "dr_m": dr, "best": best, "points": pts,
             "half_px": cam.half_px, "beta_deg": np.degrees(betas), "curve_dr": curve,
             "interval_deg": [(math.degrees(lo), math.degrees(hi)) for lo, hi in ivs],
             "opt_beta_deg": math.degrees(best_b), "opt_dr": best_f, "opt_uv_px": opt_uv,
-            "r_e_m": r_e, "n_visible": int(vis.sum())}
+            "opt_ground_xy": opt_xy, "r_e_m": r_e, "n_visible": int(vis.sum()),
+            "field_xy": scn.field.xyz[fin, :2], "field_dr": dr_all[fin],
+            "field_best_xy": scn.field.xyz[best_all, :2], "field_best_dr": float(dr_all[best_all]),
+            "unconstrained_beta_deg": math.degrees(unc_b), "unconstrained_dr": float(unc_f),
+            "unconstrained_ground_xy": ground_point(unc_b, geom)[0, :2],
+            "lander_xy": r[:2].copy(), "footprint_xy": footprint,
+            "optimum_inside_image": bool(any(lo < unc_b < hi for lo, hi in
+                                             visible_intervals(geom, R, cam, 0, 0.0)))}

@@ -14,7 +14,21 @@ built in :mod:`opnav.landing.casadi_model`).  LARGER IS BETTER for all of them:
 ``cond``    1 / cond(H) = sigma_min / sigma_max (structural)
 ``logdet``  D-optimal  log det(P^-1 + H^T R^-1 H)          (B-X1, beyond paper)
 ``mineig``  E-optimal  lambda_min(P^-1 + H^T R^-1 H)        (B-X1, beyond paper)
+``svd_w``   ``svd`` of the whitened H_w = R^-1/2 H P^1/2         (B-X1, beyond paper)
+``gdop_w``  ``gdop`` of H_w                                       (B-X1, beyond paper)
+``cond_w``  ``cond`` of H_w                                       (B-X1, beyond paper)
 ==========  ================================================================
+
+Whitened variants: H mixes units (1/m in the position and landmark columns,
+1 in the attitude columns), so its smallest structural singular value is set
+by the 1/range block and ``svd``, ``gdop`` and ``cond`` rank candidates
+identically (see below). Scaling H by the prior covariance square root
+(Cholesky factor L, P = L L^T; any square root gives the same singular
+values) and by R^-1/2 makes every column "one prior sigma" and every row
+"one noise sigma": H_w = C^-1 H L with R = C C^T. Its rank is still 4, and
+the three scores are taken from its four structural singular values as for
+H. They need ``ctx.P`` and ``ctx.R_meas``; there is no closed form, every path
+builds H_w explicitly.
 
 Rank choice (documented deviation from a literal reading of the SPEC)
 ---------------------------------------------------------------------
@@ -135,9 +149,11 @@ from scipy.linalg.lapack import dsyev as _dsyev
 
 from opnav.landing import casadi_model as cm
 
-METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig")
+METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig", "svd_w", "gdop_w", "cond_w")
 H_METRICS = ("svd", "gdop", "cond")
 INFO_METRICS = ("logdet", "mineig")
+#: whitened baselines (B-X1): the paper's H metric of H_w = R^-1/2 H P^1/2
+WHITENED = {"svd_w": "svd", "gdop_w": "gdop", "cond_w": "cond"}
 #: structural rank of the 6 x 12 two-bearing Jacobian (2 per unit bearing)
 STRUCTURAL_RANK = 4
 _EYE3 = np.eye(3)
@@ -212,6 +228,22 @@ class MetricContext:
         if not (math.isfinite(self.min_range_m) and self.min_range_m >= 0):
             raise ValueError("MetricContext.min_range_m must be finite and >= 0")
         s(self, "_cache", {})
+
+    @classmethod
+    def trusted(cls, r_L, v_L, R_LtoB, p_known_L, P=None, R_meas=None, boresight_B=None,
+                min_range_m: float = 1e-6) -> "MetricContext":
+        """A context from inputs already validated once (per descent, by the
+        caller): no copies, no checks, so building it is not timed as metric
+        work on the planner's path. ``boresight_B`` must be a unit vector or
+        None; arrays must be float64 of the documented shapes and not be
+        modified while the context is in use."""
+        self = object.__new__(cls)
+        s = object.__setattr__
+        for k, v in (("r_L", r_L), ("v_L", v_L), ("R_LtoB", R_LtoB), ("p_known_L", p_known_L),
+                     ("P", P), ("R_meas", R_meas), ("boresight_B", boresight_B),
+                     ("min_range_m", float(min_range_m)), ("_cache", {})):
+            s(self, k, v)
+        return self
 
     # ---- per-context precomputation (cached on the frozen instance) ----
     def _geom(self):
@@ -324,6 +356,8 @@ def _scores_from_sq(name, lp1, lm1, lp2, lm2):
 
 def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
     """The obvious linear algebra on explicit H (n, 6, 12)."""
+    if name in WHITENED:
+        return _whitened_scores(name, H, ctx)
     if name in H_METRICS:
         s = np.linalg.svd(H, compute_uv=False)  # descending, 6 values
         if name == "svd":
@@ -486,6 +520,28 @@ def _tangent_scalar(name: str, ctx: MetricContext, tg, d0: float, d1: float, d2:
     return 1.0 / lmax if info == 0 and lmax > 0 else -math.inf
 
 
+def _whitening(ctx: MetricContext):
+    """(C^-1 (6, 6), L (12, 12)) with R_meas = C C^T and P = L L^T (cached)."""
+    c = ctx._cache
+    if "whiten" not in c:
+        P, Rm, _, _ = ctx._info()
+        Cr = np.linalg.cholesky(Rm)
+        c["whiten"] = (np.linalg.inv(Cr), np.linalg.cholesky(P))
+    return c["whiten"]
+
+
+def _whitened_scores(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
+    """The ``WHITENED[name]`` score of H_w = C^-1 H L for H (n, 6, 12)."""
+    Ci, L = _whitening(ctx)
+    s = np.linalg.svd(Ci @ H @ L, compute_uv=False)[..., :STRUCTURAL_RANK]
+    base = WHITENED[name]
+    if base == "svd":
+        return s[..., -1]
+    if base == "cond":
+        return s[..., -1] / s[..., 0]
+    return 1.0 / np.sum(1.0 / (s * s), axis=-1)
+
+
 def _candidate_H(ctx: MetricContext, d0: float, d1: float, d2: float, rho: float) -> np.ndarray:
     """H (6 x 12) of eq. 14-18 for one candidate at offset d = p - r, with the
     known-landmark rows cached on ``ctx`` and the candidate rows written out."""
@@ -513,6 +569,8 @@ def _matrix_scalar(name: str, ctx: MetricContext, d0: float, d1: float, d2: floa
     svd/gdop/cond (gdop from the singular values above PINV_RCOND sigma_max,
     i.e. exactly the pseudo-inverse trace), or the generic 12 x 12 information."""
     H = _candidate_H(ctx, d0, d1, d2, rho)
+    if name in WHITENED:
+        return float(_whitened_scores(name, H[None], ctx)[0])
     if name not in H_METRICS:
         return _info_scalar(name, ctx, H)
     sv = _dgesvd(H, compute_uv=0)[1]
@@ -624,6 +682,9 @@ class Metric:
             cr = np.cross(u, w)
             s2 = np.einsum("ij,ij->i", cr, cr)
             out[ok] = _scores_from_sq(self.name, *_structural_sq(x, y, cg, s2))
+        elif self.name in WHITENED:
+            H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c[ok], ctx.R_LtoB)
+            out[ok] = _whitened_scores(self.name, H, ctx)
         else:
             tg = _tangent_setup(ctx)
             if tg is not None:
@@ -650,6 +711,8 @@ class Metric:
             return -math.inf
         if bs_L is not None and d0 * bs_L[0] + d1 * bs_L[1] + d2 * bs_L[2] <= 0.0:
             return -math.inf
+        if self.name in WHITENED:
+            return _matrix_scalar(self.name, ctx, d0, d1, d2, rho2)
         if self.name not in H_METRICS:
             tg = _tangent_setup(ctx)
             if tg is not None:
@@ -730,7 +793,7 @@ class Metric:
 
         def build(c):
             H = cm.jacobian_casadi_batch(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB, parallelization)
-            if self.name in H_METRICS:
+            if self.name in H_METRICS or self.name in WHITENED:
                 return _scores_from_H(self.name, H, ctx)
             return _info_scores_fast(self.name, H, ctx)
 
@@ -745,7 +808,7 @@ class Metric:
 
         def build(c):
             H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB)
-            if self.name in H_METRICS:
+            if self.name in H_METRICS or self.name in WHITENED:
                 return _scores_from_H(self.name, H, ctx)
             return _info_scores_fast(self.name, H, ctx)
 

@@ -38,7 +38,7 @@ __all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stat
            "same_pick_pct", "pick_quality"]
 
 _PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index", "plan_edge",
-         "plan_ratio")
+         "plan_ratio", "plan_ns_alt", "plan_cpu_ns_alt")
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
            "sig_yaw_deg", "nees_r", "nees_v", "updated")
 
@@ -242,6 +242,9 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
         row["landmarks_per_run"] = float(st["n_landmarks"].mean())
         row["median_plan_time_us"] = _median_us(data[m]["plan_ns"])
         row["median_plan_cpu_us"] = _median_us(data[m]["plan_cpu_ns"])
+        if "plan_ns_alt" in data[m]:     # the same calls on the alternative metric path
+            row["median_plan_time_alt_us"] = _median_us(data[m]["plan_ns_alt"])
+            row["median_plan_cpu_alt_us"] = _median_us(data[m]["plan_cpu_ns_alt"])
         ev = data[m]["plan_evals"]
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
@@ -251,11 +254,24 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
         for b in methods:
             if b == m:
                 continue
+            from opnav.landing.ranking import pair_comparison
+
+            pc = pair_comparison(data[m], data[b])
+            row[f"same_pick_vs_{b}_pct"] = pc["same_pick_pct"]
+            row[f"median_abs_dbeta_vs_{b}_deg"] = pc["median_abs_dbeta_deg"]
+            for k in ("d_rms_pos", "d_final_pos"):
+                row[f"{k}_vs_{b}_m"] = pc[f"{k}_m"]
+                row[f"{k}_vs_{b}_lo_m"] = pc[f"{k}_lo_m"]
+                row[f"{k}_vs_{b}_hi_m"] = pc[f"{k}_hi_m"]
             red, sd = time_reduction(data[m], data[b])
             row[f"time_reduction_vs_{b}_pct"] = red
             row[f"time_reduction_vs_{b}_pct_std"] = sd
             row[f"cpu_time_reduction_vs_{b}_pct"] = time_reduction(data[m], data[b], n_boot=0,
                                                                    key="plan_cpu_ns")[0]
+            if "plan_ns_alt" in data[m] and "plan_ns_alt" in data[b]:
+                red, sd = time_reduction(data[m], data[b], key="plan_ns_alt")
+                row[f"time_reduction_vs_{b}_alt_pct"] = red
+                row[f"time_reduction_vs_{b}_alt_pct_std"] = sd
         rows.append(row)
     df = pd.DataFrame(rows)
     if published_reduction_vs_svd is not None:

@@ -61,6 +61,7 @@ __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "Pl
            "plan", "OBJECTIVES", "PICKERS", "available_methods", "depth_objective"]
 
 INVPHI = (math.sqrt(5.0) - 1.0) / 2.0      # 1/phi = 0.618...
+_EYE6 = np.eye(6)
 
 
 def golden_section(fun: Callable[[float], float], a: float, b: float, tol: float
@@ -339,9 +340,10 @@ def metric_objective(name: str) -> Callable:
         from opnav.landing.metrics import MetricContext
 
         m = _metric(name)
-        ctx = MetricContext(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
-                            p_known_L=np.asarray(cfg.p_known, float), P=state.P,
-                            R_meas=(sigma_b**2) * np.eye(6), boresight_B=camera.boresight_B)
+        # inputs validated once per descent (descent.run_descent), not per call
+        ctx = MetricContext.trusted(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
+                                    p_known_L=np.asarray(cfg.p_known, float), P=state.P,
+                                    R_meas=(sigma_b**2) * _EYE6, boresight_B=camera.boresight_B)
         ground = _ground_fn(geom)
         path = cfg.eval_path
         # batch scoring of landmarks (edge rule): the same computation as the search's
@@ -407,6 +409,16 @@ def _pick_center(field_, cand, state, camera, rng) -> int:
 PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center}
 
 
+def alternative_path(cfg: PlannerConfig) -> PlannerConfig:
+    """``cfg`` on the other fastest faithful evaluation path of the baselines:
+    closed-form singular values if ``cfg`` uses the explicit matrices, else the
+    explicit H + LAPACK path (``matrix_scalar``); for timing both (B-F7, B-T3)."""
+    import dataclasses
+
+    return dataclasses.replace(cfg, eval_path="matrix_scalar" if cfg.eval_path == "closed_form"
+                               else "closed_form")
+
+
 def available_methods() -> tuple[str, ...]:
     return tuple(OBJECTIVES) + tuple(PICKERS)
 
@@ -442,7 +454,7 @@ def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
 def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
          visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
          exclude: set = frozenset(), rng: np.random.Generator | None = None,
-         detected: np.ndarray | None = None) -> PlanResult:
+         detected: np.ndarray | None = None, diagnose: bool = True) -> PlanResult:
     """One planning call (see :func:`_plan`), with its wall time (``time_ns``,
     ``perf_counter_ns``) and the CPU time of the calling thread (``cpu_ns``,
     CLOCK_THREAD_CPUTIME_ID, insensitive to other processes on a shared machine).
@@ -460,7 +472,7 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     c0 = _thread_ns()
     res, fun = _plan(method, state, camera, field_, visible, cfg, exclude, rng, cand)
     res.cpu_ns = _thread_ns() - c0
-    if fun is not None and res.index >= 0 and cand.size:
+    if diagnose and fun is not None and res.index >= 0 and cand.size:
         vals = getattr(fun, "diagnostic", fun.batch)(field_.xyz[cand])
         fin = np.isfinite(vals)
         if fin.any():

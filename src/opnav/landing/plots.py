@@ -17,9 +17,11 @@ __all__ = ["fig_true_states", "fig_depth_error_map", "fig_nav_error_envelopes",
            "fig_planning_time", "METHOD_COLORS"]
 
 METHOD_COLORS = {"depth": "C0", "svd": "C1", "gdop": "C2", "cond": "C3", "logdet": "C4",
-                 "mineig": "C5", "random": "C6", "center": "C7"}
+                 "mineig": "C5", "random": "C6", "center": "C7", "svd_w": "C8", "gdop_w": "C9",
+                 "cond_w": "k"}
 METHOD_LABELS = {"depth": "depth error", "svd": "SVD", "gdop": "GDOP", "cond": "cond. number",
-                 "logdet": "log-det", "mineig": "min. eigenvalue"}
+                 "logdet": "log-det", "mineig": "min. eigenvalue", "svd_w": "SVD (whitened)",
+                 "gdop_w": "GDOP (whitened)", "cond_w": "cond. (whitened)"}
 
 
 def _color(m, i):
@@ -48,26 +50,32 @@ def fig_true_states(t, r, v, rpy_deg):
         return fig
 
 
-def fig_depth_error_map(uv_px, dr_m, best_idx, half_px, curve_beta_deg, curve_dr, interval_deg,
-                        opt_beta_deg, opt_uv_px=None):
-    """B-F5: depth error of the visible landmarks in the image (a), the single
-    optimum marked, and along the velocity's vertical plane vs beta (b)."""
+def fig_depth_error_map(dm: dict):
+    """B-F5 from :func:`opnav.landing.descent.depth_map`: (a) the detected
+    landmarks in the image coloured by depth error, the best one and the
+    in-plane golden-section direction marked; (b) the whole field on the
+    ground (no image constraint), its best landmark, the unconstrained in-plane
+    optimum, the image footprint and the in-plane direction; (c) the in-plane
+    depth error vs signed beta with the visible interval."""
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
 
+    uv_px, dr_m, best_idx, half_px = dm["uv_px"], dm["dr_m"], dm["best"], dm["half_px"]
     with figures.style():
-        fig, axs = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.0), constrained_layout=True,
-                                gridspec_kw={"width_ratios": [1.15, 1]})
-        ax = axs[0]
+        fig, axs = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 2.9), constrained_layout=True,
+                                gridspec_kw={"width_ratios": [1.1, 1.1, 1]})
         fin = np.isfinite(dr_m)
-        sc = ax.scatter(uv_px[fin, 0], uv_px[fin, 1], c=dr_m[fin], s=3, cmap="viridis",
-                        norm=LogNorm(vmin=np.nanmin(dr_m[fin]), vmax=np.nanpercentile(dr_m[fin], 99)),
+        lo_c = float(min(np.nanmin(dr_m[fin]), dm["field_best_dr"]))
+        norm = LogNorm(vmin=lo_c, vmax=float(np.nanpercentile(dr_m[fin], 99)))
+        ax = axs[0]
+        sc = ax.scatter(uv_px[fin, 0], uv_px[fin, 1], c=dr_m[fin], s=3, cmap="viridis", norm=norm,
                         rasterized=True)
         ax.plot(*uv_px[best_idx], marker="*", ms=12, mfc="red", mec="k", ls="none", zorder=5,
-                clip_on=False, label=f"optimum ({dr_m[best_idx]:.0f} m)")
-        if opt_uv_px is not None and np.all(np.isfinite(opt_uv_px)):
-            ax.plot(*opt_uv_px, marker="+", ms=12, mew=2.0, color="red", ls="none", zorder=5,
-                    clip_on=False, label="golden-section direction")
+                clip_on=False, label=f"best detected ({dr_m[best_idx]:.0f} m)")
+        opt_uv = dm.get("opt_uv_px")
+        if opt_uv is not None and np.all(np.isfinite(opt_uv)):
+            ax.plot(*opt_uv, marker="+", ms=12, mew=2.0, color="red", ls="none", zorder=5,
+                    clip_on=False, label=f"golden section ({dm['opt_dr']:.0f} m)")
         ax.plot([-half_px, half_px, half_px, -half_px, -half_px],
                 [-half_px, -half_px, half_px, half_px, -half_px], color="k", lw=0.6)
         ax.set_xlim(-1.06 * half_px, 1.06 * half_px)
@@ -75,17 +83,43 @@ def fig_depth_error_map(uv_px, dr_m, best_idx, half_px, curve_beta_deg, curve_dr
         ax.set_aspect("equal")
         ax.set_xlabel("image u (px)")
         ax.set_ylabel("image v (px)")
-        ax.legend(loc="upper left", fontsize="small")
-        fig.colorbar(sc, ax=ax, label="depth estimation error (m)")
+        ax.set_title("(a) detected landmarks", fontsize="small")
+        ax.legend(loc="upper left", fontsize="x-small")
         ax = axs[1]
-        ax.semilogy(curve_beta_deg, curve_dr, color="C0")
-        for lo, hi in interval_deg:
+        fx, fd = dm["field_xy"], dm["field_dr"]
+        ax.scatter(fx[:, 0] / 1e3, fx[:, 1] / 1e3, c=fd, s=1, cmap="viridis", norm=norm,
+                   rasterized=True)
+        fp = np.vstack([dm["footprint_xy"], dm["footprint_xy"][:1]]) / 1e3
+        ax.plot(fp[:, 0], fp[:, 1], color="k", lw=0.8, label="image footprint")
+        lx, ly = dm["lander_xy"] / 1e3
+        ax.plot(lx, ly, marker="^", color="k", ls="none", ms=6, label="lander (nadir)")
+        ax.plot(*(dm["field_best_xy"] / 1e3), marker="*", ms=12, mfc="orange", mec="k", ls="none",
+                zorder=5, label=f"best in field ({dm['field_best_dr']:.0f} m)")
+        ug = dm["unconstrained_ground_xy"] / 1e3
+        ax.plot(*ug, marker="x", ms=9, mew=2.0, color="orange", ls="none", zorder=5,
+                label=f"unconstrained in-plane opt. ({dm['unconstrained_dr']:.0f} m)")
+        og = dm.get("opt_ground_xy")
+        if og is not None and np.all(np.isfinite(og)):
+            ax.plot([lx, og[0] / 1e3], [ly, og[1] / 1e3], color="red", lw=1.0, ls="--",
+                    label="golden-section direction")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (km)")
+        ax.set_ylabel("y (km)")
+        ax.set_title("(b) whole field, no image constraint", fontsize="small")
+        ax.legend(loc="best", fontsize="xx-small")
+        fig.colorbar(sc, ax=axs[:2], label="depth estimation error (m)", shrink=0.8)
+        ax = axs[2]
+        ax.semilogy(dm["beta_deg"], dm["curve_dr"], color="C0")
+        for lo, hi in dm["interval_deg"]:
             ax.axvspan(lo, hi, color="0.9", zorder=0)
-        ax.axvline(opt_beta_deg, color="k", ls="--", lw=0.8,
-                   label=f"golden-section optimum {opt_beta_deg:.1f} deg")
+        ax.axvline(dm["opt_beta_deg"], color="red", ls="--", lw=0.8,
+                   label=f"golden section {dm['opt_beta_deg']:.1f} deg")
+        ax.axvline(dm["unconstrained_beta_deg"], color="orange", ls=":", lw=1.0,
+                   label=f"unconstrained {dm['unconstrained_beta_deg']:.1f} deg")
         ax.set_xlabel("signed beta (deg); grey: visible")
         ax.set_ylabel("in-plane depth error (m)")
-        ax.legend(loc="upper right", fontsize="small")
+        ax.set_title("(c) velocity's vertical plane", fontsize="small")
+        ax.legend(loc="upper right", fontsize="x-small")
         return fig
 
 
@@ -119,33 +153,59 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
         return fig
 
 
-def fig_planning_time(data: dict[str, dict], published_reduction_vs_svd: float | None = None):
+def fig_planning_time(data: dict[str, dict], published_reduction_vs_svd: float | None = None,
+                      eval_path: str = "matrix_scalar"):
     """B-F7: planning-call wall time (us) per method, box = quartiles, whiskers =
-    min/max (as the paper's Fig. 7), medians and evaluations per call annotated."""
+    min/max (as the paper's Fig. 7), medians and evaluations per call annotated.
+    Methods with an alternative metric evaluation path (``plan_ns_alt``: the
+    same calls re-timed on it) get a second, hatched box beside the first."""
     import matplotlib.pyplot as plt
 
+    from opnav.landing.planner import alternative_path, PlannerConfig
+
+    alt_name = alternative_path(PlannerConfig(eval_path=eval_path)).eval_path
     methods = list(data)
     with figures.style():
-        fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.8), constrained_layout=True)
-        vals = [np.asarray(data[m]["plan_ns"], float) / 1e3 for m in methods]
-        bp = ax.boxplot(vals, whis=(0, 100), showfliers=False, patch_artist=True, widths=0.6)
-        for k, (patch, m) in enumerate(zip(bp["boxes"], methods)):
-            patch.set_facecolor(_color(m, k))
+        fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 3.0), constrained_layout=True)
+        pos, vals, cols, hatch = [], [], [], []
+        for k, m in enumerate(methods, start=1):
+            v = np.asarray(data[m]["plan_ns"], float) / 1e3
+            va = np.asarray(data[m].get("plan_ns_alt", data[m]["plan_ns"]), float) / 1e3
+            has_alt = m != "depth" and "plan_ns_alt" in data[m] and not np.array_equal(v, va)
+            pos.append(k - 0.18 if has_alt else k)
+            vals.append(v)
+            cols.append(_color(m, k - 1))
+            hatch.append("")
+            if has_alt:
+                pos.append(k + 0.18)
+                vals.append(va)
+                cols.append(_color(m, k - 1))
+                hatch.append("///")
+        bp = ax.boxplot(vals, positions=pos, whis=(0, 100), showfliers=False, patch_artist=True,
+                        widths=0.32)
+        for patch, c, h in zip(bp["boxes"], cols, hatch):
+            patch.set_facecolor(c)
             patch.set_alpha(0.5)
+            patch.set_hatch(h)
         ax.set_yscale("log")
         labels = []
-        for m, v in zip(methods, vals):
+        for m in methods:
             ev = np.median(data[m]["plan_evals"]) if len(data[m]["plan_evals"]) else math.nan
             labels.append(f"{_label(m)}\n{ev:.0f} evals")
         ax.set_xticks(range(1, len(methods) + 1), labels, fontsize="small")
-        for k, v in enumerate(vals, start=1):
+        for p_, v in zip(pos, vals):
             if len(v):
                 med = float(np.median(v))
-                ax.annotate(f"{med:.0f}", (k, med), xytext=(0, 3), textcoords="offset points",
-                            ha="center", va="bottom", fontsize="x-small")
+                ax.annotate(f"{med:.0f}", (p_, med), xytext=(0, 3), textcoords="offset points",
+                            ha="center", va="bottom", fontsize="xx-small")
         ax.set_ylabel("planning-call time (us)")
+        ax.set_xlabel(f"plain: {eval_path}; hatched: {alt_name}", fontsize="small")
         if published_reduction_vs_svd is not None and "depth" in data and "svd" in data:
-            ours = 100 * (1 - np.median(vals[methods.index("depth")]) / np.median(vals[methods.index("svd")]))
-            ax.set_title(f"depth vs SVD median: {ours:.1f} % less (published {published_reduction_vs_svd:.2f} %)",
-                         fontsize="small")
+            d = np.median(data["depth"]["plan_ns"])
+            ours = 100 * (1 - d / np.median(data["svd"]["plan_ns"]))
+            title = f"depth vs SVD: {ours:.1f} % less ({eval_path})"
+            if "plan_ns_alt" in data["svd"]:
+                ours_alt = 100 * (1 - d / np.median(data["svd"]["plan_ns_alt"]))
+                title += f", {ours_alt:.1f} % ({alt_name})"
+            ax.set_title(f"{title}\npublished {published_reduction_vs_svd:.2f} %", fontsize="x-small")
         return fig

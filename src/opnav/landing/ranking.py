@@ -33,7 +33,8 @@ from scipy import stats
 from opnav.landing.montecarlo import per_run_stats, same_pick_pct
 
 __all__ = ["paired_t_interval", "bootstrap_mean_interval", "paired_difference",
-           "competition_rank", "ranking_table", "headline"]
+           "competition_rank", "ranking_table", "headline", "median_abs_dbeta_deg",
+           "pair_comparison", "pair_table"]
 
 
 def paired_t_interval(d, level: float = 0.95) -> tuple[float, float, float, float]:
@@ -90,6 +91,49 @@ def paired_difference(a, b, n_boot: int = 2000, seed: int = 0, level: float = 0.
     return {"mean": m, "t_lo": lo, "t_hi": hi, "p": p, "boot_lo": blo, "boot_hi": bhi,
             "a_lower_pct": float(100.0 * np.mean(a < b)),
             "equal_pct": float(100.0 * np.mean(a == b)), "n": int(d.size)}
+
+
+def _calls(d: dict) -> dict:
+    beta = d.get("plan_beta", np.full(len(d["plan_index"]), np.nan))
+    return {(int(r), float(t)): (int(i), float(b)) for r, t, i, b in
+            zip(d["plan_run"], d["plan_t"], d["plan_index"], beta)}
+
+
+def median_abs_dbeta_deg(a: dict, b: dict) -> float:
+    """Median over planning calls matched by (run, time) of |beta*_a - beta*_b|
+    (deg), the in-plane optima of two methods; NaN if no call has both."""
+    ka, kb = _calls(a), _calls(b)
+    d = [abs(ka[k][1] - kb[k][1]) for k in set(ka) & set(kb)
+         if math.isfinite(ka[k][1]) and math.isfinite(kb[k][1])]
+    return float(np.degrees(np.median(d))) if d else math.nan
+
+
+def pair_comparison(a: dict, b: dict, level: float = 0.95) -> dict:
+    """What a comparison of two methods' accuracy rests on (same paired runs):
+    the share of planning calls where they chose the same landmark (%), the
+    median |delta beta*| (deg), and the paired difference a - b of the per-run
+    RMS and final (touchdown) position error norms (m) with its paired-t
+    interval at ``level``, also relative to b's mean (%)."""
+    sa, sb = per_run_stats(a), per_run_stats(b)
+    out = {"same_pick_pct": same_pick_pct(a, b), "median_abs_dbeta_deg": median_abs_dbeta_deg(a, b)}
+    for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos")):
+        x, y = sa[key].to_numpy(), sb[key].to_numpy()
+        if x.shape != y.shape or x.size == 0:
+            raise ValueError("pair_comparison: the two methods must have flown the same runs")
+        m, lo, hi, p = paired_t_interval(x - y, level)
+        base = float(np.mean(y))
+        out.update({f"d_{name}_m": m, f"d_{name}_lo_m": lo, f"d_{name}_hi_m": hi, f"d_{name}_p": p,
+                    f"d_{name}_rel_pct": 100.0 * m / base,
+                    f"d_{name}_rel_lo_pct": 100.0 * lo / base, f"d_{name}_rel_hi_pct": 100.0 * hi / base})
+    return out
+
+
+def pair_table(data: dict[str, dict], level: float = 0.95) -> pd.DataFrame:
+    """:func:`pair_comparison` for every unordered pair of methods (in order)."""
+    names = list(data)
+    rows = [{"method_a": a, "method_b": b, **pair_comparison(data[a], data[b], level)}
+            for i, a in enumerate(names) for b in names[i + 1:]]
+    return pd.DataFrame(rows)
 
 
 def competition_rank(values, rtol: float = 0.0) -> np.ndarray:
@@ -173,6 +217,8 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
                 row["equal_to_ref_pct"] = pdiff["equal_pct"]
         row["same_pick_as_ref_pct"] = (100.0 if m == reference
                                        else same_pick_pct(d, data[reference]))
+        row["median_abs_dbeta_vs_ref_deg"] = (0.0 if m == reference
+                                              else median_abs_dbeta_deg(d, data[reference]))
         lo, hi = row["d_rms_pos_vs_ref_t_lo"], row["d_rms_pos_vs_ref_t_hi"]
         row["vs_ref"] = ("reference" if m == reference else
                          "n/a" if math.isnan(lo) else

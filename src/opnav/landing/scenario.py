@@ -24,8 +24,34 @@ def derived_initial_attitude_deg(landing_cfg: dict) -> np.ndarray:
 
     s = landing_cfg["initial_state"]
     tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),
-                      landing_cfg["gravity_mps2"], float(landing_cfg.get("yaw_deg", 0.0)))
+                      landing_cfg["gravity_mps2"], float(landing_cfg.get("yaw_deg", 0.0)),
+                      landing_cfg.get("terminal_accel_mps2"))
     return euler_rpy_deg(tr.R_LtoB[0])
+
+
+def thrust_tilt_azimuth_deg(landing_cfg: dict) -> tuple[float, float]:
+    """Initial thrust axis (body +z in {L}) as (tilt from the vertical, azimuth
+    from +x toward +y), deg."""
+    from opnav.landing.trajectory import truth_states
+
+    s = landing_cfg["initial_state"]
+    tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),
+                      landing_cfg["gravity_mps2"], float(landing_cfg.get("yaw_deg", 0.0)),
+                      landing_cfg.get("terminal_accel_mps2"))
+    z = tr.R_LtoB[0][2]
+    return (float(np.degrees(np.arccos(np.clip(z[2], -1.0, 1.0)))),
+            float(np.degrees(np.arctan2(z[1], z[0]))))
+
+
+def initial_attitude_report(landing_cfg: dict) -> dict:
+    """Our initial attitude in the convention that matches the paper's Table 1
+    triple: ``-(yaw, pitch, roll)`` of the Z-Y-X sequence with roll 0 that
+    points body +z along the initial thrust, i.e. ``-(azimuth, tilt, 0)``
+    (deg). The tilt follows from the Table 1 state and the touchdown; the
+    azimuth also from the unstated terminal horizontal acceleration."""
+    tilt, az = thrust_tilt_azimuth_deg(landing_cfg)
+    return {"paper_convention_deg": [-az, -tilt, 0.0], "tilt_deg": tilt, "azimuth_deg": az,
+            "rpy_deg": [float(x) for x in derived_initial_attitude_deg(landing_cfg)]}
 
 
 def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
@@ -34,11 +60,12 @@ def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
     guidance thrust direction)."""
     s = landing_cfg["initial_state"]
     pub = published.paper_b()["table1_initial_state"]
-    att = derived_initial_attitude_deg(landing_cfg)
+    att = initial_attitude_report(landing_cfg)["paper_convention_deg"]
     rows = [
         ("position", "m", s["r_m"], pub["r_m"], s["r_m"]),
         ("velocity", "m/s", s["v_mps"], pub["v_mps"], s["v_mps"]),
-        ("attitude (roll, pitch, yaw)", "deg", s["att_deg"], pub["att_deg"], np.round(att, 2)),
+        ("attitude -(yaw, pitch, roll), Z-Y-X, roll 0", "deg", s["att_deg"], pub["att_deg"],
+         np.round(att, 2)),
     ]
     return pd.DataFrame(
         {
@@ -73,3 +100,27 @@ def error_bounds_table(landing_cfg: dict) -> pd.DataFrame:
             "runs": [n] * 3,
         }
     )
+
+
+def camera_scenarios(landing_cfg: dict) -> dict[str, dict]:
+    """The ``landing`` config of every camera scenario (``landing.scenarios``:
+    name -> overlay on ``landing.camera``), in config order; each holds the
+    merged ``camera`` and no ``scenarios`` key. Raises ``ValueError`` naming
+    ``landing.headline_scenario`` if it is not one of the scenarios."""
+    scen = landing_cfg.get("scenarios") or {"default": {}}
+    head = landing_cfg.get("headline_scenario")
+    if head is not None and head not in scen:
+        raise ValueError(f"landing.headline_scenario: {head!r} is not one of landing.scenarios "
+                         f"({', '.join(scen)})")
+    out = {}
+    for name, overlay in scen.items():
+        cfg = {k: v for k, v in landing_cfg.items() if k not in ("scenarios", "headline_scenario")}
+        cfg["camera"] = {**landing_cfg["camera"], **(overlay or {})}
+        out[name] = cfg
+    return out
+
+
+def headline_scenario(landing_cfg: dict) -> str:
+    """The scenario the manuscript leads with (validated by :func:`camera_scenarios`)."""
+    scen = camera_scenarios(landing_cfg)
+    return landing_cfg.get("headline_scenario") or next(iter(scen))

@@ -6,11 +6,13 @@ Polynomial guidance: the acceleration in the landing frame {L} is quadratic in
 time, ``a(t) = c0 + c1 t + c2 t^2`` per axis, with the three coefficients per
 axis fixed by touchdown at the site at ``t = T``::
 
-    r(T) = 0,  v(T) = 0,  a(T) = 0
+    r(T) = 0,  v(T) = 0,  a(T) = (a_x, a_y, 0)
 
-The last condition makes the terminal thrust vertical (specific force
-``f(T) = a(T) - g = -g``, straight up), the Apollo-style terminal constraint of
-the SPEC. Planet rotation is neglected (paper assumption 1), gravity ``g`` is
+With the default ``a_x = a_y = 0`` (config ``landing.terminal_accel_mps2``)
+the terminal thrust is vertical (specific force ``f(T) = -g``, straight up),
+the Apollo-style terminal constraint of the SPEC. The paper does not state
+its terminal constraint; the initial thrust azimuth depends on it, the
+initial tilt hardly (``opnav.landing.scenario.initial_attitude_report``). Planet rotation is neglected (paper assumption 1), gravity ``g`` is
 uniform (flat ground, {L} z up).
 
 Attitude follows the thrust: the body +z axis is along the specific force
@@ -31,9 +33,11 @@ from scipy.spatial.transform import Rotation
 __all__ = ["guidance_coefficients", "Truth", "truth_states", "euler_rpy_deg"]
 
 
-def guidance_coefficients(r0: np.ndarray, v0: np.ndarray, T: float) -> np.ndarray:
+def guidance_coefficients(r0: np.ndarray, v0: np.ndarray, T: float, a_T=None) -> np.ndarray:
     """Coefficients ``c`` (3, 3) of ``a(t) = c[0] + c[1] t + c[2] t^2`` (per axis)
-    that bring ``(r0, v0)`` to ``r = v = a = 0`` at ``t = T`` (s)."""
+    that bring ``(r0, v0)`` to ``r = v = 0`` and ``a = a_T`` at ``t = T`` (s);
+    ``a_T`` (m/s^2) is the terminal horizontal acceleration ``(a_x, a_y)``
+    (default 0: vertical terminal thrust), its vertical part 0."""
     if not (np.isfinite(T) and T > 0):
         raise ValueError(f"landing.duration_s must be positive, got {T}")
     r0 = np.asarray(r0, float)
@@ -44,7 +48,10 @@ def guidance_coefficients(r0: np.ndarray, v0: np.ndarray, T: float) -> np.ndarra
     A = np.array([[T**2 / 2, T**3 / 6, T**4 / 12],
                   [T, T**2 / 2, T**3 / 3],
                   [1.0, T, T**2]])
-    rhs = np.stack([-r0 - v0 * T, -v0, np.zeros(3)])
+    aT = np.zeros(3)
+    if a_T is not None:
+        aT[:2] = np.asarray(a_T, float)[:2]
+    rhs = np.stack([-r0 - v0 * T, -v0, aT])
     return np.linalg.solve(A, rhs)
 
 
@@ -73,7 +80,7 @@ def _attitude_from_thrust(f: np.ndarray, yaw_deg: float) -> np.ndarray:
     return np.transpose(R_BtoL, (0, 2, 1))
 
 
-def truth_states(t: np.ndarray, r0, v0, T: float, g, yaw_deg: float = 0.0) -> Truth:
+def truth_states(t: np.ndarray, r0, v0, T: float, g, yaw_deg: float = 0.0, a_T=None) -> Truth:
     """Truth position, velocity, acceleration and attitude at times ``t`` (s).
 
     Raises ``ValueError`` if the thrust (specific force) vanishes, i.e. the
@@ -83,7 +90,7 @@ def truth_states(t: np.ndarray, r0, v0, T: float, g, yaw_deg: float = 0.0) -> Tr
     r0 = np.asarray(r0, float)
     v0 = np.asarray(v0, float)
     g = np.asarray(g, float)
-    c = guidance_coefficients(r0, v0, T)
+    c = guidance_coefficients(r0, v0, T, a_T)
     tt = t[:, None]
     a = c[0] + c[1] * tt + c[2] * tt**2
     v = v0 + c[0] * tt + c[1] * tt**2 / 2 + c[2] * tt**3 / 3

@@ -1,0 +1,27 @@
+"""Gather per-scenario summaries of paper B into one JSON: ``scenarios`` (by
+name, with each scenario's camera), ``headline_scenario``, and the headline
+scenario's keys also at the top level (the manuscript's default numbers)."""
+
+import json
+
+from opnav.snakeio import mock_snakemake, script_context
+from opnav.tables import write_json
+
+if "snakemake" not in globals():  # standalone debugging run
+    snakemake = mock_snakemake(
+        input={"parts": [f"results/landing/summaries/B-summary_{s}.json" for s in ("site-tilt", "interior")]},
+        output=["results/landing/B-summary.json"])
+    snakemake.params = type("P", (), {"scenarios": ["site-tilt", "interior"], "headline": "interior",
+                                      "cameras": {}})()
+
+with script_context(snakemake) as log:
+    names = list(snakemake.params.scenarios)
+    parts = {n: json.loads(open(p).read()) for n, p in zip(names, snakemake.input.parts)}
+    head = snakemake.params.headline
+    out = dict(parts[head])
+    cams = dict(snakemake.params.cameras)
+    out["scenarios"] = {n: {**parts[n], "camera": cams.get(n, {})} for n in names}
+    out["headline_scenario"] = head
+    out["scenario_names_text"] = ", ".join(names)
+    write_json(snakemake.output[0], out)
+    log.info("%s: scenarios %s, headline %s", snakemake.output[0], names, head)

@@ -1,0 +1,22 @@
+"""B-F4: the truth trajectory of paper B's descent (camera-independent)."""
+
+import numpy as np
+
+from opnav import figures
+from opnav.landing import plots
+from opnav.landing.trajectory import euler_rpy_deg, truth_states
+from opnav.snakeio import mock_snakemake, script_context
+
+if "snakemake" not in globals():  # standalone debugging run
+    snakemake = mock_snakemake(output={"f4": ["results/landing/B-F4_true_states.pdf",
+                                              "results/landing/B-F4_true_states.png"]})
+    snakemake.params = type("P", (), {"landing": snakemake.config["landing"]})()
+
+with script_context(snakemake) as log:
+    c = snakemake.params.landing
+    T = float(c["duration_s"])
+    t = np.linspace(0.0, T, int(round(T)) * 10 + 1)
+    tr = truth_states(t, c["initial_state"]["r_m"], c["initial_state"]["v_mps"], T,
+                      c["gravity_mps2"], float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2"))
+    figures.save(plots.fig_true_states(tr.t, tr.r, tr.v, euler_rpy_deg(tr.R_LtoB)), snakemake.output.f4)
+    log.info("B-F4 over %d samples", t.size)
