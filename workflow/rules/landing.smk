@@ -55,7 +55,11 @@ _B_SIM_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "termin
 B_SIMS = {s: canonical({**{k: c[k] for k in _B_SIM_KEYS},
                         "mc": {k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")}})
           for s, c in B_SCENARIO_CFG.items()}
-B_SIM = B_SIMS[B_HEADLINE]          # the headline scenario (B-X2 ablations)
+# B-X2 ablations sweep values of landing.camera itself (fov_deg), so they fly the
+# base camera with no scenario overlay (e.g. 45 deg FOV with interior's 10 deg tilt
+# would lose the site)
+B_SIM = canonical({**{k: config["landing"][k] for k in _B_SIM_KEYS},
+                   "mc": {k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")}})
 B_SRC = src("landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
             "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
             "landing/planner.py", "landing/descent.py", "landing/montecarlo.py",

@@ -2,7 +2,7 @@
 # Included right after landing.smk: reuses its LANDING, B_SIM(S), B_SRC, B_METHODS,
 # B_SCENARIOS and its Monte-Carlo wildcard rules (an extra method is one more gathered
 # results/landing/mc/{scenario}/{method}.npz, same runs, same seeds). The ablations
-# run in the headline scenario (B_SIM).
+# fly landing.camera without scenario overlay (B_SIM).
 from opnav.landing.ablation import SWEEPS as _B_SWEEPS, value_label as _b_value_label
 
 _BX = config["landing"]["extra"]

@@ -533,7 +533,16 @@ def _whitening(ctx: MetricContext):
 def _whitened_scores(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
     """The ``WHITENED[name]`` score of H_w = C^-1 H L for H (n, 6, 12)."""
     Ci, L = _whitening(ctx)
-    s = np.linalg.svd(Ci @ H @ L, compute_uv=False)[..., :STRUCTURAL_RANK]
+    Hw = Ci @ H @ L
+    if Hw.shape[0] == 1:
+        s = _dgesvd(Hw[0], compute_uv=0)[1][None, :STRUCTURAL_RANK]
+    else:
+        # batch: the singular values squared are the eigenvalues of the 6 x 6 Gram
+        # matrix Hw Hw^T (LAPACK dsyevd, ~5x faster than a 6 x 12 SVD per candidate;
+        # relative error of s4 ~ eps (s1 / s4)^2, tested against the SVD)
+        G = Hw @ np.swapaxes(Hw, -1, -2)
+        lam = np.linalg.eigvalsh(0.5 * (G + np.swapaxes(G, -1, -2)))[..., ::-1][..., :STRUCTURAL_RANK]
+        s = np.sqrt(np.maximum(lam, 0.0))
     base = WHITENED[name]
     if base == "svd":
         return s[..., -1]

@@ -470,10 +470,11 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     if exclude:
         cand = cand[~np.isin(cand, np.fromiter(exclude, np.int64))]
     c0 = _thread_ns()
-    res, fun = _plan(method, state, camera, field_, visible, cfg, exclude, rng, cand)
+    res, fun, vals = _plan(method, state, camera, field_, visible, cfg, exclude, rng, cand)
     res.cpu_ns = _thread_ns() - c0
     if diagnose and fun is not None and res.index >= 0 and cand.size:
-        vals = getattr(fun, "diagnostic", fun.batch)(field_.xyz[cand])
+        if vals is None:       # (edge calls scored every detected landmark already)
+            vals = getattr(fun, "diagnostic", fun.batch)(field_.xyz[cand])
         fin = np.isfinite(vals)
         if fin.any():
             f_pick = vals[np.searchsorted(cand, res.index)] if res.index in cand else math.nan
@@ -491,7 +492,8 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
           visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
           exclude: set, rng: np.random.Generator | None, cand: np.ndarray):
     """One planning call: choose the next unknown landmark; returns the
-    :class:`PlanResult` and the objective used (None for direct pickers).
+    :class:`PlanResult`, the objective used (None for direct pickers) and the
+    detected landmarks' scores if the edge rule computed them (else None).
 
     ``visible(points_L (n, 3)) -> bool (n,)`` says which landmarks the camera
     actually detects (truth pose; the same for every method); ``cand`` (sorted
@@ -513,7 +515,7 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     if method in PICKERS:
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
-                          math.nan, 0, time.perf_counter_ns() - t0), None
+                          math.nan, 0, time.perf_counter_ns() - t0), None, None
     build = OBJECTIVES.get(method)
     if build is None:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
@@ -543,11 +545,12 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
             -(state.R_LtoB.T @ camera.boresight_B)[2], 1e-3)
         k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
         return PlanResult(method, k, math.nan, point, math.nan, n, time.perf_counter_ns() - t0,
-                          note or "no finite objective"), fun
+                          note or "no finite objective"), fun, None
     fx, x, a, b = best
     point = np.array(_ground_fn(geom)(x))
     edge = min(x - a, b - x) <= cfg.tol_rad
     k = -1
+    vals = None
     if edge and cand.size:
         vals = fun.batch(field_.xyz[cand])
         n += int(cand.size)
@@ -556,4 +559,4 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     if k < 0:
         k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
     return PlanResult(method, k, x, point, fx, n, time.perf_counter_ns() - t0, note,
-                      edge=bool(edge)), fun
+                      edge=bool(edge)), fun, vals
