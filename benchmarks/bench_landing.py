@@ -109,7 +109,7 @@ def run_mc(config: str | None) -> float:
     tmp = Path(tempfile.mkdtemp(prefix="bench_landing_"))
     try:
         res_dir = tmp / "results"
-        targets = [str(res_dir / "landing" / "B-T3_summary.csv")]
+        targets = [str(res_dir / "landing" / "B-summary.json")]     # every camera scenario
         cmd = [sys.executable, "-m", "snakemake", "--cores", "2", "--quiet", "rules",
                "--config", f"results_dir={res_dir}"]
         if config:
