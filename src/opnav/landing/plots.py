@@ -62,7 +62,7 @@ def fig_depth_error_map(dm: dict):
 
     uv_px, dr_m, best_idx, half_px = dm["uv_px"], dm["dr_m"], dm["best"], dm["half_px"]
     with figures.style():
-        fig, axs = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 2.9), constrained_layout=True,
+        fig, axs = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 3.4), constrained_layout=True,
                                 gridspec_kw={"width_ratios": [1.1, 1.1, 1]})
         fin = np.isfinite(dr_m)
         lo_c = float(min(np.nanmin(dr_m[fin]), dm["field_best_dr"]))
@@ -102,12 +102,18 @@ def fig_depth_error_map(dm: dict):
         if og is not None and np.all(np.isfinite(og)):
             ax.plot([lx, og[0] / 1e3], [ly, og[1] / 1e3], color="red", lw=1.0, ls="--",
                     label="golden-section direction")
+        # the field's extent (a footprint corner near the horizon reaches far beyond it)
+        lo_xy, hi_xy = fx.min(axis=0) / 1e3, fx.max(axis=0) / 1e3
+        pad = 0.05 * float(np.max(hi_xy - lo_xy))
+        ax.set_xlim(lo_xy[0] - pad, hi_xy[0] + pad)
+        ax.set_ylim(lo_xy[1] - pad, hi_xy[1] + pad)
         ax.set_aspect("equal")
         ax.set_xlabel("x (km)")
         ax.set_ylabel("y (km)")
         ax.set_title("(b) whole field, no image constraint", fontsize="small")
-        ax.legend(loc="best", fontsize="xx-small")
-        fig.colorbar(sc, ax=axs[:2], label="depth estimation error (m)", shrink=0.8)
+        ax.legend(loc="lower left", fontsize=4.5, framealpha=0.8)
+        fig.colorbar(sc, ax=axs[:2], label="depth estimation error (m)", shrink=0.7,
+                     location="bottom", pad=0.02)
         ax = axs[2]
         ax.semilogy(dm["beta_deg"], dm["curve_dr"], color="C0")
         for lo, hi in dm["interval_deg"]:
@@ -116,9 +122,9 @@ def fig_depth_error_map(dm: dict):
                    label=f"golden section {dm['opt_beta_deg']:.1f} deg")
         ax.axvline(dm["unconstrained_beta_deg"], color="orange", ls=":", lw=1.0,
                    label=f"unconstrained {dm['unconstrained_beta_deg']:.1f} deg")
-        ax.set_xlabel("signed beta (deg); grey: visible")
+        ax.set_xlabel("signed beta (deg)")
         ax.set_ylabel("in-plane depth error (m)")
-        ax.set_title("(c) velocity's vertical plane", fontsize="small")
+        ax.set_title("(c) velocity's plane (grey: visible)", fontsize="small")
         ax.legend(loc="upper right", fontsize="x-small")
         return fig
 
