@@ -225,6 +225,16 @@ def _num(x: float, fmt: str = "{:.4g}") -> str:
     return fmt.format(x)
 
 
+def _stall_or(r, text: str) -> str:
+    """'stalled (k/n)' for a row the stall rule flags (SPEC A.3c), else ``text``."""
+    st = r.get("stalled")
+    if isinstance(st, str):
+        st = st.strip().lower() == "true"
+    if st:
+        return f"stalled ({_num(r.get('stalled_seeds'), '{:.0f}')}/{_num(r.get('n_seeds'), '{:.0f}')})"
+    return text
+
+
 def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     """A-T1 for the page: one table per scenario variant, ours beside published.
 
@@ -243,8 +253,9 @@ def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
                 'truth x, y (")': f"{_num(r['truth_x_arcsec'], '{:g}')}, {_num(r['truth_y_arcsec'], '{:g}')}",
                 'est. x (")': _pm(r["est_x_mean"], r.get("est_x_std")),
                 'est. y (")': _pm(r["est_y_mean"], r.get("est_y_std")),
-                'CRLB x, y (")': f"{_num(r['crlb_x_arcsec'], '{:.3g}')}, {_num(r['crlb_y_arcsec'], '{:.3g}')}",
-                "data (samples)": _num(r["data_to_converge_samples"], "{:.0f}"),
+                'CRLB x, y, data used (")': f"{_num(r['crlb_x_arcsec'], '{:.3g}')}, {_num(r['crlb_y_arcsec'], '{:.3g}')}",
+                "data (samples)": _stall_or(r, _num(r["data_to_converge_samples"], "{:.0f}")),
+                'to ML (")': _num(r.get("dist_to_ml_arcsec"), "{:.3g}"),
                 "nav. before / after (km)": f"{_num(r['nav_err_before_km'], '{:.1f}')} / {_num(r['nav_err_after_km'], '{:.1f}')}",
                 'published est. x, y (")': f"{_num(r.get('pub_est_x_mean'), '{:g}')}, {_num(r.get('pub_est_y_mean'), '{:g}')}",
                 "published data": _num(r.get("pub_data_to_converge_samples"), "{:.0f}"),

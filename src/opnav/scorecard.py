@@ -99,7 +99,7 @@ def score_rows(rows: list[dict]) -> pd.DataFrame:
             "ours (spread)": r.get("spread", float("nan")),
             "difference": diff,
             "verdict": v.verdict,
-            "reason": v.reason,
+            "reason": v.reason + r.get("reason_note", ""),
         })
     return pd.DataFrame(out, columns=SCORECARD_COLUMNS)
 
@@ -156,7 +156,8 @@ def rows_paper_a(table1: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
             }
             if axis and f"truth_{axis}_arcsec" in table1.columns and f"crlb_{axis}_arcsec" in table1.columns:
                 row["truth"] = float(r[f"truth_{axis}_arcsec"])
-                row["crlb"] = float(r[f"crlb_{axis}_arcsec"])
+                row["crlb"] = float(r[f"crlb_{axis}_arcsec"])  # the bound of the data the estimate used
+            row["reason_note"] = _stall_note(r)
             rows.append(row)
     rows += _rows_paper_a_headline(summary, pub.get("headline", {}))
     head = pub.get("headline", {})
@@ -168,6 +169,20 @@ def rows_paper_a(table1: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
                      "reason": "A-T1: tz unobservable in every case and variant" if not tz_obs
                      else "A-T1: tz observable in some case"})
     return rows
+
+
+def _stall_note(r) -> str:
+    """Reason suffix for a row whose EM run the stall rule flags (A-T1 ``stalled``): such a
+    run is never 'converged', and the distance to the ML estimate of the same data is given."""
+    st = r.get("stalled")
+    if isinstance(st, str):
+        st = st.strip().lower() == "true"
+    if not st:
+        return ""
+    d = r.get("dist_to_ml_arcsec", float("nan"))
+    k, n = r.get("stalled_seeds", float("nan")), r.get("n_seeds", float("nan"))
+    return (f"; EM STALLED in {k:.0f}/{n:.0f} seeds (not converged; {d:.3g} arcsec from the ML "
+            "estimate of the same data)")
 
 
 def _rows_paper_a_headline(summary: dict, head: dict) -> list[dict]:
@@ -189,7 +204,8 @@ def _rows_paper_a_headline(summary: dict, head: dict) -> list[dict]:
         else:
             verdict, reason = NOT_REPRODUCED, f"RMS axis error {err:.3g} arcsec although the CRLB is {crlb:.3g}"
         rows.append({"paper": "A", "item": f"claim [{name}]: bias accuracy better than {target:g} arcsec",
-                     "published": target, "ours": err, "unit": "arcsec", "verdict": verdict, "reason": reason})
+                     "published": target, "ours": err, "unit": "arcsec", "verdict": verdict, "reason": reason,
+                     "reason_note": _stall_note(v)})
         if "nav_err_before_km_text" in head and "nav_err_before_km" in v:
             rows.append({"paper": "A", "item": f"claim [{name}]: nav. error before compensation (sec. 3 text)",
                          "published": float(head["nav_err_before_km_text"]), "ours": float(v["nav_err_before_km"]),

@@ -21,16 +21,23 @@ A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/ekf.py", "ap
 
 A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
         for v in A_VARIANTS for g in a_groups(v) for m in A_METHODS}
+_a_seg, _a_grow = config["approach"]["segments"], config["approach"]["growing"]
+if _a_grow["methods"] and (_a_seg["L"] * _a_seg["N"]) % _a_grow["N"]:
+    raise ValueError(f"config approach.growing.N = {_a_grow['N']} must divide approach.segments.L * N = "
+                     f"{_a_seg['L'] * _a_seg['N']} (growing windows cover the same data)")
+# Table 1 again with growing windows (approach.growing), as its own rows: scheme "growing-<method>"
+A_MC_GROWING = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__growing-{m}.pkl"
+                for v in A_VARIANTS for g in a_groups(v) for m in config["approach"]["growing"]["methods"]}
 
 
 wildcard_constraints:
     variant="literal|prior|roll|reference-start",
     group="size|polarity|initial|pixel|install|headline|all",
-    method="plain|squarem",
+    method="plain|squarem|growing-plain|growing-squarem",
 
 
 rule approach_mc:
-    """Monte Carlo of one case group, scenario variant and EM scheme (seeds batched)."""
+    """Monte Carlo of one case group, scenario variant and EM scheme (sliding, or growing-<method>; seeds batched)."""
     input:
         A_SRC,
     output:
@@ -78,7 +85,7 @@ rule approach_crlb:
 rule approach_tables:
     """A-T1 (Table 1 with published values), A-X1 table and verdict, A-summary.json."""
     input:
-        mc=list(A_MC.values()),
+        mc=list(A_MC.values()) + list(A_MC_GROWING.values()),
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
         code=src("approach/report.py", "tables.py", "published.py", "data/published.yaml"),
@@ -98,7 +105,7 @@ rule approach_tables:
 
 
 rule approach_figures:
-    """A-F4, A-F5, A-F6 for the headline case of one variant."""
+    """A-F4, A-F5, A-F6 and A-X4 (NEES/NIS) for the headline case of one variant."""
     input:
         mc=a_headline_mc,
         code=src("approach/plots.py", "figures.py", "opnav.mplstyle", "data/published.yaml"),
@@ -106,6 +113,7 @@ rule approach_figures:
         f4=report_figure(f"{APPROACH}/A-F4_bias_estimate_{{variant}}", "A-F4", "Paper A", "{variant}"),
         f5=report_figure(f"{APPROACH}/A-F5_nav_accuracy_{{variant}}", "A-F5", "Paper A", "{variant}"),
         f6=report_figure(f"{APPROACH}/A-F6_nav_error_compensation_{{variant}}", "A-F6", "Paper A", "{variant}"),
+        x4=report_figure(f"{APPROACH}/A-X4_consistency_{{variant}}", "A-X4", "Paper A", "{variant}"),
     params:
         segments=cfg("approach", "segments"),
     log:

@@ -96,8 +96,11 @@ def a_groups(variant):
 
 # approach.smk
 def a_headline_mc(wildcards):
+    """The headline group's Monte-Carlo pickles of a variant: every sliding scheme and every
+    growing one (A_MC_GROWING, approach.smk)."""
     g = a_groups(wildcards.variant)[0]  # the group holding T1-01
-    return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS]
+    return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS] + [
+        p for (v, gg, m), p in A_MC_GROWING.items() if v == wildcards.variant and gg == g]
 
 
 # approach_extra.smk

@@ -1,4 +1,4 @@
-"""CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case)."""
+"""CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case), with Q and Q = 0."""
 
 from pathlib import Path
 
@@ -14,11 +14,12 @@ if "snakemake" not in globals():  # standalone debugging run
 with script_context(snakemake) as log:
     cfg = snakemake.params.approach
     case = headline_case(cfg)
-    curves = {}
+    curves = {"Q": {}, "Q0": {}}  # with the filter's process noise, and with none (as the truth)
     for v in cfg["variants"]:
         geo = sc.build_geometry(cfg, v)
         Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-        curves[v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v)
-        log.info("%s: CRLB at end %s arcsec", v, curves[v][-1])
+        curves["Q"][v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v)
+        curves["Q0"][v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v, zero_q=True)
+        log.info("%s: CRLB at end %s arcsec (Q = 0: %s)", v, curves["Q"][v][-1], curves["Q0"][v][-1])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], curves)

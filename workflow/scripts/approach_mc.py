@@ -12,6 +12,7 @@ if "snakemake" not in globals():  # standalone debugging run
 
 with script_context(snakemake) as log:
     w = snakemake.wildcards
-    res = run_group(snakemake.params.approach, w.variant, w.group, w.method, log=log)
+    mode, _, method = w.method.rpartition("-")  # "growing-squarem" -> growing windows, SQUAREM
+    res = run_group(snakemake.params.approach, w.variant, w.group, method, mode or "sliding", log=log)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], res)

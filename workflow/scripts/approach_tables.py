@@ -24,10 +24,11 @@ with script_context(snakemake) as log:
     pub = published.paper_a()
     t1 = report.table1_frame(results, pub, snakemake.params.profile)
     csv, tex, md = snakemake.output.t1
-    cap = "A-T1: paper A Table 1 reproduced; mean and sd over Monte-Carlo seeds; pub_* = published."
+    cap = ("A-T1: paper A Table 1 reproduced; mean and sd over Monte-Carlo seeds; CRLB of the data each "
+           "estimate used; stalled runs never count as converged; pub_* = published.")
     write_table(t1, [csv], caption=cap)  # every column
     write_table(report.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
-    x1 = report.crlb_rows(cfg, curves, conv, t1)
+    x1 = report.crlb_rows(cfg, curves["Q"], conv, t1, curves["Q0"])
     write_table(x1, snakemake.output.x1,
                 caption="A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.")
     atomic_write_text(snakemake.output.verdict, report.identifiability_text(cfg, x1))

@@ -9,7 +9,7 @@ from opnav.snakeio import load_pickle, script_context
 
 with script_context(snakemake) as log:
     cfg = snakemake.params.approach
-    curves = load_pickle(snakemake.input.crlb)
+    curves = load_pickle(snakemake.input.crlb)["Q"]
     conv = {}
     for p in snakemake.input.conv:
         c = load_pickle(p)

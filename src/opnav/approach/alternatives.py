@@ -258,13 +258,17 @@ def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) 
         rows.append(row)
 
     for r in em_results:
+        if r.get("mode", "sliding") != "sliding":
+            continue
         m = f"em_{r['method']}"
         if m not in METHOD_LABELS:
             continue
         rt = em_times.get(r["variant"], {}).get(m, math.nan) if r["case_id"] == "T1-01" else math.nan
         add(r["variant"], r["case"], m, np.asarray(r["truth_arcsec"], float), r["theta_final_arcsec"],
             r["nav_err_after_km"], r["data_to_converge"], rt,
-            {"nav_err_before_km": float(np.mean(r["nav_err_before_km"]))})
+            {"nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
+             # sliding EM rests on its last window: that bound, and the stall rule's verdict
+             "crlb_used_x_arcsec": float(r["crlb_arcsec"][0]), "stalled_seeds": int(np.sum(r["stalled"]))})
     for r in alt_results:
         for m, d in r["methods"].items():
             extra = {}

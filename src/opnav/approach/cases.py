@@ -39,7 +39,7 @@ import numpy as np
 
 from . import scenario as sc
 from .ekf import predict_only, run_filter
-from .em import em_window
+from .em import contraction_per_map, em_window, maps_per_segment, ml_estimate, stalled
 
 GROUPS = ("size", "polarity", "initial", "pixel", "install")
 GROUP_TITLES = {
@@ -57,6 +57,7 @@ class Case:
     init_arcsec: tuple
     sigma3_px: tuple
     install_deg: float
+    init_mode: str | None = None  # initial-error mode of this run (None: the config's)
 
 
 def table1_cases(cfg: dict) -> list[Case]:
@@ -103,6 +104,28 @@ def data_to_converge(theta_seg_arcsec: np.ndarray, seg_data: np.ndarray, tol: fl
     return seg_data[last_bad + 1]
 
 
+def lateral_range_errors(x: np.ndarray, P: np.ndarray, dx_true: np.ndarray, C: np.ndarray):
+    """Position error split along the line of sight (camera z axis of ``C`` = A_c^i) and
+    across it, with the filter's 3-sigma of each: (lateral, |range|, 3 sig lateral,
+    3 sig range), km, each (S,). The lateral sigma is ``sqrt(P_xx + P_yy)`` of the
+    position covariance rotated into the camera frame (2 dof), the range sigma ``sqrt(P_zz)``."""
+    e = (x[:, :3] - dx_true[:3]) @ C.T
+    Pc = np.einsum("ij,sjk,lk->sil", C, P[:, :3, :3], C)
+    return (np.hypot(e[:, 0], e[:, 1]), np.abs(e[:, 2]),
+            3.0 * np.sqrt(Pc[:, 0, 0] + Pc[:, 1, 1]), 3.0 * np.sqrt(Pc[:, 2, 2]))
+
+
+def consistency(f, dx_true: np.ndarray) -> dict:
+    """Position NEES (3 dof) and NIS (3 dof) of a filter run over time, (S, n+1) each:
+    ``e^T P_rr^-1 e`` with ``e`` the filtered position error, and ``nu^T S^-1 nu`` with the
+    innovation ``nu`` and its covariance ``S`` (index 0, the prior, has no NIS: NaN)."""
+    e = f.xf[:, :, :3] - dx_true[None, :, :3]
+    nees = np.einsum("ski,ski->sk", e, np.linalg.solve(f.Pf[:, :, :3, :3], e[..., None])[..., 0])
+    nis = np.einsum("ski,skij,skj->sk", f.nu, f.Sinv, f.nu)
+    nis[:, 0] = np.nan
+    return {"nees_pos": nees, "nis": nis}
+
+
 def segment_windows(cfg: dict) -> list[tuple[int, int]]:
     """(a, b) sample ranges of the L segments (start sample a has no measurement)."""
     s = cfg["segments"]
@@ -145,24 +168,23 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
     init_mode = init_mode or cfg["initial_error"]["mode"]
     seed_indices = list(seed_indices)
     ns = len(seed_indices)
-    zs, e0s, Rvs, inits = [], [], [], []
+    zs, dx0s, Rvs, inits = [], [], [], []
     for case in case_list:
         Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
         rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
         z, e0 = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), rngs)
         zs.append(z)
-        e0s.append(e0)
+        dx0s.append(sc.prior_mean_deviation(geo, e0, case.init_mode or init_mode))
         Rvs.append(np.broadcast_to(Rvar[:, None, :], (Rvar.shape[0], ns, 3)))
         inits.append(np.broadcast_to(sc.rad(case.init_arcsec), (ns, 3)))
     z = np.concatenate(zs)
-    e0 = np.concatenate(e0s)
+    dx0 = np.concatenate(dx0s)
     Rvar = np.concatenate(Rvs, axis=1)
     if all(np.array_equal(c.sigma3_px, case_list[0].sigma3_px) for c in case_list):
         Rvar = Rvar[:, 0]  # shared by every run: the cheaper broadcast form
     theta = np.concatenate(inits).copy()
     win = geo.window(Rvar)
     S = z.shape[0]
-    dx0 = sc.prior_mean_deviation(geo, e0, init_mode)
     dx_true = geo.dx_true
     tz_tol = cfg["em"]["tz_tol"]
 
@@ -171,12 +193,16 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
 
     start = sc.START_OF[variant]
     windows = segment_windows(cfg)
-    seg_theta, it_theta, it_ll, it_data, seg_err, seg_sig = [], [], [], [], [], []
+    em_cfg = cfg["em"]
+    M = cfg["segments"]["M"]
+    theta_init = theta.copy()
+    seg_theta, it_theta, it_ll, it_data = [], [], [], []
+    seg_lat, seg_rng, seg_lat3, seg_rng3 = [], [], [], []
     unobs = None
     for (a, b) in windows:
         x0, P0 = start_state(start, a, f0, dx_true, dx0, geo.P0, win)
-        tr = em_window(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), cfg["segments"]["M"],
-                       method, tz_tol)
+        theta_seg_start = theta
+        tr = em_window(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), M, method, tz_tol)
         theta = tr.theta[-1]
         unobs = tr.unobservable
         used = b - windows[0][0]
@@ -185,27 +211,42 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
         it_ll.extend(tr.loglik)
         it_data.extend([used] * len(tr.theta))
         f = tr.last_filter
-        seg_err.append(np.linalg.norm(f.xf[:, -1, :3] - dx_true[b, :3], axis=-1))
-        seg_sig.append(3.0 * np.sqrt(np.trace(f.Pf[:, -1, :3, :3], axis1=1, axis2=2)))
+        lat, rng, lat3, rng3 = lateral_range_errors(f.xf[:, -1], f.Pf[:, -1], dx_true[b], geo.C[b])
+        seg_lat.append(lat)
+        seg_rng.append(rng)
+        seg_lat3.append(lat3)
+        seg_rng3.append(rng3)
+
+    # the stall rule (SPEC A.3c) on the last segment: the ML estimate of that segment's data
+    # (one window when sliding, the cumulative data when growing), reached from the final
+    # estimate by SQUAREM, and the measured contraction factor per map toward it
+    theta_ml, ml_done, _ = ml_estimate(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), tz_tol,
+                                       em_cfg["ml_max_maps"])
+    rate = contraction_per_map(theta_seg_start, theta, theta_ml, maps_per_segment(method, M))
+    dist_ml = np.abs(sc.arcsec(theta - theta_ml))[:, :2].max(1)
+    moved = np.abs(sc.arcsec(theta - theta_init))[:, :2].max(1)
+    stall = stalled(moved, rate, dist_ml, em_cfg["stall_move_tol_arcsec"], em_cfg["stall_rate"],
+                    em_cfg["converge_tol_arcsec"])
 
     f1 = run_filter(z, theta, dx0, geo.P0, win)
     err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
     frac = cfg["nav_error"]["last_fraction"]
     seg_theta_as = sc.arcsec(np.stack(seg_theta, 1))
-    N = cfg["segments"]["N"]
-    seg_data = np.array([(l + 1) * N for l in range(len(windows))])
-    if cfg["segments"]["mode"] == "growing":
-        seg_data = np.array([b - windows[0][0] for (_, b) in windows])
-    conv = data_to_converge(seg_theta_as, seg_data, cfg["em"]["converge_tol_arcsec"])
+    seg_data = np.array([b - windows[0][0] for (_, b) in windows])
+    conv = data_to_converge(seg_theta_as, seg_data, em_cfg["converge_tol_arcsec"]).astype(float)
+    conv[stall] = np.nan  # a stalled run has not converged, whatever its last segments did
     theta_iter = sc.arcsec(np.stack(it_theta, 1))
     ll_iter = np.stack(it_ll, 1)
-    seg_err, seg_sig = np.stack(seg_err, 1), np.stack(seg_sig, 1)
+    seg_lat, seg_rng = np.stack(seg_lat, 1), np.stack(seg_rng, 1)
+    seg_lat3, seg_rng3 = np.stack(seg_lat3, 1), np.stack(seg_rng3, 1)
     nb, na = rms_last(err_before, frac), rms_last(err_after, frac)
+    cons = {"before": consistency(f0, dx_true), "after": consistency(f1, dx_true)}
     out = []
     for i, case in enumerate(case_list):
         sl = slice(i * ns, (i + 1) * ns)
         out.append({
             "variant": variant,
+            "mode": cfg["segments"]["mode"],
             "case_id": case.case_id,
             "seed_indices": np.asarray(seed_indices),
             "truth_arcsec": np.asarray(case.truth_arcsec, float),
@@ -215,14 +256,23 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
             "loglik_iter": ll_iter[sl],
             "iter_data_used": np.asarray(it_data),
             "seg_data_used": seg_data,
-            "seg_pos_err_km": seg_err[sl],
-            "seg_pos_3sig_km": seg_sig[sl],
+            "maps_per_segment": maps_per_segment(method, M),
+            "seg_pos_err_km": np.hypot(seg_lat[sl], seg_rng[sl]),
+            "seg_lat_err_km": seg_lat[sl], "seg_rng_err_km": seg_rng[sl],
+            "seg_lat_3sig_km": seg_lat3[sl], "seg_rng_3sig_km": seg_rng3[sl],
             "tz_unobservable": bool(np.all(unobs[sl, 0])) if unobs is not None else False,
             "data_to_converge": conv[sl],
+            "stalled": stall[sl],
+            "moved_arcsec": moved[sl],
+            "contraction_per_map": rate[sl],
+            "theta_ml_arcsec": sc.arcsec(theta_ml[sl]),
+            "ml_converged": ml_done[sl],
+            "dist_to_ml_arcsec": dist_ml[sl],
             "nav_err_before_km": nb[sl],
             "nav_err_after_km": na[sl],
             "err_before_t_km": err_before[sl],
             "err_after_t_km": err_after[sl],
+            "consistency_t": {k: {q: v[q][sl] for q in v} for k, v in cons.items()},
             "t_s": geo.t,
         })
     return out
@@ -241,8 +291,6 @@ def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_sa
     ``max_maps`` is reported as ``max_maps + 1`` (stalled) together with the
     contraction rate per map measured over its last iterations.
     """
-    from .em import em_window
-
     N0 = cfg["segments"]["N0"]
     geo = geo or sc.build_geometry(cfg, variant, n=N0 + data_samples)
     init_mode = init_mode or cfg["initial_error"]["mode"]
@@ -261,16 +309,8 @@ def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_sa
 
     # SQUAREM cycles from theta0 until the step is below 1e-4 arcsec: its end point is the
     # reference theta* (the ML estimate), its history the SQUAREM convergence record
-    sq_theta, sq_ll = [], []
-    th = theta0
-    while len(sq_theta) < max(max_maps, 30):
-        tr = em_window(wz, th, x0, P0, ww, 3, "squarem", tz_tol)
-        sq_theta.extend(tr.theta)
-        sq_ll.extend(tr.loglik)
-        step = np.abs(sc.arcsec(tr.theta[-1] - th))[:, :2].max()
-        th = tr.theta[-1]
-        if step < 1e-4:
-            break
+    th, _, sq = ml_estimate(wz, theta0, x0, P0, ww, tz_tol, max(max_maps, 30))
+    sq_theta, sq_ll = sq.theta, sq.loglik
     ref_as = sc.arcsec(th)
     traces = {"squarem": (sq_theta, sq_ll)}
     tr = em_window(wz, theta0, x0, P0, ww, max_maps, "plain", tz_tol)

@@ -7,6 +7,8 @@ Example::
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 
@@ -45,8 +47,9 @@ def run(args) -> int:
     from opnav.cli import print_json, with_flags
     from opnav.config import ConfigError, load_config
     from . import scenario as sc
+    from . import cases
     from .cases import Case, run_case
-    from .pipeline import bound_curve
+    from .pipeline import bound_curve, segment_bounds
 
     config = load_config(overlays=[args.config] if args.config else [])
     if args.seed < 0:
@@ -69,24 +72,43 @@ def run(args) -> int:
     seeds = range(args.seed, args.seed + args.seeds)
     r = run_case(cfg, args.variant, case, seeds, geo=geo, method=method)
     Rvar = sc.measurement_variance(geo, cfg, px)
+    bound = segment_bounds(cfg, geo, Rvar, truth, args.variant)[-1]
     curve = bound_curve(cfg, geo, Rvar, truth, args.variant)
     s = cfg["segments"]
     used = min(s["L"] * s["N"], len(curve) - 1)
+    last = cases.segment_windows(cfg)[-1]
     th = r["theta_final_arcsec"]
+    st = r["stalled"]
+    tz = "unobservable" if r["tz_unobservable"] else None
     out = {
         "variant": args.variant, "method": method, "seeds": list(seeds), "segments": s,
         "pixel_sigma3_px": list(px),
         "truth_arcsec": list(truth),
+        "status": ("STALLED" if st.all() else "partly stalled" if st.any() else "converged"),
         "estimate_arcsec": {"mean": th.mean(0),
                             "std": th.std(0, ddof=1) if th.shape[0] > 1 else None,
                             "per_seed": th.round(4)},
-        "crlb_arcsec": {"tx": float(curve[used, 0]), "ty": float(curve[used, 1]), "data_samples": int(used),
-                        "tz": "unobservable" if r["tz_unobservable"] else float(curve[used, 2])},
+        # the bound of the data the estimate used: the last window (sliding) or all data from N0 (growing)
+        "crlb_arcsec": {"tx": float(bound[0]), "ty": float(bound[1]), "tz": tz or float(bound[2]),
+                        "data": f"samples {last[0] + 1}..{last[1]} ({s['mode']} segment)"},
+        "crlb_all_data_arcsec": {"tx": float(curve[used, 0]), "ty": float(curve[used, 1]), "data_samples": int(used),
+                                 "tz": tz or float(curve[used, 2])},
+        "stall": {"stalled": [bool(v) for v in st],
+                  "moved_from_start_arcsec": [float(v) for v in r["moved_arcsec"]],
+                  "contraction_per_map": [float(v) for v in r["contraction_per_map"]],
+                  "ml_estimate_same_data_arcsec": r["theta_ml_arcsec"][:, :2].round(4).tolist(),
+                  "distance_to_ml_arcsec": [float(v) for v in r["dist_to_ml_arcsec"]],
+                  "rule": (f"stalled if moved <= {cfg['em']['stall_move_tol_arcsec']:g} arcsec, or contraction "
+                           f">= {cfg['em']['stall_rate']:g} per map while farther than "
+                           f"{cfg['em']['converge_tol_arcsec']:g} arcsec from the ML estimate")},
         "iterations": {"em_maps": int(r["theta_iter_arcsec"].shape[1]),
-                       "per_segment": s["M"], "segments": s["L"]},
-        "data_to_converge_samples": [int(v) for v in r["data_to_converge"]],
+                       "per_segment": int(r["maps_per_segment"]), "segments": s["L"]},
+        "data_to_converge_samples": [None if np.isnan(v) else int(v) for v in r["data_to_converge"]],
         "nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
         "nav_err_after_km": float(np.mean(r["nav_err_after_km"])),
     }
+    if st.any():
+        print(f"opnav approach: WARNING: EM stalled in {int(st.sum())} of {st.size} seed(s): the estimate is "
+              "not converged (see 'stall')", file=sys.stderr)
     print_json(out, indent=2)
     return 0

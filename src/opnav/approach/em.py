@@ -149,7 +149,8 @@ def em_window(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     """EM over one window with a budget of ``iterations`` EM maps.
 
     ``plain``: that many EM iterations (paper M); ``squarem``: ceil(M/3) SQUAREM
-    cycles of 3 maps each, i.e. the same work (rounded up to whole cycles).
+    cycles of 3 maps each, i.e. ``3 ceil(M/3)`` maps (6 for M = 5: the budget is
+    rounded *up* to whole cycles; :func:`maps_per_segment` gives the count).
     """
     tr = EMTrace()
     theta = np.array(theta0, float)
@@ -171,6 +172,61 @@ def em_window(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     else:
         raise ValueError(f"approach.em.method must be 'plain' or 'squarem', got {method!r}")
     return tr
+
+
+def maps_per_segment(method: str, iterations: int) -> int:
+    """EM map evaluations :func:`em_window` spends on one segment (plain: M; SQUAREM: 3 ceil(M/3))."""
+    return iterations if method == "plain" else 3 * max(1, -(-iterations // 3))
+
+
+def ml_estimate(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray, win: Window,
+                tz_tol: float = 1e-6, max_maps: int = 60, step_tol_rad: float = 1e-4 * np.pi / 648000.0
+                ) -> tuple[np.ndarray, np.ndarray, EMTrace]:
+    """Maximum-likelihood theta of one window's data: SQUAREM cycles from ``theta0`` until
+    the cycle step in (tx, ty) is below ``step_tol_rad`` for every seed, or ``max_maps`` maps.
+
+    Returns theta_ML (S,3), a per-seed flag that the step criterion was met, and the
+    trace of every map (its last entries are the reference iterates).
+    """
+    th = np.array(theta0, float)
+    tr = EMTrace()
+    done = np.zeros(th.shape[0], bool)
+    while len(tr.theta) < max_maps:
+        t = em_window(z, th, x0, P0, win, 3, "squarem", tz_tol)
+        tr.theta.extend(t.theta)
+        tr.loglik.extend(t.loglik)
+        tr.unobservable = t.unobservable
+        new = t.theta[-1]
+        done = np.abs(new - th)[:, :2].max(1) < step_tol_rad
+        th = new
+        if done.all():
+            break
+    return th, done, tr
+
+
+def contraction_per_map(theta_start: np.ndarray, theta_end: np.ndarray, theta_ml: np.ndarray,
+                        maps: int, floor_rad: float = 1e-6 * np.pi / 648000.0) -> np.ndarray:
+    """Measured contraction factor per EM map toward the ML estimate of the same data (S,).
+
+    ``(d_end / d_start) ** (1 / maps)`` with ``d = max(|tx - tx_ML|, |ty - ty_ML|)``:
+    about 1 means the iteration does not approach its fixed point (stalled), 0 means
+    it got there at once. NaN where the start is already within ``floor_rad`` of it.
+    """
+    d0 = np.abs(theta_start - theta_ml)[:, :2].max(1)
+    d1 = np.abs(theta_end - theta_ml)[:, :2].max(1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rate = (np.maximum(d1, 1e-300) / d0) ** (1.0 / max(maps, 1))
+    return np.where(d0 > floor_rad, rate, np.nan)
+
+
+def stalled(moved_arcsec: np.ndarray, rate: np.ndarray, dist_ml_arcsec: np.ndarray,
+            move_tol_arcsec: float, rate_max: float, ml_tol_arcsec: float) -> np.ndarray:
+    """The stall rule (SPEC A.3c), per seed: the estimate never moved more than
+    ``move_tol_arcsec`` from its start, *or* its contraction factor per map toward the
+    ML estimate of the same data is at least ``rate_max`` while it is still farther
+    than ``ml_tol_arcsec`` from it. A stalled run is never reported as converged."""
+    slow = np.nan_to_num(rate, nan=0.0) >= rate_max
+    return (moved_arcsec <= move_tol_arcsec) | (slow & (dist_ml_arcsec > ml_tol_arcsec))
 
 
 def squarem_cycle(theta0: np.ndarray, F) -> np.ndarray:

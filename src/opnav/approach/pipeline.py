@@ -11,34 +11,97 @@ Units: arcsec, km, samples.
 
 from __future__ import annotations
 
+import copy
+from dataclasses import replace
+
 import numpy as np
 
 from . import cases, crlb
 from . import scenario as sc
-from .ekf import predict_only, run_filter
+from .ekf import Window, run_filter
 
 
-def bound_curve(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str) -> np.ndarray:
-    """1-sigma CRLB (arcsec) of theta after d = 0..n-N0 samples from N0, (n-N0+1, 3).
+def _window(geo: sc.Geometry, Rvar: np.ndarray, zero_q: bool = False) -> Window:
+    win = geo.window(Rvar)
+    return replace(win, Q=np.zeros_like(win.Q)) if zero_q else win
+
+
+def _start_covariances(geo: sc.Geometry, win: Window, variant: str) -> np.ndarray:
+    """Covariance of the state at every sample (n+1, 6, 6) that a window starting there
+    begins with: the prior propagated without data (``prior``, ``roll``) or the theta = 0
+    filter's ``P`` (``reference-start``: the truth as mean, with the filter's covariance;
+    ``P`` of a linear filter does not depend on the data)."""
+    n = win.n
+    if sc.START_OF[variant] == "truth":
+        z = np.zeros((1, n + 1, 3))
+        return run_filter(z, np.zeros((1, 3)), np.zeros((1, 6)), geo.P0, win).Pf[0]
+    out = np.empty((n + 1, 6, 6))
+    P = geo.P0.copy()
+    out[0] = P
+    for k in range(1, n + 1):
+        P = win.Phi[k] @ P @ win.Phi[k].T + win.Q
+        out[k] = P
+    return out
+
+
+def bound_curve(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
+                zero_q: bool = False) -> np.ndarray:
+    """1-sigma CRLB (arcsec) of theta after d = 0..n-N0 samples from N0, (n-N0+1, 3): the
+    bound of the *cumulative* data (growing windows, all-data estimators).
 
     ``literal``: all data from t0 with the prior P_X0 (the literal filter start
     re-uses the data before N0, so this is its honest bound); ``prior`` and
     ``roll``: data after N0 with the prior propagated to N0; ``reference-start``
     (diagnostic): data after N0 with the true state known to the filter's P_N0.
+    ``zero_q``: the same with no process noise (the truth has none).
     """
     N0 = cfg["segments"]["N0"]
-    win = geo.window(Rvar)
+    win = _window(geo, Rvar, zero_q)
     th = sc.rad(theta_arcsec)
     sig = cfg["crlb"]["theta_prior_sigma_rad"]
-    start = sc.START_OF[variant]
-    if start == "filter":
+    if sc.START_OF[variant] == "filter":
         return sc.arcsec(crlb.crlb_curve(win, geo.u_true, geo.P0, th, sig)[N0:])
-    if start == "prior":
-        P = predict_only(np.zeros(6), geo.P0, win.slice(0, N0))[1]
-    else:
-        z = np.zeros((1, N0 + 1, 3))
-        P = run_filter(z, np.zeros((1, 3)), np.zeros((1, 6)), geo.P0, win.slice(0, N0)).Pf[0, -1]
+    P = _start_covariances(geo, win.slice(0, N0), variant)[-1]
     return sc.arcsec(crlb.crlb_curve(win.slice(N0, win.n), geo.u_true[N0:], P, th, sig))
+
+
+def segment_bounds(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
+                   zero_q: bool = False) -> np.ndarray:
+    """The bound for the data each segment's estimate rests on (L, 3), arcsec, 1-sigma.
+
+    ``growing``: the cumulative data from N0 to the segment's end (:func:`bound_curve`).
+    ``sliding``: that one window, started from the variant's state at its first sample
+    (prior propagated without data; the filter's covariance for reference-start). The
+    ``literal`` start is the theta = 0 filter's estimate, which carries every earlier
+    sample: its bound is the cumulative one from t0 to the window's end in both modes.
+    """
+    windows = cases.segment_windows(cfg)
+    N0 = cfg["segments"]["N0"]
+    if cfg["segments"]["mode"] == "growing" or sc.START_OF[variant] == "filter":
+        curve = bound_curve(cfg, geo, Rvar, theta_arcsec, variant, zero_q)
+        return np.stack([curve[b - N0] for (_, b) in windows])
+    win = _window(geo, Rvar, zero_q)
+    Pa = _start_covariances(geo, win, variant)
+    th = sc.rad(theta_arcsec)
+    sig = cfg["crlb"]["theta_prior_sigma_rad"]
+    return np.stack([sc.arcsec(crlb.crlb_curve(win.slice(a, b), geo.u_true[a:b + 1], Pa[a], th, sig)[-1])
+                     for (a, b) in windows])
+
+
+def scheme_config(cfg: dict, mode: str) -> dict:
+    """The config of a Table-1 scheme: ``sliding`` is the config's ``segments``; ``growing``
+    uses ``growing.N`` and ``growing.M`` over the same data (L = segments.L N / growing.N)."""
+    if mode == "sliding":
+        return cfg
+    if mode != "growing":
+        raise ValueError(f"unknown segment mode {mode!r}; use 'sliding' or 'growing'")
+    s, g = cfg["segments"], cfg["growing"]
+    total = s["L"] * s["N"]
+    if total % g["N"]:
+        raise ValueError(f"approach.growing.N = {g['N']} must divide segments.L * segments.N = {total}")
+    out = copy.deepcopy(cfg)
+    out["segments"].update(mode="growing", N=g["N"], M=g["M"], L=total // g["N"])
+    return out
 
 
 def groups_for(cfg: dict, variant: str) -> list[str]:
@@ -58,25 +121,45 @@ def cases_in(cfg: dict, group: str) -> list[cases.Case]:
     return [c for c in allc if c.group == group]
 
 
-def run_group(cfg: dict, variant: str, group: str, method: str, log=None) -> list[dict]:
-    """Monte Carlo of every case of ``group`` under ``variant`` and EM ``method``."""
+def run_group(cfg: dict, variant: str, group: str, method: str, mode: str = "sliding", log=None) -> list[dict]:
+    """Monte Carlo of every case of ``group`` under ``variant``, EM ``method`` and segment
+    ``mode``, each case with the bound of the data its estimate used (``crlb_arcsec``; per
+    segment ``crlb_seg_arcsec``; the same with Q = 0 beside), the bound of all data
+    (``crlb_total_arcsec``) and, for the headline case, a rerun with the initial error drawn
+    from the prior (``sampled``: the only spread that may be set beside a Bayesian bound)."""
+    cfg = scheme_config(cfg, mode)
     geo = sc.build_geometry(cfg, variant)
     seeds = range(cfg["n_seeds"])
     out = []
-    s = cfg["segments"]
     clist = cases_in(cfg, group)
-    for case, r in zip(clist, cases.run_cases(cfg, variant, clist, seeds, geo=geo, method=method)):
-        Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-        curve = bound_curve(cfg, geo, Rvar, case.truth_arcsec, variant)
-        used = s["L"] * s["N"]
-        r["crlb_total_arcsec"] = curve[min(used, len(curve) - 1)]
-        r["crlb_window_arcsec"] = curve[min(s["N"], len(curve) - 1)]
+    head = [c for c in clist if c.case_index == 1]
+    runs = cases.run_cases(cfg, variant, clist + [replace(c, init_mode="sampled") for c in head],
+                           seeds, geo=geo, method=method)
+    sampled = runs[len(clist):]
+    for case, r in zip(clist, runs):
+        _attach_bounds(cfg, geo, case, variant, r)
         r.update(method=method, group=group, case=case)
-        if case.case_index != 1:  # time series only for the headline case (figures)
-            for k in ("err_before_t_km", "err_after_t_km"):
+        if case.case_index == 1:
+            smp = sampled[0]
+            r["sampled"] = {k: smp[k] for k in ("theta_final_arcsec", "stalled", "dist_to_ml_arcsec",
+                                                "consistency_t", "nav_err_after_km", "nav_err_before_km")}
+        else:  # time series only for the headline case (figures)
+            for k in ("err_before_t_km", "err_after_t_km", "consistency_t"):
                 r.pop(k)
         out.append(r)
         if log:
-            log.info("%s %s %s %s: est %s", variant, group, method, case.case_id,
-                     np.round(r["theta_final_arcsec"].mean(0), 3))
+            log.info("%s %s %s/%s %s: est %s, bound %s, stalled %d/%d", variant, group, mode, method,
+                     case.case_id, np.round(r["theta_final_arcsec"].mean(0), 3),
+                     np.round(r["crlb_arcsec"][:2], 3), r["stalled"].sum(), r["stalled"].size)
     return out
+
+
+def _attach_bounds(cfg, geo, case, variant, r):
+    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    seg = segment_bounds(cfg, geo, Rvar, case.truth_arcsec, variant)
+    seg0 = segment_bounds(cfg, geo, Rvar, case.truth_arcsec, variant, zero_q=True)
+    curve = bound_curve(cfg, geo, Rvar, case.truth_arcsec, variant)
+    s = cfg["segments"]
+    r["crlb_seg_arcsec"], r["crlb_seg_q0_arcsec"] = seg, seg0
+    r["crlb_arcsec"], r["crlb_q0_arcsec"] = seg[-1], seg0[-1]
+    r["crlb_total_arcsec"] = curve[min(s["L"] * s["N"], len(curve) - 1)]

@@ -36,24 +36,52 @@ def _band_log(ax, x, y, color, label, ls="-"):
     ax.fill_between(x, lo, hi, color=color, alpha=0.2, lw=0)
 
 
+def run_label(r: dict) -> str:
+    """Legend label of one EM run: scheme, and the stall rule's verdict (never 'converged')."""
+    mode = r.get("mode", "sliding")
+    lab = f"EM ({r['method']}{', growing' if mode == 'growing' else ''})"
+    st = np.asarray(r.get("stalled", []), bool)
+    if st.size and st.any():
+        lab += f", STALLED {st.sum()}/{st.size}"
+    return lab
+
+
+def _color(r: dict) -> str:
+    return "C2" if r.get("mode", "sliding") == "growing" else COLORS.get(r["method"], "C4")
+
+
+def iteration_axis(r: dict) -> np.ndarray:
+    """Data used (samples) at each EM map of a run, maps spread evenly inside their segment
+    (index 0: the EM initial value at zero data)."""
+    d = np.asarray(r["seg_data_used"], float)
+    per = r["theta_iter_arcsec"].shape[1] // len(d)
+    prev = np.r_[0.0, d[:-1]]
+    frac = np.arange(1, per + 1) / per
+    return np.r_[0.0, (prev[:, None] + frac[None, :] * (d - prev)[:, None]).ravel()]
+
+
 def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
-    """A-F4: theta estimate vs cumulative EM iterations, mean +- 1 sd over seeds, truth lines."""
+    """A-F4: theta estimate vs data used, mean +- 1 sd over seeds, truth lines, and the
+    1-sigma bound of the data each segment's estimate used (dotted, around the truth)."""
     import matplotlib.pyplot as plt
 
     with figures.style():
         fig, axes = plt.subplots(3, 1, figsize=(figures.PAGE_WIDTH_IN, 5.2), sharex=True)
         truth = None
-        for method, r in runs.items():
+        for key, r in runs.items():
             th = r["theta_iter_arcsec"]
             init = np.broadcast_to(np.asarray(r["case"].init_arcsec, float), (th.shape[0], 1, 3))
             th = np.concatenate([init, th], axis=1)  # iteration 0 = the EM initial value
-            L = len(r["seg_data_used"])
-            per = (th.shape[1] - 1) // L  # EM maps per segment
-            # EM maps spread evenly inside their segment: x = data used when the map runs
-            x = np.r_[0.0, (np.repeat(np.arange(L), per) + np.tile(np.arange(1, per + 1) / per, L)) * N]
+            x = iteration_axis(r)
             truth = r["truth_arcsec"]
+            col = _color(r)
             for i, ax in enumerate(axes):
-                _band(ax, x, th[:, :, i], COLORS[method], f"EM ({method})")
+                _band(ax, x, th[:, :, i], col, run_label(r))
+                if i < 2 and "crlb_seg_arcsec" in r:
+                    b = r["crlb_seg_arcsec"][:, i]
+                    d = r["seg_data_used"]
+                    ax.plot(d, truth[i] + b, color=col, ls=":", lw=0.8)
+                    ax.plot(d, truth[i] - b, color=col, ls=":", lw=0.8)
         names = ["$\\theta_x$", "$\\theta_y$", "$\\theta_z$"]
         hp = pub["headline"]
         for i, ax in enumerate(axes):
@@ -62,31 +90,84 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
             if i < 2:
                 val = hp["est_x_arcsec"] if i == 0 else hp["est_y_arcsec"]
                 ax.plot([x[-1]], [val], **figures.PUBLISHED_STYLE)
+            lo, hi = ax.get_ylim()
+            span = max(abs(truth[i]), 5.0) * 3
+            ax.set_ylim(max(lo, truth[i] - span), min(hi, truth[i] + span))
+        axes[0].plot([], [], color="k", ls=":", lw=0.8, label="truth +- 1-sigma bound of the data used")
         axes[2].text(0.01, 0.05, "$\\theta_z$: unobservable (held at its initial value)",
                      transform=axes[2].transAxes, fontsize=7)
-        axes[-1].set_xlabel(f"data used (samples); EM iterations spread over each {N}-sample segment")
-        axes[0].legend(loc="best", fontsize=7, ncol=4)
+        axes[-1].set_xlabel("data used (samples); EM iterations spread over each segment")
+        axes[0].legend(loc="best", fontsize=6, ncol=3)
         axes[0].set_title(f"A-F4 bias estimate, variant: {variant}", fontsize=8)
         fig.tight_layout()
     return fig
 
 
 def fig_nav_accuracy(runs: dict, variant: str):
-    """A-F5: position error at each segment end during the estimation (median, 16-84 %) and filter 3-sigma."""
+    """A-F5: lateral and range position error at each segment end during the estimation
+    (median, 16-84 %), each with the filter's own 3-sigma of that component (dotted)."""
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.6))
-        for method, r in runs.items():
+        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.6), sharex=True)
+        for key, r in runs.items():
             d = r["seg_data_used"]
-            _band_log(ax, d, r["seg_pos_err_km"], COLORS[method], f"|r error| median, EM ({method})")
-            ax.plot(d, r["seg_pos_3sig_km"].mean(0), color=COLORS[method], ls=":", label=f"3-sigma ({method})")
-        ax.set_xlabel("data used (samples)")
-        ax.set_ylabel("position error (km)")
-        ax.set_yscale("log")
-        _plain_log_ticks(ax)
-        ax.legend(fontsize=6)
-        ax.set_title(f"A-F5 navigation during estimation, {variant}", fontsize=8)
+            col = _color(r)
+            for ax, comp in zip(axes, ("lat", "rng")):
+                _band_log(ax, d, r[f"seg_{comp}_err_km"], col, f"median error, {run_label(r)}")
+                ax.plot(d, r[f"seg_{comp}_3sig_km"].mean(0), color=col, ls=":")
+        axes[0].plot([], [], color="k", ls=":", label="filter 3-sigma of that component (same colour)")
+        for ax, name in zip(axes, ("lateral (across the line of sight)", "range (along it)")):
+            ax.set_xlabel("data used (samples)")
+            ax.set_ylabel(f"{name.split()[0]} error (km)")
+            ax.set_yscale("log")
+            _plain_log_ticks(ax)
+            ax.set_title(f"A-F5 {name}, {variant}", fontsize=8)
+        axes[0].legend(fontsize=5.5)
+        fig.tight_layout()
+    return fig
+
+
+def chi2_band(dof: int, n_runs: int, p: float = 0.95) -> tuple[float, float]:
+    """Two-sided ``p`` interval of the mean of ``n_runs`` chi-square(dof) values
+    (``chi2(dof n_runs) / n_runs``): the consistency band of a seed-averaged NEES/NIS."""
+    from scipy.stats import chi2
+
+    a = (1.0 - p) / 2.0
+    return chi2.ppf(a, dof * n_runs) / n_runs, chi2.ppf(1.0 - a, dof * n_runs) / n_runs
+
+
+def fig_consistency(runs: dict, variant: str):
+    """A-X4: position NEES and NIS over time, mean over seeds (initial error drawn from the
+    prior), for the theta = 0 filter and the filter with each scheme's estimate, with the
+    95 % chi-square band of the seed average (3 dof each)."""
+    import matplotlib.pyplot as plt
+
+    with figures.style():
+        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.6), sharex=True)
+        first = True
+        n = 1
+        for key, r in runs.items():
+            smp = r.get("sampled")
+            if not smp:
+                continue
+            t = r["t_s"]
+            n = smp["theta_final_arcsec"].shape[0]
+            for ax, q in zip(axes, ("nees_pos", "nis")):
+                if first:
+                    ax.plot(t, np.nanmean(smp["consistency_t"]["before"][q], 0), color="k", ls="--",
+                            label="theta = 0")
+                ax.plot(t, np.nanmean(smp["consistency_t"]["after"][q], 0), color=_color(r),
+                        label=f"theta = estimate, {run_label(r)}")
+            first = False
+        lo, hi = chi2_band(3, n)
+        for ax, name in zip(axes, ("position NEES (3 dof)", "NIS (3 dof)")):
+            ax.axhspan(lo, hi, color="0.6", alpha=0.35, lw=0, label=f"95 % chi-square band, {n} seeds")
+            ax.set_yscale("log")
+            ax.set_xlabel("time (s)")
+            ax.set_ylabel(name)
+            ax.set_title(f"A-X4 {name}, {variant}", fontsize=8)
+        axes[0].legend(fontsize=5.5)
         fig.tight_layout()
     return fig
 
@@ -104,7 +185,7 @@ def fig_compensation(runs: dict, variant: str, pub: dict):
                 ax.plot(t, r["err_before_t_km"].mean(0), color="k", ls="--", lw=1.2, zorder=3,
                         label="before (theta = 0)")
                 first = False
-            ax.plot(t, r["err_after_t_km"].mean(0), color=COLORS[method], label=f"after, EM ({method})")
+            ax.plot(t, r["err_after_t_km"].mean(0), color=_color(r), label=f"after, {run_label(r)}")
         hp = pub["headline"]
         ax.plot([t[-1]], [hp["nav_err_before_km"]], **{**figures.PUBLISHED_STYLE, "label": "published before/after"})
         ax.plot([t[-1]], [hp["nav_err_after_km"]], **{**figures.PUBLISHED_STYLE, "label": None})
