@@ -43,7 +43,8 @@ rule approach_mc:
     output:
         f"{A_WORK}/mc/{{variant}}__{{group}}__{{method}}.pkl",
     params:
-        approach=cfg("approach", *A_EM),
+        # growing schemes also read approach.growing (editing it reruns only them)
+        approach=lambda wc: cfg("approach", *A_EM, *(("growing",) if wc.method.startswith("growing-") else ())),
     log:
         f"{APPROACH}/logs/mc_{{variant}}__{{group}}__{{method}}.log",
     benchmark:
@@ -95,7 +96,8 @@ rule approach_tables:
         verdict=f"{APPROACH}/A-X1_identifiability.md",
         summary=f"{APPROACH}/A-summary.json",
     params:
-        approach=cfg("approach", "segments", "accuracy_target_arcsec", "convergence_study", "crlb"),
+        approach=cfg("approach", "segments", "accuracy_target_arcsec", "convergence_study", "crlb",
+                     "prior_sigma", "geometry"),
         profile=config["profile"],
     log:
         f"{APPROACH}/logs/tables.log",
