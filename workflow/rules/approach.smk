@@ -97,7 +97,7 @@ rule approach_tables:
         summary=f"{APPROACH}/A-summary.json",
     params:
         approach=cfg("approach", "segments", "accuracy_target_arcsec", "convergence_study", "crlb",
-                     "prior_sigma", "geometry"),
+                     "prior_sigma", "geometry", "em"),
         profile=config["profile"],
     log:
         f"{APPROACH}/logs/tables.log",

@@ -97,6 +97,32 @@ rule approach_ablation_segment:
         "../scripts/approach_ablation.py"
 
 
+A_SENSITIVITY = {"prior": "prior_scale", "range": "range_km", "roll_rate": "roll_rate_deg_s"}
+
+
+rule approach_sensitivity:
+    """A-X5: sensitivity sweep (prior sigma, range or roll rate) of the headline case: bound and
+    spreads per value (initial error sampled), and their log-log slopes."""
+    input:
+        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "figures.py", "tables.py"),
+    output:
+        table=report_table(f"{APPROACH}/A-X5_sensitivity_{{sweep}}", "A-X5", "Paper A"),
+        slopes=report_table(f"{APPROACH}/A-X5_sensitivity_{{sweep}}_slopes", "A-X5", "Paper A"),
+        fig=report_figure(f"{APPROACH}/A-X5_sensitivity_{{sweep}}", "A-X5", "Paper A", "{sweep}"),
+    wildcard_constraints:
+        sweep="prior|range|roll_rate",
+    params:
+        approach=lambda wc: a_ablation_cfg(A_SENSITIVITY[wc.sweep]),
+        sweep=lambda wc: wc.sweep,
+    log:
+        f"{APPROACH}/logs/sensitivity_{{sweep}}.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/sensitivity_{{sweep}}.tsv"
+    script:
+        "../scripts/approach_ablation.py"
+
+
+ALL_TARGETS.extend(expand(rules.approach_sensitivity.output, sweep=list(A_SENSITIVITY)))
 ALL_TARGETS.extend(rules.approach_x2_tables.output.table)
 ALL_TARGETS.append(rules.approach_x2_tables.output.summary)
 ALL_TARGETS.extend(rules.approach_x2_figure.output)

@@ -1,9 +1,10 @@
-"""A-X3 ablation (pixel noise or segment length): table and figure of estimate spread vs CRLB."""
+"""A-X3 ablation (pixel noise or segment length) and A-X5 sensitivity (prior sigma, range, roll rate):
+table and figure of estimate spread vs CRLB (A-X5 also the log-log slopes)."""
 
 import numpy as np
 
 from opnav import figures
-from opnav.approach.ablation import run_sweep
+from opnav.approach.ablation import SLOPE_SWEEPS, loglog_slopes, run_sweep
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_table
 
@@ -13,16 +14,25 @@ if "snakemake" not in globals():  # standalone debugging run
                 "fig": ["results/approach/A-X3_ablation_pixel.pdf", "results/approach/A-X3_ablation_pixel.png"]})
     snakemake.params = type("P", (), {"approach": snakemake.config["approach"], "sweep": "pixel"})()
 
-XLABEL = {"pixel": "centroid pixel error, 3-sigma (px)", "segment": "EM segment length N (samples)"}
-TITLE = {"pixel": "pixel noise", "segment": "segment length"}
+XLABEL = {"pixel": "centroid pixel error, 3-sigma (px)", "segment": "EM segment length N (samples)",
+          "prior": "prior 1-sigma / configured prior 1-sigma", "range": "initial range (km)",
+          "roll_rate": "roll rate (deg/s)"}
+TITLE = {"pixel": "pixel noise", "segment": "segment length", "prior": "prior sigma", "range": "initial range",
+         "roll_rate": "roll rate"}
 
 with script_context(snakemake) as log:
     cfg = snakemake.params.approach
     sweep = snakemake.params.sweep
     df = run_sweep(cfg, sweep, log=log)
+    tag = "A-X5" if sweep in SLOPE_SWEEPS else "A-X3"
     write_table(df, snakemake.output.table,
-                caption=f"A-X3: {TITLE[sweep]} ablation of the headline case; spread = sd over seeds (arcsec), "
-                        "RMSE and 1-sigma CRLB in arcsec.")
+                caption=f"{tag}: {TITLE[sweep]} sweep of the headline case (initial error drawn from the prior); "
+                        "spread = sd over seeds (arcsec), RMSE and 1-sigma CRLB of the data each estimator used, arcsec.")
+    if sweep in SLOPE_SWEEPS:
+        slopes = loglog_slopes(df)
+        write_table(slopes, snakemake.output.slopes,
+                    caption=f"A-X5: log-log slopes against the {TITLE[sweep]} of the bound and of the spread.")
+        log.info("A-X5 %s slopes:\n%s", sweep, slopes.to_string())
     with figures.style():
         import matplotlib.pyplot as plt
 
@@ -42,7 +52,9 @@ with script_context(snakemake) as log:
                 ax.plot(au["value"], au[f"rmse_{axis}_arcsec"], "s:", color=col, ms=4, mfc="none",
                         label=f"{v}: augmented EKF RMSE")
                 ax.plot(em["value"], em[f"crlb_{axis}_arcsec"], "-", color="k" if i == 0 else "0.55", lw=1.5,
-                        label=f"{v}: CRLB")
+                        label=f"{v}: CRLB of the data EM-EKF used")
+                ax.plot(au["value"], au[f"crlb_{axis}_arcsec"], "--", color="k" if i == 0 else "0.55", lw=1.0,
+                        label=f"{v}: CRLB of all data")
             ax.set_yscale("log")
             if np.all(df["value"] > 0):
                 ax.set_xscale("log")

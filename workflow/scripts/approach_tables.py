@@ -34,5 +34,6 @@ with script_context(snakemake) as log:
     atomic_write_text(snakemake.output.verdict, report.identifiability_text(cfg, x1))
     summ = report.summary(cfg, t1, x1)
     summ["profile"] = snakemake.params.profile
+    summ["text"] = report.findings(cfg, summ, pub["headline"])  # the manuscript's finding sentences
     write_json(snakemake.output.summary, summ)
     log.info("wrote %d Table-1 rows", len(t1))

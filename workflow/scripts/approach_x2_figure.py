@@ -54,8 +54,11 @@ with script_context(snakemake) as log:
                 d = pm[pm["method"] == m].set_index("variant").reindex(variants)
                 x = np.arange(len(variants)) + (i - (len(methods) - 1) / 2) * width
                 vals = d[col].to_numpy(float)
-                ax.bar(x, np.where(np.isfinite(vals), vals, 0.0), width, color=COLORS[m],
-                       label=METHOD_LABELS[m])
+                if logy:  # bars have no natural base on a log axis: markers
+                    ax.plot(x, vals, "o", color=COLORS[m], ms=4, label=METHOD_LABELS[m])
+                else:
+                    ax.bar(x, np.where(np.isfinite(vals), vals, 0.0), width, color=COLORS[m],
+                           label=METHOD_LABELS[m])
             if col in ("bias", "spread"):
                 cr = pm.groupby("variant", sort=False)["crlb"].first().reindex(variants)
                 for j, v in enumerate(cr):

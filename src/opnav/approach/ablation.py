@@ -33,13 +33,25 @@ import pandas as pd
 from . import alternatives as alt
 from . import cases
 from . import scenario as sc
-from .pipeline import bound_curve
+from .pipeline import bound_curve, segment_bounds
 
-SWEEPS = {"pixel": "sigma3_px", "segment": "segment_N"}
+SWEEPS = {"pixel": "sigma3_px", "segment": "segment_N",
+          # sensitivity sweeps (A-X5): prior 1-sigma, initial range, roll rate
+          "prior": "prior_scale", "range": "range_km", "roll_rate": "roll_rate_deg_s"}
+#: sweeps whose figure of merit is a power law: the log-log slope of the bound is reported
+#: (literal case: the bound should follow sigma_prior / rho, slopes +1 and -1)
+SLOPE_SWEEPS = ("prior", "range", "roll_rate")
 
 
 def sweep_configs(cfg: dict, sweep: str) -> list[tuple[float, dict, cases.Case]]:
-    """(value, config, headline case) for every value of the sweep."""
+    """(value, config, headline case) for every value of the sweep. Every run draws its
+    initial error from the prior (``initial_error.mode = sampled``): the spread over seeds
+    is then comparable with the Bayesian bound beside it.
+
+    ``prior``: both prior 1-sigmas (position and velocity) scaled by the value (the
+    position sigma is ``value * prior_sigma.r_km``); ``range``: ``geometry.range_km``;
+    ``roll_rate``: ``roll.rate_deg_s`` (deg/s; acts in the roll variant only).
+    """
     if sweep not in SWEEPS:
         raise ValueError(f"unknown ablation sweep {sweep!r}; use one of {sorted(SWEEPS)}")
     abl = cfg["ablation"]
@@ -48,18 +60,39 @@ def sweep_configs(cfg: dict, sweep: str) -> list[tuple[float, dict, cases.Case]]
     for v in abl[SWEEPS[sweep]]:
         c = copy.deepcopy(cfg)
         c["n_seeds"] = abl["n_seeds"]
+        c["initial_error"]["mode"] = "sampled"
         case = base
         if sweep == "pixel":
             ratio = cfg["camera"]["radius_to_centroid_ratio"]
             case = cases.Case(base.case_index, base.case_id, base.group, base.truth_arcsec,
                               base.init_arcsec, (float(v), float(v), ratio * float(v)), base.install_deg)
-        else:
+        elif sweep == "segment":
             s = c["segments"]
             total = s["L"] * s["N"]
             s["N"] = int(v)
             s["L"] = max(1, int(round(total / int(v))))
+        elif sweep == "prior":
+            c["prior_sigma"] = {k: float(v) * x for k, x in cfg["prior_sigma"].items()}
+        elif sweep == "range":
+            c["geometry"]["range_km"] = float(v)
+        else:
+            c["roll"]["rate_deg_s"] = float(v)
         out.append((float(v), c, case))
     return out
+
+
+def loglog_slopes(df: pd.DataFrame, columns=("crlb_x_arcsec", "sd_x_arcsec")) -> pd.DataFrame:
+    """Least-squares slope of log(column) against log(value) per variant and estimator
+    (a power-law exponent: +1 means proportional). Rows with non-positive values are skipped."""
+    rows = []
+    for (v, est), g in df.groupby(["variant", "estimator"], sort=False):
+        row = {"variant": v, "estimator": est, "sweep": g["sweep"].iloc[0]}
+        for col in columns:
+            ok = (g["value"] > 0) & (g[col] > 0)
+            x, y = np.log(g.loc[ok, "value"].to_numpy(float)), np.log(g.loc[ok, col].to_numpy(float))
+            row[f"slope_{col}"] = float(np.polyfit(x, y, 1)[0]) if ok.sum() >= 2 and np.ptp(x) > 0 else math.nan
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 def _row(variant, sweep, value, estimator, th, truth, crlb_xy, data_used):
@@ -78,22 +111,25 @@ def _row(variant, sweep, value, estimator, th, truth, crlb_xy, data_used):
 def run_sweep(cfg: dict, sweep: str, log=None) -> pd.DataFrame:
     """The ablation table of one sweep (module docstring)."""
     rows = []
-    for variant in cfg["ablation"]["variants"]:
-        geo = None
+    variants = cfg["ablation"]["variants"]
+    if sweep == "roll_rate":  # the roll rate acts in the roll variant only
+        variants = [v for v in variants if v == "roll"] or ["roll"]
+    for variant in variants:
         for value, c, case in sweep_configs(cfg, sweep):
             seg = c["segments"]
             n_needed = seg["N0"] + seg["L"] * seg["N"]
-            if geo is None or geo.t.size - 1 != n_needed:
-                geo = sc.build_geometry(c, variant, n=n_needed)
+            geo = sc.build_geometry(c, variant, n=n_needed)
             seeds = range(c["n_seeds"])
             em = cases.run_case(c, variant, case, seeds, geo=geo, method=c["em"]["method"])
             Rvar = sc.measurement_variance(geo, c, case.sigma3_px)
             used = seg["L"] * seg["N"]
             curve = bound_curve(c, geo, Rvar, case.truth_arcsec, variant)
-            cb = curve[min(used, len(curve) - 1)]
+            cb = curve[min(used, len(curve) - 1)]  # all data: the augmented EKF's bound
+            cb_em = segment_bounds(c, geo, Rvar, case.truth_arcsec, variant)[-1]  # the data EM used
             truth = np.asarray(case.truth_arcsec, float)
             rows.append(_row(variant, sweep, value, f"EM-EKF ({c['em']['method']})",
-                             em["theta_final_arcsec"], truth, cb, used))
+                             em["theta_final_arcsec"], truth, cb_em, used)
+                        | {"stalled_seeds": int(np.sum(em["stalled"]))})
             ra = alt.run_case_alternatives(c, variant, case, seeds, geo, methods=("augmented",))
             rows.append(_row(variant, sweep, value, "augmented EKF",
                              ra["methods"]["augmented"]["theta_final_arcsec"], truth, cb, used))
