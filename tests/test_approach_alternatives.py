@@ -37,13 +37,13 @@ def _data(geo, win, truth, seeds, base=11):
     return z, sc.prior_mean_deviation(geo, e0, "sampled")
 
 
-def test_bound_is_informative(roll_case):
+def test_roll_bound_is_below_3_arcsec_and_tz_stays_at_its_prior(roll_case):
     _, _, _, bound = roll_case
     assert bound[:2].max() < 3.0  # arcsec: a case where theta is well observable
     assert bound[2] > 1000.0  # tz: unobservable, stays at the diffuse prior
 
 
-def test_augmented_batch_ml_and_em_agree(roll_case):
+def test_augmented_batch_ml_and_em_within_4_bound_sigma_and_ml_equals_em(roll_case):
     """All three estimators are within a few CRLB sigma of the truth; batch ML and converged EM
     maximise the same observed-data likelihood, so they agree far more closely."""
     _, geo, win, bound = roll_case

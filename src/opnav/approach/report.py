@@ -188,7 +188,7 @@ def _first_window_bound(t1, variant, curve, s):
 def prior_bound_arcsec(cfg: dict) -> float:
     """What the prior alone bounds theta to: the 1-sigma prior position error seen from the
     initial range, ``sigma_r / rho`` (arcsec), from the config."""
-    return sc.arcsec(cfg["prior_sigma"]["r_km"] / cfg["geometry"]["range_km"])
+    return float(sc.arcsec(cfg["prior_sigma"]["r_km"] / cfg["geometry"]["range_km"]))
 
 
 def _first_below(values: np.ndarray, target: float) -> float:
