@@ -1,17 +1,18 @@
 """What a config edit reruns, read from the dry-run job list of a completed quick run.
 
-Rules get only the config keys they use (editing one ablation value lists that
-ablation's jobs and the manuscript that shows it, no Monte Carlo), and Monte-Carlo
-chunks are kept and named by their run indices (raising n_runs lists only the
-chunks of the new runs).
+Rules get only the config keys they use (editing one study's values lists that
+study's jobs for the new values and the manuscript that shows it, no other Monte
+Carlo), and Monte-Carlo chunks are kept and named by their run indices (raising
+n_runs or a study's runs lists only the chunks of the new runs).
 """
 
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
-from conftest import dry_run_jobs
+from conftest import REPO, dry_run_jobs, run_snakemake
 
 # rules that only gather finished outputs into the manuscript; any new output reruns them
 AGGREGATORS = {"paper_floats", "paper_macros", "paper_pdf", "paper_scorecard", "all"}
@@ -31,9 +32,9 @@ def test_unchanged_config_lists_nothing(quick_results):
 
 
 @pytest.mark.parametrize("overlay, only", [
-    ({"approach": {"ablation": {"sigma3_px": [0.1, 0.7]}}}, {"approach_ablation_pixel"}),
-    ({"approach": {"ablation": {"segment_N": [25, 40]}}}, {"approach_ablation_segment"}),
     ({"approach": {"accuracy_target_arcsec": 3.0}}, {"approach_tables", "approach_x1_figure"}),
+    ({"approach": {"convergence_study": {"tol_arcsec": 0.2}}},
+     {"approach_convergence", "approach_tables", "approach_x1_figure"}),
 ])
 def test_editing_one_key_reruns_only_its_users(quick_results, overlay, only):
     rules = {r for r, _ in _edit(quick_results, overlay)}
@@ -41,12 +42,34 @@ def test_editing_one_key_reruns_only_its_users(quick_results, overlay, only):
     assert rules - only <= AGGREGATORS, f"also listed: {sorted(rules - only - AGGREGATORS)}"
 
 
-def test_landing_ablation_value_edit_lists_only_that_value(quick_results):
-    jobs = _edit(quick_results, {"landing": {"ablation": {"fov_deg": [45.0, 70.0]}}})
+@pytest.mark.parametrize("study, values", [
+    ("fov", {"landing.camera.fov_deg": [45.0, 70.0]}),
+    ("ifov", {"approach.camera.ifov_arcsec": [10.0, 15.0]}),
+])
+def test_editing_one_study_lists_only_its_new_value(quick_results, study, values):
+    """Only the new value's runs are flown; only that study's table and figure are redone."""
+    jobs = _edit(quick_results, {"studies": {study: {"vary": values}}})
     sims = [(r, w) for r, w in jobs if r not in AGGREGATORS]
-    chunks = [w for r, w in sims if r == "landing_ablation_chunk"]
-    assert chunks and all(w["bsweep"] == "fov" and w["bvalue"] == "70" for w in chunks), chunks
-    assert {r for r, _ in sims} == {"landing_ablation_chunk", "landing_ablation_fov"}
+    runs = [w for r, w in sims if r == "study_runs"]
+    assert runs, sims
+    assert len({w["sdigest"] for w in runs}) == 1           # one new simulation config
+    assert {r for r, _ in sims} == {"study_runs", f"study_{study}_table", f"study_{study}_figure"}, sims
+    cfg = yaml.safe_load((quick_results / "config" / "quick.yaml").read_text())["studies"][study]
+    per_value = len(range(0, cfg["runs"], cfg.get("runs_per_job", 25)))
+    paper = "approach" if study == "ifov" else "landing"
+    units = 4 if paper == "approach" else 2              # (2 variants x) 2 methods
+    assert len(runs) == units * per_value and {w["spaper"] for w in runs} == {paper}
+
+
+def test_a_new_study_in_an_overlay_lists_only_its_jobs(quick_results):
+    block = {"studies": {"accel": {"paper": "landing", "vary": {"landing.imu.sigma_a_mps2": [5.0e-4, 1.0e-3]},
+                                   "methods": ["depth", "svd"], "runs": 2, "runs_per_job": 2}}}
+    jobs = _edit(quick_results, block)
+    rules = {r for r, _ in jobs} - AGGREGATORS
+    assert rules == {"study_runs", "study_accel_table", "study_accel_figure"}
+    runs = [w for r, w in jobs if r == "study_runs"]
+    # 5.0e-4 is the configured value: the main-value simulation the fov/obs studies already flew
+    assert len(runs) == 2 and {w["sunit"] for w in runs} == {"depth", "svd"}
 
 
 def test_raising_n_runs_flies_only_the_new_runs(quick_results):
@@ -63,4 +86,32 @@ def test_raising_n_runs_flies_only_the_new_runs(quick_results):
     assert len(chunks) == len({(w["bscn"], w["bmethod"]) for w in chunks}) == 2 * len(methods)
     assert {w["bscn"] for w in chunks} == {"site-tilt", "interior"} and len(methods) >= 4
     assert {w["bmethod"] for r, w in jobs if r == "landing_mc_gather"} == methods
-    assert not {r for r, _ in jobs} & {"landing_ablation_chunk", "landing_single", "approach_mc"}
+    assert not {r for r, _ in jobs} & {"study_runs", "landing_single", "approach_mc"}
+
+
+def _readme_study_block() -> dict:
+    text = (REPO / "README.md").read_text()
+    tail = text.split("<!-- study-example", 1)[1]
+    return yaml.safe_load(tail.split("```yaml\n", 1)[1].split("```", 1)[0])
+
+
+def test_readme_study_example_runs_only_its_jobs(quick_results):
+    """The README's study block, at quick-profile sizes, from one command: only its own
+    runs are flown (its configured value is shared with the fov/obs studies), and it
+    gives its table and figure."""
+    block = _readme_study_block()
+    (name, spec), = block["studies"].items()
+    (quick_results / "my-study.yaml").write_text(yaml.safe_dump(block))
+    (quick_results / "sizes.yaml").write_text(yaml.safe_dump({"studies": {name: {"runs": 2, "runs_per_job": 2}}}))
+    proc = run_snakemake(quick_results, "--cores", "2", f"study_{name}", "--configfile", "config/quick.yaml",
+                         "my-study.yaml", "sizes.yaml")
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
+    log = proc.stdout + proc.stderr
+    n_values = len(next(iter(spec["vary"].values())))
+    flown = log.count("rule study_runs:")
+    assert flown == (n_values - 1) * len(spec["methods"]), log[-3000:]
+    out = quick_results / "results" / "quick" / "studies" / name
+    table = pd.read_csv(out / f"B-S_{name}.csv")
+    assert len(table) == n_values * len(spec["methods"]) * len(spec["metrics"])
+    assert set(table["metric"]) == set(spec["metrics"]) and (table["n_runs"] == 2).all()
+    assert (out / f"B-S_{name}.png").stat().st_size > 10_000

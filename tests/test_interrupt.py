@@ -30,9 +30,9 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     wd.mkdir()
     copy_workflow(wd)
     (wd / "small.yaml").write_text("landing: {mc: {n_runs: 3, runs_per_job: 1}}\n")
-    target = "results/landing/mc/site-tilt/depth.npz"
+    target = "results/quick/landing/mc/site-tilt/depth.npz"  # the quick profile's results_dir
     args = [target, "--cores", "1", "--configfile", "config/quick.yaml", "small.yaml"]
-    chunks = wd / "results" / "landing" / "mc" / "site-tilt" / "chunks" / "depth"
+    chunks = wd / "results" / "quick" / "landing" / "mc" / "site-tilt" / "chunks" / "depth"
 
     proc = _snakemake(wd, *args)
     deadline = time.time() + 240
@@ -71,7 +71,7 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     again = _snakemake(wd, *args)
     out, _ = again.communicate(timeout=600)
     assert again.returncode != 0
-    log = wd / "results" / "landing" / "logs" / "mc_site-tilt_depth_gather.log"
+    log = wd / "results" / "quick" / "landing" / "logs" / "mc_site-tilt_depth_gather.log"
     assert str(log.relative_to(wd)) in out, out
     assert chunk.name in out and "snakemake --cores 2 --force" in out, out
     text = log.read_text()

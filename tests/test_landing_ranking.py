@@ -1,4 +1,5 @@
-"""B-X1 ranking / paired statistics and B-X2 ablation plumbing (paper B, beyond)."""
+"""B-X1 ranking / paired statistics (paper B, beyond). The B-X2 ablations are parameter
+studies now: tests/test_studies.py."""
 
 import math
 
@@ -8,11 +9,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import stats
 
-from conftest import REPO
-from opnav.config import load_config
-from opnav.landing.ablation import (SWEEPS, default_value, parse_value, sweep_table, value_label,
-                                    with_value)
-from opnav.landing.montecarlo import run_chunk
 from opnav.landing.ranking import (bootstrap_mean_interval, competition_rank, headline,
                                    paired_difference, paired_t_interval, ranking_table)
 
@@ -150,54 +146,6 @@ def test_ranking_refuses_unpaired_runs():
         ranking_table({"depth": a, "svd": b})
     with pytest.raises(ValueError, match="reference"):
         ranking_table({"svd": a}, reference="depth")
-
-
-# -------------------------------------------------------------------- ablation
-
-def test_ablation_value_labels_and_config_keys():
-    cfg = load_config(REPO / "config" / "config.yaml")["landing"]
-    assert value_label("fov", 60.0) == "60" and value_label("fov", 22.5) == "22.5"
-    assert value_label("obs", 3) == "3"
-    assert parse_value("fov", "60", [45.0, 60.0]) == 60.0
-    with pytest.raises(ValueError, match="landing.ablation.fov_deg"):
-        parse_value("fov", "61", [45.0, 60.0])
-    with pytest.raises(ValueError, match="unknown ablation sweep"):
-        with_value(cfg, "pixels", 1)
-    for name, (key, section, sub, _, _) in SWEEPS.items():
-        assert key in cfg["ablation"]
-        new = with_value(cfg, name, 7)
-        assert new[section][sub] == 7 and cfg[section][sub] != 7       # copy, not in place
-        assert {k: v for k, v in new.items() if k != section} == \
-            {k: v for k, v in cfg.items() if k != section}
-
-
-def test_ablation_run_at_default_value_equals_main_run():
-    """Seeds depend on the run index only: ablation run i at the configured value
-    is main Monte-Carlo run i (bit for bit); another value changes the run."""
-    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"])["landing"]
-    main = run_chunk(cfg, "depth", [1])
-    for name in ("fov", "obs"):
-        abl = run_chunk(with_value(cfg, name, default_value(cfg, name)), "depth", [1])
-        for k in ("err_r", "err_v", "err_th_deg", "nees_r", "plan_index", "plan_t", "init_error"):
-            assert np.array_equal(main[k], abl[k]), (name, k)
-    other = run_chunk(with_value(cfg, "obs", default_value(cfg, "obs") + 2), "depth", [1])
-    assert np.array_equal(other["init_error"], main["init_error"])      # same draws (paired)
-    assert not np.array_equal(other["err_r"], main["err_r"])            # different setting
-
-
-def test_sweep_table_rows():
-    runs = np.arange(4)
-    d = {45.0: {"depth": _fake_mc(np.ones(4), runs, 100.0, 0), "svd": _fake_mc(2 * np.ones(4), runs, 900.0, 1)},
-         60.0: {"depth": _fake_mc(3 * np.ones(4), runs, 100.0, 2), "svd": _fake_mc(np.ones(4), runs, 900.0, 3)}}
-    df = sweep_table("fov", d)
-    assert list(df["fov_deg"]) == [45.0, 45.0, 60.0, 60.0]
-    assert list(df["method"]) == ["depth", "svd", "depth", "svd"]
-    assert df["final_pos_err_m_mean"].to_numpy() == pytest.approx(math.sqrt(3) * np.array([1, 2, 3, 1]))
-    assert df["final_pos_err_m_3sigma"].to_numpy() == pytest.approx(0.0)
-    assert (df["n_runs"] == 4).all() and (df["landmarks_per_run"] == 4).all()
-    d[60.0]["svd"]["plan_index"][:3] = -1                 # 3 of 12 plans chose nothing
-    df = sweep_table("fov", d)
-    assert list(df["no_pick_pct"]) == [0.0, 0.0, 0.0, 25.0]
 
 
 def test_headline_feeds_manuscript_macros():

@@ -67,27 +67,31 @@ def test_quick_profile_is_a_valid_overlay_of_only_changed_keys():
 def test_quick_profile_end_to_end(quick_results):
     workdir = quick_results  # the complete quick run (conftest), shared with the dry-run tests
     before = sorted(p.relative_to(REPO) for p in (REPO / "results").rglob("*")) if (REPO / "results").exists() else []
-    t1 = (workdir / "results" / "landing" / "B-T1_initial_state.csv").read_text()
+    out = workdir / "results" / "quick"           # the quick profile's own results folder
+    assert not (workdir / "results" / "landing").exists()
+    t1 = (out / "landing" / "B-T1_initial_state.csv").read_text()
     assert "3300" in t1 and "published" in t1
-    assert (workdir / "results" / "paper" / "scorecard.csv").is_file()
+    assert (out / "paper" / "scorecard.csv").is_file()
     if shutil.which("latexmk"):
         # the manuscript rebuilds byte-identically (SOURCE_DATE_EPOCH, no paths or IDs)
-        pdf = workdir / "results" / "paper" / "main.pdf"
+        pdf = out / "paper" / "main.pdf"
         first = pdf.read_bytes()
         assert len(first) > 10_000
         pdf.unlink()
-        again = run_snakemake(workdir, "results/paper/main.pdf", "--cores", "1",
+        again = run_snakemake(workdir, "results/quick/paper/main.pdf", "--cores", "1",
                               "--configfile", "config/quick.yaml")
         assert again.returncode == 0, again.stderr[-3000:]
         assert pdf.read_bytes() == first
         # every number the text quotes was written by a rule
-        log = (workdir / "results" / "paper" / "logs" / "paper_pdf.log").read_text()
+        log = (out / "paper" / "logs" / "paper_pdf.log").read_text()
         assert "opnav-missing-macro" not in log, log[-2000:]
     # the Snakemake report, with a caption for every figure and table
     rep = run_snakemake(workdir, "--cores", "1", "--configfile", "config/quick.yaml",
-                        "--report", "results/report.html")
+                        "--report", "results/quick/report.html")
     assert rep.returncode == 0, rep.stderr[-3000:]
-    assert (workdir / "results" / "report.html").stat().st_size > 10_000
+    html = (out / "report.html").read_text(errors="replace")
+    assert len(html) > 10_000
+    assert "made by the quick profile" in html          # the report names its profile
     after = sorted(p.relative_to(REPO) for p in (REPO / "results").rglob("*")) if (REPO / "results").exists() else []
     assert before == after, "the quick run must not touch the repository's results/"
 

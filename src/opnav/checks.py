@@ -20,7 +20,8 @@ one line per problem naming the keys:
   measurement-cut-off altitude, and above its initial position errors) and its
   nominal guidance trajectory not through the ground; a planning margin that
   leaves part of the detector; the landing site in the configured camera's view at the
-  start and while the filter measures (for every swept field of view too);
+  start and while the filter measures (a parameter study runs these checks on
+  every swept value: :func:`opnav.studies.plan`);
   every method name known to :func:`opnav.landing.planner.available_methods`
   (the planner's own registry); the B-X1 reference among the flown methods;
   the B-F5 instant inside the descent on a filter step; memory bounds;
@@ -248,7 +249,7 @@ def landing_problems(c: dict) -> list[str]:
     if T * rate > MAX_LANDING_IMU_SAMPLES:
         out.append(f"{k}imu.rate_hz': duration_s x rate_hz = {T * rate:.0f} IMU samples exceeds "
                    f"the limit {MAX_LANDING_IMU_SAMPLES} (memory)")
-    for key, runs in (("mc.n_runs", c["mc"]["n_runs"]), ("ablation.n_runs", c["ablation"]["n_runs"])):
+    for key, runs in (("mc.n_runs", c["mc"]["n_runs"]),):
         if runs * n_steps > MAX_LANDING_RUN_STEPS:
             out.append(f"{k}{key}': {runs} runs x {n_steps} filter steps exceeds the limit "
                        f"{MAX_LANDING_RUN_STEPS} (memory)")
@@ -259,7 +260,7 @@ def landing_problems(c: dict) -> list[str]:
 
     known = available_methods()
     lists = {"mc.methods": c["mc"]["methods"], "extra.methods": c["extra"]["methods"],
-             "ablation.methods": c["ablation"]["methods"], "extra.reference": [c["extra"]["reference"]],
+             "extra.reference": [c["extra"]["reference"]],
              "single.method": [c["single"]["method"]]}
     for key, names in lists.items():
         bad = [m for m in names if m not in known]
@@ -269,10 +270,6 @@ def landing_problems(c: dict) -> list[str]:
         dup = _duplicates(names)
         if dup:
             out.append(f"{k}{key}': duplicated {', '.join(dup)}")
-    for key in ("ablation.fov_deg", "ablation.obs_per_landmark"):
-        dup = _duplicates(c["ablation"][key.split(".")[1]])
-        if dup:
-            out.append(f"{k}{key}': duplicated {', '.join(map(str, dup))}")
     if c["extra"]["n_boot"] == 1:
         out.append(f"{k}extra.n_boot': 1 resample gives no interval; use 0 (paired t only) or >= 2")
     flown = list(c["mc"]["methods"]) + list(c["extra"]["methods"])
@@ -310,23 +307,19 @@ def landing_problems(c: dict) -> list[str]:
         return out
     measuring = tr.r[:, 2] > alt_min                 # where the filter takes bearings
     to_site_B = np.einsum("kij,kj->ki", tr.R_LtoB, -tr.r)
-    fovs = [c["camera"]["fov_deg"], *c["ablation"]["fov_deg"]]
-    for i, fov in enumerate(dict.fromkeys(fovs)):
-        key = "camera" if i == 0 else "ablation.fov_deg"
-        try:
-            cam = camera_from_config({**c["camera"], "fov_deg": fov})
-        except ValueError as exc:
-            out.append(f"{k}{key}': {exc}")
-            continue
-        seen = cam.in_view(to_site_B)
-        if i > 0 and any(f"{k}camera'" in line for line in out):
-            break                                    # the configured camera already fails
-        if not seen[0]:
-            out.append(f"{k}{key}': the landing site is not in the camera's view at t = 0 "
-                       f"(fov_deg {fov:g}, tilt_deg {c['camera']['tilt_deg']:g}, "
-                       f"tilt_azimuth_deg {c['camera']['tilt_azimuth_deg']:g})")
-        elif not np.all(seen[measuring]):
-            t_out = t[np.nonzero(measuring & ~seen)[0][0]]
-            out.append(f"{k}{key}': the landing site leaves the camera's view at t = {t_out:g} s "
-                       f"of the nominal descent (fov_deg {fov:g})")
+    key = "camera"
+    fov = c["camera"]["fov_deg"]
+    try:
+        cam = camera_from_config(c["camera"])
+    except ValueError as exc:
+        return [*out, f"{k}{key}': {exc}"]
+    seen = cam.in_view(to_site_B)
+    if not seen[0]:
+        out.append(f"{k}{key}': the landing site is not in the camera's view at t = 0 "
+                   f"(fov_deg {fov:g}, tilt_deg {c['camera']['tilt_deg']:g}, "
+                   f"tilt_azimuth_deg {c['camera']['tilt_azimuth_deg']:g})")
+    elif not np.all(seen[measuring]):
+        t_out = t[np.nonzero(measuring & ~seen)[0][0]]
+        out.append(f"{k}{key}': the landing site leaves the camera's view at t = {t_out:g} s "
+                   f"of the nominal descent (fov_deg {fov:g})")
     return out

@@ -128,7 +128,63 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         mod.register(sub)
+    for p in sub.choices.values():
+        add_config_arguments(p)
     return parser
+
+
+def add_config_arguments(p: argparse.ArgumentParser) -> None:
+    """``--config FILE`` (overlay) and ``--set KEY.PATH=VALUE`` on a subcommand."""
+    g = p.add_argument_group("configuration (applied in this order, then validated once)")
+    g.add_argument("--config", dest="overlays", action="append", default=[], metavar="FILE",
+                   help="config overlay merged on the defaults (config/config.yaml), after the "
+                        "top-level `opnav --config`; repeatable")
+    g.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY.PATH=VALUE",
+                   help="set one config key, the value parsed as YAML (e.g. --set landing.camera.fov_deg=75, "
+                        "--set approach.camera.sigma3_px=[0.2,0.2,0.4]); repeatable; the subcommand's own "
+                        "flags are applied after it")
+
+
+_SET_KEY_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
+
+
+def parse_set(text: str) -> tuple[str, Any]:
+    """``KEY.PATH=VALUE`` -> (dotted key, YAML-parsed value); raises :class:`ConfigError`."""
+    import yaml
+
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    if not sep or not _SET_KEY_RE.fullmatch(key):
+        raise ConfigError(f"--set {text!r}: expected KEY.PATH=VALUE, e.g. --set landing.camera.fov_deg=75")
+    try:
+        value = yaml.safe_load(raw)
+    except yaml.YAMLError as exc:
+        what = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(f"--set {key}: the value {raw!r} is not valid YAML: {what}") from None
+    return key, value
+
+
+def load_cli_config(args) -> dict:
+    """The config of one subcommand run: the defaults (``config/config.yaml``), the top-level
+    ``opnav --config`` overlay, the subcommand's ``--config`` overlays, then its ``--set``
+    keys, validated by the same schema and physics checks as the pipeline's config. A
+    ``--set`` key must exist; its errors name the flag."""
+    from opnav.config import load_config
+
+    overlays = [*([args.config] if getattr(args, "config", None) else []), *getattr(args, "overlays", [])]
+    config = load_config(overlays=overlays)
+    flags = {}
+    for text in getattr(args, "sets", []):
+        key, value = parse_set(text)
+        node, parts = config, key.split(".")
+        for i, part in enumerate(parts):
+            if not isinstance(node, dict) or part not in node:
+                where = ".".join(parts[:i]) or "the top level"
+                have = ", ".join(sorted(node)) if isinstance(node, dict) else "no sub-keys"
+                raise ConfigError(f"--set {key}: no config key '{key}' ({where} has: {have})")
+            node = node[part]
+        flags[key] = (f"--set {key}", value)
+    return with_flags(config, flags) if flags else config
 
 
 def main(argv: list[str] | None = None) -> int:

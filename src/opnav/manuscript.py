@@ -181,8 +181,10 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
     for p in map(Path, paths):
         cid = output_id(p)
         cap_file = captions_dir / f"{cid}.rst"
+        if not cap_file.is_file():  # a generated caption beside the output (parameter studies)
+            cap_file = p.parent / f"{cid}.rst"
         if not cap_file.is_file():
-            raise FileNotFoundError(f"no caption file {cap_file} for {p}")
+            raise FileNotFoundError(f"no caption file {captions_dir / f'{cid}.rst'} for {p}")
         caption = rst_to_latex(cap_file.read_text())
         variant = output_variant(p)
         rel = Path(os.path.relpath(p, relative_to)).as_posix()
@@ -389,7 +391,7 @@ def compact_b_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return [("", pd.DataFrame(rows))]
 
 
-COMPACT_VIEWS.update({"A-X2": compact_a_x2, "A-X3": compact_a_x3, "B-X1": compact_b_x1, "B-X2": compact_b_x2})
+COMPACT_VIEWS.update({"A-X2": compact_a_x2, "A-X3": compact_a_x3, "B-X1": compact_b_x1})
 
 
 def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:

@@ -112,15 +112,32 @@ def a_ablation_cfg(values_key):
     return c
 
 
-# landing_extra.smk
-def _abl_chunks(sweep):
-    return [f"{LANDING}/ablation/{sweep}/{lab}/{m}_{c}.npz"
-            for lab in ABL_VALUES[sweep] for c in ABL_CHUNKS for m in ABL_METHODS]
-
-
 # paper.smk
 def _floats(part):
-    """The part's final figures (PDF) and tables (.tex), in id order."""
+    """The part's final figures (PDF) and tables (.tex), in id order; then its parameter
+    studies' (studies.smk), whose captions are generated beside them."""
     prefix = str(Path(RESULTS, part)) + os.sep
     keep = [t for t in _targets if t.startswith(prefix) and t.endswith((".pdf", ".tex"))]
-    return sorted(keep, key=lambda p: (Path(p).stem.split("_")[0][2:3] != "T", Path(p).stem))
+    own = sorted(keep, key=lambda p: (Path(p).stem.split("_")[0][2:3] != "T", Path(p).stem))
+    studies = [t for name, s in sorted(STUDIES.items(), key=lambda kv: (kv[1].id, kv[0]))
+               if s.paper == part for t in STUDY_TARGETS[name] if t.endswith((".pdf", ".tex"))]
+    return own + studies
+
+
+# studies.smk
+def _check_study_config(c):
+    """A swept value's merged config: the schema and the config-time physics checks."""
+    validate_config(c, root=workflow.basedir)
+
+
+# studies.smk
+def _study_units(s):
+    return [f"{v}__{m}" if v else m for v, m in s.units]
+
+
+# studies.smk
+def _study_runs(s):
+    """(chunk file, instance label) for every run of every value and method of study s."""
+    chunks = [chunk_label(c) for c in mc_chunks(s.runs, s.runs_per_job)]
+    return [(f"{STUDIES_DIR}/runs/{s.paper}/{i.digest}/{u}/{c}.csv", i.label)
+            for i in s.instances for u in _study_units(s) for c in chunks]

@@ -40,6 +40,7 @@ rule paper_floats:
         landing=_floats("landing"),
         tables_csv=[c for c in (t[:-4] + ".csv" for t in _floats("approach") + _floats("landing")) if c in _targets],
         captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
+        study_captions=[t for ts in STUDY_TARGETS.values() for t in ts if t.endswith(".rst")],
         code=src("manuscript.py"),
     output:
         approach=f"{PAPER}/floats_approach.tex",
@@ -86,10 +87,9 @@ rule paper_macros:
         f"{PAPER}/macros.tex",
     params:
         profile=config["profile"],
-        # the model configuration the text may quote (\Cfg... macros); ablation and study
-        # values are reported by their own outputs, so editing one reruns no macro
-        config=canonical({k: {kk: vv for kk, vv in config[k].items() if kk != "ablation"}
-                          for k in ("approach", "landing")}),
+        # the model configuration the text may quote (\Cfg... macros); study values are
+        # reported by the studies' own outputs, so editing a study reruns no macro
+        config=canonical({k: config[k] for k in ("approach", "landing")}),
     log:
         f"{PAPER}/logs/paper_macros.log",
     localrule: True

@@ -44,14 +44,14 @@ FLAG_KEYS = {"bias": "approach.truth_bias_arcsec", "init": "approach.theta_init_
 
 
 def run(args) -> int:
-    from opnav.cli import print_json, with_flags
+    from opnav.cli import load_cli_config, print_json, with_flags
     from opnav.config import ConfigError, load_config
     from . import scenario as sc
     from . import cases
     from .cases import Case, run_case
     from .pipeline import bound_curve, segment_bounds
 
-    config = load_config(overlays=[args.config] if args.config else [])
+    config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
     if args.seed < 0:
         raise ConfigError(f"--seed: must be >= 0, got {args.seed}")
     px = None

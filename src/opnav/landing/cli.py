@@ -13,11 +13,11 @@ from __future__ import annotations
 
 
 def _run(args) -> int:
-    from opnav.cli import print_json, with_flags
+    from opnav.cli import load_cli_config, print_json, with_flags
     from opnav.config import load_config
     from opnav.landing.descent import build_scenario, run_descent, summarize_run
 
-    config = load_config(overlays=[args.config] if args.config else [])
+    config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
     # the planner's registry and the seed's limits are checked as the config's
     # landing.single.method / run_index (opnav.checks), naming the flag
     cfg = with_flags(config, {"landing.single.method": ("--method", args.method),

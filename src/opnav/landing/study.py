@@ -1,0 +1,53 @@
+"""Paper B in a parameter study (:mod:`opnav.studies`): per-run metrics of one method.
+
+:func:`run_runs` flies the runs ``run_indices`` of ``method`` with a (study-modified)
+``landing`` config (:func:`opnav.landing.montecarlo.run_chunk`; run ``i`` draws from
+``SeedSequence([landing.mc.base_seed, i])`` only, so values and methods are paired) and
+returns one row per run: the final and RMS error norms of position (m), velocity (m/s)
+and attitude (deg) and the mean NEES (:func:`opnav.landing.montecarlo.per_run_stats`),
+landmarks used, and per run the median wall / CPU time of a planning call (us) and the
+share of planning calls that chose no landmark (%). :func:`add_derived` adds
+``converged_pct`` (100 if the final position error is below ``converged_pos_err_m``, else
+0; its mean over runs is the converged share, as in B-T3).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from opnav.landing.montecarlo import per_run_stats, run_chunk
+
+
+def per_run_metrics(data: dict) -> pd.DataFrame:
+    """One row per run of a chunk or gathered Monte-Carlo dict (module docstring)."""
+    st = per_run_stats(data).reset_index()
+    runs = st["run"].to_numpy()
+    pr = np.asarray(data["plan_run"])
+    med_t, med_c, nopick = [], [], []
+    for r in runs:
+        sel = pr == r
+        ns, cpu, idx = (np.asarray(data[k])[sel] for k in ("plan_ns", "plan_cpu_ns", "plan_index"))
+        med_t.append(float(np.median(ns)) / 1e3 if ns.size else math.nan)
+        med_c.append(float(np.median(cpu)) / 1e3 if cpu.size else math.nan)
+        nopick.append(float(100.0 * np.mean(idx < 0)) if idx.size else math.nan)
+    st["median_plan_time_us"] = med_t
+    st["median_plan_cpu_us"] = med_c
+    st["no_pick_pct"] = nopick
+    return st
+
+
+def run_runs(landing_cfg: dict, method: str, run_indices) -> pd.DataFrame:
+    """Fly ``run_indices`` with ``method``; one row per run (module docstring)."""
+    df = per_run_metrics(run_chunk(landing_cfg, method, list(run_indices)))
+    df.insert(1, "method", method)
+    return df
+
+
+def add_derived(runs: pd.DataFrame, converged_pos_err_m: float) -> pd.DataFrame:
+    """``converged_pct`` per run (0 or 100) from the final position error."""
+    out = runs.copy()
+    out["converged_pct"] = np.where(out["final_pos_err_m"] < converged_pos_err_m, 100.0, 0.0)
+    return out

@@ -1,0 +1,431 @@
+"""Parameter studies: sweep config keys of one paper, compare methods on paired runs.
+
+Description
+    A study (config section ``studies``, schema ``schemas/studies.schema.yaml``)
+    names its paper, one or more dotted config keys with their values
+    (``vary``; zipped, or every combination with ``grid: true``), the methods
+    (and for paper A the scenario variants) to compare, the runs per value and
+    the metrics to tabulate. :func:`plan` turns every study into
+    :class:`Study` objects before any job starts:
+
+    * each value set (an *instance*) is merged into a copy of the whole config
+      and validated by the project schema (plus any extra check passed in), so
+      a bad value is refused naming the study and the key;
+    * a swept key must be one the paper's simulation reads (``shape``, the
+      simulation's ``params:``), or the sweep would change nothing;
+    * the simulation config of an instance (the config projected on
+      ``shape``) is content-addressed (:func:`config_digest`): identical
+      simulations (the same value in two studies, a value equal to the
+      default in another) share their Monte-Carlo jobs, and editing one
+      study's values adds only the new value's jobs.
+
+    Runs are paired: run ``i`` uses the paper's stream of run index ``i``
+    (paper B: ``SeedSequence([landing.mc.base_seed, i])``; paper A: the
+    headline case's ``SeedSequence([approach.base_seed, 1, i])``) at every
+    value and for every method, whatever the chunking.
+
+Statistics (:func:`summarize`), per (instance, [variant,] method, metric) over
+the runs: n, mean, sample sd, RMS, median, the 95 % confidence interval of the
+mean (Student t, n - 1 degrees of freedom) and the paired difference against
+the first method (mean and 95 % interval of the per-run differences).
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping
+
+import numpy as np
+import pandas as pd
+
+from opnav.config import ConfigError
+
+__all__ = ["METRICS", "APPROACH_METHODS", "Study", "plan", "config_digest", "instance_label",
+           "get_path", "set_path", "project", "summarize", "table_metrics", "wide_table", "caption", "ci95"]
+
+#: Per-run metrics a study can tabulate: name -> (label with unit, CRLB column or None).
+METRICS: dict[str, dict[str, tuple[str, str | None]]] = {
+    "landing": {
+        "final_pos_err_m": ("final position error (m)", None),
+        "rms_pos_err_m": ("RMS position error (m)", None),
+        "final_vel_err_mps": ("final velocity error (m/s)", None),
+        "rms_vel_err_mps": ("RMS velocity error (m/s)", None),
+        "final_att_err_deg": ("final attitude error (deg)", None),
+        "rms_att_err_deg": ("RMS attitude error (deg)", None),
+        "mean_nees_pos": ("mean position NEES (-)", None),
+        "mean_nees_vel": ("mean velocity NEES (-)", None),
+        "n_landmarks": ("landmarks used per run (-)", None),
+        "converged_pct": ("runs converged (%)", None),
+        "median_plan_time_us": ("median planning time (us)", None),
+        "median_plan_cpu_us": ("median planning CPU time (us)", None),
+        "no_pick_pct": ("plans choosing no landmark (%)", None),
+    },
+    "approach": {
+        "err_x_arcsec": ("tx estimate - truth (arcsec)", "crlb_x_arcsec"),
+        "err_y_arcsec": ("ty estimate - truth (arcsec)", "crlb_y_arcsec"),
+        "err_z_arcsec": ("tz estimate - truth (arcsec)", None),
+        "crlb_x_arcsec": ("1-sigma CRLB of tx (arcsec)", None),
+        "crlb_y_arcsec": ("1-sigma CRLB of ty (arcsec)", None),
+        "nav_err_after_km": ("RMS nav. error after compensation (km)", None),
+        "data_to_converge_samples": ("data needed to converge (samples)", None),
+    },
+}
+DEFAULT_METRICS = {"landing": ["final_pos_err_m", "rms_pos_err_m", "mean_nees_pos"],
+                   "approach": ["err_x_arcsec", "err_y_arcsec", "nav_err_after_km"]}
+DEFAULT_METHODS = {"landing": ["depth", "svd"], "approach": ["em", "augmented"]}
+#: Paper-A estimators: em = EM-EKF with approach.em.method; augmented = augmented EKF.
+APPROACH_METHODS = ("em", "em_plain", "em_squarem", "augmented")
+STATISTICS = ("mean", "sd", "rms")
+_LETTER = {"approach": "A", "landing": "B"}
+
+
+@dataclass(frozen=True)
+class Instance:
+    """One value set of a study: ``label`` (file name), the overrides, the simulation config."""
+
+    label: str
+    values: dict[str, Any]
+    sim: dict[str, Any] = field(repr=False)
+    digest: str = ""
+
+
+@dataclass(frozen=True)
+class Study:
+    name: str
+    paper: str
+    id: str
+    title: str
+    keys: tuple[str, ...]
+    grid: bool
+    methods: tuple[str, ...]
+    variants: tuple[str, ...]
+    runs: int
+    runs_per_job: int
+    metrics: tuple[str, ...]
+    statistic: str
+    instances: tuple[Instance, ...]
+
+    @property
+    def units(self) -> list[tuple[str, str]]:
+        """(variant, method) pairs, one line each in the figure (variant '' for paper B)."""
+        return [(v, m) for v in (self.variants or ("",)) for m in self.methods]
+
+    def spec(self) -> dict:
+        """Plain-data description (rule params, caption, table provenance)."""
+        return {"name": self.name, "paper": self.paper, "id": self.id, "title": self.title,
+                "keys": list(self.keys), "grid": self.grid, "methods": list(self.methods),
+                "variants": list(self.variants), "runs": self.runs, "metrics": list(self.metrics),
+                "statistic": self.statistic,
+                "instances": {i.label: i.values for i in self.instances}}
+
+
+# ------------------------------------------------------------------ config paths
+def get_path(cfg: Mapping, dotted: str):
+    node: Any = cfg
+    for part in dotted.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            raise KeyError(dotted)
+        node = node[part]
+    return node
+
+
+def set_path(cfg: dict, dotted: str, value) -> None:
+    parts = dotted.split(".")
+    node = cfg
+    for part in parts[:-1]:
+        node = node[part]
+    node[parts[-1]] = copy.deepcopy(value)
+
+
+def project(src: Mapping, shape: Mapping) -> dict:
+    """``src`` restricted to the keys of ``shape`` (recursively): the simulation's view."""
+    out = {}
+    for k in sorted(shape):
+        if isinstance(shape[k], Mapping) and isinstance(src.get(k), Mapping):
+            out[k] = project(src[k], shape[k])
+        else:
+            out[k] = copy.deepcopy(src[k])
+    return out
+
+
+def _in_shape(shape: Mapping, parts: list[str]) -> bool:
+    node: Any = shape
+    for p in parts:
+        if not isinstance(node, Mapping):
+            return True          # a sub-key of a value the simulation reads whole
+        if p not in node:
+            return False
+        node = node[p]
+    return True
+
+
+def config_digest(obj) -> str:
+    """A short content hash of plain data (key order and int/float spelling independent)."""
+    def norm(x):
+        if isinstance(x, Mapping):
+            return {str(k): norm(x[k]) for k in sorted(x)}
+        if isinstance(x, (list, tuple)):
+            return [norm(v) for v in x]
+        if isinstance(x, bool) or x is None or isinstance(x, str):
+            return x
+        if isinstance(x, (int, float, np.integer, np.floating)):
+            f = float(x)
+            return int(f) if f.is_integer() and abs(f) < 2**53 else repr(f)
+        return str(x)
+    text = json.dumps(norm(obj), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+# ------------------------------------------------------------------ labels
+def _slug(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.12g}"
+    if isinstance(value, (list, tuple)):
+        return ",".join(_slug(v) for v in value)
+    if isinstance(value, Mapping):
+        return ",".join(f"{k}={_slug(value[k])}" for k in sorted(value))
+    return re.sub(r"[^A-Za-z0-9._,+-]", "_", str(value))
+
+
+def _display(value):
+    """A swept value for a table cell: lists as '(a, b, c)' (a LaTeX row must not start with '[')."""
+    if isinstance(value, (list, tuple)):
+        return "(" + ", ".join(str(_display(v)) for v in value) + ")"
+    return value
+
+
+def _short_keys(keys: Iterable[str]) -> dict[str, str]:
+    """Each dotted key by its last component, more components where two would clash."""
+    keys = list(keys)
+    for depth in range(1, max(k.count(".") for k in keys) + 2):
+        short = {k: ".".join(k.split(".")[-depth:]) for k in keys}
+        if len(set(short.values())) == len(keys):
+            return short
+    return {k: k for k in keys}
+
+
+def instance_label(values: Mapping[str, Any]) -> str:
+    """File-name label of a value set: ``fov_deg~45`` or ``N~25_L~80`` (Paramspace style)."""
+    short = _short_keys(values)
+    return "_".join(f"{short[k]}~{_slug(values[k])}" for k in values)
+
+
+# ------------------------------------------------------------------ planning
+def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
+    vary = spec["vary"]
+    keys = list(vary)
+    lists = [list(vary[k]) for k in keys]
+    if spec.get("grid", False):
+        combos = list(itertools.product(*lists))
+    else:
+        if len({len(v) for v in lists}) != 1:
+            lens = ", ".join(f"{k}: {len(v)}" for k, v in zip(keys, lists))
+            raise ConfigError(f"study '{name}': the vary lists have different lengths ({lens}); "
+                              "give them the same length or set grid: true")
+        combos = list(zip(*lists))
+    return [dict(zip(keys, c)) for c in combos]
+
+
+def plan(config: Mapping, shapes: Mapping[str, Mapping],
+         validate: Callable[[dict], Any], landing_methods: Iterable[str] = ()) -> dict[str, Study]:
+    """Every study of ``config["studies"]``, checked and expanded (module docstring).
+
+    ``shapes[paper]`` is the simulation's view of ``config[paper]`` (what its
+    Monte-Carlo rule passes as ``params``); ``validate(cfg)`` raises
+    :class:`ConfigError` (or ``ValueError``) for a bad merged config;
+    ``landing_methods`` are the planner's method names.
+    """
+    out = {}
+    for name, spec in (config.get("studies") or {}).items():
+        out[name] = _plan_one(name, spec, config, shapes, validate, tuple(landing_methods))
+    return out
+
+
+def _spec_defaults() -> dict:
+    """Per-study defaults from the schema (validators fill ``properties`` defaults only,
+    not those of a map's ``additionalProperties``)."""
+    import yaml
+
+    from opnav.config import SCHEMA_PATH
+
+    schema = yaml.safe_load((SCHEMA_PATH.parent / "studies.schema.yaml").read_text())
+    props = schema["additionalProperties"]["properties"]
+    return {k: v["default"] for k, v in props.items() if "default" in v}
+
+
+def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
+    spec = {**_spec_defaults(), **spec}
+    paper = spec["paper"]
+    where = f"study '{name}'"
+    for key in spec["vary"]:
+        parts = key.split(".")
+        if parts[0] != paper:
+            raise ConfigError(f"{where}: key '{key}' is not under '{paper}.' (the study's paper)")
+        try:
+            get_path(config, key)
+        except KeyError:
+            raise ConfigError(f"{where}: key '{key}' is not a config key") from None
+        if not _in_shape(shapes[paper], parts[1:]):
+            raise ConfigError(f"{where}: key '{key}' is not read by the {paper} simulation, so sweeping "
+                              f"it changes nothing (it reads: {', '.join(sorted(shapes[paper]))})")
+    methods = list(spec.get("methods") or DEFAULT_METHODS[paper])
+    allowed = APPROACH_METHODS if paper == "approach" else landing_methods
+    if allowed:
+        bad = [m for m in methods if m not in allowed]
+        if bad:
+            raise ConfigError(f"{where}: unknown method(s) {bad} for paper {paper}; "
+                              f"available: {', '.join(allowed)}")
+    if paper == "landing" and spec.get("variants"):
+        raise ConfigError(f"{where}: 'variants' are paper-A scenario variants; paper B has none")
+    variants = list(spec.get("variants") or (["literal", "roll"] if paper == "approach" else []))
+    metrics = list(spec.get("metrics") or DEFAULT_METRICS[paper])
+    bad = [m for m in metrics if m not in METRICS[paper]]
+    if bad:
+        raise ConfigError(f"{where}: unknown metric(s) {bad}; available for {paper}: "
+                          f"{', '.join(METRICS[paper])}")
+    statistic = spec.get("statistic", "mean")
+    instances, seen = [], {}
+    for values in _value_sets(name, spec):
+        merged = copy.deepcopy(dict(config))
+        merged.pop("studies", None)
+        for k, v in values.items():
+            set_path(merged, k, v)
+        try:
+            validate(merged)
+        except (ConfigError, ValueError) as exc:
+            shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            raise ConfigError(f"{where}: value {shown} refused: {exc}") from None
+        # the validated (defaults filled, possibly normalised) values
+        values = {k: get_path(merged, k) for k in values}
+        label = instance_label(values)
+        if label in seen:
+            raise ConfigError(f"{where}: values {seen[label]} and {values} coincide (label {label!r})")
+        seen[label] = values
+        sim = project(merged[paper], shapes[paper])
+        instances.append(Instance(label, values, sim, config_digest({"paper": paper, "sim": sim})))
+    keys = tuple(spec["vary"])
+    letter = _LETTER[paper]
+    return Study(name=name, paper=paper, id=spec.get("id") or f"{letter}-S",
+                 title=spec.get("title") or ", ".join(keys), keys=keys, grid=bool(spec.get("grid", False)),
+                 methods=tuple(methods), variants=tuple(variants), runs=int(spec["runs"]),
+                 runs_per_job=int(spec["runs_per_job"]), metrics=tuple(metrics), statistic=statistic,
+                 instances=tuple(instances))
+
+
+def table_metrics(study: Mapping) -> list[str]:
+    """The study's metrics and, after them, the bounds they are compared with (paper A CRLB)."""
+    mets = list(study["metrics"])
+    bounds = [METRICS[study["paper"]][m][1] for m in mets]
+    return mets + [b for b in dict.fromkeys(bounds) if b and b not in mets]
+
+
+# ------------------------------------------------------------------ statistics
+def ci95(x) -> tuple[float, float]:
+    """95 % confidence interval of the mean of the finite values of ``x`` (Student t,
+    :func:`opnav.landing.ranking.paired_t_interval`); NaN below two values."""
+    from opnav.landing.ranking import paired_t_interval
+
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    if x.size < 2:
+        return math.nan, math.nan
+    _, lo, hi, _ = paired_t_interval(x, 0.95)
+    return lo, hi
+
+
+def summarize(runs: pd.DataFrame, metrics: Iterable[str], methods: Iterable[str]) -> pd.DataFrame:
+    """Tidy summary: one row per (instance, [variant,] method, metric).
+
+    ``runs`` holds one row per (instance, [variant,] method, run) with the
+    metric columns. The paired difference is against the first of ``methods``
+    on the same (instance, variant, run).
+    """
+    methods = list(methods)
+    ref = methods[0]
+    unit = ["instance"] + (["variant"] if "variant" in runs else [])
+    rows = []
+    for keys, g in runs.groupby(unit, sort=False):
+        keys = keys if isinstance(keys, tuple) else (keys,)
+        base = g[g["method"] == ref].set_index("run")
+        for m in methods:
+            gm = g[g["method"] == m]
+            for metric in metrics:
+                x = gm[metric].to_numpy(float)
+                fin = x[np.isfinite(x)]
+                lo, hi = ci95(fin)
+                row = dict(zip(unit, keys))
+                row.update(method=m, metric=metric, n_runs=int(fin.size),
+                           mean=float(fin.mean()) if fin.size else math.nan,
+                           sd=float(fin.std(ddof=1)) if fin.size > 1 else math.nan,
+                           rms=float(np.sqrt(np.mean(fin**2))) if fin.size else math.nan,
+                           median=float(np.median(fin)) if fin.size else math.nan,
+                           ci95_low=lo, ci95_high=hi)
+                if m != ref:
+                    d = (gm.set_index("run")[metric] - base[metric]).to_numpy(float)
+                    d = d[np.isfinite(d)]
+                    dlo, dhi = ci95(d)
+                    row.update({"diff_vs": ref, "diff_mean": float(d.mean()) if d.size else math.nan,
+                                "diff_ci95_low": dlo, "diff_ci95_high": dhi})
+                else:
+                    row.update({"diff_vs": "", "diff_mean": math.nan, "diff_ci95_low": math.nan,
+                                "diff_ci95_high": math.nan})
+                rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def wide_table(tidy: pd.DataFrame, study: Mapping) -> pd.DataFrame:
+    """The human view: one row per value x [variant x] method, '<stat> [lo, hi]' per metric."""
+    stat = study["statistic"]
+    inst = study["instances"]
+    rows = []
+    unit = ["instance"] + (["variant"] if "variant" in tidy else []) + ["method"]
+    for keys, g in tidy.groupby(unit, sort=False):
+        row = {k: _display(v) for k, v in inst[keys[0]].items()}
+        row.update(dict(zip(unit[1:], keys[1:])))
+        row["n_runs"] = int(g["n_runs"].max())
+        for r in g.itertuples():
+            if r.metric not in study["metrics"]:  # a bound (the same for every run)
+                row[r.metric] = f"{r.mean:.4g}"
+            elif stat == "mean":  # mean +- half-width of its 95 % interval
+                row[r.metric] = (f"{r.mean:.4g} ± {(r.ci95_high - r.ci95_low) / 2:.2g}"
+                                 if np.isfinite(r.ci95_low) else f"{r.mean:.4g}")
+            else:
+                row[f"{r.metric} ({stat})"] = f"{getattr(r, stat):.4g}"
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def caption(study: Mapping) -> str:
+    """The study's caption, from its spec (report and manuscript)."""
+    paper = {"approach": "paper A", "landing": "paper B"}[study["paper"]]
+    vals = "; ".join(", ".join(f"{k.split('.')[-1]} = {_slug(v)}" for k, v in vs.items())
+                     for vs in study["instances"].values())
+    keys = ", ".join(f"``{k}``" for k in study["keys"])
+    how = "every combination" if study["grid"] and len(study["keys"]) > 1 else "values"
+    who = ", ".join(study["methods"])
+    if study["variants"]:
+        who += " under the scenario variants " + ", ".join(study["variants"])
+        runs = (f"{study['runs']} paired Monte-Carlo seeds of the headline case (T1-01) per value, "
+                "the same seeds for every value, variant and estimator")
+    else:
+        runs = (f"{study['runs']} paired runs per value and method (run indices 0-{study['runs'] - 1}, "
+                "the same random streams for every value and method)")
+    stat = {"mean": "mean over runs with its 95 % confidence interval (Student t)",
+            "sd": "spread (sample sd over runs)", "rms": "RMS over runs"}[study["statistic"]]
+    mets = ", ".join(METRICS[study["paper"]][m][0] for m in study["metrics"])
+    return (f"Study '{study['name']}' ({paper}): {keys} swept, {how} {vals}; all other settings as "
+            f"configured. Compared: {who}; {runs}. Plotted: the {stat} of {mets}"
+            + (" beside the 1-sigma Cramer-Rao bound" if study["paper"] == "approach"
+               and study["statistic"] != "mean" else "")
+            + ". The CSV table (tidy, one row per value, method and metric) gives n, mean, sd, RMS, "
+            f"median, the 95 % interval of the mean and the paired difference against {study['methods'][0]}.")

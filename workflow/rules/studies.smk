@@ -1,0 +1,114 @@
+# Parameter studies (opnav.studies): config section `studies`, one YAML block each.
+#   snakemake --cores 2 study_<name>                       one study (table + figure)
+#   snakemake --cores 2 studies                            every study
+# Included after the paper rules: each paper's simulation view (B_SIM; paper A's
+# scenario + EM + augmented-EKF keys) is what a swept value may change. A study
+# value's runs are keyed by the digest of its simulation config, so identical
+# simulations are flown once, and editing one study's values queues only the new
+# values' jobs. Outputs: results/studies/<name>/.
+from opnav import studies as _studies
+from opnav.landing.planner import available_methods as _planner_methods
+
+STUDIES_DIR = res("studies")
+STUDY_SHAPES = {
+    "landing": B_SIM,
+    "approach": cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives"),
+}
+
+
+STUDIES = _studies.plan(config, STUDY_SHAPES, _check_study_config, _planner_methods())
+STUDY_SIMS = {i.digest: i.sim for s in STUDIES.values() for i in s.instances}
+STUDY_SRC = {"landing": B_SRC + src("landing/study.py"),
+             "approach": A_X2_SRC + src("approach/study.py")}
+
+
+rule study_runs:
+    """One study job: runs of one method (paper A: variant and estimator) at one value."""
+    input:
+        lambda wc: STUDY_SRC[wc.spaper],
+    output:
+        f"{STUDIES_DIR}/runs/{{spaper}}/{{sdigest}}/{{sunit}}/{{schunk}}.csv",
+    wildcard_constraints:
+        spaper="approach|landing",
+        sdigest="[0-9a-f]+",
+        sunit="[a-z][a-z0-9_-]*",
+        schunk=CHUNK_PATTERN,
+    params:
+        sim=lambda wc: STUDY_SIMS[wc.sdigest],
+        runs=lambda wc: chunk_runs(wc.schunk),
+    log:
+        f"{STUDIES_DIR}/logs/runs_{{spaper}}_{{sdigest}}_{{sunit}}_{{schunk}}.log",
+    benchmark:
+        f"{STUDIES_DIR}/benchmarks/runs_{{spaper}}_{{sdigest}}_{{sunit}}_{{schunk}}.tsv"
+    script:
+        "../scripts/study_runs.py"
+
+
+STUDY_TARGETS = {}
+for _name, _s in STUDIES.items():
+    _dir = f"{STUDIES_DIR}/{_name}"
+    _stem = f"{_dir}/{_s.id}_{_name}"
+    _spec = canonical(_s.spec())
+    _cap = _studies.caption(_s.spec())
+    _files = _study_runs(_s)
+
+    rule:
+        name:
+            f"study_{_name}_table"
+        input:
+            runs=[f for f, _ in _files],
+            code=src("studies.py", "landing/study.py", "tables.py"),
+        output:
+            table=[report(f"{_stem}.csv", caption=_caption("study"), category="Studies",
+                          subcategory=_name), f"{_stem}.tex", f"{_stem}.md"],
+            runs=f"{_dir}/runs.csv",
+            caption=f"{_dir}/{_s.id}.rst",
+        params:
+            study=_spec,
+            labels=[lab for _, lab in _files],
+            caption=_cap,
+            converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
+        log:
+            f"{STUDIES_DIR}/logs/{_name}_table.log",
+        localrule: True
+        script:
+            "../scripts/study_table.py"
+
+    rule:
+        name:
+            f"study_{_name}_figure"
+        input:
+            table=f"{_stem}.csv",
+            code=src("study_plots.py", "studies.py", "figures.py", "opnav.mplstyle"),
+        output:
+            fig=[f"{_stem}.pdf", report(f"{_stem}.png", caption=_caption("study"), category="Studies",
+                                        subcategory=_name)],
+        params:
+            study=_spec,
+            caption=_cap,
+        log:
+            f"{STUDIES_DIR}/logs/{_name}_figure.log",
+        localrule: True
+        script:
+            "../scripts/study_figure.py"
+
+    STUDY_TARGETS[_name] = [*table_outputs(_stem), f"{_dir}/runs.csv", f"{_dir}/{_s.id}.rst",
+                            *figure_outputs(_stem)]
+
+    rule:
+        name:
+            f"study_{_name}"
+        input:
+            STUDY_TARGETS[_name],
+        localrule: True
+
+
+rule studies:
+    """Every study of the config (tables and figures)."""
+    input:
+        [t for ts in STUDY_TARGETS.values() for t in ts],
+    localrule: True
+
+
+for _ts in STUDY_TARGETS.values():
+    ALL_TARGETS.extend(_ts)

@@ -1,0 +1,12 @@
+"""A parameter study's figure: each metric against the swept value, one line per method."""
+
+import pandas as pd
+
+from opnav import figures
+from opnav.snakeio import script_context
+from opnav.study_plots import fig_study
+
+with script_context(snakemake) as log:
+    tidy = pd.read_csv(snakemake.input.table, keep_default_na=False, na_values=[""])
+    figures.save(fig_study(tidy, snakemake.params.study), snakemake.output.fig)
+    log.info("study %s figure", snakemake.params.study["name"])
