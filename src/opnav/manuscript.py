@@ -372,25 +372,6 @@ def compact_b_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return [("", pd.DataFrame(rows))]
 
 
-def compact_b_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
-    """B-X2 for the page: accuracy, consistency and timing over the swept value."""
-    import pandas as pd
-
-    swept = df.columns[0]
-    rows = []
-    for _, r in df.iterrows():
-        rows.append({
-            swept: _num(r[swept], "{:g}"), "method": r["method"],
-            "final pos (m)": _pm(r.get("final_pos_err_m_mean"), r.get("final_pos_err_m_3sigma")),
-            "RMS pos (m)": _pm(r.get("rms_pos_err_m_mean"), r.get("rms_pos_err_m_3sigma")),
-            "final vel (m/s)": _pm(r.get("final_vel_err_mps_mean"), r.get("final_vel_err_mps_3sigma")),
-            "NEES pos, vel": f"{_num(r.get('mean_nees_pos'), '{:.2f}')}, {_num(r.get('mean_nees_vel'), '{:.2f}')}",
-            "landmarks": _num(r.get("landmarks_per_run"), "{:.1f}"),
-            "median plan (µs)": _num(r.get("median_plan_time_us"), "{:.0f}"),
-        })
-    return [("", pd.DataFrame(rows))]
-
-
 COMPACT_VIEWS.update({"A-X2": compact_a_x2, "A-X3": compact_a_x3, "B-X1": compact_b_x1})
 
 
