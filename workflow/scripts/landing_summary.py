@@ -6,7 +6,7 @@ import json
 import math
 
 from opnav import published
-from opnav.landing.montecarlo import load, summary_table
+from opnav.landing.montecarlo import load, summary_table, yaw_convergence
 from opnav.landing.ranking import pair_table
 from opnav.landing.scenario import initial_attitude_report
 from opnav.snakeio import mock_snakemake, script_context
@@ -46,12 +46,7 @@ with script_context(snakemake) as log:
                          f"{snakemake.params.converged_pos_err_m:g} m."))
     with open(snakemake.input.single) as fh:
         single = json.load(fh)
-    # yaw: does its Monte-Carlo 3-sigma envelope shrink? (paper: it does not)
-    d0 = data[methods[0]]
-    yaw = d0["err_rpy_deg"][:, :, 2]
-    s_first, s_last = float(3 * yaw[:, 0].std(ddof=1)), float(3 * yaw[:, -1].std(ddof=1))
-    ratio = float(snakemake.params.yaw_ratio)
-    converges = s_last < ratio * s_first
+    yaw = yaw_convergence(data[methods[0]], float(snakemake.params.yaw_ratio), methods[0])
     pairs = pair_table(data)
     att = initial_attitude_report(snakemake.params.landing)
     t = df.set_index("method")
@@ -67,11 +62,9 @@ with script_context(snakemake) as log:
         "initial_attitude_deg": att["paper_convention_deg"],
         "initial_tilt_deg": att["tilt_deg"],
         "initial_azimuth_deg": att["azimuth_deg"],
-        "yaw_converges": bool(converges),
-        "yaw_reason": (f"yaw 3-sigma over the {yaw.shape[0]} runs ({methods[0]}): "
-                       f"{s_first:.2f} deg at start, {s_last:.2f} deg at touchdown "
-                       f"({'below' if converges else 'not below'} {ratio:.0%} of the start)"),
-        "n_runs": int(yaw.shape[0]),
+        "yaw_converges": yaw["converges"],
+        "yaw_reason": yaw["reason"],
+        "n_runs": yaw["n_runs"],
         "min_same_pick_vs_depth_pct": float(min((t.loc[m, "same_pick_as_depth_pct"] for m in methods
                                                  if m != "depth"), default=math.nan)),
     }

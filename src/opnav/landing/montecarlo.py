@@ -33,7 +33,7 @@ import pandas as pd
 
 from opnav.landing.descent import build_scenario, run_descent
 
-__all__ = ["run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
+__all__ = ["yaw_convergence", "run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
            "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality"]
 
@@ -211,6 +211,19 @@ def same_pick_pct(a: dict, b: dict) -> float:
     if not common:
         return math.nan
     return 100.0 * sum(ka[k] == kb[k] for k in common) / len(common)
+
+
+def yaw_convergence(data: dict, ratio: float, method: str) -> dict:
+    """Does the Monte-Carlo 3-sigma envelope of the yaw error shrink (paper B: it
+    does not, one known landmark leaves yaw unobservable)? Converging means the
+    3-sigma at touchdown is below ``ratio`` times the one at the start (deg)."""
+    yaw = data["err_rpy_deg"][:, :, 2]
+    s_first, s_last = float(3 * yaw[:, 0].std(ddof=1)), float(3 * yaw[:, -1].std(ddof=1))
+    converges = s_last < ratio * s_first
+    return {"converges": bool(converges), "n_runs": int(yaw.shape[0]),
+            "reason": (f"yaw 3-sigma over the {yaw.shape[0]} runs ({method}): "
+                       f"{s_first:.2f} deg at start, {s_last:.2f} deg at touchdown "
+                       f"({'below' if converges else 'not below'} {ratio:.0%} of the start)")}
 
 
 def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | None = None,

@@ -1,0 +1,17 @@
+"""The yaw-convergence verdict (B-T3 summary, scorecard) flips with the data."""
+
+import numpy as np
+
+from opnav.landing.montecarlo import yaw_convergence
+
+
+def _runs(shrink: float) -> dict:
+    rng = np.random.default_rng(3)
+    scale = np.linspace(1.0, shrink, 40)[None, :, None]
+    return {"err_rpy_deg": rng.normal(size=(200, 40, 3)) * scale}
+
+
+def test_shrinking_yaw_envelope_reads_converging_and_a_flat_one_does_not():
+    assert yaw_convergence(_runs(0.2), 0.5, "depth")["converges"]
+    flat = yaw_convergence(_runs(1.0), 0.5, "depth")
+    assert not flat["converges"] and "not below 50%" in flat["reason"] and flat["n_runs"] == 200
