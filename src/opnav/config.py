@@ -75,6 +75,10 @@ def _is_number(checker, instance) -> bool:
             and math.isfinite(instance))
 
 
+#: libyaml's loader where PyYAML has it (same documents, several times faster).
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
 @functools.lru_cache(maxsize=8)
 def _validator(schema_path: Path):
     import jsonschema
@@ -87,10 +91,13 @@ def _validator(schema_path: Path):
         # kept for referenced section files too: jsonschema otherwise switches
         # to the plain Draft 2020-12 validator for every schema naming its
         # dialect, and nested sections were never filled.
-        contents = yaml.safe_load(path.read_text())
+        contents = yaml.load(path.read_text(), Loader=_YAML_LOADER)
         contents.pop("$schema", None)
         return contents
 
+    # The registry is immutable: without a cache every validation (the Snakefile
+    # validates each study value's config too) re-read every section file.
+    @functools.lru_cache(maxsize=None)
     def retrieve(uri: str) -> Resource:
         path = Path(uri.removeprefix("file://"))
         return Resource.from_contents(load(path), default_specification=DRAFT202012)

@@ -13,9 +13,10 @@ import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import TYPE_CHECKING, Iterable, Iterator
 
-import pandas as pd
+if TYPE_CHECKING:  # pandas is imported where a table is built (scripts that only write files skip it)
+    import pandas as pd
 
 
 def _umask() -> int:
@@ -86,6 +87,8 @@ def to_latex(df: pd.DataFrame, caption: str | None = None, label: str | None = N
 
 def to_markdown(df: pd.DataFrame, caption: str | None = None, float_format: str = "{:.4g}") -> str:
     """A GitHub-flavoured Markdown table with an optional caption line above."""
+    import pandas as pd
+
     fmt = df.copy()
     for c in fmt.columns:
         if pd.api.types.is_float_dtype(fmt[c]):

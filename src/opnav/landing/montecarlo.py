@@ -28,10 +28,14 @@ from __future__ import annotations
 import math
 import re
 
-import numpy as np
-import pandas as pd
+from typing import TYPE_CHECKING
 
-from opnav.landing.descent import build_scenario, run_descent
+import numpy as np
+
+if TYPE_CHECKING:
+    import pandas as pd
+# The descent (scipy, CasADi) and pandas are imported by the functions that use them:
+# the workflow parses this module at start-up and the gather jobs only stack arrays.
 
 __all__ = ["yaw_convergence", "run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
            "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
@@ -77,6 +81,8 @@ CHUNK_PATTERN = r"r[0-9]+-[0-9]+"
 
 def run_chunk(landing_cfg: dict, method: str, run_indices) -> dict:
     """Fly the runs ``run_indices`` with ``method``; stacked arrays (see module doc)."""
+    from opnav.landing.descent import build_scenario, run_descent
+
     scn = build_scenario(landing_cfg)
     runs = [run_descent(scn, method, int(i)) for i in run_indices]
     out = {"run_index": np.asarray(list(run_indices), np.int64), "t": scn.truth.t.copy()}
@@ -141,6 +147,8 @@ def gather(parts: list[dict]) -> dict:
 
 def per_run_stats(data: dict) -> pd.DataFrame:
     """Per run: final and RMS error norms (m, m/s, deg) and mean NEES."""
+    import pandas as pd
+
     rows = {}
     for key, name in (("err_r", "pos_err_m"), ("err_v", "vel_err_mps"), ("err_th_deg", "att_err_deg")):
         nrm = np.linalg.norm(data[key], axis=2)
@@ -231,6 +239,8 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
     """B-T3: one row per method (see the module docstring for the columns);
     ``converged_runs_pct`` counts the runs whose final position error is below
     ``converged_pos_err_m`` (m)."""
+    import pandas as pd
+
     methods = list(data)
     rows = []
     for m in methods:
