@@ -1,5 +1,6 @@
 import os
 import re
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -16,11 +17,17 @@ def copy_workflow(dst: Path) -> Path:
     return _copy_workflow(REPO, dst)
 
 
-def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.CompletedProcess:
-    """Run snakemake in ``cwd``; its scripts import the ``opnav`` copy under ``cwd/src``."""
-    cmd = [sys.executable, "-m", "snakemake", *args]
+def _snakemake_cmd(cwd: Path, *args: str) -> tuple[list[str], dict]:
+    """The command and environment of a snakemake run in ``cwd``: its scripts import
+    the ``opnav`` copy under ``cwd/src``."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         p for p in (str(Path(cwd) / "src"), os.environ.get("PYTHONPATH", "")) if p))
+    return [sys.executable, "-m", "snakemake", *args], env
+
+
+def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.CompletedProcess:
+    """Run snakemake in ``cwd`` (see :func:`_snakemake_cmd`)."""
+    cmd, env = _snakemake_cmd(cwd, *args)
     return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, check=check, env=env)
 
 
@@ -29,19 +36,74 @@ def workdir(tmp_path: Path) -> Path:
     return copy_workflow(tmp_path)
 
 
+# ------------------------------------------------------------ the shared quick build
+# One complete quick-profile run serves every test that needs finished results (the
+# end-to-end test and the dry-run tests of test_incremental). It starts in the
+# background at the first test of the session, if any collected test uses it, and
+# those tests run last: the build overlaps the rest of the suite instead of adding
+# its wall time to it.
+QUICK_FIXTURE = "quick_results"
+
+
+def _uses_quick_build(item) -> bool:
+    return QUICK_FIXTURE in getattr(item, "fixturenames", ())
+
+
+def pytest_collection_modifyitems(config, items):
+    """Tests that read the shared quick build run after all others (order kept otherwise)."""
+    items.sort(key=_uses_quick_build)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _quick_build(request, tmp_path_factory):
+    """The background quick-profile run: (workdir, process, log file), or None when
+    no selected test needs it. Stopped (with its jobs) when the session ends."""
+    if not any(_uses_quick_build(it) for it in request.session.items):
+        yield None
+        return
+    wd = copy_workflow(tmp_path_factory.mktemp("quick"))
+    log_path = wd / "quick-build.log"
+    cmd, env = _snakemake_cmd(wd, "--cores", "2", "--configfile", "config/quick.yaml")
+    with open(log_path, "w") as log:
+        proc = subprocess.Popen(cmd, cwd=wd, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+    try:
+        yield wd, proc, log_path
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGTERM)
+            try:
+                proc.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+
+
 @pytest.fixture(scope="session")
-def quick_results(tmp_path_factory) -> Path:
+def quick_results(_quick_build) -> Path:
     """A scratch copy of the workflow after one complete quick-profile run (shared by
     the end-to-end test and the dry-run tests that need recorded provenance)."""
-    wd = copy_workflow(tmp_path_factory.mktemp("quick"))
-    proc = run_snakemake(wd, "--cores", "2", "--configfile", "config/quick.yaml")
-    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
+    wd, proc, log_path = _quick_build
+    assert proc.wait() == 0, log_path.read_text()[-4000:]
     return wd
 
 
 def dry_run_jobs(cwd: Path, *args: str) -> list[tuple[str, dict]]:
     """The jobs ``snakemake -n`` lists, as (rule, wildcards) pairs."""
-    proc = run_snakemake(cwd, "-n", "--cores", "1", *args)
+    return _dry_run_jobs(run_snakemake(cwd, "-n", "--cores", "1", *args))
+
+
+def dry_run_jobs_many(cwd: Path, arg_lists: list[tuple[str, ...]], workers: int = 2) -> list[list[tuple[str, dict]]]:
+    """:func:`dry_run_jobs` for each argument tuple, ``workers`` at a time (a dry run
+    takes no lock and is single-threaded, so two use both cores)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        procs = list(pool.map(lambda a: run_snakemake(cwd, "-n", "--cores", "1", *a), arg_lists))
+    return [_dry_run_jobs(p) for p in procs]
+
+
+def _dry_run_jobs(proc: subprocess.CompletedProcess) -> list[tuple[str, dict]]:
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
     jobs = []
     for block in re.split(r"\n(?=(?:local)?rule \w+:\n)", proc.stdout):

@@ -6,49 +6,61 @@ Carlo), and Monte-Carlo chunks are kept and named by their run indices (raising
 n_runs or a study's runs lists only the chunks of the new runs).
 """
 
-from pathlib import Path
-
 import pandas as pd
 import pytest
 import yaml
 
-from conftest import REPO, dry_run_jobs, run_snakemake
+from conftest import REPO, dry_run_jobs_many, run_snakemake
 
 # rules that only gather finished outputs into the manuscript; any new output reruns them
 AGGREGATORS = {"paper_floats", "paper_macros", "paper_pdf", "paper_scorecard", "all"}
 
-
-def _edit(workdir: Path, overlay: dict) -> list[tuple[str, dict]]:
-    path = workdir / "edit.yaml"
-    path.write_text(yaml.safe_dump(overlay))
-    return dry_run_jobs(workdir, "--configfile", "config/quick.yaml", str(path))
-
+_NEW_STUDY = {"studies": {"accel": {"paper": "landing", "vary": {"landing.imu.sigma_a_mps2": [5.0e-4, 1.0e-3]},
+                                    "methods": ["depth", "svd"], "runs": 2, "runs_per_job": 2}}}
+#: Every config edit the tests below dry-run on the completed quick run, by name.
+EDITS = {
+    "nothing": {},
+    "accuracy_target": {"approach": {"accuracy_target_arcsec": 3.0}},
+    "convergence_tol": {"approach": {"convergence_study": {"tol_arcsec": 0.2}}},
+    "study_fov": {"studies": {"fov": {"vary": {"landing.camera.fov_deg": [45.0, 70.0]}}}},
+    "study_ifov": {"studies": {"ifov": {"vary": {"approach.camera.ifov_arcsec": [10.0, 15.0]}}}},
+    "new_study": _NEW_STUDY,
+    "n_runs_6": {"landing": {"mc": {"n_runs": 6}}},
+}
 
 pytestmark = pytest.mark.slow
 
 
-def test_unchanged_config_lists_nothing(quick_results):
-    assert _edit(quick_results, {}) == []
+@pytest.fixture(scope="module")
+def edits(quick_results) -> dict[str, list[tuple[str, dict]]]:
+    """{edit name: the jobs `snakemake -n` lists with that overlay on the quick profile},
+    the dry runs made two at a time."""
+    args = []
+    for name, overlay in EDITS.items():
+        path = quick_results / f"edit-{name}.yaml"
+        path.write_text(yaml.safe_dump(overlay))
+        args.append(("--configfile", "config/quick.yaml", str(path)))
+    return dict(zip(EDITS, dry_run_jobs_many(quick_results, args)))
 
 
-@pytest.mark.parametrize("overlay, only", [
-    ({"approach": {"accuracy_target_arcsec": 3.0}}, {"approach_tables", "approach_x1_figure"}),
-    ({"approach": {"convergence_study": {"tol_arcsec": 0.2}}},
-     {"approach_convergence", "approach_tables", "approach_x1_figure"}),
+def test_unchanged_config_lists_nothing(edits):
+    assert edits["nothing"] == []
+
+
+@pytest.mark.parametrize("edit, only", [
+    ("accuracy_target", {"approach_tables", "approach_x1_figure"}),
+    ("convergence_tol", {"approach_convergence", "approach_tables", "approach_x1_figure"}),
 ])
-def test_editing_one_key_reruns_only_its_users(quick_results, overlay, only):
-    rules = {r for r, _ in _edit(quick_results, overlay)}
+def test_editing_one_key_reruns_only_its_users(edits, edit, only):
+    rules = {r for r, _ in edits[edit]}
     assert only <= rules, rules
     assert rules - only <= AGGREGATORS, f"also listed: {sorted(rules - only - AGGREGATORS)}"
 
 
-@pytest.mark.parametrize("study, values", [
-    ("fov", {"landing.camera.fov_deg": [45.0, 70.0]}),
-    ("ifov", {"approach.camera.ifov_arcsec": [10.0, 15.0]}),
-])
-def test_editing_one_study_lists_only_its_new_value(quick_results, study, values):
+@pytest.mark.parametrize("study", ["fov", "ifov"])
+def test_editing_one_study_lists_only_its_new_value(quick_results, edits, study):
     """Only the new value's runs are flown; only that study's table and figure are redone."""
-    jobs = _edit(quick_results, {"studies": {study: {"vary": values}}})
+    jobs = edits[f"study_{study}"]
     sims = [(r, w) for r, w in jobs if r not in AGGREGATORS]
     runs = [w for r, w in sims if r == "study_runs"]
     assert runs, sims
@@ -61,10 +73,8 @@ def test_editing_one_study_lists_only_its_new_value(quick_results, study, values
     assert len(runs) == units * per_value and {w["spaper"] for w in runs} == {paper}
 
 
-def test_a_new_study_in_an_overlay_lists_only_its_jobs(quick_results):
-    block = {"studies": {"accel": {"paper": "landing", "vary": {"landing.imu.sigma_a_mps2": [5.0e-4, 1.0e-3]},
-                                   "methods": ["depth", "svd"], "runs": 2, "runs_per_job": 2}}}
-    jobs = _edit(quick_results, block)
+def test_a_new_study_in_an_overlay_lists_only_its_jobs(edits):
+    jobs = edits["new_study"]
     rules = {r for r, _ in jobs} - AGGREGATORS
     assert rules == {"study_runs", "study_accel_table", "study_accel_figure"}
     runs = [w for r, w in jobs if r == "study_runs"]
@@ -72,13 +82,13 @@ def test_a_new_study_in_an_overlay_lists_only_its_jobs(quick_results):
     assert len(runs) == 2 and {w["sunit"] for w in runs} == {"depth", "svd"}
 
 
-def test_raising_n_runs_flies_only_the_new_runs(quick_results):
-    """Quick profile: 4 runs in chunks of 2; 6 runs adds chunk r0004-0005 per camera
+def test_raising_n_runs_flies_only_the_new_runs(quick_results, edits):
+    """Quick profile: 4 runs in one chunk of 4; 6 runs adds chunk r0004-0005 per camera
     scenario and method and nothing else is flown again (each run's stream depends
     on its index only)."""
     cfg = yaml.safe_load((quick_results / "config" / "quick.yaml").read_text())
-    assert cfg["landing"]["mc"] == {"n_runs": 4, "runs_per_job": 2}
-    jobs = _edit(quick_results, {"landing": {"mc": {"n_runs": 6}}})
+    assert cfg["landing"]["mc"] == {"n_runs": 4, "runs_per_job": 4}
+    jobs = edits["n_runs_6"]
     chunks = [w for r, w in jobs if r == "landing_mc_chunk"]
     assert chunks and {w["bchunk"] for w in chunks} == {"r0004-0005"}, chunks
     methods = {w["bmethod"] for w in chunks}
@@ -95,10 +105,10 @@ def _readme_study_block() -> dict:
     return yaml.safe_load(tail.split("```yaml\n", 1)[1].split("```", 1)[0])
 
 
-def test_readme_study_example_runs_only_its_jobs(quick_results):
+def test_readme_study_example_runs_only_its_jobs(quick_results, edits):
     """The README's study block, at quick-profile sizes, from one command: only its own
     runs are flown (its configured value is shared with the fov/obs studies), and it
-    gives its table and figure."""
+    gives its table and figure. (It adds outputs to the shared run: after the dry runs.)"""
     block = _readme_study_block()
     (name, spec), = block["studies"].items()
     (quick_results / "my-study.yaml").write_text(yaml.safe_dump(block))
