@@ -47,7 +47,11 @@ its covariance the Jacobian of that cut plus ``depth_sigma_frac`` (10 %).
 Returned per run: errors (truth - estimate) of position, velocity (m, m/s),
 attitude (small-angle ``dtheta`` and roll/pitch/yaw differences, deg) at the
 filter times, 1-sigma of the filter, position and velocity NEES, and per
-planning call its wall time (ns) and evaluation count.
+planning call its wall time (ns) and evaluation count, and everything
+``planner.plan`` took, to replay the call exactly (``opnav.landing.timing``):
+the filter step (the truth pose, hence the detected landmarks, follows from
+the scenario), the estimate (r, v, a, R_LtoB, P), the excluded current
+landmark (-1: none) and the picker stream's state.
 """
 
 from __future__ import annotations
@@ -64,6 +68,7 @@ from opnav.landing.camera import Camera, camera_from_config
 from opnav.landing.landmarks import LandmarkField, make_field
 from opnav.landing.metrics import H_METRICS
 from opnav.landing.planner import PlannerConfig, PlanState, alternative_path, plan
+from opnav.landing.timing import RECORD_KEYS, record_plan_inputs, stack_plan_inputs
 from opnav.landing.trajectory import Truth, euler_rpy_deg, truth_states
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "initial_error", "summarize_run",
@@ -216,6 +221,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
     updated = np.zeros(n + 1, bool)
     plan_ns, plan_cpu, plan_evals, plan_t, plan_beta, plan_idx = [], [], [], [], [], []
     plan_edge, plan_ratio, plan_ns_alt, plan_cpu_alt = [], [], [], []
+    rec = {k: [] for k in RECORD_KEYS}      # every planning call's inputs (timing.replay)
     cur, n_obs, n_used = -1, 0, 0
     a_est = tr.a[0]
 
@@ -268,6 +274,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
                 if not still:
                     cur, n_obs = -1, 0
             if need_new:
+                record_plan_inputs(rec, k, st.r, st.v, a_est, st.R, st.P, cur, rng_pick)
                 res = plan(method, PlanState(st.r, st.v, a_est, st.R, st.P), cam, scn.field,
                            visible, scn.planner, exclude={cur} if cur >= 0 else set(),
                            rng=rng_pick, detected=np.flatnonzero(det))
@@ -327,6 +334,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         "plan_ns_alt": np.asarray(plan_ns_alt, np.int64),
         "plan_cpu_ns_alt": np.asarray(plan_cpu_alt, np.int64),
         "init_error": e0,
+        **stack_plan_inputs(rec),
     }
 
 

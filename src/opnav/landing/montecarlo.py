@@ -37,12 +37,14 @@ if TYPE_CHECKING:
 # The descent (scipy, CasADi) and pandas are imported by the functions that use them:
 # the workflow parses this module at start-up and the gather jobs only stack arrays.
 
+from opnav.landing.timing import RECORD_KEYS   # numpy only
+
 __all__ = ["yaw_convergence", "run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
            "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality"]
 
 _PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index", "plan_edge",
-         "plan_ratio", "plan_ns_alt", "plan_cpu_ns_alt")
+         "plan_ratio", "plan_ns_alt", "plan_cpu_ns_alt") + RECORD_KEYS   # (+ planning inputs, replay)
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
            "sig_yaw_deg", "nees_r", "nees_v", "updated")
 
