@@ -8,7 +8,11 @@ measured`` markers:
 * ``runtime`` (min) = ceil(runtime_factor x the longest measured wall time) +
   runtime_pad_min, at least runtime_min_min;
 * ``mem_mb`` = ceil(mem_factor x the largest measured max RSS) + mem_pad_mb,
-  rounded up to 100 MB.
+  rounded up to 100 MB;
+* ``threads`` (``set-threads``) only for a rule whose jobs used more than one
+  core: ceil of the largest CPU time / wall time ratio measured, when that
+  ratio exceeds ``multi_core_ratio`` (1.5; BLAS threads of a large matrix
+  product, say). Every rule of this workflow is single-threaded by design.
 
 Run after a full-profile run on the machine class of the cluster nodes::
 
@@ -58,16 +62,22 @@ def measure(rules: dict[str, str], workdir: Path) -> pd.DataFrame:
     files = [p.relative_to(workdir).as_posix() for p in workdir.rglob("*.tsv")
              if "benchmarks" in p.parts and ".snakemake" not in p.parts]
     rows = []
+    nan = float("nan")
     for name, pattern in sorted(rules.items()):
         tsvs = [f for f in files if re.fullmatch(pattern, f)] if pattern else []
         if not tsvs:
-            rows.append({"rule": name, "files": 0, "max_s": float("nan"), "max_rss_mb": float("nan")})
+            rows.append({"rule": name, "files": 0, "max_s": nan, "max_rss_mb": nan, "max_cpu_ratio": nan})
             continue
         df = pd.concat([pd.read_csv(workdir / f, sep="\t") for f in tsvs])
         rss = pd.to_numeric(df["max_rss"], errors="coerce")
+        cpu = pd.to_numeric(df.get("cpu_time", pd.Series(dtype=float)), errors="coerce")
+        # jobs under ~2 s are all start-up: their CPU/wall ratio says nothing of threads
+        long = df["s"] >= 2.0
+        ratio = (cpu[long] / df["s"][long]).max() if long.any() and cpu[long].notna().any() else nan
         rows.append({"rule": name, "files": len(tsvs), "max_s": float(df["s"].max()),
-                     "max_rss_mb": float(rss.max()) if rss.notna().any() else float("nan")})
-    return pd.DataFrame(rows, columns=["rule", "files", "max_s", "max_rss_mb"])
+                     "max_rss_mb": float(rss.max()) if rss.notna().any() else nan,
+                     "max_cpu_ratio": float(ratio)})
+    return pd.DataFrame(rows, columns=["rule", "files", "max_s", "max_rss_mb", "max_cpu_ratio"])
 
 
 #: For a cluster rule without a benchmark file (not measured).
@@ -75,8 +85,9 @@ UNMEASURED = {"runtime": 30, "mem_mb": 2000}
 
 
 def resources(m: pd.DataFrame, runtime_factor=2.0, runtime_pad_min=5, runtime_min_min=10,
-              mem_factor=1.5, mem_pad_mb=500) -> dict[str, dict[str, int]]:
-    """Runtime (min) and memory (MB) per rule from its measurements, with margins."""
+              mem_factor=1.5, mem_pad_mb=500, multi_core_ratio=1.5) -> dict[str, dict[str, int]]:
+    """Runtime (min), memory (MB) and, for multi-core rules, threads per rule from its
+    measurements, with margins."""
     out = {}
     for r in m.itertuples():
         if r.files == 0:
@@ -86,6 +97,9 @@ def resources(m: pd.DataFrame, runtime_factor=2.0, runtime_pad_min=5, runtime_mi
         rss = r.max_rss_mb if math.isfinite(r.max_rss_mb) else 1000.0
         mem = int(math.ceil((mem_factor * rss + mem_pad_mb) / 100.0) * 100)
         out[r.rule] = {"runtime": int(runtime), "mem_mb": mem}
+        ratio = getattr(r, "max_cpu_ratio", float("nan"))
+        if math.isfinite(ratio) and ratio > multi_core_ratio:
+            out[r.rule]["threads"] = int(math.ceil(ratio))
     return out
 
 
@@ -95,6 +109,10 @@ def render(res: dict[str, dict[str, int]], source: str) -> str:
     for rule, kv in sorted(res.items()):
         note = "  # not measured (no benchmark file)" if kv.get("measured") is False else ""
         lines.append(f"  {rule}: {{runtime: {kv['runtime']}, mem_mb: {kv['mem_mb']}}}{note}")
+    threads = {rule: kv["threads"] for rule, kv in sorted(res.items()) if "threads" in kv}
+    if threads:
+        lines.append("set-threads:")
+        lines += [f"  {rule}: {n}" for rule, n in threads.items()]
     lines.append(END)
     return "\n".join(lines)
 
@@ -126,7 +144,8 @@ def main(argv=None) -> int:
         return 2
     res = resources(m)
     print(m.assign(runtime_min=[res[r]["runtime"] for r in m["rule"]],
-                   mem_mb=[res[r]["mem_mb"] for r in m["rule"]]).to_string(index=False))
+                   mem_mb=[res[r]["mem_mb"] for r in m["rule"]],
+                   threads=[res[r].get("threads", 1) for r in m["rule"]]).to_string(index=False))
     block = render(res, f"{m['files'].sum()} benchmark files" + (f" ({args.label})" if args.label else ""))
     if not args.dry:
         update_profile(Path(args.profile), block)

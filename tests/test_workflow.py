@@ -10,31 +10,46 @@ from conftest import REPO, run_snakemake
 from opnav.config import load_config
 
 
-def _write_bad(workdir: Path, mutate) -> Path:
+def _write_bad(workdir: Path, mutations, name: str) -> Path:
     cfg = load_config(overlays=[REPO / "config" / "quick.yaml"])
-    mutate(cfg)
-    path = workdir / "bad.yaml"
+    for mutate in mutations:
+        mutate(cfg)
+    path = workdir / name
     path.write_text(yaml.safe_dump(cfg))
     return path
 
 
-@pytest.mark.parametrize(
-    "mutate, key, fragment",
-    [
-        (lambda c: c["landing"]["mc"].__setitem__("n_runs", "many"), "landing.mc.n_runs", "not of type"),
-        (lambda c: c["landing"]["mc"].__setitem__("n_runs", 0), "landing.mc.n_runs", "minimum"),
-        (lambda c: c["landing"]["mc"]["bounds"].__setitem__("att_deg", 400), "landing.mc.bounds.att_deg", "maximum"),
-        (lambda c: c["landing"].__setitem__("colour", "red"), "landing", "'colour' was unexpected"),
-        (lambda c: c.__setitem__("profile", "fast"), "profile", "is not one of"),
-    ],
-)
-def test_bad_config_is_refused_naming_the_key(workdir, mutate, key, fragment):
-    bad = _write_bad(workdir, mutate)
+BAD_CONFIGS = [  # (mutation, key the refusal names, text of that key's line)
+    (lambda c: c["landing"]["mc"].__setitem__("n_runs", "many"), "landing.mc.n_runs", "not of type"),
+    (lambda c: c["landing"]["mc"].__setitem__("n_runs", 0), "landing.mc.n_runs", "minimum"),
+    (lambda c: c["landing"]["mc"]["bounds"].__setitem__("att_deg", 400), "landing.mc.bounds.att_deg", "maximum"),
+    (lambda c: c["landing"].__setitem__("colour", "red"), "landing", "'colour' was unexpected"),
+    (lambda c: c.__setitem__("profile", "fast"), "profile", "is not one of"),
+]
+
+
+def _one_run_per_key(cases):
+    """Cases packed into runs, no two in a run on one key: the refusal lists every
+    problem of a config, one line each, so a run checks several cases."""
+    runs: list[list] = []
+    for case in cases:
+        run = next((r for r in runs if case[1] not in {c[1] for c in r}), None)
+        run.append(case) if run is not None else runs.append([case])
+    return runs
+
+
+@pytest.mark.parametrize("cases", _one_run_per_key(BAD_CONFIGS),
+                         ids=lambda cases: "+".join(key for _, key, _ in cases))
+def test_bad_config_is_refused_naming_the_key(workdir, cases):
+    bad = _write_bad(workdir, [m for m, _, _ in cases], "bad.yaml")
     proc = run_snakemake(workdir, "-n", "--cores", "1", "--configfile", str(bad))
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0
-    assert f"invalid config key '{key}'" in out, out[-2000:]
-    assert fragment in out
+    lines = out.splitlines()
+    for _, key, fragment in cases:
+        named = [line for line in lines if f"invalid config key '{key}'" in line]
+        assert named, out[-2000:]
+        assert any(fragment in line for line in named), (key, fragment, named)
 
 
 @pytest.mark.parametrize("configfile", ["config/config.yaml", "config/quick.yaml"])

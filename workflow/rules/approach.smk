@@ -79,6 +79,8 @@ rule approach_crlb:
         approach=cfg("approach", *A_SCENARIO, "variants"),
     log:
         f"{APPROACH}/logs/crlb.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/crlb.tsv"
     script:
         "../scripts/approach_crlb.py"
 

@@ -139,6 +139,8 @@ rule landing_single:
                                       "figures": config["landing"]["figures"]}),
     log:
         f"{LANDING}/logs/single_{{bscn}}.log",
+    benchmark:
+        f"{LANDING}/benchmarks/single_{{bscn}}.tsv"
     script:
         "../scripts/landing_single.py"
 

@@ -1,0 +1,199 @@
+"""Whole-pipeline time: a profile from an empty results folder, and where the time goes.
+
+Description
+-----------
+In a scratch copy of the workflow (``opnav.snakeio.copy_workflow``), for each
+profile asked (``quick``: ``--configfile config/quick.yaml``; ``full``: the
+default config):
+
+1. ``snakemake -n`` and its job count (the "Job stats" total) and per-rule counts;
+2. ``snakemake --cores N`` from an empty results folder, timed: wall seconds, the
+   CPU seconds of snakemake and every job (``getrusage`` of the children), and
+   the load average before and after (other processes on a shared machine);
+3. where the time goes, per rule: jobs, the wall seconds from each job's start to
+   its end in Snakemake's log (whole seconds: the log's resolution), summed over
+   the rule's jobs, and, for rules with a ``benchmark:`` file, the summed wall
+   and CPU seconds the job measured itself. The CPU beyond the benchmarked
+   jobs' own is what the other jobs and snakemake's per-job overhead cost.
+
+With ``--pytest`` it also times ``pytest -q`` of the checkout (wall and CPU).
+Targets (issue 14): quick <= 45 s, full <= 5 min wall, pytest <= 90 s on two
+cores. Ratios are the thing to compare on a loaded machine: run what you
+compare in one invocation.
+
+Use::
+
+    python benchmarks/bench_pipeline.py                       # quick profile
+    python benchmarks/bench_pipeline.py --profile quick full  # both, one after the other
+    python benchmarks/bench_pipeline.py --pytest --profile    # pytest only
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import datetime as dt
+import os
+import re
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "src"))
+
+from opnav.snakeio import copy_workflow  # noqa: E402
+
+TARGET_S = {"quick": 45.0, "full": 300.0, "pytest": 90.0}
+PROFILE_ARGS = {"quick": ["--configfile", "config/quick.yaml"], "full": []}
+
+
+def _env(wd: Path) -> dict:
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(
+        p for p in (str(wd / "src"), os.environ.get("PYTHONPATH", "")) if p))
+
+
+def _children_cpu() -> float:
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
+def timed(cmd: list[str], cwd: Path, env: dict) -> dict:
+    """Run ``cmd``; wall and CPU seconds (the process and its waited-for children)."""
+    load0, cpu0, t0 = os.getloadavg()[0], _children_cpu(), time.perf_counter()
+    proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
+    wall, cpu = time.perf_counter() - t0, _children_cpu() - cpu0
+    return {"rc": proc.returncode, "wall_s": wall, "cpu_s": cpu, "load_before": load0,
+            "load_after": os.getloadavg()[0], "out": proc.stdout + proc.stderr}
+
+
+def job_stats(text: str) -> dict[str, int]:
+    """{rule: jobs} of the last "Job stats" table in snakemake's output (with 'total')."""
+    blocks = text.split("Job stats:")
+    if len(blocks) < 2:
+        return {}
+    out = {}
+    for line in blocks[-1].splitlines()[3:]:
+        m = re.match(r"(\w+)\s+(\d+)$", line.strip())
+        if not m:
+            break
+        out[m.group(1)] = int(m.group(2))
+    return out
+
+
+_STAMP = re.compile(r"^\[(\w{3} \w{3} +\d+ \d\d:\d\d:\d\d \d{4})\]$", re.M)
+
+
+def log_job_seconds(log_text: str) -> dict[str, float]:
+    """{rule: summed seconds from each job's start to its 'Finished jobid'} from a snakemake log."""
+    start, rule_of, per_rule = {}, {}, collections.Counter()
+    pieces = _STAMP.split(log_text)
+    for stamp, body in zip(pieces[1::2], pieces[2::2]):
+        t = dt.datetime.strptime(" ".join(stamp.split()), "%a %b %d %H:%M:%S %Y")
+        for m in re.finditer(r"^(?:local)?rule (\w+):\n(?:    .*\n)*?    jobid: (\d+)", body, re.M):
+            start[m.group(2)], rule_of[m.group(2)] = t, m.group(1)
+        for m in re.finditer(r"Finished jobid: (\d+)", body):
+            j = m.group(1)
+            if j in start:
+                per_rule[rule_of[j]] += (t - start[j]).total_seconds()
+    return dict(per_rule)
+
+
+def benchmark_seconds(results: Path) -> dict[str, tuple[int, float, float]]:
+    """{benchmark file stem prefix: (files, summed wall s, summed CPU s)} of every
+    benchmark TSV under ``results`` (grouped by the part of the name before the
+    first wildcard-looking separator)."""
+    import csv
+
+    out: dict[str, list[float]] = collections.defaultdict(lambda: [0, 0.0, 0.0])
+    for f in results.rglob("benchmarks/*.tsv"):
+        with open(f) as fh:
+            rows = list(csv.DictReader(fh, delimiter="\t"))
+        if not rows:
+            continue
+        key = f"{f.parent.parent.name}/{re.split(r'_|__', f.stem)[0]}"
+        acc = out[key]
+        acc[0] += 1
+        acc[1] += float(rows[0]["s"])
+        try:
+            acc[2] += float(rows[0]["cpu_time"])
+        except (KeyError, ValueError):
+            pass
+    return {k: tuple(v) for k, v in out.items()}
+
+
+def run_profile(name: str, cores: int, keep: Path | None) -> dict:
+    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix=f"bench_pipeline_{name}_"))
+    wd = copy_workflow(REPO, tmp / name)
+    env = _env(wd)
+    base = [sys.executable, "-m", "snakemake", *PROFILE_ARGS[name]]
+    dry = timed([*base, "-n", "--cores", "1"], wd, env)
+    jobs = job_stats(dry["out"])
+    run = timed([*base, "--cores", str(cores)], wd, env)
+    if run["rc"] != 0:
+        print(run["out"][-3000:], file=sys.stderr)
+        raise SystemExit(f"bench_pipeline: the {name} profile failed (scratch copy kept in {wd})")
+    logs = sorted((wd / ".snakemake" / "log").glob("*.snakemake.log"))
+    per_rule = log_job_seconds(logs[-1].read_text()) if logs else {}
+    return {"name": name, "wd": wd, "jobs": jobs, "dry": dry, "run": run, "per_rule": per_rule,
+            "bench": benchmark_seconds(wd / "results")}
+
+
+def report_profile(r: dict, cores: int) -> None:
+    run, jobs = r["run"], r["jobs"]
+    print(f"\n== {r['name']} profile (snakemake --cores {cores}{' ' + ' '.join(PROFILE_ARGS[r['name']]) if PROFILE_ARGS[r['name']] else ''}), scratch copy {r['wd']}")
+    print(f"dry run: {jobs.get('total', 0)} jobs, parse + DAG {r['dry']['wall_s']:.1f} s wall, {r['dry']['cpu_s']:.1f} CPU-s")
+    print(f"{'rule':28s} {'jobs':>5s} {'job-s (log)':>12s}")
+    rows = sorted(((k, v) for k, v in jobs.items() if k != "total"),
+                  key=lambda kv: -r["per_rule"].get(kv[0], 0.0))
+    for rule, n in rows:
+        print(f"{rule:28s} {n:5d} {r['per_rule'].get(rule, 0.0):12.0f}")
+    print(f"{'benchmark files':28s} {'files':>5s} {'wall s':>8s} {'CPU s':>8s}")
+    bench_cpu = 0.0
+    for k, (n, w, c) in sorted(r["bench"].items(), key=lambda kv: -kv[1][1]):
+        bench_cpu += c
+        print(f"{k:28s} {n:5d} {w:8.1f} {c:8.1f}")
+    n = max(jobs.get("total", 1), 1)
+    print(f"CPU: {run['cpu_s']:.0f} CPU-s in all, {bench_cpu:.0f} in benchmarked jobs' own measurement, "
+          f"{(run['cpu_s'] - bench_cpu) / n:.2f} CPU-s per job for the rest (other jobs, imports, snakemake)")
+    print(f"load average {run['load_before']:.1f} before, {run['load_after']:.1f} after")
+    print(f"{r['name']} profile: {run['wall_s']:.1f} s wall, {run['cpu_s']:.0f} CPU-s, "
+          f"{jobs.get('total', 0)} jobs (target {TARGET_S[r['name']]:.0f} s wall)")
+
+
+def run_pytest() -> dict:
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        p for p in (str(REPO / "src"), os.environ.get("PYTHONPATH", "")) if p))
+    with tempfile.TemporaryDirectory(prefix="bench_pytest_") as base:
+        r = timed([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", f"--basetemp={base}/t"],
+                  REPO, env)
+    tail = [line for line in r["out"].splitlines() if line.strip()][-1:]
+    print(f"\n== pytest ({tail[0] if tail else 'no output'})")
+    print(f"load average {r['load_before']:.1f} before, {r['load_after']:.1f} after")
+    print(f"pytest: {r['wall_s']:.1f} s wall, {r['cpu_s']:.0f} CPU-s (target {TARGET_S['pytest']:.0f} s wall)")
+    return r
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--profile", nargs="*", default=["quick"], choices=sorted(PROFILE_ARGS),
+                    help="profiles to run from empty, in order (none: skip)")
+    ap.add_argument("--cores", type=int, default=2)
+    ap.add_argument("--pytest", action="store_true", help="also time the test suite")
+    ap.add_argument("--keep", help="make the scratch copies under this folder (kept)")
+    args = ap.parse_args(argv)
+    if args.cores < 1:
+        ap.error("--cores must be >= 1")
+    print(f"{os.cpu_count()} CPUs; load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    for name in args.profile:
+        report_profile(run_profile(name, args.cores, Path(args.keep) if args.keep else None), args.cores)
+    if args.pytest:
+        run_pytest()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
