@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from opnav.approach.cases import convergence_study, headline_case
+from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -10,11 +11,10 @@ if "snakemake" not in globals():  # standalone debugging run
     snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.approach
-    cs = cfg["convergence_study"]
-    res = convergence_study(cfg, snakemake.wildcards.variant, headline_case(cfg), range(cs["n_seeds"]),
-                            cs["data_samples"], cs["max_maps"], cs["tol_arcsec"],
-                            init_mode=cs["initial_error_mode"])
+    setup = Setup.from_config(snakemake.params.approach)
+    cs = setup.convergence_study
+    res = convergence_study(setup, snakemake.wildcards.variant, headline_case(setup), range(cs.n_seeds),
+                            cs.data_samples, cs.max_maps, cs.tol_arcsec, init_mode=cs.initial_error_mode)
     log.info("theta* mean %s; maps plain %s squarem %s", res["theta_star_arcsec"].mean(0),
              res["plain"]["maps_to_converge"], res["squarem"]["maps_to_converge"])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)

@@ -5,6 +5,7 @@ from pathlib import Path
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
 from opnav.approach.pipeline import bound_curve
+from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -12,14 +13,14 @@ if "snakemake" not in globals():  # standalone debugging run
     snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.approach
-    case = headline_case(cfg)
+    setup = Setup.from_config(snakemake.params.approach)
+    case = headline_case(setup)
     curves = {"Q": {}, "Q0": {}}  # with the filter's process noise, and with none (as the truth)
-    for v in cfg["variants"]:
-        geo = sc.build_geometry(cfg, v)
-        Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-        curves["Q"][v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v)
-        curves["Q0"][v] = bound_curve(cfg, geo, Rvar, case.truth_arcsec, v, zero_q=True)
+    for v in setup.variants:
+        geo = sc.build_geometry(setup, v)
+        Rvar = geo.measurement_variance(case.sigma3_px)
+        curves["Q"][v] = bound_curve(setup, geo, Rvar, case.truth_arcsec, v)
+        curves["Q0"][v] = bound_curve(setup, geo, Rvar, case.truth_arcsec, v, zero_q=True)
         log.info("%s: CRLB at end %s arcsec (Q = 0: %s)", v, curves["Q"][v][-1], curves["Q0"][v][-1])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], curves)

@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from opnav.approach.pipeline import run_group
+from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -13,6 +14,6 @@ if "snakemake" not in globals():  # standalone debugging run
 with script_context(snakemake) as log:
     w = snakemake.wildcards
     mode, _, method = w.method.rpartition("-")  # "growing-squarem" -> growing windows, SQUAREM
-    res = run_group(snakemake.params.approach, w.variant, w.group, method, mode or "sliding", log=log)
+    res = run_group(Setup.from_config(snakemake.params.approach), w.variant, w.group, method, mode or "sliding", log=log)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], res)

@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from opnav.approach.peers import run_variant
+from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -10,6 +11,6 @@ if "snakemake" not in globals():  # standalone debugging run
     snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
 
 with script_context(snakemake) as log:
-    res = run_variant(snakemake.params.approach, snakemake.wildcards.variant, log=log)
+    res = run_variant(Setup.from_config(snakemake.params.approach), snakemake.wildcards.variant, log=log)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], res)

@@ -4,6 +4,7 @@
 
 from opnav import published
 from opnav.approach import report
+from opnav.approach.setup import Setup
 from opnav.snakeio import load_pickle, script_context
 from opnav.tables import atomic_write_text, write_json, write_table
 
@@ -12,7 +13,7 @@ if "snakemake" not in globals():  # standalone debugging run
 
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.approach
+    setup = Setup.from_config(snakemake.params.approach)
     results = []
     for p in snakemake.input.mc:
         results.extend(load_pickle(p))
@@ -28,12 +29,12 @@ with script_context(snakemake) as log:
            "estimate used; stalled runs never count as converged; pub_* = published.")
     write_table(t1, [csv], caption=cap)  # every column
     write_table(report.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
-    x1 = report.crlb_rows(cfg, curves["Q"], conv, t1, curves["Q0"])
+    x1 = report.crlb_rows(setup, curves["Q"], conv, t1, curves["Q0"])
     write_table(x1, snakemake.output.x1,
                 caption="A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.")
-    atomic_write_text(snakemake.output.verdict, report.identifiability_text(cfg, x1))
-    summ = report.summary(cfg, t1, x1)
+    atomic_write_text(snakemake.output.verdict, report.identifiability_text(setup, x1))
+    summ = report.summary(setup, t1, x1)
     summ["profile"] = snakemake.params.profile
-    summ["text"] = report.findings(cfg, summ, pub["headline"])  # the manuscript's finding sentences
+    summ["text"] = report.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
     write_json(snakemake.output.summary, summ)
     log.info("wrote %d Table-1 rows", len(t1))

@@ -5,15 +5,16 @@ import pandas as pd
 
 from opnav import figures
 from opnav.approach import plots
+from opnav.approach.setup import Setup
 from opnav.snakeio import load_pickle, script_context
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.approach
+    setup = Setup.from_config(snakemake.params.approach)
     curves = load_pickle(snakemake.input.crlb)["Q"]
     conv = {}
     for p in snakemake.input.conv:
         c = load_pickle(p)
         conv[c["variant"]] = c
     x1 = pd.read_csv(snakemake.input.x1)
-    fig = plots.fig_crlb(curves, conv, x1, cfg["accuracy_target_arcsec"], cfg["segments"]["N0"])
+    fig = plots.fig_crlb(curves, conv, x1, setup.accuracy_target_arcsec, setup.segments.N0)
     figures.save(fig, snakemake.output.fig)

@@ -5,6 +5,7 @@ from pathlib import Path
 from opnav.approach import alternatives as alt
 from opnav.approach import scenario as sc
 from opnav.approach.pipeline import cases_in
+from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # standalone debugging run
@@ -14,13 +15,13 @@ if "snakemake" not in globals():  # standalone debugging run
 
 with script_context(snakemake) as log:
     w = snakemake.wildcards
-    cfg = snakemake.params.approach
-    res = alt.run_group_alternatives(cfg, w.variant, w.group, log=log)
+    setup = Setup.from_config(snakemake.params.approach)
+    geo = sc.build_geometry(setup, w.variant)
+    res = alt.run_group_alternatives(setup, w.variant, w.group, log=log, geo=geo)
     em_times = {}
-    headline = [c for c in cases_in(cfg, w.group) if c.case_index == 1]
+    headline = [c for c in cases_in(setup, w.group) if c.case_index == 1]
     if headline:  # EM-EKF timed on the same machine and job, headline case, all seeds
-        geo = sc.build_geometry(cfg, w.variant)
-        em_times = alt.time_em(cfg, w.variant, headline[0], range(cfg["n_seeds"]), geo)
+        em_times = alt.time_em(setup, w.variant, headline[0], range(setup.n_seeds), geo)
         log.info("EM-EKF run time per seed: %s", em_times)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], {"variant": w.variant, "group": w.group, "results": res, "em_times": em_times})

@@ -3,6 +3,7 @@
 
 
 from opnav.approach import alternatives as alt
+from opnav.approach.setup import Setup
 from opnav.snakeio import load_pickle, script_context
 from opnav.tables import write_json, write_table
 
@@ -11,7 +12,7 @@ if "snakemake" not in globals():  # standalone debugging run
 
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.approach
+    setup = Setup.from_config(snakemake.params.approach)
     alt_res, em_times = [], {}
     for p in snakemake.input.x2:
         d = load_pickle(p)
@@ -29,7 +30,7 @@ with script_context(snakemake) as log:
                 caption="A-X2: EM-EKF against the augmented EKF and batch ML (IPOPT) on the Table-1 cases; "
                         "errors in arcsec (estimate minus truth), CRLB = Cramer-Rao bound, nav error in km, "
                         "data needed in samples, run time in s per Monte-Carlo seed.")
-    summ = alt.summary_json(long, table, cfg)
+    summ = alt.summary_json(long, table, setup)
     summ["profile"] = snakemake.params.profile
     write_json(snakemake.output.summary, summ)
     log.info("A-X2: %d long rows, %d table rows", len(long), len(table))

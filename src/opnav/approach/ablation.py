@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import copy
 import math
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -33,7 +34,8 @@ import pandas as pd
 from . import alternatives as alt
 from . import cases
 from . import scenario as sc
-from .pipeline import bound_curve, segment_bounds
+from .pipeline import segment_bounds, total_bound
+from .setup import Setup
 
 SWEEPS = {"pixel": "sigma3_px", "segment": "segment_N",
           # sensitivity sweeps (A-X5): prior 1-sigma, initial range, roll rate
@@ -54,8 +56,9 @@ def sweep_configs(cfg: dict, sweep: str) -> list[tuple[float, dict, cases.Case]]
     """
     if sweep not in SWEEPS:
         raise ValueError(f"unknown ablation sweep {sweep!r}; use one of {sorted(SWEEPS)}")
-    abl = cfg["ablation"]
-    base = cases.headline_case(cfg)
+    abl = cfg["ablation"]  # the sweep derives configs (dicts) at the edge; run_sweep parses each once
+    setup = Setup.of(cfg)
+    base = cases.headline_case(setup)
     out = []
     for v in abl[SWEEPS[sweep]]:
         c = copy.deepcopy(cfg)
@@ -63,9 +66,7 @@ def sweep_configs(cfg: dict, sweep: str) -> list[tuple[float, dict, cases.Case]]
         c["initial_error"]["mode"] = "sampled"
         case = base
         if sweep == "pixel":
-            ratio = cfg["camera"]["radius_to_centroid_ratio"]
-            case = cases.Case(base.case_index, base.case_id, base.group, base.truth_arcsec,
-                              base.init_arcsec, (float(v), float(v), ratio * float(v)), base.install_deg)
+            case = replace(base, sigma3_px=setup.camera.pixel_errors(v))
         elif sweep == "segment":
             s = c["segments"]
             total = s["L"] * s["N"]
@@ -116,18 +117,16 @@ def run_sweep(cfg: dict, sweep: str, log=None) -> pd.DataFrame:
         variants = [v for v in variants if v == "roll"] or ["roll"]
     for variant in variants:
         for value, c, case in sweep_configs(cfg, sweep):
-            seg = c["segments"]
-            n_needed = seg["N0"] + seg["L"] * seg["N"]
-            geo = sc.build_geometry(c, variant, n=n_needed)
-            seeds = range(c["n_seeds"])
-            em = cases.run_case(c, variant, case, seeds, geo=geo, method=c["em"]["method"])
-            Rvar = sc.measurement_variance(geo, c, case.sigma3_px)
-            used = seg["L"] * seg["N"]
-            curve = bound_curve(c, geo, Rvar, case.truth_arcsec, variant)
-            cb = curve[min(used, len(curve) - 1)]  # all data: the augmented EKF's bound
+            c = Setup.of(c)  # the edge: each swept config parsed once
+            geo = sc.build_geometry(c, variant)
+            seeds = range(c.n_seeds)
+            em = cases.run_case(c, variant, case, seeds, geo=geo, method=c.em.method)
+            Rvar = geo.measurement_variance(case.sigma3_px)
+            used = c.segments.data_samples
+            cb = total_bound(c, geo, Rvar, case.truth_arcsec, variant)  # all data: the augmented EKF's bound
             cb_em = segment_bounds(c, geo, Rvar, case.truth_arcsec, variant)[-1]  # the data EM used
             truth = np.asarray(case.truth_arcsec, float)
-            rows.append(_row(variant, sweep, value, f"EM-EKF ({c['em']['method']})",
+            rows.append(_row(variant, sweep, value, f"EM-EKF ({c.em.method})",
                              em["theta_final_arcsec"], truth, cb_em, used)
                         | {"stalled_seeds": int(np.sum(em["stalled"]))})
             ra = alt.run_case_alternatives(c, variant, case, seeds, geo, methods=("augmented",))

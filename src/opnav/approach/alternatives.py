@@ -51,7 +51,8 @@ from . import scenario as sc
 from .augmented import run_augmented
 from .batch_ml import BatchML
 from .dynamics import ARCSEC
-from .ekf import predict_only, run_filter
+from .ekf import run_filter
+from .setup import Setup
 
 METHOD_LABELS = {
     "em_plain": "EM-EKF (plain)",
@@ -59,19 +60,6 @@ METHOD_LABELS = {
     "augmented": "augmented EKF",
     "batch_ml": "batch ML (IPOPT)",
 }
-
-
-def start_state(variant: str, z: np.ndarray, dx0: np.ndarray, geo: sc.Geometry, win, N0: int):
-    """State (S, 6) and covariance (S, 6, 6) at ``N0`` from which the variant's EM starts."""
-    S = z.shape[0]
-    start = sc.START_OF[variant]
-    if start == "prior":
-        x, P = predict_only(dx0, geo.P0, win.slice(0, N0))
-        return x, np.broadcast_to(P, (S, 6, 6)).copy()
-    f = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
-    if start == "filter":
-        return f.xf[:, -1], f.Pf[:, -1]
-    return np.broadcast_to(geo.dx_true[N0], (S, 6)).copy(), f.Pf[:, -1]
 
 
 def los_boresight(geo: sc.Geometry) -> np.ndarray:
@@ -102,29 +90,29 @@ class _BatchCache:
         return self.store[key]
 
 
-def run_case_alternatives(cfg: dict, variant: str, case: cases.Case, seed_indices,
+def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, seed_indices,
                           geo: sc.Geometry, cache: _BatchCache | None = None,
                           methods=("augmented", "batch_ml")) -> dict:
     """Augmented EKF and batch ML for one case and variant over the given seeds."""
-    alt = cfg["alternatives"]
-    seg = cfg["segments"]
-    N0, N, L = seg["N0"], seg["N"], seg["L"]
+    setup = Setup.of(setup)
+    alt = setup.alternatives
+    seg = setup.segments
+    N0, N, L = seg.N0, seg.N, seg.L
     cache = cache or _BatchCache()
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-    win = geo.window(Rvar)
     seeds = list(seed_indices)
-    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seeds)
-    theta_true = sc.rad(case.truth_arcsec)
-    z, e0 = sc.simulate(geo, Rvar, theta_true, rngs)
+    Rvar, z, dx0 = cases.simulate_case(setup, geo, case, seeds, setup.initial_error.mode)
+    win = geo.window(Rvar)
     S = z.shape[0]
-    dx0 = sc.prior_mean_deviation(geo, e0, cfg["initial_error"]["mode"])
-    x0, P0 = start_state(variant, z, dx0, geo, win, N0)
+    start = sc.START_OF[variant]
+    f0 = None if start == "prior" else run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
+    x0, P0 = cases.start_state(start, N0, f0, geo.dx_true, dx0, geo.P0, win)
+    P0 = np.broadcast_to(P0, (S, 6, 6))  # one per seed (the prior's is shared)
     wwin = win.slice(N0, N0 + L * N)
     zw = z[:, N0:N0 + L * N + 1]
     th0 = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
     seg_data = np.array([(l + 1) * N for l in range(L)])
-    tol = cfg["em"]["converge_tol_arcsec"]
-    frac = cfg["nav_error"]["last_fraction"]
+    tol = setup.em.converge_tol_arcsec
+    frac = setup.nav_last_fraction
     out = {"variant": variant, "case": case, "case_id": case.case_id,
            "seed_indices": np.asarray(seeds), "truth_arcsec": np.asarray(case.truth_arcsec, float),
            "seg_data_used": seg_data, "methods": {}}
@@ -135,10 +123,10 @@ def run_case_alternatives(cfg: dict, variant: str, case: cases.Case, seed_indice
         return cases.rms_last(err, frac)
 
     # (a) augmented EKF
-    a = alt["augmented"]
+    a = alt.augmented
     t = time.perf_counter()
-    ra = run_augmented(zw, x0, P0, th0, sc.rad(a["theta_prior_sigma_arcsec"]), wwin,
-                       q_theta=(a["theta_process_sigma_arcsec"] * ARCSEC) ** 2)
+    ra = run_augmented(zw, x0, P0, th0, sc.rad(a.theta_prior_sigma_arcsec), wwin,
+                       q_theta=(a.theta_process_sigma_arcsec * ARCSEC) ** 2)
     t_aug = (time.perf_counter() - t) / S
     seg_th = sc.arcsec(ra.theta[:, seg_data])
     out["methods"]["augmented"] = {
@@ -153,14 +141,14 @@ def run_case_alternatives(cfg: dict, variant: str, case: cases.Case, seed_indice
     if "batch_ml" not in methods:
         return out
     # (b) batch ML: final window for every seed; growing checkpoints for the first few seeds
-    b = alt["batch_ml"]
-    sig = sc.rad(b["theta_prior_sigma_arcsec"])
+    b = alt.batch_ml
+    sig = sc.rad(b.theta_prior_sigma_arcsec)
     key = (tuple(case.sigma3_px), "final")
-    bm, t_build = cache.get(key, lambda: BatchML(wwin, [L * N], sig, jit=b["jit"], tol=b["tol"]))
+    bm, t_build = cache.get(key, lambda: BatchML(wwin, [L * N], sig, jit=b.jit, tol=b.tol))
     t = time.perf_counter()
     rb = bm.solve(zw, x0, P0, th0, wwin.u_ref)
     t_solve = time.perf_counter() - t
-    ncp = min(b["checkpoint_seeds"], S)
+    ncp = min(b.checkpoint_seeds, S)
     res_b = {
         "theta_final_arcsec": sc.arcsec(rb.theta[:, -1]),
         "grad_norm": rb.grad_norm[:, -1],
@@ -172,9 +160,9 @@ def run_case_alternatives(cfg: dict, variant: str, case: cases.Case, seed_indice
         "runtime_build_s": t_build,
     }
     if ncp > 0:
-        cp = checkpoint_samples(seg_data, b["checkpoint_stride"])
+        cp = checkpoint_samples(seg_data, b.checkpoint_stride)
         bmc, t_build_c = cache.get((tuple(case.sigma3_px), "checkpoints"),
-                                   lambda: BatchML(wwin, cp, sig, jit=b["jit"], tol=b["tol"]))
+                                   lambda: BatchML(wwin, cp, sig, jit=b.jit, tol=b.tol))
         t = time.perf_counter()
         rc = bmc.solve(zw[:ncp], x0[:ncp], P0[:ncp], th0[:ncp], wwin.u_ref)
         t_cp = time.perf_counter() - t
@@ -192,16 +180,18 @@ def run_case_alternatives(cfg: dict, variant: str, case: cases.Case, seed_indice
     return out
 
 
-def run_group_alternatives(cfg: dict, variant: str, group: str, log=None) -> list[dict]:
+def run_group_alternatives(setup: Setup | dict, variant: str, group: str, log=None,
+                           geo: sc.Geometry | None = None) -> list[dict]:
     """Alternatives for every case of a Table-1 ``group`` under ``variant`` (one Snakemake job)."""
     from .pipeline import cases_in
 
-    geo = sc.build_geometry(cfg, variant)
+    setup = Setup.of(setup)
+    geo = geo or sc.build_geometry(setup, variant)
     cache = _BatchCache()
-    seeds = range(cfg["n_seeds"])
+    seeds = range(setup.n_seeds)
     res = []
-    for case in cases_in(cfg, group):
-        r = run_case_alternatives(cfg, variant, case, seeds, geo, cache)
+    for case in cases_in(setup, group):
+        r = run_case_alternatives(setup, variant, case, seeds, geo, cache)
         res.append(r)
         if log:
             log.info("%s %s %s: aug %s ml %s", variant, group, case.case_id,
@@ -210,17 +200,18 @@ def run_group_alternatives(cfg: dict, variant: str, group: str, log=None) -> lis
     return res
 
 
-def time_em(cfg: dict, variant: str, case: cases.Case, seed_indices, geo: sc.Geometry) -> dict:
+def time_em(setup: Setup | dict, variant: str, case: cases.Case, seed_indices, geo: sc.Geometry) -> dict:
     """Wall time per seed of the EM-EKF (:func:`cases.run_case`) for each configured EM scheme.
 
     ``run_case`` also runs the theta = 0 and the compensated full-arc filters
     (2 of its ``1 + M L + 1`` filter passes); the time includes them.
     """
+    setup = Setup.of(setup)
     out = {}
     S = len(list(seed_indices))
-    for m in cfg["methods"]:
+    for m in setup.methods:
         t = time.perf_counter()
-        cases.run_case(cfg, variant, case, seed_indices, geo=geo, method=m)
+        cases.run_case(setup, variant, case, seed_indices, geo=geo, method=m)
         out[f"em_{m}"] = (time.perf_counter() - t) / S
     return out
 
@@ -316,9 +307,10 @@ def summary_frame(long: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def summary_json(long: pd.DataFrame, table: pd.DataFrame, cfg: dict) -> dict:
+def summary_json(long: pd.DataFrame, table: pd.DataFrame, setup: Setup | dict) -> dict:
     """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json)."""
-    out = {"segments": cfg["segments"], "alternatives": cfg["alternatives"], "variants": {}}
+    setup = Setup.of(setup)
+    out = {"segments": setup.segments.as_dict(), "alternatives": setup.alternatives.as_dict(), "variants": {}}
     for _, r in table.iterrows():
         key = [k for k, lab in METHOD_LABELS.items() if lab == r["method"]][0]
         out["variants"].setdefault(r["variant"], {})[key] = {

@@ -47,7 +47,8 @@ import numpy as np
 
 from .camera import skew
 from .dynamics import ARCSEC
-from .ekf import LOG2PI, Window
+from . import kalman
+from .ekf import Window
 
 
 @dataclass
@@ -87,11 +88,8 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
     P = np.zeros((S, 9, 9))
     P[:, :6, :6] = np.broadcast_to(P0, (S, 6, 6))
     P[:, 6:, 6:] = np.eye(3) * (theta_prior_sigma / ARCSEC) ** 2
-    Qa = np.zeros((9, 9))
-    Qa[:6, :6] = win.Q
-    Qa[6:, 6:] = np.eye(3) * q_theta / ARCSEC**2
+    Qa = augmented_noise(win.Q, q_theta / ARCSEC**2)
     F = np.eye(9)
-    I9 = np.eye(9)
     th_out = np.empty((S, n + 1, 3))
     Pth_out = np.empty((S, n + 1, 3, 3))
     xf = np.empty((S, n + 1, 6))
@@ -110,32 +108,37 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
         U_lin = skew(np.asarray(u_lin, float)) * ARCSEC
     for k in range(1, n + 1):
         F[:6, :6] = win.Phi[k]
-        y = y @ F.T
-        P = F @ P @ F.T + Qa
+        y, P = kalman.predict(y, P, F, Qa)
         C = win.C[k]
-        H = np.zeros((S, 3, 9))
         if u_lin is None:
             th = y[:, 6:] * ARCSEC
             A = np.eye(3) - skew(th)  # (S,3,3)
             u = win.u_ref[k] - y[:, :3] @ C.T  # (S,3)
             zhat = np.einsum("sij,sj->si", A, u)
-            H[:, :, :3] = -A @ C
-            H[:, :, 6:] = skew(u) * ARCSEC
+            H = augmented_jacobian(A, C, skew(u) * ARCSEC)
         else:
-            H[:, :, :3] = -A_lin @ C
-            H[:, :, 6:] = U_lin[k]
+            H = np.broadcast_to(augmented_jacobian(A_lin, C, U_lin[k]), (S, 3, 9))
             zhat = win.u_ref[k] + np.einsum("sij,sj->si", H, y)
         nu = z[:, k] - zhat
-        PHt = P @ H.transpose(0, 2, 1)  # (S,9,3)
-        Sm = H @ PHt
-        Sm[:, [0, 1, 2], [0, 1, 2]] += win.Rvar[k]
-        Sinv = np.linalg.inv(Sm)
-        K = PHt @ Sinv
-        y = y + np.einsum("sij,sj->si", K, nu)
-        IKH = I9 - K @ H
-        P = IKH @ P @ IKH.transpose(0, 2, 1) + (K * win.Rvar[k]) @ K.transpose(0, 2, 1)
-        P = 0.5 * (P + P.transpose(0, 2, 1))
-        ll -= 0.5 * (np.linalg.slogdet(Sm)[1] + np.einsum("si,sij,sj->s", nu, Sinv, nu)
-                     + 3.0 * LOG2PI)
+        y, P, _, Sinv, det = kalman.condition_on(y, P, H, win.Rvar[k], nu, joseph=True)
+        ll += kalman.innovation_loglik(nu, Sinv, det)
         store(k)
     return AugmentedResult(th_out * ARCSEC, Pth_out * ARCSEC**2, xf, ptr, ll)
+
+
+def augmented_noise(Q: np.ndarray, q_theta: float) -> np.ndarray:
+    """Process noise (9, 9) of ``[dX; theta]``: ``Q`` and ``q_theta I`` (theta's units squared)."""
+    Qa = np.zeros((9, 9))
+    Qa[:6, :6] = Q
+    Qa[6:, 6:] = np.eye(3) * q_theta
+    return Qa
+
+
+def augmented_jacobian(A: np.ndarray, C: np.ndarray, U: np.ndarray) -> np.ndarray:
+    """``H = [-A_m C, 0_3x3, U]`` (..., 3, 9) of the augmented state ``[dX; theta]``,
+    ``U = [u x]`` in the measurement's km per unit of theta (module docstring)."""
+    AC = -A @ C
+    H = np.zeros(np.broadcast_shapes(AC.shape[:-2], np.shape(U)[:-2]) + (3, 9))
+    H[..., :3] = AC
+    H[..., 6:] = U
+    return H

@@ -58,7 +58,8 @@ import casadi as ca
 import numpy as np
 
 from .dynamics import ARCSEC
-from .ekf import LOG2PI, Window
+from .ekf import Window
+from .kalman import LOG2PI
 
 _STEP: dict[bool, ca.Function] = {}
 _JIT_DIRS: list[str] = []

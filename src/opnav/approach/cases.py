@@ -40,6 +40,7 @@ import numpy as np
 from . import scenario as sc
 from .ekf import predict_only, run_filter
 from .em import contraction_per_map, em_window, maps_per_segment, ml_estimate, stalled
+from .setup import Setup
 
 GROUPS = ("size", "polarity", "initial", "pixel", "install")
 GROUP_TITLES = {
@@ -60,12 +61,12 @@ class Case:
     init_mode: str | None = None  # initial-error mode of this run (None: the config's)
 
 
-def table1_cases(cfg: dict) -> list[Case]:
+def table1_cases(setup: Setup | dict) -> list[Case]:
     """The 17 cases of paper A Table 1 (ids T1-01..T1-17, paper row order)."""
-    truth = tuple(cfg["truth_bias_arcsec"])
-    init = tuple(cfg["theta_init_arcsec"])
-    px = tuple(cfg["camera"]["sigma3_px"])
-    ratio = cfg["camera"]["radius_to_centroid_ratio"]
+    setup = Setup.of(setup)
+    truth = setup.truth_bias_arcsec
+    init = setup.theta_init_arcsec
+    px = setup.camera.sigma3_px
     rows = []
     for b in ([10, 20, 10], [10, 10, 10], [10, 3, 10]):
         rows.append(("size", tuple(map(float, b)), init, px, 0.0))
@@ -74,14 +75,14 @@ def table1_cases(cfg: dict) -> list[Case]:
     for i in ([0, 0, 0], [-20, -20, -20]):
         rows.append(("initial", truth, tuple(map(float, i)), px, 0.0))
     for p in (0.1, 0.5, 1.0):
-        rows.append(("pixel", truth, init, (p, p, ratio * p), 0.0))
+        rows.append(("pixel", truth, init, setup.camera.pixel_errors(p), 0.0))
     for a in (0.0, 45.0, 90.0, 135.0, 180.0):
         rows.append(("install", truth, init, px, a))
     return [Case(i + 1, f"T1-{i + 1:02d}", *r) for i, r in enumerate(rows)]
 
 
-def headline_case(cfg: dict) -> Case:
-    return table1_cases(cfg)[0]
+def headline_case(setup: Setup | dict) -> Case:
+    return table1_cases(setup)[0]
 
 
 def rms_last(err_norm: np.ndarray, last_fraction: float) -> np.ndarray:
@@ -126,13 +127,17 @@ def consistency(f, dx_true: np.ndarray) -> dict:
     return {"nees_pos": nees, "nis": nis}
 
 
-def segment_windows(cfg: dict) -> list[tuple[int, int]]:
-    """(a, b) sample ranges of the L segments (start sample a has no measurement)."""
-    s = cfg["segments"]
-    N0, N, L = s["N0"], s["N"], s["L"]
-    if s["mode"] == "sliding":
-        return [(N0 + l * N, N0 + (l + 1) * N) for l in range(L)]
-    return [(N0, N0 + (l + 1) * N) for l in range(L)]
+def simulate_case(setup: Setup, geo: sc.Geometry, case: Case, seed_indices, init_mode: str | None = None,
+                  truth_arcsec=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Measurement variances (n+1, 3), measurements z (S, n+1, 3) and the prior mean
+    deviations dx0 (S, 6) of ``case`` for the given seeds (streams
+    ``SeedSequence([base_seed, case_index, seed_index])``; ``truth_arcsec`` overrides the
+    case's truth, ``init_mode`` the initial-error mode of the case and the setup)."""
+    Rvar = geo.measurement_variance(case.sigma3_px)
+    rngs = sc.seed_streams(setup.base_seed, case.case_index, seed_indices)
+    truth = case.truth_arcsec if truth_arcsec is None else truth_arcsec
+    z, e0 = sc.simulate(geo, Rvar, sc.rad(truth), rngs)
+    return Rvar, z, sc.prior_mean_deviation(geo, e0, init_mode or case.init_mode or setup.initial_error.mode)
 
 
 def start_state(start: str, a: int, f0, dx_true: np.ndarray, dx0: np.ndarray, P_X0: np.ndarray,
@@ -153,28 +158,29 @@ def start_state(start: str, a: int, f0, dx_true: np.ndarray, dx0: np.ndarray, P_
     raise ValueError(f"unknown start rule {start!r}")
 
 
-def run_case(cfg: dict, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
+def run_case(setup: Setup | dict, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
              method: str | None = None, init_mode: str | None = None) -> dict:
     """EM-EKF for one case and variant over the given seeds; arrays in arcsec / km."""
-    return run_cases(cfg, variant, [case], seed_indices, geo, method, init_mode)[0]
+    return run_cases(setup, variant, [case], seed_indices, geo, method, init_mode)[0]
 
 
-def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo: sc.Geometry | None = None,
-              method: str | None = None, init_mode: str | None = None) -> list[dict]:
+def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
+              geo: sc.Geometry | None = None, method: str | None = None, init_mode: str | None = None
+              ) -> list[dict]:
     """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
     of the stacked filter arrays (runs are independent; each keeps its own stream)."""
-    geo = geo or sc.build_geometry(cfg, variant)
-    method = method or cfg["em"]["method"]
-    init_mode = init_mode or cfg["initial_error"]["mode"]
+    setup = Setup.of(setup)
+    geo = geo or sc.build_geometry(setup, variant)
+    em_set = setup.em
+    method = method or em_set.method
+    init_mode = init_mode or setup.initial_error.mode
     seed_indices = list(seed_indices)
     ns = len(seed_indices)
     zs, dx0s, Rvs, inits = [], [], [], []
     for case in case_list:
-        Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-        rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
-        z, e0 = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), rngs)
+        Rvar, z, dx0 = simulate_case(setup, geo, case, seed_indices, case.init_mode or init_mode)
         zs.append(z)
-        dx0s.append(sc.prior_mean_deviation(geo, e0, case.init_mode or init_mode))
+        dx0s.append(dx0)
         Rvs.append(np.broadcast_to(Rvar[:, None, :], (Rvar.shape[0], ns, 3)))
         inits.append(np.broadcast_to(sc.rad(case.init_arcsec), (ns, 3)))
     z = np.concatenate(zs)
@@ -186,15 +192,14 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
     win = geo.window(Rvar)
     S = z.shape[0]
     dx_true = geo.dx_true
-    tz_tol = cfg["em"]["tz_tol"]
+    tz_tol = em_set.tz_tol
 
     f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win)
     err_before = np.linalg.norm(f0.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
 
     start = sc.START_OF[variant]
-    windows = segment_windows(cfg)
-    em_cfg = cfg["em"]
-    M = cfg["segments"]["M"]
+    windows = setup.segments.windows()
+    M = setup.segments.M
     theta_init = theta.copy()
     seg_theta, it_theta, it_ll, it_data = [], [], [], []
     seg_lat, seg_rng, seg_lat3, seg_rng3 = [], [], [], []
@@ -221,19 +226,19 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
     # (one window when sliding, the cumulative data when growing), reached from the final
     # estimate by SQUAREM, and the measured contraction factor per map toward it
     theta_ml, ml_done, _ = ml_estimate(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), tz_tol,
-                                       em_cfg["ml_max_maps"])
+                                       em_set.ml_max_maps)
     rate = contraction_per_map(theta_seg_start, theta, theta_ml, maps_per_segment(method, M))
     dist_ml = np.abs(sc.arcsec(theta - theta_ml))[:, :2].max(1)
     moved = np.abs(sc.arcsec(theta - theta_init))[:, :2].max(1)
-    stall = stalled(moved, rate, dist_ml, em_cfg["stall_move_tol_arcsec"], em_cfg["stall_rate"],
-                    em_cfg["converge_tol_arcsec"])
+    stall = stalled(moved, rate, dist_ml, em_set.stall_move_tol_arcsec, em_set.stall_rate,
+                    em_set.converge_tol_arcsec)
 
     f1 = run_filter(z, theta, dx0, geo.P0, win)
     err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
-    frac = cfg["nav_error"]["last_fraction"]
+    frac = setup.nav_last_fraction
     seg_theta_as = sc.arcsec(np.stack(seg_theta, 1))
     seg_data = np.array([b - windows[0][0] for (_, b) in windows])
-    conv = data_to_converge(seg_theta_as, seg_data, em_cfg["converge_tol_arcsec"]).astype(float)
+    conv = data_to_converge(seg_theta_as, seg_data, em_set.converge_tol_arcsec).astype(float)
     conv[stall] = np.nan  # a stalled run has not converged, whatever its last segments did
     theta_iter = sc.arcsec(np.stack(it_theta, 1))
     ll_iter = np.stack(it_ll, 1)
@@ -246,7 +251,7 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
         sl = slice(i * ns, (i + 1) * ns)
         out.append({
             "variant": variant,
-            "mode": cfg["segments"]["mode"],
+            "mode": setup.segments.mode,
             "case_id": case.case_id,
             "seed_indices": np.asarray(seed_indices),
             "truth_arcsec": np.asarray(case.truth_arcsec, float),
@@ -278,7 +283,7 @@ def run_cases(cfg: dict, variant: str, case_list: list[Case], seed_indices, geo:
     return out
 
 
-def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_samples: int,
+def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indices, data_samples: int,
                       max_maps: int, tol_arcsec: float, geo: sc.Geometry | None = None,
                       init_mode: str | None = None) -> dict:
     """Iterations of plain EM and SQUAREM to reach the maximum-likelihood estimate.
@@ -291,20 +296,18 @@ def convergence_study(cfg: dict, variant: str, case: Case, seed_indices, data_sa
     ``max_maps`` is reported as ``max_maps + 1`` (stalled) together with the
     contraction rate per map measured over its last iterations.
     """
-    N0 = cfg["segments"]["N0"]
-    geo = geo or sc.build_geometry(cfg, variant, n=N0 + data_samples)
-    init_mode = init_mode or cfg["initial_error"]["mode"]
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    setup = Setup.of(setup)
+    N0 = setup.segments.N0
+    geo = geo or sc.build_geometry(setup, variant, n=N0 + data_samples)
+    init_mode = init_mode or setup.initial_error.mode
+    Rvar, z, dx0 = simulate_case(setup, geo, case, seed_indices, init_mode)
     win = geo.window(Rvar)
-    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seed_indices)
-    z, e0 = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), rngs)
     S = z.shape[0]
-    dx0 = sc.prior_mean_deviation(geo, e0, init_mode)
     f0 = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
     x0, P0 = start_state(sc.START_OF[variant], N0, f0, geo.dx_true, dx0, geo.P0, win)
     a, b = N0, N0 + data_samples
     wz, ww = z[:, a:b + 1], win.slice(a, b)
-    tz_tol = cfg["em"]["tz_tol"]
+    tz_tol = setup.em.tz_tol
     theta0 = np.broadcast_to(sc.rad(case.init_arcsec), (S, 3)).copy()
 
     # SQUAREM cycles from theta0 until the step is below 1e-4 arcsec: its end point is the

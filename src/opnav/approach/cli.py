@@ -47,9 +47,9 @@ def run(args) -> int:
     from opnav.cli import load_cli_config, print_json, with_flags
     from opnav.config import ConfigError, load_config
     from . import scenario as sc
-    from . import cases
     from .cases import Case, run_case
     from .pipeline import bound_curve, segment_bounds
+    from .setup import Setup
 
     config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
     if args.seed < 0:
@@ -62,26 +62,26 @@ def run(args) -> int:
               "bias": list(args.bias) if args.bias else None,
               "init": list(args.init) if args.init else None}
     flags = {key: ("--" + name.replace("_", "-"), values[name]) for name, key in FLAG_KEYS.items()}
-    cfg = with_flags(config, flags)["approach"]
-    px = tuple(cfg["camera"]["sigma3_px"])
-    truth = tuple(cfg["truth_bias_arcsec"])
-    init = tuple(cfg["theta_init_arcsec"])
+    setup = Setup.from_config(with_flags(config, flags)["approach"])  # the edge: parsed once
+    px = setup.camera.sigma3_px
+    truth = setup.truth_bias_arcsec
+    init = setup.theta_init_arcsec
     case = Case(0, "cli", "cli", truth, init, px, 0.0)
-    method = cfg["em"]["method"]
-    geo = sc.build_geometry(cfg, args.variant)
+    method = setup.em.method
+    geo = sc.build_geometry(setup, args.variant)
     seeds = range(args.seed, args.seed + args.seeds)
-    r = run_case(cfg, args.variant, case, seeds, geo=geo, method=method)
-    Rvar = sc.measurement_variance(geo, cfg, px)
-    bound = segment_bounds(cfg, geo, Rvar, truth, args.variant)[-1]
-    curve = bound_curve(cfg, geo, Rvar, truth, args.variant)
-    s = cfg["segments"]
-    used = min(s["L"] * s["N"], len(curve) - 1)
-    last = cases.segment_windows(cfg)[-1]
+    r = run_case(setup, args.variant, case, seeds, geo=geo, method=method)
+    Rvar = geo.measurement_variance(px)
+    bound = segment_bounds(setup, geo, Rvar, truth, args.variant)[-1]
+    curve = bound_curve(setup, geo, Rvar, truth, args.variant)
+    s = setup.segments
+    used = min(s.data_samples, len(curve) - 1)
+    last = s.windows()[-1]
     th = r["theta_final_arcsec"]
     st = r["stalled"]
     tz = "unobservable" if r["tz_unobservable"] else None
     out = {
-        "variant": args.variant, "method": method, "seeds": list(seeds), "segments": s,
+        "variant": args.variant, "method": method, "seeds": list(seeds), "segments": s.as_dict(),
         "pixel_sigma3_px": list(px),
         "truth_arcsec": list(truth),
         "status": ("STALLED" if st.all() else "partly stalled" if st.any() else "converged"),
@@ -90,7 +90,7 @@ def run(args) -> int:
                             "per_seed": th.round(4)},
         # the bound of the data the estimate used: the last window (sliding) or all data from N0 (growing)
         "crlb_arcsec": {"tx": float(bound[0]), "ty": float(bound[1]), "tz": tz or float(bound[2]),
-                        "data": f"samples {last[0] + 1}..{last[1]} ({s['mode']} segment)"},
+                        "data": f"samples {last[0] + 1}..{last[1]} ({s.mode} segment)"},
         "crlb_all_data_arcsec": {"tx": float(curve[used, 0]), "ty": float(curve[used, 1]), "data_samples": int(used),
                                  "tz": tz or float(curve[used, 2])},
         "stall": {"stalled": [bool(v) for v in st],
@@ -98,11 +98,11 @@ def run(args) -> int:
                   "contraction_per_map": [float(v) for v in r["contraction_per_map"]],
                   "ml_estimate_same_data_arcsec": r["theta_ml_arcsec"][:, :2].round(4).tolist(),
                   "distance_to_ml_arcsec": [float(v) for v in r["dist_to_ml_arcsec"]],
-                  "rule": (f"stalled if moved <= {cfg['em']['stall_move_tol_arcsec']:g} arcsec, or contraction "
-                           f">= {cfg['em']['stall_rate']:g} per map while farther than "
-                           f"{cfg['em']['converge_tol_arcsec']:g} arcsec from the ML estimate")},
+                  "rule": (f"stalled if moved <= {setup.em.stall_move_tol_arcsec:g} arcsec, or contraction "
+                           f">= {setup.em.stall_rate:g} per map while farther than "
+                           f"{setup.em.converge_tol_arcsec:g} arcsec from the ML estimate")},
         "iterations": {"em_maps": int(r["theta_iter_arcsec"].shape[1]),
-                       "per_segment": int(r["maps_per_segment"]), "segments": s["L"]},
+                       "per_segment": int(r["maps_per_segment"]), "segments": s.L},
         "data_to_converge_samples": [None if np.isnan(v) else int(v) for v in r["data_to_converge"]],
         "nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
         "nav_err_after_km": float(np.mean(r["nav_err_after_km"])),

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import kalman
+from .augmented import augmented_jacobian, augmented_noise
 from .camera import misalignment_small, skew
 from .ekf import Window
 
@@ -48,25 +50,16 @@ def crlb_curve(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.n
     P[:6, :6] = P_start
     P[6:, 6:] = sigma_theta**2 * np.eye(3)
     A = misalignment_small(theta)
-    Qa = np.zeros((9, 9))
-    Qa[:6, :6] = win.Q
+    Qa = augmented_noise(win.Q, 0.0)
     Fa = np.eye(9)
     out = np.empty((n + 1, 3))
     out[0] = np.sqrt(np.diag(P)[6:])
     Us = theta_sensitivity(u_true)
-    I9 = np.eye(9)
     for k in range(1, n + 1):
         Fa[:6, :6] = win.Phi[k]
-        P = Fa @ P @ Fa.T + Qa
-        H = np.zeros((3, 9))
-        H[:, :3] = -A @ win.C[k]
-        H[:, 6:] = Us[k]
-        R = np.diag(win.Rvar[k])
-        S = H @ P @ H.T + R
-        K = np.linalg.solve(S, H @ P).T
-        IKH = I9 - K @ H
-        P = IKH @ P @ IKH.T + K @ R @ K.T
-        P = 0.5 * (P + P.T)
+        _, P = kalman.predict(None, P, Fa, Qa)
+        H = augmented_jacobian(A, win.C[k], Us[k])
+        P = kalman.condition_on(None, P, H, win.Rvar[k], None, joseph=True).P
         out[k] = np.sqrt(np.diag(P)[6:])
     return out
 

@@ -31,9 +31,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kalman
 from .camera import misalignment_small
 
-LOG2PI = np.log(2.0 * np.pi)
+POS = slice(0, 3)  # position columns of the state: the only ones H touches
 
 
 @dataclass
@@ -77,24 +78,6 @@ class FilterResult:
     Hr: np.ndarray | None = None  # (S, n+1, 3, 3) position block of H
 
 
-def inv_sym3(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Inverse and determinant of stacked symmetric 3x3 matrices (cofactors; fast for small stacks)."""
-    a, b, c = M[:, 0, 0], M[:, 0, 1], M[:, 0, 2]
-    d, e, f = M[:, 1, 1], M[:, 1, 2], M[:, 2, 2]
-    A00, A01, A02 = d * f - e * e, c * e - b * f, b * e - c * d
-    A11, A12, A22 = a * f - c * c, b * c - a * e, a * d - b * b
-    det = a * A00 + b * A01 + c * A02
-    out = np.empty_like(M)
-    r = 1.0 / det
-    out[:, 0, 0] = A00 * r
-    out[:, 0, 1] = out[:, 1, 0] = A01 * r
-    out[:, 0, 2] = out[:, 2, 0] = A02 * r
-    out[:, 1, 1] = A11 * r
-    out[:, 1, 2] = out[:, 2, 1] = A12 * r
-    out[:, 2, 2] = A22 * r
-    return out, det
-
-
 def predicted_measurement(theta: np.ndarray, C: np.ndarray, u_ref: np.ndarray,
                           dx: np.ndarray) -> np.ndarray:
     """``h(dX) = A_m(theta) (u_ref - C dr)`` (S, 3) for one sample."""
@@ -112,7 +95,8 @@ def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
 
 def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
                win: Window) -> FilterResult:
-    """EKF over a window for every seed at once (eq. 6).
+    """EKF over a window for every seed at once (eq. 6): :func:`kalman.predict` and
+    :func:`kalman.condition_on` with the position block of ``H``.
 
     z (S, n+1, 3) (index 0 ignored), theta (S, 3) rad, x0 (S, 6), P0 (S, 6, 6) or (6, 6).
     """
@@ -127,34 +111,21 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     x = np.array(x0, float)
     P = np.broadcast_to(P0, (S, 6, 6)).copy()
     xf[:, 0], Pf[:, 0] = x, P
-    Q = win.Q
     Ks = np.zeros((S, n + 1, 6, 3))
     Sinvs = np.zeros((S, n + 1, 3, 3))
     nus = np.zeros((S, n + 1, 3))
     dets = np.ones((S, n + 1))
-    diag = [0, 1, 2]
     for k in range(1, n + 1):
-        Phi = win.Phi[k]
-        x = x @ Phi.T
-        P = Phi @ P @ Phi.T + Q
+        x, P = kalman.predict(x, P, win.Phi[k], win.Q)
         xp[:, k], Pp[:, k] = x, P
         Hr = Hrs[:, k]
         nu = z[:, k] - Au[:, k] - (Hr @ x[:, :3, None])[..., 0]
-        PHt = P[:, :, :3] @ Hr.transpose(0, 2, 1)  # (S,6,3)
-        Sm = Hr @ PHt[:, :3, :]
-        Sm[:, diag, diag] += win.Rvar[k]
-        Sinv, det = inv_sym3(Sm)
-        K = PHt @ Sinv
-        x = x + (K @ nu[..., None])[..., 0]
-        P = P - K @ PHt.transpose(0, 2, 1)
-        P = 0.5 * (P + P.transpose(0, 2, 1))
+        x, P, K, Sinv, det = kalman.condition_on(x, P, Hr, win.Rvar[k], nu, cols=POS)
         xf[:, k], Pf[:, k] = x, P
         Ks[:, k], Sinvs[:, k], nus[:, k], dets[:, k] = K, Sinv, nu, det
     if np.any(dets <= 0):
         raise FloatingPointError("innovation covariance not positive definite")
-    ll = -0.5 * (np.log(dets[:, 1:]).sum(1)
-                 + np.einsum("ski,skij,skj->s", nus[:, 1:], Sinvs[:, 1:], nus[:, 1:])
-                 + 3.0 * n * LOG2PI)
+    ll = kalman.innovation_loglik(nus[:, 1:], Sinvs[:, 1:], dets[:, 1:]).sum(1)
     KH = np.zeros((S, 6, 6))
     KH[:, :, :3] = Ks[:, n] @ Hrs[:, n]
     return FilterResult(xf, Pf, xp, Pp, ll, KH, Ks, Sinvs, nus, Hrs)
@@ -164,6 +135,5 @@ def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window) -> tuple[np.ndarra
     """Prior mean and covariance propagated through the window without data."""
     x, P = np.array(x0, float), np.array(P0, float)
     for k in range(1, win.n + 1):
-        x = x @ win.Phi[k].T
-        P = win.Phi[k] @ P @ win.Phi[k].T + win.Q
+        x, P = kalman.predict(x, P, win.Phi[k], win.Q)
     return x, P

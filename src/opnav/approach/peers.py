@@ -72,6 +72,7 @@ from scipy.spatial.transform import Rotation
 from . import camera
 from . import scenario as sc
 from .dynamics import ARCSEC, MU_MARS, MU_SUN
+from .setup import BasiliskSettings, Setup
 
 #: Basilisk's constants for planet id 2 (astroConstants.h): the module's Mars.
 BSK_REQ_MARS_KM = 3396.19
@@ -92,9 +93,14 @@ class PeerCamera:
 
     @classmethod
     def from_config(cls, cam_cfg: dict) -> "PeerCamera":
+        """From a ``camera`` config mapping (``pixels``, ``ifov_arcsec``): :meth:`of`."""
+        return cls.of(int(cam_cfg["pixels"]), float(cam_cfg["ifov_arcsec"]))
+
+    @classmethod
+    def of(cls, pixels: int, ifov_arcsec: float) -> "PeerCamera":
         """FOV chosen so that one pixel spans the pipeline's IFOV at the image centre."""
-        res = int(cam_cfg["pixels"])
-        pitch = np.tan(cam_cfg["ifov_arcsec"] * ARCSEC)
+        res = int(pixels)
+        pitch = np.tan(ifov_arcsec * ARCSEC)
         fov = 2.0 * np.arctan(0.5 * res * pitch)
         return cls(res, float(fov), float(2.0 * np.tan(fov / 2.0) / res))
 
@@ -204,11 +210,11 @@ class UKFSettings:
     bias_process_sigma_px: float = 1e-6  # per time update; > 0 (the module's Cholesky of qNoise)
 
     @classmethod
-    def from_config(cls, c: dict, cam: PeerCamera) -> "UKFSettings":
-        return cls(alpha=c["alpha"], beta=c["beta"], kappa=c["kappa"],
-                   bias_prior_sigma_px=c["bias_prior_sigma_arcsec"] * ARCSEC / cam.pitch,
-                   radius_bias_prior_sigma_px=c["radius_bias_prior_sigma_px"],
-                   bias_process_sigma_px=c["bias_process_sigma_px"])
+    def of(cls, b: BasiliskSettings, cam: PeerCamera) -> "UKFSettings":
+        return cls(alpha=b.alpha, beta=b.beta, kappa=b.kappa,
+                   bias_prior_sigma_px=b.bias_prior_sigma_arcsec * ARCSEC / cam.pitch,
+                   radius_bias_prior_sigma_px=b.radius_bias_prior_sigma_px,
+                   bias_process_sigma_px=b.bias_process_sigma_px)
 
 
 @dataclass
@@ -302,10 +308,10 @@ def run_ukf(circles: np.ndarray, circle_var: np.ndarray, t_s: np.ndarray, sigma_
 
 
 # --------------------------------------------------------- A-P1 on paper A's data
-def peer_settings(cfg: dict) -> tuple[PeerCamera, UKFSettings]:
-    """The module's camera and tuning from the approach config section."""
-    cam = PeerCamera.from_config(cfg["camera"])
-    return cam, UKFSettings.from_config(cfg["peers"]["basilisk"], cam)
+def peer_settings(setup: Setup) -> tuple[PeerCamera, UKFSettings]:
+    """The module's camera and tuning from the setup."""
+    cam = PeerCamera.of(setup.camera.pixels, setup.camera.ifov_arcsec)
+    return cam, UKFSettings.of(setup.peers.basilisk, cam)
 
 
 def ukf_inputs(geo: sc.Geometry, install_deg: float) -> tuple[np.ndarray, np.ndarray]:
@@ -319,7 +325,7 @@ def ukf_inputs(geo: sc.Geometry, install_deg: float) -> tuple[np.ndarray, np.nda
     return mrp_from_dcm(A_b_i), mrp_from_dcm(camera.rot_x(np.deg2rad(install_deg)))
 
 
-def run_peer(cfg: dict, variant: str, case, seed_indices, truth_arcsec=None,
+def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec=None,
              geo: sc.Geometry | None = None, steps: int | None = None, stride: int = 10,
              start: str = "prior") -> dict:
     """The peer UKF on the measurements of ``case`` (same streams as the EM-EKF) per seed.
@@ -331,14 +337,14 @@ def run_peer(cfg: dict, variant: str, case, seed_indices, truth_arcsec=None,
     its 3-sigma in arcsec, the radius bias (px), the final and RMS position error
     (km) and, every ``stride`` samples, the estimate history for the figure.
     """
-    geo = geo or sc.build_geometry(cfg, variant)
-    cam, settings = peer_settings(cfg)
+    from .cases import simulate_case
+
+    setup = Setup.of(setup)
+    geo = geo or sc.build_geometry(setup, variant)
+    cam, settings = peer_settings(setup)
     truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
     seeds = list(seed_indices)
-    rngs = sc.seed_streams(cfg["base_seed"], case.case_index, seeds)
-    z, e0 = sc.simulate(geo, Rvar, sc.rad(truth), rngs)
-    dx0 = sc.prior_mean_deviation(geo, e0, cfg["initial_error"]["mode"])
+    Rvar, z, dx0 = simulate_case(setup, geo, case, seeds, setup.initial_error.mode, truth)
     sBN, sCB = ukf_inputs(geo, case.install_deg)
     r_true = geo.X_true[:, :3] - geo.X_mars[:, :3]
     est, sig3, rad_b, pos_fin, pos_rms, hist, hist_sig = [], [], [], [], [], [], []
@@ -367,14 +373,14 @@ def run_peer(cfg: dict, variant: str, case, seed_indices, truth_arcsec=None,
             "truth_bias_px": bias_px_from_theta(sc.rad(truth[:2].tolist() + [0.0]), cam)}
 
 
-def peer_bound(cfg: dict, geo: sc.Geometry, case, truth_arcsec=None) -> np.ndarray:
+def peer_bound(setup: Setup | dict, geo: sc.Geometry, case, truth_arcsec=None) -> np.ndarray:
     """1-sigma CRLB (tx, ty, tz) in arcsec on the peer's information: every sample from t0
     with the prior ``P_X0`` and the peer's bias prior (the EM-EKF's ``literal`` set)."""
     from .crlb import crlb_curve
 
-    cam, settings = peer_settings(cfg)
+    cam, settings = peer_settings(Setup.of(setup))
     truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
+    Rvar = geo.measurement_variance(case.sigma3_px)
     sig = settings.bias_prior_sigma_px * cam.pitch
     return sc.arcsec(crlb_curve(geo.window(Rvar), geo.u_true, geo.P0, sc.rad(truth), sig)[-1])
 
@@ -385,17 +391,18 @@ RUN_LABELS = {"headline": "headline case", "bias_free": "zero misalignment (sani
               "truth_start": "prior mean at the truth (diagnostic)"}
 
 
-def run_variant(cfg: dict, variant: str, log=None) -> dict:
+def run_variant(setup: Setup | dict, variant: str, log=None) -> dict:
     """A-P1 simulation job: the headline case and the bias-free sanity case of ``variant``."""
     from .cases import headline_case
 
-    geo = sc.build_geometry(cfg, variant)
-    case = headline_case(cfg)
-    seeds = range(cfg["n_seeds"])
+    setup = Setup.of(setup)
+    geo = sc.build_geometry(setup, variant)
+    case = headline_case(setup)
+    seeds = range(setup.n_seeds)
     out = {"variant": variant, "two_body": two_body_check(geo), "runs": {}}
     for name, truth, start in RUNS:
-        r = run_peer(cfg, variant, case, seeds, truth_arcsec=truth, geo=geo, start=start)
-        r["crlb_peer_arcsec"] = peer_bound(cfg, geo, case, truth)
+        r = run_peer(setup, variant, case, seeds, truth_arcsec=truth, geo=geo, start=start)
+        r["crlb_peer_arcsec"] = peer_bound(setup, geo, case, truth)
         out["runs"][name] = r
         if log:
             log.info("A-P1 %s %s: UKF (tx, ty) %s +- %s arcsec (3 sigma, seed mean); truth %s",

@@ -11,14 +11,14 @@ Units: arcsec, km, samples.
 
 from __future__ import annotations
 
-import copy
 from dataclasses import replace
 
 import numpy as np
 
-from . import cases, crlb
+from . import cases, crlb, kalman
 from . import scenario as sc
 from .ekf import Window, run_filter
+from .setup import Setup
 
 
 def _window(geo: sc.Geometry, Rvar: np.ndarray, zero_q: bool = False) -> Window:
@@ -39,12 +39,12 @@ def _start_covariances(geo: sc.Geometry, win: Window, variant: str) -> np.ndarra
     P = geo.P0.copy()
     out[0] = P
     for k in range(1, n + 1):
-        P = win.Phi[k] @ P @ win.Phi[k].T + win.Q
+        _, P = kalman.predict(None, P, win.Phi[k], win.Q)
         out[k] = P
     return out
 
 
-def bound_curve(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
+def bound_curve(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
                 zero_q: bool = False) -> np.ndarray:
     """1-sigma CRLB (arcsec) of theta after d = 0..n-N0 samples from N0, (n-N0+1, 3): the
     bound of the *cumulative* data (growing windows, all-data estimators).
@@ -55,17 +55,18 @@ def bound_curve(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, var
     (diagnostic): data after N0 with the true state known to the filter's P_N0.
     ``zero_q``: the same with no process noise (the truth has none).
     """
-    N0 = cfg["segments"]["N0"]
+    setup = Setup.of(setup)
+    N0 = setup.segments.N0
     win = _window(geo, Rvar, zero_q)
     th = sc.rad(theta_arcsec)
-    sig = cfg["crlb"]["theta_prior_sigma_rad"]
+    sig = setup.crlb_prior_sigma_rad
     if sc.START_OF[variant] == "filter":
         return sc.arcsec(crlb.crlb_curve(win, geo.u_true, geo.P0, th, sig)[N0:])
     P = _start_covariances(geo, win.slice(0, N0), variant)[-1]
     return sc.arcsec(crlb.crlb_curve(win.slice(N0, win.n), geo.u_true[N0:], P, th, sig))
 
 
-def segment_bounds(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
+def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
                    zero_q: bool = False) -> np.ndarray:
     """The bound for the data each segment's estimate rests on (L, 3), arcsec, 1-sigma.
 
@@ -75,45 +76,31 @@ def segment_bounds(cfg: dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, 
     ``literal`` start is the theta = 0 filter's estimate, which carries every earlier
     sample: its bound is the cumulative one from t0 to the window's end in both modes.
     """
-    windows = cases.segment_windows(cfg)
-    N0 = cfg["segments"]["N0"]
-    if cfg["segments"]["mode"] == "growing" or sc.START_OF[variant] == "filter":
-        curve = bound_curve(cfg, geo, Rvar, theta_arcsec, variant, zero_q)
+    setup = Setup.of(setup)
+    windows = setup.segments.windows()
+    N0 = setup.segments.N0
+    if setup.segments.mode == "growing" or sc.START_OF[variant] == "filter":
+        curve = bound_curve(setup, geo, Rvar, theta_arcsec, variant, zero_q)
         return np.stack([curve[b - N0] for (_, b) in windows])
     win = _window(geo, Rvar, zero_q)
     Pa = _start_covariances(geo, win, variant)
     th = sc.rad(theta_arcsec)
-    sig = cfg["crlb"]["theta_prior_sigma_rad"]
+    sig = setup.crlb_prior_sigma_rad
     return np.stack([sc.arcsec(crlb.crlb_curve(win.slice(a, b), geo.u_true[a:b + 1], Pa[a], th, sig)[-1])
                      for (a, b) in windows])
 
 
-def scheme_config(cfg: dict, mode: str) -> dict:
-    """The config of a Table-1 scheme: ``sliding`` is the config's ``segments``; ``growing``
-    uses ``growing.N`` and ``growing.M`` over the same data (L = segments.L N / growing.N)."""
-    if mode == "sliding":
-        return cfg
-    if mode != "growing":
-        raise ValueError(f"unknown segment mode {mode!r}; use 'sliding' or 'growing'")
-    s, g = cfg["segments"], cfg["growing"]
-    total = s["L"] * s["N"]
-    if total % g["N"]:
-        raise ValueError(f"approach.growing.N = {g['N']} must divide segments.L * segments.N = {total}")
-    out = copy.deepcopy(cfg)
-    out["segments"].update(mode="growing", N=g["N"], M=g["M"], L=total // g["N"])
-    return out
-
-
-def groups_for(cfg: dict, variant: str) -> list[str]:
+def groups_for(setup: Setup | dict, variant: str) -> list[str]:
     """Case groups a variant runs (Snakemake jobs): the five groups (or "all" in one job when
     ``scatter: variant``) for ``table1_variants``, else the headline case only."""
-    if variant not in cfg["table1_variants"]:
+    setup = Setup.of(setup)
+    if variant not in setup.table1_variants:
         return ["headline"]
-    return list(cases.GROUPS) if cfg["scatter"] == "group" else ["all"]
+    return list(cases.GROUPS) if setup.scatter == "group" else ["all"]
 
 
-def cases_in(cfg: dict, group: str) -> list[cases.Case]:
-    allc = cases.table1_cases(cfg)
+def cases_in(setup: Setup | dict, group: str) -> list[cases.Case]:
+    allc = cases.table1_cases(setup)
     if group == "headline":
         return [allc[0]]
     if group == "all":
@@ -121,23 +108,24 @@ def cases_in(cfg: dict, group: str) -> list[cases.Case]:
     return [c for c in allc if c.group == group]
 
 
-def run_group(cfg: dict, variant: str, group: str, method: str, mode: str = "sliding", log=None) -> list[dict]:
+def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: str = "sliding",
+              log=None) -> list[dict]:
     """Monte Carlo of every case of ``group`` under ``variant``, EM ``method`` and segment
     ``mode``, each case with the bound of the data its estimate used (``crlb_arcsec``; per
     segment ``crlb_seg_arcsec``; the same with Q = 0 beside), the bound of all data
     (``crlb_total_arcsec``) and, for the headline case, a rerun with the initial error drawn
     from the prior (``sampled``: the only spread that may be set beside a Bayesian bound)."""
-    cfg = scheme_config(cfg, mode)
-    geo = sc.build_geometry(cfg, variant)
-    seeds = range(cfg["n_seeds"])
+    setup = Setup.of(setup).scheme(mode)
+    geo = sc.build_geometry(setup, variant)
+    seeds = range(setup.n_seeds)
     out = []
-    clist = cases_in(cfg, group)
+    clist = cases_in(setup, group)
     head = [c for c in clist if c.case_index == 1]
-    runs = cases.run_cases(cfg, variant, clist + [replace(c, init_mode="sampled") for c in head],
+    runs = cases.run_cases(setup, variant, clist + [replace(c, init_mode="sampled") for c in head],
                            seeds, geo=geo, method=method)
     sampled = runs[len(clist):]
     for case, r in zip(clist, runs):
-        _attach_bounds(cfg, geo, case, variant, r)
+        _attach_bounds(setup, geo, case, variant, r)
         r.update(method=method, group=group, case=case)
         if case.case_index == 1:
             smp = sampled[0]
@@ -154,12 +142,16 @@ def run_group(cfg: dict, variant: str, group: str, method: str, mode: str = "sli
     return out
 
 
-def _attach_bounds(cfg, geo, case, variant, r):
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-    seg = segment_bounds(cfg, geo, Rvar, case.truth_arcsec, variant)
-    seg0 = segment_bounds(cfg, geo, Rvar, case.truth_arcsec, variant, zero_q=True)
-    curve = bound_curve(cfg, geo, Rvar, case.truth_arcsec, variant)
-    s = cfg["segments"]
+def _attach_bounds(setup: Setup, geo, case, variant, r):
+    Rvar = geo.measurement_variance(case.sigma3_px)
+    seg = segment_bounds(setup, geo, Rvar, case.truth_arcsec, variant)
+    seg0 = segment_bounds(setup, geo, Rvar, case.truth_arcsec, variant, zero_q=True)
     r["crlb_seg_arcsec"], r["crlb_seg_q0_arcsec"] = seg, seg0
     r["crlb_arcsec"], r["crlb_q0_arcsec"] = seg[-1], seg0[-1]
-    r["crlb_total_arcsec"] = curve[min(s["L"] * s["N"], len(curve) - 1)]
+    r["crlb_total_arcsec"] = total_bound(setup, geo, Rvar, case.truth_arcsec, variant)
+
+
+def total_bound(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str) -> np.ndarray:
+    """The bound of all the segments' data, L N samples after N0 (3,), arcsec, 1-sigma."""
+    curve = bound_curve(setup, geo, Rvar, theta_arcsec, variant)
+    return curve[min(setup.segments.data_samples, len(curve) - 1)]

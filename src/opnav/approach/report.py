@@ -14,6 +14,7 @@ import pandas as pd
 
 from . import cases
 from . import scenario as sc
+from .setup import Setup
 
 
 def variant_label(variant: str, method: str, mode: str = "sliding") -> str:
@@ -121,7 +122,7 @@ def table1_compact(t1: pd.DataFrame) -> pd.DataFrame:
     return t1[list(COMPACT_COLUMNS)].rename(columns=COMPACT_COLUMNS)
 
 
-def crlb_rows(cfg: dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: dict | None = None) -> pd.DataFrame:
+def crlb_rows(setup: Setup | dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: dict | None = None) -> pd.DataFrame:
     """A-X1 table: the bound per variant beside the EM estimates' spread and EM iterations.
 
     The EM errors set beside the bound come from the headline case rerun with the initial
@@ -129,12 +130,13 @@ def crlb_rows(cfg: dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: 
     initial error the spread over seeds is noise only and is not comparable with a
     Bayesian bound. ``crlb_q0_*``: the bound if the truth, like ours, had no process noise.
     """
-    s = cfg["segments"]
-    target = cfg["accuracy_target_arcsec"]
-    cs = cfg["convergence_study"]
+    setup = Setup.of(setup)
+    s = setup.segments
+    target = setup.accuracy_target_arcsec
+    cs = setup.convergence_study
     rows = []
     for v, curve in curves.items():
-        d_total = min(s["L"] * s["N"], len(curve) - 1)
+        d_total = min(s.data_samples, len(curve) - 1)
         c0 = (curves_q0 or {}).get(v)
         row = {
             "variant": v,
@@ -144,7 +146,7 @@ def crlb_rows(cfg: dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: 
             "crlb_y_total_arcsec": curve[d_total, 1],
             "crlb_q0_x_total_arcsec": c0[min(d_total, len(c0) - 1), 0] if c0 is not None else math.nan,
             "total_samples": d_total,
-            "tz_observable": bool(curve[-1, 2] < 0.5 * sc.arcsec(cfg["crlb"]["theta_prior_sigma_rad"])),
+            "tz_observable": bool(curve[-1, 2] < 0.5 * sc.arcsec(setup.crlb_prior_sigma_rad)),
             "bound_reaches_target": bool(curve[d_total, :2].max() <= target),
             "samples_to_target": _first_below(curve[:, :2].max(1), target),
         }
@@ -171,7 +173,7 @@ def crlb_rows(cfg: dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: 
             row["plain_rate_per_map"] = float(np.median(c["plain"]["rate_per_map"]))
             row["maps_squarem_median"] = float(np.median(c["squarem"]["maps_to_converge"]))
             row["max_maps"] = c["max_maps"]
-            row["tol_arcsec"] = cs["tol_arcsec"]
+            row["tol_arcsec"] = cs.tol_arcsec
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -182,13 +184,14 @@ def _first_window_bound(t1, variant, curve, s):
     h = t1[(t1["scenario"] == variant) & (t1["case_id"] == "T1-01") & (t1.get("mode", "sliding") == "sliding")]
     if len(h) and "crlb_x_arcsec" in h:
         return float(h["crlb_x_arcsec"].iloc[0])
-    return curve[min(s["N"], len(curve) - 1), 0]
+    return curve[min(s.N, len(curve) - 1), 0]
 
 
-def prior_bound_arcsec(cfg: dict) -> float:
+def prior_bound_arcsec(setup: Setup | dict) -> float:
     """What the prior alone bounds theta to: the 1-sigma prior position error seen from the
     initial range, ``sigma_r / rho`` (arcsec), from the config."""
-    return float(sc.arcsec(cfg["prior_sigma"]["r_km"] / cfg["geometry"]["range_km"]))
+    setup = Setup.of(setup)
+    return float(sc.arcsec(setup.prior_sigma.r_km / setup.geometry.range_km))
 
 
 def _first_below(values: np.ndarray, target: float) -> float:
@@ -201,12 +204,13 @@ def _fmt(x, nd=2):
     return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
 
 
-def identifiability_text(cfg: dict, x1: pd.DataFrame) -> str:
+def identifiability_text(setup: Setup | dict, x1: pd.DataFrame) -> str:
     """Plain-language A-X1 verdict, generated from the numbers of the A-X1 table."""
-    target = cfg["accuracy_target_arcsec"]
-    s = cfg["segments"]
+    setup = Setup.of(setup)
+    target = setup.accuracy_target_arcsec
+    s = setup.segments
     lines = ["# A-X1: what the data can tell about the camera misalignment", "",
-             f"Profile segments: N0 = {s['N0']}, N = {s['N']}, M = {s['M']}, L = {s['L']} ({s['mode']}); "
+             f"Profile segments: N0 = {s.N0}, N = {s.N}, M = {s.M}, L = {s.L} ({s.mode}); "
              f"the paper claims an accuracy better than {target:g} arcsec (published).", ""]
     for _, r in x1.iterrows():
         v = r["variant"]
@@ -217,15 +221,15 @@ def identifiability_text(cfg: dict, x1: pd.DataFrame) -> str:
         need = r.get("samples_to_target")
         need_txt = (f" The bound falls below {target:g} arcsec after {int(need)} samples."
                     if need is not None and not pd.isna(need) else "")
-        ps, rng = cfg["prior_sigma"], cfg["geometry"]["range_km"]
-        ratio = f"{ps['r_km']:g} km / {rng:.3g} km = {prior_bound_arcsec(cfg):.3g} arcsec"
+        ps, rng = setup.prior_sigma, setup.geometry.range_km
+        ratio = f"{ps.r_km:g} km / {rng:.3g} km = {prior_bound_arcsec(setup):.3g} arcsec"
         why = {
             "literal": "the camera looks at Mars without turning, so a misalignment shifts the Mars vector "
                        "sideways by about rho*theta, which the data cannot tell from a lateral position error; "
-                       f"only the {ps['r_km']:g} km prior separates them ({ratio}). The literal "
+                       f"only the {ps.r_km:g} km prior separates them ({ratio}). The literal "
                        "EM start X_N0 from the theta = 0 filter has already absorbed the offset",
             "prior": "the same geometry: the lateral offset rho*theta looks like a position error, and the "
-                     f"prior ({ps['r_km']:g} km, {ps['v_kms']:g} km/s) only bounds theta to about {ratio}",
+                     f"prior ({ps.r_km:g} km, {ps.v_kms:g} km/s) only bounds theta to about {ratio}",
             "roll": "turning the camera about its boresight turns the misalignment's offset in inertial space "
                     "while a position error stays fixed, so the data separate the two",
             "reference-start": "knowing the true start state removes the position ambiguity",
@@ -233,7 +237,7 @@ def identifiability_text(cfg: dict, x1: pd.DataFrame) -> str:
         q0 = r.get("crlb_q0_x_total_arcsec", math.nan)
         q0_txt = (f"; {_fmt(q0)} arcsec with Q = 0, the truth having no process noise" if not pd.isna(q0) else "")
         lines.append(f"* **{v}**{diag}: CRLB(tx) = {_fmt(b)} arcsec after {int(r['total_samples'])} samples{q0_txt} "
-                     f"(one {s['N']}-sample sliding segment: {_fmt(r['crlb_x_window_arcsec'])} arcsec). "
+                     f"(one {s.N}-sample sliding segment: {_fmt(r['crlb_x_window_arcsec'])} arcsec). "
                      f"The information in this variant's data and prior {verdict} support {target:g} arcsec: "
                      f"{why}.{need_txt}")
         extra = []
@@ -265,11 +269,12 @@ def identifiability_text(cfg: dict, x1: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
-def summary(cfg: dict, t1: pd.DataFrame, x1: pd.DataFrame) -> dict:
+def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame) -> dict:
     """Headline numbers per variant and EM scheme for the manuscript macros."""
-    out = {"profile_segments": cfg["segments"], "accuracy_target_arcsec": cfg["accuracy_target_arcsec"],
-           "prior_bound_arcsec": prior_bound_arcsec(cfg),
-           "convergence_max_maps": cfg["convergence_study"]["max_maps"], "variants": {}}
+    setup = Setup.of(setup)
+    out = {"profile_segments": setup.segments.as_dict(), "accuracy_target_arcsec": setup.accuracy_target_arcsec,
+           "prior_bound_arcsec": prior_bound_arcsec(setup),
+           "convergence_max_maps": setup.convergence_study.max_maps, "variants": {}}
     for _, r in t1[t1["case_id"] == "T1-01"].iterrows():
         x = x1[x1["variant"] == r["scenario"]]
         x = x.iloc[0] if len(x) else {}
@@ -312,7 +317,7 @@ def _join(items: list[str], none: str = "none") -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def findings(cfg: dict, summ: dict, pub_headline: dict) -> dict:
+def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
     """Every sentence of the manuscript's paper-A results that states a finding, generated
     from the summary's flags and numbers (plain text; the macros escape it). Keys:
 
@@ -324,7 +329,8 @@ def findings(cfg: dict, summ: dict, pub_headline: dict) -> dict:
                  of our rows lies closest to the published estimates.
     ``headline_<label>`` one sentence per Table-1 headline row.
     """
-    target = cfg["accuracy_target_arcsec"]
+    setup = Setup.of(setup)
+    target = setup.accuracy_target_arcsec
     var = summ["variants"]
     base = {k: v for k, v in var.items() if k == v["scenario"]}  # plain EM, sliding: the paper's scheme
     out = {}
@@ -345,7 +351,7 @@ def findings(cfg: dict, summ: dict, pub_headline: dict) -> dict:
     if lit is not None:
         r = lit / pb
         s += (f" The prior alone bounds theta to sigma_r / rho = {nice(pb)} arcsec "
-              f"({cfg['prior_sigma']['r_km']:g} km seen from {cfg['geometry']['range_km']:.3g} km); the literal "
+              f"({setup.prior_sigma.r_km:g} km seen from {setup.geometry.range_km:.3g} km); the literal "
               f"bound is {r:.2f} times that, so in the literal geometry the measurements "
               + ("add almost nothing to the prior." if r > 0.8 else "add information beyond the prior."))
     out["bound"] = s
@@ -364,7 +370,7 @@ def findings(cfg: dict, summ: dict, pub_headline: dict) -> dict:
 
     for k, v in var.items():
         d_ml = v.get("dist_to_ml_arcsec")
-        at_ml = d_ml is not None and d_ml <= cfg["em"]["converge_tol_arcsec"]
+        at_ml = d_ml is not None and d_ml <= setup.em.converge_tol_arcsec
         st = (f"STALLED in {v['stalled_seeds']} of {v['n_seeds']} seeds: not converged, "
               f"{nice(d_ml)} arcsec from the maximum-likelihood estimate of the same data"
               + (" (its start already is that estimate: the data do not move it)" if at_ml else "")

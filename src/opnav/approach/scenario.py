@@ -36,6 +36,7 @@ import numpy as np
 from . import camera, dynamics
 from .dynamics import ARCSEC
 from .ekf import Window
+from .setup import Setup
 
 VARIANTS = ("literal", "prior", "roll", "reference-start")
 START_OF = {"literal": "filter", "prior": "prior", "roll": "prior", "reference-start": "truth"}
@@ -56,6 +57,7 @@ class Geometry:
     P0: np.ndarray  # prior covariance at t0
     e_fixed: np.ndarray  # (6,) the paper's initial error (prior mean - truth)
     variant: str
+    ifov_arcsec: float = 10.0  # pixel size of the camera the variances are made for
 
     @property
     def dx_true(self) -> np.ndarray:
@@ -65,26 +67,29 @@ class Geometry:
     def window(self, Rvar: np.ndarray) -> Window:
         return Window(self.Phi, self.C, self.u_ref, Rvar, self.Q)
 
+    def measurement_variance(self, sigma3_px) -> np.ndarray:
+        """Rvar (n+1, 3), km^2, from the pinhole camera at the reference range (paper eq. 3-4)."""
+        return camera.noise_sigma_km(self.rho_ref, self.ifov_arcsec, sigma3_px) ** 2
 
-def initial_truth(cfg: dict) -> np.ndarray:
+
+def initial_truth(setup: Setup | dict) -> np.ndarray:
     """Heliocentric truth state at t0: Mars state + hyperbolic approach state (km, km/s)."""
-    el = dynamics.KeplerElements.from_config(cfg["mars_elements"])
-    g = cfg["geometry"]
-    Xm = dynamics.kepler_state(el, 0.0)
-    d = np.asarray(g["v_inf_dir"], float)
+    setup = Setup.of(setup)
+    g = setup.geometry
+    Xm = dynamics.kepler_state(setup.mars, 0.0)
+    d = np.asarray(g.v_inf_dir, float)
     d /= np.linalg.norm(d)
     perp = np.cross(d, [0.0, 0.0, 1.0])
     perp /= np.linalg.norm(perp)
-    r_rel = -g["range_km"] * d + g["aim_offset_km"] * perp
-    r_rel *= g["range_km"] / np.linalg.norm(r_rel)
-    vmag = np.sqrt(g["v_inf_kms"] ** 2 + 2.0 * dynamics.MU_MARS / g["range_km"])
+    r_rel = -g.range_km * d + g.aim_offset_km * perp
+    r_rel *= g.range_km / np.linalg.norm(r_rel)
+    vmag = np.sqrt(g.v_inf_kms ** 2 + 2.0 * dynamics.MU_MARS / g.range_km)
     return Xm + np.concatenate([r_rel, vmag * d])
 
 
-def n_samples(cfg: dict) -> int:
+def n_samples(setup: Setup | dict) -> int:
     """Samples after t0 that the arc needs: N0 + L*N."""
-    s = cfg["segments"]
-    return s["N0"] + s["L"] * s["N"]
+    return Setup.of(setup).segments.n_samples
 
 
 def mars_disc_px(range_km: float, ifov_arcsec: float) -> float:
@@ -93,42 +98,45 @@ def mars_disc_px(range_km: float, ifov_arcsec: float) -> float:
     return 2.0 * np.rad2deg(np.arcsin(dynamics.R_MARS_KM / range_km)) * 3600.0 / ifov_arcsec
 
 
-def build_geometry(cfg: dict, variant: str, n: int | None = None) -> Geometry:
+def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> Geometry:
     """Truth, reference with STMs, attitude of ``variant`` (see module docstring)."""
+    setup = Setup.of(setup)
     if variant not in VARIANTS:
         raise ValueError(f"unknown approach variant {variant!r}; use one of {VARIANTS}")
-    n = n_samples(cfg) if n is None else n
-    dt = cfg["dt_s"]
-    t = dt * np.arange(n + 1)
-    el = dynamics.KeplerElements.from_config(cfg["mars_elements"])
-    X0 = initial_truth(cfg)
+    n = setup.segments.n_samples if n is None else n
+    t = setup.dt_s * np.arange(n + 1)
+    el = setup.mars
+    X0 = initial_truth(setup)
     X_true = dynamics.propagate(X0, t, el)
-    ie = cfg["initial_error"]
-    e_fixed = np.concatenate([ie["r_km"], ie["v_kms"]]).astype(float)
+    e_fixed = setup.initial_error.e_fixed
     X_ref, Phi = dynamics.propagate_with_stm(X0 + e_fixed, t, el)
     X_mars = dynamics.kepler_state(el, t)
     los = X_mars[:, :3] - X_true[:, :3]
-    roll_cfg = cfg["roll"]
-    roll = (camera.roll_angle(t, roll_cfg["rate_deg_s"], roll_cfg["steps_deg"],
-                              roll_cfg["step_interval_s"]) if variant == "roll" else np.zeros_like(t))
+    r = setup.roll
+    roll = (camera.roll_angle(t, r.rate_deg_s, list(r.steps_deg), r.step_interval_s)
+            if variant == "roll" else np.zeros_like(t))
     rho = np.linalg.norm(los, axis=1)
-    disc_px = mars_disc_px(rho.min(), cfg["camera"]["ifov_arcsec"])
-    if disc_px > cfg["camera"]["pixels"]:
+    cam = setup.camera
+    disc_px = mars_disc_px(rho.min(), cam.ifov_arcsec)
+    if disc_px > cam.pixels:
         raise ValueError(f"approach.camera: Mars ({disc_px:.0f} px across) does not fit the "
-                         f"{cfg['camera']['pixels']} px detector; raise camera.ifov_arcsec or the range")
+                         f"{cam.pixels} px detector; raise camera.ifov_arcsec or the range")
     C = camera.tracking_attitude(los, roll)
     u_ref = np.einsum("kij,kj->ki", C, X_mars[:, :3] - X_ref[:, :3])
     u_true = np.einsum("kij,kj->ki", C, los)
-    ps = cfg["prior_sigma"]
-    P0 = np.diag(np.r_[np.full(3, ps["r_km"] ** 2), np.full(3, ps["v_kms"] ** 2)])
-    Q = np.diag(np.asarray(cfg["process_noise_diag"], float))
     return Geometry(t, X_true, X_ref, X_mars, Phi, C, u_ref, u_true,
-                    np.linalg.norm(u_ref, axis=1), Q, P0, e_fixed, variant)
+                    np.linalg.norm(u_ref, axis=1), setup.Q, setup.prior_sigma.P0, e_fixed, variant,
+                    cam.ifov_arcsec)
 
 
-def measurement_variance(geo: Geometry, cfg: dict, sigma3_px) -> np.ndarray:
-    """Rvar (n+1, 3), km^2, from the pinhole camera at the reference range."""
-    return camera.noise_sigma_km(geo.rho_ref, cfg["camera"]["ifov_arcsec"], sigma3_px) ** 2
+def measurement_variance(geo: Geometry, setup: Setup | dict, sigma3_px) -> np.ndarray:
+    """:meth:`Geometry.measurement_variance`, for callers holding the config as well: the
+    geometry carries the camera it was built for, and a different ``camera.ifov_arcsec``
+    in ``setup`` is an error, not a silent override."""
+    ifov = Setup.of(setup).camera.ifov_arcsec
+    if ifov != geo.ifov_arcsec:
+        raise ValueError(f"approach.camera.ifov_arcsec = {ifov:g} differs from the geometry's {geo.ifov_arcsec:g}")
+    return geo.measurement_variance(sigma3_px)
 
 
 def seed_streams(base_seed: int, case_index: int, seed_indices) -> list[np.random.Generator]:

@@ -24,24 +24,23 @@ import pandas as pd
 from . import alternatives as alt
 from . import cases
 from . import scenario as sc
-from .pipeline import bound_curve
+from .pipeline import total_bound
+from .setup import Setup
 
 
-def run_runs(cfg: dict, variant: str, method: str, seeds) -> pd.DataFrame:
+def run_runs(setup: Setup | dict, variant: str, method: str, seeds) -> pd.DataFrame:
     """One row per seed (module docstring)."""
+    setup = Setup.of(setup)
     seeds = [int(s) for s in seeds]
-    case = cases.headline_case(cfg)
-    geo = sc.build_geometry(cfg, variant)
-    seg = cfg["segments"]
-    used = seg["L"] * seg["N"]
-    Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-    curve = bound_curve(cfg, geo, Rvar, case.truth_arcsec, variant)
-    crlb = curve[min(used, len(curve) - 1)]
+    case = cases.headline_case(setup)
+    geo = sc.build_geometry(setup, variant)
+    used = setup.segments.data_samples
+    crlb = total_bound(setup, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec, variant)
     if method.startswith("em"):
-        scheme = cfg["em"]["method"] if method == "em" else method.removeprefix("em_")
-        r = cases.run_case(cfg, variant, case, seeds, geo=geo, method=scheme)
+        scheme = setup.em.method if method == "em" else method.removeprefix("em_")
+        r = cases.run_case(setup, variant, case, seeds, geo=geo, method=scheme)
     elif method == "augmented":
-        r = alt.run_case_alternatives(cfg, variant, case, seeds, geo, methods=("augmented",))
+        r = alt.run_case_alternatives(setup, variant, case, seeds, geo, methods=("augmented",))
         r = r["methods"]["augmented"]
     else:
         raise ValueError(f"unknown paper-A study estimator {method!r}")
