@@ -14,9 +14,9 @@ A_EM = A_SCENARIO + ("n_seeds", "em", "nav_error")
 A_GROUPS = ["size", "polarity", "initial", "pixel", "install"]
 A_VARIANTS = config["approach"]["variants"]
 A_METHODS = config["approach"]["methods"]
-A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/ekf.py", "approach/smoother.py",
-            "approach/em.py", "approach/crlb.py", "approach/scenario.py", "approach/cases.py",
-            "approach/pipeline.py")
+A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
+            "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
+            "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py")
 
 
 A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
@@ -91,7 +91,7 @@ rule approach_tables:
         mc=list(A_MC.values()) + list(A_MC_GROWING.values()),
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
-        code=src("approach/report.py", "tables.py", "published.py", "data/published.yaml"),
+        code=src("approach/report.py", "approach/setup.py", "tables.py", "published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
         x1=report_table(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),

@@ -3,7 +3,7 @@
 # Uses approach.smk's names (APPROACH, A_WORK, A_SCENARIO, A_EM, A_SRC, A_MC, A_METHODS, a_groups):
 # include it after approach.smk.
 
-A_X2_SRC = A_SRC + src("approach/augmented.py", "approach/batch_ml.py", "approach/alternatives.py")
+A_X2_SRC = A_SRC + src("approach/batch_ml.py", "approach/alternatives.py")
 A_X2_VARIANTS = config["approach"]["table1_variants"]
 
 
@@ -32,7 +32,7 @@ rule approach_x2_tables:
     input:
         x2=list(A_X2.values()),
         mc=[A_MC[(v, g, m)] for v in A_X2_VARIANTS for g in a_groups(v) for m in A_METHODS],
-        code=src("approach/alternatives.py", "tables.py"),
+        code=src("approach/report.py", "approach/setup.py", "tables.py"),
     output:
         table=report_table(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
         long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
@@ -51,7 +51,7 @@ rule approach_x2_figure:
     """A-X2 figure: error, spread and CRLB, navigation error, data needed and run time per method."""
     input:
         long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
-        code=src("figures.py", "opnav.mplstyle"),
+        code=src("approach/report.py", "figures.py", "opnav.mplstyle"),
     output:
         fig=report_figure(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
     log:

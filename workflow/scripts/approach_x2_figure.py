@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 
 from opnav import figures
-from opnav.approach.alternatives import METHOD_LABELS
+from opnav.approach.report import METHOD_LABELS
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # standalone debugging run

@@ -2,7 +2,7 @@
 
 
 
-from opnav.approach import alternatives as alt
+from opnav.approach import report
 from opnav.approach.setup import Setup
 from opnav.snakeio import load_pickle, script_context
 from opnav.tables import write_json, write_table
@@ -23,14 +23,14 @@ with script_context(snakemake) as log:
     variants = {r["variant"] for r in alt_res}
     for p in snakemake.input.mc:
         em_res.extend(r for r in load_pickle(p) if r["variant"] in variants)
-    long = alt.long_frame(alt_res, em_res, em_times)
+    long = report.long_frame(alt_res, em_res, em_times)
     long.to_csv(snakemake.output.long, index=False)
-    table = alt.summary_frame(long)
+    table = report.summary_frame(long)
     write_table(table, snakemake.output.table,
                 caption="A-X2: EM-EKF against the augmented EKF and batch ML (IPOPT) on the Table-1 cases; "
                         "errors in arcsec (estimate minus truth), CRLB = Cramer-Rao bound, nav error in km, "
                         "data needed in samples, run time in s per Monte-Carlo seed.")
-    summ = alt.summary_json(long, table, setup)
+    summ = report.summary_json(long, table, setup)
     summ["profile"] = snakemake.params.profile
     write_json(snakemake.output.summary, summ)
     log.info("A-X2: %d long rows, %d table rows", len(long), len(table))

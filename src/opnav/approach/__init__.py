@@ -1,1 +1,42 @@
-"""Paper A: EM-EKF camera optical-axis bias estimation on Mars approach."""
+"""Paper A: EM-EKF camera optical-axis bias estimation on Mars approach.
+
+Equation -> function (paper A's equation numbers; SPEC section A for what is ours)
+
+=========  ==========================================================  ==============================================  ====================
+eq.        what                                                        function                                        units
+=========  ==========================================================  ==============================================  ====================
+1-2        heliocentric dynamics, Sun + Mars third body                dynamics.acceleration, dynamics.propagate       km, km/s, s
+1-2 (lin.) one-step STM Phi_{k,k-1} of the variational equations        dynamics.propagate_with_stm                     --
+3-4        Mars vector in the measured camera frame, the measurement   ekf.predicted_measurement; scenario.simulate     km
+                                                                       (truth, exact rotation)
+3 (noise)  pixel 3-sigma -> km at the reference range                  camera.noise_sigma_km,                          km, km^2
+                                                                       scenario.Geometry.measurement_variance
+5          misalignment A_m^c = I - [theta x]; the exact rotation      camera.misalignment_small,                      rad
+                                                                       camera.misalignment_exact
+6          EKF time and measurement update (the one predict and the   kalman.predict, kalman.condition_on;            km, km/s
+           one update of every filter here), batched over seeds        ekf.run_filter, ekf.predict_only
+7-9        RTS smoother (gain, mean, covariance)                       smoother.rts (smoother.bryson_frazier,          km, km/s
+                                                                       the same moments)
+10-14      observed-data log-likelihood, prediction-error form         kalman.innovation_loglik (ekf.run_filter)       nats
+18         lag-one smoothed cross-covariance P_{k,k-1|N}               smoother.rts (gain form),                       km^2...
+                                                                       smoother.lag_one_recursive
+21-22      expected complete-data log-likelihood Q(theta|theta_r)      em.expected_complete_loglik                     nats
+23, 26     Tr(R^-1 B(theta)) and its closed-form minimiser (M-step)    em.trace_RinvB; em.estep, em.mstep              rad
+24-25      smoothed moments X_{k|N}, P_{k|N}                           smoother.rts                                    km, km/s
+27         H_k = [-A_m^c A_c^i, 0] (sign: d/d r, not d/d r_pM)         ekf.measurement_jacobian                        km/km
+sec. 2.3   segment-wise EM-EKF (N0, N, M, L), Table 1                  cases.run_cases, setup.Segments.windows,        arcsec, km, samples
+                                                                       em.em_window
+SPEC A.3b  Cramér-Rao bound of theta with the unknown state            crlb.crlb_curve (the augmented filter's         rad (1-sigma)
+                                                                       covariance via kalman.*), crlb.batch_crlb
+SPEC A.3c  stall rule: contraction per map toward the ML estimate      em.ml_estimate, em.contraction_per_map,         arcsec
+                                                                       em.stalled
+SPEC A.4   A-X2 alternatives: augmented EKF, batch ML (CasADi/IPOPT)   augmented.run_augmented, batch_ml.BatchML,      rad, arcsec
+                                                                       alternatives.run_case_alternatives
+=========  ==========================================================  ==============================================  ====================
+
+Layers
+    ``setup`` (the config parsed once, frozen) -> ``dynamics``, ``camera``, ``kalman`` ->
+    ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml`` -> ``scenario``,
+    ``cases`` -> ``pipeline``, ``alternatives``, ``ablation``, ``study``, ``peers`` ->
+    ``report`` (tables and texts), ``plots``, ``peer_plots``; ``cli`` at the edge.
+"""

@@ -127,10 +127,11 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
 
 
 def augmented_noise(Q: np.ndarray, q_theta: float) -> np.ndarray:
-    """Process noise (9, 9) of ``[dX; theta]``: ``Q`` and ``q_theta I`` (theta's units squared)."""
-    Qa = np.zeros((9, 9))
-    Qa[:6, :6] = Q
-    Qa[6:, 6:] = np.eye(3) * q_theta
+    """Process noise (..., 9, 9) of ``[dX; theta]``: ``Q (..., 6, 6)`` and ``q_theta I`` (theta's units squared)."""
+    Q = np.asarray(Q)
+    Qa = np.zeros(Q.shape[:-2] + (9, 9))
+    Qa[..., :6, :6] = Q
+    Qa[..., 6:, 6:] = np.eye(3) * q_theta
     return Qa
 
 

@@ -45,22 +45,35 @@ def crlb_curve(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.n
     ``u_true`` (n+1, 3): Mars vector in the calibrated camera frame at the truth.
     ``P_start``: covariance of the state at the window start (prior).
     """
-    n = win.n
-    P = np.zeros((9, 9))
-    P[:6, :6] = P_start
-    P[6:, 6:] = sigma_theta**2 * np.eye(3)
+    return crlb_curves(win.Phi[None], win.C[None], win.Rvar[None], win.Q, u_true[None],
+                       np.asarray(P_start)[None], theta, sigma_theta)[0]
+
+
+def crlb_curves(Phi: np.ndarray, C: np.ndarray, Rvar: np.ndarray, Q: np.ndarray, u_true: np.ndarray,
+                P_start: np.ndarray, theta: np.ndarray, sigma_theta: float = 1.0) -> np.ndarray:
+    """:func:`crlb_curve` for a batch of B windows of equal length at once, (B, n+1, 3), rad.
+
+    Phi (B, n+1, 6, 6), C (B, n+1, 3, 3), Rvar (B, n+1, 3), Q (6, 6), u_true (B, n+1, 3),
+    P_start (B, 6, 6), theta (3,) or (B, 3) rad. The covariance recursion of the linear
+    augmented Kalman filter of ``[dX; theta]`` (:func:`kalman.predict`,
+    :func:`kalman.condition_on`, Joseph form), with theta constant.
+    """
+    B, n = Phi.shape[0], Phi.shape[1] - 1
+    P = np.zeros((B, 9, 9))
+    P[:, :6, :6] = P_start
+    P[:, 6:, 6:] = sigma_theta**2 * np.eye(3)
     A = misalignment_small(theta)
-    Qa = augmented_noise(win.Q, 0.0)
-    Fa = np.eye(9)
-    out = np.empty((n + 1, 3))
-    out[0] = np.sqrt(np.diag(P)[6:])
+    Qa = augmented_noise(Q, 0.0)
+    Fa = np.broadcast_to(np.eye(9), (B, 9, 9)).copy()
+    out = np.empty((B, n + 1, 3))
+    out[:, 0] = np.sqrt(np.diagonal(P, axis1=1, axis2=2)[:, 6:])
     Us = theta_sensitivity(u_true)
     for k in range(1, n + 1):
-        Fa[:6, :6] = win.Phi[k]
+        Fa[:, :6, :6] = Phi[:, k]
         _, P = kalman.predict(None, P, Fa, Qa)
-        H = augmented_jacobian(A, win.C[k], Us[k])
-        P = kalman.condition_on(None, P, H, win.Rvar[k], None, joseph=True).P
-        out[k] = np.sqrt(np.diag(P)[6:])
+        H = augmented_jacobian(A, C[:, k], Us[:, k])
+        P = kalman.condition_on(None, P, H, Rvar[:, k], None, joseph=True).P
+        out[:, k] = np.sqrt(np.diagonal(P, axis1=1, axis2=2)[:, 6:])
     return out
 
 

@@ -27,8 +27,8 @@ Description
     term of the prediction-error decomposition of the log-likelihood.
 
 Shapes
-    Leading axes ``...`` (seeds, or none) broadcast: ``m (..., d)``,
-    ``P (..., d, d)``, ``F, Q (d, d)``, ``H (..., 3, c)``, ``rvar (..., 3)``.
+    Leading axes ``...`` (seeds, windows, or none) broadcast: ``m (..., d)``,
+    ``P (..., d, d)``, ``F (d, d)`` or ``(..., d, d)``, ``Q (d, d)``, ``H (..., 3, c)``, ``rvar (..., 3)``.
     ``m`` and ``nu`` may be ``None`` for a covariance-only recursion.
 Units: those of the state and measurement (km, km/s; theta in rad or arcsec).
 """
@@ -68,8 +68,12 @@ def _t(A: np.ndarray) -> np.ndarray:
 
 def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray
             ) -> tuple[np.ndarray | None, np.ndarray]:
-    """Time update ``(F m, F P F^T + Q)`` (module docstring); ``m`` may be None."""
-    return (None if m is None else m @ F.T), F @ P @ F.T + Q
+    """Time update ``(F m, F P F^T + Q)`` (module docstring); ``m`` may be None.
+    ``F`` (d, d) is shared by the batch, or (..., d, d) one per batch member."""
+    Ft = _t(F)
+    if m is not None:
+        m = m @ Ft if F.ndim == 2 else (m[..., None, :] @ Ft)[..., 0, :]
+    return m, F @ P @ Ft + Q
 
 
 class Update(NamedTuple):

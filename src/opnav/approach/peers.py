@@ -449,7 +449,7 @@ def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id:
     """
     import pandas as pd
 
-    from .alternatives import METHOD_LABELS
+    from .report import METHOD_LABELS
 
     rows = []
     for p in peer:

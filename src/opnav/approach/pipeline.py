@@ -55,15 +55,22 @@ def bound_curve(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_a
     (diagnostic): data after N0 with the true state known to the filter's P_N0.
     ``zero_q``: the same with no process noise (the truth has none).
     """
+    return bound_curves(setup, geo, [(Rvar, theta_arcsec, zero_q)], variant)[0]
+
+
+def bound_curves(setup: Setup | dict, geo: sc.Geometry, items, variant: str) -> list[np.ndarray]:
+    """:func:`bound_curve` of several ``(Rvar, theta_arcsec, zero_q)`` items in one batched recursion."""
     setup = Setup.of(setup)
     N0 = setup.segments.N0
-    win = _window(geo, Rvar, zero_q)
-    th = sc.rad(theta_arcsec)
-    sig = setup.crlb_prior_sigma_rad
-    if sc.START_OF[variant] == "filter":
-        return sc.arcsec(crlb.crlb_curve(win, geo.u_true, geo.P0, th, sig)[N0:])
-    P = _start_covariances(geo, win.slice(0, N0), variant)[-1]
-    return sc.arcsec(crlb.crlb_curve(win.slice(N0, win.n), geo.u_true[N0:], P, th, sig))
+    a = 0 if sc.START_OF[variant] == "filter" else N0
+    wins = [_window(geo, Rvar, zq) for Rvar, _, zq in items]
+    P = [geo.P0 if a == 0 else _start_covariances(geo, w.slice(0, N0), variant)[-1] for w in wins]
+    B, n1 = len(items), geo.Phi.shape[0] - a
+    curves = crlb.crlb_curves(np.broadcast_to(geo.Phi[a:], (B, n1, 6, 6)), np.broadcast_to(geo.C[a:], (B, n1, 3, 3)),
+                              np.stack([w.Rvar[a:] for w in wins]), np.stack([w.Q for w in wins]),
+                              np.broadcast_to(geo.u_true[a:], (B, n1, 3)), np.stack(P),
+                              np.stack([sc.rad(th) for _, th, _ in items]), setup.crlb_prior_sigma_rad)
+    return [sc.arcsec(c[N0 - a:]) for c in curves]
 
 
 def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
@@ -76,18 +83,33 @@ def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, thet
     ``literal`` start is the theta = 0 filter's estimate, which carries every earlier
     sample: its bound is the cumulative one from t0 to the window's end in both modes.
     """
+    return segment_bounds_many(setup, geo, [(Rvar, theta_arcsec, zero_q)], variant)[0]
+
+
+def segment_bounds_many(setup: Setup | dict, geo: sc.Geometry, items, variant: str,
+                        curves: list[np.ndarray] | None = None) -> list[np.ndarray]:
+    """:func:`segment_bounds` of several ``(Rvar, theta_arcsec, zero_q)`` items, every window
+    of every item in one batched recursion; ``curves``: their :func:`bound_curves`, if known."""
     setup = Setup.of(setup)
     windows = setup.segments.windows()
     N0 = setup.segments.N0
     if setup.segments.mode == "growing" or sc.START_OF[variant] == "filter":
-        curve = bound_curve(setup, geo, Rvar, theta_arcsec, variant, zero_q)
-        return np.stack([curve[b - N0] for (_, b) in windows])
-    win = _window(geo, Rvar, zero_q)
-    Pa = _start_covariances(geo, win, variant)
-    th = sc.rad(theta_arcsec)
-    sig = setup.crlb_prior_sigma_rad
-    return np.stack([sc.arcsec(crlb.crlb_curve(win.slice(a, b), geo.u_true[a:b + 1], Pa[a], th, sig)[-1])
-                     for (a, b) in windows])
+        curves = curves if curves is not None else bound_curves(setup, geo, items, variant)
+        return [np.stack([c[b - N0] for (_, b) in windows]) for c in curves]
+    idx = np.array([np.arange(a, b + 1) for (a, b) in windows])  # (L, N+1): the samples of each window
+    start = [a for (a, _) in windows]
+    wins = [_window(geo, Rvar, zq) for Rvar, _, zq in items]
+    Pa = [_start_covariances(geo, w, variant)[start] for w in wins]
+    L, n1 = idx.shape
+    B = len(items) * L
+    out = crlb.crlb_curves(np.broadcast_to(geo.Phi[idx], (len(items), L, n1, 6, 6)).reshape(B, n1, 6, 6),
+                           np.broadcast_to(geo.C[idx], (len(items), L, n1, 3, 3)).reshape(B, n1, 3, 3),
+                           np.concatenate([w.Rvar[idx] for w in wins]),
+                           np.repeat(np.stack([w.Q for w in wins]), L, axis=0),
+                           np.broadcast_to(geo.u_true[idx], (len(items), L, n1, 3)).reshape(B, n1, 3),
+                           np.concatenate(Pa), np.repeat(np.stack([sc.rad(th) for _, th, _ in items]), L, axis=0),
+                           setup.crlb_prior_sigma_rad)[:, -1]
+    return list(sc.arcsec(out).reshape(len(items), L, 3))
 
 
 def groups_for(setup: Setup | dict, variant: str) -> list[str]:
@@ -124,8 +146,9 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
     runs = cases.run_cases(setup, variant, clist + [replace(c, init_mode="sampled") for c in head],
                            seeds, geo=geo, method=method)
     sampled = runs[len(clist):]
-    for case, r in zip(clist, runs):
-        _attach_bounds(setup, geo, case, variant, r)
+    bounds = case_bounds(setup, geo, clist, variant)
+    for case, r, b in zip(clist, runs, bounds):
+        r.update(b)
         r.update(method=method, group=group, case=case)
         if case.case_index == 1:
             smp = sampled[0]
@@ -142,16 +165,27 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
     return out
 
 
-def _attach_bounds(setup: Setup, geo, case, variant, r):
-    Rvar = geo.measurement_variance(case.sigma3_px)
-    seg = segment_bounds(setup, geo, Rvar, case.truth_arcsec, variant)
-    seg0 = segment_bounds(setup, geo, Rvar, case.truth_arcsec, variant, zero_q=True)
-    r["crlb_seg_arcsec"], r["crlb_seg_q0_arcsec"] = seg, seg0
-    r["crlb_arcsec"], r["crlb_q0_arcsec"] = seg[-1], seg0[-1]
-    r["crlb_total_arcsec"] = total_bound(setup, geo, Rvar, case.truth_arcsec, variant)
+def case_bounds(setup: Setup, geo: sc.Geometry, case_list: list[cases.Case], variant: str) -> list[dict]:
+    """Per case, the bound of the data its estimate used (``crlb_arcsec``; per segment
+    ``crlb_seg_arcsec``; with Q = 0: ``crlb_q0_arcsec``, ``crlb_seg_q0_arcsec``) and of all
+    the segments' data (``crlb_total_arcsec``), arcsec, 1-sigma; every case and both Q at once."""
+    items = [(geo.measurement_variance(c.sigma3_px), c.truth_arcsec, zq) for c in case_list for zq in (False, True)]
+    need_curves = setup.segments.mode == "growing" or sc.START_OF[variant] == "filter"
+    curves = bound_curves(setup, geo, items if need_curves else items[::2], variant)
+    segs = segment_bounds_many(setup, geo, items, variant, curves if need_curves else None)
+    out = []
+    for i in range(len(case_list)):
+        seg, seg0 = segs[2 * i], segs[2 * i + 1]
+        curve = curves[2 * i] if need_curves else curves[i]
+        out.append({"crlb_seg_arcsec": seg, "crlb_seg_q0_arcsec": seg0, "crlb_arcsec": seg[-1],
+                    "crlb_q0_arcsec": seg0[-1], "crlb_total_arcsec": _at_total(setup, curve)})
+    return out
+
+
+def _at_total(setup: Setup, curve: np.ndarray) -> np.ndarray:
+    return curve[min(setup.segments.data_samples, len(curve) - 1)]
 
 
 def total_bound(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str) -> np.ndarray:
     """The bound of all the segments' data, L N samples after N0 (3,), arcsec, 1-sigma."""
-    curve = bound_curve(setup, geo, Rvar, theta_arcsec, variant)
-    return curve[min(setup.segments.data_samples, len(curve) - 1)]
+    return _at_total(setup, bound_curve(setup, geo, Rvar, theta_arcsec, variant))
