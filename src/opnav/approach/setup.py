@@ -67,8 +67,29 @@ def _tuple(x) -> tuple:
     return tuple(float(v) for v in x)
 
 
+#: How a field's annotation converts its config value (nested sections: their class name).
+_CONVERT = {"float": float, "int": int, "str": str, "bool": bool, "tuple": _tuple,
+            "tuple[str, ...]": lambda v: tuple(str(x) for x in v)}
+
+
+class _Section:
+    """A frozen config section: :meth:`from_config` converts each key by its field's annotation."""
+
+    @classmethod
+    def from_config(cls, c: Mapping):
+        kw = {}
+        for f in dataclasses.fields(cls):
+            conv = _CONVERT.get(f.type) or globals()[f.type].from_config
+            kw[f.name] = conv(c[f.name])
+        return cls(**kw)
+
+    def as_dict(self) -> dict:
+        """The section as the config holds it (for reports and JSON)."""
+        return dataclasses.asdict(self)
+
+
 @dataclass(frozen=True)
-class ApproachGeometry:
+class ApproachGeometry(_Section):
     """``geometry``: hyperbolic approach from ``range_km`` with ``v_inf_kms`` along ``v_inf_dir``."""
 
     range_km: float
@@ -76,22 +97,14 @@ class ApproachGeometry:
     aim_offset_km: float
     v_inf_dir: tuple
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "ApproachGeometry":
-        return cls(float(c["range_km"]), float(c["v_inf_kms"]), float(c["aim_offset_km"]), _tuple(c["v_inf_dir"]))
-
 
 @dataclass(frozen=True)
-class InitialError:
+class InitialError(_Section):
     """``initial_error``: the paper's fixed initial error (km, km/s) and the mode (fixed / sampled)."""
 
     r_km: tuple
     v_kms: tuple
     mode: str
-
-    @classmethod
-    def from_config(cls, c: Mapping) -> "InitialError":
-        return cls(_tuple(c["r_km"]), _tuple(c["v_kms"]), str(c["mode"]))
 
     @property
     def e_fixed(self) -> np.ndarray:
@@ -100,18 +113,11 @@ class InitialError:
 
 
 @dataclass(frozen=True)
-class PriorSigma:
+class PriorSigma(_Section):
     """``prior_sigma``: 1-sigma of the prior on position (km) and velocity (km/s) per axis."""
 
     r_km: float
     v_kms: float
-
-    @classmethod
-    def from_config(cls, c: Mapping) -> "PriorSigma":
-        return cls(float(c["r_km"]), float(c["v_kms"]))
-
-    def scaled(self, factor: float) -> "PriorSigma":
-        return PriorSigma(factor * self.r_km, factor * self.v_kms)
 
     @property
     def P0(self) -> np.ndarray:
@@ -120,7 +126,7 @@ class PriorSigma:
 
 
 @dataclass(frozen=True)
-class Camera:
+class Camera(_Section):
     """``camera``: pixel size (arcsec), detector size (px), 3-sigma pixel errors of
     (centroid x, centroid y, radius) and the radius/centroid error ratio of the pixel sweep."""
 
@@ -129,31 +135,22 @@ class Camera:
     sigma3_px: tuple
     radius_to_centroid_ratio: float
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "Camera":
-        return cls(float(c["ifov_arcsec"]), int(c["pixels"]), _tuple(c["sigma3_px"]),
-                   float(c["radius_to_centroid_ratio"]))
-
     def pixel_errors(self, centroid_px: float) -> tuple:
         """3-sigma (x, y, radius) errors for a centroid error, with the configured ratio."""
         return (float(centroid_px), float(centroid_px), self.radius_to_centroid_ratio * float(centroid_px))
 
 
 @dataclass(frozen=True)
-class Roll:
+class Roll(_Section):
     """``roll``: the camera's roll about its boresight in the ``roll`` variant."""
 
     rate_deg_s: float
     steps_deg: tuple
     step_interval_s: float
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "Roll":
-        return cls(float(c["rate_deg_s"]), _tuple(c["steps_deg"]), float(c["step_interval_s"]))
-
 
 @dataclass(frozen=True)
-class Segments:
+class Segments(_Section):
     """``segments``: N0 samples before the first window, L windows of N samples, M EM maps each;
     ``sliding`` windows or ``growing`` ones (all data from N0)."""
 
@@ -162,10 +159,6 @@ class Segments:
     M: int
     L: int
     mode: str = "sliding"
-
-    @classmethod
-    def from_config(cls, c: Mapping) -> "Segments":
-        return cls(int(c["N0"]), int(c["N"]), int(c["M"]), int(c["L"]), str(c["mode"]))
 
     @property
     def data_samples(self) -> int:
@@ -184,12 +177,9 @@ class Segments:
             return [(N0 + l * N, N0 + (l + 1) * N) for l in range(L)]
         return [(N0, N0 + (l + 1) * N) for l in range(L)]
 
-    def as_dict(self) -> dict:
-        return dataclasses.asdict(self)
-
 
 @dataclass(frozen=True)
-class EMSettings:
+class EMSettings(_Section):
     """``em``: scheme (plain / squarem), unobservable-direction tolerance, the convergence and
     stall rules (arcsec, contraction per map) and the map budget of the ML reference."""
 
@@ -200,14 +190,9 @@ class EMSettings:
     stall_rate: float
     ml_max_maps: int
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "EMSettings":
-        return cls(str(c["method"]), float(c["tz_tol"]), float(c["converge_tol_arcsec"]),
-                   float(c["stall_move_tol_arcsec"]), float(c["stall_rate"]), int(c["ml_max_maps"]))
-
 
 @dataclass(frozen=True)
-class ConvergenceStudy:
+class ConvergenceStudy(_Section):
     """``convergence_study``: plain EM vs SQUAREM to the ML estimate on one window."""
 
     n_seeds: int
@@ -216,27 +201,18 @@ class ConvergenceStudy:
     tol_arcsec: float
     initial_error_mode: str
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "ConvergenceStudy":
-        return cls(int(c["n_seeds"]), int(c["data_samples"]), int(c["max_maps"]), float(c["tol_arcsec"]),
-                   str(c["initial_error_mode"]))
-
 
 @dataclass(frozen=True)
-class Growing:
+class Growing(_Section):
     """``growing``: Table 1 again with growing windows of ``N`` samples, ``M`` maps, per scheme."""
 
-    methods: tuple
+    methods: tuple[str, ...]
     N: int
     M: int
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "Growing":
-        return cls(tuple(str(m) for m in c["methods"]), int(c["N"]), int(c["M"]))
-
 
 @dataclass(frozen=True)
-class AugmentedSettings:
+class AugmentedSettings(_Section):
     """``alternatives.augmented``: prior and random-walk 1-sigma of theta, arcsec."""
 
     theta_prior_sigma_arcsec: float
@@ -244,7 +220,7 @@ class AugmentedSettings:
 
 
 @dataclass(frozen=True)
-class BatchMLSettings:
+class BatchMLSettings(_Section):
     """``alternatives.batch_ml``: theta prior (arcsec), checkpoint seeds and stride, IPOPT
     tolerance, JIT compilation."""
 
@@ -256,25 +232,15 @@ class BatchMLSettings:
 
 
 @dataclass(frozen=True)
-class Alternatives:
+class Alternatives(_Section):
     """``alternatives``: the A-X2 estimators' settings."""
 
     augmented: AugmentedSettings
     batch_ml: BatchMLSettings
 
-    @classmethod
-    def from_config(cls, c: Mapping) -> "Alternatives":
-        a, b = c["augmented"], c["batch_ml"]
-        return cls(AugmentedSettings(float(a["theta_prior_sigma_arcsec"]), float(a["theta_process_sigma_arcsec"])),
-                   BatchMLSettings(float(b["theta_prior_sigma_arcsec"]), int(b["checkpoint_seeds"]),
-                                   int(b["checkpoint_stride"]), float(b["tol"]), bool(b["jit"])))
-
-    def as_dict(self) -> dict:
-        return dataclasses.asdict(self)
-
 
 @dataclass(frozen=True)
-class BasiliskSettings:
+class BasiliskSettings(_Section):
     """``peers.basilisk``: the peer UKF's tuning (A-P1)."""
 
     alpha: float
@@ -286,21 +252,11 @@ class BasiliskSettings:
 
 
 @dataclass(frozen=True)
-class Peers:
+class Peers(_Section):
     """``peers``: the variants of A-P1 and the peer's tuning."""
 
-    variants: tuple
+    variants: tuple[str, ...]
     basilisk: BasiliskSettings
-
-    @classmethod
-    def from_config(cls, c: Mapping) -> "Peers":
-        b = c["basilisk"]
-        return cls(tuple(c["variants"]), BasiliskSettings(*(float(b[f.name]) for f in
-                                                           dataclasses.fields(BasiliskSettings))))
-
-
-def _kepler(c: Mapping) -> KeplerElements:
-    return KeplerElements.from_config(c)
 
 
 #: Setup field -> (config key, parser); a key absent from the section becomes Missing(key).
@@ -308,7 +264,7 @@ _FIELDS: dict[str, tuple[str, Any]] = {
     "base_seed": ("base_seed", int),
     "n_seeds": ("n_seeds", int),
     "dt_s": ("dt_s", float),
-    "mars": ("mars_elements", _kepler),
+    "mars": ("mars_elements", KeplerElements.from_config),
     "geometry": ("geometry", ApproachGeometry.from_config),
     "initial_error": ("initial_error", InitialError.from_config),
     "prior_sigma": ("prior_sigma", PriorSigma.from_config),
