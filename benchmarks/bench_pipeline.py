@@ -127,6 +127,7 @@ def benchmark_seconds(results: Path) -> dict[str, tuple[int, float, float]]:
 
 def run_profile(name: str, cores: int, keep: Path | None) -> dict:
     tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix=f"bench_pipeline_{name}_"))
+    (tmp / name).mkdir(parents=True, exist_ok=True)
     wd = copy_workflow(REPO, tmp / name)
     env = _env(wd)
     base = [sys.executable, "-m", "snakemake", *PROFILE_ARGS[name]]
