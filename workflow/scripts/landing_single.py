@@ -5,7 +5,9 @@ import json
 
 from opnav import figures
 from opnav.landing import plots
-from opnav.landing.descent import build_scenario, depth_map, run_descent, summarize_run
+from opnav.landing.depth_map import depth_map
+from opnav.landing.descent import build_scenario, run_descent
+from opnav.landing.montecarlo import summarize_run
 from opnav.landing.scenario import initial_attitude_report
 from opnav.snakeio import mock_snakemake, script_context
 

@@ -55,16 +55,16 @@ class Camera:
         return (z > 0) & (np.abs(d[:, 0]) < lim * z) & (np.abs(d[:, 1]) < lim * z)
 
     def measure(self, dir_B: np.ndarray, noise_px: np.ndarray) -> np.ndarray:
-        """Noisy unit bearing in {B} of the true direction ``dir_B`` (3,), given the
-        standard-normal pixel noise draw ``noise_px`` (2,). Raises ``ValueError``
-        for a direction behind the camera."""
-        d = self.R_BtoC @ np.asarray(dir_B, float)
-        if d[2] <= 0:
+        """Noisy unit bearing(s) in {B} of the true direction(s) ``dir_B`` (..., 3),
+        given the standard-normal pixel noise draws ``noise_px`` (..., 2). Raises
+        ``ValueError`` for a direction behind the camera."""
+        d = np.asarray(dir_B, float) @ self.R_BtoC.T
+        if np.any(d[..., 2] <= 0):
             raise ValueError("landmark behind the camera: no image point")
-        uv = self.focal_px * d[:2] / d[2] + self.sigma_px * np.asarray(noise_px, float)
-        c = np.array([uv[0], uv[1], self.focal_px])
-        c /= np.linalg.norm(c)
-        return self.R_BtoC.T @ c
+        uv = self.focal_px * d[..., :2] / d[..., 2:3] + self.sigma_px * np.asarray(noise_px, float)
+        c = np.concatenate([uv, np.full(uv.shape[:-1] + (1,), self.focal_px)], axis=-1)
+        c /= np.linalg.norm(c, axis=-1, keepdims=True)
+        return c @ self.R_BtoC
 
 
 def camera_from_config(cam: dict) -> Camera:

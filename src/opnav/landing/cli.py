@@ -15,7 +15,8 @@ from __future__ import annotations
 def _run(args) -> int:
     from opnav.cli import load_cli_config, print_json, with_flags
     from opnav.config import load_config
-    from opnav.landing.descent import build_scenario, run_descent, summarize_run
+    from opnav.landing.descent import build_scenario, run_descent
+    from opnav.landing.montecarlo import summarize_run
 
     config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
     # the planner's registry and the seed's limits are checked as the config's

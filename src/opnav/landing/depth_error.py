@@ -47,7 +47,8 @@ import numpy as np
 
 __all__ = ["depth", "depth_error", "PlaneGeometry", "plane_geometry", "signed_alpha",
            "signed_depth_error", "ground_point", "baseline", "error_radius", "max_eig_sym3",
-           "angles_to_landmarks", "depth_error_at_landmarks"]
+           "angles_to_landmarks", "depth_error_at_landmarks", "depth_error_in_plane",
+           "depth_error_of_points"]
 
 
 def _check_positive(name: str, x: float) -> float:
@@ -211,3 +212,45 @@ def depth_error_at_landmarks(r_L, v_L, a_L, p_L, t_s: float, r_e: float) -> np.n
     """Depth error (m) of each ground landmark ``p_L`` (n, 3), eq. 23-25 (B-F5)."""
     alpha, beta, cd = angles_to_landmarks(r_L, v_L, p_L)
     return depth_error(beta, alpha, cd, baseline(v_L, a_L, t_s), r_e)
+
+
+# ---------------------------------------------------------------- batched forms
+# (the planner's batched descent: many runs' planes at once; the same arithmetic
+# as the per-call objective of opnav.landing.planner.depth_objective)
+
+def depth_error_in_plane(beta_signed, gamma, cd, b, r_e) -> np.ndarray:
+    """Depth error (m, eq. 23-25) at signed beta (rad) in the velocity's vertical
+    plane, broadcast over all arguments (one plane per element: flight-path angle
+    ``gamma`` rad, ``|CD|`` m, baseline ``b`` m > 0, error radius ``r_e`` m);
+    ``+inf`` at beta = 0 and where the line of sight misses the ground."""
+    beta = np.asarray(beta_signed, float)
+    g = np.asarray(gamma, float)
+    b = np.asarray(b, float)
+    sa = np.sin(g)                                         # sin(alpha) on both sides
+    ca = np.where(beta > 0.0, -np.cos(g), np.cos(g))       # alpha = pi - gamma | gamma
+    ab = np.abs(beta)
+    sb, cb = np.sin(ab), np.cos(ab)
+    s = sa * cb + ca * sb                                  # sin(alpha + beta)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = cd * sa / s                                    # law of sines
+        rks = np.sqrt(b * b + d * d - 2.0 * b * d * cb)    # eq. 25
+        out = (2.0 * np.asarray(r_e, float) / b) * rks / sb    # eq. 23-24: 2 r_e / sin(theta)
+    return np.where((beta != 0.0) & (s > 0.0) & (rks > 0.0), out, np.inf)
+
+
+def depth_error_of_points(points, C, v_hat, b, r_e) -> np.ndarray:
+    """Depth error (m, eq. 23-25) of ground points ``points`` (..., n, 3) seen from
+    C (..., 3) moving along ``v_hat`` (..., 3), baseline ``b`` (...,) m, error
+    radius ``r_e`` (...,) m: for a given landmark the depth of eq. 25 is its
+    range ``|p - C|``, so ``dr = 2 r_e |r^(k+s)| / (b sin beta)``; ``+inf`` at
+    beta = 0 and for points not below C."""
+    C = np.asarray(C, float)[..., None, :]
+    lc = np.asarray(points, float) - C
+    rho = np.sqrt(np.einsum("...ij,...ij->...i", lc, lc))
+    cb = np.clip(np.einsum("...ij,...j->...i", lc, np.asarray(v_hat, float)) / rho, -1.0, 1.0)
+    sb = np.sqrt(1.0 - cb * cb)
+    b = np.asarray(b, float)[..., None]
+    rk = np.sqrt(np.maximum(b * b + rho * rho - 2.0 * b * rho * cb, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = (2.0 * np.asarray(r_e, float)[..., None] / b) * rk / sb
+    return np.where((sb > 0) & (np.asarray(points)[..., 2] < C[..., 2]), out, np.inf)

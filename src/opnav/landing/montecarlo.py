@@ -4,10 +4,12 @@
 Description
 -----------
 Run ``i`` of every method uses the random stream ``SeedSequence([base_seed,
-i])`` only (``opnav.landing.descent.run_descent``), so the methods are paired
+i])`` only (``opnav.landing.descent.run_descents``), so the methods are paired
 (same initial errors, IMU and pixel noise) and a run's result does not depend
-on how runs are grouped into Snakemake jobs. :func:`run_chunk` flies a list of
-run indices and stacks the per-run arrays; :func:`gather` concatenates chunks
+on how runs are grouped into Snakemake jobs or batches. :func:`run_chunk`
+flies a list of run indices (in batches of ``landing.mc.batch_size``) and
+stacks the per-run arrays; :func:`summarize_run` is one run's
+:func:`per_run_stats` row; :func:`gather` concatenates chunks
 in run order; :func:`summary_table` builds B-T3.
 
 Statistics (per method, over the runs): final (touchdown) and RMS (over time)
@@ -39,7 +41,7 @@ if TYPE_CHECKING:
 
 from opnav.landing.timing import RECORD_KEYS   # numpy only
 
-__all__ = ["yaw_convergence", "run_chunk", "save", "load", "gather", "summary_table", "per_run_stats",
+__all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "summary_table", "per_run_stats",
            "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality"]
 
@@ -81,21 +83,53 @@ def chunk_runs(label: str) -> list[int]:
 CHUNK_PATTERN = r"r[0-9]+-[0-9]+"
 
 
-def run_chunk(landing_cfg: dict, method: str, run_indices) -> dict:
-    """Fly the runs ``run_indices`` with ``method``; stacked arrays (see module doc)."""
-    from opnav.landing.descent import build_scenario, run_descent
+def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | None = None) -> dict:
+    """Fly the runs ``run_indices`` with ``method``; stacked arrays (see module doc).
+
+    Runs are flown in batches of ``batch_size`` (default ``landing.mc.batch_size``;
+    0 = all runs as one batch); the numbers do not depend on it (to round-off)."""
+    from opnav.landing.descent import run_descents
+    from opnav.landing.scenario import build_scenario
 
     scn = build_scenario(landing_cfg)
-    runs = [run_descent(scn, method, int(i)) for i in run_indices]
-    out = {"run_index": np.asarray(list(run_indices), np.int64), "t": scn.truth.t.copy()}
+    idx = [int(i) for i in run_indices]
+    if batch_size is None:
+        batch_size = int(landing_cfg.get("mc", {}).get("batch_size", 1))
+    size = len(idx) if batch_size <= 0 else int(batch_size)
+    runs = []
+    for a in range(0, len(idx), max(size, 1)):
+        runs.extend(run_descents(scn, method, idx[a:a + size]))
+    return stack_runs(idx, runs, scn.truth.t)
+
+
+def stack_runs(run_indices, runs: list[dict], t: np.ndarray) -> dict:
+    """The per-run dicts of :func:`opnav.landing.descent.run_descents` as one
+    chunk: tracks stacked (runs x ...), planning calls concatenated with their
+    run index (``plan_run``)."""
+    out = {"run_index": np.asarray(list(run_indices), np.int64), "t": np.asarray(t).copy()}
     for k in _TRACKS:
         out[k] = np.stack([r[k] for r in runs])
     for k in _PLAN:
         out[k] = np.concatenate([r[k] for r in runs]) if runs else np.zeros(0)
-    out["plan_run"] = np.concatenate([np.full(len(r["plan_ns"]), int(i), np.int64)
+    out["plan_run"] = np.concatenate([np.full(len(r["plan_t"]), int(i), np.int64)
                                       for i, r in zip(run_indices, runs)]) if runs else np.zeros(0, np.int64)
     out["n_landmarks"] = np.array([r["n_landmarks"] for r in runs], np.int64)
     out["init_error"] = np.stack([r["init_error"] for r in runs])
+    return out
+
+
+def summarize_run(run: dict, run_index: int = 0) -> dict:
+    """One run of :func:`opnav.landing.descent.run_descent`: its
+    :func:`per_run_stats` row (final, last-vision and RMS error norms, mean
+    NEES, landmarks used) plus the final yaw error (deg), the number of
+    planning calls, their median time (us) and median evaluation count."""
+    data = stack_runs([run_index], [run], run["t"])
+    out = {k: (int(v) if k == "n_landmarks" else float(v))
+           for k, v in per_run_stats(data).iloc[0].items()}
+    out["final_yaw_err_deg"] = float(run["err_rpy_deg"][-1, 2])
+    out["n_plans"] = int(len(run["plan_t"]))
+    out["median_plan_time_us"] = _median_us(run["plan_ns"])
+    out["median_plan_evals"] = float(np.median(run["plan_evals"])) if len(run["plan_evals"]) else math.nan
     return out
 
 
@@ -156,7 +190,7 @@ def per_run_stats(data: dict) -> pd.DataFrame:
         nrm = np.linalg.norm(data[key], axis=2)
         rows[f"final_{name}"] = nrm[:, -1]
         if "updated" in data:      # at the last vision update (then the IMU-only coast)
-            rows[f"lastvis_{name}"] = nrm[np.arange(len(nrm)), _last_update(data["updated"])]
+            rows[f"lastvis_{name}"] = nrm[np.arange(len(nrm)), last_update_index(data["updated"])]
         rows[f"rms_{name}"] = np.sqrt(np.mean(nrm**2, axis=1))
     rows["mean_nees_pos"] = data["nees_r"].mean(axis=1)
     rows["mean_nees_vel"] = data["nees_v"].mean(axis=1)
@@ -164,11 +198,14 @@ def per_run_stats(data: dict) -> pd.DataFrame:
     return pd.DataFrame(rows, index=pd.Index(data["run_index"], name="run"))
 
 
-def _last_update(updated: np.ndarray) -> np.ndarray:
-    """Per run, the index of the last filter time with a vision update (0 if none)."""
+def last_update_index(updated: np.ndarray):
+    """Index of the last filter time with a vision update (0 if none), per run
+    for ``updated`` (runs, times), or an int for one run (times,): after it the
+    filter coasts on the IMU to touchdown."""
     u = np.asarray(updated, bool)
-    last = u.shape[1] - 1 - np.argmax(u[:, ::-1], axis=1)
-    return np.where(u.any(axis=1), last, 0)
+    last = u.shape[-1] - 1 - np.argmax(u[..., ::-1], axis=-1)
+    out = np.where(u.any(axis=-1), last, 0)
+    return int(out) if u.ndim == 1 else out
 
 
 def _median_us(ns: np.ndarray) -> float:

@@ -58,7 +58,8 @@ from opnav.landing.depth_error import PlaneGeometry, baseline, error_radius, pla
 from opnav.landing.landmarks import LandmarkField
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig",
-           "plan", "OBJECTIVES", "PICKERS", "available_methods", "depth_objective"]
+           "plan", "plan_batch", "golden_section_batch", "OBJECTIVES", "PICKERS",
+           "available_methods", "depth_objective"]
 
 INVPHI = (math.sqrt(5.0) - 1.0) / 2.0      # 1/phi = 0.618...
 _EYE6 = np.eye(6)
@@ -560,3 +561,414 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
         k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
     return PlanResult(method, k, x, point, fx, n, time.perf_counter_ns() - t0, note,
                       edge=bool(edge)), fun, vals
+
+
+# ----------------------------------------------------------------- batched planning
+# The runs of a batched descent that need a new landmark at the same image are
+# planned together: the same steps as :func:`_plan` (same picks), with the
+# golden-section searches in lockstep, the objective evaluated for all runs at
+# once, one KD-tree query for all runs. Not timed (planning time comes from
+# replaying recorded inputs through :func:`plan`).
+
+def golden_section_batch(fun: Callable[[np.ndarray, np.ndarray], np.ndarray], a, b, tol: float
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Many independent golden-section searches in lockstep: problem ``i`` on
+    ``[a[i], b[i]]``; ``fun(i (m,), x (m,)) -> (m,)`` evaluates problems ``i`` at
+    ``x``. Each problem runs exactly the iterations (and arithmetic) of
+    :func:`golden_section` (masks: a problem stops when its bracket is shorter
+    than ``tol``). Returns ``(x, f(x), n_evals)``, arrays (m,)."""
+    a = np.array(a, float)
+    b = np.array(b, float)
+    if not (np.isfinite(a).all() and np.isfinite(b).all()) or np.any(b < a):
+        raise ValueError("golden_section: bad interval")
+    if not tol > 0:
+        raise ValueError(f"golden_section: tolerance must be positive, got {tol}")
+    m = a.size
+    c = b - INVPHI * (b - a)
+    d = a + INVPHI * (b - a)
+    every = np.arange(m)
+    fc = np.asarray(fun(every, c), float).copy()
+    fd = np.asarray(fun(every, d), float).copy()
+    n = np.full(m, 2, np.int64)
+    act = np.flatnonzero((b - a) > tol)
+    while act.size:
+        left = fc[act] <= fd[act]
+        il, ir = act[left], act[~left]
+        b[il], d[il], fd[il] = d[il], c[il], fc[il]
+        c[il] = b[il] - INVPHI * (b[il] - a[il])
+        a[ir], c[ir], fc[ir] = c[ir], d[ir], fd[ir]
+        d[ir] = a[ir] + INVPHI * (b[ir] - a[ir])
+        f = np.asarray(fun(act, np.where(left, c[act], d[act])), float)
+        fc[il] = f[left]
+        fd[ir] = f[~left]
+        n[act] += 1
+        act = act[(b[act] - a[act]) > tol]
+    use_c = fc <= fd
+    return np.where(use_c, c, d), np.where(use_c, fc, fd), n
+
+
+def _ground_points(beta, C, v_hat, w_hat, cd, gamma) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_ground_fn` for many (plane, beta): points (m, 3) and a mask of
+    the betas whose line of sight meets the ground."""
+    alpha = np.where(beta > 0, math.pi - gamma, gamma)
+    ab = np.abs(beta)
+    s = np.sin(alpha + ab)
+    ok = (beta != 0.0) & (alpha + ab < math.pi) & (s > 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dd = (cd * np.sin(alpha) / s)[:, None]
+    cb, sb = np.cos(beta)[:, None], np.sin(beta)[:, None]
+    return C + dd * (cb * v_hat + sb * w_hat), ok
+
+
+class _Contexts:
+    """The H baselines' per-run context (lander, attitude, known landmark) of a
+    batch, for evaluating many candidates of many runs at once (the metrics
+    module's formulas: eq. 14-18 and its closed-form singular values)."""
+
+    def __init__(self, states: PlanState, cfg: PlannerConfig, camera: Camera):
+        from opnav.landing.metrics import MetricContext
+
+        self.r, self.R = states.r, states.R_LtoB
+        self.p_known = np.asarray(cfg.p_known, float)
+        self.min_range = MetricContext.trusted(states.r[0], states.v[0], states.R_LtoB[0],
+                                               self.p_known).min_range_m
+        d1 = self.p_known - self.r
+        rho1 = np.linalg.norm(d1, axis=1)
+        self.bs_L = np.einsum("bji,j->bi", self.R, camera.boresight_B)      # R^T boresight
+        self.known_ok = (rho1 > self.min_range) & (np.einsum("bi,bi->b", d1, self.bs_L) > 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.u = d1 / rho1[:, None]
+            self.x = 1.0 / rho1
+
+    def _valid(self, i, pts):
+        d2 = pts - self.r[i]
+        rho2 = np.sqrt(np.einsum("...k,...k->...", d2, d2))
+        ok = (rho2 > self.min_range) & (np.einsum("...k,...k->...", d2, self.bs_L[i]) > 0.0)
+        return d2, rho2, ok & self.known_ok[i]
+
+    def closed_form(self, name: str, i, pts) -> np.ndarray:
+        """Metric ``name`` (larger is better) of candidates ``pts`` (..., 3) of runs
+        ``i`` (closed-form structural singular values; -inf where invalid)."""
+        from opnav.landing.metrics import _scores_from_sq, _structural_sq
+
+        d2, rho2, ok = self._valid(i, pts)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = d2 / rho2[..., None]
+            u = self.u[i]
+            cg = np.einsum("...k,...k->...", w, u)
+            cr = np.cross(u, w)
+            s2 = np.einsum("...k,...k->...", cr, cr)
+            sc = _scores_from_sq(name, *_structural_sq(self.x[i], 1.0 / rho2, cg, s2))
+        return np.where(ok, sc, -np.inf)
+
+    def explicit(self, name: str, i, pts) -> np.ndarray:
+        """The same metric by the explicit H (eq. 14-18) and its singular values
+        (LAPACK), one candidate per run ``i`` (pts (m, 3))."""
+        from opnav.landing.ekf import bearing_jacobian
+        from opnav.landing.metrics import PINV_RCOND, STRUCTURAL_RANK
+
+        d2, rho2, ok = self._valid(i, pts)
+        out = np.full(len(pts), -np.inf)
+        if not ok.any():
+            return out
+        i, pts = i[ok], pts[ok]
+        r, R = self.r[i], self.R[i]
+        H = np.zeros((len(i), 6, 12))
+        Hr, Ht, _ = bearing_jacobian(r, R, np.broadcast_to(self.p_known, r.shape))
+        H[:, 0:3, 0:3], H[:, 0:3, 6:9] = Hr, Ht
+        Hr, Ht, Hp = bearing_jacobian(r, R, pts)
+        H[:, 3:6, 0:3], H[:, 3:6, 6:9], H[:, 3:6, 9:12] = Hr, Ht, Hp
+        sv = np.linalg.svd(H, compute_uv=False)
+        s4 = sv[:, STRUCTURAL_RANK - 1]
+        if name == "svd":
+            out[ok] = s4
+        elif name == "cond":
+            out[ok] = s4 / sv[:, 0]
+        else:
+            keep = sv > PINV_RCOND * sv[:, :1]
+            out[ok] = 1.0 / np.sum(np.where(keep, 1.0 / np.where(keep, sv * sv, 1.0), 0.0), axis=1)
+        return out
+
+
+def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkField,
+               visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
+               exclude: np.ndarray, rngs: list | None = None, detected: np.ndarray | None = None,
+               diagnose: bool = True) -> list[PlanResult]:
+    """:func:`plan` for a batch of runs seeing the same image: ``states`` holds
+    arrays with a leading run axis (m, ...), ``exclude`` (m,) each run's current
+    landmark (-1: none), ``rngs`` each run's picker stream. Returns one
+    :class:`PlanResult` per run with the picks, optima, edge flags, evaluation
+    counts and pick ratios of the per-call :func:`plan` (to round-off), and no
+    timing (``time_ns = cpu_ns = 0``).
+
+    The golden-section searches of all runs and sub-intervals run in lockstep
+    (:func:`golden_section_batch`); the depth objective and the paper's H
+    baselines are evaluated for all runs at once (other objectives run by run);
+    the edge rule of the H baselines scores every detected landmark by the
+    closed-form singular values and evaluates the explicit path only on those
+    within 1e-6 of the best (the paths agree to ~1e-9 relative, checked on
+    that shortlist; else all are evaluated), which gives the same pick."""
+    exclude = np.asarray(exclude, np.int64)
+    m = exclude.size
+    rngs = [None] * m if rngs is None else list(rngs)
+    if detected is None:
+        detected = np.flatnonzero(visible(field_.xyz))
+    det = np.sort(np.asarray(detected, np.int64))
+    pts = field_.xyz[det]
+    candmask = det[None, :] != exclude[:, None]                 # (m, n_det)
+    n_cand = candmask.sum(axis=1)
+
+    def one(j):
+        return PlanState(states.r[j], states.v[j], states.a[j], states.R_LtoB[j], states.P[j])
+
+    if method in PICKERS:
+        out = []
+        for j in range(m):
+            cand = det[candmask[j]]
+            k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, one(j), camera, rngs[j])])
+            out.append(PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
+                                  math.nan, 0, 0))
+        return out
+    build = OBJECTIVES.get(method)
+    if build is None:
+        raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
+    notes = [""] * m
+    geoms: list = [None] * m
+    funs: list = [None] * m
+    owner, lo, hi = [], [], []
+    for j in range(m):
+        try:
+            geom = plane_geometry(states.r[j], states.v[j])
+            ivs = visible_intervals(geom, states.R_LtoB[j], camera, cfg.n_grid, cfg.margin_px)
+            if ivs:
+                funs[j] = build(state=one(j), geom=geom, cfg=cfg, camera=camera, sigma_b=camera.sigma_b)
+                geoms[j] = geom
+                for a, b in ivs:
+                    owner.append(j)
+                    lo.append(a)
+                    hi.append(b)
+            else:
+                notes[j] = "no visible interval"
+        except ValueError as exc:
+            if "depth error" not in str(exc):
+                raise
+            notes[j] = str(exc)
+    searched = np.array([g is not None for g in geoms])
+    G = _plane_arrays(geoms, searched)
+    evaluate = _batch_objective(method, states, G, cfg, camera, funs)
+    owner = np.asarray(owner, np.int64)
+    best_x = np.full(m, math.nan)
+    best_f = np.full(m, math.inf)
+    best_a = np.full(m, math.nan)
+    best_b = np.full(m, math.nan)
+    n_ev = np.zeros(m, np.int64)
+    if owner.size:
+        x, fx, ne = golden_section_batch(lambda i, bb: evaluate(owner[i], bb), lo, hi, cfg.tol_rad)
+        for q in range(owner.size):            # intervals in order: the first, then a better one
+            j = owner[q]
+            n_ev[j] += ne[q]
+            if fx[q] < best_f[j] or math.isnan(best_x[j]):
+                best_x[j], best_f[j], best_a[j], best_b[j] = x[q], fx[q], lo[q], hi[q]
+    found = ~np.isnan(best_x)
+    point = np.full((m, 3), math.nan)
+    if found.any():
+        f = np.flatnonzero(found)
+        point[f] = _ground_points(best_x[f], G["C"][f], G["v_hat"][f], G["w_hat"][f], G["cd"][f],
+                                  G["gamma"][f])[0]
+    edge = found & (np.minimum(best_x - best_a, best_b - best_x) <= cfg.tol_rad)
+    pick = np.full(m, -1, np.int64)
+    vals: list = [None] * m                  # per run: the scores behind its pick ratio
+    ie = np.flatnonzero(edge & (n_cand > 0))
+    if ie.size:
+        exact, pos = _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask)
+        for j, (vv, pp) in zip(ie, zip(exact, pos)):
+            n_ev[j] += n_cand[j]
+            fin = np.isfinite(vv)
+            if fin.any():
+                pick[j] = det[pp[int(np.argmin(np.where(fin, vv, np.inf)))]]
+            vals[j] = (vv, pp)
+    # the nearest detected landmark to the ideal ground point (one KD-tree query)
+    need = np.flatnonzero(pick < 0)
+    if need.size:
+        fb = need[~found[need]]
+        if fb.size:                          # documented fallback: nearest the boresight
+            bs = np.einsum("bji,j->bi", states.R_LtoB[fb], camera.boresight_B)
+            point[fb] = states.r[fb] + bs * (np.maximum(states.r[fb, 2], 1.0)
+                                            / np.maximum(-bs[:, 2], 1e-3))[:, None]
+        pick[need] = _pick_nearest_batch(field_, point[need], visible, cfg.knn, exclude[need])
+    if diagnose:
+        _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, candmask)
+    out = []
+    for j in range(m):
+        if found[j]:
+            res = PlanResult(method, int(pick[j]), float(best_x[j]), point[j], float(best_f[j]),
+                             int(n_ev[j]), 0, notes[j], edge=bool(edge[j]))
+        else:
+            res = PlanResult(method, int(pick[j]), math.nan, point[j], math.nan, int(n_ev[j]), 0,
+                             notes[j] or "no finite objective")
+        r = vals[j]
+        if isinstance(r, float):
+            res.pick_ratio = r
+        out.append(res)
+    return out
+
+
+def _plane_arrays(geoms, searched) -> dict:
+    m = len(geoms)
+    G = {"C": np.full((m, 3), math.nan), "v_hat": np.full((m, 3), math.nan),
+         "w_hat": np.full((m, 3), math.nan), "cd": np.full(m, math.nan),
+         "gamma": np.full(m, math.nan)}
+    for j in np.flatnonzero(searched):
+        g = geoms[j]
+        G["C"][j], G["v_hat"][j], G["w_hat"][j] = g.C, g.v_hat, g.w_hat
+        G["cd"][j], G["gamma"][j] = g.cd, g.gamma
+    return G
+
+
+def _depth_constants(states, G, cfg, rows):
+    """Per run: baseline (eq. 19) and error radius (eq. 22) of the depth objective."""
+    from opnav.landing.depth_error import error_radius
+
+    b = np.array([baseline(states.v[j], states.a[j], cfg.t_s) for j in rows])
+    r_e = np.array([error_radius(states.P[j, 3:6, 3:6], cfg.t_s, cfg.n_sigma_v) for j in rows])
+    return b, r_e
+
+
+def _batch_objective(method, states, G, cfg, camera, funs) -> Callable:
+    """``f(runs (n,), beta (n,)) -> (n,)``: the method's objective (minimised) at
+    signed beta in each run's plane, for many runs at once."""
+    m = len(funs)
+    if method == "depth":
+        b, r_e = np.full(m, math.nan), np.full(m, math.nan)
+        rows = [j for j in range(m) if funs[j] is not None]
+        if rows:
+            b[rows], r_e[rows] = _depth_constants(states, G, cfg, rows)
+        from opnav.landing.depth_error import depth_error_in_plane
+
+        return lambda i, beta: depth_error_in_plane(beta, G["gamma"][i], G["cd"][i], b[i], r_e[i])
+    from opnav.landing.metrics import H_METRICS
+
+    if method in H_METRICS:
+        ctx = _Contexts(states, cfg, camera)
+        score = ctx.closed_form if cfg.eval_path == "closed_form" else ctx.explicit
+
+        def f(i, beta):
+            p, ok = _ground_points(beta, G["C"][i], G["v_hat"][i], G["w_hat"][i], G["cd"][i],
+                                   G["gamma"][i])
+            out = np.full(len(i), math.inf)
+            if ok.any():
+                out[ok] = -score(method, i[ok], p[ok])
+            return out
+
+        return f
+    return lambda i, beta: np.array([funs[j](float(x)) for j, x in zip(i, beta)])
+
+
+_SHORTLIST_RTOL = 1e-6      # candidates this close to the closed-form best get the explicit path
+_AGREE_RTOL = 1e-7          # closed form vs explicit path on the shortlist, else all explicit
+
+
+def _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask):
+    """Edge rule for runs ``ie``: per run, the scores (minimised) of its detected
+    candidates that decide the pick and the positions (into the detected list)
+    they belong to, in candidate order."""
+    from opnav.landing.metrics import H_METRICS
+
+    out_v, out_p = [], []
+    if method == "depth":
+        b, r_e = _depth_constants(states, G, cfg, ie)
+        from opnav.landing.depth_error import depth_error_of_points
+
+        allv = depth_error_of_points(pts[None], G["C"][ie], G["v_hat"][ie], b, r_e)
+        for q, j in enumerate(ie):
+            pp = np.flatnonzero(candmask[j])
+            out_v.append(allv[q, pp])
+            out_p.append(pp)
+        return out_v, out_p
+    if method in H_METRICS:
+        ctx = _Contexts(states, cfg, camera)
+        cf = -ctx.closed_form(method, ie[:, None], pts[None])
+        for q, j in enumerate(ie):
+            pp = np.flatnonzero(candmask[j])
+            v = cf[q, pp]
+            fin = np.isfinite(v)
+            if not fin.any():
+                out_v.append(v)
+                out_p.append(pp)
+                continue
+            fmin = v[fin].min()
+            sl = fin & (v <= fmin + _SHORTLIST_RTOL * abs(fmin))
+            ex = funs[j].batch(pts[pp[sl]])
+            if np.all(np.abs(ex - v[sl]) <= _AGREE_RTOL * np.abs(v[sl])):
+                out_v.append(ex)
+                out_p.append(pp[sl])
+            else:                           # paths disagree: score every candidate explicitly
+                out_v.append(funs[j].batch(pts[pp]))
+                out_p.append(pp)
+        return out_v, out_p
+    for j in ie:
+        pp = np.flatnonzero(candmask[j])
+        out_v.append(funs[j].batch(pts[pp]))
+        out_p.append(pp)
+    return out_v, out_p
+
+
+def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, visible: Callable,
+                        knn: int, exclude: np.ndarray) -> np.ndarray:
+    """:func:`_pick_nearest` for many ideal points (one KD-tree query; a run
+    whose ``knn`` nearest hold no detected landmark widens alone)."""
+    n_field = len(field_.xyz)
+    k = min(max(int(knn), 1), n_field)
+    _, idx = field_.tree.query(np.asarray(points, float)[:, :2], k=k)
+    idx = np.asarray(idx).reshape(len(points), k)
+    vis = visible(field_.xyz[idx.ravel()]).reshape(idx.shape) & (idx != exclude[:, None])
+    out = np.full(len(points), -1, np.int64)
+    hit = vis.any(axis=1)
+    out[hit] = idx[hit, np.argmax(vis[hit], axis=1)]
+    for j in np.flatnonzero(~hit):
+        ex = {int(exclude[j])} if exclude[j] >= 0 else set()
+        out[j] = _pick_nearest(field_, points[j], visible, knn, ex)
+    return out
+
+
+def _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, candmask) -> None:
+    """Per run: the picked landmark's score over the best detected one's
+    (``fun.ratio``), from the edge scores where the edge rule computed them,
+    else every detected landmark scored by the method's fastest path; written
+    into ``vals`` as floats (runs without a ratio keep None)."""
+    from opnav.landing.metrics import H_METRICS
+
+    m = len(pick)
+    todo = [j for j in range(m) if funs[j] is not None and pick[j] >= 0 and candmask[j].any()]
+    fresh = [j for j in todo if vals[j] is None]
+    scores = {}
+    if fresh:
+        rows = np.asarray(fresh)
+        if method == "depth":
+            from opnav.landing.depth_error import depth_error_of_points
+
+            b, r_e = _depth_constants(states, G, cfg, rows)
+            allv = depth_error_of_points(pts[None], G["C"][rows], G["v_hat"][rows], b, r_e)
+        elif method in H_METRICS:
+            allv = -_Contexts(states, cfg, camera).closed_form(method, rows[:, None], pts[None])
+        else:
+            allv = None
+        for q, j in enumerate(fresh):
+            pp = np.flatnonzero(candmask[j])
+            if allv is not None:
+                v = allv[q, pp]
+            else:
+                fun = funs[j]
+                v = getattr(fun, "diagnostic", fun.batch)(pts[pp])
+            scores[j] = (v, pp)
+    for j in todo:
+        v, pp = vals[j] if vals[j] is not None else scores[j]
+        vals[j] = None
+        fin = np.isfinite(v)
+        if fin.any():
+            hit = np.flatnonzero(det[pp] == pick[j])
+            f_pick = v[hit[0]] if hit.size else math.nan
+            vals[j] = float(funs[j].ratio(f_pick, float(v[fin].min())))
+    for j in range(m):
+        if not isinstance(vals[j], float):
+            vals[j] = None

@@ -51,7 +51,7 @@ def fig_true_states(t, r, v, rpy_deg):
 
 
 def fig_depth_error_map(dm: dict):
-    """B-F5 from :func:`opnav.landing.descent.depth_map`: (a) the detected
+    """B-F5 from :func:`opnav.landing.depth_map.depth_map`: (a) the detected
     landmarks in the image coloured by depth error, the best one and the
     in-plane golden-section direction marked; (b) the whole field on the
     ground (no image constraint), its best landmark, the unconstrained in-plane

@@ -1,5 +1,9 @@
-"""Paper B's simulation scenario as tables: initial state (Table 1) and
-Monte-Carlo initial-error bounds (Table 2), rendered from the config.
+"""Paper B's simulation scenario: the ``landing`` config parsed once into the
+frozen :class:`Scenario` shared by every run and method (truth trajectory,
+noise-free IMU, landmark field, camera, process noise, filter and planner
+settings; :func:`build_scenario`), the camera scenarios of the config
+(:func:`camera_scenarios`), and the scenario as tables: initial state
+(Table 1) and Monte-Carlo initial-error bounds (Table 2).
 
 Units: position m, velocity m/s, attitude deg, frame {L} (landing site origin,
 z up).
@@ -7,10 +11,107 @@ z up).
 
 from __future__ import annotations
 
+import json
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
 import numpy as np
 import pandas as pd
 
 from opnav import published
+from opnav.landing import ekf, imu
+from opnav.landing.camera import Camera, camera_from_config
+from opnav.landing.landmarks import LandmarkField, make_field
+from opnav.landing.planner import PlannerConfig, alternative_path
+from opnav.landing.trajectory import Truth, truth_states
+
+
+@dataclass(frozen=True)
+class Scenario:
+    truth: Truth               # at the filter times (n_steps + 1)
+    truth_imu: Truth           # at the IMU nodes
+    f: np.ndarray              # noise-free IMU specific force (m, 3)
+    w: np.ndarray              # noise-free IMU rate (m, 3)
+    g: np.ndarray
+    dt_imu: float
+    n_sub: int
+    Dt: float
+    n_steps: int
+    Q: np.ndarray
+    sigma_a: float
+    sigma_w: float             # rad/s
+    camera: Camera
+    field: LandmarkField
+    planner: PlannerConfig
+    planner_alt: PlannerConfig  # the same on the alternative metric evaluation path (timing)
+    obs_per_landmark: int
+    depth_sigma_frac: float
+    min_update_alt: float
+    oc: bool                   # observability-constrained EKF (ekf.oc_transition)
+    iterations: int            # iterated-EKF relinearisations per update
+    noise_scale: float         # filter bearing noise / true pixel noise
+    bounds: tuple              # (m, m/s, rad)
+    base_seed: int
+
+
+def _scenario_from_json(text: str) -> Scenario:
+    c = json.loads(text)
+    T = float(c["duration_s"])
+    Dt = float(c["filter"]["dt_s"])
+    rate = float(c["imu"]["rate_hz"])
+    n_sub = int(round(rate * Dt))
+    if n_sub < 1 or abs(n_sub / rate - Dt) > 1e-9:
+        raise ValueError(f"landing.imu.rate_hz ({rate}) times landing.filter.dt_s ({Dt}) "
+                         "must be a positive integer")
+    n_steps = int(round(T / Dt))
+    if abs(n_steps * Dt - T) > 1e-9:
+        raise ValueError(f"landing.duration_s ({T}) must be a multiple of landing.filter.dt_s ({Dt})")
+    dt = Dt / n_sub
+    g = np.asarray(c["gravity_mps2"], float)
+    s0 = c["initial_state"]
+    yaw = float(c.get("yaw_deg", 0.0))
+    t_imu = np.arange(n_steps * n_sub + 1) * dt
+    tr_imu = truth_states(t_imu, s0["r_m"], s0["v_mps"], T, g, yaw, c.get("terminal_accel_mps2"))
+    tr = Truth(t=tr_imu.t[::n_sub], r=tr_imu.r[::n_sub], v=tr_imu.v[::n_sub],
+               a=tr_imu.a[::n_sub], R_LtoB=tr_imu.R_LtoB[::n_sub])
+    f, w = imu.synthesize(tr_imu.v, tr_imu.R_LtoB, dt, g)
+    sa = float(c["imu"]["sigma_a_mps2"])
+    sw = math.radians(float(c["imu"]["sigma_w_degps"]))
+    pl = c["planner"]
+    pcfg = PlannerConfig(t_s=Dt, n_sigma_v=float(pl["n_sigma_v"]), tol_rad=float(pl["tol_rad"]),
+                         n_grid=int(pl["n_grid"]), margin_px=float(pl["margin_px"]),
+                         knn=int(pl["knn"]), eval_path=str(pl["eval_path"]))
+    lm = c["landmarks"]
+    b = c["mc"]["bounds"]
+    fl = c["filter"]
+    return Scenario(truth=tr, truth_imu=tr_imu, f=f, w=w, g=g, dt_imu=dt, n_sub=n_sub, Dt=Dt,
+                    n_steps=n_steps, Q=ekf.process_noise(sa, sw, dt, n_sub), sigma_a=sa, sigma_w=sw,
+                    camera=camera_from_config(c["camera"]),
+                    field=make_field(float(lm["half_width_m"]), int(lm["count"]), int(lm["seed"])),
+                    planner=pcfg, planner_alt=alternative_path(pcfg), obs_per_landmark=int(fl["obs_per_landmark"]),
+                    depth_sigma_frac=float(fl["depth_sigma_frac"]),
+                    min_update_alt=float(fl["min_update_altitude_m"]),
+                    oc=bool(fl["observability_constrained"]),
+                    iterations=int(fl["iterations"]),
+                    noise_scale=float(fl["meas_noise_scale"]),
+                    bounds=(float(b["r_m"]), float(b["v_mps"]), math.radians(float(b["att_deg"]))),
+                    base_seed=int(c["mc"]["base_seed"]))
+
+
+_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu", "camera", "landmarks",
+         "filter", "planner", "mc")
+
+
+def build_scenario(landing_cfg: dict) -> Scenario:
+    """The shared scenario of a ``landing`` config (cached per distinct config)."""
+    sub = {k: landing_cfg[k] for k in _KEYS if k in landing_cfg}
+    return _cached(json.dumps(sub, sort_keys=True))
+
+
+@lru_cache(maxsize=4)
+def _cached(text: str) -> Scenario:
+    return _scenario_from_json(text)
 
 
 def _vec(v) -> str:
@@ -20,7 +121,7 @@ def _vec(v) -> str:
 def derived_initial_attitude_deg(landing_cfg: dict) -> np.ndarray:
     """Our initial (roll, pitch, yaw), deg: body +z along the guidance thrust at
     t = 0 with the configured yaw (``opnav.landing.trajectory``)."""
-    from opnav.landing.trajectory import euler_rpy_deg, truth_states
+    from opnav.landing.trajectory import euler_rpy_deg
 
     s = landing_cfg["initial_state"]
     tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),
@@ -32,7 +133,6 @@ def derived_initial_attitude_deg(landing_cfg: dict) -> np.ndarray:
 def thrust_tilt_azimuth_deg(landing_cfg: dict) -> tuple[float, float]:
     """Initial thrust axis (body +z in {L}) as (tilt from the vertical, azimuth
     from +x toward +y), deg."""
-    from opnav.landing.trajectory import truth_states
 
     s = landing_cfg["initial_state"]
     tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),

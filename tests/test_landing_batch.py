@@ -1,0 +1,167 @@
+"""The batched descent (opnav.landing.descent.run_descents) against the frozen
+per-run descent of main before the refactor (tests/descent_reference.py), a
+run alone against the same run inside batches of other sizes and orders, and
+the batched planner's picks against the per-call planner on many planning
+states (both camera scenarios, every method)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from opnav.config import load_config
+from opnav.landing import planner as PL
+from opnav.landing.descent import run_descent, run_descents, tracking_step
+from opnav.landing.scenario import build_scenario, camera_scenarios
+
+sys.path.insert(0, str(Path(__file__).parent))
+import descent_reference as REF  # noqa: E402
+
+#: per-run outputs compared (timing aside)
+KEYS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg", "sig_yaw_deg",
+        "nees_r", "nees_v", "updated", "plan_t", "plan_beta", "plan_index", "plan_edge", "plan_ratio",
+        "plan_evals", "n_landmarks", "init_error")
+
+
+@pytest.fixture(scope="module")
+def scenarios():
+    return {name: build_scenario(c) for name, c in camera_scenarios(load_config()["landing"]).items()}
+
+
+def assert_same_run(a: dict, b: dict, rtol: float = 1e-7, atol: float = 1e-9):
+    for k in KEYS:
+        x, y = np.asarray(a[k]), np.asarray(b[k])
+        assert x.shape == y.shape, k
+        if x.dtype.kind in "bi":
+            np.testing.assert_array_equal(x, y, err_msg=k)
+        else:
+            np.testing.assert_allclose(x, y, rtol=rtol, atol=atol, err_msg=k)
+
+
+@pytest.mark.parametrize("scenario, methods", [("interior", ("depth", "svd", "logdet", "random")),
+                                                ("site-tilt", ("depth", "cond"))])
+def test_batched_descent_equals_the_per_run_reference(scenarios, scenario, methods):
+    """Two runs flown as one batch give the numbers of the pre-refactor per-run
+    descent (picks identical, states to round-off), in both camera scenarios
+    (interior: the paper's in-plane optimum; site-tilt: the edge rule)."""
+    scn = scenarios[scenario]
+    for m in methods:
+        batch = run_descents(scn, m, [3, 1])
+        for run, i in zip(batch, (3, 1)):
+            assert_same_run(run, REF.run_descent(scn, m, i))
+
+
+def test_a_run_alone_equals_the_run_inside_batches(scenarios):
+    """Batch size and order never change a run's numbers."""
+    scn = scenarios["interior"]
+    alone = run_descent(scn, "svd", 2)
+    for runs in ([2, 0], [3, 1, 0, 2]):
+        got = run_descents(scn, "svd", runs)[runs.index(2)]
+        assert_same_run(got, alone, rtol=1e-9, atol=1e-10)
+    # ...and the batch of one is run_descent itself
+    assert_same_run(run_descents(scn, "svd", [2])[0], alone, rtol=0, atol=0)
+
+
+def test_runs_differ_and_draws_follow_the_run_index(scenarios):
+    """Mutation guard: different runs (streams) give different numbers, and a
+    run's initial error is that of SeedSequence([base_seed, i]) whatever its
+    position in the batch."""
+    scn = scenarios["interior"]
+    a, b = run_descents(scn, "depth", [5, 6])
+    assert not np.allclose(a["err_r"], b["err_r"])
+    ss = np.random.SeedSequence([scn.base_seed, 6]).spawn(4)[0]
+    np.testing.assert_array_equal(b["init_error"], REF.initial_error(np.random.default_rng(ss), scn.bounds))
+
+
+def _planning_calls(scn, runs):
+    """(states, visible, exclude, detected) of every batched planning call of a
+    depth descent of ``runs``."""
+    from opnav.landing import descent as D
+
+    seen = []
+    orig = D.plan_batch
+
+    def spy(method, states, camera, field_, visible, cfg, exclude, rngs=None, detected=None, **k):
+        seen.append((states, visible, np.array(exclude), np.array(detected)))
+        return orig(method, states, camera, field_, visible, cfg, exclude, rngs, detected, **k)
+
+    D.plan_batch = spy
+    try:
+        run_descents(scn, "depth", runs)
+    finally:
+        D.plan_batch = orig
+    return seen
+
+
+@pytest.mark.parametrize("scenario", ["interior", "site-tilt"])
+def test_batched_planner_picks_equal_the_per_call_planner(scenarios, scenario):
+    """Every method of planner.available_methods(): on the planning states of a
+    batched descent (every 7th call, all runs of it), plan_batch gives the
+    landmark, optimum, edge flag, evaluation count and pick ratio of one plan()
+    call per run (site-tilt: the edge rule decides the picks; interior: the
+    depth optimum lies inside the image, the H baselines' may not)."""
+    scn = scenarios[scenario]
+    calls = _planning_calls(scn, [0, 1, 2])[::9]
+    assert len(calls) >= 4
+    n_edge = dict.fromkeys(PL.available_methods(), 0)
+    for method in PL.available_methods():
+        for states, visible, exclude, detected in calls:
+            m = len(exclude)
+            rngs = [np.random.default_rng(j) for j in range(m)]
+            got = PL.plan_batch(method, states, scn.camera, scn.field, visible, scn.planner, exclude,
+                                rngs, detected)
+            for j in range(m):
+                one = PL.PlanState(states.r[j], states.v[j], states.a[j], states.R_LtoB[j], states.P[j])
+                want = PL.plan(method, one, scn.camera, scn.field, visible, scn.planner,
+                               exclude={int(exclude[j])} if exclude[j] >= 0 else set(),
+                               rng=np.random.default_rng(j), detected=detected)
+                g = got[j]
+                assert g.index == want.index, (method, j)
+                assert g.edge == want.edge and g.n_evals == want.n_evals, (method, j)
+                np.testing.assert_allclose(g.beta, want.beta, rtol=1e-9, atol=1e-12)
+                np.testing.assert_allclose(g.pick_ratio, want.pick_ratio, rtol=1e-7)
+                n_edge[method] += want.edge
+    n_calls = sum(len(c[2]) for c in calls)
+    if scenario == "site-tilt":        # the edge rule is exercised by every search method
+        assert n_edge["depth"] >= 0.8 * n_calls
+        assert all(n_edge[m] > 0 for m in PL.OBJECTIVES)
+    else:
+        assert n_edge["depth"] == 0
+
+
+def test_golden_section_batch_runs_each_search_as_the_scalar_one():
+    """Lockstep searches with different brackets (hence iteration counts) and
+    objectives, including +inf plateaus, equal the scalar search exactly."""
+    rng = np.random.default_rng(3)
+    lo = rng.uniform(-2, 0, 40)
+    hi = lo + rng.uniform(1e-4, 3, 40)
+    mid = rng.uniform(-2, 1, 40)
+
+    def f1(i, x):
+        return np.where(x < mid[i] - 0.5, np.inf, (x - mid[i]) ** 2 + 0.1 * np.sin(7 * x))
+
+    x, fx, n = PL.golden_section_batch(f1, lo, hi, 1e-3)
+    for q in range(40):
+        xs, fs, ns = PL.golden_section(lambda t, q=q: float(f1(np.array([q]), np.array([t]))[0]),
+                                       lo[q], hi[q], 1e-3)
+        assert (x[q], fx[q], n[q]) == (xs, fs, ns)
+    assert len(set(n.tolist())) > 3                  # the searches really differ in length
+    with pytest.raises(ValueError):
+        PL.golden_section_batch(f1, [1.0], [0.0], 1e-3)
+
+
+def test_tracking_step_is_the_fig3_strategy():
+    """Known answers: plan when none / observed enough / left the image, unless
+    the image holds no other landmark (keep it while seen, else drop it)."""
+    cur = np.array([-1, 5, 5, 5, 5, 5])
+    n_obs = np.array([0, 1, 3, 1, 3, 1])
+    still = np.array([False, True, True, False, True, False])
+    other = np.array([True, True, True, True, False, False])
+    plan_, observe, cur2, n2 = tracking_step(cur, n_obs, still, other, 3)
+    np.testing.assert_array_equal(plan_, [True, False, True, True, False, False])
+    np.testing.assert_array_equal(observe, [False, True, False, False, True, False])
+    np.testing.assert_array_equal(cur2, [-1, 5, 5, 5, 5, -1])
+    np.testing.assert_array_equal(n2, [0, 2, 3, 1, 4, 0])
