@@ -48,7 +48,7 @@ import numpy as np
 __all__ = ["depth", "depth_error", "PlaneGeometry", "plane_geometry", "signed_alpha",
            "signed_depth_error", "ground_point", "baseline", "error_radius", "max_eig_sym3",
            "angles_to_landmarks", "depth_error_at_landmarks", "depth_error_in_plane",
-           "depth_error_of_points"]
+           "depth_error_of_points", "error_radius_batch"]
 
 
 def _check_positive(name: str, x: float) -> float:
@@ -239,18 +239,28 @@ def depth_error_in_plane(beta_signed, gamma, cd, b, r_e) -> np.ndarray:
 
 
 def depth_error_of_points(points, C, v_hat, b, r_e) -> np.ndarray:
-    """Depth error (m, eq. 23-25) of ground points ``points`` (..., n, 3) seen from
-    C (..., 3) moving along ``v_hat`` (..., 3), baseline ``b`` (...,) m, error
-    radius ``r_e`` (...,) m: for a given landmark the depth of eq. 25 is its
-    range ``|p - C|``, so ``dr = 2 r_e |r^(k+s)| / (b sin beta)``; ``+inf`` at
-    beta = 0 and for points not below C."""
-    C = np.asarray(C, float)[..., None, :]
-    lc = np.asarray(points, float) - C
-    rho = np.sqrt(np.einsum("...ij,...ij->...i", lc, lc))
-    cb = np.clip(np.einsum("...ij,...j->...i", lc, np.asarray(v_hat, float)) / rho, -1.0, 1.0)
+    """Depth error (m, eq. 23-25) of ground points ``points`` (n, 3) seen from each
+    of m lander positions C (m, 3) moving along ``v_hat`` (m, 3), baselines ``b``
+    (m,) m, error radii ``r_e`` (m,) m; returns (m, n). For a given landmark the
+    depth of eq. 25 is its range ``|p - C|``, so ``dr = 2 r_e |r^(k+s)| / (b sin
+    beta)``; ``+inf`` at beta = 0 and for points not below C."""
+    p = np.asarray(points, float)
+    C = np.asarray(C, float)
+    lc = p[None, :, :] - C[:, None, :]
+    rho = np.sqrt(np.einsum("mij,mij->mi", lc, lc))
+    cb = np.clip((lc @ np.asarray(v_hat, float)[:, :, None])[..., 0] / rho, -1.0, 1.0)
     sb = np.sqrt(1.0 - cb * cb)
-    b = np.asarray(b, float)[..., None]
+    b = np.asarray(b, float)[:, None]
     rk = np.sqrt(np.maximum(b * b + rho * rho - 2.0 * b * rho * cb, 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
-        out = (2.0 * np.asarray(r_e, float)[..., None] / b) * rk / sb
-    return np.where((sb > 0) & (np.asarray(points)[..., 2] < C[..., 2]), out, np.inf)
+        out = (2.0 * np.asarray(r_e, float)[:, None] / b) * rk / sb
+    return np.where((sb > 0) & (p[None, :, 2] < C[:, None, 2]), out, np.inf)
+
+
+def error_radius_batch(P_vv: np.ndarray, t_s: float, n_sigma: float) -> np.ndarray:
+    """:func:`error_radius` (m, eq. 22) for a stack of velocity covariances
+    (..., 3, 3): ``n_sigma sqrt(largest eigenvalue) t_s`` (LAPACK eigenvalues;
+    the same as the closed form to round-off)."""
+    P = np.asarray(P_vv, float)
+    lam = np.linalg.eigvalsh(0.5 * (P + np.swapaxes(P, -1, -2)))[..., -1]
+    return n_sigma * np.sqrt(np.maximum(lam, 0.0)) * t_s

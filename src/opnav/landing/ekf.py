@@ -56,15 +56,16 @@ __all__ = ["NavState", "transition_matrix", "oc_transition", "process_noise", "p
            "update", "init_landmark", "inject", "nullspace", "init_jacobian", "Bearing"]
 
 N_X = 12
-_EPS = np.zeros((3, 3, 3))
-_EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
-_EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 
 
 def _skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrices ``[a x]`` (..., 3, 3) of vectors (..., 3) (exact:
-    every entry is 0 or +-a_k)."""
-    return np.einsum("ijk,...k->...ij", -_EPS, a)
+    """Cross-product matrices ``[a x]`` (..., 3, 3) of vectors (..., 3)."""
+    a = np.asarray(a, float)
+    S = np.zeros(a.shape[:-1] + (3, 3))
+    x, y, z = a[..., 0], a[..., 1], a[..., 2]
+    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -z, y, -x
+    S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = z, -y, x
+    return S
 
 
 def _T(A: np.ndarray) -> np.ndarray:
@@ -280,10 +281,13 @@ def update(st: NavState, meas: list[Bearing], sigma_b: float,
         H_k, res = _linearise(it, meas, N)
         PHt = st.P @ _T(H_k)
         S = H_k @ PHt + Rn
-        K_k = _T(np.linalg.solve(S, _T(PHt)))
-        if k == 0:
-            nis = np.einsum("...i,...i->...", res, np.linalg.solve(S, res[..., None])[..., 0])
+        if k == 0:         # one solve for the gain and the NIS
+            X = np.linalg.solve(S, np.concatenate([_T(PHt), res[..., None]], axis=-1))
+            K_k = _T(X[..., :N_X])
+            nis = np.einsum("...i,...i->...", res, X[..., N_X])
             K, H = K_k, H_k
+        else:
+            K_k = _T(np.linalg.solve(S, _T(PHt)))
         delta_new = _mv(K_k, res + _mv(H_k, delta))
         g = going[..., None]
         K = np.where(g[..., None], K_k, K)

@@ -622,8 +622,8 @@ def _ground_points(beta, C, v_hat, w_hat, cd, gamma) -> tuple[np.ndarray, np.nda
 
 class _Contexts:
     """The H baselines' per-run context (lander, attitude, known landmark) of a
-    batch, for evaluating many candidates of many runs at once (the metrics
-    module's formulas: eq. 14-18 and its closed-form singular values)."""
+    batch, for evaluating many candidates of many runs at once by the metrics
+    module's closed-form structural singular values of H (eq. 14-18)."""
 
     def __init__(self, states: PlanState, cfg: PlannerConfig, camera: Camera):
         from opnav.landing.metrics import MetricContext
@@ -660,34 +660,6 @@ class _Contexts:
             s2 = np.einsum("...k,...k->...", cr, cr)
             sc = _scores_from_sq(name, *_structural_sq(self.x[i], 1.0 / rho2, cg, s2))
         return np.where(ok, sc, -np.inf)
-
-    def explicit(self, name: str, i, pts) -> np.ndarray:
-        """The same metric by the explicit H (eq. 14-18) and its singular values
-        (LAPACK), one candidate per run ``i`` (pts (m, 3))."""
-        from opnav.landing.ekf import bearing_jacobian
-        from opnav.landing.metrics import PINV_RCOND, STRUCTURAL_RANK
-
-        d2, rho2, ok = self._valid(i, pts)
-        out = np.full(len(pts), -np.inf)
-        if not ok.any():
-            return out
-        i, pts = i[ok], pts[ok]
-        r, R = self.r[i], self.R[i]
-        H = np.zeros((len(i), 6, 12))
-        Hr, Ht, _ = bearing_jacobian(r, R, np.broadcast_to(self.p_known, r.shape))
-        H[:, 0:3, 0:3], H[:, 0:3, 6:9] = Hr, Ht
-        Hr, Ht, Hp = bearing_jacobian(r, R, pts)
-        H[:, 3:6, 0:3], H[:, 3:6, 6:9], H[:, 3:6, 9:12] = Hr, Ht, Hp
-        sv = np.linalg.svd(H, compute_uv=False)
-        s4 = sv[:, STRUCTURAL_RANK - 1]
-        if name == "svd":
-            out[ok] = s4
-        elif name == "cond":
-            out[ok] = s4 / sv[:, 0]
-        else:
-            keep = sv > PINV_RCOND * sv[:, :1]
-            out[ok] = 1.0 / np.sum(np.where(keep, 1.0 / np.where(keep, sv * sv, 1.0), 0.0), axis=1)
-        return out
 
 
 def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkField,
@@ -733,30 +705,36 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
     if build is None:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
     notes = [""] * m
-    geoms: list = [None] * m
-    funs: list = [None] * m
-    owner, lo, hi = [], [], []
-    for j in range(m):
+    G = _planes(states.r, states.v)
+    for j in np.flatnonzero(~G["ok"]):          # the scalar raises the documented reason
         try:
-            geom = plane_geometry(states.r[j], states.v[j])
-            ivs = visible_intervals(geom, states.R_LtoB[j], camera, cfg.n_grid, cfg.margin_px)
-            if ivs:
-                funs[j] = build(state=one(j), geom=geom, cfg=cfg, camera=camera, sigma_b=camera.sigma_b)
-                geoms[j] = geom
-                for a, b in ivs:
-                    owner.append(j)
-                    lo.append(a)
-                    hi.append(b)
-            else:
-                notes[j] = "no visible interval"
+            plane_geometry(states.r[j], states.v[j])
         except ValueError as exc:
             if "depth error" not in str(exc):
                 raise
             notes[j] = str(exc)
-    searched = np.array([g is not None for g in geoms])
-    G = _plane_arrays(geoms, searched)
+    owner, lo, hi = _intervals(G, states.R_LtoB, camera, cfg)
+    searched = np.zeros(m, bool)
+    searched[owner] = True
+    for j in np.flatnonzero(G["ok"] & ~searched):
+        notes[j] = "no visible interval"
+    funs = _LazyObjectives(build, one, G, cfg, camera)
+    if method == "depth":
+        G["b"], G["r_e"] = _depth_constants(states, cfg)
+        for j in np.flatnonzero(searched & ~(G["b"] > 0)):
+            try:                                # zero baseline: the objective says why
+                funs[j]
+            except ValueError as exc:
+                if "depth error" not in str(exc):
+                    raise
+                notes[j] = str(exc)
+                searched[j] = False
+        keep = searched[owner]
+        owner, lo, hi = owner[keep], lo[keep], hi[keep]
+    elif method not in _VECTORISED and owner.size:
+        for j in np.flatnonzero(searched):
+            funs[j]                             # build now (errors as the per-call planner)
     evaluate = _batch_objective(method, states, G, cfg, camera, funs)
-    owner = np.asarray(owner, np.int64)
     best_x = np.full(m, math.nan)
     best_f = np.full(m, math.inf)
     best_a = np.full(m, math.nan)
@@ -797,7 +775,7 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
                                             / np.maximum(-bs[:, 2], 1e-3))[:, None]
         pick[need] = _pick_nearest_batch(field_, point[need], visible, cfg.knn, exclude[need])
     if diagnose:
-        _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, candmask)
+        _pick_ratios(method, pick, vals, funs, searched, states, G, cfg, camera, pts, det, candmask)
     out = []
     for j in range(m):
         if found[j]:
@@ -813,44 +791,129 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
     return out
 
 
-def _plane_arrays(geoms, searched) -> dict:
-    m = len(geoms)
-    G = {"C": np.full((m, 3), math.nan), "v_hat": np.full((m, 3), math.nan),
-         "w_hat": np.full((m, 3), math.nan), "cd": np.full(m, math.nan),
-         "gamma": np.full(m, math.nan)}
-    for j in np.flatnonzero(searched):
-        g = geoms[j]
-        G["C"][j], G["v_hat"][j], G["w_hat"][j] = g.C, g.v_hat, g.w_hat
-        G["cd"][j], G["gamma"][j] = g.cd, g.gamma
-    return G
+class _LazyObjectives:
+    """Per run, the per-call planner's objective (``OBJECTIVES[method]``), built
+    on first use: the batched paths need it only for some runs."""
+
+    def __init__(self, build, state_of, G, cfg, camera):
+        self._build, self._state_of, self._G, self._cfg, self._camera = build, state_of, G, cfg, camera
+        self._funs: dict = {}
+
+    def __getitem__(self, j):
+        j = int(j)
+        if j not in self._funs:
+            G = self._G
+            geom = PlaneGeometry(C=G["C"][j], v_hat=G["v_hat"][j], w_hat=G["w_hat"][j],
+                                 cd=float(G["cd"][j]), gamma=float(G["gamma"][j]))
+            self._funs[j] = self._build(state=self._state_of(j), geom=geom, cfg=self._cfg,
+                                        camera=self._camera, sigma_b=self._camera.sigma_b)
+        return self._funs[j]
+
+    def ratio(self, j):
+        """The method's pick-ratio rule (the same for every run)."""
+        fun = next(iter(self._funs.values())) if self._funs else self[j]
+        return fun.ratio
 
 
-def _depth_constants(states, G, cfg, rows):
-    """Per run: baseline (eq. 19) and error radius (eq. 22) of the depth objective."""
-    from opnav.landing.depth_error import error_radius
+def _planes(r: np.ndarray, v: np.ndarray) -> dict:
+    """:func:`~opnav.landing.depth_error.plane_geometry` for many runs (the same
+    arithmetic): arrays C, v_hat, w_hat (m, 3), cd, gamma (m,) and ``ok`` (m,),
+    False where the scalar function raises (zero velocity, lander not above
+    the ground, velocity not descending)."""
+    sp = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+    ok = np.isfinite(sp) & (sp >= 1e-9) & (r[:, 2] > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = v / sp[:, None]
+        ok &= a[:, 2] < 0
+        nh = np.hypot(a[:, 0], a[:, 1])
+        vert = nh < 1e-9                         # vertical velocity: the plane through {L} +x
+        h0 = np.where(vert, 1.0, a[:, 0] / nh)
+        h1 = np.where(vert, 0.0, a[:, 1] / nh)
+        hv = h0 * a[:, 0] + h1 * a[:, 1]
+        w = np.stack([h0 - hv * a[:, 0], h1 - hv * a[:, 1], -hv * a[:, 2]], axis=1)
+        nw = np.sqrt(w[:, 0] * w[:, 0] + w[:, 1] * w[:, 1] + w[:, 2] * w[:, 2])
+        return {"C": r.copy(), "v_hat": a, "w_hat": w / nw[:, None], "cd": r[:, 2] / -a[:, 2],
+                "gamma": np.arcsin(np.minimum(1.0, -a[:, 2])), "ok": ok}
 
-    b = np.array([baseline(states.v[j], states.a[j], cfg.t_s) for j in rows])
-    r_e = np.array([error_radius(states.P[j, 3:6, 3:6], cfg.t_s, cfg.n_sigma_v) for j in rows])
-    return b, r_e
+
+def _intervals(G: dict, R_LtoB: np.ndarray, camera: Camera, cfg: PlannerConfig):
+    """The visible sub-intervals of every run with a plane (``G["ok"]``), in the
+    per-run order of :func:`visible_intervals`: (owner run, lo, hi) arrays."""
+    rows = np.flatnonzero(G["ok"])
+    if cfg.n_grid > 0:                           # reference grid path: run by run
+        owner, lo, hi = [], [], []
+        for j in rows:
+            geom = PlaneGeometry(C=G["C"][j], v_hat=G["v_hat"][j], w_hat=G["w_hat"][j],
+                                 cd=float(G["cd"][j]), gamma=float(G["gamma"][j]))
+            for a, b in visible_intervals(geom, R_LtoB[j], camera, cfg.n_grid, cfg.margin_px):
+                owner.append(j)
+                lo.append(a)
+                hi.append(b)
+        return np.asarray(owner, np.int64), np.asarray(lo, float), np.asarray(hi, float)
+    k = (camera.half_px - cfg.margin_px) / camera.focal_px
+    if k <= 0 or not rows.size:
+        return np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
+    M = camera.R_BtoC @ R_LtoB[rows]
+    A = np.einsum("mij,mj->mi", M, G["v_hat"][rows])
+    Cc = np.einsum("mij,mj->mi", M, G["w_hat"][rows])
+    gamma = G["gamma"][rows]
+    pi = math.pi
+    phis = np.stack([np.arctan2(k * Cc[:, 2] - Cc[:, 0], k * A[:, 2] - A[:, 0]),
+                     np.arctan2(k * Cc[:, 2] + Cc[:, 0], k * A[:, 2] + A[:, 0]),
+                     np.arctan2(k * Cc[:, 2] - Cc[:, 1], k * A[:, 2] - A[:, 1]),
+                     np.arctan2(k * Cc[:, 2] + Cc[:, 1], k * A[:, 2] + A[:, 1]),
+                     gamma - pi / 2], axis=1)
+    phis.sort(axis=1)
+    gaps = np.concatenate([np.diff(phis, axis=1), (phis[:, 0] + 2 * pi - phis[:, 4])[:, None]], axis=1)
+    j = np.argmax(gaps, axis=1)
+    fits = gaps[np.arange(rows.size), j] > pi          # else the centres do not fit in a half circle
+    start = (j + 1) % 5
+    # rotate to start at `start`; the wrapped centres get one turn (unwrap into one window)
+    pos = (start[:, None] + np.arange(5)[None, :]) % 5
+    un = np.take_along_axis(phis, pos, axis=1)
+    un = np.where(pos < start[:, None], un + 2 * pi, un)
+    b0, b1 = un[:, -1] - pi / 2, un[:, 0] + pi / 2
+    mid = 0.5 * (b0 + b1)
+    shift = 2 * pi * np.round((gamma - pi / 2 - mid) / (2 * pi))
+    b0, b1 = b0 + shift + 1e-12, b1 + shift - 1e-12
+    eps = 1e-9
+    neg_lo, neg_hi = b0, np.minimum(b1, -eps)
+    pos_lo, pos_hi = np.maximum(b0, eps), b1
+    has_neg = fits & (b0 < 0) & (neg_hi > neg_lo)
+    has_pos = fits & (b1 > 0) & (pos_hi > pos_lo)
+    owner = np.concatenate([rows[has_neg], rows[has_pos]])
+    lo = np.concatenate([neg_lo[has_neg], pos_lo[has_pos]])
+    hi = np.concatenate([neg_hi[has_neg], pos_hi[has_pos]])
+    order = np.argsort(owner, kind="stable")            # per run: the negative side first
+    return owner[order], lo[order], hi[order]
+
+
+def _depth_constants(states, cfg) -> tuple[np.ndarray, np.ndarray]:
+    """Per run: baseline (m, eq. 19) and error radius (m, eq. 22) of the depth
+    objective, for all runs at once."""
+    from opnav.landing.depth_error import error_radius_batch
+
+    h = 0.5 * cfg.t_s * cfg.t_s
+    bvec = states.v * cfg.t_s + states.a * h
+    b = np.sqrt(np.einsum("bi,bi->b", bvec, bvec))
+    return b, error_radius_batch(states.P[:, 3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
 
 
 def _batch_objective(method, states, G, cfg, camera, funs) -> Callable:
     """``f(runs (n,), beta (n,)) -> (n,)``: the method's objective (minimised) at
     signed beta in each run's plane, for many runs at once."""
-    m = len(funs)
     if method == "depth":
-        b, r_e = np.full(m, math.nan), np.full(m, math.nan)
-        rows = [j for j in range(m) if funs[j] is not None]
-        if rows:
-            b[rows], r_e[rows] = _depth_constants(states, G, cfg, rows)
         from opnav.landing.depth_error import depth_error_in_plane
 
-        return lambda i, beta: depth_error_in_plane(beta, G["gamma"][i], G["cd"][i], b[i], r_e[i])
+        return lambda i, beta: depth_error_in_plane(beta, G["gamma"][i], G["cd"][i], G["b"][i],
+                                                    G["r_e"][i])
     from opnav.landing.metrics import H_METRICS
 
     if method in H_METRICS:
-        ctx = _Contexts(states, cfg, camera)
-        score = ctx.closed_form if cfg.eval_path == "closed_form" else ctx.explicit
+        # the closed-form structural singular values of H (metrics module): the
+        # explicit H + LAPACK path's values to ~1e-12 relative, at a fraction of
+        # the cost (the per-call planner keeps the configured eval_path)
+        score = _Contexts(states, cfg, camera).closed_form
 
         def f(i, beta):
             p, ok = _ground_points(beta, G["C"][i], G["v_hat"][i], G["w_hat"][i], G["cd"][i],
@@ -864,6 +927,8 @@ def _batch_objective(method, states, G, cfg, camera, funs) -> Callable:
     return lambda i, beta: np.array([funs[j](float(x)) for j, x in zip(i, beta)])
 
 
+#: objectives evaluated for many runs at once by :func:`_batch_objective`
+_VECTORISED = ("depth", "svd", "gdop", "cond")
 _SHORTLIST_RTOL = 1e-6      # candidates this close to the closed-form best get the explicit path
 _AGREE_RTOL = 1e-7          # closed form vs explicit path on the shortlist, else all explicit
 
@@ -876,10 +941,9 @@ def _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask):
 
     out_v, out_p = [], []
     if method == "depth":
-        b, r_e = _depth_constants(states, G, cfg, ie)
         from opnav.landing.depth_error import depth_error_of_points
 
-        allv = depth_error_of_points(pts[None], G["C"][ie], G["v_hat"][ie], b, r_e)
+        allv = depth_error_of_points(pts, G["C"][ie], G["v_hat"][ie], G["b"][ie], G["r_e"][ie])
         for q, j in enumerate(ie):
             pp = np.flatnonzero(candmask[j])
             out_v.append(allv[q, pp])
@@ -931,7 +995,7 @@ def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, visible: Call
     return out
 
 
-def _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, candmask) -> None:
+def _pick_ratios(method, pick, vals, funs, searched, states, G, cfg, camera, pts, det, candmask) -> None:
     """Per run: the picked landmark's score over the best detected one's
     (``fun.ratio``), from the edge scores where the edge rule computed them,
     else every detected landmark scored by the method's fastest path; written
@@ -939,7 +1003,7 @@ def _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, can
     from opnav.landing.metrics import H_METRICS
 
     m = len(pick)
-    todo = [j for j in range(m) if funs[j] is not None and pick[j] >= 0 and candmask[j].any()]
+    todo = [j for j in range(m) if searched[j] and pick[j] >= 0 and candmask[j].any()]
     fresh = [j for j in todo if vals[j] is None]
     scores = {}
     if fresh:
@@ -947,8 +1011,8 @@ def _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, can
         if method == "depth":
             from opnav.landing.depth_error import depth_error_of_points
 
-            b, r_e = _depth_constants(states, G, cfg, rows)
-            allv = depth_error_of_points(pts[None], G["C"][rows], G["v_hat"][rows], b, r_e)
+            allv = depth_error_of_points(pts, G["C"][rows], G["v_hat"][rows], G["b"][rows],
+                                         G["r_e"][rows])
         elif method in H_METRICS:
             allv = -_Contexts(states, cfg, camera).closed_form(method, rows[:, None], pts[None])
         else:
@@ -968,7 +1032,7 @@ def _pick_ratios(method, pick, vals, funs, states, G, cfg, camera, pts, det, can
         if fin.any():
             hit = np.flatnonzero(det[pp] == pick[j])
             f_pick = v[hit[0]] if hit.size else math.nan
-            vals[j] = float(funs[j].ratio(f_pick, float(v[fin].min())))
+            vals[j] = float(funs.ratio(j)(f_pick, float(v[fin].min())))
     for j in range(m):
         if not isinstance(vals[j], float):
             vals[j] = None

@@ -1,0 +1,107 @@
+"""Descent throughput of paper B's Monte Carlo: descents per CPU-second
+(time.process_time) of the same runs flown one at a time (batch size 1) and
+as batches of the default size (landing.mc.batch_size; 0 = the whole chunk,
+here all runs at once), per camera scenario and planning method, in one
+process; also the pre-refactor per-run descent (tests/descent_reference.py)
+on the same runs, and a check that the batched numbers equal the per-run ones.
+
+    PYTHONPATH=src python benchmarks/bench_descent.py [--runs 50] [--methods depth,svd]
+        [--scenarios interior,site-tilt] [--batch N] [--no-reference]
+
+The last line reads ``batch speedup: X``: total descents per CPU-second at the
+default batch size over the same at batch size 1 (all cells pooled).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "src"))
+sys.path.insert(0, str(REPO / "tests"))
+
+from opnav.config import load_config  # noqa: E402
+from opnav.landing.descent import run_descents  # noqa: E402
+from opnav.landing.scenario import build_scenario, camera_scenarios  # noqa: E402
+
+
+def fly(scn, method, runs, batch):
+    size = len(runs) if batch <= 0 else batch
+    t0 = time.process_time()
+    out = []
+    for a in range(0, len(runs), size):
+        out.extend(run_descents(scn, method, runs[a:a + size]))
+    return out, time.process_time() - t0
+
+
+def max_rel_diff(a, b) -> float:
+    worst = 0.0
+    for x, y in zip(a, b):
+        for k in ("err_r", "err_v", "sig_r", "plan_beta"):
+            u, v = np.asarray(x[k], float), np.asarray(y[k], float)
+            if u.shape != v.shape:
+                return np.inf
+            fin = np.isfinite(v)
+            worst = max(worst, float(np.max(np.abs(u[fin] - v[fin]) / (1e-9 + np.abs(v[fin])), initial=0)))
+        if not np.array_equal(x["plan_index"], y["plan_index"]):
+            return np.inf
+    return worst
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--runs", type=int, default=50)
+    ap.add_argument("--methods", default="depth,svd")
+    ap.add_argument("--scenarios", default="interior,site-tilt")
+    ap.add_argument("--batch", type=int, default=None,
+                    help="batched size (default landing.mc.batch_size; 0 = all runs)")
+    ap.add_argument("--no-reference", action="store_true", help="skip the pre-refactor per-run code")
+    args = ap.parse_args(argv)
+    cfg = load_config()["landing"]
+    batch = int(cfg["mc"]["batch_size"]) if args.batch is None else args.batch
+    runs = list(range(args.runs))
+    scns = camera_scenarios(cfg)
+    ref = None
+    if not args.no_reference:
+        import descent_reference as ref
+    print(f"{len(runs)} runs per cell; batched size {batch or len(runs)} "
+          f"({'landing.mc.batch_size' if args.batch is None else '--batch'} = {batch}); CPU s = process_time")
+    print(f"{'scenario':10s} {'method':7s} {'per-run ref':>12s} {'batch 1':>10s} {'batched':>10s} "
+          f"{'x vs 1':>7s} {'x vs ref':>8s} {'max rel diff':>12s}   (descents per CPU-second)")
+    tot = {"1": 0.0, "b": 0.0, "ref": 0.0}
+    n_cells = 0
+    for name in args.scenarios.split(","):
+        scn = build_scenario(scns[name])
+        for m in args.methods.split(","):
+            run_descents(scn, m, [0, 1])                          # warm caches / imports
+            one, t1 = fly(scn, m, runs, 1)
+            bat, tb = fly(scn, m, runs, batch)
+            diff = max_rel_diff(bat, one)
+            tr = np.nan
+            if ref is not None:
+                t0 = time.process_time()
+                refr = [ref.run_descent(scn, m, i) for i in runs]
+                tr = time.process_time() - t0
+                diff = max(diff, max_rel_diff(bat, refr))
+                tot["ref"] += tr
+            tot["1"] += t1
+            tot["b"] += tb
+            n_cells += 1
+            n = len(runs)
+            print(f"{name:10s} {m:7s} {n / tr:12.1f} {n / t1:10.1f} {n / tb:10.1f} {t1 / tb:7.1f} "
+                  f"{tr / tb:8.1f} {diff:12.2e}", flush=True)
+    n = len(runs) * n_cells
+    print(f"all cells: per-run reference {n / tot['ref']:.1f}, batch 1 {n / tot['1']:.1f}, "
+          f"batched {n / tot['b']:.1f} descents per CPU-second; batched vs per-run reference "
+          f"{tot['ref'] / tot['b']:.1f}x")
+    print(f"batch speedup: {tot['1'] / tot['b']:.1f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
