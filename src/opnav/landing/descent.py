@@ -252,9 +252,10 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             has = cur >= 0
             still = np.zeros(B, bool)
             still[has] = visible(field_xyz[cur[has]], 0.0)
-            det = visible(field_xyz)               # the image's feature list (truth pose)
-            n_det = int(det.sum())
-            other = n_det - np.where(has, det[np.maximum(cur, 0)], False) > 0
+            other = np.zeros(B, bool)
+            if (act & tracking_step(cur, n_obs, still, ~other, scn.obs_per_landmark)[0]).any():
+                det = visible(field_xyz)           # the image's feature list (truth pose)
+                other = int(det.sum()) - np.where(has, det[np.maximum(cur, 0)], False) > 0
             need, observe, cur_new, n_obs_new = tracking_step(cur, n_obs, still, other,
                                                               scn.obs_per_landmark)
             need &= act

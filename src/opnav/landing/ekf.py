@@ -50,6 +50,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 
 __all__ = ["NavState", "transition_matrix", "oc_transition", "process_noise", "propagate",
@@ -190,16 +191,10 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
 
 
 def _exp_so3(phi: np.ndarray) -> np.ndarray:
-    """Rotation matrices (..., 3, 3) of rotation vectors (..., 3), Rodrigues."""
-    th2 = np.einsum("...i,...i->...", phi, phi)
-    K = _skew(phi)
-    KK = K @ K
-    small = th2 < 1e-16
-    th = np.sqrt(th2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = np.where(small, 1.0, np.sin(th) / th)
-        b = np.where(small, 0.5, (1.0 - np.cos(th)) / th2)
-    return np.eye(3) + a[..., None, None] * K + b[..., None, None] * KK
+    """Rotation matrices (..., 3, 3) of rotation vectors (..., 3) rad (the
+    active rotation of ``measurement.exp_so3``, batched by scipy)."""
+    phi = np.asarray(phi, float)
+    return Rotation.from_rotvec(phi.reshape(-1, 3)).as_matrix().reshape(phi.shape[:-1] + (3, 3))
 
 
 def inject(st: NavState, dx: np.ndarray) -> None:

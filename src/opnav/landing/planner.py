@@ -1017,15 +1017,23 @@ def _pick_ratios(method, pick, vals, funs, searched, states, G, cfg, camera, pts
             allv = -_Contexts(states, cfg, camera).closed_form(method, rows[:, None], pts[None])
         else:
             allv = None
-        for q, j in enumerate(fresh):
-            pp = np.flatnonzero(candmask[j])
-            if allv is not None:
-                v = allv[q, pp]
-            else:
+        if allv is not None:          # all runs at once: the best candidate and the pick's score
+            fin = np.isfinite(allv) & candmask[rows]
+            best = np.min(np.where(fin, allv, np.inf), axis=1)
+            at = np.minimum(np.searchsorted(det, pick[rows]), det.size - 1)
+            ok = (det[at] == pick[rows]) & candmask[rows, at]
+            f_pick = np.where(ok, allv[np.arange(rows.size), at], np.nan)
+            has = fin.any(axis=1)
+            for q, j in enumerate(fresh):
+                vals[j] = float(funs.ratio(j)(f_pick[q], best[q])) if has[q] else None
+        else:
+            for j in fresh:
+                pp = np.flatnonzero(candmask[j])
                 fun = funs[j]
-                v = getattr(fun, "diagnostic", fun.batch)(pts[pp])
-            scores[j] = (v, pp)
+                scores[j] = (getattr(fun, "diagnostic", fun.batch)(pts[pp]), pp)
     for j in todo:
+        if isinstance(vals[j], float) or (vals[j] is None and j not in scores):
+            continue
         v, pp = vals[j] if vals[j] is not None else scores[j]
         vals[j] = None
         fin = np.isfinite(v)
