@@ -61,6 +61,11 @@ def test_a_run_alone_equals_the_run_inside_batches(scenarios):
     for runs in ([2, 0], [3, 1, 0, 2]):
         got = run_descents(scn, "svd", runs)[runs.index(2)]
         assert_same_run(got, alone, rtol=1e-9, atol=1e-10)
+        # the recorded planning inputs (timing replay) too
+        for k in ("plan_step", "plan_exclude", "plan_rng"):
+            np.testing.assert_array_equal(got[k], alone[k], err_msg=k)
+        for k in ("plan_r", "plan_v", "plan_a", "plan_R", "plan_P"):
+            np.testing.assert_allclose(got[k], alone[k], rtol=1e-9, atol=1e-10, err_msg=k)
     # ...and the batch of one is run_descent itself
     assert_same_run(run_descents(scn, "svd", [2])[0], alone, rtol=0, atol=0)
 

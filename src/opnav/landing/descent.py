@@ -61,7 +61,11 @@ Returned per run: errors (truth - estimate) of position, velocity (m, m/s),
 attitude (small-angle ``dtheta`` and roll/pitch/yaw differences, deg) at the
 filter times, 1-sigma of the filter, position and velocity NEES, and per
 planning call its time, optimum, pick, edge flag, pick ratio and evaluation
-count.
+count, and everything ``planner.plan`` took, to replay the call exactly
+(``opnav.landing.timing``): the filter step (the truth pose, hence the
+detected landmarks, follows from the scenario), the estimate (r, v, a,
+R_LtoB, P), the excluded current landmark (-1: none) and the picker stream's
+state.
 """
 
 from __future__ import annotations
@@ -72,6 +76,7 @@ from opnav.landing import ekf, imu
 from opnav.landing.metrics import H_METRICS, MetricContext
 from opnav.landing.planner import PlanState, plan, plan_batch
 from opnav.landing.scenario import Scenario, build_scenario
+from opnav.landing.timing import RECORD_KEYS, record_plan_inputs, stack_plan_inputs
 from opnav.landing.trajectory import euler_rpy_deg
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
@@ -206,6 +211,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     nees_v = np.empty((B, n + 1))
     updated = np.zeros((B, n + 1), bool)
     plans = [{k: [] for k in PLAN_KEYS} for _ in range(B)]
+    recs = [{k: [] for k in RECORD_KEYS} for _ in range(B)]     # planning inputs (timing.replay)
     cur = np.full(B, -1, np.int64)
     n_obs = np.zeros(B, np.int64)
     n_used = np.zeros(B, np.int64)
@@ -264,6 +270,9 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             n_obs = np.where(act, n_obs_new, n_obs)
             ip = np.flatnonzero(need)
             if ip.size:
+                for b in ip:
+                    record_plan_inputs(recs[b], k, st.r[b], st.v[b], a_est[b], st.R[b], st.P[b],
+                                       cur[b], rng_pick[b])
                 states = PlanState(st.r[ip], st.v[ip], a_est[ip], st.R[ip], st.P[ip])
                 res = _plan_runs(scn, method, states, visible, cur[ip], [rng_pick[b] for b in ip],
                                  np.flatnonzero(det), timed=B == 1)
@@ -321,6 +330,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             "n_landmarks": int(n_used[b]), "init_error": e0[b],
         }
         d.update({k: np.asarray(v, _PLAN_DTYPES[k]) for k, v in plans[b].items()})
+        d.update(stack_plan_inputs(recs[b]))
         out.append(d)
     return out
 
