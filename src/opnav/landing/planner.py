@@ -713,7 +713,14 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
             if "depth error" not in str(exc):
                 raise
             notes[j] = str(exc)
-    owner, lo, hi = _intervals(G, states.R_LtoB, camera, cfg)
+    if method not in _VECTORISED:
+        # objectives evaluated run by run: the per-call planner's own geometry, so
+        # that flat objectives (mineig's plateau, decided by rounding) pick alike
+        for j in np.flatnonzero(G["ok"]):
+            g = plane_geometry(states.r[j], states.v[j])
+            G["C"][j], G["v_hat"][j], G["w_hat"][j], G["cd"][j], G["gamma"][j] = (
+                g.C, g.v_hat, g.w_hat, g.cd, g.gamma)
+    owner, lo, hi = _intervals(G, states.R_LtoB, camera, cfg, scalar=method not in _VECTORISED)
     searched = np.zeros(m, bool)
     searched[owner] = True
     for j in np.flatnonzero(G["ok"] & ~searched):
@@ -836,11 +843,13 @@ def _planes(r: np.ndarray, v: np.ndarray) -> dict:
                 "gamma": np.arcsin(np.minimum(1.0, -a[:, 2])), "ok": ok}
 
 
-def _intervals(G: dict, R_LtoB: np.ndarray, camera: Camera, cfg: PlannerConfig):
+def _intervals(G: dict, R_LtoB: np.ndarray, camera: Camera, cfg: PlannerConfig,
+               scalar: bool = False):
     """The visible sub-intervals of every run with a plane (``G["ok"]``), in the
-    per-run order of :func:`visible_intervals`: (owner run, lo, hi) arrays."""
+    per-run order of :func:`visible_intervals`: (owner run, lo, hi) arrays
+    (``scalar``: by :func:`visible_intervals` run by run)."""
     rows = np.flatnonzero(G["ok"])
-    if cfg.n_grid > 0:                           # reference grid path: run by run
+    if cfg.n_grid > 0 or scalar:                 # reference grid path, or run by run
         owner, lo, hi = [], [], []
         for j in rows:
             geom = PlaneGeometry(C=G["C"][j], v_hat=G["v_hat"][j], w_hat=G["w_hat"][j],
