@@ -52,6 +52,7 @@ from .augmented import run_augmented
 from .batch_ml import BatchML
 from .dynamics import ARCSEC
 from .ekf import run_filter
+from .pipeline import cases_in
 from .setup import Setup
 
 def los_boresight(geo: sc.Geometry) -> np.ndarray:
@@ -175,8 +176,6 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
 def run_group_alternatives(setup: Setup | dict, variant: str, group: str, log=None,
                            geo: sc.Geometry | None = None) -> list[dict]:
     """Alternatives for every case of a Table-1 ``group`` under ``variant`` (one Snakemake job)."""
-    from .pipeline import cases_in
-
     setup = Setup.of(setup)
     geo = geo or sc.build_geometry(setup, variant)
     cache = _BatchCache()

@@ -2,7 +2,12 @@
 
 Description
     * :func:`bound_curve` - the CRLB of theta versus data used after ``N0``
-      for a variant's information set (see :mod:`opnav.approach.crlb`).
+      for a variant's information set (see :mod:`opnav.approach.crlb`);
+      :func:`segment_bounds` - the bound of each segment's data. Their ``_many`` /
+      plural forms (:func:`bound_curves`, :func:`segment_bounds_many`) run several
+      items, and every window of each, as one batched recursion
+      (:func:`opnav.approach.crlb.crlb_curves`); :func:`case_bounds` does every case
+      of a group with and without process noise at once.
     * :func:`run_group` - the Monte Carlo of one case group, variant and EM
       scheme (a Snakemake job), each case with its bound attached.
     Tables, the verdict text and the summary live in :mod:`opnav.approach.report`.
