@@ -20,6 +20,7 @@ include: "workflow/rules/approach_extra.smk"
 include: "workflow/rules/approach_peers.smk"
 include: "workflow/rules/landing.smk"
 include: "workflow/rules/landing_extra.smk"
+include: "workflow/rules/landing_timing.smk"
 include: "workflow/rules/studies.smk"
 include: "workflow/rules/paper.smk"
 

@@ -97,7 +97,11 @@ def test_methods_are_paired_and_the_table_is_complete(landing):
     d = {m: run_chunk(landing, m, [0, 1]) for m in ("depth", "svd")}
     np.testing.assert_array_equal(d["depth"]["init_error"], d["svd"]["init_error"])
     np.testing.assert_array_equal(d["depth"]["err_r"][:, 0], d["svd"]["err_r"][:, 0])
-    df = summary_table(d, published_reduction_vs_svd=29.03)
+    from opnav.landing.timing import replay
+
+    tm = replay(build_scenario(landing), d, list(d), max_calls=6)
+    assert tm["mismatch"].tolist() == [0, 0]
+    df = summary_table(d, tm, published_reduction_vs_svd=29.03)
     for col in ("final_pos_err_m_mean", "final_pos_err_m_3sigma", "rms_vel_err_mps_mean",
                 "rms_att_err_deg_3sigma", "median_plan_time_us", "metric_evals_per_call",
                 "time_reduction_vs_svd_pct", "time_reduction_vs_svd_pct_published"):

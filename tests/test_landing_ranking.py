@@ -112,6 +112,15 @@ def _fake_mc(rms_scale, runs, plan_us, seed):
             "plan_t": np.tile([1.0, 2.0, 3.0], n), "plan_index": np.tile([1, 2, 3], n)}
 
 
+def _timing(data):
+    """The replay result of the fake Monte Carlos' planning times (same calls)."""
+    from opnav.landing.timing import from_times
+
+    first = next(iter(data.values()))
+    return from_times({m: d["plan_ns"] for m, d in data.items()},
+                      {m: d["plan_cpu_ns"] for m, d in data.items()}, first["plan_run"])
+
+
 def test_ranking_table_ties_and_paired_difference():
     runs = np.arange(6)
     base = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
@@ -119,7 +128,7 @@ def test_ranking_table_ties_and_paired_difference():
             "svd": _fake_mc(base + 1.0, runs, 800.0, 1),
             "gdop": _fake_mc(base + 1.0, runs, 900.0, 2),     # same errors as svd: a tie
             "random": _fake_mc(base * 0.5, runs, 50.0, 3)}
-    df = ranking_table(data, "depth", n_boot=100)
+    df = ranking_table(data, _timing(data), "depth", n_boot=100)
     t = df.set_index("method")
     assert t.loc["random", "rank_accuracy"] == 1
     assert t.loc["depth", "rank_accuracy"] == 2
@@ -143,9 +152,9 @@ def test_ranking_refuses_unpaired_runs():
     a = _fake_mc(np.ones(3), np.arange(3), 1.0, 0)
     b = _fake_mc(np.ones(3), np.arange(1, 4), 1.0, 0)
     with pytest.raises(ValueError, match="not paired"):
-        ranking_table({"depth": a, "svd": b})
+        ranking_table({"depth": a, "svd": b}, _timing({"depth": a, "svd": a}))
     with pytest.raises(ValueError, match="reference"):
-        ranking_table({"svd": a}, reference="depth")
+        ranking_table({"svd": a}, _timing({"svd": a}), reference="depth")
 
 
 def test_headline_feeds_manuscript_macros():
@@ -158,7 +167,7 @@ def test_headline_feeds_manuscript_macros():
     data = {"depth": _fake_mc(np.arange(1.0, 6.0), runs, 100.0, 0),
             "svd": _fake_mc(np.arange(1.0, 6.0) * (1 + 1e-5), runs, 800.0, 1),
             "logdet": _fake_mc(np.arange(2.0, 7.0), runs, 900.0, 2)}
-    df = ranking_table(data, "depth", n_boot=50, rtol=1e-3)
+    df = ranking_table(data, _timing(data), "depth", n_boot=50, rtol=1e-3)
     t = df.set_index("method")
     assert t.loc["svd", "rank_accuracy"] == t.loc["depth", "rank_accuracy"] == 1   # within 0.1 %
     h = json.loads(json.dumps(headline(df, "depth")))
@@ -178,7 +187,7 @@ def test_tied_order_is_by_method_name_not_timing():
     def build(times):
         data = {m: _fake_mc(base + (0.0 if m in ("depth", "svd", "cond") else 1.0), runs, times[m], i)
                 for i, m in enumerate(["svd", "depth", "mineig", "cond", "gdop"])}
-        df = ranking_table(data, "depth", n_boot=20, rtol=1e-3)
+        df = ranking_table(data, _timing(data), "depth", n_boot=20, rtol=1e-3)
         return df, headline(df, "depth")
 
     df1, h1 = build({"svd": 900.0, "depth": 100.0, "mineig": 50.0, "cond": 400.0, "gdop": 60.0})

@@ -13,8 +13,9 @@ rule landing_x1_summary:
     """B-X1 of one scenario: all methods on the paired Monte Carlo, envelopes, ranking, JSON."""
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
-        code=src("landing/ranking.py", "landing/montecarlo.py", "landing/plots.py", "tables.py",
-                 "figures.py", "opnav.mplstyle"),
+        timing=f"{LANDING}/timing/{{bscn}}.npz",
+        code=src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py", "landing/plots.py",
+                 "tables.py", "figures.py", "opnav.mplstyle"),
     output:
         f=report_figure(f"{LANDING}/B-X1_envelopes_{{bscn}}", "B-X1", "Paper B", "beyond"),
         t=report_table(f"{LANDING}/B-X1_ranking_{{bscn}}", "B-X1", "Paper B"),

@@ -13,4 +13,4 @@ with script_context(snakemake) as log:
     runs = list(snakemake.params.runs)
     data = run_chunk(snakemake.params.landing, method, runs)
     save(snakemake.output[0], data, method)
-    log.info("%s: runs %s..%s, %d planning calls", method, runs[0], runs[-1], len(data["plan_ns"]))
+    log.info("%s: runs %s..%s, %d planning calls", method, runs[0], runs[-1], len(data["plan_index"]))

@@ -6,6 +6,7 @@ import json
 import math
 
 from opnav import published
+from opnav.landing import timing
 from opnav.landing.montecarlo import load, summary_table, yaw_convergence
 from opnav.landing.ranking import pair_table
 from opnav.landing.scenario import initial_attitude_report
@@ -16,7 +17,8 @@ if "snakemake" not in globals():  # standalone debugging run
     _s = "site-tilt"
     snakemake = mock_snakemake(
         input={"mc": [f"results/landing/mc/{_s}/{m}.npz" for m in ("depth", "svd", "gdop", "cond")],
-               "single": f"results/landing/single/summary_{_s}.json"},
+               "single": f"results/landing/single/summary_{_s}.json",
+               "timing": f"results/landing/timing/{_s}.npz"},
         output={"t3": [f"results/landing/B-T3_summary_{_s}.csv"],
                 "summary": f"results/landing/summaries/B-summary_{_s}.json"},
         wildcards={"bscn": _s})
@@ -30,7 +32,8 @@ with script_context(snakemake) as log:
     scn = snakemake.wildcards.bscn
     methods = list(snakemake.params.methods)
     data = {m: load(p) for m, p in zip(methods, snakemake.input.mc)}
-    df = summary_table(data, published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
+    tm = timing.load(snakemake.input.timing)     # planning times by replay, not the descents'
+    df = summary_table(data, tm, published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
                        converged_pos_err_m=float(snakemake.params.converged_pos_err_m))
     write_table(df, snakemake.output.t3,
                 caption=(f"B-T3 ({scn} camera): per planning method, navigation errors at touchdown "
@@ -40,10 +43,11 @@ with script_context(snakemake) as log:
                          "one's; per pair of methods the same-pick rate, median |delta beta*| and "
                          "the paired difference of RMS and final position errors with its 95 % "
                          "interval; median planning-call time ("
-                         f"baselines on the {snakemake.params.eval_path} path) and its reduction "
-                         "against each other method; the published 29.03 % (depth vs SVD) is "
+                         f"baselines on the {snakemake.params.eval_path} path, _alt on the other) "
+                         "and its reduction against each other method (bootstrap standard "
+                         "deviation over runs); the published 29.03 % (depth vs SVD) is "
                          "labelled published. Converged: final position error below "
-                         f"{snakemake.params.converged_pos_err_m:g} m."))
+                         f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
     with open(snakemake.input.single) as fh:
         single = json.load(fh)
     yaw = yaw_convergence(data[methods[0]], float(snakemake.params.yaw_ratio), methods[0])
@@ -58,6 +62,7 @@ with script_context(snakemake) as log:
         "time_reduction_vs_svd_pct": (float(t.loc["depth", "time_reduction_vs_svd_pct"])
                                       if {"svd", "depth"} <= set(t.index) else None),
         "eval_path": snakemake.params.eval_path,
+        "timing": timing.method_summary(tm),
         "published_time_reduction_vs_svd_pct": pub["depth_time_reduction_vs_svd_pct"],
         "initial_attitude_deg": att["paper_convention_deg"],
         "initial_tilt_deg": att["tilt_deg"],

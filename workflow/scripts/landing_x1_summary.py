@@ -5,7 +5,7 @@ the reference (depth), and B-X1-summary.json for the manuscript macros."""
 import json
 
 from opnav import figures
-from opnav.landing import plots
+from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
 from opnav.landing.ranking import headline, ranking_table
 from opnav.snakeio import mock_snakemake, script_context
@@ -14,7 +14,8 @@ from opnav.tables import write_table
 if "snakemake" not in globals():  # standalone debugging run
     _m = ["depth", "svd", "gdop", "cond", "logdet", "mineig", "random", "center"]
     snakemake = mock_snakemake(
-        input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in _m]},
+        input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in _m],
+               "timing": "results/landing/timing/site-tilt.npz"},
         output={"f": ["results/landing/B-X1_envelopes_site-tilt.pdf", "results/landing/B-X1_envelopes_site-tilt.png"],
                 "t": ["results/landing/B-X1_ranking_site-tilt.csv"],
                 "summary": "results/landing/summaries/B-X1-summary_site-tilt.json"})
@@ -30,7 +31,8 @@ with script_context(snakemake) as log:
     n_boot = int(snakemake.params.extra["n_boot"])
     rtol = float(snakemake.params.extra["tie_rtol"])
     conv = float(snakemake.params.converged_pos_err_m)
-    df = ranking_table(data, reference=ref, n_boot=n_boot, seed=0, rtol=rtol,
+    tm = timing.load(snakemake.input.timing)     # planning times by replay, not the descents'
+    df = ranking_table(data, tm, reference=ref, n_boot=n_boot, seed=0, rtol=rtol,
                        converged_pos_err_m=conv)
     write_table(df, snakemake.output.t,
                 caption=(f"B-X1: all planning methods on the same paired Monte Carlo, ranked by mean "
@@ -39,7 +41,7 @@ with script_context(snakemake) as log:
                          f"rank); paired differences method minus "
                          f"{ref} of the per-run RMS and final position errors (m) with 95 % paired-t "
                          f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
-                         f"error below {conv:g} m."))
+                         f"error below {conv:g} m. " + timing.method_text(tm)))
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f)
     out = headline(df, ref)

@@ -26,6 +26,10 @@ def _run(args) -> int:
     scn = build_scenario(cfg)
     run = run_descent(scn, args.method, args.seed)
     s = summarize_run(run)
+    from opnav.landing.timing import median_us, replay_own
+
+    tm = replay_own(scn, run, args.method)       # planning time by replay of the run's calls
+    s["median_plan_time_us"] = median_us(tm, args.method)
     s.update(method=args.method, seed=args.seed,
              final_pos_err_m_xyz=[round(float(x), 4) for x in run["err_r"][-1]],
              final_vel_err_mps_xyz=[round(float(x), 5) for x in run["err_v"][-1]],

@@ -17,12 +17,13 @@ error norms of position (m), velocity (m/s) and attitude (deg, small-angle
 ``dtheta``), each as mean and ``3 sigma`` (three sample standard deviations),
 and the position and velocity error at the last vision update (``lastvis_``:
 the filter then coasts on the IMU to touchdown); the median
-wall time of a planning call over every planning call of every run (us), the
-median objective evaluations per call; the depth method's time reduction
-against each baseline ``100 (1 - median_depth / median_baseline)`` (%), with a
-bootstrap standard deviation over runs; the same for the planning call's CPU
-time (``thread_time_ns``), which other processes on a shared machine do not
-inflate.
+objective evaluations per call (the descent's count). Planning times come from
+the replay of the recorded planning calls (``opnav.landing.timing``), not from
+the descent: the median wall and CPU (``thread_time_ns``) time of a call (us)
+on the configured and the alternative metric path, and each method's time
+reduction against each other ``100 (1 - median_a / median_b)`` (%) on the same
+replayed calls, with a paired bootstrap standard deviation
+(``timing.time_reduction``).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ if TYPE_CHECKING:
 from opnav.landing.timing import RECORD_KEYS   # numpy only
 
 __all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "summary_table", "per_run_stats",
-           "time_reduction", "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
+           "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality"]
 
 _PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index", "plan_edge",
@@ -212,28 +213,6 @@ def _median_us(ns: np.ndarray) -> float:
     return float(np.median(ns) / 1e3) if len(ns) else math.nan
 
 
-def time_reduction(a: dict, b: dict, n_boot: int = 200, seed: int = 0, key: str = "plan_ns"
-                   ) -> tuple[float, float]:
-    """``100 (1 - median_a / median_b)`` (%) of planning times (``key``: wall
-    ``plan_ns`` or CPU ``plan_cpu_ns``) and its bootstrap standard deviation
-    (runs resampled, paired by run index)."""
-    ta, tb = _median_us(a[key]), _median_us(b[key])
-    red = 100.0 * (1.0 - ta / tb)
-    runs = np.intersect1d(np.unique(a["plan_run"]), np.unique(b["plan_run"]))
-    if len(runs) < 2 or n_boot < 2:
-        return red, math.nan
-    rng = np.random.default_rng(seed)
-    ga = {r: a[key][a["plan_run"] == r] for r in runs}
-    gb = {r: b[key][b["plan_run"] == r] for r in runs}
-    vals = []
-    for _ in range(n_boot):
-        pick = rng.choice(runs, size=len(runs), replace=True)
-        ma = np.median(np.concatenate([ga[r] for r in pick]))
-        mb = np.median(np.concatenate([gb[r] for r in pick]))
-        vals.append(100.0 * (1.0 - ma / mb))
-    return red, float(np.std(vals, ddof=1))
-
-
 def pick_quality(d: dict) -> dict:
     """Per method: share of planning calls whose in-plane optimum fell on an end
     of the visible interval (edge rule, %), and the median / max over calls of
@@ -273,14 +252,21 @@ def yaw_convergence(data: dict, ratio: float, method: str) -> dict:
                        f"({'below' if converges else 'not below'} {ratio:.0%} of the start)")}
 
 
-def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | None = None,
+def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_svd: float | None = None,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-T3: one row per method (see the module docstring for the columns);
+    ``timing``: the replay of the scenario's planning calls
+    (``opnav.landing.timing.replay``, every method of ``data`` timed);
     ``converged_runs_pct`` counts the runs whose final position error is below
     ``converged_pos_err_m`` (m)."""
     import pandas as pd
 
+    from opnav.landing import timing as tmg
+
     methods = list(data)
+    missing = [m for m in methods if tmg.times_ns(timing, m).size == 0 and len(timing["source"])]
+    if missing:
+        raise ValueError(f"the planning-time replay did not time {missing}")
     rows = []
     for m in methods:
         st = per_run_stats(data[m])
@@ -302,11 +288,14 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
         row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
         row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
         row["landmarks_per_run"] = float(st["n_landmarks"].mean())
-        row["median_plan_time_us"] = _median_us(data[m]["plan_ns"])
-        row["median_plan_cpu_us"] = _median_us(data[m]["plan_cpu_ns"])
-        if "plan_ns_alt" in data[m]:     # the same calls on the alternative metric path
-            row["median_plan_time_alt_us"] = _median_us(data[m]["plan_ns_alt"])
-            row["median_plan_cpu_alt_us"] = _median_us(data[m]["plan_cpu_ns_alt"])
+        alt_m = "alt" if tmg.times_ns(timing, m, "alt").size else "main"
+        row["median_plan_time_us"] = tmg.median_us(timing, m)
+        row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
+        # the same replayed calls on the alternative metric path (the configured one
+        # for methods without it)
+        row["median_plan_time_alt_us"] = tmg.median_us(timing, m, alt_m)
+        row["median_plan_cpu_alt_us"] = tmg.median_us(timing, m, alt_m, clock="cpu")
+        row["timed_calls"] = int(len(timing["source"]))
         ev = data[m]["plan_evals"]
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
@@ -325,15 +314,15 @@ def summary_table(data: dict[str, dict], published_reduction_vs_svd: float | Non
                 row[f"{k}_vs_{b}_m"] = pc[f"{k}_m"]
                 row[f"{k}_vs_{b}_lo_m"] = pc[f"{k}_lo_m"]
                 row[f"{k}_vs_{b}_hi_m"] = pc[f"{k}_hi_m"]
-            red, sd = time_reduction(data[m], data[b])
+            red, sd = tmg.time_reduction(timing, m, b)
             row[f"time_reduction_vs_{b}_pct"] = red
             row[f"time_reduction_vs_{b}_pct_std"] = sd
-            row[f"cpu_time_reduction_vs_{b}_pct"] = time_reduction(data[m], data[b], n_boot=0,
-                                                                   key="plan_cpu_ns")[0]
-            if "plan_ns_alt" in data[m] and "plan_ns_alt" in data[b]:
-                red, sd = time_reduction(data[m], data[b], key="plan_ns_alt")
-                row[f"time_reduction_vs_{b}_alt_pct"] = red
-                row[f"time_reduction_vs_{b}_alt_pct_std"] = sd
+            row[f"cpu_time_reduction_vs_{b}_pct"] = tmg.time_reduction(timing, m, b, clock="cpu",
+                                                                       n_boot=0)[0]
+            alt_b = "alt" if tmg.times_ns(timing, b, "alt").size else "main"
+            red, sd = tmg.time_reduction(timing, m, b, path_a=alt_m, path_b=alt_b)
+            row[f"time_reduction_vs_{b}_alt_pct"] = red
+            row[f"time_reduction_vs_{b}_alt_pct_std"] = sd
         rows.append(row)
     df = pd.DataFrame(rows)
     if published_reduction_vs_svd is not None:

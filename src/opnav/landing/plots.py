@@ -159,25 +159,26 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
         return fig
 
 
-def fig_planning_time(data: dict[str, dict], published_reduction_vs_svd: float | None = None,
-                      eval_path: str = "matrix_scalar"):
-    """B-F7: planning-call wall time (us) per method, box = quartiles, whiskers =
-    min/max (as the paper's Fig. 7), medians and evaluations per call annotated.
-    Methods with an alternative metric evaluation path (``plan_ns_alt``: the
-    same calls re-timed on it) get a second, hatched box beside the first."""
+def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float | None = None):
+    """B-F7: planning-call wall time (us) per method on the replayed planning
+    calls (``timing``: ``opnav.landing.timing.replay``, the same calls for every
+    method), box = quartiles, whiskers = min/max (as the paper's Fig. 7),
+    medians and evaluations per call annotated. Methods timed on the
+    alternative metric evaluation path too get a second, hatched box."""
     import matplotlib.pyplot as plt
 
-    from opnav.landing.planner import alternative_path, PlannerConfig
+    from opnav.landing import timing as tmg
 
-    alt_name = alternative_path(PlannerConfig(eval_path=eval_path)).eval_path
-    methods = list(data)
+    methods = list(methods)
+    paths = {str(p): str(e) for p, e in zip(timing["variant_path"], timing["variant_eval_path"])}
+    main_name, alt_name = paths.get("main", ""), paths.get("alt", "")
     with figures.style():
         fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 3.0), constrained_layout=True)
         pos, vals, cols, hatch = [], [], [], []
         for k, m in enumerate(methods, start=1):
-            v = np.asarray(data[m]["plan_ns"], float) / 1e3
-            va = np.asarray(data[m].get("plan_ns_alt", data[m]["plan_ns"]), float) / 1e3
-            has_alt = m != "depth" and "plan_ns_alt" in data[m] and not np.array_equal(v, va)
+            v = tmg.times_ns(timing, m).astype(float) / 1e3
+            va = tmg.times_ns(timing, m, "alt").astype(float) / 1e3
+            has_alt = va.size > 0
             pos.append(k - 0.18 if has_alt else k)
             vals.append(v)
             cols.append(_color(m, k - 1))
@@ -196,7 +197,7 @@ def fig_planning_time(data: dict[str, dict], published_reduction_vs_svd: float |
         ax.set_yscale("log")
         labels = []
         for m in methods:
-            ev = np.median(data[m]["plan_evals"]) if len(data[m]["plan_evals"]) else math.nan
+            ev = tmg.median_evals(timing, m)
             labels.append(f"{_label(m)}\n{ev:.0f} evals")
         ax.set_xticks(range(1, len(methods) + 1), labels, fontsize="small")
         for p_, v in zip(pos, vals):
@@ -205,13 +206,13 @@ def fig_planning_time(data: dict[str, dict], published_reduction_vs_svd: float |
                 ax.annotate(f"{med:.0f}", (p_, med), xytext=(0, 3), textcoords="offset points",
                             ha="center", va="bottom", fontsize="xx-small")
         ax.set_ylabel("planning-call time (us)")
-        ax.set_xlabel(f"plain: {eval_path}; hatched: {alt_name}", fontsize="small")
-        if published_reduction_vs_svd is not None and "depth" in data and "svd" in data:
-            d = np.median(data["depth"]["plan_ns"])
-            ours = 100 * (1 - d / np.median(data["svd"]["plan_ns"]))
-            title = f"depth vs SVD: {ours:.1f} % less ({eval_path})"
-            if "plan_ns_alt" in data["svd"]:
-                ours_alt = 100 * (1 - d / np.median(data["svd"]["plan_ns_alt"]))
+        ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; plain: {main_name}"
+                      + (f"; hatched: {alt_name}" if alt_name else ""), fontsize="small")
+        if published_reduction_vs_svd is not None and {"depth", "svd"} <= set(methods):
+            ours = tmg.time_reduction(timing, "depth", "svd", n_boot=0)[0]
+            title = f"depth vs SVD: {ours:.1f} % less ({main_name})"
+            if tmg.times_ns(timing, "svd", "alt").size:
+                ours_alt = tmg.time_reduction(timing, "depth", "svd", path_b="alt", n_boot=0)[0]
                 title += f", {ours_alt:.1f} % ({alt_name})"
             ax.set_title(f"{title}\npublished {published_reduction_vs_svd:.2f} %", fontsize="x-small")
         return fig

@@ -16,7 +16,8 @@ is lower. :func:`competition_rank` ranks with ties sharing the best rank
 timing. :func:`ranking_table` builds the B-X1 table: per method the
 accuracy (mean and 3-sigma of final and RMS position and velocity error
 norms, NEES, landmarks used, share of planning calls that chose no landmark), planning time (median wall and CPU time of a planning call, us, and
-the ratio to the reference's), ranks by accuracy (mean RMS position error)
+the ratio to the reference's, from the replay of the recorded planning calls,
+:mod:`opnav.landing.timing`), ranks by accuracy (mean RMS position error)
 and by time (median CPU time, which other processes on a shared machine do
 not inflate), and the paired comparison against the reference method.
 All functions are pure (no I/O).
@@ -164,12 +165,7 @@ def competition_rank(values, rtol: float = 0.0) -> np.ndarray:
     return ranks
 
 
-def _median_us(ns) -> float:
-    ns = np.asarray(ns)
-    return float(np.median(ns) / 1e3) if ns.size else math.nan
-
-
-def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int = 2000,
+def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth", n_boot: int = 2000,
                   seed: int = 0, level: float = 0.95, rtol: float = 0.0,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-X1: one row per method of ``data`` (gathered Monte-Carlo dicts, same
@@ -177,7 +173,11 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
     ``d_rms_pos_vs_ref_*`` / ``d_final_pos_vs_ref_*`` are method minus
     reference (m; negative = the method is more accurate); ``converged_runs_pct``
     counts runs whose final position error is below ``converged_pos_err_m`` (m),
-    as in B-T3."""
+    as in B-T3. Time columns (median wall and CPU time of a planning call, us)
+    come from ``timing``, the replay of the recorded planning calls
+    (``opnav.landing.timing.replay``: every method on the same calls)."""
+    from opnav.landing import timing as tmg
+
     if reference not in data:
         raise ValueError(f"landing.extra.reference {reference!r} not among the methods {list(data)}")
     st = {m: per_run_stats(d) for m, d in data.items()}
@@ -186,7 +186,7 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
         if not s.index.equals(ref_runs):
             raise ValueError(f"method {m!r} flew runs {list(s.index)[:5]}..., reference "
                              f"{reference!r} flew {list(ref_runs)[:5]}...: not paired")
-    ref_cpu = _median_us(data[reference]["plan_cpu_ns"])
+    ref_cpu = tmg.median_us(timing, reference, clock="cpu")
     rows = []
     for m, d in data.items():
         s = st[m]
@@ -201,11 +201,11 @@ def ranking_table(data: dict[str, dict], reference: str = "depth", n_boot: int =
         row["converged_runs_pct"] = float(100.0 * (s["final_pos_err_m"] < converged_pos_err_m).mean())
         row["mean_nees_pos"] = float(s["mean_nees_pos"].mean())
         row["landmarks_per_run"] = float(s["n_landmarks"].mean())
-        row["plan_calls"] = int(len(d["plan_ns"]))
+        row["plan_calls"] = int(len(d["plan_index"]))
         idx = np.asarray(d["plan_index"])
         row["no_pick_pct"] = float(100.0 * np.mean(idx < 0)) if idx.size else math.nan
-        row["median_plan_time_us"] = _median_us(d["plan_ns"])
-        row["median_plan_cpu_us"] = _median_us(d["plan_cpu_ns"])
+        row["median_plan_time_us"] = tmg.median_us(timing, m)
+        row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
         row["cpu_time_ratio_to_ref"] = row["median_plan_cpu_us"] / ref_cpu
         for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos")):
             pdiff = paired_difference(s[key].to_numpy(), st[reference][key].to_numpy(),

@@ -5,8 +5,9 @@
 ``SeedSequence([landing.mc.base_seed, i])`` only, so values and methods are paired) and
 returns one row per run: the final and RMS error norms of position (m), velocity (m/s)
 and attitude (deg) and the mean NEES (:func:`opnav.landing.montecarlo.per_run_stats`),
-landmarks used, and per run the median wall / CPU time of a planning call (us) and the
-share of planning calls that chose no landmark (%). :func:`add_derived` adds
+landmarks used, and per run the median wall / CPU time of a planning call (us; by replay
+of the run's recorded planning calls through its method, :func:`opnav.landing.timing.replay_own`,
+apart from the filter's work) and the share of planning calls that chose no landmark (%). :func:`add_derived` adds
 ``converged_pct`` (100 if the final position error is below ``converged_pos_err_m``, else
 0; its mean over runs is the converged share, as in B-T3).
 """
@@ -21,27 +22,32 @@ import pandas as pd
 from opnav.landing.montecarlo import per_run_stats, run_chunk
 
 
-def per_run_metrics(data: dict) -> pd.DataFrame:
-    """One row per run of a chunk or gathered Monte-Carlo dict (module docstring)."""
+def per_run_metrics(data: dict, timing: dict, method: str) -> pd.DataFrame:
+    """One row per run of a chunk or gathered Monte-Carlo dict (module docstring);
+    ``timing``: the replay of its planning calls (``timing.replay_own``)."""
+    from opnav.landing.timing import per_run_median_us
+
     st = per_run_stats(data).reset_index()
     runs = st["run"].to_numpy()
     pr = np.asarray(data["plan_run"])
-    med_t, med_c, nopick = [], [], []
+    wall, cpu = per_run_median_us(timing, method), per_run_median_us(timing, method, "cpu")
+    nopick = []
     for r in runs:
-        sel = pr == r
-        ns, cpu, idx = (np.asarray(data[k])[sel] for k in ("plan_ns", "plan_cpu_ns", "plan_index"))
-        med_t.append(float(np.median(ns)) / 1e3 if ns.size else math.nan)
-        med_c.append(float(np.median(cpu)) / 1e3 if cpu.size else math.nan)
+        idx = np.asarray(data["plan_index"])[pr == r]
         nopick.append(float(100.0 * np.mean(idx < 0)) if idx.size else math.nan)
-    st["median_plan_time_us"] = med_t
-    st["median_plan_cpu_us"] = med_c
+    st["median_plan_time_us"] = [wall.get(int(r), math.nan) for r in runs]
+    st["median_plan_cpu_us"] = [cpu.get(int(r), math.nan) for r in runs]
     st["no_pick_pct"] = nopick
     return st
 
 
 def run_runs(landing_cfg: dict, method: str, run_indices) -> pd.DataFrame:
     """Fly ``run_indices`` with ``method``; one row per run (module docstring)."""
-    df = per_run_metrics(run_chunk(landing_cfg, method, list(run_indices)))
+    from opnav.landing.descent import build_scenario
+    from opnav.landing.timing import replay_own
+
+    data = run_chunk(landing_cfg, method, list(run_indices))
+    df = per_run_metrics(data, replay_own(build_scenario(landing_cfg), data, method), method)
     df.insert(1, "method", method)
     return df
 

@@ -9,13 +9,44 @@ the camera's detected landmarks, follows from the scenario), the estimate
 ``PlanState(r, v, a, R_LtoB, P)``, the excluded current landmark and the state
 of the run's picker stream (:data:`RECORD_KEYS`). Timing is then done apart
 from the filter's own work.
+
+Replay (:func:`replay`): the recorded calls of the Monte Carlo of every
+method are pooled (in method order, then run, then call); a deterministic
+subset of at most ``max_calls`` of them, evenly spaced by pool index
+(:func:`select_calls`), is replayed through every method's planning call
+(``planner.plan``), the paper's H baselines (``metrics.H_METRICS``) on both
+evaluation paths (the configured one and ``planner.alternative_path``), one
+call at a time in one process. For the ``q``-th replayed call the variants
+(method, path) run in the configured order rotated by ``q`` (never ordered by
+a clock), so slow drifts of the machine (frequency, other processes) fall on
+every method alike; every method is timed on the same states, so the
+comparison is paired per call. Each call is timed by ``time.perf_counter_ns``
+(wall) and ``time.thread_time_ns`` (CPU time of the calling thread, which
+other processes do not inflate), around ``planner.plan`` with the image's
+detected landmarks given (the feature detector's list, computed from the
+truth pose before the clock starts, as in the descent) and without the
+pick-ratio diagnostic. The garbage collector is held during the timed calls
+(collected between calls). One untimed warm-up call per variant precedes the
+timing (imports, caches).
+
+Check: the replayed pick of the method whose descent recorded the call, on
+the configured path, must equal the recorded pick; mismatches are counted per
+method (``mismatch``; nonzero means the replay is not the descent's call).
+
+Units: times ns in the arrays, us in the summaries.
 """
 
 from __future__ import annotations
 
+import gc
+import math
+import time
+
 import numpy as np
 
-__all__ = ["RECORD_KEYS", "record_plan_inputs", "stack_plan_inputs", "rng_words", "rng_from_words"]
+__all__ = ["RECORD_KEYS", "record_plan_inputs", "stack_plan_inputs", "rng_words", "rng_from_words",
+           "select_calls", "variants", "replay", "save", "load", "times_ns", "median_us",
+           "time_reduction", "method_text", "summary_frame", "median_evals", "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us"]
 
 #: per planning call: filter step index, estimate r (3), v (3), a (3), R_LtoB (3, 3),
 #: covariance P (12, 12), excluded landmark (-1: none), picker stream state (6 words)
@@ -62,3 +93,386 @@ def stack_plan_inputs(rec: dict) -> dict:
     """The recorded lists as arrays (calls first), empty arrays of the right shape if none."""
     return {k: (np.stack(rec[k]) if rec[k] else np.zeros((0,) + _SHAPES[k], _DTYPES.get(k, float)))
             for k in RECORD_KEYS}
+
+
+# ----------------------------------------------------------------- replay
+
+def select_calls(n_pool: int, max_calls: int) -> np.ndarray:
+    """Pool indices replayed: all if ``max_calls`` is 0 or at least ``n_pool``,
+    else ``max_calls`` indices evenly spaced over the pool (``floor(i n / m)``,
+    distinct, increasing; deterministic)."""
+    n, m = int(n_pool), int(max_calls)
+    if m < 0:
+        raise ValueError(f"landing.timing.max_calls must be >= 0, got {m}")
+    if m == 0 or m >= n:
+        return np.arange(n, dtype=np.int64)
+    return (np.arange(m, dtype=np.int64) * n) // m
+
+
+def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
+    """The timed (method, path, PlannerConfig): every method on ``cfg``'s path
+    (``"main"``), the paper's H baselines also on the alternative path
+    (``"alt"``) unless ``alt`` is false."""
+    from opnav.landing.metrics import H_METRICS
+    from opnav.landing.planner import alternative_path
+
+    alt_cfg = alternative_path(cfg)
+    out = []
+    for m in methods:
+        out.append((m, "main", cfg))
+        if alt and m in H_METRICS:
+            out.append((m, "alt", alt_cfg))
+    return out
+
+
+def _pool(recorded: dict) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(source method position, call position within its Monte Carlo) of every recorded call."""
+    names = list(recorded)
+    src, pos = [], []
+    for i, m in enumerate(names):
+        d = recorded[m]
+        missing = [k for k in RECORD_KEYS if k not in d]
+        if missing:
+            raise ValueError(f"Monte Carlo of {m!r} holds no planning inputs ({', '.join(missing)}): "
+                             "rebuild it with this version")
+        n = len(d["plan_step"])
+        for k in ("plan_r", "plan_v", "plan_a", "plan_R", "plan_P"):
+            if len(d[k]) != n or not np.isfinite(d[k]).all():
+                raise ValueError(f"Monte Carlo of {m!r}: recorded {k} not finite or not one per call")
+        src.append(np.full(n, i, np.int64))
+        pos.append(np.arange(n, dtype=np.int64))
+    return (np.concatenate(src) if src else np.zeros(0, np.int64),
+            np.concatenate(pos) if pos else np.zeros(0, np.int64), names)
+
+
+def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: bool = True) -> dict:
+    """Replay recorded planning calls through every method (module docstring).
+
+    ``scn``: the descent's scenario (``descent.build_scenario``); ``recorded``:
+    method -> gathered Monte-Carlo dict (``montecarlo.gather``), the sources of
+    the calls; ``methods``: the methods timed. Returns arrays: per replayed call
+    ``source`` (position in ``sources``), ``run``, ``call`` (position in its
+    source's calls), ``step``; per call and variant ``wall_ns``, ``cpu_ns``,
+    ``pick``, ``n_evals``, ``slot`` (position in that call's order); per
+    variant ``variant_method``, ``variant_path``, ``variant_eval_path``; per
+    method of ``methods`` ``mismatch`` (recorded pick != replayed pick, own
+    calls) and ``checked`` (own calls replayed); ``n_pool``, ``max_calls``.
+    ``alt = False`` times the configured evaluation path only.
+    """
+    from opnav.landing.planner import PlanState, plan
+
+    methods = list(methods)
+    if not methods:
+        raise ValueError("replay: no methods to time")
+    src, pos, names = _pool(recorded)
+    sel = select_calls(len(src), max_calls)
+    var = variants(methods, scn.planner, alt)
+    nv, nc = len(var), len(sel)
+    cam, field_, xyz = scn.camera, scn.field, scn.field.xyz
+    tr = scn.truth
+    margin = scn.planner.margin_px
+    wall = np.zeros((nc, nv), np.int64)
+    cpu = np.zeros((nc, nv), np.int64)
+    pick = np.full((nc, nv), -2, np.int64)
+    evals = np.zeros((nc, nv), np.int64)
+    slot = np.zeros((nc, nv), np.int64)
+    own = {m: (names.index(m) if m in names else -1) for m in methods}
+    mismatch = np.zeros(len(methods), np.int64)
+    checked = np.zeros(len(methods), np.int64)
+    run = np.zeros(nc, np.int64)
+    step = np.zeros(nc, np.int64)
+
+    def inputs(q):
+        d = recorded[names[src[sel[q]]]]
+        i = pos[sel[q]]
+        k = int(d["plan_step"][i])
+        r_t, R_t = tr.r[k], tr.R_LtoB[k]
+
+        def visible(pts, margin=margin, r_t=r_t, R_t=R_t):
+            return cam.in_view((np.asarray(pts) - r_t) @ R_t.T, margin)
+
+        state = PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
+        ex = int(d["plan_exclude"][i])
+        return (d, i, k, state, visible, {ex} if ex >= 0 else set(),
+                np.flatnonzero(visible(xyz)), d["plan_rng"][i])
+
+    perf, thread = time.perf_counter_ns, time.thread_time_ns
+    if nc:
+        _, _, _, state, visible, exclude, det, words = inputs(0)
+        for m, _, cfg in var:                                     # warm-up, untimed
+            plan(m, state, cam, field_, visible, cfg, exclude=exclude, rng=rng_from_words(words),
+                 detected=det, diagnose=False)
+    gc_was = gc.isenabled()
+    gc.collect()
+    gc.disable()
+    try:
+        for q in range(nc):
+            d, i, k, state, visible, exclude, det, words = inputs(q)
+            run[q] = int(d["plan_run"][i]) if "plan_run" in d else -1
+            step[q] = k
+            for s_, v in enumerate(np.roll(np.arange(nv), -(q % nv))):
+                m, _, cfg = var[v]
+                rng = rng_from_words(words)
+                t0 = perf()
+                c0 = thread()
+                res = plan(m, state, cam, field_, visible, cfg, exclude=exclude, rng=rng,
+                           detected=det, diagnose=False)
+                c1 = thread()
+                t1 = perf()
+                wall[q, v], cpu[q, v] = t1 - t0, c1 - c0
+                pick[q, v], evals[q, v], slot[q, v] = res.index, res.n_evals, s_
+            if q % 64 == 63:
+                gc.collect()
+    finally:
+        if gc_was:
+            gc.enable()
+    for j, m in enumerate(methods):
+        mine = src[sel] == own[m]
+        v = next(x for x, (mm, path, _) in enumerate(var) if mm == m and path == "main")
+        if own[m] >= 0 and mine.any():
+            recorded_pick = recorded[m]["plan_index"][pos[sel][mine]]
+            checked[j] = int(mine.sum())
+            mismatch[j] = int(np.sum(pick[mine, v] != recorded_pick))
+    return {"sources": np.array(names), "methods": np.array(methods),
+            "source": src[sel], "call": pos[sel], "run": run, "step": step,
+            "wall_ns": wall, "cpu_ns": cpu, "pick": pick, "n_evals": evals, "slot": slot,
+            "variant_method": np.array([v[0] for v in var]),
+            "variant_path": np.array([v[1] for v in var]),
+            "variant_eval_path": np.array([v[2].eval_path for v in var]),
+            "mismatch": mismatch, "checked": checked,
+            "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls)}
+
+
+def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
+    """Replay a Monte-Carlo dict's (or one ``run_descent`` output's) own calls
+    through its own method, configured evaluation path only (parameter
+    studies, the CLI: no other methods to interleave with)."""
+    d = dict(data)
+    if "plan_run" not in d:
+        d["plan_run"] = np.zeros(len(d["plan_index"]), np.int64)
+    return replay(scn, {method: d}, [method], max_calls, alt=False)
+
+
+def per_run_median_us(tm: dict, method: str, clock: str = "wall") -> dict[int, float]:
+    """Median replayed planning time (us) per run (the run of the recorded call)."""
+    t = times_ns(tm, method, "main", clock)
+    run = np.asarray(tm["run"])
+    return {int(r): float(np.median(t[run == r]) / 1e3) for r in np.unique(run)}
+
+
+def save(path, tm: dict) -> None:
+    """Write a :func:`replay` result (``.npz``, atomically)."""
+    from opnav.tables import atomic_target
+
+    with atomic_target(path) as tmp:
+        np.savez_compressed(tmp, **tm)
+
+
+def load(path) -> dict:
+    """Read a :func:`save` file (corrupt files raise ``CorruptIntermediate``)."""
+    from opnav.landing.montecarlo import load as _load
+
+    return _load(path)
+
+
+def from_times(wall_ns: dict, cpu_ns: dict, run, n_evals: int = 0) -> dict:
+    """A :func:`replay`-shaped result from given per-call times (ns) per
+    method, all on the configured path, calls of one source with run indices
+    ``run`` (for tests and times measured elsewhere)."""
+    methods = list(wall_ns)
+    n, k = len(run), len(methods)
+    return {"sources": np.array(methods[:1]), "methods": np.array(methods),
+            "source": np.zeros(n, np.int64), "call": np.arange(n, dtype=np.int64),
+            "run": np.asarray(run, np.int64), "step": np.zeros(n, np.int64),
+            "wall_ns": np.column_stack([np.asarray(wall_ns[m]) for m in methods]).astype(np.int64),
+            "cpu_ns": np.column_stack([np.asarray(cpu_ns[m]) for m in methods]).astype(np.int64),
+            "pick": np.full((n, k), -2, np.int64), "n_evals": np.full((n, k), int(n_evals), np.int64),
+            "slot": np.zeros((n, k), np.int64), "variant_method": np.array(methods),
+            "variant_path": np.array(["main"] * k), "variant_eval_path": np.array(["main"] * k),
+            "mismatch": np.zeros(k, np.int64), "checked": np.zeros(k, np.int64),
+            "n_pool": np.int64(n), "max_calls": np.int64(0)}
+
+
+# ----------------------------------------------------------------- consumers
+
+def _variant(tm: dict, method: str, path: str) -> int | None:
+    vm, vp = [str(x) for x in tm["variant_method"]], [str(x) for x in tm["variant_path"]]
+    for j, (m, p) in enumerate(zip(vm, vp)):
+        if m == method and p == path:
+            return j
+    return None
+
+
+def times_ns(tm: dict, method: str, path: str = "main", clock: str = "wall") -> np.ndarray:
+    """Per replayed call, the planning time (ns) of ``method`` on ``path``
+    (``"main"`` / ``"alt"``) by ``clock`` (``"wall"``: perf_counter, ``"cpu"``:
+    thread CPU); empty if that variant was not timed."""
+    if clock not in ("wall", "cpu"):
+        raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
+    j = _variant(tm, method, path)
+    if j is None:
+        return np.zeros(0, np.int64)
+    return np.asarray(tm[f"{clock}_ns"])[:, j]
+
+
+def median_evals(tm: dict, method: str, path: str = "main") -> float:
+    """Median objective evaluations per replayed call (nan if none)."""
+    j = _variant(tm, method, path)
+    if j is None or not len(tm["source"]):
+        return math.nan
+    return float(np.median(np.asarray(tm["n_evals"])[:, j]))
+
+
+def median_us(tm: dict, method: str, path: str = "main", clock: str = "wall") -> float:
+    """Median planning time (us) over the replayed calls (nan if none)."""
+    t = times_ns(tm, method, path, clock)
+    return float(np.median(t) / 1e3) if t.size else math.nan
+
+
+def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str = "main",
+                   path_b: str = "main", n_boot: int = 200, seed: int = 0) -> tuple[float, float]:
+    """``100 (1 - median_a / median_b)`` (%) of the planning times of methods
+    ``a`` (on ``path_a``) and ``b`` (``path_b``) on the same replayed calls,
+    and its bootstrap standard deviation: clusters (source Monte Carlo, run)
+    resampled with replacement, both methods from the same resample (paired).
+    ``nan`` if a variant is missing; the spread is ``nan`` below two clusters
+    or two resamples."""
+    ta, tb = times_ns(tm, a, path_a, clock), times_ns(tm, b, path_b, clock)
+    if not ta.size or not tb.size:
+        return math.nan, math.nan
+    red = 100.0 * (1.0 - float(np.median(ta)) / float(np.median(tb)))
+    key = np.asarray(tm["source"]) * (1 << 32) + np.asarray(tm["run"])
+    clusters, inv = np.unique(key, return_inverse=True)
+    if len(clusters) < 2 or n_boot < 2:
+        return red, math.nan
+    rng = np.random.default_rng(seed)
+    members = [np.flatnonzero(inv == c) for c in range(len(clusters))]
+    vals = np.empty(n_boot)
+    for i in range(n_boot):
+        idx = np.concatenate([members[c] for c in rng.integers(len(clusters), size=len(clusters))])
+        vals[i] = 100.0 * (1.0 - np.median(ta[idx]) / np.median(tb[idx]))
+    return red, float(np.std(vals, ddof=1))
+
+
+def method_summary(tm: dict) -> dict:
+    """The replay's method in numbers (summary JSON, manuscript macros): calls
+    replayed and recorded, ``max_calls``, methods timed, own calls checked and
+    pick mismatches."""
+    return {"method": "replay", "timed_calls": int(len(tm["source"])), "recorded_calls": int(tm["n_pool"]),
+            "max_calls": int(tm["max_calls"]), "all_calls": bool(len(tm["source"]) == int(tm["n_pool"])),
+            "n_methods": int(len(tm["methods"])), "checked_calls": int(np.sum(tm["checked"])),
+            "pick_mismatches": int(np.sum(tm["mismatch"])),
+            "sources_text": ", ".join(str(x) for x in tm["sources"])}
+
+
+def method_text(tm: dict) -> str:
+    """One sentence stating how the times were measured (captions, paper)."""
+    n, pool = len(tm["source"]), int(tm["n_pool"])
+    srcs = ", ".join(str(x) for x in tm["sources"])
+    subset = (f"all {pool} recorded planning calls" if n == pool else
+              f"{n} of the {pool} recorded planning calls (every {pool / n:.1f}th by index, "
+              f"landing.timing.max_calls = {int(tm['max_calls'])})")
+    mis = int(np.sum(tm["mismatch"]))
+    return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
+            "every method's planning call, one call at a time, interleaved across methods in one "
+            "process (order rotated per call), the same states for every method; wall clock "
+            "perf_counter_ns, CPU clock thread_time_ns; replayed picks equal to the recorded ones "
+            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls.")
+
+
+def summary_frame(tm: dict):
+    """One row per timed variant: method, path, evaluation path, replayed calls,
+    median and 5-95 % quantiles of the wall and CPU times (us), median
+    evaluations; the method's own-call check (checked, mismatch) on its main row."""
+    import pandas as pd
+
+    methods = [str(m) for m in tm["methods"]]
+    rows = []
+    for j, (m, p, e) in enumerate(zip(tm["variant_method"], tm["variant_path"], tm["variant_eval_path"])):
+        w, c = np.asarray(tm["wall_ns"])[:, j] / 1e3, np.asarray(tm["cpu_ns"])[:, j] / 1e3
+        row = {"method": str(m), "path": str(p), "eval_path": str(e), "calls": int(len(w))}
+        for name, x in (("wall", w), ("cpu", c)):
+            q = np.quantile(x, [0.05, 0.5, 0.95]) if len(x) else [math.nan] * 3
+            row.update({f"{name}_median_us": float(q[1]), f"{name}_p05_us": float(q[0]),
+                        f"{name}_p95_us": float(q[2])})
+        row["median_evals"] = float(np.median(np.asarray(tm["n_evals"])[:, j])) if len(w) else math.nan
+        if str(p) == "main":
+            i = methods.index(str(m))
+            row["checked"], row["mismatch"] = int(tm["checked"][i]), int(tm["mismatch"][i])
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0,
+                  repeats: int = 3) -> dict:
+    """The planning call's overhead beyond its objective evaluations, by replay.
+
+    For each selected recorded call of ``recorded[method]`` (evenly spaced,
+    :func:`select_calls`): the whole ``planner.plan`` call (as :func:`replay`
+    times it) and, in the same process, its objective evaluations alone: the
+    objective the call builds (``planner.OBJECTIVES[method]``) evaluated at the
+    betas the call's golden-section searches evaluate (recorded by a first,
+    untimed pass), in a plain loop. Each is the minimum over ``repeats``
+    (thread CPU clock, ns). Returns per call ``call_ns``, ``evals_ns``,
+    ``n_evals`` (scalar evaluations; edge-rule batch scoring is counted in the
+    call, not in the evaluations) and ``overhead_ratio = (call - evals) / evals``.
+    """
+    from opnav.landing import planner as pl
+    from opnav.landing.depth_error import plane_geometry
+
+    d = recorded[method]
+    sel = select_calls(len(d["plan_step"]), max_calls)
+    cam, field_, tr, cfg = scn.camera, scn.field, scn.truth, scn.planner
+    thread = time.thread_time_ns
+    call_ns, evals_ns, n_ev = [], [], []
+    build = pl.OBJECTIVES[method]
+    gc_was = gc.isenabled()
+    gc.disable()
+    try:
+        for i in sel:
+            k = int(d["plan_step"][i])
+            r_t, R_t = tr.r[k], tr.R_LtoB[k]
+
+            def visible(pts, r_t=r_t, R_t=R_t):
+                return cam.in_view((np.asarray(pts) - r_t) @ R_t.T, cfg.margin_px)
+
+            state = pl.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i],
+                                 d["plan_P"][i])
+            ex = int(d["plan_exclude"][i])
+            exclude = {ex} if ex >= 0 else set()
+            det = np.flatnonzero(visible(field_.xyz))
+            geom = plane_geometry(state.r, state.v)
+            ivs = pl.visible_intervals(geom, state.R_LtoB, cam, cfg.n_grid, cfg.margin_px)
+            if not ivs:
+                continue
+            f = build(state=state, geom=geom, cfg=cfg, camera=cam, sigma_b=cam.sigma_b)
+            betas = []
+
+            def spy(b, f=f, betas=betas):
+                betas.append(b)
+                return f(b)
+
+            for a, b in ivs:
+                pl.golden_section(spy, a, b, cfg.tol_rad)
+            best_call = best_eval = None
+            for _ in range(max(int(repeats), 1)):
+                c0 = thread()
+                pl.plan(method, state, cam, field_, visible, cfg, exclude=exclude, rng=None,
+                        detected=det, diagnose=False)
+                c1 = thread()
+                for b in betas:
+                    f(b)
+                c2 = thread()
+                best_call = c1 - c0 if best_call is None else min(best_call, c1 - c0)
+                best_eval = c2 - c1 if best_eval is None else min(best_eval, c2 - c1)
+            call_ns.append(best_call)
+            evals_ns.append(best_eval)
+            n_ev.append(len(betas))
+    finally:
+        if gc_was:
+            gc.enable()
+    call_ns, evals_ns = np.asarray(call_ns, np.int64), np.asarray(evals_ns, np.int64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = (call_ns - evals_ns) / evals_ns
+    return {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": np.asarray(n_ev, np.int64),
+            "overhead_ratio": ratio}

@@ -1,0 +1,151 @@
+"""Planning time by replay (opnav.landing.timing): the replay is the descent's
+call (same picks), deterministic and order independent, and the consumers
+(B-T3, B-X1 ranking, B-F7) read the replayed times."""
+
+import copy
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from opnav.config import load_config
+from opnav.landing import timing
+from opnav.landing.descent import build_scenario
+from opnav.landing.montecarlo import run_chunk, summary_table
+from opnav.landing.scenario import camera_scenarios
+
+METHODS = ("depth", "svd", "random", "center")
+
+
+@pytest.fixture(scope="module")
+def recorded():
+    """One run of each method in the interior scenario (quick profile)."""
+    cfg = camera_scenarios(load_config(overlays=["config/quick.yaml"])["landing"])["interior"]
+    rec = {m: run_chunk(cfg, m, [1]) for m in METHODS}
+    return build_scenario(cfg), rec
+
+
+@given(st.integers(0, 2**63), st.integers(1, 50))
+@settings(max_examples=25, deadline=None)
+def test_rng_words_restore_the_stream(seed, n_draws):
+    g = np.random.default_rng(seed)
+    g.integers(7, size=n_draws % 5)          # leave it mid-stream (has_uint32 either way)
+    g.random(n_draws % 3)
+    w = timing.rng_words(g)
+    h = timing.rng_from_words(w)
+    np.testing.assert_array_equal(g.integers(1000, size=n_draws), h.integers(1000, size=n_draws))
+
+
+@given(st.integers(0, 5000), st.integers(0, 6000))
+def test_select_calls_evenly_spaced_distinct(n, m):
+    idx = timing.select_calls(n, m)
+    want = n if m == 0 or m >= n else m
+    assert len(idx) == want and len(np.unique(idx)) == want
+    assert np.all(np.diff(idx) > 0) and (want == 0 or (idx[0] == 0 and idx[-1] < n))
+
+
+def test_replay_reproduces_every_recorded_pick(recorded):
+    """Every own call replayed (max_calls = 0): the replayed pick is the recorded one."""
+    scn, rec = recorded
+    tm = timing.replay(scn, {m: rec[m] for m in ("depth", "random", "center")},
+                       ["depth", "random", "center"], max_calls=0)
+    n = sum(len(rec[m]["plan_index"]) for m in ("depth", "random", "center"))
+    assert len(tm["source"]) == n and tm["checked"].sum() == n
+    assert tm["mismatch"].tolist() == [0, 0, 0]
+    assert (tm["wall_ns"] > 0).all() and (tm["cpu_ns"] >= 0).all()
+
+
+def test_the_pick_check_can_fail(recorded):
+    """Replaying from the wrong filter step (the wrong image) or without the
+    excluded landmark changes picks: the check counts them."""
+    scn, rec = recorded
+    for key, bad in (("plan_step", lambda x: x + 3), ("plan_exclude", lambda x: np.full_like(x, -1))):
+        d = dict(rec["depth"])
+        d[key] = bad(d[key])
+        tm = timing.replay(scn, {"depth": d}, ["depth"], max_calls=0)
+        assert tm["mismatch"][0] > 0, key
+
+
+def test_replay_deterministic_and_order_independent(recorded):
+    """Same inputs, same picks, whatever the method order or the subset; the
+    H baseline is timed on both paths with the same picks; the rotation puts
+    every variant first in turn."""
+    scn, rec = recorded
+    a = timing.replay(scn, rec, list(METHODS), max_calls=12)
+    b = timing.replay(scn, rec, list(METHODS)[::-1], max_calls=12)
+    full = timing.replay(scn, rec, ["svd"], max_calls=0)
+    assert a["mismatch"].sum() == 0 and b["mismatch"].sum() == 0
+    for m in METHODS:
+        ja = timing._variant(a, m, "main")
+        jb = timing._variant(b, m, "main")
+        np.testing.assert_array_equal(a["pick"][:, ja], b["pick"][:, jb], err_msg=m)
+    np.testing.assert_array_equal(a["pick"][:, timing._variant(a, "svd", "alt")],
+                                  a["pick"][:, timing._variant(a, "svd", "main")])
+    # the subset's calls are the full pool's calls at the selected indices
+    sel = timing.select_calls(int(a["n_pool"]), 12)
+    pool_src = np.concatenate([np.full(len(rec[m]["plan_index"]), i) for i, m in enumerate(METHODS)])
+    np.testing.assert_array_equal(a["source"], pool_src[sel])
+    svd_calls = a["source"] == list(METHODS).index("svd")
+    np.testing.assert_array_equal(a["pick"][svd_calls, timing._variant(a, "svd", "main")],
+                                  full["pick"][a["call"][svd_calls], 0])
+    nv = a["wall_ns"].shape[1]
+    assert set(a["slot"][:, 0][:nv]) == set(range(nv))
+
+
+def _fake_timing(wall_us: dict, cpu_us: dict, runs):
+    """A replay result with given per-call times (us) per method (main path)."""
+    return timing.from_times({m: np.asarray(v) * 1e3 for m, v in wall_us.items()},
+                             {m: np.asarray(v) * 1e3 for m, v in cpu_us.items()}, runs, n_evals=7)
+
+
+def test_time_reduction_known_answer_and_paired_bootstrap():
+    rng = np.random.default_rng(0)
+    b = rng.lognormal(6.0, 0.5, 200)
+    runs = np.repeat(np.arange(20), 10)
+    tm = _fake_timing({"depth": b / 2, "svd": b}, {"depth": b / 2, "svd": b}, runs)
+    red, sd = timing.time_reduction(tm, "depth", "svd", n_boot=100)
+    assert red == pytest.approx(50.0, abs=0.01)
+    assert sd < 0.01          # paired: every resample halves the median exactly
+    red_cpu, sd_cpu = timing.time_reduction(tm, "svd", "depth", clock="cpu", n_boot=0)
+    assert red_cpu == pytest.approx(-100.0, abs=0.05) and np.isnan(sd_cpu)
+
+
+def test_b_t3_and_ranking_read_the_replayed_times(recorded):
+    """The tables' time columns are the replay's, not the descent's clocks: with
+    replayed times that make svd 4x faster than depth, B-T3 reports a negative
+    reduction and the ranking puts svd first in time."""
+    from opnav.landing.ranking import ranking_table
+
+    _, rec = recorded
+    data = {m: copy.copy(rec[m]) for m in ("depth", "svd")}
+    n = 40
+    runs = np.repeat(np.arange(8), 5)
+    tm = _fake_timing({"depth": np.full(n, 400.0), "svd": np.full(n, 100.0)},
+                      {"depth": np.full(n, 380.0), "svd": np.full(n, 90.0)}, runs)
+    t = summary_table(data, tm, published_reduction_vs_svd=29.03).set_index("method")
+    assert t.loc["depth", "median_plan_time_us"] == pytest.approx(400.0)
+    assert t.loc["svd", "median_plan_cpu_us"] == pytest.approx(90.0)
+    assert t.loc["depth", "time_reduction_vs_svd_pct"] == pytest.approx(-300.0)
+    assert t.loc["depth", "cpu_time_reduction_vs_svd_pct"] == pytest.approx(100 * (1 - 380 / 90))
+    assert t.loc["depth", "timed_calls"] == n
+    r = ranking_table(data, tm, "depth", n_boot=0).set_index("method")
+    assert r.loc["svd", "rank_time"] == 1 and r.loc["depth", "rank_time"] == 2
+    assert r.loc["svd", "cpu_time_ratio_to_ref"] == pytest.approx(90 / 380)
+    with pytest.raises(ValueError, match="did not time"):
+        summary_table({**data, "center": rec["center"]}, tm)
+
+
+def test_b_f7_boxes_are_the_replayed_times():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from opnav.landing.plots import fig_planning_time
+
+    runs = np.repeat(np.arange(4), 5)
+    tm = _fake_timing({"depth": np.full(20, 123.0), "svd": np.full(20, 4567.0)},
+                      {"depth": np.full(20, 120.0), "svd": np.full(20, 4000.0)}, runs)
+    fig = fig_planning_time(tm, ["depth", "svd"], 29.03)
+    ax = fig.axes[0]
+    notes = sorted(t.get_text() for t in ax.texts)
+    assert notes == ["123", "4567"]
+    assert "97.3 % less" in ax.get_title()        # 100 (1 - 123 / 4567)

@@ -1,0 +1,26 @@
+# Paper B planning time by replay (opnav.landing.timing): the planning inputs recorded by
+# every method's Monte Carlo of a camera scenario are replayed through every method's
+# planning call, one call at a time, interleaved across methods in one process. B-F7,
+# B-T3 and the B-X1 time columns read its output, not the descents' clocks.
+# Included after landing_extra.smk (reuses LANDING, B_SIMS, B_SRC, X1_METHODS, b_mc).
+
+
+rule landing_timing:
+    """Planning times of every method on the same recorded planning calls of one scenario."""
+    input:
+        mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
+        code=B_SRC + src("landing/timing.py"),
+    output:
+        f"{LANDING}/timing/{{bscn}}.npz",
+    wildcard_constraints:
+        bscn=B_SCN_RE,
+    params:
+        landing=lambda wc: B_SIMS[wc.bscn],
+        methods=X1_METHODS,
+        max_calls=config["landing"]["timing"]["max_calls"],
+    log:
+        f"{LANDING}/logs/timing_{{bscn}}.log",
+    benchmark:
+        f"{LANDING}/benchmarks/timing_{{bscn}}.tsv"
+    script:
+        "../scripts/landing_timing.py"

@@ -1,0 +1,22 @@
+"""Planning time by replay of one camera scenario (opnav.landing.timing.replay)."""
+
+from opnav.landing import timing
+from opnav.landing.descent import build_scenario
+from opnav.landing.montecarlo import load
+from opnav.snakeio import mock_snakemake, script_context
+
+if "snakemake" not in globals():  # standalone debugging run
+    _m = ["depth", "svd", "gdop", "cond"]
+    snakemake = mock_snakemake(input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in _m]},
+                               output=["results/landing/timing/site-tilt.npz"])
+    snakemake.params = type("P", (), {"methods": _m, "max_calls": 1000,
+                                      "landing": snakemake.config["landing"]})()
+
+with script_context(snakemake) as log:
+    methods = list(snakemake.params.methods)
+    recorded = {m: load(p) for m, p in zip(methods, snakemake.input.mc)}
+    tm = timing.replay(build_scenario(snakemake.params.landing), recorded, methods,
+                       int(snakemake.params.max_calls))
+    timing.save(snakemake.output[0], tm)
+    log.info("%s", timing.method_text(tm))
+    log.info("%s", timing.summary_frame(tm).to_string())
