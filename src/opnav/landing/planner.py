@@ -468,8 +468,8 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     if detected is None:
         detected = np.flatnonzero(visible(field_.xyz))
     cand = np.sort(np.asarray(detected, np.int64))
-    if exclude:
-        cand = cand[~np.isin(cand, np.fromiter(exclude, np.int64))]
+    for e in exclude:          # (at most a few: a mask per element, not np.isin's sort)
+        cand = cand[cand != e]
     c0 = _thread_ns()
     res, fun, vals = _plan(method, state, camera, field_, visible, cfg, exclude, rng, cand)
     res.cpu_ns = _thread_ns() - c0

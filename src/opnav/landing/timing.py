@@ -412,10 +412,12 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     times it) and, in the same process, its objective evaluations alone: the
     objective the call builds (``planner.OBJECTIVES[method]``) evaluated at the
     betas the call's golden-section searches evaluate (recorded by a first,
-    untimed pass), in a plain loop. Each is the minimum over ``repeats``
-    (thread CPU clock, ns). Returns per call ``call_ns``, ``evals_ns``,
-    ``n_evals`` (scalar evaluations; edge-rule batch scoring is counted in the
-    call, not in the evaluations) and ``overhead_ratio = (call - evals) / evals``.
+    untimed pass), in a plain loop, plus, for a call whose search ended on the
+    edge of the visible interval, the objective's batch scoring of the detected
+    landmarks (edge rule: metric evaluations too). Each is the minimum over
+    ``repeats`` (thread CPU clock, ns). Returns per call ``call_ns``,
+    ``evals_ns``, ``n_evals`` (scalar evaluations plus landmarks scored),
+    ``edge`` and ``overhead_ratio = (call - evals) / evals``.
     """
     from opnav.landing import planner as pl
     from opnav.landing.depth_error import plane_geometry
@@ -424,7 +426,7 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     sel = select_calls(len(d["plan_step"]), max_calls)
     cam, field_, tr, cfg = scn.camera, scn.field, scn.truth, scn.planner
     thread = time.thread_time_ns
-    call_ns, evals_ns, n_ev = [], [], []
+    call_ns, evals_ns, n_ev, edges = [], [], [], []
     build = pl.OBJECTIVES[method]
     gc_was = gc.isenabled()
     gc.disable()
@@ -454,20 +456,25 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
 
             for a, b in ivs:
                 pl.golden_section(spy, a, b, cfg.tol_rad)
+            cand = det[~np.isin(det, list(exclude))] if exclude else det
+            pts = field_.xyz[cand]
             best_call = best_eval = None
             for _ in range(max(int(repeats), 1)):
                 c0 = thread()
-                pl.plan(method, state, cam, field_, visible, cfg, exclude=exclude, rng=None,
-                        detected=det, diagnose=False)
+                res = pl.plan(method, state, cam, field_, visible, cfg, exclude=exclude, rng=None,
+                              detected=det, diagnose=False)
                 c1 = thread()
                 for b in betas:
                     f(b)
+                if res.edge and cand.size:
+                    f.batch(pts)
                 c2 = thread()
                 best_call = c1 - c0 if best_call is None else min(best_call, c1 - c0)
                 best_eval = c2 - c1 if best_eval is None else min(best_eval, c2 - c1)
             call_ns.append(best_call)
             evals_ns.append(best_eval)
-            n_ev.append(len(betas))
+            n_ev.append(len(betas) + (int(cand.size) if res.edge else 0))
+            edges.append(bool(res.edge))
     finally:
         if gc_was:
             gc.enable()
@@ -475,4 +482,4 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = (call_ns - evals_ns) / evals_ns
     return {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": np.asarray(n_ev, np.int64),
-            "overhead_ratio": ratio}
+            "edge": np.asarray(edges, bool), "overhead_ratio": ratio}
