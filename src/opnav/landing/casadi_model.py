@@ -61,6 +61,8 @@ from functools import lru_cache
 import casadi as ca
 import numpy as np
 
+from opnav.rotations import skew
+
 #: column slices of the 12-state layout [r, v, dtheta, p_cand]
 SL_R = slice(0, 3)
 SL_V = slice(3, 6)
@@ -70,18 +72,10 @@ N_STATE = 12
 N_MEAS = 6
 
 
-def _skew(a):
-    return ca.vertcat(
-        ca.horzcat(0, -a[2], a[1]),
-        ca.horzcat(a[2], 0, -a[0]),
-        ca.horzcat(-a[1], a[0], 0),
-    )
-
-
 def _cayley(a):
     """Rotation matrix of the Cayley map: ((1-|a|^2) I + 2 a a^T + 2 [a x]) / (1 + |a|^2)."""
     n2 = ca.dot(a, a)
-    return ((1 - n2) * ca.SX.eye(3) + 2 * (a @ a.T) + 2 * _skew(a)) / (1 + n2)
+    return ((1 - n2) * ca.SX.eye(3) + 2 * (a @ a.T) + 2 * ca.skew(a)) / (1 + n2)
 
 
 @lru_cache(maxsize=None)
@@ -158,19 +152,6 @@ def jacobian_casadi_batch(r_L, v_L, p_known_L, cand_L, R_LtoB, parallelization="
 # --------------------------------------------------------------------------
 
 
-def skew_np(a: np.ndarray) -> np.ndarray:
-    """[a x] for a of shape (..., 3) -> (..., 3, 3)."""
-    a = np.asarray(a, dtype=float)
-    S = np.zeros(a.shape[:-1] + (3, 3))
-    S[..., 0, 1] = -a[..., 2]
-    S[..., 0, 2] = a[..., 1]
-    S[..., 1, 0] = a[..., 2]
-    S[..., 1, 2] = -a[..., 0]
-    S[..., 2, 0] = -a[..., 1]
-    S[..., 2, 1] = a[..., 0]
-    return S
-
-
 def bearings_numpy(r_L, p_L, R_LtoB) -> np.ndarray:
     """Unit bearings in {B} to landmarks p_L (..., 3) from r_L (paper eq. 12, dtheta = 0)."""
     d = np.asarray(p_L, dtype=float) - np.asarray(r_L, dtype=float)
@@ -187,7 +168,7 @@ def _blocks(r_L, p_L, R_LtoB):
     P = np.eye(3) - u[..., :, None] * u[..., None, :]
     HC = (R @ P) / rho[..., None, None]  # eq. 18: C (|r|^2 I - r r^T) / |r|^3
     b = u @ R.T
-    return HC, skew_np(b)  # eq. 16: H_C [r x] C^T = [b x]
+    return HC, skew(b)  # eq. 16: H_C [r x] C^T = [b x]
 
 
 def jacobian_numpy(r_L, v_L, p_known_L, cand_L, R_LtoB) -> np.ndarray:

@@ -78,6 +78,7 @@ from opnav.landing.planner import PlanState, plan, plan_batch
 from opnav.landing.scenario import Scenario, build_scenario
 from opnav.landing.timing import RECORD_KEYS, record_plan_inputs, stack_plan_inputs
 from opnav.landing.trajectory import euler_rpy_deg
+from opnav.rotations import exp_so3
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
            "yaw_sigma_rad", "tracking_step"]
@@ -199,7 +200,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     P0[:9, :9] = np.diag(np.repeat([br**2 / 3, bv**2 / 3, bt**2 / 3], 3))
     P0[9:, 9:] = np.eye(3) * 1e8      # dormant until the first landmark is initialised
     st = ekf.NavState(r=tr.r[0] - e0[:, 0:3], v=tr.v[0] - e0[:, 3:6],
-                      R=imu.exp_batch(e0[:, 6:9]) @ tr.R_LtoB[0], p=np.zeros((B, 3)),
+                      R=exp_so3(e0[:, 6:9]) @ tr.R_LtoB[0], p=np.zeros((B, 3)),
                       P=np.broadcast_to(P0, (B, 12, 12)).copy())
     n = scn.n_steps
     err_r = np.empty((B, n + 1, 3))
@@ -364,5 +365,5 @@ def _plan_runs(scn: Scenario, method: str, states: PlanState, visible, cur: np.n
 
 def _est_rpy(R_true: np.ndarray, dth: np.ndarray) -> np.ndarray:
     """Estimated roll/pitch/yaw (deg) from the truth and dtheta (R_est = Exp(dtheta) R_true)."""
-    R_est = imu.exp_batch(dth) @ R_true
+    R_est = exp_so3(dth) @ R_true
     return euler_rpy_deg(R_est)

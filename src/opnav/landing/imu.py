@@ -35,15 +35,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-__all__ = ["synthesize", "add_noise", "Preintegrated", "preintegrate", "dead_reckon",
-           "exp_batch"]
+from opnav.rotations import exp_so3, log_so3
 
-
-def exp_batch(phi: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) of rotation vectors ``phi`` (n, 3), rad."""
-    return Rotation.from_rotvec(np.asarray(phi, float).reshape(-1, 3)).as_matrix()
+__all__ = ["synthesize", "add_noise", "Preintegrated", "preintegrate", "dead_reckon"]
 
 
 def synthesize(v: np.ndarray, R_LtoB: np.ndarray, dt: float, g) -> tuple[np.ndarray, np.ndarray]:
@@ -53,8 +48,8 @@ def synthesize(v: np.ndarray, R_LtoB: np.ndarray, dt: float, g) -> tuple[np.ndar
         raise ValueError(f"IMU step must be positive, got {dt}")
     R_BtoL = np.swapaxes(np.asarray(R_LtoB, float), 1, 2)
     dR = np.einsum("nji,njk->nik", R_BtoL[:-1], R_BtoL[1:])     # R_k^T R_{k+1}
-    w = Rotation.from_matrix(dR).as_rotvec() / dt
-    R_mid = R_BtoL[:-1] @ exp_batch(w * dt / 2)
+    w = log_so3(dR) / dt
+    R_mid = R_BtoL[:-1] @ exp_so3(w * dt / 2)
     acc = (v[1:] - v[:-1]) / dt - np.asarray(g, float)
     f = np.einsum("nji,nj->ni", R_mid, acc)                      # R_mid^T acc
     return f, w
@@ -92,7 +87,7 @@ def preintegrate(f: np.ndarray, w: np.ndarray, dt: float, n_sub: int) -> Preinte
     dv = np.zeros((m, 3))
     dp = np.zeros((m, 3))
     for k in range(n_sub):
-        half = exp_batch(W[:, k] * dt / 2)
+        half = exp_so3(W[:, k] * dt / 2)
         R_mid = dR @ half
         inc = np.einsum("mij,mj->mi", R_mid, F[:, k]) * dt
         dp += dv * dt + 0.5 * inc * dt

@@ -20,7 +20,7 @@ rotation applied on the body side::
 
     R_LtoB_true = Exp(-dtheta) @ R_LtoB_est  ~=  (I - [dtheta x]) @ R_LtoB_est
 
-where ``Exp(phi) = scipy.spatial.transform.Rotation.from_rotvec(phi).as_matrix()``
+where ``Exp(phi) = opnav.rotations.exp_so3(phi)`` (= ``Rotation.from_rotvec(phi).as_matrix()``)
 and ``[a x]`` is the cross-product matrix. Equivalently
 ``R_BtoL_true = R_BtoL_est @ Exp(dtheta)``. This is the paper's
 ``dq = q (x) q_hat^-1 ~= [dtheta/2, 1]`` with JPL quaternions, and it is the
@@ -43,32 +43,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["skew", "exp_so3", "bearing", "bearing_jacobian", "BehindCameraError"]
+from opnav.rotations import skew
+
+__all__ = ["bearing", "bearing_jacobian", "BehindCameraError"]
 
 
 class BehindCameraError(ValueError):
     """The landmark coincides with the lander (zero range): no bearing exists."""
-
-
-def skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrix ``[a x]`` with ``skew(a) @ b == np.cross(a, b)``."""
-    a = np.asarray(a, dtype=float)
-    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-
-
-def exp_so3(phi: np.ndarray) -> np.ndarray:
-    """Rotation matrix of the rotation vector ``phi`` (rad), Rodrigues' formula.
-
-    Same as ``Rotation.from_rotvec(phi).as_matrix()`` (active rotation), written
-    out because it is called in the filter's inner loop.
-    """
-    phi = np.asarray(phi, dtype=float)
-    th2 = float(phi @ phi)
-    K = skew(phi)
-    if th2 < 1e-16:
-        return np.eye(3) + K + 0.5 * (K @ K)
-    th = np.sqrt(th2)
-    return np.eye(3) + (np.sin(th) / th) * K + ((1.0 - np.cos(th)) / th2) * (K @ K)
 
 
 def _rho(r_L: np.ndarray, p_L: np.ndarray) -> np.ndarray:
