@@ -54,6 +54,7 @@ import pandas as pd
 from scipy.spatial.transform import Rotation
 
 from opnav.landing import casadi_model as cm
+from opnav.landing import measurement as me
 from opnav.landing.metrics import METRIC_NAMES, MetricContext, make_metric
 
 IMPLEMENTATIONS = (
@@ -150,7 +151,7 @@ def run_jacobian(n: int = 50, reps: int = 30, seed: int = 0) -> pd.DataFrame:
         "casadi_per_cand": lambda: [cm.jacobian_casadi(*args, p, R) for p in cand],
         "casadi_map_serial": lambda: cm.jacobian_casadi_batch(*args, cand, R, "serial"),
         "casadi_map_thread": lambda: cm.jacobian_casadi_batch(*args, cand, R, "thread"),
-        "numpy": lambda: cm.jacobian_numpy(*args, cand, R),
+        "numpy": lambda: me.selection_jacobian(kw["r_L"], R, kw["p_known_L"], cand),
     }
     rows = []
     for k, f in routes.items():

@@ -1,12 +1,16 @@
-"""Finite-difference checks of the bearing Jacobians (paper B eq. 15-18) and of
-the attitude-error convention R_LtoB_true = Exp(-dtheta) R_LtoB_est."""
+"""Finite-difference checks of the bearing Jacobians (paper B eq. 15-18), of
+the attitude-error convention R_LtoB_true = Exp(-dtheta) R_LtoB_est, and of the
+batched / tangent-plane forms of opnav.landing.measurement (the one numpy home
+of eq. 12-18; its CasADi cross-check is in test_landing_metrics.py)."""
 
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 
-from opnav.landing.measurement import BehindCameraError, bearing, bearing_jacobian
+from opnav.landing.measurement import (BehindCameraError, bearing, bearing_jacobian,
+                                       selection_jacobian, tangent_basis, tangent_jacobian,
+                                       tangent_jacobian_scalar)
 from opnav.rotations import exp_so3, skew
 
 
@@ -57,3 +61,64 @@ def test_zero_range_is_a_clear_error():
         bearing(np.zeros(3), np.eye(3), np.zeros(3))
     with pytest.raises(ValueError):
         bearing(np.array([np.nan, 0, 0]), np.eye(3), np.zeros(3))
+
+
+def _batch(seed, shape):
+    rng = np.random.default_rng(seed)
+    r = rng.uniform(-5000, 5000, shape + (3,)) + np.array([0, 0, 6000.0])
+    p = np.concatenate([rng.uniform(-8000, 8000, shape + (2,)), np.zeros(shape + (1,))], axis=-1)
+    R = Rotation.random(int(np.prod(shape)), random_state=seed).as_matrix().reshape(shape + (3, 3))
+    return r, R, p
+
+
+def test_jacobians_batch_over_leading_dims_with_the_bits_of_one_at_a_time():
+    """runs x candidates: the same numbers as one landmark at a time (a batched
+    caller reproduces a sequential one), broadcasting a per-run pose."""
+    r, R, p = _batch(7, (3, 4))
+    Hr, Ht, Hp = bearing_jacobian(r[:, :1], R[:, :1], p)     # pose (3, 1) broadcast over 4 candidates
+    assert Hr.shape == (3, 4, 3, 3)
+    for i in range(3):
+        for j in range(4):
+            one = bearing_jacobian(r[i, 0], R[i, 0], p[i, j])
+            for got, want in zip((Hr[i, j], Ht[i, j], Hp[i, j]), one):
+                assert np.array_equal(got, want)
+            assert np.array_equal(bearing(r[:, :1], R[:, :1], p)[i, j], bearing(r[i, 0], R[i, 0], p[i, j]))
+
+
+def test_eq16_identity_and_selection_jacobian_layout():
+    """H_theta = H_C [rho x] R^T (eq. 16 as printed) = [b x]; H rows of the
+    known landmark have no landmark columns; v columns are zero."""
+    r, R, p = _case(5)
+    Hr, Ht, Hp = bearing_jacobian(r, R, p)
+    rho = p - r
+    np.testing.assert_allclose(Ht, Hp @ skew(rho) @ R.T, atol=1e-13)
+    pk = np.array([10.0, -20.0, 0.0])
+    H = selection_jacobian(r, R, pk, np.stack([p, p + 100.0]))
+    assert H.shape == (2, 6, 12)
+    assert np.all(H[:, :, 3:6] == 0) and np.all(H[:, 0:3, 9:12] == 0)
+    Hk = bearing_jacobian(r, R, pk)
+    assert np.array_equal(H[0, 0:3, 0:3], Hk[0]) and np.array_equal(H[0, 0:3, 6:9], Hk[1])
+    assert np.array_equal(H[0, 3:6, 0:3], Hr) and np.array_equal(H[0, 3:6, 9:12], Hp)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10_000), st.floats(0.1, 1e4))
+def test_tangent_jacobian_is_the_projected_candidate_rows(seed, scale):
+    """G = scale T^T H_c with T = R [t1, t2] orthonormal and orthogonal to b; its
+    float-arithmetic twin gives the same bits."""
+    r, R, p = _batch(seed, (5,))
+    p[0] = r[0] + np.array([1e-3, -2e-3, -3000.0])        # near-nadir: the e_x branch
+    G = tangent_jacobian(r, R, p, scale)
+    u = (p - r) / np.linalg.norm(p - r, axis=1)[:, None]
+    t1, t2 = tangent_basis(u)
+    np.testing.assert_allclose(np.einsum("ni,ni->n", t1, u), 0, atol=1e-15)
+    np.testing.assert_allclose(np.einsum("ni,ni->n", t2, u), 0, atol=1e-15)
+    np.testing.assert_allclose(np.linalg.norm(t1, axis=1), 1, atol=1e-15)
+    TB = np.stack([t1, t2], axis=-1)                       # (n, 3, 2) in {L}
+    H = selection_jacobian(r, R, np.zeros(3), p)[:, 3:6]   # candidate rows
+    want = scale * np.swapaxes(R @ TB, -1, -2) @ H
+    np.testing.assert_allclose(G, want, rtol=0, atol=1e-12 * np.abs(want).max())
+    for k in range(5):
+        d = (p[k] - r[k]).tolist()
+        rho = float(np.sqrt(np.sum((p[k] - r[k]) ** 2)))
+        assert np.array_equal(tangent_jacobian_scalar(R[k].tolist(), *d, rho, scale), G[k])

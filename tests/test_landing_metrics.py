@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from opnav.landing import casadi_model as cm
+from opnav.landing import measurement as me
 from opnav.rotations import skew
 from opnav.landing.metrics import (
     H_METRICS,
@@ -152,7 +153,7 @@ def test_jacobian_blocks_are_paper_eq_15_to_18():
 def test_numpy_and_map_jacobians_equal_casadi_function(r, R, seed):
     rng = np.random.default_rng(seed)
     cand = _ground(rng, 5)
-    Hn = cm.jacobian_numpy(r, V0, np.zeros(3), cand, R)
+    Hn = me.selection_jacobian(r, R, np.zeros(3), cand)
     Hm = cm.jacobian_casadi_batch(r, V0, np.zeros(3), cand, R)
     Hr = np.stack([cm.jacobian_casadi(r, V0, np.zeros(3), p, R) for p in cand])
     np.testing.assert_allclose(Hn, Hr, rtol=0, atol=1e-10 * np.abs(Hr).max())
@@ -185,9 +186,9 @@ def test_H_has_structural_rank_four(r, R, seed):
     ``cond`` use the 4 structural singular values)."""
     rng = np.random.default_rng(seed)
     cand = _ground(rng, 4)
-    H = cm.jacobian_numpy(r, V0, np.zeros(3), cand, R)
+    H = me.selection_jacobian(r, R, np.zeros(3), cand)
     b = np.concatenate(
-        [np.broadcast_to(cm.bearings_numpy(r, np.zeros(3), R), (4, 3)), cm.bearings_numpy(r, cand, R)], axis=1
+        [np.broadcast_to(me.bearing(r, R, np.zeros(3)), (4, 3)), me.bearing(r, R, cand)], axis=1
     )
     np.testing.assert_allclose(np.einsum("ni,nij->nj", b[:, :3], H[:, :3]), 0, atol=1e-14)
     np.testing.assert_allclose(np.einsum("ni,nij->nj", b[:, 3:], H[:, 3:]), 0, atol=1e-14)
@@ -239,7 +240,7 @@ def test_batched_scalar_and_map_equal_reference(name, r, R, seed, aniso):
     if name == "mineig":
         # eigvalsh on the mixed-unit information (entries 1e-7..1e7) has absolute
         # error ~eps * ||Lambda||; the fast path goes through the posterior covariance
-        Lam = np.linalg.inv(ctx.P) + 2 * (cm.jacobian_numpy(r, V0, np.zeros(3), cand, R) ** 2).sum() / SIG_BEARING**2
+        Lam = np.linalg.inv(ctx.P) + 2 * (me.selection_jacobian(r, R, np.zeros(3), cand) ** 2).sum() / SIG_BEARING**2
         atol = 1e3 * np.finfo(float).eps * np.abs(Lam).max()
         rtol = 1e-6
     elif name == "logdet":
@@ -400,10 +401,10 @@ def test_information_metrics_against_50_digit_reference():
     rng = np.random.default_rng(0)
     ctx = _ctx(r=r, R=R, rng=rng)
     cand = _ground(rng, 3)
-    H = cm.jacobian_numpy(r, V0, np.zeros(3), cand, R)
-    ld, me = make_metric("logdet"), make_metric("mineig")
-    fast = (ld(ctx, cand), me(ctx, cand))
-    scal = ([ld.scalar(ctx, p) for p in cand], [me.scalar(ctx, p) for p in cand])
+    H = me.selection_jacobian(r, R, np.zeros(3), cand)
+    ld, mi = make_metric("logdet"), make_metric("mineig")
+    fast = (ld(ctx, cand), mi(ctx, cand))
+    scal = ([ld.scalar(ctx, p) for p in cand], [mi.scalar(ctx, p) for p in cand])
     for i in range(3):
         Lam = mp.matrix(ctx.P.tolist()) ** -1 + mp.matrix(H[i].T.tolist()) * mp.matrix(
             np.linalg.inv(ctx.R_meas).tolist()
@@ -508,3 +509,31 @@ def test_paper_baselines_rank_identically_and_whitened_ones_do_not():
     assert spearmanr(sc["svd"], sc["cond"])[0] > 0.999999
     assert spearmanr(sc["svd_w"], sc["cond_w"])[0] < 0.99
     assert spearmanr(sc["svd"], sc["svd_w"])[0] < 0.99
+
+
+@pytest.mark.parametrize("name", METRIC_NAMES)
+def test_batch_over_runs_equals_each_context_alone(name):
+    """Metric.batch on R planning contexts (runs) x n candidates, ragged lists
+    padded with a mask, gives each run's own numbers (the batched descent's
+    call); one run with correlated R_meas mixes the tangent and generic paths,
+    one has a boresight that puts some candidates behind the camera."""
+    from opnav.landing.metrics import stack_contexts
+
+    rng = np.random.default_rng(17)
+    bs = np.array([0.0, 0.0, -1.0])
+    ctxs = [_ctx(r=R0 + rng.normal(0, 300, 3), R=Rotation.random(random_state=k).as_matrix(), rng=rng,
+                 R_meas=_aniso_R(rng) if k == 1 else None, boresight=bs) for k in range(3)]
+    cand = np.stack([_ground(rng, 6) for _ in ctxs])
+    mask = np.ones((3, 6), bool)
+    mask[2, 4:] = False
+    cand[2, 5] = np.nan                                   # padding may hold anything
+    m = make_metric(name)
+    got = m.batch(stack_contexts(ctxs), cand, mask)
+    assert got.shape == (3, 6) and m.n_evals == 16
+    for k, ctx in enumerate(ctxs):
+        n = int(mask[k].sum())
+        want = m(ctx, cand[k, :n])
+        np.testing.assert_allclose(got[k, :n], want, rtol=1e-12, atol=0)
+        assert np.all(got[k, n:] == -np.inf)
+    with pytest.raises(ValueError):
+        m.batch(ctxs, cand[:2])

@@ -1,1 +1,45 @@
-"""Paper B: Mars powered descent, vision-aided inertial EKF, landmark selection."""
+"""Paper B: Mars powered descent, vision-aided inertial EKF, landmark selection.
+
+Li, Wang, Dong, Li, Xu (J. Deep Space Explor. 2023): landmark selection by the
+depth estimation error, compared with SVD / GDOP / condition-number baselines.
+
+Equation -> function (each equation has one home; the modules' docstrings give
+the derivations, conventions and tests)
+-----------------------------------------------------------------------------
+
+=========  ==========================================================  ===============================
+eq.        function                                                    units
+=========  ==========================================================  ===============================
+1          ``trajectory.truth_states`` (truth), ``imu.apply_increment``  m, m/s, m/s^2, s
+           (r, v, attitude propagation)
+2          ``imu.synthesize``, ``imu.add_noise``, ``imu.preintegrate``    m/s^2 (specific force), rad/s
+           (IMU model; planet rotation neglected, assumption 1)
+3-5        ``ekf.NavState`` (state r, v, R_LtoB, p), error state          m, m/s, rad, m
+           [dr, dv, dtheta, dp] with ``R_true = Exp(-dtheta) R_est``
+           (``measurement`` docstring; ``opnav.rotations.exp_so3``)
+6-10       ``ekf.transition_matrix`` (Phi, eq. 8-10),                     Phi: m, s, dimensionless blocks
+           ``ekf.propagate``, ``ekf.process_noise``
+11-12      ``measurement.bearing`` (unit line of sight in {B})            dimensionless
+13         ``ekf.update`` (bearing update, noise ``camera.Camera``          rad (sigma_b = sigma_px / f)
+           ``sigma_b``)
+14         ``measurement.selection_jacobian`` (n_s = n_p = 1, 6 x 12);     1/m (r, p columns),
+           the filter stacks ``measurement.bearing_jacobian`` rows         1 (attitude columns)
+15-18      ``measurement.bearing_jacobian`` (H_r, H_theta, H_p),          1/m; H_theta dimensionless
+           ``measurement.jacobian_blocks`` (H_C, [b x]);
+           tangent-plane form ``measurement.tangent_jacobian``
+           (cross-check: ``casadi_model.jacobian_function``, CasADi)
+19-20      ``depth_error.baseline`` (estimated baseline |b|)               m
+21-22      ``depth_error.error_radius`` (r = eps_v t_s)                    m
+23-25      ``depth_error.depth_error`` / ``signed_depth_error``            m
+           (law of sines ``depth_error.depth``);
+           planner hot paths ``depth_error.depth_error_scalar``,
+           ``depth_error.depth_error_at_points``;
+           arbitrary landmarks ``depth_error.depth_error_at_landmarks``
+26         ``planner.plan`` (golden-section ``planner.golden_section``     rad (beta), m (ground point)
+           over the visible interval), plane ``depth_error.plane_geometry``,
+           ground point ``depth_error.ground_point`` /
+           ``depth_error.ground_point_scalar``
+sec. 2.2   ``metrics.make_metric`` (svd, gdop, cond from the 6 x 12 H;     1/m (svd), 1/m^2 (gdop), 1 (cond)
+           B-X1 logdet, mineig, whitened variants), ``planner.OBJECTIVES``
+=========  ==========================================================  ===============================
+"""

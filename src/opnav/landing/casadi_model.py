@@ -23,9 +23,10 @@ objects:
 * :func:`jacobian_function` -- H(r, v, p_known, p_cand, R_LtoB), 6 x 12, dtheta = 0;
 * :func:`jacobian_map` -- ``Function.map(N)`` of the latter over N candidates.
 
-and provides a vectorised numpy evaluation of the same expressions
-(:func:`jacobian_numpy`, :func:`bearings_numpy`) which the tests prove equal to
-the CasADi Function to 1e-10.
+It is the *cross-check* of the one numpy home of eq. 12-18,
+:mod:`opnav.landing.measurement` (``selection_jacobian``), which the tests
+prove equal to these Functions (tests/test_landing_metrics.py); the metrics'
+``reference`` and ``casadi_map`` paths evaluate H through it.
 
 Conventions
 -----------
@@ -49,9 +50,9 @@ candidate through one Function call from Python (call + DM -> numpy
 conversion), ~11 us per candidate through ``Function.map(50)`` ("serial";
 "thread" is ~7x slower for this tiny body, "openmp" is not compiled in this
 CasADi build and falls back to serial), and ~1 us per candidate through
-:func:`jacobian_numpy`, which is therefore the fastest faithful evaluation
-(tested equal to the Function to 1e-10 relative to max|H|).  The metrics in
-:mod:`opnav.landing.metrics` go one step further with closed forms.
+``measurement.selection_jacobian`` (numpy), which is therefore the fastest
+faithful evaluation.  The metrics in :mod:`opnav.landing.metrics` go one step
+further with closed forms.
 """
 
 from __future__ import annotations
@@ -61,15 +62,8 @@ from functools import lru_cache
 import casadi as ca
 import numpy as np
 
-from opnav.rotations import skew
-
-#: column slices of the 12-state layout [r, v, dtheta, p_cand]
-SL_R = slice(0, 3)
-SL_V = slice(3, 6)
-SL_THETA = slice(6, 9)
-SL_P = slice(9, 12)
-N_STATE = 12
-N_MEAS = 6
+# the 12-state column layout [r, v, dtheta, p_cand] and the 6 rows: one definition
+from opnav.landing.measurement import N_MEAS, N_STATE, SL_P, SL_R, SL_THETA, SL_V  # noqa: E402,F401
 
 
 def _cayley(a):
@@ -145,43 +139,3 @@ def jacobian_casadi_batch(r_L, v_L, p_known_L, cand_L, R_LtoB, parallelization="
     n = cand_L.shape[0]
     out = jacobian_map(n, parallelization)(r_L, v_L, p_known_L, cand_L.T, R_LtoB).full()
     return out.reshape(N_MEAS, n, N_STATE).transpose(1, 0, 2)
-
-
-# --------------------------------------------------------------------------
-# numpy evaluation of the same expressions (vectorised over candidates)
-# --------------------------------------------------------------------------
-
-
-def bearings_numpy(r_L, p_L, R_LtoB) -> np.ndarray:
-    """Unit bearings in {B} to landmarks p_L (..., 3) from r_L (paper eq. 12, dtheta = 0)."""
-    d = np.asarray(p_L, dtype=float) - np.asarray(r_L, dtype=float)
-    w = d @ np.asarray(R_LtoB, dtype=float).T
-    return w / np.linalg.norm(w, axis=-1, keepdims=True)
-
-
-def _blocks(r_L, p_L, R_LtoB):
-    """(H_C, [b x]) for landmarks p_L (..., 3): eq. 18 and eq. 16."""
-    R = np.asarray(R_LtoB, dtype=float)
-    d = np.asarray(p_L, dtype=float) - np.asarray(r_L, dtype=float)
-    rho = np.linalg.norm(d, axis=-1)
-    u = d / rho[..., None]
-    P = np.eye(3) - u[..., :, None] * u[..., None, :]
-    HC = (R @ P) / rho[..., None, None]  # eq. 18: C (|r|^2 I - r r^T) / |r|^3
-    b = u @ R.T
-    return HC, skew(b)  # eq. 16: H_C [r x] C^T = [b x]
-
-
-def jacobian_numpy(r_L, v_L, p_known_L, cand_L, R_LtoB) -> np.ndarray:
-    """H (n, 6, 12) for candidates cand_L (n, 3), same expressions as the
-    CasADi Function (eq. 14-18); v_L is unused (zero columns)."""
-    cand_L = np.atleast_2d(np.asarray(cand_L, dtype=float))
-    n = cand_L.shape[0]
-    HCk, Bk = _blocks(r_L, p_known_L, R_LtoB)
-    HCc, Bc = _blocks(r_L, cand_L, R_LtoB)
-    H = np.zeros((n, N_MEAS, N_STATE))
-    H[:, 0:3, SL_R] = -HCk
-    H[:, 0:3, SL_THETA] = Bk
-    H[:, 3:6, SL_R] = -HCc
-    H[:, 3:6, SL_THETA] = Bc
-    H[:, 3:6, SL_P] = HCc
-    return H

@@ -148,6 +148,7 @@ from scipy.linalg.lapack import dpotrf as _dpotrf
 from scipy.linalg.lapack import dsyev as _dsyev
 
 from opnav.landing import casadi_model as cm
+from opnav.landing import measurement as me
 
 METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig", "svd_w", "gdop_w", "cond_w")
 H_METRICS = ("svd", "gdop", "cond")
@@ -357,7 +358,8 @@ def _scores_from_sq(name, lp1, lm1, lp2, lm2):
 def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
     """The obvious linear algebra on explicit H (n, 6, 12)."""
     if name in WHITENED:
-        return _whitened_scores(name, H, ctx)
+        Ci, L = _whitening(ctx)
+        return _whitened_scores(name, Ci @ H @ L)
     if name in H_METRICS:
         s = np.linalg.svd(H, compute_uv=False)  # descending, 6 values
         if name == "svd":
@@ -374,21 +376,23 @@ def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
     return np.linalg.eigvalsh(Lam)[:, 0]
 
 
-def _info_scores_fast(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
-    """Batched information metrics: logdet by equilibrated Cholesky of the 12 x 12
-    information; mineig = 1 / lambda_max of the posterior covariance via the
-    6 x 6 innovation covariance S = R + H P H^T."""
-    P, Rm, Pinv, W = ctx._info()
+def _info_scores_fast(name: str, H: np.ndarray, info) -> np.ndarray:
+    """Batched information metrics for H (..., 6, 12) and ``info = (P, R_meas,
+    P^-1, R_meas^-1)`` (each broadcast against H's leading dimensions): logdet by
+    equilibrated Cholesky of the 12 x 12 information; mineig = 1 / lambda_max of
+    the posterior covariance via the 6 x 6 innovation covariance S = R + H P H^T."""
+    P, Rm, Pinv, W = info
+    Ht = np.swapaxes(H, -1, -2)
     if name == "logdet":
-        Lam = Pinv + np.swapaxes(H, 1, 2) @ W @ H
-        return chol_logdet(0.5 * (Lam + np.swapaxes(Lam, 1, 2)))
-    HP = H @ P  # (n, 6, 12)
-    S = HP @ np.swapaxes(H, 1, 2) + Rm
-    S = 0.5 * (S + np.swapaxes(S, 1, 2))
+        Lam = Pinv + Ht @ W @ H
+        return chol_logdet(0.5 * (Lam + np.swapaxes(Lam, -1, -2)))
+    HP = H @ P  # (..., 6, 12)
+    S = HP @ Ht + Rm
+    S = 0.5 * (S + np.swapaxes(S, -1, -2))
     K = np.linalg.solve(S, HP)  # S^-1 H P
-    Ppost = P - np.swapaxes(HP, 1, 2) @ K
-    Ppost = 0.5 * (Ppost + np.swapaxes(Ppost, 1, 2))
-    lmax = np.linalg.eigvalsh(Ppost)[:, -1]
+    Ppost = P - np.swapaxes(HP, -1, -2) @ K
+    Ppost = 0.5 * (Ppost + np.swapaxes(Ppost, -1, -2))
+    lmax = np.linalg.eigvalsh(Ppost)[..., -1]
     with np.errstate(divide="ignore"):
         return np.where(lmax > 0, 1.0 / lmax, -np.inf)
 
@@ -421,7 +425,7 @@ def _tangent_setup(ctx: MetricContext):
         if not iso:
             c["tangent"] = None
         else:
-            Hk = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, ctx.p_known_L[None], ctx.R_LtoB)[0, 0:3]
+            Hk = me.selection_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, ctx.p_known_L)[0:3]
             Lk = Pinv + Hk.T @ W[0:3, 0:3] @ Hk
             Lk = 0.5 * (Lk + Lk.T)
             ld = float(chol_logdet(Lk[None])[0])
@@ -432,79 +436,36 @@ def _tangent_setup(ctx: MetricContext):
     return c["tangent"]
 
 
-def _tangent_G(ctx: MetricContext, d: np.ndarray, rho: np.ndarray, w: float) -> np.ndarray:
-    """G = sqrt(w) T^T H_c (n, 2, 12) for candidate offsets d = p - r (n, 3)."""
-    R = ctx.R_LtoB
-    u = d / rho[:, None]
-    # t1 = normalised u x a, a the {L} axis least aligned with u; t2 = u x t1
-    a = np.zeros_like(u)
-    use_x = np.abs(u[:, 2]) > 0.9
-    a[use_x, 0] = 1.0
-    a[~use_x, 2] = 1.0
-    t1 = np.cross(u, a)
-    t1 /= np.linalg.norm(t1, axis=1)[:, None]
-    t2 = np.cross(u, t1)
-    t1B, t2B = t1 @ R.T, t2 @ R.T
-    sw = math.sqrt(w)
-    G = np.zeros((d.shape[0], 2, 12))
-    q = (sw / rho)[:, None]
-    # T^T H_C = T_L^T / rho (eq. 18), T^T [b x] = [-t2_B; t1_B] (eq. 16)
-    G[:, 0, 0:3] = -q * t1
-    G[:, 0, 6:9] = -sw * t2B
-    G[:, 0, 9:12] = q * t1
-    G[:, 1, 0:3] = -q * t2
-    G[:, 1, 6:9] = sw * t1B
-    G[:, 1, 9:12] = q * t2
-    return G
-
-
-def _tangent_scores(name: str, G: np.ndarray, Sig: np.ndarray, ld: float) -> np.ndarray:
-    GS = G @ Sig  # (n, 2, 12)
-    Q = GS @ np.swapaxes(G, 1, 2)
-    a = 1.0 + Q[:, 0, 0]
-    b = 0.5 * (Q[:, 0, 1] + Q[:, 1, 0])
-    e = 1.0 + Q[:, 1, 1] - b * b / a  # Schur complement, >= 1
+def _tangent_scores(name: str, G: np.ndarray, Sig: np.ndarray, ld) -> np.ndarray:
+    """logdet / mineig from the whitened tangent rows G (..., 2, 12)
+    (``measurement.tangent_jacobian``) and the known-landmark posterior Sigma_k
+    (..., 12, 12) with its log det ``ld`` (...), see :func:`_tangent_setup`."""
+    GS = G @ Sig  # (..., 2, 12)
+    Q = GS @ np.swapaxes(G, -1, -2)
+    a = 1.0 + Q[..., 0, 0]
+    b = 0.5 * (Q[..., 0, 1] + Q[..., 1, 0])
+    e = 1.0 + Q[..., 1, 1] - b * b / a  # Schur complement, >= 1
     if name == "logdet":
         return ld + np.log(a) + np.log(e)
     det = a * e
     Minv = np.empty_like(Q)
-    Minv[:, 0, 0] = (1.0 + Q[:, 1, 1]) / det
-    Minv[:, 1, 1] = a / det
-    Minv[:, 0, 1] = Minv[:, 1, 0] = -b / det
-    Spost = Sig - np.swapaxes(GS, 1, 2) @ Minv @ GS
-    lmax = np.linalg.eigvalsh(0.5 * (Spost + np.swapaxes(Spost, 1, 2)))[:, -1]
+    Minv[..., 0, 0] = (1.0 + Q[..., 1, 1]) / det
+    Minv[..., 1, 1] = a / det
+    Minv[..., 0, 1] = Minv[..., 1, 0] = -b / det
+    Spost = Sig - np.swapaxes(GS, -1, -2) @ Minv @ GS
+    lmax = np.linalg.eigvalsh(0.5 * (Spost + np.swapaxes(Spost, -1, -2)))[..., -1]
     with np.errstate(divide="ignore"):
         return np.where(lmax > 0, 1.0 / lmax, -np.inf)
 
 
 def _tangent_scalar(name: str, ctx: MetricContext, tg, d0: float, d1: float, d2: float, rho: float) -> float:
-    """:func:`_tangent_G` + :func:`_tangent_scores` for one candidate in floats."""
+    """:func:`_tangent_scores` for one candidate at offset d = p - r in floats,
+    G from ``measurement.tangent_jacobian_scalar``."""
     w, Sig, ld = tg
     c = ctx._cache
     if "R_rows" not in c:
         c["R_rows"] = ctx.R_LtoB.tolist()
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = c["R_rows"]
-    inv = 1.0 / rho
-    u0, u1, u2 = d0 * inv, d1 * inv, d2 * inv
-    if abs(u2) > 0.9:  # t1 = u x e_x
-        a0, a1, a2 = 0.0, u2, -u1
-    else:  # t1 = u x e_z
-        a0, a1, a2 = u1, -u0, 0.0
-    na = 1.0 / math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-    a0, a1, a2 = a0 * na, a1 * na, a2 * na
-    b0, b1, b2 = u1 * a2 - u2 * a1, u2 * a0 - u0 * a2, u0 * a1 - u1 * a0  # t2 = u x t1
-    sw = math.sqrt(w)
-    q = sw * inv
-    G = np.array(
-        [
-            [-q * a0, -q * a1, -q * a2, 0.0, 0.0, 0.0,
-             -sw * (r00 * b0 + r01 * b1 + r02 * b2), -sw * (r10 * b0 + r11 * b1 + r12 * b2),
-             -sw * (r20 * b0 + r21 * b1 + r22 * b2), q * a0, q * a1, q * a2],
-            [-q * b0, -q * b1, -q * b2, 0.0, 0.0, 0.0,
-             sw * (r00 * a0 + r01 * a1 + r02 * a2), sw * (r10 * a0 + r11 * a1 + r12 * a2),
-             sw * (r20 * a0 + r21 * a1 + r22 * a2), q * b0, q * b1, q * b2],
-        ]
-    )
+    G = me.tangent_jacobian_scalar(c["R_rows"], d0, d1, d2, rho, math.sqrt(w))
     GS = G @ Sig
     (q00, q01), (q10, q11) = (GS @ G.T).tolist()
     a = 1.0 + q00
@@ -530,11 +491,10 @@ def _whitening(ctx: MetricContext):
     return c["whiten"]
 
 
-def _whitened_scores(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
-    """The ``WHITENED[name]`` score of H_w = C^-1 H L for H (n, 6, 12)."""
-    Ci, L = _whitening(ctx)
-    Hw = Ci @ H @ L
-    if Hw.shape[0] == 1:
+def _whitened_scores(name: str, Hw: np.ndarray, exact_svd: bool = False) -> np.ndarray:
+    """The ``WHITENED[name]`` score of whitened H_w = C^-1 H L (..., 6, 12);
+    ``exact_svd``: one LAPACK SVD (the single-candidate matrix path, Hw (1, 6, 12))."""
+    if exact_svd:
         s = _dgesvd(Hw[0], compute_uv=0)[1][None, :STRUCTURAL_RANK]
     else:
         # batch: the singular values squared are the eigenvalues of the 6 x 6 Gram
@@ -552,22 +512,19 @@ def _whitened_scores(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray
 
 
 def _candidate_H(ctx: MetricContext, d0: float, d1: float, d2: float, rho: float) -> np.ndarray:
-    """H (6 x 12) of eq. 14-18 for one candidate at offset d = p - r, with the
-    known-landmark rows cached on ``ctx`` and the candidate rows written out."""
+    """H (6 x 12) of eq. 14-18 for one candidate at offset d = p - r: the
+    known-landmark rows cached on ``ctx``, the candidate rows from
+    ``measurement.jacobian_blocks`` (same values as ``measurement.selection_jacobian``)."""
     c = ctx._cache
     if "known_rows" not in c:
-        Hb = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, ctx.p_known_L[None], ctx.R_LtoB)[0]
+        Hb = me.selection_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, ctx.p_known_L)
         Hb[3:6] = 0.0
         c["known_rows"] = Hb
     H = c["known_rows"].copy()
-    R = ctx.R_LtoB
     inv = 1.0 / rho
-    u = np.array([d0 * inv, d1 * inv, d2 * inv])
-    b = R @ u
-    HC = (R - b[:, None] * u[None, :]) * inv  # eq. 18
-    b0, b1, b2 = b.tolist()
+    _, HC, Sb = me.jacobian_blocks(ctx.R_LtoB, np.array([d0 * inv, d1 * inv, d2 * inv]), inv)
     H[3:6, 0:3] = -HC  # eq. 15
-    H[3:6, 6:9] = ((0.0, -b2, b1), (b2, 0.0, -b0), (-b1, b0, 0.0))  # eq. 16: [b x]
+    H[3:6, 6:9] = Sb   # eq. 16
     H[3:6, 9:12] = HC  # eq. 17
     return H
 
@@ -579,7 +536,8 @@ def _matrix_scalar(name: str, ctx: MetricContext, d0: float, d1: float, d2: floa
     i.e. exactly the pseudo-inverse trace), or the generic 12 x 12 information."""
     H = _candidate_H(ctx, d0, d1, d2, rho)
     if name in WHITENED:
-        return float(_whitened_scores(name, H[None], ctx)[0])
+        Ci, L = _whitening(ctx)
+        return float(_whitened_scores(name, (Ci @ H @ L)[None], exact_svd=True)[0])
     if name not in H_METRICS:
         return _info_scalar(name, ctx, H)
     sv = _dgesvd(H, compute_uv=0)[1]
@@ -630,17 +588,117 @@ def _as_cands(cand_L) -> np.ndarray:
     return c
 
 
+class ContextStack:
+    """A batch of planning contexts (one :class:`MetricContext` per run) with
+    their per-run arrays stacked along a leading run axis R: ``r_L`` (R, 3),
+    ``R_LtoB`` (R, 3, 3), ``p_known_L`` (R, 3), the known line of sight ``u``
+    (R, 3) and inverse range ``x`` (R,), ``bs_L`` (R, 3) or None, ``known_ok``
+    and ``min_range`` (R,). Per-run precomputations (whitening, the
+    tangent-plane setup, the information pieces) come from each context's own
+    cache, stacked on first use. Build it once per planning step
+    (:func:`stack_contexts`) and pass it to :meth:`Metric.batch`."""
+
+    def __init__(self, ctxs):
+        self.ctxs = tuple(ctxs)
+        if not self.ctxs:
+            raise ValueError("stack_contexts: no contexts")
+        geo = [c._geom() for c in self.ctxs]
+        self.r_L = np.stack([c.r_L for c in self.ctxs])
+        self.R_LtoB = np.stack([c.R_LtoB for c in self.ctxs])
+        self.p_known_L = np.stack([c.p_known_L for c in self.ctxs])
+        self.u = np.stack([g[0] for g in geo])
+        self.x = np.array([g[1] for g in geo])
+        has_bs = [g[2] is not None for g in geo]
+        if any(has_bs) and not all(has_bs):
+            raise ValueError("stack_contexts: boresight_B must be given for every context or for none")
+        self.bs_L = np.stack([g[2] for g in geo]) if all(has_bs) else None
+        self.known_ok = np.array([g[3] for g in geo], dtype=bool)
+        self.min_range = np.array([c.min_range_m for c in self.ctxs])
+        self._per_run = {}
+
+    def __len__(self):
+        return len(self.ctxs)
+
+    def per_run(self, key: str, fn):
+        """``fn(ctx)`` for every run, computed once (cached on the stack)."""
+        if key not in self._per_run:
+            self._per_run[key] = [fn(c) for c in self.ctxs]
+        return self._per_run[key]
+
+    def stacked(self, key: str, fn):
+        """The tuple ``fn(ctx)`` of arrays stacked over runs, computed once."""
+        k = "stacked:" + key
+        if k not in self._per_run:
+            vals = self.per_run(key, fn)
+            self._per_run[k] = tuple(np.stack(v) for v in zip(*vals))
+        return self._per_run[k]
+
+
+def stack_contexts(ctxs) -> ContextStack:
+    """A :class:`ContextStack` of the contexts ``ctxs`` (one per run)."""
+    return ctxs if isinstance(ctxs, ContextStack) else ContextStack(ctxs)
+
+
+def _single_stack(ctx: MetricContext) -> ContextStack:
+    c = ctx._cache
+    if "stack" not in c:
+        c["stack"] = ContextStack((ctx,))
+    return c["stack"]
+
+
+def _pairs(st: ContextStack, c: np.ndarray, mask=None):
+    """Valid (run, candidate) pairs of candidates ``c`` (R, n, 3): ``(ok (R, n),
+    run index (K,), p (K, 3), d = p - r (K, 3), |d| (K,))``."""
+    d = c - st.r_L[:, None, :]
+    rho = np.sqrt(np.einsum("...i,...i->...", d, d))
+    ok = rho > st.min_range[:, None]
+    if st.bs_L is not None:
+        ok &= np.einsum("rni,ri->rn", d, st.bs_L) > 0.0
+    ok &= st.known_ok[:, None]
+    if mask is not None:
+        ok &= mask
+    ri = np.nonzero(ok)[0]
+    return ok, ri, c[ok], d[ok], rho[ok]
+
+
 def _valid(ctx: MetricContext, c: np.ndarray):
-    """(d2, rho2, valid mask) for candidates c (n, 3)."""
-    u, x, bs_L, known_ok = ctx._geom()
-    d2 = c - ctx.r_L
-    rho2 = np.sqrt(np.einsum("ij,ij->i", d2, d2))
-    ok = rho2 > ctx.min_range_m
-    if bs_L is not None:
-        ok &= d2 @ bs_L > 0.0
-    if not known_ok:
-        ok[:] = False
-    return d2, rho2, ok
+    """(d2, rho2, valid mask) for candidates c (n, 3) of one context."""
+    st = _single_stack(ctx)
+    d = c - ctx.r_L
+    rho = np.sqrt(np.einsum("...i,...i->...", d, d))
+    return d, rho, _pairs(st, c[None], None)[0][0]
+
+
+def _score_pairs(name: str, st: ContextStack, ri, p, d, rho) -> np.ndarray:
+    """Scores of the valid pairs (run ``ri`` (K,), candidate ``p`` (K, 3)): the
+    closed form (svd/gdop/cond), the whitened H of ``measurement.selection_jacobian``
+    (B-X1 whitened), or the information update (tangent-plane 2 x 2 update for runs
+    with isotropic candidate noise, else the generic 12 x 12 path)."""
+    if name in H_METRICS:
+        u = st.u[ri]
+        w = d / rho[:, None]
+        cr = np.cross(u, w)
+        return _scores_from_sq(name, *_structural_sq(st.x[ri], 1.0 / rho, np.einsum("ij,ij->i", w, u),
+                                                     np.einsum("ij,ij->i", cr, cr)))
+    if name in WHITENED:
+        Ci, L = st.stacked("whiten", _whitening)
+        H = me.selection_jacobian(st.r_L[ri], st.R_LtoB[ri], st.p_known_L[ri], p)
+        return _whitened_scores(name, Ci[ri] @ H @ L[ri])
+    tg = st.per_run("tangent", _tangent_setup)
+    out = np.empty(len(ri))
+    tan = np.array([t is not None for t in tg])[ri]
+    if tan.any():
+        rs = ri[tan]
+        fill = (math.nan, np.zeros((12, 12)), math.nan)
+        w, Sig, ld = (np.stack(v) for v in zip(*[t if t is not None else fill for t in tg]))
+        G = me.tangent_jacobian(st.r_L[rs], st.R_LtoB[rs], p[tan], np.sqrt(w[rs]))
+        out[tan] = _tangent_scores(name, G, Sig[rs], ld[rs])
+    if not tan.all():
+        rs = ri[~tan]
+        info = st.stacked("info", MetricContext._info)
+        H = me.selection_jacobian(st.r_L[rs], st.R_LtoB[rs], st.p_known_L[rs], p[~tan])
+        out[~tan] = _info_scores_fast(name, H, tuple(a[rs] for a in info))
+    return out
 
 
 class Metric:
@@ -678,30 +736,32 @@ class Metric:
         c = _as_cands(cand_L)
         if c.shape[0] == 1:  # the sequential golden-section case: scalar fast path
             return np.array([self.scalar(ctx, c[0])])
-        self._count(c.shape[0])
-        d2, rho2, ok = _valid(ctx, c)
-        out = np.full(c.shape[0], -np.inf)
-        if not np.any(ok):
-            return out
-        if self.name in H_METRICS:
-            u, x, _, _ = ctx._geom()
-            w = d2[ok] / rho2[ok, None]
-            y = 1.0 / rho2[ok]
-            cg = w @ u
-            cr = np.cross(u, w)
-            s2 = np.einsum("ij,ij->i", cr, cr)
-            out[ok] = _scores_from_sq(self.name, *_structural_sq(x, y, cg, s2))
-        elif self.name in WHITENED:
-            H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c[ok], ctx.R_LtoB)
-            out[ok] = _whitened_scores(self.name, H, ctx)
-        else:
-            tg = _tangent_setup(ctx)
-            if tg is not None:
-                G = _tangent_G(ctx, d2[ok], rho2[ok], tg[0])
-                out[ok] = _tangent_scores(self.name, G, tg[1], tg[2])
-            else:
-                H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c[ok], ctx.R_LtoB)
-                out[ok] = _info_scores_fast(self.name, H, ctx)
+        return self.batch(_single_stack(ctx), c[None])[0]
+
+    def batch(self, ctxs, cand_L, mask=None) -> np.ndarray:
+        """Scores (R, n) of candidates ``cand_L`` (R, n, 3) (m, {L}) for R planning
+        contexts ``ctxs`` (a sequence of :class:`MetricContext` or a
+        :class:`ContextStack`, one per run): the fastest faithful batch path
+        (closed form, or H from ``measurement`` and batched LAPACK), the same
+        numbers as ``metric(ctx_r, cand_L[r])`` run by run. ``mask`` (R, n)
+        bool marks real candidates (ragged candidate lists padded to n); masked
+        entries score -inf and may hold any value. Counts the real candidates."""
+        st = stack_contexts(ctxs)
+        c = np.asarray(cand_L, dtype=float)
+        if c.ndim != 3 or c.shape[0] != len(st) or c.shape[2] != 3:
+            raise ValueError(f"cand_L must have shape ({len(st)}, n, 3), got {c.shape}")
+        if mask is not None:
+            mask = np.asarray(mask, dtype=bool)
+            if mask.shape != c.shape[:2]:
+                raise ValueError(f"mask must have shape {c.shape[:2]}, got {mask.shape}")
+            c = np.where(mask[..., None], c, st.r_L[:, None, :])  # padding: at the lander (invalid)
+        if not np.all(np.isfinite(c)):
+            raise ValueError("cand_L must be finite")
+        self._count(int(c.shape[0] * c.shape[1] if mask is None else mask.sum()))
+        ok, ri, p, d, rho = _pairs(st, c, mask)
+        out = np.full(ok.shape, -np.inf)
+        if ri.size:
+            out[ok] = _score_pairs(self.name, st, ri, p, d, rho)
         return out
 
     # ---- minimal-overhead single candidate (golden-section inner loop) ----
@@ -804,7 +864,7 @@ class Metric:
             H = cm.jacobian_casadi_batch(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB, parallelization)
             if self.name in H_METRICS or self.name in WHITENED:
                 return _scores_from_H(self.name, H, ctx)
-            return _info_scores_fast(self.name, H, ctx)
+            return _info_scores_fast(self.name, H, ctx._info())
 
         return self._explicit(ctx, cand_L, build)
 
@@ -816,10 +876,10 @@ class Metric:
             return np.array([self.matrix_scalar(ctx, c[0])])
 
         def build(c):
-            H = cm.jacobian_numpy(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB)
+            H = me.selection_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, c)
             if self.name in H_METRICS or self.name in WHITENED:
                 return _scores_from_H(self.name, H, ctx)
-            return _info_scores_fast(self.name, H, ctx)
+            return _info_scores_fast(self.name, H, ctx._info())
 
         return self._explicit(ctx, cand_L, build)
 

@@ -23,8 +23,9 @@ Every method runs the SAME search; only the scalar objective differs:
    (low altitude: the image holds few landmarks) no landmark is chosen.
 
 Objectives (minimised) are built by a table of factories, :data:`OBJECTIVES`:
-``depth`` is the depth estimation error (eq. 23-25, scalar fast path tested
-against the vectorised :func:`~opnav.landing.depth_error.depth_error`); every
+``depth`` is the depth estimation error (eq. 23-25,
+:func:`~opnav.landing.depth_error.depth_error_scalar`, tested against the
+vectorised :func:`~opnav.landing.depth_error.depth_error`); every
 name of :data:`opnav.landing.metrics.METRIC_NAMES` (``svd``, ``gdop``,
 ``cond``, ``logdet``, ``mineig``) is the negated metric at the ground point of
 ``beta`` (``metrics.make_metric``; larger is better there). Methods without a
@@ -54,7 +55,10 @@ from typing import Callable
 import numpy as np
 
 from opnav.landing.camera import Camera
-from opnav.landing.depth_error import PlaneGeometry, baseline, error_radius, plane_geometry
+from opnav.landing import metrics
+from opnav.landing.depth_error import (DegenerateGeometry, PlaneGeometry, baseline, depth_error_at_points,
+                                       depth_error_scalar, error_radius, ground_point_scalar,
+                                       plane_geometry)
 from opnav.landing.landmarks import LandmarkField
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig",
@@ -232,55 +236,13 @@ def _visible_grid(geom, R_LtoB, camera, n_grid, margin_px):
 # ----------------------------------------------------------------- objectives
 
 def depth_objective(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, **_) -> Callable:
-    """Depth estimation error (eq. 23-25) as a scalar function of signed beta
-    (fast path of ``depth_error.signed_depth_error``; +inf outside the domain)."""
+    """Depth estimation error (eq. 23-25, ``depth_error.depth_error_scalar``) as
+    a scalar function of signed beta; ``batch`` scores landmarks
+    (``depth_error.depth_error_at_points``)."""
     b = baseline(state.v, state.a, cfg.t_s)
-    if not b > 0:
-        raise ValueError("depth error: zero baseline (zero velocity)")
     r_e = error_radius(state.P[3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
-    cd, g = geom.cd, geom.gamma
-    sin, cos, sqrt, inf = math.sin, math.cos, math.sqrt, math.inf
-    # the two sides of the velocity: alpha = pi - gamma (beta > 0), gamma (beta < 0)
-    sa = sin(g)                        # sin(alpha) on both sides
-    ca_pos, ca_neg = -math.cos(g), math.cos(g)
-    k = 2.0 * r_e / b
-    b2 = b * b
-
-    def f(beta: float) -> float:
-        if beta > 0.0:
-            ca = ca_pos
-        elif beta < 0.0:
-            ca = ca_neg
-            beta = -beta
-        else:
-            return inf
-        sb, cb = sin(beta), cos(beta)
-        s = sa * cb + ca * sb                                     # sin(alpha + beta)
-        if s <= 0.0:
-            return inf                                            # ray misses the ground
-        d = cd * sa / s                                           # law of sines
-        rks = sqrt(b2 + d * d - 2.0 * b * d * cb)                 # eq. 25
-        if rks <= 0.0:
-            return inf
-        return k * rks / sb                                       # eq. 23-24: 2 r_e / sin(theta)
-
-    C, v_hat = geom.C, geom.v_hat
-
-    def batch(points: np.ndarray) -> np.ndarray:
-        """The same depth error (m) at ground points (n, 3), vectorised: for a
-        given landmark the depth of eq. 25 is its range |p - C| (the law of
-        sines only serves the in-plane parametrisation), so
-        dr = 2 r_e |r^(k+s)| / (b sin beta) (eq. 23-24); +inf at beta = 0."""
-        lc = np.asarray(points, float) - C
-        rho = np.sqrt(np.einsum("ij,ij->i", lc, lc))
-        cb = np.clip((lc @ v_hat) / rho, -1.0, 1.0)
-        sb_ = np.sqrt(1.0 - cb * cb)
-        rk = np.sqrt(np.maximum(b2 + rho * rho - 2.0 * b * rho * cb, 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = k * rk / sb_
-        return np.where((sb_ > 0) & (points[:, 2] < C[2]), out, np.inf)
-
-    f.batch = batch
+    f = depth_error_scalar(geom, b, r_e)
+    f.batch = lambda points: depth_error_at_points(points, geom, b, r_e)
     f.ratio = _ratio_positive
     return f
 
@@ -304,33 +266,10 @@ def _ratio_log(f_pick: float, f_best: float) -> float:
 _METRIC_CACHE: dict = {}
 
 
-def _metric(name: str):
+def _metric(name: str) -> metrics.Metric:
     if name not in _METRIC_CACHE:
-        from opnav.landing import metrics
-
         _METRIC_CACHE[name] = metrics.make_metric(name)
     return _METRIC_CACHE[name]
-
-
-def _ground_fn(geom: PlaneGeometry):
-    C0, C1, C2 = (float(x) for x in geom.C)
-    v0, v1, v2 = (float(x) for x in geom.v_hat)
-    w0, w1, w2 = (float(x) for x in geom.w_hat)
-    cd, g = geom.cd, geom.gamma
-    sin, cos, pi = math.sin, math.cos, math.pi
-
-    def ground(beta: float):
-        alpha = pi - g if beta > 0 else g
-        ab = abs(beta)
-        s = sin(alpha + ab)
-        if beta == 0.0 or alpha + ab >= pi or s <= 0.0:
-            return None
-        d = cd * sin(alpha) / s
-        cb, sb = cos(beta), sin(beta)
-        return (C0 + d * (cb * v0 + sb * w0), C1 + d * (cb * v1 + sb * w1),
-                C2 + d * (cb * v2 + sb * w2))
-
-    return ground
 
 
 def metric_objective(name: str) -> Callable:
@@ -338,14 +277,12 @@ def metric_objective(name: str) -> Callable:
 
     def build(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, camera: Camera,
               sigma_b: float, **_) -> Callable:
-        from opnav.landing.metrics import MetricContext
-
         m = _metric(name)
         # inputs validated once per descent (descent.run_descent), not per call
-        ctx = MetricContext.trusted(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
+        ctx = metrics.MetricContext.trusted(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
                                     p_known_L=np.asarray(cfg.p_known, float), P=state.P,
                                     R_meas=(sigma_b**2) * _EYE6, boresight_B=camera.boresight_B)
-        ground = _ground_fn(geom)
+        ground = ground_point_scalar(geom)
         path = cfg.eval_path
         # batch scoring of landmarks (edge rule): the same computation as the search's
         # path, vectorised: closed-form singular values, or H for all + batched LAPACK
@@ -379,17 +316,9 @@ def metric_objective(name: str) -> Callable:
     return build
 
 
-def _metric_names() -> tuple[str, ...]:
-    try:
-        from opnav.landing.metrics import METRIC_NAMES
-    except ImportError:  # metrics module not available: depth only
-        return ()
-    return tuple(METRIC_NAMES)
-
-
 #: method name -> objective factory (minimised over signed beta)
 OBJECTIVES: dict[str, Callable] = {"depth": depth_objective}
-OBJECTIVES.update({n: metric_objective(n) for n in _metric_names()})
+OBJECTIVES.update({n: metric_objective(n) for n in metrics.METRIC_NAMES})
 
 def _pick_random(field_, cand, state, camera, rng) -> int:
     """A detected landmark drawn uniformly (the run's own picker stream)."""
@@ -536,9 +465,7 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
                     best = (fx, x, a, b)
         else:
             note = "no visible interval"
-    except ValueError as exc:
-        if "depth error" not in str(exc):
-            raise
+    except DegenerateGeometry as exc:
         note = str(exc)
     if math.isnan(best[1]):
         # documented fallback: the detected landmark nearest the boresight
@@ -548,7 +475,7 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
         return PlanResult(method, k, math.nan, point, math.nan, n, time.perf_counter_ns() - t0,
                           note or "no finite objective"), fun, None
     fx, x, a, b = best
-    point = np.array(_ground_fn(geom)(x))
+    point = np.array(ground_point_scalar(geom)(x))
     edge = min(x - a, b - x) <= cfg.tol_rad
     k = -1
     vals = None
