@@ -625,13 +625,19 @@ class ContextStack:
             self._per_run[key] = [fn(c) for c in self.ctxs]
         return self._per_run[key]
 
-    def stacked(self, key: str, fn):
-        """The tuple ``fn(ctx)`` of arrays stacked over runs, computed once."""
+    def stacked(self, key: str, fn, fill=None):
+        """The tuple ``fn(ctx)`` of arrays stacked over runs, computed once;
+        runs where ``fn`` returns None get ``fill``."""
         k = "stacked:" + key
         if k not in self._per_run:
-            vals = self.per_run(key, fn)
+            vals = [fill if v is None else v for v in self.per_run(key, fn)]
             self._per_run[k] = tuple(np.stack(v) for v in zip(*vals))
         return self._per_run[k]
+
+    def take(self, a: np.ndarray, ri: np.ndarray) -> np.ndarray:
+        """Per-run array ``a`` (R, ...) at the pairs' runs ``ri`` (one run: the
+        run's own array, broadcast, without a copy per candidate)."""
+        return a[0] if len(self.ctxs) == 1 else a[ri]
 
 
 def stack_contexts(ctxs) -> ContextStack:
@@ -646,27 +652,38 @@ def _single_stack(ctx: MetricContext) -> ContextStack:
     return c["stack"]
 
 
-def _pairs(st: ContextStack, c: np.ndarray, mask=None):
-    """Valid (run, candidate) pairs of candidates ``c`` (R, n, 3): ``(ok (R, n),
-    run index (K,), p (K, 3), d = p - r (K, 3), |d| (K,))``."""
+def _offsets(st: ContextStack, c: np.ndarray):
+    """``(d = c - r_L, |d|, valid)`` for candidates ``c`` (R, n, 3): valid = beyond
+    ``min_range``, in front of the camera, and the known landmark usable."""
     d = c - st.r_L[:, None, :]
     rho = np.sqrt(np.einsum("...i,...i->...", d, d))
     ok = rho > st.min_range[:, None]
     if st.bs_L is not None:
-        ok &= np.einsum("rni,ri->rn", d, st.bs_L) > 0.0
+        ok &= (d @ st.bs_L[:, :, None])[..., 0] > 0.0
     ok &= st.known_ok[:, None]
+    return d, rho, ok
+
+
+def _pairs(st: ContextStack, c: np.ndarray, mask=None):
+    """Valid (run, candidate) pairs of candidates ``c`` (R, n, 3): ``(ok (R, n),
+    run index (K,), p (K, 3), d = p - r (K, 3), |d| (K,))``."""
+    d, rho, ok = _offsets(st, c)
     if mask is not None:
         ok &= mask
+    if len(st) == 1:  # one context: 1-D selections (cheaper), run index all 0
+        j = np.flatnonzero(ok[0])
+        return ok, np.zeros(j.size, np.intp), c[0, j], d[0, j], rho[0, j]
     ri = np.nonzero(ok)[0]
     return ok, ri, c[ok], d[ok], rho[ok]
 
 
 def _valid(ctx: MetricContext, c: np.ndarray):
     """(d2, rho2, valid mask) for candidates c (n, 3) of one context."""
-    st = _single_stack(ctx)
-    d = c - ctx.r_L
-    rho = np.sqrt(np.einsum("...i,...i->...", d, d))
-    return d, rho, _pairs(st, c[None], None)[0][0]
+    d, rho, ok = _offsets(_single_stack(ctx), c[None])
+    return d[0], rho[0], ok[0]
+
+
+_NO_TANGENT = (math.nan, np.zeros((12, 12)), math.nan)
 
 
 def _score_pairs(name: str, st: ContextStack, ri, p, d, rho) -> np.ndarray:
@@ -674,30 +691,35 @@ def _score_pairs(name: str, st: ContextStack, ri, p, d, rho) -> np.ndarray:
     closed form (svd/gdop/cond), the whitened H of ``measurement.selection_jacobian``
     (B-X1 whitened), or the information update (tangent-plane 2 x 2 update for runs
     with isotropic candidate noise, else the generic 12 x 12 path)."""
+    tk = st.take
     if name in H_METRICS:
-        u = st.u[ri]
+        u = tk(st.u, ri)
         w = d / rho[:, None]
         cr = np.cross(u, w)
-        return _scores_from_sq(name, *_structural_sq(st.x[ri], 1.0 / rho, np.einsum("ij,ij->i", w, u),
-                                                     np.einsum("ij,ij->i", cr, cr)))
+        # row sums (not w @ u): the bits of one candidate at a time, whatever the batch
+        add = np.add.reduce
+        return _scores_from_sq(name, *_structural_sq(tk(st.x, ri), 1.0 / rho, add(w * u, axis=-1),
+                                                     add(cr * cr, axis=-1)))
     if name in WHITENED:
         Ci, L = st.stacked("whiten", _whitening)
-        H = me.selection_jacobian(st.r_L[ri], st.R_LtoB[ri], st.p_known_L[ri], p)
-        return _whitened_scores(name, Ci[ri] @ H @ L[ri])
-    tg = st.per_run("tangent", _tangent_setup)
+        H = me.selection_jacobian(tk(st.r_L, ri), tk(st.R_LtoB, ri), tk(st.p_known_L, ri), p)
+        return _whitened_scores(name, tk(Ci, ri) @ H @ tk(L, ri))
+    tan_ok = np.array([t is not None for t in st.per_run("tangent", _tangent_setup)])
+    if tan_ok.all():
+        w, Sig, ld = st.stacked("tangent", _tangent_setup)
+        G = me.tangent_jacobian(tk(st.r_L, ri), tk(st.R_LtoB, ri), p, np.sqrt(tk(w, ri)))
+        return _tangent_scores(name, G, tk(Sig, ri), tk(ld, ri))
     out = np.empty(len(ri))
-    tan = np.array([t is not None for t in tg])[ri]
-    if tan.any():
+    tan = tan_ok[ri]
+    if tan.any():   # runs of both kinds in one batch
         rs = ri[tan]
-        fill = (math.nan, np.zeros((12, 12)), math.nan)
-        w, Sig, ld = (np.stack(v) for v in zip(*[t if t is not None else fill for t in tg]))
+        w, Sig, ld = st.stacked("tangent", _tangent_setup, _NO_TANGENT)
         G = me.tangent_jacobian(st.r_L[rs], st.R_LtoB[rs], p[tan], np.sqrt(w[rs]))
         out[tan] = _tangent_scores(name, G, Sig[rs], ld[rs])
-    if not tan.all():
-        rs = ri[~tan]
-        info = st.stacked("info", MetricContext._info)
-        H = me.selection_jacobian(st.r_L[rs], st.R_LtoB[rs], st.p_known_L[rs], p[~tan])
-        out[~tan] = _info_scores_fast(name, H, tuple(a[rs] for a in info))
+    rs = ri[~tan]
+    info = st.stacked("info", MetricContext._info)
+    H = me.selection_jacobian(tk(st.r_L, rs), tk(st.R_LtoB, rs), tk(st.p_known_L, rs), p[~tan])
+    out[~tan] = _info_scores_fast(name, H, tuple(tk(a, rs) for a in info))
     return out
 
 
@@ -736,7 +758,8 @@ class Metric:
         c = _as_cands(cand_L)
         if c.shape[0] == 1:  # the sequential golden-section case: scalar fast path
             return np.array([self.scalar(ctx, c[0])])
-        return self.batch(_single_stack(ctx), c[None])[0]
+        self._count(c.shape[0])
+        return self._batch(_single_stack(ctx), c[None], None)[0]
 
     def batch(self, ctxs, cand_L, mask=None) -> np.ndarray:
         """Scores (R, n) of candidates ``cand_L`` (R, n, 3) (m, {L}) for R planning
@@ -758,6 +781,9 @@ class Metric:
         if not np.all(np.isfinite(c)):
             raise ValueError("cand_L must be finite")
         self._count(int(c.shape[0] * c.shape[1] if mask is None else mask.sum()))
+        return self._batch(st, c, mask)
+
+    def _batch(self, st: ContextStack, c: np.ndarray, mask) -> np.ndarray:
         ok, ri, p, d, rho = _pairs(st, c, mask)
         out = np.full(ok.shape, -np.inf)
         if ri.size:
