@@ -39,16 +39,6 @@ def test_jacobians_match_central_differences(seed):
         np.testing.assert_allclose(Ht[:, j], fd_t, rtol=1e-5, atol=1e-9)
 
 
-def test_exp_so3_matches_scipy_and_small_angle_convention():
-    rng = np.random.default_rng(1)
-    for _ in range(20):
-        phi = rng.normal(size=3)
-        np.testing.assert_allclose(exp_so3(phi), Rotation.from_rotvec(phi).as_matrix(), atol=1e-12)
-    d = np.array([1e-7, -2e-7, 3e-7])
-    np.testing.assert_allclose(exp_so3(-d), np.eye(3) - skew(d), atol=1e-13)
-    np.testing.assert_allclose(skew(d) @ np.array([1.0, 2, 3]), np.cross(d, [1.0, 2, 3]))
-
-
 def test_bearing_is_unit_and_points_at_landmark():
     r, R, p = _case(3)
     b = bearing(r, R, p)

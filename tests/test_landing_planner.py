@@ -78,6 +78,29 @@ def test_degenerate_geometry_falls_back_with_a_note(scn):
     assert "does not descend" in res.note and math.isnan(res.beta)
 
 
+def test_only_degenerate_geometry_falls_back_other_errors_propagate(scn):
+    """The fallback is keyed on the exception type (DegenerateGeometry), not on
+    its text; every metric is a planning method (no method dropped silently)."""
+    import dataclasses
+
+    from opnav.landing.depth_error import DegenerateGeometry
+    from opnav.landing.metrics import METRIC_NAMES
+
+    assert set(METRIC_NAMES) <= set(OBJECTIVES)
+    tr = scn.truth
+    k = 20
+    P = np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3)
+    vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
+    bad = dataclasses.replace(scn.planner, eval_path="nope")
+    with pytest.raises(ValueError, match="eval_path") as exc:
+        plan("svd", PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], P), scn.camera, scn.field, vis, bad)
+    assert not isinstance(exc.value, DegenerateGeometry)
+    st0 = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], P)
+    st0 = dataclasses.replace(st0, v=np.zeros(3), a=np.zeros(3))   # zero velocity: fallback, a note
+    res = plan("depth", st0, scn.camera, scn.field, vis, scn.planner)
+    assert "zero velocity" in res.note and res.index >= 0
+
+
 def test_landing_site_in_view_for_the_whole_descent(scn):
     tr = scn.truth
     d = np.einsum("nij,nj->ni", tr.R_LtoB[:-1], -tr.r[:-1])   # site direction in {B}

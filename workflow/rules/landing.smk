@@ -64,7 +64,7 @@ B_SRC = src("landing/trajectory.py", "landing/imu.py", "landing/camera.py", "lan
             "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
             "landing/planner.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
             "landing/depth_map.py",
-            "landing/metrics.py", "landing/casadi_model.py")
+            "landing/metrics.py", "landing/casadi_model.py", "rotations.py")
 B_SCN_RE = "|".join(B_SCENARIOS)
 
 

@@ -6,7 +6,8 @@ Description
 Every metric scores a *candidate* unknown landmark p_cand (in {L}, m) given the
 lander state and the known landmark at the {L} origin, from the two-landmark
 bearing Jacobian H (6 x 12, paper eq. 14-18, columns [dr, dv, dtheta, dp_cand],
-built in :mod:`opnav.landing.casadi_model`).  LARGER IS BETTER for all of them:
+``opnav.landing.measurement.selection_jacobian``, cross-checked against its
+CasADi derivation in :mod:`opnav.landing.casadi_model`).  LARGER IS BETTER for all of them:
 
 ==========  ================================================================
 ``svd``     sigma_min(H): smallest *structural* singular value (see below)
@@ -127,7 +128,13 @@ the known-landmark rows cached, one LAPACK dgesvd of the 6 x 12 H, or the
 12 x 12 information); ``metric.numpy_H`` with one candidate dispatches to it,
 with n > 1 it builds all H in numpy and applies batched LAPACK.
 ``metric.reference`` calls the compiled CasADi Function once per candidate
-(slow, obvious); ``metric.casadi_map`` uses ``Function.map(n)``.  Every path adds the number of candidates it scored to
+(slow, obvious); ``metric.casadi_map`` uses ``Function.map(n)``.
+
+Batch over planning contexts (runs): ``metric.batch(stack_contexts(ctxs),
+cand_L (R, n, 3), mask (R, n) or None) -> (R, n)`` scores n candidates for each
+of R contexts in one vectorised call (the batched descent's call; ragged
+candidate lists padded and masked), with each run's own numbers;
+``metric(ctx, cand_L)`` is its R = 1 case.  Every path adds the number of candidates it scored to
 ``metric.n_evals`` (and 1 to ``metric.n_calls``); ``metric.reset()`` zeroes both.
 See ``benchmarks/bench_metrics.py`` for the timings; on this machine (2 shared
 cores, median, us per candidate evaluation): svd/gdop/cond ~2-4 (scalar closed
