@@ -537,3 +537,9 @@ def test_batch_over_runs_equals_each_context_alone(name):
         assert np.all(got[k, n:] == -np.inf)
     with pytest.raises(ValueError):
         m.batch(ctxs, cand[:2])
+    # the matrix path: the bits of the planner's per-candidate matrix_scalar
+    mat = m.batch(ctxs, cand, mask, path="matrix")
+    for k, ctx in enumerate(ctxs):
+        n = int(mask[k].sum())
+        assert np.array_equal(mat[k, :n], [m.matrix_scalar(ctx, p) for p in cand[k, :n]])
+        assert np.all(mat[k, n:] == -np.inf)

@@ -541,7 +541,11 @@ def _matrix_scalar(name: str, ctx: MetricContext, d0: float, d1: float, d2: floa
     H by eq. 14-18, then one LAPACK SVD (dgesvd) of the 6 x 12 H for
     svd/gdop/cond (gdop from the singular values above PINV_RCOND sigma_max,
     i.e. exactly the pseudo-inverse trace), or the generic 12 x 12 information."""
-    H = _candidate_H(ctx, d0, d1, d2, rho)
+    return _matrix_score(name, ctx, _candidate_H(ctx, d0, d1, d2, rho))
+
+
+def _matrix_score(name: str, ctx: MetricContext, H: np.ndarray) -> float:
+    """The explicit matrix computation on one 6 x 12 H (see :func:`_matrix_scalar`)."""
     if name in WHITENED:
         Ci, L = _whitening(ctx)
         return float(_whitened_scores(name, (Ci @ H @ L)[None], exact_svd=True)[0])
@@ -768,14 +772,18 @@ class Metric:
         self._count(c.shape[0])
         return self._batch(_single_stack(ctx), c[None], None)[0]
 
-    def batch(self, ctxs, cand_L, mask=None) -> np.ndarray:
+    def batch(self, ctxs, cand_L, mask=None, path: str = "fast") -> np.ndarray:
         """Scores (R, n) of candidates ``cand_L`` (R, n, 3) (m, {L}) for R planning
         contexts ``ctxs`` (a sequence of :class:`MetricContext` or a
         :class:`ContextStack`, one per run): the fastest faithful batch path
         (closed form, or H from ``measurement`` and batched LAPACK), the same
         numbers as ``metric(ctx_r, cand_L[r])`` run by run. ``mask`` (R, n)
         bool marks real candidates (ragged candidate lists padded to n); masked
-        entries score -inf and may hold any value. Counts the real candidates."""
+        entries score -inf and may hold any value. Counts the real candidates.
+        ``path="matrix"``: the explicit matrix computation per pair (H of eq.
+        14-18 for all pairs at once, then the LAPACK SVD / 12 x 12 information
+        of :meth:`matrix_scalar`, the same bits as it: the planner's default
+        ``eval_path``)."""
         st = stack_contexts(ctxs)
         c = np.asarray(cand_L, dtype=float)
         if c.ndim != 3 or c.shape[0] != len(st) or c.shape[2] != 3:
@@ -788,13 +796,21 @@ class Metric:
         if not np.all(np.isfinite(c)):
             raise ValueError("cand_L must be finite")
         self._count(int(c.shape[0] * c.shape[1] if mask is None else mask.sum()))
-        return self._batch(st, c, mask)
+        return self._batch(st, c, mask, path)
 
-    def _batch(self, st: ContextStack, c: np.ndarray, mask) -> np.ndarray:
+    def _batch(self, st: ContextStack, c: np.ndarray, mask, path: str = "fast") -> np.ndarray:
         ok, ri, p, d, rho = _pairs(st, c, mask)
         out = np.full(ok.shape, -np.inf)
-        if ri.size:
+        if not ri.size:
+            return out
+        if path == "fast":
             out[ok] = _score_pairs(self.name, st, ri, p, d, rho)
+        elif path == "matrix":  # H of all pairs at once, then per-pair LAPACK
+            tk = st.take
+            H = me.selection_jacobian(tk(st.r_L, ri), tk(st.R_LtoB, ri), tk(st.p_known_L, ri), p)
+            out[ok] = [_matrix_score(self.name, st.ctxs[r], Hk) for r, Hk in zip(ri.tolist(), H)]
+        else:
+            raise ValueError(f"Metric.batch: path must be 'fast' or 'matrix', got {path!r}")
         return out
 
     # ---- minimal-overhead single candidate (golden-section inner loop) ----
