@@ -131,6 +131,9 @@ def jacobian_blocks(R_LtoB, u, inv_rho) -> tuple[np.ndarray, np.ndarray, np.ndar
     hold ``u`` and the range, e.g. the metrics' per-candidate path, call it
     directly)."""
     R = np.asarray(R_LtoB, dtype=float)
+    if u.ndim == 1 and R.ndim == 2:  # one landmark (the metrics' per-candidate path): the
+        b = R @ u                     # same operations without the broadcasting overhead
+        return b, (R - b[:, None] * u[None, :]) * inv_rho, skew(b)
     b = _rotate(R, u)
     HC = (R - b[..., :, None] * u[..., None, :]) * np.asarray(inv_rho)[..., None, None]
     return b, HC, skew(b)
