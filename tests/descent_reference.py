@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from opnav.landing import imu
-from opnav.landing.measurement import bearing_jacobian, exp_so3, skew
+from opnav.landing.measurement import bearing_jacobian
+from opnav.rotations import exp_so3, skew
 from opnav.landing.metrics import H_METRICS
 from opnav.landing.planner import PlanState, plan
 from opnav.landing.trajectory import euler_rpy_deg
@@ -275,7 +276,7 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
     P0[:9, :9] = np.diag(np.repeat([br**2 / 3, bv**2 / 3, bt**2 / 3], 3))
     P0[9:, 9:] = np.eye(3) * 1e8      # dormant until the first landmark is initialised
     st = NavState(r=tr.r[0] - e0[0:3], v=tr.v[0] - e0[3:6],
-                      R=imu.exp_batch(e0[6:9][None])[0] @ tr.R_LtoB[0], p=np.zeros(3), P=P0)
+                      R=exp_so3(e0[6:9]) @ tr.R_LtoB[0], p=np.zeros(3), P=P0)
     n = scn.n_steps
     err_r = np.empty((n + 1, 3))
     err_v = np.empty((n + 1, 3))
@@ -424,5 +425,5 @@ def _detects_other(detected: np.ndarray, cur: int) -> bool:
 
 def _est_rpy(R_true: np.ndarray, dth: np.ndarray) -> np.ndarray:
     """Estimated roll/pitch/yaw (deg) from the truth and dtheta (R_est = Exp(dtheta) R_true)."""
-    R_est = imu.exp_batch(dth) @ R_true
+    R_est = exp_so3(dth) @ R_true
     return euler_rpy_deg(R_est)

@@ -535,7 +535,7 @@ def golden_section_batch(fun: Callable[[np.ndarray, np.ndarray], np.ndarray], a,
 
 
 def _ground_points(beta, C, v_hat, w_hat, cd, gamma) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_ground_fn` for many (plane, beta): points (m, 3) and a mask of
+    """:func:`~opnav.landing.depth_error.ground_point_scalar` for many (plane, beta): points (m, 3) and a mask of
     the betas whose line of sight meets the ground."""
     alpha = np.where(beta > 0, math.pi - gamma, gamma)
     ab = np.abs(beta)
@@ -636,9 +636,7 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
     for j in np.flatnonzero(~G["ok"]):          # the scalar raises the documented reason
         try:
             plane_geometry(states.r[j], states.v[j])
-        except ValueError as exc:
-            if "depth error" not in str(exc):
-                raise
+        except DegenerateGeometry as exc:
             notes[j] = str(exc)
     if method not in _VECTORISED:
         # objectives evaluated run by run: the per-call planner's own geometry, so
@@ -658,9 +656,7 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
         for j in np.flatnonzero(searched & ~(G["b"] > 0)):
             try:                                # zero baseline: the objective says why
                 funs[j]
-            except ValueError as exc:
-                if "depth error" not in str(exc):
-                    raise
+            except DegenerateGeometry as exc:
                 notes[j] = str(exc)
                 searched[j] = False
         keep = searched[owner]
