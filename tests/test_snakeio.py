@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from opnav.landing import montecarlo
-from opnav.snakeio import CorruptIntermediate, load_pickle, mock_snakemake, save_pickle, script_context
+from opnav.snakeio import CorruptIntermediate, load_pickle, save_pickle, script_context, stand_in
 
 
 def test_failing_job_writes_traceback_to_its_log(tmp_path):
     log = tmp_path / "logs" / "job.log"
-    smk = mock_snakemake(log=[str(log)], config={})
+    smk = stand_in(log=[str(log)], config={})
     smk.rule = "demo_rule"
     with pytest.raises(SystemExit) as err:
         with script_context(smk) as logger:
@@ -25,7 +25,7 @@ def test_failing_job_writes_traceback_to_its_log(tmp_path):
 
 
 def test_interrupt_is_not_swallowed(tmp_path):
-    smk = mock_snakemake(log=[str(tmp_path / "x.log")], config={})
+    smk = stand_in(log=[str(tmp_path / "x.log")], config={})
     with pytest.raises(KeyboardInterrupt):
         with script_context(smk):
             raise KeyboardInterrupt

@@ -3,9 +3,10 @@
 :func:`script_context` sends stderr/stdout and the ``logging`` module to the
 rule's log file, and a failing job's traceback too (Snakemake then shows one
 line naming the log); :func:`mock_snakemake` builds a stand-in ``snakemake`` object
-so a script can be run by hand for debugging, e.g.::
+(the real rule's job, built from the ``Snakefile``) so a script can be run by hand
+for debugging, e.g.::
 
-    python workflow/scripts/landing_tables.py   # uses mock_snakemake defaults
+    python workflow/scripts/landing_tables.py --configfile config/quick.yaml
 """
 
 from __future__ import annotations
@@ -53,9 +54,10 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
             logger.removeHandler(handler)
 
 
-def mock_snakemake(input=None, output=None, params=None, log=None, wildcards=None,
-                   threads: int = 1, config: dict | None = None) -> SimpleNamespace:
-    """A minimal stand-in for the ``snakemake`` object of a script directive."""
+def stand_in(input=None, output=None, params=None, log=None, wildcards=None,
+             threads: int = 1, config: dict | None = None) -> SimpleNamespace:
+    """A bare object shaped like a script's ``snakemake`` (named lists), for unit tests of
+    this module's plumbing. To run a workflow script by hand use :func:`mock_snakemake`."""
 
     def ns(x):
         if x is None:
@@ -64,13 +66,93 @@ def mock_snakemake(input=None, output=None, params=None, log=None, wildcards=Non
             return _Named(list(x.values()), x)
         return _Named(list(x), {})
 
-    if config is None:
-        from opnav.config import load_config
-
-        config = load_config()
     return SimpleNamespace(input=ns(input), output=ns(output), params=ns(params),
                            log=ns(log), wildcards=ns(wildcards), threads=threads,
-                           config=config)
+                           config={} if config is None else config)
+
+
+def workflow_root(start: str | Path | None = None) -> Path:
+    """The checkout holding the ``Snakefile``: ``start`` or its parents, else this
+    package's checkout."""
+    for base in ([Path(start).resolve()] if start else []) + [Path.cwd(), Path(__file__).resolve()]:
+        for d in (base, *base.parents):
+            if (d / "Snakefile").is_file() and (d / "workflow" / "rules").is_dir():
+                return d
+    raise FileNotFoundError("no Snakefile found above the current directory or the opnav package")
+
+
+def _argv_options(argv) -> tuple[list[str], dict[str, str]]:
+    """``--configfile A [B ...]`` and ``NAME=VALUE`` wildcards from a script's command line."""
+    usage = "by hand a script takes [--configfile FILE ...] [NAME=VALUE ...]"
+    files, wildcards, in_files = [], {}, False
+    for a in argv:
+        if a == "--configfile":
+            in_files = True
+        elif "=" in a and not a.startswith("-"):
+            k, v = a.split("=", 1)
+            wildcards[k] = v
+            in_files = False
+        elif in_files and not a.startswith("-"):
+            files.append(a)
+        else:
+            raise SystemExit(f"unexpected argument {a!r}: {usage}")
+    return files, wildcards
+
+
+def mock_snakemake(rule: str, *, configfiles=(), root: str | Path | None = None,
+                   argv=None, **wildcards):
+    """The ``snakemake`` object the real job of ``rule`` would get, for running a script
+    by hand (PyPSA-Eur's ``mock_snakemake``): the workflow (``Snakefile``, its
+    ``configfile:`` and the overlays ``configfiles``, validated as in a run) is parsed
+    with Snakemake's API, and the job of ``rule`` with ``wildcards`` gives ``input``,
+    ``output``, ``params``, ``wildcards``, ``log``, ``threads``, ``resources`` and
+    ``config``; paths are made absolute (under ``root``, the checkout by default).
+
+    ``argv`` (a script passes ``sys.argv[1:]``) may add ``--configfile FILE ...`` and
+    ``NAME=VALUE`` wildcards, which override the script's defaults::
+
+        python workflow/scripts/landing_tables.py --configfile config/quick.yaml
+        python workflow/scripts/approach_mc.py variant=roll group=headline method=plain
+
+    See ``workflow/scripts/README.md``.
+    """
+    from snakemake.api import SnakemakeApi
+    from snakemake.dag import DAG
+    from snakemake.jobs import Job
+    from snakemake.script import Snakemake
+    from snakemake.settings.types import ConfigSettings, DAGSettings, ResourceSettings
+
+    root = workflow_root(root)
+    extra_files, extra_wc = _argv_options(argv or [])
+    files = [Path(f) if Path(f).is_absolute() else Path.cwd() / f for f in [*configfiles, *extra_files]]
+    for f in files:
+        if not f.is_file():
+            raise SystemExit(f"config file not found: {f}")
+    wildcards = {**wildcards, **extra_wc}
+    with SnakemakeApi() as api:
+        wapi = api.workflow(resource_settings=ResourceSettings(),
+                            config_settings=ConfigSettings(configfiles=files),
+                            snakefile=root / "Snakefile", workdir=root)
+        wf = wapi._workflow
+        wf.dag_settings = DAGSettings()
+        try:
+            job_rule = wf.get_rule(rule)
+        except Exception:
+            raise SystemExit(f"no rule {rule!r} in {root / 'Snakefile'}") from None
+        missing = sorted(set(job_rule.wildcard_names) - set(wildcards))
+        if missing:
+            raise SystemExit(f"rule {rule} needs the wildcard(s) {', '.join(missing)} "
+                             f"(give NAME=VALUE on the command line)")
+        dag = DAG(wf, rules=[job_rule], targetfiles=[], targetrules=[])
+        job = Job(job_rule, dag, wildcards_dict=wildcards)
+        for io in (job.input, job.output, job.log):
+            for i, p in enumerate(io):
+                io[i] = str(Path(p) if Path(p).is_absolute() else root / p)
+        smk = Snakemake(job.input, job.output, job.params, job.wildcards, job.threads,
+                        job.resources, job.log, wf.config, job_rule.name, None)
+    for p in [*smk.output, *smk.log]:
+        Path(p).parent.mkdir(parents=True, exist_ok=True)
+    return smk
 
 
 class CorruptIntermediate(ValueError):

@@ -1,6 +1,8 @@
 """A-X3 ablation (pixel noise or segment length) and A-X5 sensitivity (prior sigma, range, roll rate):
 table and figure of estimate spread vs CRLB (A-X5 also the log-log slopes)."""
 
+import sys
+
 import numpy as np
 
 from opnav import figures
@@ -8,11 +10,9 @@ from opnav.approach.ablation import SLOPE_SWEEPS, loglog_slopes, run_sweep
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(
-        output={"table": [f"results/approach/A-X3_ablation_pixel.{e}" for e in ("csv", "tex", "md")],
-                "fig": ["results/approach/A-X3_ablation_pixel.pdf", "results/approach/A-X3_ablation_pixel.png"]})
-    snakemake.params = type("P", (), {"approach": snakemake.config["approach"], "sweep": "pixel"})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_ablation_pixel", argv=sys.argv[1:])
+
 
 XLABEL = {"pixel": "centroid pixel error, 3-sigma (px)", "segment": "EM segment length N (samples)",
           "prior": "prior 1-sigma / configured prior 1-sigma", "range": "initial range (km)",

@@ -1,14 +1,14 @@
 """Plain EM vs SQUAREM iterations to the maximum-likelihood estimate (headline case, one window)."""
 
+import sys
 from pathlib import Path
 
 from opnav.approach.cases import convergence_study, headline_case
 from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/approach/work/conv/roll.pkl"], wildcards={"variant": "roll"})
-    snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_convergence", argv=sys.argv[1:], variant="roll")
 
 with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)

@@ -1,5 +1,6 @@
 """CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case), with Q and Q = 0."""
 
+import sys
 from pathlib import Path
 
 from opnav.approach import scenario as sc
@@ -8,9 +9,8 @@ from opnav.approach.pipeline import bound_curve
 from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/approach/work/crlb.pkl"])
-    snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_crlb", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)

@@ -1,9 +1,14 @@
 """A-F4, A-F5, A-F6 and A-X4 for the headline case (T1-01) of one scenario variant."""
 
 
+import sys
+
 from opnav import figures, published
 from opnav.approach import plots
-from opnav.snakeio import load_pickle, script_context
+from opnav.snakeio import load_pickle, mock_snakemake, script_context
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_figures", argv=sys.argv[1:], variant="literal")
 
 with script_context(snakemake) as log:
     runs = {}

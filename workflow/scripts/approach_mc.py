@@ -1,15 +1,14 @@
 """Monte Carlo of one Table-1 case group under one scenario variant and EM scheme."""
 
+import sys
 from pathlib import Path
 
 from opnav.approach.pipeline import run_group
 from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/approach/work/mc/literal__size__plain.pkl"],
-                               wildcards={"variant": "literal", "group": "size", "method": "plain"})
-    snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_mc", argv=sys.argv[1:], variant="literal", group="size", method="plain")
 
 with script_context(snakemake) as log:
     w = snakemake.wildcards

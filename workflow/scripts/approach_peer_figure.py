@@ -1,17 +1,15 @@
 """A-P1 figure: the peer UKF's (tx, ty) over the arc with its own 3 sigma, against the others' end values."""
 
+import sys
+
 import pandas as pd
 
 from opnav import figures
 from opnav.approach import peer_plots
 from opnav.snakeio import load_pickle, mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(input={"peer": ["results/approach/work/peers/literal.pkl",
-                                               "results/approach/work/peers/roll.pkl"],
-                                      "table": "results/approach/A-P1_peer_ukf.csv"},
-                               output={"fig": ["results/approach/A-P1_peer_ukf.pdf",
-                                               "results/approach/A-P1_peer_ukf.png"]})
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_peer_figure", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     peer = [load_pickle(p) for p in snakemake.input.peer]

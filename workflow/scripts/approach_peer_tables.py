@@ -1,11 +1,13 @@
 """A-P1 table and summary: the peer UKF beside the EM-EKF, augmented EKF, batch ML and the CRLB."""
 
+import sys
+
 from opnav.approach import peers
-from opnav.snakeio import load_pickle, script_context
+from opnav.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.tables import write_json, write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    raise SystemExit("run through snakemake (needs the A-P1, A-X2 and EM-EKF pickles)")
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_peer_tables", argv=sys.argv[1:])
 
 
 def load(paths):
@@ -14,7 +16,6 @@ def load(paths):
         d = load_pickle(p)
         out.extend(d if isinstance(d, list) else d.get("results", [d]))
     return out
-
 
 with script_context(snakemake) as log:
     peer = load(snakemake.input.peer)

@@ -1,16 +1,15 @@
 """A-T1 (Table 1 beside the published values), A-X1 table + verdict text, A-summary.json."""
 
-
+import sys
 
 from opnav import published
 from opnav.approach import report
 from opnav.approach.setup import Setup
-from opnav.snakeio import load_pickle, script_context
+from opnav.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.tables import atomic_write_text, write_json, write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    raise SystemExit("run through snakemake (needs the gathered Monte-Carlo pickles)")
-
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_tables", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)

@@ -1,12 +1,16 @@
 """A-X1 figure: the CRLB per variant beside the EM estimates; EM iterations plain vs SQUAREM."""
 
+import sys
 
 import pandas as pd
 
 from opnav import figures
 from opnav.approach import plots
 from opnav.approach.setup import Setup
-from opnav.snakeio import load_pickle, script_context
+from opnav.snakeio import load_pickle, mock_snakemake, script_context
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_x1_figure", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)

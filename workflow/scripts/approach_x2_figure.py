@@ -1,5 +1,7 @@
 """A-X2 figure: EM-EKF vs augmented EKF vs batch ML, per scenario variant (from the long-form CSV)."""
 
+import sys
+
 import numpy as np
 import pandas as pd
 
@@ -7,10 +9,9 @@ from opnav import figures
 from opnav.approach.report import METHOD_LABELS
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(input={"long": "results/approach/work/x2/A-X2_alternatives_cases.csv"},
-                               output={"fig": ["results/approach/A-X2_alternatives.pdf",
-                                               "results/approach/A-X2_alternatives.png"]})
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_x2_figure", argv=sys.argv[1:])
+
 
 COLORS = {"em_plain": "#0072B2", "em_squarem": "#56B4E9", "augmented": "#D55E00", "batch_ml": "#009E73"}
 
@@ -31,7 +32,6 @@ def per_method(long: pd.DataFrame) -> pd.DataFrame:
             "runtime": float(h["runtime_s_per_seed"].iloc[0]) if len(h) else np.nan,
         })
     return pd.DataFrame(rows)
-
 
 with script_context(snakemake) as log:
     long = pd.read_csv(snakemake.input.long)

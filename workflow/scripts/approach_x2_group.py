@@ -1,5 +1,6 @@
 """A-X2: augmented EKF and batch ML on one Table-1 case group under one variant (one Snakemake job)."""
 
+import sys
 from pathlib import Path
 
 from opnav.approach import alternatives as alt
@@ -8,10 +9,8 @@ from opnav.approach.pipeline import cases_in
 from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/approach/work/x2/roll__size.pkl"],
-                               wildcards={"variant": "roll", "group": "size"})
-    snakemake.params = type("P", (), {"approach": snakemake.config["approach"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_x2_group", argv=sys.argv[1:], variant="roll", group="size")
 
 with script_context(snakemake) as log:
     w = snakemake.wildcards

@@ -1,15 +1,14 @@
 """A-X2 table (EM-EKF vs augmented EKF vs batch ML), long form per case, A-X2-summary.json."""
 
-
+import sys
 
 from opnav.approach import report
 from opnav.approach.setup import Setup
-from opnav.snakeio import load_pickle, script_context
+from opnav.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.tables import write_json, write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    raise SystemExit("run through snakemake (needs the A-X2 and EM-EKF Monte-Carlo pickles)")
-
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("approach_x2_tables", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)

@@ -3,16 +3,13 @@ name, with each scenario's camera), ``headline_scenario``, and the headline
 scenario's keys also at the top level (the manuscript's default numbers)."""
 
 import json
+import sys
 
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_json
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(
-        input={"parts": [f"results/landing/summaries/B-summary_{s}.json" for s in ("site-tilt", "interior")]},
-        output=["results/landing/B-summary.json"])
-    snakemake.params = type("P", (), {"scenarios": ["site-tilt", "interior"], "headline": "interior",
-                                      "cameras": {}})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_summary_all", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     names = list(snakemake.params.scenarios)

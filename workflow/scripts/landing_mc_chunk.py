@@ -1,12 +1,12 @@
 """One Monte-Carlo job of paper B: runs `params.runs` of `wildcards.method` (scatter)."""
 
+import sys
+
 from opnav.landing.montecarlo import run_chunk, save
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output=["results/landing/mc/site-tilt/chunks/depth/r0000-0001.npz"],
-                               wildcards={"bmethod": "depth", "bchunk": "r0000-0001"})
-    snakemake.params = type("P", (), {"landing": snakemake.config["landing"], "runs": [0, 1]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_mc_chunk", argv=sys.argv[1:], bscn="site-tilt", bmethod="depth", bchunk="r0000-0001")
 
 with script_context(snakemake) as log:
     method = snakemake.wildcards.bmethod

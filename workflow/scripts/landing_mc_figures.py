@@ -1,19 +1,14 @@
 """B-F6 (navigation-error 3-sigma envelopes) and B-F7 (planning-time box plots)."""
 
+import sys
+
 from opnav import figures, published
 from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(
-        input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in ("depth", "svd", "gdop", "cond")],
-               "timing": "results/landing/timing/site-tilt.npz"},
-        output={"f6": ["results/landing/B-F6_nav_error_envelopes_site-tilt.pdf",
-                       "results/landing/B-F6_nav_error_envelopes_site-tilt.png"],
-                "f7": ["results/landing/B-F7_planning_time_site-tilt.pdf",
-                       "results/landing/B-F7_planning_time_site-tilt.png"]})
-    snakemake.params = type("P", (), {"methods": ["depth", "svd", "gdop", "cond"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_mc_figures", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
     data = {m: load(p) for m, p in zip(snakemake.params.methods, snakemake.input.mc)}

@@ -1,11 +1,12 @@
 """Gather the Monte-Carlo chunks of one method of paper B (in run order)."""
 
+import sys
+
 from opnav.landing.montecarlo import gather, load, save
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(input=["results/landing/mc/site-tilt/chunks/depth/r0000-0001.npz"],
-                               output=["results/landing/mc/site-tilt/depth.npz"], wildcards={"bmethod": "depth", "bscn": "site-tilt"})
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_mc_gather", argv=sys.argv[1:], bscn="site-tilt", bmethod="depth")
 
 with script_context(snakemake) as log:
     data = gather([load(p) for p in snakemake.input])

@@ -2,6 +2,7 @@
 B-F5 (depth-error maps: detected landmarks, whole field, in-plane curve)."""
 
 import json
+import sys
 
 from opnav import figures
 from opnav.landing import plots
@@ -11,11 +12,8 @@ from opnav.landing.montecarlo import summarize_run
 from opnav.landing.scenario import initial_attitude_report
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output={"summary": "results/landing/single/summary_site-tilt.json",
-                                       "f5": ["results/landing/B-F5_depth_error_map_site-tilt.pdf",
-                                              "results/landing/B-F5_depth_error_map_site-tilt.png"]})
-    snakemake.params = type("P", (), {"landing": snakemake.config["landing"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_single", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
     cfg = snakemake.params.landing

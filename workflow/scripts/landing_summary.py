@@ -4,6 +4,7 @@ numbers for the manuscript and the scorecard)."""
 
 import json
 import math
+import sys
 
 from opnav import published
 from opnav.landing import timing
@@ -13,19 +14,8 @@ from opnav.landing.scenario import initial_attitude_report
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_json, write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    _s = "site-tilt"
-    snakemake = mock_snakemake(
-        input={"mc": [f"results/landing/mc/{_s}/{m}.npz" for m in ("depth", "svd", "gdop", "cond")],
-               "single": f"results/landing/single/summary_{_s}.json",
-               "timing": f"results/landing/timing/{_s}.npz"},
-        output={"t3": [f"results/landing/B-T3_summary_{_s}.csv"],
-                "summary": f"results/landing/summaries/B-summary_{_s}.json"},
-        wildcards={"bscn": _s})
-    snakemake.params = type("P", (), {"methods": ["depth", "svd", "gdop", "cond"], "yaw_ratio": 0.5,
-                                      "converged_pos_err_m": 100.0, "eval_path": "matrix_scalar",
-                                      "landing": snakemake.config["landing"]})()
-
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_summary", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
     pub = published.paper_b()

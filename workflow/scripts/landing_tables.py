@@ -1,15 +1,13 @@
 """B-T1, B-T2: the descent's initial state and Monte-Carlo error bounds, from the config."""
 
+import sys
+
 from opnav.landing.scenario import error_bounds_table, initial_state_table
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(
-        output={"t1": ["results/landing/B-T1_initial_state.csv"],
-                "t2": ["results/landing/B-T2_error_bounds.csv"]}
-    )
-    snakemake.params = type("P", (), {"landing": snakemake.config["landing"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_tables", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     cfg = snakemake.params.landing

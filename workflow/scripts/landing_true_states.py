@@ -1,5 +1,7 @@
 """B-F4: the truth trajectory of paper B's descent (camera-independent)."""
 
+import sys
+
 import numpy as np
 
 from opnav import figures
@@ -7,10 +9,8 @@ from opnav.landing import plots
 from opnav.landing.trajectory import euler_rpy_deg, truth_states
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    snakemake = mock_snakemake(output={"f4": ["results/landing/B-F4_true_states.pdf",
-                                              "results/landing/B-F4_true_states.png"]})
-    snakemake.params = type("P", (), {"landing": snakemake.config["landing"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_true_states", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     c = snakemake.params.landing

@@ -3,6 +3,7 @@ Carlo: 3-sigma envelopes figure, ranking table with paired comparison against
 the reference (depth), and B-X1-summary.json for the manuscript macros."""
 
 import json
+import sys
 
 from opnav import figures
 from opnav.landing import plots, timing
@@ -11,18 +12,8 @@ from opnav.landing.ranking import headline, ranking_table
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_table
 
-if "snakemake" not in globals():  # standalone debugging run
-    _m = ["depth", "svd", "gdop", "cond", "logdet", "mineig", "random", "center"]
-    snakemake = mock_snakemake(
-        input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in _m],
-               "timing": "results/landing/timing/site-tilt.npz"},
-        output={"f": ["results/landing/B-X1_envelopes_site-tilt.pdf", "results/landing/B-X1_envelopes_site-tilt.png"],
-                "t": ["results/landing/B-X1_ranking_site-tilt.csv"],
-                "summary": "results/landing/summaries/B-X1-summary_site-tilt.json"})
-    snakemake.params = type("P", (), {"methods": _m,
-                                      "extra": {"reference": "depth", "n_boot": 2000,
-                                                "tie_rtol": 1e-3},
-                                      "converged_pos_err_m": 100.0})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_x1_summary", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
     methods = list(snakemake.params.methods)

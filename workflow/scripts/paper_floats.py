@@ -4,13 +4,17 @@ Tables too wide for a page (ids in opnav.manuscript.COMPACT_VIEWS) are shown
 through a compact view computed from their CSV, written under compact/.
 """
 
+import sys
 from pathlib import Path
 
 import pandas as pd
 
 from opnav.manuscript import COMPACT_VIEWS, float_block, output_id
-from opnav.snakeio import script_context
+from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_write_text, write_table
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("paper_floats", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     compact_dir = Path(snakemake.output.compact)

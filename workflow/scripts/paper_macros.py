@@ -1,11 +1,15 @@
 """results/paper/macros.tex: one \\newcommand per number the manuscript quotes."""
 
 import json
+import sys
 
 from opnav import published
 from opnav.manuscript import macros_from_summary, render_macros
-from opnav.snakeio import script_context
+from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_write_text
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("paper_macros", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     macros = {}

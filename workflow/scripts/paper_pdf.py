@@ -4,9 +4,13 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
-from opnav.snakeio import script_context
+from opnav.snakeio import mock_snakemake, script_context
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("paper_pdf", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     paper_dir = Path(snakemake.params.paper_dir).resolve()

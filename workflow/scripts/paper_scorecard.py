@@ -1,12 +1,16 @@
 """The reproduced-vs-published scorecard from the generated tables and summaries."""
 
 import json
+import sys
 
 import pandas as pd
 
 from opnav import published, scorecard
-from opnav.snakeio import script_context
+from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_write_text, write_table
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("paper_scorecard", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     inp = snakemake.input

@@ -1,11 +1,13 @@
 """One parameter-study job: runs `params.runs` of one (variant and) method with one
 study value's simulation config (opnav.studies; results keyed by that config's digest)."""
 
-from opnav.snakeio import script_context
+import sys
+
+from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_target
 
-if "snakemake" not in globals():  # standalone debugging run
-    raise SystemExit("run through snakemake: snakemake --cores 2 study_<name>")
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("study_runs", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     w = snakemake.wildcards

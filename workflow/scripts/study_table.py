@@ -1,11 +1,16 @@
 """A parameter study's tables: every run (tidy), the summary (tidy: one row per value,
 method and metric) and its page view, and the generated caption (opnav.studies)."""
 
+import sys
+
 import pandas as pd
 
 from opnav import studies
-from opnav.snakeio import script_context
+from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_write_text, write_table
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("study_fov_table", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     study = snakemake.params.study
