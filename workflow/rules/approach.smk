@@ -143,8 +143,3 @@ rule approach_x1_figure:
     localrule: True
     script:
         "../scripts/approach_x1_figure.py"
-
-
-ALL_TARGETS.extend(rules.approach_tables.output)
-ALL_TARGETS.extend(rules.approach_x1_figure.output)
-ALL_TARGETS.extend(expand(rules.approach_figures.output, variant=A_VARIANTS))

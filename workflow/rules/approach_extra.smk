@@ -51,7 +51,7 @@ rule approach_x2_figure:
     """A-X2 figure: error, spread and CRLB, navigation error, data needed and run time per method."""
     input:
         long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
-        code=src("approach/report.py", "figures.py", "opnav.mplstyle"),
+        code=src("approach/plots.py", "approach/report.py", "figures.py", "opnav.mplstyle"),
     output:
         fig=report_figure(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
     log:
@@ -64,7 +64,7 @@ rule approach_x2_figure:
 rule approach_ablation_pixel:
     """A-X3: pixel-noise sweep (approach.ablation.sigma3_px) of the headline case per variant."""
     input:
-        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "figures.py", "tables.py"),
+        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "approach/plots.py", "figures.py", "tables.py"),
     output:
         table=report_table(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
         fig=report_figure(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
@@ -82,7 +82,7 @@ rule approach_ablation_pixel:
 rule approach_ablation_segment:
     """A-X3: segment-length sweep (approach.ablation.segment_N) of the headline case per variant."""
     input:
-        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "figures.py", "tables.py"),
+        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "approach/plots.py", "figures.py", "tables.py"),
     output:
         table=report_table(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
         fig=report_figure(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
@@ -104,7 +104,7 @@ rule approach_sensitivity:
     """A-X5: sensitivity sweep (prior sigma, range or roll rate) of the headline case: bound and
     spreads per value (initial error sampled), and their log-log slopes."""
     input:
-        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "figures.py", "tables.py"),
+        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "approach/plots.py", "figures.py", "tables.py"),
     output:
         table=report_table(f"{APPROACH}/A-X5_sensitivity_{{sweep}}", "A-X5", "Paper A"),
         slopes=report_table(f"{APPROACH}/A-X5_sensitivity_{{sweep}}_slopes", "A-X5", "Paper A"),
@@ -120,11 +120,3 @@ rule approach_sensitivity:
         f"{APPROACH}/benchmarks/sensitivity_{{sweep}}.tsv"
     script:
         "../scripts/approach_ablation.py"
-
-
-ALL_TARGETS.extend(expand(rules.approach_sensitivity.output, sweep=list(A_SENSITIVITY)))
-ALL_TARGETS.extend(rules.approach_x2_tables.output.table)
-ALL_TARGETS.append(rules.approach_x2_tables.output.summary)
-ALL_TARGETS.extend(rules.approach_x2_figure.output)
-ALL_TARGETS.extend(rules.approach_ablation_pixel.output)
-ALL_TARGETS.extend(rules.approach_ablation_segment.output)

@@ -60,9 +60,6 @@ if HAVE_BSK:
         script:
             "../scripts/approach_peer_figure.py"
 
-    ALL_TARGETS.extend(rules.approach_peer_tables.output.table)
-    ALL_TARGETS.append(rules.approach_peer_tables.output.summary)
-    ALL_TARGETS.extend(rules.approach_peer_figure.output)
 else:
     print("opnav: Basilisk (bsk) not installed, skipping A-P1 (peer UKF); "
           "install it with: pip install -e '.[peers]'", file=sys.stderr)

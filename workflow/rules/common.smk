@@ -1,4 +1,4 @@
-# Shared helpers: config validation, output paths, and the list `rule all` gathers.
+# Shared helpers: config validation, output paths, and the final outputs (final_outputs).
 import sys
 from pathlib import Path
 
@@ -22,8 +22,6 @@ RESULTS = config["results_dir"]
 report: "../report/workflow.rst"
 SRC = Path(workflow.basedir) / "src" / "opnav"
 
-# Each rules file appends the final outputs it owns; `rule all` requests them.
-ALL_TARGETS = []
 
 
 def res(*parts):
@@ -81,6 +79,40 @@ def report_figure(stem, caption_id, category, subcategory=None):
     pdf, png = figure_outputs(stem)
     kw = {"subcategory": subcategory} if subcategory else {}
     return [pdf, report(png, caption=_caption(caption_id), category=category, **kw)]
+
+
+def result_outputs():
+    """Every final table, figure and summary of both papers and of the parameter studies
+    (not the manuscript's own files): what the manuscript floats and macros draw from.
+    Reads the rules at call time, so call it once the rule files are included."""
+    a = [*rules.approach_tables.output, *rules.approach_x1_figure.output,
+         *expand(rules.approach_figures.output, variant=A_VARIANTS),
+         *expand(rules.approach_sensitivity.output, sweep=list(A_SENSITIVITY)),
+         *rules.approach_x2_tables.output.table, rules.approach_x2_tables.output.summary,
+         *rules.approach_x2_figure.output,
+         *rules.approach_ablation_pixel.output, *rules.approach_ablation_segment.output]
+    if HAVE_BSK:
+        a += [*rules.approach_peer_tables.output.table, rules.approach_peer_tables.output.summary,
+              *rules.approach_peer_figure.output]
+    b = [*rules.landing_tables.output, *rules.landing_true_states.output,
+         *expand(rules.landing_single.output.f5, bscn=B_SCENARIOS),
+         *expand(rules.landing_mc_figures.output, bscn=B_SCENARIOS),
+         *expand(rules.landing_summary.output.t3, bscn=B_SCENARIOS),
+         *rules.landing_summary_all.output,
+         *expand(rules.landing_x1_summary.output.f, bscn=B_SCENARIOS),
+         *expand(rules.landing_x1_summary.output.t, bscn=B_SCENARIOS),
+         *rules.landing_x1_summary_all.output]
+    studies = [t for ts in STUDY_TARGETS.values() for t in ts]
+    return [str(t) for t in a + b + studies]
+
+
+def final_outputs():
+    """Everything `rule all` builds: result_outputs(), the manuscript's generated inputs
+    and, with LaTeX and paper.build_pdf, the PDF. The one list of final outputs."""
+    out = result_outputs() + [str(f) for outs in PAPER_INPUTS for f in outs]
+    if config["paper"]["build_pdf"] and HAVE_LATEX:
+        out.append(str(rules.paper_pdf.output[0]))
+    return out
 
 
 # Helpers of the rule files, kept here so no .smk file mixes rules and functions

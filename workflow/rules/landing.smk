@@ -21,9 +21,6 @@ rule landing_tables:
         "../scripts/landing_tables.py"
 
 
-ALL_TARGETS.extend(rules.landing_tables.output)
-
-
 # ---------------------------------------------------------------- simulation
 # Every result-relevant value reaches the rules through `params:` (B_SIM); the
 # Monte Carlo is scattered over (method, chunk) jobs and gathered per method.
@@ -209,10 +206,3 @@ rule landing_summary_all:
     localrule: True
     script:
         "../scripts/landing_combine.py"
-
-
-ALL_TARGETS.extend(rules.landing_true_states.output)
-ALL_TARGETS.extend(expand(rules.landing_single.output.f5, bscn=B_SCENARIOS))
-ALL_TARGETS.extend(expand(rules.landing_mc_figures.output, bscn=B_SCENARIOS))
-ALL_TARGETS.extend(expand(rules.landing_summary.output.t3, bscn=B_SCENARIOS))
-ALL_TARGETS.extend(rules.landing_summary_all.output)

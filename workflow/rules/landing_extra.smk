@@ -48,8 +48,3 @@ rule landing_x1_summary_all:
     localrule: True
     script:
         "../scripts/landing_combine.py"
-
-
-ALL_TARGETS.extend(expand(rules.landing_x1_summary.output.f, bscn=B_SCENARIOS))
-ALL_TARGETS.extend(expand(rules.landing_x1_summary.output.t, bscn=B_SCENARIOS))
-ALL_TARGETS.extend(rules.landing_x1_summary_all.output)

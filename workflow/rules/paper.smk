@@ -1,5 +1,5 @@
 # The reproduction manuscript: generated floats, macros, scorecard, and the PDF.
-# Included last, so ALL_TARGETS already lists every table and figure.
+# Included last: result_outputs() (common.smk) reads every other rule file's rules.
 import os
 import shutil
 
@@ -9,7 +9,7 @@ PAPER = res("paper")
 PAPER_DIR = Path(workflow.basedir) / "paper"
 CAPTIONS = Path(workflow.basedir) / "workflow" / "report"
 
-_targets = [str(t) for t in ALL_TARGETS]
+_targets = result_outputs()
 
 
 SUMMARIES = {
@@ -41,7 +41,7 @@ rule paper_floats:
         tables_csv=[c for c in (t[:-4] + ".csv" for t in _floats("approach") + _floats("landing")) if c in _targets],
         captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
         study_captions=[t for ts in STUDY_TARGETS.values() for t in ts if t.endswith(".rst")],
-        code=src("manuscript.py"),
+        code=src("manuscript.py", "approach/report.py", "landing/report.py", "tables.py"),
     output:
         approach=f"{PAPER}/floats_approach.tex",
         landing=f"{PAPER}/floats_landing.tex",
@@ -62,7 +62,7 @@ rule paper_scorecard:
         **SCORE_INPUTS,
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         published=src("data/published.yaml"),
-        code=src("scorecard.py", "published.py"),
+        code=src("scorecard.py", "verdicts.py", "approach/report.py", "landing/report.py", "published.py"),
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
         longtable=f"{PAPER}/scorecard_longtable.tex",
@@ -118,7 +118,6 @@ rule provenance:
 
 PAPER_INPUTS = [rules.paper_floats.output, rules.paper_macros.output, rules.paper_scorecard.output,
                 rules.provenance.output]
-ALL_TARGETS.extend(PAPER_INPUTS)
 
 LATEX_HINT = (
     "opnav: LaTeX not found, skipping results/paper/main.pdf; to build it install: "
@@ -147,7 +146,5 @@ rule paper_pdf:
         "../scripts/paper_pdf.py"
 
 
-if config["paper"]["build_pdf"] and HAVE_LATEX:
-    ALL_TARGETS.append(rules.paper_pdf.output[0])
-elif config["paper"]["build_pdf"]:
+if config["paper"]["build_pdf"] and not HAVE_LATEX:
     print(LATEX_HINT, file=sys.stderr)

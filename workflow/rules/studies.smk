@@ -108,7 +108,3 @@ rule studies:
     input:
         [t for ts in STUDY_TARGETS.values() for t in ts],
     localrule: True
-
-
-for _ts in STUDY_TARGETS.values():
-    ALL_TARGETS.extend(_ts)
