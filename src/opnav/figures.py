@@ -1,10 +1,14 @@
-"""The shared figure style and deterministic figure saving.
+"""The shared figure style, the one colour palette, and deterministic figure saving.
 
-Every plot of the pipeline is made under :func:`style` (one matplotlib style
-file, ``opnav.mplstyle``, sized for a journal column) and written by
-:func:`save`, which produces PDF and PNG without creation dates or software
-stamps, so the same data give byte-identical files. Estimators never import
-this module: plotting lives in ``workflow/scripts`` and here only.
+Every plot of the pipeline is drawn by a plots module (:mod:`opnav.approach.plots`,
+:mod:`opnav.approach.peer_plots`, :mod:`opnav.landing.plots`,
+:mod:`opnav.study_plots`) under :func:`style` (one matplotlib style file,
+``opnav.mplstyle``, sized for a journal column), coloured by :func:`color` (one
+colour per method and per scenario variant, the same in every figure of both
+papers: :data:`PALETTE`), and written by :func:`save`, which produces PDF and PNG
+without creation dates or software stamps, so the same data give byte-identical
+files. ``workflow/scripts`` only call these functions; estimators and simulations
+never import a plots module or this one.
 """
 
 from __future__ import annotations
@@ -18,6 +22,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import zlib  # noqa: E402
+
 from opnav.tables import atomic_target  # noqa: E402
 
 STYLE = Path(__file__).with_name("opnav.mplstyle")
@@ -28,6 +34,37 @@ PAGE_WIDTH_IN = 7.0
 
 #: Colour/marker used everywhere for the papers' published values.
 PUBLISHED_STYLE = dict(color="0.35", marker="x", linestyle="none", label="published")
+
+#: The one palette: every method and scenario variant of both papers -> its colour, used
+#: by every figure (a figure that shows variants and estimators together colours one
+#: and draws the other with line styles). Paper A's variants and estimators, and paper
+#: B's planning methods, have distinct colours within their paper.
+PALETTE: dict[str, str] = {
+    # paper A: scenario variants (approach.variants)
+    "literal": "C0", "prior": "C1", "roll": "C2", "reference-start": "C3",
+    # paper A: estimators (EM schemes, growing windows, A-X2 alternatives, study names)
+    "plain": "#0072B2", "squarem": "#56B4E9", "em": "#332288",
+    "growing-plain": "#8C510A", "growing-squarem": "#E69F00",
+    "augmented": "#D55E00", "batch_ml": "#009E73",
+    # paper B: planning methods (landing.mc.methods, landing.extra.methods)
+    "depth": "C0", "svd": "C1", "gdop": "C2", "cond": "C3", "logdet": "C4", "mineig": "C5",
+    "random": "C6", "center": "C7", "svd_w": "C8", "gdop_w": "C9", "cond_w": "k",
+}
+#: Other spellings of the same method (table labels, study estimator names).
+ALIASES: dict[str, str] = {
+    "em_plain": "plain", "em_squarem": "squarem", "EM-EKF (plain)": "plain",
+    "EM-EKF (SQUAREM)": "squarem", "augmented EKF": "augmented", "batch ML (IPOPT)": "batch_ml",
+}
+
+
+def color(label: str) -> str:
+    """The colour of a method or scenario variant (:data:`PALETTE`, through
+    :data:`ALIASES`); a label outside the palette (a new planning method) gets a
+    colour from its name alone, so it too is the same in every figure."""
+    key = ALIASES.get(label, label)
+    if key in PALETTE:
+        return PALETTE[key]
+    return f"C{zlib.crc32(key.encode()) % 10}"
 
 
 @contextlib.contextmanager

@@ -1,7 +1,8 @@
 """Figure of a parameter study (:mod:`opnav.studies`): each metric against the swept value.
 
 One panel per metric, one line per method (paper A: per scenario variant and
-estimator). ``statistic: mean`` draws the mean over runs with its 95 %
+estimator, the variant's colour and the estimator's line style; colours are
+:func:`opnav.figures.color`'s, as in every figure). ``statistic: mean`` draws the mean over runs with its 95 %
 confidence interval as error bars; ``sd`` / ``rms`` draw the spread or RMS over
 runs, and for paper-A errors the 1-sigma CRLB beside it (dashed, black). A
 single numeric swept key gives a numeric x axis (log scale when the values span
@@ -20,6 +21,9 @@ from opnav import figures
 from opnav.studies import METRICS, _slug
 
 
+_LINESTYLES = ("-", "--", "-.", ":")
+
+
 def _x_axis(study: Mapping):
     labels = list(study["instances"])
     vals = [study["instances"][lab] for lab in labels]
@@ -34,8 +38,6 @@ def _x_axis(study: Mapping):
 def fig_study(tidy: pd.DataFrame, study: Mapping):
     import matplotlib.pyplot as plt
 
-    from opnav.landing.plots import METHOD_COLORS
-
     stat = study["statistic"]
     metrics = list(study["metrics"])
     xmap, ticks, xlabel = _x_axis(study)
@@ -48,7 +50,7 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
         for ax, metric in zip(axs.ravel(), metrics):
             label, bound = METRICS[study["paper"]][metric]
             d = tidy[tidy["metric"] == metric]
-            for k, (variant, method) in enumerate(units):
+            for variant, method in units:
                 dm = d[d["method"] == method]
                 if variant:
                     dm = dm[dm["variant"] == variant]
@@ -56,16 +58,18 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
                 order = np.argsort(x, kind="stable")
                 x = x[order]
                 y = dm[stat].to_numpy(float)[order]
-                col = METHOD_COLORS.get(method, f"C{k % 10}") if not variant else f"C{k % 10}"
+                # paper A: the variant's colour, the estimator's line style; paper B: the method's colour
+                col = figures.color(variant or method)
+                ls = _LINESTYLES[list(study["methods"]).index(method) % len(_LINESTYLES)] if variant else "-"
                 name = f"{variant}: {method}" if variant else method
                 if stat == "mean":
                     lo = dm["ci95_low"].to_numpy(float)[order]
                     hi = dm["ci95_high"].to_numpy(float)[order]
                     err = np.vstack([y - lo, hi - y])
                     err = np.where(np.isfinite(err), err, 0.0)
-                    ax.errorbar(x, y, yerr=err, fmt="o-", color=col, ms=3, capsize=2, label=name)
+                    ax.errorbar(x, y, yerr=err, fmt="o", ls=ls, color=col, ms=3, capsize=2, label=name)
                 else:
-                    ax.plot(x, y, "o-", color=col, ms=3, label=f"{name} ({stat})")
+                    ax.plot(x, y, "o", ls=ls, color=col, ms=3, label=f"{name} ({stat})")
             if bound and stat != "mean":
                 b = tidy[(tidy["metric"] == bound)]
                 for j, variant in enumerate(study["variants"] or [""]):

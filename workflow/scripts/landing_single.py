@@ -9,7 +9,6 @@ from opnav.landing import plots
 from opnav.landing.depth_map import depth_map
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
-from opnav.landing.scenario import initial_attitude_report
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)

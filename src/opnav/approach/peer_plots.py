@@ -9,8 +9,6 @@ import numpy as np
 
 from opnav import figures
 
-ECOLORS = {"EM-EKF (plain)": "#0072B2", "EM-EKF (SQUAREM)": "#56B4E9", "augmented EKF": "#D55E00",
-           "batch ML (IPOPT)": "#009E73"}
 RCOLORS = {"headline": "k", "bias_free": "#CC79A7", "truth_start": "0.55"}
 
 
@@ -46,7 +44,7 @@ def peer_figure(peer: list[dict], table):
             for k, (_, o) in enumerate(others.iterrows()):
                 x = t_end * (1.03 + 0.025 * k)
                 ax.errorbar([x], [o[f"est_{comp}_mean_arcsec"]], yerr=[o[f"est_{comp}_sd_arcsec"]],
-                            fmt="o", ms=3, color=ECOLORS.get(o["estimator"], "C5"), label=o["estimator"])
+                            fmt="o", ms=3, color=figures.color(o["estimator"]), label=o["estimator"])
             ax.set_ylabel(f"t{comp} (arcsec)")
             if i == 0:
                 ax.set_title(v)

@@ -10,8 +10,6 @@ import numpy as np
 
 from opnav import figures
 
-COLORS = {"plain": "C0", "squarem": "C3"}
-VCOLORS = {"literal": "C0", "prior": "C1", "roll": "C2", "reference-start": "C3"}
 
 
 def _plain_log_ticks(ax):
@@ -47,7 +45,8 @@ def run_label(r: dict) -> str:
 
 
 def _color(r: dict) -> str:
-    return "C2" if r.get("mode", "sliding") == "growing" else COLORS.get(r["method"], "C4")
+    growing = r.get("mode", "sliding") == "growing"
+    return figures.color(f"growing-{r['method']}" if growing else r["method"])
 
 
 def iteration_axis(r: dict) -> np.ndarray:
@@ -207,7 +206,7 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.8))
         for v, c in curves.items():
             d = np.arange(len(c))
-            col = VCOLORS.get(v, "k")
+            col = figures.color(v)
             lab = v + (" (diagnostic)" if v == "reference-start" else "")
             a1.plot(d[1:], c[1:, 0], color=col, label=f"CRLB tx, {lab}")
             row = x1[x1["variant"] == v]
@@ -227,7 +226,7 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
         a1.set_ylabel("1-sigma bound / RMS error (arcsec)")
         a1.legend(fontsize=5.5)
         for v, c in conv.items():
-            col = VCOLORS.get(v, "k")
+            col = figures.color(v)
             for method, ls in (("plain", "-"), ("squarem", "--")):
                 dist = np.median(c[method]["dist_arcsec"], axis=0)
                 a2.plot(np.arange(1, len(dist) + 1), np.maximum(dist, 1e-6), color=col, ls=ls,
@@ -237,4 +236,127 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
         a2.set_ylabel("|theta - theta_ML| (arcsec), median")
         a2.legend(fontsize=5.5, ncol=2)
         fig.tight_layout()
+    return fig
+
+
+#: A-X2 per-method panels: (column of :func:`alternatives_per_method`, y label, log scale)
+_X2_PANELS = [("bias", "mean |bias error| (arcsec)", True),
+              ("spread", "spread (sd over seeds, arcsec)", True),
+              ("nav_after", "nav. error after (km)", False),
+              ("data", "data needed (samples)", False),
+              ("runtime", "run time (s per seed)", True)]
+
+
+def alternatives_per_method(long) -> "pd.DataFrame":
+    """A-X2 figure data: per variant and method, the mean |bias error| and median spread
+    over the Table-1 cases (tx and ty, arcsec), the median CRLB, the mean navigation
+    error after (and before) compensation (km), the median data needed (samples) and the
+    headline case's run time per seed (s); ``long`` is the per-case A-X2 table."""
+    import pandas as pd
+
+    rows = []
+    for (v, m), g in long.groupby(["variant", "method"], sort=False):
+        h = g[g["case_id"] == "T1-01"]
+        rows.append({
+            "variant": v, "method": m,
+            "bias": float(np.mean(np.abs(np.r_[g["err_x_mean_arcsec"], g["err_y_mean_arcsec"]]))),
+            "spread": float(np.median(np.r_[g["err_x_std_arcsec"], g["err_y_std_arcsec"]])),
+            "crlb": float(np.median(np.r_[g["crlb_x_arcsec"], g["crlb_y_arcsec"]])),
+            "nav_after": float(g["nav_err_after_km"].mean()),
+            "nav_before": float(g["nav_err_before_km"].mean()) if "nav_err_before_km" in g else np.nan,
+            "data": float(np.nanmedian(g["data_to_converge_samples"]))
+            if g["data_to_converge_samples"].notna().any() else np.nan,
+            "runtime": float(h["runtime_s_per_seed"].iloc[0]) if len(h) else np.nan,
+        })
+    return pd.DataFrame(rows)
+
+
+def fig_alternatives(long, method_labels: dict):
+    """A-X2: EM-EKF vs augmented EKF vs batch ML per scenario variant (five panels of
+    :func:`alternatives_per_method`, CRLB and the error before compensation beside)."""
+    import matplotlib.pyplot as plt
+
+    pm = alternatives_per_method(long)
+    variants = list(dict.fromkeys(pm["variant"]))
+    methods = [m for m in method_labels if m in set(pm["method"])]
+    width = 0.8 / len(methods)
+    with figures.style():
+        fig, axes = plt.subplots(2, 3, figsize=(figures.PAGE_WIDTH_IN, 4.4))
+        axes = axes.ravel()
+        for ax, (col, label, logy) in zip(axes, _X2_PANELS):
+            for i, m in enumerate(methods):
+                d = pm[pm["method"] == m].set_index("variant").reindex(variants)
+                x = np.arange(len(variants)) + (i - (len(methods) - 1) / 2) * width
+                vals = d[col].to_numpy(float)
+                if logy:  # bars have no natural base on a log axis: markers
+                    ax.plot(x, vals, "o", color=figures.color(m), ms=4, label=method_labels[m])
+                else:
+                    ax.bar(x, np.where(np.isfinite(vals), vals, 0.0), width, color=figures.color(m),
+                           label=method_labels[m])
+            if col in ("bias", "spread"):
+                cr = pm.groupby("variant", sort=False)["crlb"].first().reindex(variants)
+                for j, v in enumerate(cr):
+                    ax.hlines(v, j - 0.45, j + 0.45, colors="k", linestyles="--",
+                              label="CRLB (median over cases)" if j == 0 else None)
+            if col == "nav_after":
+                nb = pm[pm["method"].str.startswith("em_")].groupby("variant", sort=False)["nav_before"].first()
+                for j, v in enumerate(nb.reindex(variants)):
+                    ax.hlines(v, j - 0.45, j + 0.45, colors="0.4", linestyles=":",
+                              label="before compensation" if j == 0 else None)
+            if logy:
+                ax.set_yscale("log")
+            ax.set_xticks(np.arange(len(variants)), variants)
+            ax.set_ylabel(label)
+        handles, labels = [], []
+        for ax in axes[:5]:
+            for h, lab in zip(*ax.get_legend_handles_labels()):
+                if lab not in labels:
+                    handles.append(h)
+                    labels.append(lab)
+        axes[5].axis("off")
+        axes[5].legend(handles, labels, loc="center", frameon=False)
+        fig.tight_layout()
+    return fig
+
+
+#: A-X3 / A-X5 sweep axes: x label and title per sweep name
+ABLATION_XLABEL = {"pixel": "centroid pixel error, 3-sigma (px)", "segment": "EM segment length N (samples)",
+                   "prior": "prior 1-sigma / configured prior 1-sigma", "range": "initial range (km)",
+                   "roll_rate": "roll rate (deg/s)"}
+
+
+def fig_ablation(df, sweep: str):
+    """A-X3 / A-X5: spread, RMSE and CRLB of tx and ty against the swept value, per scenario
+    variant (its colour) and estimator (line style); ``df`` is the sweep's table."""
+    import matplotlib.pyplot as plt
+
+    with figures.style():
+        variants = list(dict.fromkeys(df["variant"]))
+        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.6), sharex=True)
+        for ax, axis in zip(axes, ("x", "y")):
+            for i, v in enumerate(variants):
+                d = df[df["variant"] == v]
+                col = figures.color(v)
+                em = d[d["estimator"].str.startswith("EM-EKF")]
+                au = d[d["estimator"] == "augmented EKF"]
+                ax.plot(em["value"], em[f"sd_{axis}_arcsec"], "o-", color=col, label=f"{v}: EM-EKF spread")
+                ax.plot(em["value"], em[f"rmse_{axis}_arcsec"], "o:", color=col, mfc="none",
+                        label=f"{v}: EM-EKF RMSE")
+                ax.plot(au["value"], au[f"sd_{axis}_arcsec"], "s--", color=col, ms=3,
+                        label=f"{v}: augmented EKF spread")
+                ax.plot(au["value"], au[f"rmse_{axis}_arcsec"], "s:", color=col, ms=4, mfc="none",
+                        label=f"{v}: augmented EKF RMSE")
+                ax.plot(em["value"], em[f"crlb_{axis}_arcsec"], "-", color="k" if i == 0 else "0.55", lw=1.5,
+                        label=f"{v}: CRLB of the data EM-EKF used")
+                ax.plot(au["value"], au[f"crlb_{axis}_arcsec"], "--", color="k" if i == 0 else "0.55", lw=1.0,
+                        label=f"{v}: CRLB of all data")
+            ax.set_yscale("log")
+            if np.all(df["value"] > 0):
+                ax.set_xscale("log")
+            ax.set_xlabel(ABLATION_XLABEL.get(sweep, sweep))
+            ax.set_ylabel(f"t{axis}: spread, RMSE, CRLB (arcsec)")
+        h, lab = axes[0].get_legend_handles_labels()
+        fig.legend(h, lab, loc="lower center", ncol=len(variants) * 2 if len(variants) < 3 else 5,
+                   fontsize="x-small", frameon=False)
+        fig.tight_layout(rect=(0, 0.2, 1, 1))
     return fig

@@ -14,18 +14,11 @@ import numpy as np
 from opnav import figures
 
 __all__ = ["fig_true_states", "fig_depth_error_map", "fig_nav_error_envelopes",
-           "fig_planning_time", "METHOD_COLORS"]
+           "fig_planning_time"]
 
-METHOD_COLORS = {"depth": "C0", "svd": "C1", "gdop": "C2", "cond": "C3", "logdet": "C4",
-                 "mineig": "C5", "random": "C6", "center": "C7", "svd_w": "C8", "gdop_w": "C9",
-                 "cond_w": "k"}
 METHOD_LABELS = {"depth": "depth error", "svd": "SVD", "gdop": "GDOP", "cond": "cond. number",
                  "logdet": "log-det", "mineig": "min. eigenvalue", "svd_w": "SVD (whitened)",
                  "gdop_w": "GDOP (whitened)", "cond_w": "cond. (whitened)"}
-
-
-def _color(m, i):
-    return METHOD_COLORS.get(m, f"C{i % 10}")
 
 
 def _label(m):
@@ -147,7 +140,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
                 for k, (m, d) in enumerate(data.items()):
                     e = d[key][:, :, j]
                     s3 = 3.0 * e.std(axis=0, ddof=1) if e.shape[0] > 1 else np.abs(e[0])
-                    ax.plot(t, s3, color=_color(m, k), lw=1.0, label=_label(m),
+                    ax.plot(t, s3, color=figures.color(m), lw=1.0, label=_label(m),
                             ls=("-", "--", "-.", ":")[k % 4])
                 ax.set_yscale("log")
                 ax.set_title(f"{name} {axes[j]}", fontsize="medium")
@@ -181,12 +174,12 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             has_alt = va.size > 0
             pos.append(k - 0.18 if has_alt else k)
             vals.append(v)
-            cols.append(_color(m, k - 1))
+            cols.append(figures.color(m))
             hatch.append("")
             if has_alt:
                 pos.append(k + 0.18)
                 vals.append(va)
-                cols.append(_color(m, k - 1))
+                cols.append(figures.color(m))
                 hatch.append("///")
         bp = ax.boxplot(vals, positions=pos, whis=(0, 100), showfliers=False, patch_artist=True,
                         widths=0.32)

@@ -1,0 +1,119 @@
+"""One palette (opnav.figures.PALETTE): every method and scenario variant of both papers
+has one colour, and every figure that draws it uses that colour (A-X1 and A-X3 used to
+colour the roll variant differently)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.colors import to_rgba
+
+from opnav import figures, study_plots
+from opnav.approach import plots as aplots
+from opnav.approach.alternatives import METHOD_LABELS
+from opnav.config import load_config
+from opnav.landing import plots as lplots
+from opnav.landing.planner import available_methods
+from opnav.studies import APPROACH_METHODS
+
+VARIANTS = ["literal", "prior", "roll", "reference-start"]
+A_ESTIMATORS = ["plain", "squarem", "growing-plain", "growing-squarem", *METHOD_LABELS, *APPROACH_METHODS]
+
+
+def test_every_label_has_its_own_palette_entry():
+    cfg = load_config()
+    b_methods = set(available_methods()) | set(cfg["landing"]["mc"]["methods"]) | set(cfg["landing"]["extra"]["methods"])
+    for label in [*VARIANTS, *A_ESTIMATORS, *METHOD_LABELS.values(), *b_methods]:
+        assert figures.ALIASES.get(label, label) in figures.PALETTE, label
+    # distinct within what one paper's figures draw side by side
+    for group in (VARIANTS, sorted({figures.ALIASES.get(m, m) for m in A_ESTIMATORS}), sorted(b_methods)):
+        cols = [figures.color(x) for x in group]
+        assert len(set(cols)) == len(cols), dict(zip(group, cols))
+    # aliases are the same method: the same colour
+    assert figures.color("EM-EKF (SQUAREM)") == figures.color("em_squarem") == figures.color("squarem")
+    # a label outside the palette still gets one colour, from its name alone
+    assert figures.color("new_method") == figures.color("new_method")
+
+
+def _drawn(fig) -> dict[str, set]:
+    """legend label -> set of RGBA colours it is drawn with, over every axis of ``fig``."""
+    out: dict[str, set] = {}
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            lab = line.get_label()
+            if not lab.startswith("_"):
+                out.setdefault(lab, set()).add(to_rgba(line.get_color()))
+        for cont in ax.containers:
+            lab = cont.get_label()
+            if lab and not lab.startswith("_"):
+                patches = getattr(cont, "patches", None)
+                if patches:
+                    out.setdefault(lab, set()).update(to_rgba(p.get_facecolor()) for p in patches)
+    return out
+
+
+def _ablation_df():
+    rows = []
+    for v in ("literal", "roll"):
+        for est in ("EM-EKF (plain)", "augmented EKF"):
+            for x in (0.1, 1.0):
+                rows.append({"variant": v, "estimator": est, "value": x, **{
+                    f"{k}_{a}_arcsec": 1.0 + x for k in ("sd", "rmse", "crlb") for a in "xy"}})
+    return pd.DataFrame(rows)
+
+
+def _study_tidy(paper, variants, methods, metrics):
+    rows = []
+    for inst, x in (("k~1", 1.0), ("k~2", 2.0)):
+        for v in variants or [""]:
+            for m in methods:
+                for met in metrics:
+                    row = {"instance": inst, "method": m, "metric": met, "mean": x, "sd": x, "rms": x,
+                           "ci95_low": x - 0.1, "ci95_high": x + 0.1}
+                    if v:
+                        row["variant"] = v
+                    rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _study(paper, variants, methods, metrics):
+    return {"name": "t", "id": "A-S", "title": "t", "paper": paper, "keys": [f"{paper}.k"],
+            "statistic": "mean", "metrics": metrics, "methods": methods, "variants": variants,
+            "instances": {"k~1": {f"{paper}.k": 1.0}, "k~2": {f"{paper}.k": 2.0}}}
+
+
+def _figures():
+    yield "A-X3", aplots.fig_ablation(_ablation_df(), "pixel"), lambda lab: lab.split(":")[0]
+    a = _study("approach", ["literal", "roll"], ["em", "augmented"], ["err_x_arcsec"])
+    yield "A study", study_plots.fig_study(_study_tidy("approach", a["variants"], a["methods"], a["metrics"]), a), \
+        lambda lab: lab.split(":")[0]
+    b = _study("landing", [], ["depth", "svd", "gdop"], ["final_pos_err_m"])
+    yield "B study", study_plots.fig_study(_study_tidy("landing", [], b["methods"], b["metrics"]), b), lambda lab: lab
+    t = np.linspace(0, 1, 5)
+    rng = np.random.default_rng(0)
+    data = {m: {k: rng.normal(size=(3, 5, 3)) for k in ("err_r", "err_v", "err_rpy_deg")}
+            for m in ("depth", "svd", "cond")}
+    names = {lplots._label(m): m for m in data}
+    yield "B-F6", lplots.fig_nav_error_envelopes(t, data), names.get
+    long = pd.DataFrame([{"variant": v, "method": m, "case_id": "T1-01", "err_x_mean_arcsec": 1.0,
+                          "err_y_mean_arcsec": 1.0, "err_x_std_arcsec": 1.0, "err_y_std_arcsec": 1.0,
+                          "crlb_x_arcsec": 0.5, "crlb_y_arcsec": 0.5, "nav_err_after_km": 1.0,
+                          "nav_err_before_km": 2.0, "data_to_converge_samples": 100.0,
+                          "runtime_s_per_seed": 1.0} for v in ("literal", "roll") for m in METHOD_LABELS])
+    inv = {lab: m for m, lab in METHOD_LABELS.items()}
+    yield "A-X2", aplots.fig_alternatives(long, METHOD_LABELS), inv.get
+
+
+def test_every_figure_draws_a_label_in_its_palette_colour():
+    import matplotlib.pyplot as plt
+
+    seen: dict[str, set] = {}
+    for name, fig, key_of in _figures():
+        for lab, cols in _drawn(fig).items():
+            key = key_of(lab)
+            if key in (None, "") or "CRLB" in lab:
+                continue
+            seen.setdefault(key, set()).update(cols)
+            assert cols == {to_rgba(figures.color(key))}, (name, lab, cols)
+        plt.close(fig)
+    assert {"roll", "literal", "depth", "svd", "augmented"} <= set(seen)
+    assert all(len(c) == 1 for c in seen.values()), seen
