@@ -49,7 +49,7 @@ def test_score_rows_keeps_prejudged_claims():
 def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
     import pandas as pd
 
-    from opnav.scorecard import rows_paper_a
+    from opnav.approach.report import rows_paper_a
 
     t1 = pd.DataFrame([{
         "variant": "literal", "case_id": "T1-01", "truth_x_arcsec": 10.0, "truth_y_arcsec": 20.0,
@@ -69,7 +69,7 @@ def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
 def test_rows_paper_b_timing_and_same_accuracy():
     import pandas as pd
 
-    from opnav.scorecard import rows_paper_b
+    from opnav.landing.report import rows_paper_b
 
     t3 = pd.DataFrame([
         {"method": "depth", "time_reduction_vs_svd_pct": 80.0, "rms_pos_err_m_mean": 100.0},
@@ -89,7 +89,7 @@ def test_wide_band_does_not_count_as_reproduced():
 def test_same_accuracy_is_not_reproduced_when_the_methods_pick_the_same_landmark():
     """Equal accuracy because the methods choose the same landmark in 99.96 % of
     the calls is no test of the claim: never 'reproduced', and the reason says why."""
-    from opnav.scorecard import same_accuracy_verdict
+    from opnav.landing.report import same_accuracy_verdict
 
     v = same_accuracy_verdict({"svd": 0.4, "gdop": 0.4}, {"svd": 99.96, "gdop": 99.96},
                               {"svd": (-1.0, 1.8), "gdop": (-1.0, 1.8)})
@@ -98,7 +98,7 @@ def test_same_accuracy_is_not_reproduced_when_the_methods_pick_the_same_landmark
 
 
 def test_same_accuracy_is_reproduced_when_it_could_have_failed():
-    from opnav.scorecard import same_accuracy_verdict
+    from opnav.landing.report import same_accuracy_verdict
 
     v = same_accuracy_verdict({"svd": 3.0, "gdop": -2.0}, {"svd": 35.0, "gdop": 41.5},
                               {"svd": (-4.0, 10.0), "gdop": (-9.0, 5.0)})
@@ -112,7 +112,7 @@ def test_same_accuracy_is_reproduced_when_it_could_have_failed():
 def test_rows_paper_b_per_scenario_from_the_summary():
     import pandas as pd
 
-    from opnav.scorecard import rows_paper_b
+    from opnav.landing.report import rows_paper_b
 
     def methods(pick):
         return {"depth": {"method": "depth", "time_reduction_vs_svd_pct": 30.0, "rms_pos_err_m_mean": 100.0,
@@ -135,7 +135,7 @@ def test_rows_paper_b_per_scenario_from_the_summary():
 def test_a_stalled_em_row_says_so_in_the_reason_and_never_converged():
     import pandas as pd
 
-    from opnav.scorecard import rows_paper_a
+    from opnav.approach.report import rows_paper_a
 
     base = {"variant": "roll", "case_id": "T1-01", "truth_x_arcsec": 10.0, "truth_y_arcsec": 20.0,
             "est_x_mean": 0.02, "est_x_std": 0.002, "crlb_x_arcsec": 8.2, "crlb_y_arcsec": 8.2,

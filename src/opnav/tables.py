@@ -8,12 +8,13 @@ file is either complete or absent (written to a temporary name, then renamed).
 from __future__ import annotations
 
 import math
+import numbers
 
 import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterable, Iterator
+from typing import TYPE_CHECKING, Any, Iterable, Iterator
 
 if TYPE_CHECKING:  # pandas is imported where a table is built (scripts that only write files skip it)
     import pandas as pd
@@ -154,3 +155,40 @@ def write_json(path: str | Path, obj) -> None:
     import json
 
     atomic_write_text(path, json.dumps(json_ready(obj), indent=2, sort_keys=True) + "\n")
+
+
+# ------------------------------------------------------------ table cells
+#: What a missing value reads as in the manuscript (never "nan").
+MISSING = "--"
+
+
+def is_missing(x: Any) -> bool:
+    """None, NaN (any float type), pandas' NA/NaT, or the text ``nan``."""
+    if x is None:
+        return True
+    if isinstance(x, str):
+        return x.strip().lower() in ("nan", "<na>", "nat", "none", "")
+    if isinstance(x, numbers.Real) and not isinstance(x, bool):
+        return math.isnan(float(x))
+    try:
+        import pandas as pd
+
+        return bool(pd.isna(x)) if pd.api.types.is_scalar(x) else False
+    except (ImportError, TypeError, ValueError):
+        return False
+
+
+def cell_pm(mean: float, spread: float, fmt: str = "{:.3g}") -> str:
+    """A page-table cell 'mean ± spread' (the mean alone without a spread; missing: MISSING)."""
+    if is_missing(mean) or not math.isfinite(float(mean)):
+        return MISSING
+    if is_missing(spread) or not math.isfinite(float(spread)):
+        return fmt.format(mean)
+    return f"{fmt.format(mean)} ± {fmt.format(spread)}"
+
+
+def cell_num(x: float, fmt: str = "{:.4g}") -> str:
+    """A page-table cell for one number (missing or non-finite: MISSING)."""
+    if is_missing(x) or (isinstance(x, numbers.Real) and not math.isfinite(float(x))):
+        return MISSING
+    return fmt.format(x)

@@ -6,6 +6,8 @@ import sys
 import pandas as pd
 
 from opnav import published, scorecard
+from opnav.approach.report import rows_paper_a
+from opnav.landing.report import rows_paper_b
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_write_text, write_table
 
@@ -17,10 +19,10 @@ with script_context(snakemake) as log:
     rows = []
     if "a_table1" in inp.keys():
         summary_a = json.loads(open(inp["summary_A"]).read()) if "summary_A" in inp.keys() else {}
-        rows += scorecard.rows_paper_a(pd.read_csv(inp["a_table1"]), summary_a, published.paper_a())
+        rows += rows_paper_a(pd.read_csv(inp["a_table1"]), summary_a, published.paper_a())
     if "b_summary_table" in inp.keys():
         summary_b = json.loads(open(inp["summary_B"]).read()) if "summary_B" in inp.keys() else {}
-        rows += scorecard.rows_paper_b(pd.read_csv(inp["b_summary_table"]), summary_b, published.paper_b())
+        rows += rows_paper_b(pd.read_csv(inp["b_summary_table"]), summary_b, published.paper_b())
     df = scorecard.score_rows(rows)
     write_table(df, snakemake.output.table, caption="Scorecard: published values beside ours.")
     atomic_write_text(snakemake.output.longtable, scorecard.to_longtable(df))
