@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from approach_helpers import small_window
-from opnav.approach import ablation, alternatives, crlb
+from opnav.approach import alternatives, crlb
 from opnav.approach import scenario as sc
 from opnav.approach.augmented import run_augmented
 from opnav.approach.batch_ml import BatchML
@@ -181,16 +181,27 @@ def test_checkpoint_samples_keep_the_last():
     assert alternatives.checkpoint_samples(seg, 100)[-1] == 500
 
 
-def test_ablation_sweeps_change_one_value():
-    cfg = load_config()["approach"]
+def test_ablation_studies_change_one_value():
+    """The A-X3 ablations are studies (config.yaml): the segment sweep keeps the data
+    length L N, the pixel sweep keeps the radius / centroid ratio, and every value of
+    both changes only its own keys (and draws the initial error from the prior)."""
+    from opnav import studies
+
+    full = load_config()
+    cfg = full["approach"]
+    shape = {k: cfg[k] for k in cfg}
+    plan = studies.plan(full, {"approach": shape, "landing": full["landing"]}, lambda c: None)
     base = cfg["segments"]["L"] * cfg["segments"]["N"]
-    for value, c, case in ablation.sweep_configs(cfg, "segment"):
-        assert c["segments"]["N"] == value
-        assert abs(c["segments"]["L"] * c["segments"]["N"] - base) <= value / 2
-        assert case.sigma3_px == tuple(cfg["camera"]["sigma3_px"])
-    for value, c, case in ablation.sweep_configs(cfg, "pixel"):
-        r = cfg["camera"]["radius_to_centroid_ratio"]
-        assert case.sigma3_px == (value, value, r * value)
-        assert c["segments"] == cfg["segments"]
-    with pytest.raises(ValueError, match="sweep"):
-        ablation.sweep_configs(cfg, "nope")
+    seg = plan["segment"]
+    assert seg.keys == ("approach.segments.N", "approach.segments.L") and len(seg.instances) >= 2
+    for inst in seg.instances:
+        N, L = inst.values["approach.segments.N"], inst.values["approach.segments.L"]
+        assert abs(L * N - base) <= N / 2
+        assert inst.sim["camera"] == cfg["camera"] and inst.sim["segments"]["N0"] == cfg["segments"]["N0"]
+    r = cfg["camera"]["radius_to_centroid_ratio"]
+    for inst in plan["pixel"].instances:
+        px = inst.values["approach.camera.sigma3_px"]
+        assert px[0] == px[1] and px[2] == pytest.approx(r * px[0])
+        assert inst.sim["segments"] == cfg["segments"]
+    for name in ("pixel", "segment", "prior", "range", "roll_rate"):
+        assert all(i.sim["initial_error"]["mode"] == "sampled" for i in plan[name].instances), name

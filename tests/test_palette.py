@@ -1,6 +1,6 @@
 """One palette (opnav.figures.PALETTE): every method and scenario variant of both papers
-has one colour, and every figure that draws it uses that colour (A-X1 and A-X3 used to
-colour the roll variant differently)."""
+has one colour, and every figure that draws it uses that colour (A-X1 and the A-X3
+ablation figure used to colour the roll variant differently)."""
 
 import numpy as np
 import pandas as pd
@@ -51,16 +51,6 @@ def _drawn(fig) -> dict[str, set]:
     return out
 
 
-def _ablation_df():
-    rows = []
-    for v in ("literal", "roll"):
-        for est in ("EM-EKF (plain)", "augmented EKF"):
-            for x in (0.1, 1.0):
-                rows.append({"variant": v, "estimator": est, "value": x, **{
-                    f"{k}_{a}_arcsec": 1.0 + x for k in ("sd", "rmse", "crlb") for a in "xy"}})
-    return pd.DataFrame(rows)
-
-
 def _study_tidy(paper, variants, methods, metrics):
     rows = []
     for inst, x in (("k~1", 1.0), ("k~2", 2.0)):
@@ -82,7 +72,6 @@ def _study(paper, variants, methods, metrics):
 
 
 def _figures():
-    yield "A-X3", aplots.fig_ablation(_ablation_df(), "pixel"), lambda lab: lab.split(":")[0]
     a = _study("approach", ["literal", "roll"], ["em", "augmented"], ["err_x_arcsec"])
     yield "A study", study_plots.fig_study(_study_tidy("approach", a["variants"], a["methods"], a["metrics"]), a), \
         lambda lab: lab.split(":")[0]

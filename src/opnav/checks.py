@@ -160,8 +160,7 @@ def approach_problems(a: dict) -> list[str]:
         return out
     for key, seeds, samples in (("n_seeds", a["n_seeds"], n),
                                 ("convergence_study.n_seeds", a["convergence_study"]["n_seeds"],
-                                 s["N0"] + a["convergence_study"]["data_samples"]),
-                                ("ablation.n_seeds", a["ablation"]["n_seeds"], n)):
+                                 s["N0"] + a["convergence_study"]["data_samples"])):
         if seeds * samples > MAX_APPROACH_SEED_SAMPLES:
             out.append(f"{k}{key}': {seeds} seeds x {samples} samples exceeds the limit "
                        f"{MAX_APPROACH_SEED_SAMPLES} (memory)")
@@ -174,8 +173,7 @@ def approach_problems(a: dict) -> list[str]:
     if roll["steps_deg"] and not _multiple(roll["step_interval_s"], dt):
         out.append(f"{k}roll.step_interval_s': {roll['step_interval_s']} s is not a multiple of "
                    f"approach.dt_s = {dt} s")
-    for key in ("variants", "table1_variants", "methods", "ablation.variants",
-                "ablation.sigma3_px", "ablation.segment_N"):
+    for key in ("variants", "table1_variants", "methods"):
         node = a
         for part in key.split("."):
             node = node[part]

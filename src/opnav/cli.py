@@ -3,7 +3,9 @@
 Subcommands are contributed by the subpackages: a module ``opnav.<part>.cli``
 that defines ``register(subparsers)`` adds its own (``opnav approach``,
 ``opnav landing``). Each prints a JSON summary to stdout (:func:`print_json`:
-valid JSON, a non-finite number written as ``null``).
+valid JSON, a non-finite number written as ``null``). ``opnav study NAME`` runs
+one parameter study of the config (``studies``) through the checkout's Snakemake
+workflow (its target ``study_NAME``) and prints where its outputs are.
 
 Errors are one line each on stderr, no traceback. Exit codes: 0 success;
 :data:`EXIT_USER` (2) for every user error (a bad flag or config value, an
@@ -128,6 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         mod.register(sub)
+    _register_study(sub)
     for p in sub.choices.values():
         add_config_arguments(p)
     return parser
@@ -185,6 +188,72 @@ def load_cli_config(args) -> dict:
             node = node[part]
         flags[key] = (f"--set {key}", value)
     return with_flags(config, flags) if flags else config
+
+
+def _register_study(sub) -> None:
+    p = sub.add_parser("study", help="run one parameter study (config `studies`) with Snakemake",
+                       description="Run the parameter study NAME of the config (the defaults plus the "
+                                   "--config overlays, e.g. one holding a new `studies` block) through "
+                                   "the checkout's workflow: `snakemake --cores N --configfile FILE ... "
+                                   "-- study_NAME`. Only that study's jobs run.")
+    p.add_argument("name", metavar="NAME", help="the study's name (a key of `studies`)")
+    p.add_argument("--cores", type=integer, default=2, help="Snakemake cores (default 2)")
+    p.add_argument("-n", "--dry-run", action="store_true", help="list the jobs, run nothing")
+    p.set_defaults(func=run_study)
+
+
+def study_command(name: str, overlays, cores: int = 2, dry_run: bool = False) -> list[str]:
+    """The Snakemake command line that runs study ``name`` with the config ``overlays``
+    (files; the target after ``--``, since ``--configfile`` takes every word after it)."""
+    cmd = [sys.executable, "-m", "snakemake", "--cores", str(cores)]
+    if dry_run:
+        cmd.append("--dry-run")
+    if overlays:
+        cmd += ["--configfile", *map(str, overlays)]
+    return cmd + ["--", f"study_{name}"]
+
+
+def run_study(args) -> int:
+    """``opnav study NAME``: validate the merged config and the study (before any job),
+    then run its Snakemake target in the checkout."""
+    import os
+    import subprocess
+    import tempfile
+    from pathlib import Path
+
+    import yaml
+
+    from opnav.config import repo_root
+
+    config = load_cli_config(args)  # every overlay and --set validated, errors name the key
+    studies = config.get("studies") or {}
+    if args.name not in studies:
+        raise ConfigError(f"no study '{args.name}' in the config (studies: {', '.join(sorted(studies)) or 'none'}); "
+                          "declare it in an overlay given with --config")
+    if args.cores < 1:
+        raise ConfigError("--cores: must be at least 1")
+    root = repo_root()
+    overlays = [Path(f).resolve() for f in [*([args.config] if getattr(args, "config", None) else []),
+                                            *args.overlays]]
+    with tempfile.TemporaryDirectory() as tmp:
+        if args.sets:  # --set keys reach Snakemake as one more overlay
+            sets = {}
+            for text in args.sets:
+                key, value = parse_set(text)
+                _set(sets, key, value)
+            extra = Path(tmp, "set.yaml")
+            extra.write_text(yaml.safe_dump(sets))
+            overlays.append(extra)
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            p for p in (str(root / "src"), os.environ.get("PYTHONPATH", "")) if p))
+        proc = subprocess.run(study_command(args.name, overlays, args.cores, args.dry_run), cwd=root, env=env)
+    if proc.returncode:
+        print(f"opnav: error: snakemake failed for study '{args.name}' (exit {proc.returncode})", file=sys.stderr)
+        return EXIT_NUMERICAL
+    out = Path(config["results_dir"]) / "studies" / args.name
+    print_json({"study": args.name, "dry_run": bool(args.dry_run),
+                "outputs": str(out if out.is_absolute() else root / out)})
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -46,8 +46,9 @@ import pandas as pd
 
 from opnav.config import ConfigError
 
-__all__ = ["METRICS", "APPROACH_METHODS", "Study", "plan", "config_digest", "instance_label",
-           "get_path", "set_path", "project", "summarize", "table_metrics", "wide_table", "caption", "ci95"]
+__all__ = ["METRICS", "CONSTANT_METRICS", "APPROACH_METHODS", "Study", "plan", "config_digest",
+           "instance_label", "get_path", "set_path", "project", "summarize", "table_metrics", "wide_table",
+           "caption", "ci95", "gather_runs", "tidy_table", "shown_statistic", "loglog_slopes"]
 
 #: Per-run metrics a study can tabulate: name -> (label with unit, CRLB column or None).
 METRICS: dict[str, dict[str, tuple[str, str | None]]] = {
@@ -70,12 +71,20 @@ METRICS: dict[str, dict[str, tuple[str, str | None]]] = {
         "err_x_arcsec": ("tx estimate - truth (arcsec)", "crlb_x_arcsec"),
         "err_y_arcsec": ("ty estimate - truth (arcsec)", "crlb_y_arcsec"),
         "err_z_arcsec": ("tz estimate - truth (arcsec)", None),
-        "crlb_x_arcsec": ("1-sigma CRLB of tx (arcsec)", None),
-        "crlb_y_arcsec": ("1-sigma CRLB of ty (arcsec)", None),
+        "crlb_x_arcsec": ("1-sigma CRLB of tx, all data (arcsec)", None),
+        "crlb_y_arcsec": ("1-sigma CRLB of ty, all data (arcsec)", None),
+        "crlb_used_x_arcsec": ("1-sigma CRLB of tx, data the estimator used (arcsec)", None),
+        "crlb_used_y_arcsec": ("1-sigma CRLB of ty, data the estimator used (arcsec)", None),
+        "stalled_pct": ("EM seeds the stall rule flags (%)", None),
         "nav_err_after_km": ("RMS nav. error after compensation (km)", None),
         "data_to_converge_samples": ("data needed to converge (samples)", None),
     },
 }
+#: Metrics that are one number per value and method (the same for every run): tables and
+#: figures show their value (the mean), whatever the study's statistic.
+CONSTANT_METRICS = frozenset({"crlb_x_arcsec", "crlb_y_arcsec", "crlb_used_x_arcsec", "crlb_used_y_arcsec"})
+#: Per-run 0/100 indicators: their mean is the share of runs, whatever the study's statistic.
+SHARE_METRICS = frozenset({"converged_pct", "stalled_pct"})
 DEFAULT_METRICS = {"landing": ["final_pos_err_m", "rms_pos_err_m", "mean_nees_pos"],
                    "approach": ["err_x_arcsec", "err_y_arcsec", "nav_err_after_km"]}
 DEFAULT_METHODS = {"landing": ["depth", "svd"], "approach": ["em", "augmented"]}
@@ -110,6 +119,9 @@ class Study:
     metrics: tuple[str, ...]
     statistic: str
     instances: tuple[Instance, ...]
+    fixed: dict = field(default_factory=dict)
+    slopes: bool = False
+    note: str = ""
 
     @property
     def units(self) -> list[tuple[str, str]]:
@@ -121,7 +133,8 @@ class Study:
         return {"name": self.name, "paper": self.paper, "id": self.id, "title": self.title,
                 "keys": list(self.keys), "grid": self.grid, "methods": list(self.methods),
                 "variants": list(self.variants), "runs": self.runs, "metrics": list(self.metrics),
-                "statistic": self.statistic,
+                "statistic": self.statistic, "fixed": dict(self.fixed), "slopes": self.slopes,
+                "note": self.note,
                 "instances": {i.label: i.values for i in self.instances}}
 
 
@@ -267,7 +280,8 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
     spec = {**_spec_defaults(), **spec}
     paper = spec["paper"]
     where = f"study '{name}'"
-    for key in spec["vary"]:
+    fixed = dict(spec.get("fixed") or {})
+    for key in [*spec["vary"], *fixed]:
         parts = key.split(".")
         if parts[0] != paper:
             raise ConfigError(f"{where}: key '{key}' is not under '{paper}.' (the study's paper)")
@@ -276,8 +290,11 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
         except KeyError:
             raise ConfigError(f"{where}: key '{key}' is not a config key") from None
         if not _in_shape(shapes[paper], parts[1:]):
-            raise ConfigError(f"{where}: key '{key}' is not read by the {paper} simulation, so sweeping "
+            raise ConfigError(f"{where}: key '{key}' is not read by the {paper} simulation, so setting "
                               f"it changes nothing (it reads: {', '.join(sorted(shapes[paper]))})")
+    both = sorted(set(spec["vary"]) & set(fixed))
+    if both:
+        raise ConfigError(f"{where}: key(s) {both} are both swept (vary) and fixed")
     methods = list(spec.get("methods") or DEFAULT_METHODS[paper])
     allowed = APPROACH_METHODS if paper == "approach" else landing_methods
     if allowed:
@@ -298,7 +315,7 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
     for values in _value_sets(name, spec):
         merged = copy.deepcopy(dict(config))
         merged.pop("studies", None)
-        for k, v in values.items():
+        for k, v in {**fixed, **values}.items():
             set_path(merged, k, v)
         try:
             validate(merged)
@@ -319,7 +336,8 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
                  title=spec.get("title") or ", ".join(keys), keys=keys, grid=bool(spec.get("grid", False)),
                  methods=tuple(methods), variants=tuple(variants), runs=int(spec["runs"]),
                  runs_per_job=int(spec["runs_per_job"]), metrics=tuple(metrics), statistic=statistic,
-                 instances=tuple(instances))
+                 instances=tuple(instances), fixed=fixed, slopes=bool(spec.get("slopes", False)),
+                 note=str(spec.get("note", "")))
 
 
 def table_metrics(study: Mapping) -> list[str]:
@@ -327,6 +345,66 @@ def table_metrics(study: Mapping) -> list[str]:
     mets = list(study["metrics"])
     bounds = [METRICS[study["paper"]][m][1] for m in mets]
     return mets + [b for b in dict.fromkeys(bounds) if b and b not in mets]
+
+
+# ------------------------------------------------------------------ tables
+def gather_runs(parts: Iterable[tuple[str, pd.DataFrame]], study: Mapping,
+                converged_pos_err_m: float | None = None) -> pd.DataFrame:
+    """Every run of a study, one row per (instance, [variant,] method, run): the chunk
+    tables ``(instance label, frame)`` joined, runs beyond ``study["runs"]`` dropped (kept
+    chunks of a larger earlier study), paper-B derived metrics added, the swept values
+    beside each row."""
+    frames = []
+    for label, df in parts:
+        df = df.copy()
+        df.insert(0, "instance", label)
+        frames.append(df)
+    runs = pd.concat(frames, ignore_index=True)
+    runs = runs[runs["run"] < study["runs"]]
+    if study["paper"] == "landing":
+        from opnav.landing.study import add_derived
+
+        runs = add_derived(runs, converged_pos_err_m)
+    for key in study["keys"]:
+        runs.insert(1, key, [str(study["instances"][i][key]) for i in runs["instance"]])
+    return runs.reset_index(drop=True)
+
+
+def tidy_table(runs: pd.DataFrame, study: Mapping) -> pd.DataFrame:
+    """The study's tidy summary (:func:`summarize`) with the study name and swept values."""
+    tidy = summarize(runs, table_metrics(study), study["methods"])
+    for key in reversed(study["keys"]):
+        tidy.insert(1, key, [study["instances"][i][key] for i in tidy["instance"]])
+    tidy.insert(0, "study", study["name"])
+    return tidy
+
+
+def shown_statistic(study: Mapping, metric: str) -> str:
+    """The statistic a figure draws for ``metric``: the study's; the value (mean) of a
+    metric that is the same for every run (:data:`CONSTANT_METRICS`); the share (mean) of a
+    0/100 indicator (:data:`SHARE_METRICS`)."""
+    return "mean" if metric in CONSTANT_METRICS | SHARE_METRICS else study["statistic"]
+
+
+def loglog_slopes(tidy: pd.DataFrame, study: Mapping) -> pd.DataFrame:
+    """Power-law exponents: per ([variant,] method, metric) the least-squares slope of
+    log(statistic) against log(first swept key), the statistic being
+    :func:`shown_statistic`'s (+1: proportional). Values or statistics <= 0 are left out;
+    NaN below two points."""
+    key = study["keys"][0]
+    unit = (["variant"] if "variant" in tidy else []) + ["method", "metric"]
+    rows = []
+    for keys, g in tidy[tidy["metric"].isin(table_metrics(study))].groupby(unit, sort=False):
+        keys = keys if isinstance(keys, tuple) else (keys,)
+        stat = shown_statistic(study, keys[-1])
+        x = np.array([float(study["instances"][i][key]) for i in g["instance"]])
+        y = g[stat].to_numpy(float)
+        ok = (x > 0) & (y > 0) & np.isfinite(y)
+        slope = (float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0])
+                 if ok.sum() >= 2 and np.ptp(np.log(x[ok])) > 0 else math.nan)
+        rows.append({"study": study["name"], **dict(zip(unit, keys)), "statistic": stat,
+                     "against": key, "n_values": int(ok.sum()), "slope": slope})
+    return pd.DataFrame(rows)
 
 
 # ------------------------------------------------------------------ statistics
@@ -394,9 +472,13 @@ def wide_table(tidy: pd.DataFrame, study: Mapping) -> pd.DataFrame:
         row.update(dict(zip(unit[1:], keys[1:])))
         row["n_runs"] = int(g["n_runs"].max())
         for r in g.itertuples():
-            if r.metric not in study["metrics"]:  # a bound (the same for every run)
+            shown = shown_statistic(study, r.metric)
+            if not np.isfinite(getattr(r, shown)):  # e.g. the stall share of a non-EM estimator
+                row[r.metric if shown == "mean" else f"{r.metric} ({stat})"] = "--"
+                continue
+            if r.metric not in study["metrics"] or r.metric in CONSTANT_METRICS:  # the same for every run
                 row[r.metric] = f"{r.mean:.4g}"
-            elif stat == "mean":  # mean +- half-width of its 95 % interval
+            elif shown == "mean":  # mean +- half-width of its 95 % interval
                 row[r.metric] = (f"{r.mean:.4g} ± {(r.ci95_high - r.ci95_low) / 2:.2g}"
                                  if np.isfinite(r.ci95_low) else f"{r.mean:.4g}")
             else:
@@ -423,9 +505,15 @@ def caption(study: Mapping) -> str:
     stat = {"mean": "mean over runs with its 95 % confidence interval (Student t)",
             "sd": "spread (sample sd over runs)", "rms": "RMS over runs"}[study["statistic"]]
     mets = ", ".join(METRICS[study["paper"]][m][0] for m in study["metrics"])
-    return (f"Study '{study['name']}' ({paper}): {keys} swept, {how} {vals}; all other settings as "
+    fixed = study.get("fixed") or {}
+    fixed_text = ("; " + ", ".join(f"``{k}`` = {_slug(v)}" for k, v in fixed.items()) + " for every value"
+                  if fixed else "")
+    return (f"Study '{study['name']}' ({paper}): {keys} swept, {how} {vals}{fixed_text}; all other settings as "
             f"configured. Compared: {who}; {runs}. Plotted: the {stat} of {mets}"
             + (" beside the 1-sigma Cramer-Rao bound" if study["paper"] == "approach"
                and study["statistic"] != "mean" else "")
             + ". The CSV table (tidy, one row per value, method and metric) gives n, mean, sd, RMS, "
-            f"median, the 95 % interval of the mean and the paired difference against {study['methods'][0]}.")
+            f"median, the 95 % interval of the mean and the paired difference against {study['methods'][0]}"
+            + (f"; the slopes table, the log-log slope of each against {study['keys'][0]}"
+               if study.get("slopes") else "") + "."
+            + (f" {study['note']}" if study.get("note") else ""))

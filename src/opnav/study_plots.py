@@ -18,27 +18,49 @@ import numpy as np
 import pandas as pd
 
 from opnav import figures
-from opnav.studies import METRICS, _slug
+from opnav.studies import METRICS, _slug, shown_statistic
 
 
 _LINESTYLES = ("-", "--", "-.", ":")
 
 
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _order_key(values: Mapping, keys):
+    """Sort key of a value set: its values in key order (numbers and lists of numbers
+    compare naturally; anything else by its text)."""
+    def one(v):
+        if _is_number(v):
+            return (0, float(v), "")
+        if isinstance(v, (list, tuple)) and all(_is_number(x) for x in v):
+            return (1, tuple(float(x) for x in v), "")
+        return (2, (), str(v))
+    return tuple(one(values[k]) for k in keys)
+
+
 def _x_axis(study: Mapping):
+    """x position of every instance, the tick labels (None: a numeric axis) and the label.
+    A numeric first key gives a numeric axis (zipped keys named beside it); otherwise the
+    value sets are categories in ascending order of their values."""
     labels = list(study["instances"])
     vals = [study["instances"][lab] for lab in labels]
-    if len(study["keys"]) == 1:
-        xs = [v[study["keys"][0]] for v in vals]
-        if all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in xs):
-            return {lab: float(x) for lab, x in zip(labels, xs)}, None, study["keys"][0]
-    ticks = [", ".join(_slug(v[k]) for k in study["keys"]) for v in vals]
-    return {lab: float(i) for i, lab in enumerate(labels)}, ticks, ", ".join(k.split(".")[-1] for k in study["keys"])
+    keys = list(study["keys"])
+    xs = [v[keys[0]] for v in vals]
+    if all(_is_number(x) for x in xs) and len(set(xs)) == len(xs):
+        others = ", ".join(k.split(".")[-1] for k in keys[1:])
+        xlabel = keys[0] + (f" (zipped: {others})" if others else "")
+        return {lab: float(x) for lab, x in zip(labels, xs)}, None, xlabel
+    order = sorted(range(len(labels)), key=lambda i: _order_key(vals[i], keys))
+    ticks = [", ".join(_slug(vals[i][k]) for k in keys) for i in order]
+    return ({labels[i]: float(j) for j, i in enumerate(order)}, ticks,
+            ", ".join(k.split(".")[-1] for k in keys))
 
 
 def fig_study(tidy: pd.DataFrame, study: Mapping):
     import matplotlib.pyplot as plt
 
-    stat = study["statistic"]
     metrics = list(study["metrics"])
     xmap, ticks, xlabel = _x_axis(study)
     ncol = min(3, len(metrics))
@@ -49,6 +71,7 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
                                 squeeze=False, constrained_layout=True)
         for ax, metric in zip(axs.ravel(), metrics):
             label, bound = METRICS[study["paper"]][metric]
+            stat = shown_statistic(study, metric)
             d = tidy[tidy["metric"] == metric]
             for variant, method in units:
                 dm = d[d["method"] == method]

@@ -1,5 +1,6 @@
-# Paper A, beyond the paper: A-X2 (EM-EKF against the augmented EKF and batch ML)
-# and A-X3 (one-value ablations of pixel noise and segment length).
+# Paper A, beyond the paper: A-X2 (EM-EKF against the augmented EKF and batch ML).
+# The A-X3 ablations (pixel noise, segment length) and the A-X5 sensitivity sweeps
+# (prior sigma, range, roll rate) are parameter studies (config `studies`, studies.smk).
 # Uses approach.smk's names (APPROACH, A_WORK, A_SCENARIO, A_EM, A_SRC, A_MC, A_METHODS, a_groups):
 # include it after approach.smk.
 
@@ -59,64 +60,3 @@ rule approach_x2_figure:
     localrule: True
     script:
         "../scripts/approach_x2_figure.py"
-
-
-rule approach_ablation_pixel:
-    """A-X3: pixel-noise sweep (approach.ablation.sigma3_px) of the headline case per variant."""
-    input:
-        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "approach/plots.py", "figures.py", "tables.py"),
-    output:
-        table=report_table(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
-        fig=report_figure(f"{APPROACH}/A-X3_ablation_pixel", "A-X3", "Paper A"),
-    params:
-        approach=a_ablation_cfg("sigma3_px"),
-        sweep="pixel",
-    log:
-        f"{APPROACH}/logs/ablation_pixel.log",
-    benchmark:
-        f"{APPROACH}/benchmarks/ablation_pixel.tsv"
-    script:
-        "../scripts/approach_ablation.py"
-
-
-rule approach_ablation_segment:
-    """A-X3: segment-length sweep (approach.ablation.segment_N) of the headline case per variant."""
-    input:
-        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "approach/plots.py", "figures.py", "tables.py"),
-    output:
-        table=report_table(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
-        fig=report_figure(f"{APPROACH}/A-X3_ablation_segment", "A-X3", "Paper A"),
-    params:
-        approach=a_ablation_cfg("segment_N"),
-        sweep="segment",
-    log:
-        f"{APPROACH}/logs/ablation_segment.log",
-    benchmark:
-        f"{APPROACH}/benchmarks/ablation_segment.tsv"
-    script:
-        "../scripts/approach_ablation.py"
-
-
-A_SENSITIVITY = {"prior": "prior_scale", "range": "range_km", "roll_rate": "roll_rate_deg_s"}
-
-
-rule approach_sensitivity:
-    """A-X5: sensitivity sweep (prior sigma, range or roll rate) of the headline case: bound and
-    spreads per value (initial error sampled), and their log-log slopes."""
-    input:
-        A_X2_SRC + src("approach/ablation.py", "approach/pipeline.py", "approach/plots.py", "figures.py", "tables.py"),
-    output:
-        table=report_table(f"{APPROACH}/A-X5_sensitivity_{{sweep}}", "A-X5", "Paper A"),
-        slopes=report_table(f"{APPROACH}/A-X5_sensitivity_{{sweep}}_slopes", "A-X5", "Paper A"),
-        fig=report_figure(f"{APPROACH}/A-X5_sensitivity_{{sweep}}", "A-X5", "Paper A", "{sweep}"),
-    wildcard_constraints:
-        sweep="prior|range|roll_rate",
-    params:
-        approach=lambda wc: a_ablation_cfg(A_SENSITIVITY[wc.sweep]),
-        sweep=lambda wc: wc.sweep,
-    log:
-        f"{APPROACH}/logs/sensitivity_{{sweep}}.log",
-    benchmark:
-        f"{APPROACH}/benchmarks/sensitivity_{{sweep}}.tsv"
-    script:
-        "../scripts/approach_ablation.py"

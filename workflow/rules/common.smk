@@ -87,10 +87,8 @@ def result_outputs():
     Reads the rules at call time, so call it once the rule files are included."""
     a = [*rules.approach_tables.output, *rules.approach_x1_figure.output,
          *expand(rules.approach_figures.output, variant=A_VARIANTS),
-         *expand(rules.approach_sensitivity.output, sweep=list(A_SENSITIVITY)),
          *rules.approach_x2_tables.output.table, rules.approach_x2_tables.output.summary,
-         *rules.approach_x2_figure.output,
-         *rules.approach_ablation_pixel.output, *rules.approach_ablation_segment.output]
+         *rules.approach_x2_figure.output]
     if HAVE_BSK:
         a += [*rules.approach_peer_tables.output.table, rules.approach_peer_tables.output.summary,
               *rules.approach_peer_figure.output]
@@ -133,15 +131,6 @@ def a_headline_mc(wildcards):
     g = a_groups(wildcards.variant)[0]  # the group holding T1-01
     return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS] + [
         p for (v, gg, m), p in A_MC_GROWING.items() if v == wildcards.variant and gg == g]
-
-
-# approach_extra.smk
-def a_ablation_cfg(values_key):
-    """The keys an A-X3 sweep reads: scenario, EM, augmented EKF and its own values only."""
-    c = cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives")
-    abl = config["approach"]["ablation"]
-    c["ablation"] = canonical({k: abl[k] for k in ("variants", "n_seeds", values_key)})
-    return c
 
 
 # paper.smk

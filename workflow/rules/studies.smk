@@ -63,6 +63,7 @@ for _name, _s in STUDIES.items():
                           subcategory=_name), f"{_stem}.tex", f"{_stem}.md"],
             runs=f"{_dir}/runs.csv",
             caption=f"{_dir}/{_s.id}.rst",
+            slopes=table_outputs(f"{_stem}_slopes") if _s.slopes else [],
         params:
             study=_spec,
             labels=[lab for _, lab in _files],
@@ -92,8 +93,8 @@ for _name, _s in STUDIES.items():
         script:
             "../scripts/study_figure.py"
 
-    STUDY_TARGETS[_name] = [*table_outputs(_stem), f"{_dir}/runs.csv", f"{_dir}/{_s.id}.rst",
-                            *figure_outputs(_stem)]
+    STUDY_TARGETS[_name] = [*table_outputs(_stem), *(table_outputs(f"{_stem}_slopes") if _s.slopes else []),
+                            f"{_dir}/runs.csv", f"{_dir}/{_s.id}.rst", *figure_outputs(_stem)]
 
     rule:
         name:

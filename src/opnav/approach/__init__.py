@@ -37,6 +37,6 @@ SPEC A.4   A-X2 alternatives: augmented EKF, batch ML (CasADi/IPOPT)   augmented
 Layers
     ``setup`` (the config parsed once, frozen) -> ``dynamics``, ``camera``, ``kalman`` ->
     ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml`` -> ``scenario``,
-    ``cases`` -> ``pipeline``, ``alternatives``, ``ablation``, ``study``, ``peers`` ->
+    ``cases`` -> ``pipeline``, ``alternatives``, ``study``, ``peers`` ->
     ``report`` (tables and texts), ``plots``, ``peer_plots``; ``cli`` at the edge.
 """

@@ -620,20 +620,6 @@ def compact_a_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return [("", pd.DataFrame(rows))]
 
 
-def compact_a_x3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
-    """A-X3 for the page: estimate spread and error against the CRLB over the swept value."""
-    rows = []
-    for _, r in df.iterrows():
-        rows.append({
-            "variant": r["variant"], str(r.get("sweep", "value")): cell_num(r["value"], "{:g}"),
-            "estimator": r["estimator"],
-            'sd x (")': cell_num(r.get("sd_x_arcsec"), "{:.3g}"),
-            'RMSE x (")': cell_num(r.get("rmse_x_arcsec"), "{:.3g}"),
-            'CRLB x (")': cell_num(r.get("crlb_x_arcsec"), "{:.3g}"),
-            "sd / CRLB": cell_num(r.get("sd_over_crlb_x"), "{:.3g}"),
-        })
-    return [("", pd.DataFrame(rows))]
-
 
 def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     """A-P1 for the page: the peer UKF beside the paper's estimators, estimate, own 3-sigma, bound."""
@@ -651,8 +637,7 @@ def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
 
 
 #: Page views of paper A's tables too wide for a page, by SPEC id.
-COMPACT_VIEWS = {"A-T1": compact_a_t1, "A-X1": compact_a_x1, "A-X2": compact_a_x2, "A-X3": compact_a_x3,
-                 "A-P1": compact_a_p1}
+COMPACT_VIEWS = {"A-T1": compact_a_t1, "A-X1": compact_a_x1, "A-X2": compact_a_x2, "A-P1": compact_a_p1}
 
 
 #: floors for values published with few digits (see module docstring)

@@ -12,8 +12,11 @@ measurements for every value and estimator, so comparisons are paired) with one 
 
 One row per seed: the final estimate minus the truth of tx, ty, tz (arcsec), the
 RMS navigation error after compensation (km, last ``nav_error.last_fraction`` of the
-arc), the data needed to converge (samples), and the 1-sigma Cramér-Rao bound of tx and
-ty for the data used (:func:`opnav.approach.pipeline.bound_curve`; the same for every seed).
+arc), the data needed to converge (samples), the 1-sigma Cramér-Rao bound of tx and
+ty for all the data (:func:`opnav.approach.pipeline.total_bound`; the same for every seed)
+and for the data the estimator used (``crlb_used_*``: the EM-EKF's last window,
+:func:`opnav.approach.pipeline.segment_bounds`; the augmented EKF uses all data), and
+whether the stall rule flags the EM run (``stalled_pct``: 100 or 0; NaN for the augmented EKF).
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ import pandas as pd
 from . import alternatives as alt
 from . import cases
 from . import scenario as sc
-from .pipeline import total_bound
+from .pipeline import segment_bounds, total_bound
 from .setup import Setup
 
 
@@ -39,9 +42,13 @@ def run_runs(setup: Setup | dict, variant: str, method: str, seeds) -> pd.DataFr
     if method.startswith("em"):
         scheme = setup.em.method if method == "em" else method.removeprefix("em_")
         r = cases.run_case(setup, variant, case, seeds, geo=geo, method=scheme)
+        crlb_used = segment_bounds(setup, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec,
+                                   variant)[-1]
+        stalled = 100.0 * np.asarray(r["stalled"], float)
     elif method == "augmented":
         r = alt.run_case_alternatives(setup, variant, case, seeds, geo, methods=("augmented",))
         r = r["methods"]["augmented"]
+        crlb_used, stalled = crlb, np.full(len(seeds), np.nan)
     else:
         raise ValueError(f"unknown paper-A study estimator {method!r}")
     err = np.asarray(r["theta_final_arcsec"], float) - np.asarray(case.truth_arcsec, float)
@@ -51,5 +58,7 @@ def run_runs(setup: Setup | dict, variant: str, method: str, seeds) -> pd.DataFr
         "nav_err_after_km": np.asarray(r["nav_err_after_km"], float),
         "data_to_converge_samples": np.asarray(r["data_to_converge"], float),
         "crlb_x_arcsec": float(crlb[0]), "crlb_y_arcsec": float(crlb[1]),
+        "crlb_used_x_arcsec": float(crlb_used[0]), "crlb_used_y_arcsec": float(crlb_used[1]),
+        "stalled_pct": stalled,
         "data_samples": used,
     })

@@ -1,0 +1,47 @@
+"""Running one study by name: `opnav study NAME --config FILE` runs Snakemake with
+`--configfile FILE ... -- study_NAME` (without `--` the target is read as one more
+config file), so only that study's jobs run; an unknown study or a bad value is
+refused before any job."""
+
+import json
+import os
+import subprocess
+import sys
+
+import yaml
+
+from opnav.cli import study_command
+from test_incremental import _readme_study_block
+
+
+def _overlay(wd):
+    block = _readme_study_block()
+    (name, spec), = block["studies"].items()
+    spec.update(runs=2, runs_per_job=2)
+    (wd / "my-study.yaml").write_text(yaml.safe_dump(block))
+    return name, spec
+
+
+def _opnav(wd, *args):
+    env = dict(os.environ, PYTHONPATH=str(wd / "src"))
+    return subprocess.run([sys.executable, "-m", "opnav", *args], cwd=wd, capture_output=True, text=True, env=env)
+
+
+def test_opnav_study_runs_only_that_study(workdir):
+    name, spec = _overlay(workdir)
+    cmd = study_command(name, ["a.yaml", "b.yaml"])
+    assert cmd[-5:] == ["--configfile", "a.yaml", "b.yaml", "--", f"study_{name}"]
+    proc = _opnav(workdir, "study", name, "--config", "config/quick.yaml", "--config", "my-study.yaml", "-n")
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
+    listed = {line.split()[-1].rstrip(":") for line in proc.stdout.splitlines()
+              if line.startswith(("rule ", "localrule "))}
+    assert listed == {"study_runs", f"study_{name}_table", f"study_{name}_figure", f"study_{name}"}, listed
+    n_values = len(next(iter(spec["vary"].values())))
+    assert proc.stdout.count("rule study_runs:") == n_values * len(spec["methods"])
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["study"] == name and out["outputs"].endswith(f"results/quick/studies/{name}")
+    bad = _opnav(workdir, "study", "nope", "--config", "config/quick.yaml")
+    assert bad.returncode == 2 and "no study 'nope'" in bad.stderr and "fov" in bad.stderr
+    val = _opnav(workdir, "study", name, "--config", "config/quick.yaml", "--config", "my-study.yaml",
+                 "--set", f"studies.{name}.runs=0", "-n")
+    assert val.returncode == 2 and f"studies.{name}.runs" in val.stderr
