@@ -77,6 +77,14 @@ def test_configured_studies_plan_and_share_identical_simulations(quick):
      ["study 'bad'", "unknown metric(s) ['happiness']"]),
     ({"paper": "landing", "vary": {"landing.camera.fov_deg": [45, 45.0]}},
      ["study 'bad'", "coincide"]),
+    ({"paper": "approach", "vary": {"approach.camera.ifov_arcsec": [10.0]}, "runs": 10000, "runs_per_job": 10000},
+     ["study 'bad'", "runs_per_job = 10000", "memory"]),
+    ({"paper": "approach", "vary": {"approach.camera.ifov_arcsec": [10.0]},
+      "fixed": {"approach.camera.ifov_arcsec": 20.0}},
+     ["study 'bad'", "both swept (vary) and fixed"]),
+    ({"paper": "approach", "vary": {"approach.camera.ifov_arcsec": [10.0]},
+      "fixed": {"approach.initial_error.mode": "guessed"}},
+     ["study 'bad'", "approach.initial_error.mode"]),
 ])
 def test_bad_study_is_refused_naming_study_and_key(quick, spec, fragments):
     with pytest.raises(ConfigError) as exc:

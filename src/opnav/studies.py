@@ -322,6 +322,8 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
         except (ConfigError, ValueError) as exc:
             shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
             raise ConfigError(f"{where}: value {shown} refused: {exc}") from None
+        if paper == "approach":  # one job holds runs_per_job seeds of the whole arc in memory
+            _check_approach_job_size(where, merged["approach"], min(int(spec["runs_per_job"]), int(spec["runs"])))
         # the validated (defaults filled, possibly normalised) values
         values = {k: get_path(merged, k) for k in values}
         label = instance_label(values)
@@ -338,6 +340,18 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
                  runs_per_job=int(spec["runs_per_job"]), metrics=tuple(metrics), statistic=statistic,
                  instances=tuple(instances), fixed=fixed, slopes=bool(spec.get("slopes", False)),
                  note=str(spec.get("note", "")))
+
+
+def _check_approach_job_size(where: str, approach: Mapping, seeds_per_job: int) -> None:
+    """A paper-A study job runs its seeds batched over the whole arc: the same memory
+    limit as the Monte Carlo's (:data:`opnav.checks.MAX_APPROACH_SEED_SAMPLES`)."""
+    from opnav.approach.scenario import n_samples
+    from opnav.checks import MAX_APPROACH_SEED_SAMPLES
+
+    n = n_samples(approach)
+    if seeds_per_job * n > MAX_APPROACH_SEED_SAMPLES:
+        raise ConfigError(f"{where}: runs_per_job = {seeds_per_job} seeds x {n} samples exceeds the limit "
+                          f"{MAX_APPROACH_SEED_SAMPLES} (memory); lower runs_per_job")
 
 
 def table_metrics(study: Mapping) -> list[str]:

@@ -195,6 +195,7 @@ rule landing_summary_all:
     """B-summary.json: every scenario's summary, the headline's also at the top level."""
     input:
         parts=expand(f"{LANDING}/summaries/B-summary_{{bscn}}.json", bscn=B_SCENARIOS),
+        code=src("landing/report.py"),
     output:
         f"{LANDING}/B-summary.json",
     params:

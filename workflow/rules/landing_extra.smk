@@ -37,6 +37,7 @@ rule landing_x1_summary_all:
     """B-X1-summary.json: every scenario's B-X1 summary, the headline's also at the top level."""
     input:
         parts=expand(f"{LANDING}/summaries/B-X1-summary_{{bscn}}.json", bscn=B_SCENARIOS),
+        code=src("landing/report.py"),
     output:
         f"{LANDING}/B-X1-summary.json",
     params:

@@ -56,6 +56,17 @@ def compact_b_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return [("", pd.DataFrame(rows))]
 
 
+def combine_scenarios(parts: dict[str, dict], headline: str, cameras: dict[str, dict]) -> dict:
+    """One summary of every camera scenario (B-summary.json, B-X1-summary.json): the
+    headline scenario's summary at the top level, every scenario's (with its camera)
+    under ``scenarios``, in the given order."""
+    out = dict(parts[headline])
+    out["scenarios"] = {n: {**p, "camera": cameras.get(n, {})} for n, p in parts.items()}
+    out["headline_scenario"] = headline
+    out["scenario_names_text"] = ", ".join(parts)
+    return out
+
+
 #: Page views of paper B's tables too wide for a page, by SPEC id.
 COMPACT_VIEWS = {"B-T3": compact_b_t3, "B-X1": compact_b_x1}
 
