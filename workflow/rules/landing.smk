@@ -179,7 +179,7 @@ rule landing_summary:
         bscn=B_SCN_RE,
     params:
         methods=B_METHODS,
-        yaw_ratio=0.5,
+        yaw_ratio=config["landing"]["mc"]["yaw_ratio"],
         converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
         eval_path=config["landing"]["planner"]["eval_path"],
         landing=cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg",
