@@ -46,8 +46,10 @@ def _drawn(fig) -> dict[str, set]:
             lab = cont.get_label()
             if lab and not lab.startswith("_"):
                 patches = getattr(cont, "patches", None)
-                if patches:
+                if patches:  # bars
                     out.setdefault(lab, set()).update(to_rgba(p.get_facecolor()) for p in patches)
+                elif getattr(cont, "lines", None) and cont.lines[0] is not None:  # error bars: the data line
+                    out.setdefault(lab, set()).add(to_rgba(cont.lines[0].get_color()))
     return out
 
 
