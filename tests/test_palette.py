@@ -9,7 +9,7 @@ from matplotlib.colors import to_rgba
 
 from opnav import figures, study_plots
 from opnav.approach import plots as aplots
-from opnav.approach.alternatives import METHOD_LABELS
+from opnav.approach.report import METHOD_LABELS
 from opnav.config import load_config
 from opnav.landing import plots as lplots
 from opnav.landing.planner import available_methods
