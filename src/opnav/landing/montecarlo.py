@@ -95,7 +95,7 @@ def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | Non
     scn = build_scenario(landing_cfg)
     idx = [int(i) for i in run_indices]
     if batch_size is None:
-        batch_size = int(landing_cfg.get("mc", {}).get("batch_size", 1))
+        batch_size = int(landing_cfg.get("mc", {}).get("batch_size", 0))
     size = len(idx) if batch_size <= 0 else int(batch_size)
     runs = []
     for a in range(0, len(idx), max(size, 1)):
