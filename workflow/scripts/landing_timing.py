@@ -1,16 +1,14 @@
 """Planning time by replay of one camera scenario (opnav.landing.timing.replay)."""
 
+import sys
+
 from opnav.landing import timing
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import load
 from opnav.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # standalone debugging run
-    _m = ["depth", "svd", "gdop", "cond"]
-    snakemake = mock_snakemake(input={"mc": [f"results/landing/mc/site-tilt/{m}.npz" for m in _m]},
-                               output=["results/landing/timing/site-tilt.npz"])
-    snakemake.params = type("P", (), {"methods": _m, "max_calls": 1000,
-                                      "landing": snakemake.config["landing"]})()
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_timing", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
     methods = list(snakemake.params.methods)
