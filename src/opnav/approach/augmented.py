@@ -45,7 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .camera import skew
+from opnav.rotations import skew
+
 from .dynamics import ARCSEC
 from . import kalman
 from .ekf import Window

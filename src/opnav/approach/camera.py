@@ -30,16 +30,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from opnav.rotations import skew
+
 from .dynamics import ARCSEC, R_MARS_KM
-
-
-def skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrix ``[a x]`` (..., 3, 3): ``skew(a) @ b == cross(a, b)``."""
-    a = np.asarray(a, float)
-    z = np.zeros(a.shape[:-1])
-    return np.stack([np.stack([z, -a[..., 2], a[..., 1]], -1),
-                     np.stack([a[..., 2], z, -a[..., 0]], -1),
-                     np.stack([-a[..., 1], a[..., 0], z], -1)], -2)
 
 
 def misalignment_small(theta: np.ndarray) -> np.ndarray:

@@ -27,9 +27,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from opnav.rotations import skew
+
 from . import kalman
 from .augmented import augmented_jacobian, augmented_noise
-from .camera import misalignment_small, skew
+from .camera import misalignment_small
 from .ekf import Window
 
 

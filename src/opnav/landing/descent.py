@@ -78,7 +78,7 @@ from opnav.landing.planner import PlanState, plan, plan_batch
 from opnav.landing.scenario import Scenario, build_scenario
 from opnav.landing.timing import RECORD_KEYS, record_plan_inputs, stack_plan_inputs
 from opnav.landing.trajectory import euler_rpy_deg
-from opnav.rotations import exp_so3
+from opnav.rotations import exp_so3, log_so3
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
            "yaw_sigma_rad", "tracking_step"]
@@ -100,14 +100,7 @@ def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
 
 def _att_error(R_true: np.ndarray, R_est: np.ndarray) -> np.ndarray:
     """dtheta (..., 3) rad with R_true = Exp(-dtheta) R_est (log map; angles < pi/2)."""
-    D = R_true @ np.swapaxes(R_est, -1, -2)
-    w = 0.5 * np.stack([D[..., 2, 1] - D[..., 1, 2], D[..., 0, 2] - D[..., 2, 0],
-                        D[..., 1, 0] - D[..., 0, 1]], axis=-1)
-    s = np.linalg.norm(w, axis=-1)
-    c = 0.5 * (D[..., 0, 0] + D[..., 1, 1] + D[..., 2, 2] - 1.0)
-    small = s < 1e-12
-    scale = np.where(small, 1.0, np.arctan2(s, c) / np.where(small, 1.0, s))
-    return -w * scale[..., None]
+    return -log_so3(R_true @ np.swapaxes(R_est, -1, -2))
 
 
 def _wrap_deg(x):

@@ -50,23 +50,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
+from opnav.landing.measurement import bearing, bearing_jacobian
+from opnav.rotations import exp_so3, skew
 
 __all__ = ["NavState", "transition_matrix", "oc_transition", "process_noise", "propagate",
            "update", "init_landmark", "inject", "nullspace", "init_jacobian", "Bearing"]
 
 N_X = 12
-
-
-def _skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrices ``[a x]`` (..., 3, 3) of vectors (..., 3)."""
-    a = np.asarray(a, float)
-    S = np.zeros(a.shape[:-1] + (3, 3))
-    x, y, z = a[..., 0], a[..., 1], a[..., 2]
-    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -z, y, -x
-    S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = z, -y, x
-    return S
 
 
 def _T(A: np.ndarray) -> np.ndarray:
@@ -76,16 +67,6 @@ def _T(A: np.ndarray) -> np.ndarray:
 def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Matrix (..., n, m) times vector (..., m)."""
     return (A @ x[..., None])[..., 0]
-
-
-def bearing_jacobian(r, R, p):
-    """eq. 15-18 broadcast over leading dimensions (same arithmetic as
-    ``measurement.bearing_jacobian``; to be replaced by it once it broadcasts)."""
-    rho = p - r
-    n = np.linalg.norm(rho, axis=-1)[..., None, None]
-    H_C = R @ ((n * n) * np.eye(3) - _outer(rho, rho)) / n**3       # eq. 18
-    H_theta = H_C @ _skew(rho) @ _T(R)                               # eq. 16
-    return -H_C, H_theta, H_C                                         # eq. 15, 17
 
 
 @dataclass
@@ -117,8 +98,8 @@ def transition_matrix(r_i, v_i, C_i, r_j, v_j, C_j, Dt: float, g) -> np.ndarray:
     r_i = np.asarray(r_i, float)
     Phi = np.broadcast_to(np.eye(N_X), r_i.shape[:-1] + (N_X, N_X)).copy()
     Phi[..., 0:3, 3:6] = Dt * np.eye(3)
-    Phi[..., 0:3, 6:9] = _skew(r_i - r_j + v_i * Dt + 0.5 * g * Dt**2) @ _T(C_i)
-    Phi[..., 3:6, 6:9] = _skew(v_i - v_j + g * Dt) @ _T(C_i)
+    Phi[..., 0:3, 6:9] = skew(r_i - r_j + v_i * Dt + 0.5 * g * Dt**2) @ _T(C_i)
+    Phi[..., 3:6, 6:9] = skew(v_i - v_j + g * Dt) @ _T(C_i)
     Phi[..., 6:9, 6:9] = C_j @ _T(C_i)
     return Phi
 
@@ -190,18 +171,11 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
     return NavState(r_j, v_j, C_j, st.p.copy(), 0.5 * (P + _T(P)))
 
 
-def _exp_so3(phi: np.ndarray) -> np.ndarray:
-    """Rotation matrices (..., 3, 3) of rotation vectors (..., 3) rad (the
-    active rotation of ``measurement.exp_so3``, batched by scipy)."""
-    phi = np.asarray(phi, float)
-    return Rotation.from_rotvec(phi.reshape(-1, 3)).as_matrix().reshape(phi.shape[:-1] + (3, 3))
-
-
 def inject(st: NavState, dx: np.ndarray) -> None:
     """Apply an error-state correction (..., 12) in place (attitude on the body side)."""
     st.r = st.r + dx[..., 0:3]
     st.v = st.v + dx[..., 3:6]
-    st.R = _exp_so3(-dx[..., 6:9]) @ st.R
+    st.R = exp_so3(-dx[..., 6:9]) @ st.R
     st.p = st.p + dx[..., 9:12]
 
 
@@ -234,9 +208,8 @@ def _linearise(st: NavState, meas: list[Bearing], N):
     res = np.empty(lead + (3 * m,))
     for i, ms in enumerate(meas):
         p = st.p if ms.p_known is None else np.broadcast_to(ms.p_known, st.r.shape)
-        Hr, Ht, Hp = bearing_jacobian(st.r, st.R, p)
-        rho = _mv(st.R, p - st.r)
-        res[..., 3 * i:3 * i + 3] = ms.b - rho / np.linalg.norm(rho, axis=-1, keepdims=True)
+        Hr, Ht, Hp = bearing_jacobian(st.r, st.R, p)                 # eq. 15-18
+        res[..., 3 * i:3 * i + 3] = ms.b - bearing(st.r, st.R, p)      # eq. 12
         H[..., 3 * i:3 * i + 3, 0:3] = Hr
         H[..., 3 * i:3 * i + 3, 6:9] = Ht
         if ms.p_known is None:
@@ -314,7 +287,7 @@ def init_jacobian(st: NavState, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     proj = np.eye(3) - _outer(u, np.array([0.0, 0.0, 1.0])) / uz[..., None, None]
     J = np.zeros(b.shape[:-1] + (3, 9))
     J[..., 0:3] = proj
-    J[..., 6:9] = proj @ (-d[..., None, None] * _T(st.R) @ _skew(b))
+    J[..., 6:9] = proj @ (-d[..., None, None] * _T(st.R) @ skew(b))
     return st.r + d[..., None] * u, J, d, ok
 
 
