@@ -142,10 +142,9 @@ def test_pick_nearest_widens_until_a_detected_landmark():
     field = make_field(1000.0, 500, seed=3)
     point = np.array([0.0, 0.0, 0.0])
     far = np.argsort(np.hypot(*field.xyz[:, :2].T))[200]          # the 201st nearest
-    visible = lambda p: np.isin(np.arange(len(field.xyz)), [far])[  # noqa: E731
-        [int(np.flatnonzero((field.xyz == q).all(axis=1))[0]) for q in p]]
-    assert _pick_nearest(field, point, visible, knn=16, exclude=set()) == far
-    assert _pick_nearest(field, point, lambda p: np.zeros(len(p), bool), 16, set()) == -1
+    assert _pick_nearest(field, point, np.array([far]), exclude=set()) == far
+    assert _pick_nearest(field, point, np.array([far]), exclude={int(far)}) == -1
+    assert _pick_nearest(field, point, np.zeros(0, np.int64), set()) == -1
 
 
 def _image_grid_field(scn, k, n=3, inset_px=60.0):
@@ -204,7 +203,7 @@ def test_edge_optimum_picks_the_best_detected_landmark_at_a_corner(scn, method):
         half = scn.camera.half_px
         assert np.all(np.abs(uv[res.index]) > 0.8 * half), "best landmark not at a corner"
         from opnav.landing.planner import _pick_nearest
-        assert _pick_nearest(field, res.ground, vis, 16, set()) != res.index
+        assert _pick_nearest(field, res.ground, np.flatnonzero(vis(field.xyz)), set()) != res.index
 
 
 def test_pick_ratio_records_how_far_the_pick_is_from_the_best(scn):

@@ -17,10 +17,13 @@ Every method runs the SAME search; only the scalar objective differs:
 3. a golden-section search (:func:`golden_section`, tolerance ``tol_rad``) on
    each sub-interval; the better of the two optima wins;
 4. ``beta*`` is mapped to its ground point (eq. 26: the ideal direction) and
-   the landmark nearest to it (horizontal distance, ``cKDTree``) among those
-   actually detected in the image (truly inside the field of view with the
-   margin) is chosen; if none of its ``knn`` nearest landmarks is detected
-   (low altitude: the image holds few landmarks) no landmark is chosen.
+   the landmark nearest to it (horizontal distance, exact ties to the smaller
+   index) among those actually detected in the image (truly inside the field
+   of view with the margin) is chosen, however far (the optimum is planned
+   from the estimated pose); no landmark only if the image holds none. One
+   call asks the field's bucket index (``LandmarkField.grid``); the batched
+   planner asks the ``cKDTree`` for the ``knn`` nearest of every run at once
+   and widens a run alone when they do not settle it.
 
 Objectives (minimised) are built by a table of factories, :data:`OBJECTIVES`:
 ``depth`` is the depth estimation error (eq. 23-25,
@@ -42,7 +45,14 @@ matrix computation the paper describes, with minimal call overhead),
 beyond the paper, see ``opnav.landing.metrics``).
 
 Timing: :func:`plan` measures its whole call with ``time.perf_counter_ns`` and
-counts objective evaluations, so a timing comparison rests on both.
+counts objective evaluations, so a timing comparison rests on both. The
+per-call path is kept lean because its overhead beyond the objective
+evaluations is a target (issue 14: at most 2x the evaluations for ``depth``,
+``benchmarks/bench_planning.py`` prints it): scalar float arithmetic where
+the measured numpy call overhead on 3-vectors exceeded the arithmetic
+(plane, visible interval, eq. 19/22 constants, eq. 26 ground point), the
+candidate list sorted only where the edge rule or the diagnostic needs it,
+and the bucket index for the one nearest-landmark query.
 """
 
 from __future__ import annotations
@@ -181,6 +191,9 @@ def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n
 
 
 def _visible_exact(geom, R_LtoB, camera, margin_px):
+    # scalar floats after the two matrix-vector products: the planner's timed
+    # path (tiny lists, not arrays; the same arithmetic as the batched
+    # planner's _intervals)
     M = camera.R_BtoC @ R_LtoB
     a0, a1, a2 = (M @ geom.v_hat).tolist()
     c0, c1, c2 = (M @ geom.w_hat).tolist()
@@ -193,16 +206,17 @@ def _visible_exact(geom, R_LtoB, camera, margin_px):
             atan2(k * c2 - c1, k * a2 - a1), atan2(k * c2 + c1, k * a2 + a1),
             geom.gamma - pi / 2]
     phis.sort()
-    gaps = [phis[i + 1] - phis[i] for i in range(4)] + [phis[0] + 2 * pi - phis[4]]
-    j = max(range(5), key=gaps.__getitem__)
-    if gaps[j] <= pi:
+    # the widest gap between consecutive centres (first on ties), around the circle
+    j, gap = 4, phis[0] + 2 * pi - phis[4]
+    for i in (3, 2, 1, 0):
+        g = phis[i + 1] - phis[i]
+        if g >= gap:
+            j, gap = i, g
+    if gap <= pi:
         return []                      # the centres do not fit in a half circle
-    start = (j + 1) % 5
-    un = [phis[(start + i) % 5] for i in range(5)]
-    for i in range(1, 5):              # unwrap into one window
-        while un[i] < un[i - 1]:
-            un[i] += 2 * pi
-    b0, b1 = un[-1] - pi / 2, un[0] + pi / 2
+    # the window starts after the gap; the centres before it get one turn (unwrap)
+    b0 = (phis[j] + 2 * pi if j < 4 else phis[4]) - pi / 2
+    b1 = phis[(j + 1) % 5] + pi / 2
     # express in the ground arc (-(pi - gamma), gamma)
     mid = 0.5 * (b0 + b1)
     g0 = geom.gamma - pi / 2
@@ -355,30 +369,26 @@ def available_methods() -> tuple[str, ...]:
 
 # ----------------------------------------------------------------- planning
 
-def _pick_nearest(field_: LandmarkField, point, visible: Callable, knn: int,
-                  exclude: set) -> int:
-    """The detected landmark nearest (horizontally) to ``point``; -1 only if
-    the camera detects no landmark at all (paper B sec. 2.2: "the visible
-    landmark nearest to the optimum").
+def _pick_nearest(field_: LandmarkField, point, detected: np.ndarray, exclude=()) -> int:
+    """The detected landmark nearest (horizontally) to ``point``, less
+    ``exclude``; -1 only if the image holds no other landmark (paper B sec.
+    2.2: "the visible landmark nearest to the optimum"). ``detected``: the
+    image's feature list, field indices in increasing order.
 
-    The KD-tree is asked for the ``knn`` nearest landmarks first; when none of
-    them is detected (the optimum, planned from the *estimated* pose, may fall
-    just outside the *true* image) the query widens by a factor of 4 until a
-    detected landmark is found or the whole field has been searched.
-    """
-    n_field = len(field_.xyz)
-    k = max(int(knn), 1)
-    while True:
-        idx = field_.nearest(point, k)
-        for e in exclude:
-            idx = idx[idx != e]
-        if idx.size:
-            vis = visible(field_.xyz[idx])
-            if vis.any():
-                return int(idx[np.argmax(vis)])
-        if k >= n_field:
-            return -1
-        k = min(4 * k, n_field)
+    The optimum, planned from the *estimated* pose, may fall outside the *true*
+    image: the pick is then the nearest landmark the image does hold, however
+    far. Exact distance ties go to the smaller index. By the field's bucket
+    index (``LandmarkField.grid``, plain floats: a few us per query where a
+    ``cKDTree`` query costs ~15 us of call overhead for one point)."""
+    return field_.grid.nearest(point[0], point[1], detected, exclude)
+
+
+def _candidates(detected: np.ndarray, exclude) -> np.ndarray:
+    """The detected landmarks less ``exclude``, sorted field indices."""
+    cand = np.sort(np.asarray(detected, np.int64))
+    for e in exclude:          # (at most a few: a mask per element, not np.isin's sort)
+        cand = cand[cand != e]
+    return cand
 
 
 def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
@@ -389,49 +399,49 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     ``perf_counter_ns``) and the CPU time of the calling thread (``cpu_ns``,
     CLOCK_THREAD_CPUTIME_ID, insensitive to other processes on a shared machine).
 
-    ``detected``: field indices of the landmarks the image holds (the feature
-    detector's list, the same for every method); computed from ``visible`` if
-    not given. Building it is not planning work, so it stays outside the timed
-    path, as does the diagnostic ``pick_ratio`` (every detected landmark scored
-    by the method's own metric, fastest path)."""
+    ``detected``: field indices, in increasing order, of the landmarks the
+    image holds (the feature detector's list, the same for every method, as
+    ``np.flatnonzero`` of the image's mask gives them); computed from
+    ``visible`` if not given. Building it is not planning work, so it stays
+    outside the timed path, as does the diagnostic ``pick_ratio`` (every
+    detected landmark scored by the method's own metric, fastest path)."""
     if detected is None:
         detected = np.flatnonzero(visible(field_.xyz))
-    cand = np.sort(np.asarray(detected, np.int64))
-    for e in exclude:          # (at most a few: a mask per element, not np.isin's sort)
-        cand = cand[cand != e]
     c0 = _thread_ns()
-    res, fun, vals = _plan(method, state, camera, field_, visible, cfg, exclude, rng, cand)
+    res, fun, vals, cand = _plan(method, state, camera, field_, cfg, exclude, rng,
+                                 np.asarray(detected, np.int64))
     res.cpu_ns = _thread_ns() - c0
-    if diagnose and fun is not None and res.index >= 0 and cand.size:
-        if vals is None:       # (edge calls scored every detected landmark already)
-            vals = getattr(fun, "diagnostic", fun.batch)(field_.xyz[cand])
-        fin = np.isfinite(vals)
-        if fin.any():
-            f_pick = vals[np.searchsorted(cand, res.index)] if res.index in cand else math.nan
-            res.pick_ratio = float(fun.ratio(f_pick, float(vals[fin].min())))
+    if diagnose and fun is not None and res.index >= 0:
+        if cand is None:
+            cand = _candidates(detected, exclude)
+        if cand.size:
+            if vals is None:       # (edge calls scored every detected landmark already)
+                vals = getattr(fun, "diagnostic", fun.batch)(field_.xyz[cand])
+            fin = np.isfinite(vals)
+            if fin.any():
+                f_pick = vals[np.searchsorted(cand, res.index)] if res.index in cand else math.nan
+                res.pick_ratio = float(fun.ratio(f_pick, float(vals[fin].min())))
     return res
 
 
-def _thread_ns() -> int:
-    """CPU time of the calling thread, ns (clock_gettime: ~0.4 us here, where
-    time.thread_time_ns costs ~5 us)."""
-    return time.clock_gettime_ns(time.CLOCK_THREAD_CPUTIME_ID)
+#: CPU time of the calling thread, ns (CLOCK_THREAD_CPUTIME_ID; measured 0.46 us
+#: per call here, clock_gettime_ns 0.55 us)
+_thread_ns = time.thread_time_ns
 
 
-def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
-          visible: Callable[[np.ndarray], np.ndarray], cfg: PlannerConfig,
-          exclude: set, rng: np.random.Generator | None, cand: np.ndarray):
+def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
+          exclude: set, rng: np.random.Generator | None, detected: np.ndarray):
     """One planning call: choose the next unknown landmark; returns the
-    :class:`PlanResult`, the objective used (None for direct pickers) and the
-    detected landmarks' scores if the edge rule computed them (else None).
+    :class:`PlanResult`, the objective used (None for direct pickers), the
+    detected landmarks' scores if the edge rule computed them (else None) and
+    the candidates they belong to (else None).
 
-    ``visible(points_L (n, 3)) -> bool (n,)`` says which landmarks the camera
-    actually detects (truth pose; the same for every method); ``cand`` (sorted
-    field indices) are the detected landmarks less ``exclude`` (the current
-    landmark). If the planning geometry is degenerate (velocity not
-    descending, zero velocity) or no interval is visible, the detected
-    landmark nearest to the image centre is chosen and ``note`` says why
-    (never a silent NaN).
+    ``detected`` (increasing field indices) are the landmarks the camera
+    actually detects (truth pose; the same for every method); the candidates
+    are those less ``exclude`` (the current landmark). If the planning
+    geometry is degenerate (velocity not descending, zero velocity) or no
+    interval is visible, the detected landmark nearest to the image centre is
+    chosen and ``note`` says why (never a silent NaN).
 
     Edge rule (one rule for every metric): when the in-plane golden-section
     optimum lies on an end of its visible sub-interval (within ``tol_rad``),
@@ -439,13 +449,16 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     end need not be the best one in the image (it may sit at a corner), so
     every detected landmark is scored directly by the same metric
     (vectorised, ``objective.batch``) and the best is chosen (first index on
-    ties); ``edge`` says so and the evaluations are counted.
+    ties); ``edge`` says so and the evaluations are counted. Otherwise the
+    detected landmark nearest to the optimum's ground point is chosen
+    (:func:`_pick_nearest`); only the edge rule needs the candidate list.
     """
     t0 = time.perf_counter_ns()
     if method in PICKERS:
+        cand = _candidates(detected, exclude)
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
-                          math.nan, 0, time.perf_counter_ns() - t0), None, None
+                          math.nan, 0, time.perf_counter_ns() - t0), None, None, cand
     build = OBJECTIVES.get(method)
     if build is None:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
@@ -471,23 +484,25 @@ def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
         # documented fallback: the detected landmark nearest the boresight
         point = state.r + state.R_LtoB.T @ camera.boresight_B * max(state.r[2], 1.0) / max(
             -(state.R_LtoB.T @ camera.boresight_B)[2], 1e-3)
-        k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
+        k = _pick_nearest(field_, point, detected, exclude)
         return PlanResult(method, k, math.nan, point, math.nan, n, time.perf_counter_ns() - t0,
-                          note or "no finite objective"), fun, None
+                          note or "no finite objective"), fun, None, None
     fx, x, a, b = best
     point = np.array(ground_point_scalar(geom)(x))
     edge = min(x - a, b - x) <= cfg.tol_rad
     k = -1
-    vals = None
-    if edge and cand.size:
-        vals = fun.batch(field_.xyz[cand])
-        n += int(cand.size)
-        if np.isfinite(vals).any():
-            k = int(cand[int(np.argmin(np.where(np.isfinite(vals), vals, np.inf)))])
+    vals = cand = None
+    if edge:
+        cand = _candidates(detected, exclude)
+        if cand.size:
+            vals = fun.batch(field_.xyz[cand])
+            n += int(cand.size)
+            if np.isfinite(vals).any():
+                k = int(cand[int(np.argmin(np.where(np.isfinite(vals), vals, np.inf)))])
     if k < 0:
-        k = _pick_nearest(field_, point, visible, cfg.knn, exclude)
+        k = _pick_nearest(field_, point, detected, exclude)
     return PlanResult(method, k, x, point, fx, n, time.perf_counter_ns() - t0, note,
-                      edge=bool(edge)), fun, vals
+                      edge=bool(edge)), fun, vals, cand
 
 
 # ----------------------------------------------------------------- batched planning
@@ -698,7 +713,7 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
             bs = np.einsum("bji,j->bi", states.R_LtoB[fb], camera.boresight_B)
             point[fb] = states.r[fb] + bs * (np.maximum(states.r[fb, 2], 1.0)
                                             / np.maximum(-bs[:, 2], 1e-3))[:, None]
-        pick[need] = _pick_nearest_batch(field_, point[need], visible, cfg.knn, exclude[need])
+        pick[need] = _pick_nearest_batch(field_, point[need], det, cfg.knn, exclude[need])
     if diagnose:
         _pick_ratios(method, pick, vals, funs, searched, states, G, cfg, camera, pts, det, candmask)
     out = []
@@ -904,22 +919,36 @@ def _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask):
     return out_v, out_p
 
 
-def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, visible: Callable,
+def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, detected: np.ndarray,
                         knn: int, exclude: np.ndarray) -> np.ndarray:
-    """:func:`_pick_nearest` for many ideal points (one KD-tree query; a run
-    whose ``knn`` nearest hold no detected landmark widens alone)."""
+    """:func:`_pick_nearest` for many ideal points (one KD-tree query for all
+    of them, ``knn`` nearest each). Among a point's ``knn`` the detected ones
+    (``detected``: increasing field indices) less its ``exclude`` are ranked
+    by the bucket index's order (``dx*dx + dy*dy``, ties by the smaller
+    index); a point whose best there is not clearly nearer than the farthest
+    of its ``knn`` (relative 1e-12: the tree's own distances may round
+    otherwise), or that has none, is answered by :func:`_pick_nearest` alone,
+    so every pick is the per-call planner's."""
+    points = np.asarray(points, float)
     n_field = len(field_.xyz)
     k = min(max(int(knn), 1), n_field)
-    _, idx = field_.tree.query(np.asarray(points, float)[:, :2], k=k)
+    _, idx = field_.tree.query(points[:, :2], k=k)
     idx = np.asarray(idx).reshape(len(points), k)
-    vis = visible(field_.xyz[idx.ravel()]).reshape(idx.shape) & (idx != exclude[:, None])
-    out = np.full(len(points), -1, np.int64)
-    hit = vis.any(axis=1)
-    out[hit] = idx[hit, np.argmax(vis[hit], axis=1)]
-    for j in np.flatnonzero(~hit):
-        ex = {int(exclude[j])} if exclude[j] >= 0 else set()
-        out[j] = _pick_nearest(field_, points[j], visible, knn, ex)
-    return out
+    det = np.asarray(detected, np.int64)
+    at = np.minimum(np.searchsorted(det, idx), max(det.size - 1, 0))
+    ok = (det[at] == idx) & (idx != exclude[:, None]) if det.size else np.zeros(idx.shape, bool)
+    dx = field_.xyz[idx, 0] - points[:, 0:1]
+    dy = field_.xyz[idx, 1] - points[:, 1:2]
+    d2 = dx * dx + dy * dy
+    dm = np.where(ok, d2, np.inf)
+    best = dm.min(axis=1)
+    tie = ok & (dm == best[:, None])
+    out = np.where(tie, idx, n_field).min(axis=1)
+    sure = (best < d2.max(axis=1) * (1.0 - 1e-12)) | (k == n_field)
+    out = np.where(ok.any(axis=1), out, -1)
+    for j in np.flatnonzero(~sure | (out < 0)):
+        out[j] = _pick_nearest(field_, points[j], det, {int(exclude[j])} if exclude[j] >= 0 else ())
+    return out.astype(np.int64)
 
 
 def _pick_ratios(method, pick, vals, funs, searched, states, G, cfg, camera, pts, det, candmask) -> None:
