@@ -53,18 +53,19 @@ def planning_states(landing: dict, run_index: int = 0):
     """(PlanState, visible-function) at every planning instant of one depth descent."""
     scn = D.build_scenario(landing)
     captured = []
-    orig = D.plan
+    orig = D.plan_batch
 
-    def spy(method, state, camera, field, visible, cfg, exclude=frozenset(), rng=None, detected=None):
-        captured.append((state, visible, set(exclude), detected))
-        return orig(method, state, camera, field, visible, cfg, exclude=exclude, rng=rng,
-                    detected=detected)
+    def spy(method, states, camera, field, visible, cfg, exclude, rngs=None, detected=None, **kw):
+        for j, ex in enumerate(exclude):          # the descent plans a batch of runs at once
+            state = PL.PlanState(states.r[j], states.v[j], states.a[j], states.R_LtoB[j], states.P[j])
+            captured.append((state, visible, {int(ex)} if ex >= 0 else set(), detected))
+        return orig(method, states, camera, field, visible, cfg, exclude, rngs, detected, **kw)
 
-    D.plan = spy
+    D.plan_batch = spy
     try:
         D.run_descent(scn, "depth", run_index)
     finally:
-        D.plan = orig
+        D.plan_batch = orig
     return scn, captured
 
 

@@ -1,5 +1,6 @@
 """SIGINT in the middle of a Monte Carlo loses nothing but the job in flight: the
-rerun completes and its output equals a clean computation, timing fields aside."""
+rerun completes and its output equals a clean computation exactly (the descent
+records no clock: planning time is measured by replay, opnav.landing.timing)."""
 
 import os
 import signal
@@ -10,9 +11,6 @@ import time
 import numpy as np
 
 from conftest import REPO, copy_workflow
-
-#: Per planning call wall and CPU times (both metric paths): the only fields allowed to differ.
-TIMING_FIELDS = {"plan_ns", "plan_cpu_ns", "plan_ns_alt", "plan_cpu_ns_alt"}
 
 
 def _snakemake(wd, *args):
@@ -64,7 +62,7 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     assert set(got) - {"method"} == set(clean)
     differ = {k for k in clean if not np.array_equal(np.asarray(got[k]), np.asarray(clean[k]),
                                                      equal_nan=np.asarray(clean[k]).dtype.kind == "f")}
-    assert differ <= TIMING_FIELDS, differ
+    assert not differ, differ
 
     # a truncated intermediate found downstream: the job fails with the file's name and
     # the rebuild command, the traceback is in the rule's log, and Snakemake names the log

@@ -10,7 +10,8 @@ from scipy.stats import chi2
 from opnav.config import load_config
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
-from opnav.landing.montecarlo import chunks, gather, run_chunk, summary_table
+from opnav.landing.montecarlo import chunks, gather, run_chunk
+from opnav.landing.report import summary_table
 
 N_RUNS = 12
 
@@ -77,10 +78,6 @@ def test_zero_errors_zero_noise_stay_near_truth(landing):
     assert np.abs(run["err_v"]).max() < 0.5
 
 
-def _strip_timing(d):
-    return {k: v for k, v in d.items() if k not in ("plan_ns", "plan_cpu_ns", "plan_ns_alt", "plan_cpu_ns_alt")}
-
-
 def test_chunking_does_not_change_results(landing):
     # at one batch size chunking changes no bit; the batch size itself (a job's
     # chunk flown as one batch by default) changes numbers only at round-off
@@ -89,10 +86,12 @@ def test_chunking_does_not_change_results(landing):
     for p in parts:
         p["method"] = np.array("depth")
     g = gather(parts)
-    a, b = _strip_timing(whole), _strip_timing(g)
+    # nothing clock-based is recorded (planning time is measured by replay): every field equal
+    a, b = whole, {k: v for k, v in g.items() if k != "method"}
+    assert set(a) == set(b)
     for k in a:
         np.testing.assert_array_equal(a[k], b[k], err_msg=k)
-    batched = _strip_timing(run_chunk(landing, "depth", [0, 1, 2]))
+    batched = run_chunk(landing, "depth", [0, 1, 2])
     for k in a:
         if np.asarray(a[k]).dtype.kind == "f":
             np.testing.assert_allclose(batched[k], a[k], rtol=1e-7, atol=1e-9, err_msg=k)
@@ -101,15 +100,21 @@ def test_chunking_does_not_change_results(landing):
     assert chunks(5, 2) == [[0, 1], [2, 3], [4]]
 
 
-def test_methods_are_paired_and_the_table_is_complete(landing):
-    d = {m: run_chunk(landing, m, [0, 1]) for m in ("depth", "svd")}
-    np.testing.assert_array_equal(d["depth"]["init_error"], d["svd"]["init_error"])
-    np.testing.assert_array_equal(d["depth"]["err_r"][:, 0], d["svd"]["err_r"][:, 0])
+@pytest.fixture(scope="module")
+def paired(landing):
+    """Two runs of depth and svd, their replayed planning times and B-T3."""
     from opnav.landing.timing import replay
 
+    d = {m: run_chunk(landing, m, [0, 1]) for m in ("depth", "svd")}
     tm = replay(build_scenario(landing), d, list(d), max_calls=6)
+    return d, tm, summary_table(d, tm, published_reduction_vs_svd=29.03)
+
+
+def test_methods_are_paired_and_the_table_is_complete(paired):
+    d, tm, df = paired
+    np.testing.assert_array_equal(d["depth"]["init_error"], d["svd"]["init_error"])
+    np.testing.assert_array_equal(d["depth"]["err_r"][:, 0], d["svd"]["err_r"][:, 0])
     assert tm["mismatch"].tolist() == [0, 0]
-    df = summary_table(d, tm, published_reduction_vs_svd=29.03)
     for col in ("final_pos_err_m_mean", "final_pos_err_m_3sigma", "rms_vel_err_mps_mean",
                 "rms_att_err_deg_3sigma", "median_plan_time_us", "metric_evals_per_call",
                 "time_reduction_vs_svd_pct", "time_reduction_vs_svd_pct_published"):
@@ -127,6 +132,45 @@ def test_methods_are_paired_and_the_table_is_complete(landing):
     # the paired difference is antisymmetric
     assert t.loc["svd", "d_rms_pos_vs_depth_m"] == pytest.approx(-t.loc["depth", "d_rms_pos_vs_svd_m"])
     assert df.set_index("method").loc["depth", "time_reduction_vs_svd_pct_published"] == 29.03
+
+
+def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
+    """The summary JSON of a scenario (report.scenario_summary): the headline
+    reduction and same-pick floor from B-T3, the yaw verdict from the runs, the
+    initial attitude from the config; without SVD no reduction is claimed."""
+    import json
+
+    import pandas as pd
+
+    from opnav.landing.montecarlo import yaw_convergence
+    from opnav.landing.report import scenario_summary
+    from opnav.landing.scenario import initial_attitude_report
+
+    d, tm, df = paired
+    # a third method, a copy of svd's runs, whose row claims a lower same-pick rate
+    data = {**d, "cond": d["svd"]}
+    cond = df[df["method"] == "svd"].assign(method="cond", same_pick_as_depth_pct=3.5)
+    table = pd.concat([df, cond], ignore_index=True)
+    kw = dict(eval_path="matrix_scalar", yaw_ratio=0.5, published_reduction_vs_svd=29.03)
+    s = scenario_summary("interior", table, data, tm, {"n_plans": 7}, landing, **kw)
+    t = table.set_index("method")
+    assert s["time_reduction_vs_svd_pct"] == t.loc["depth", "time_reduction_vs_svd_pct"]
+    assert s["published_time_reduction_vs_svd_pct"] == 29.03
+    assert s["min_same_pick_vs_depth_pct"] == 3.5 < t.loc["svd", "same_pick_as_depth_pct"]
+    assert list(s["methods"]) == ["depth", "svd", "cond"]
+    assert list(s["pairs"]) == ["depth_vs_svd", "depth_vs_cond", "svd_vs_cond"]
+    assert s["pairs"]["svd_vs_cond"]["same_pick_pct"] == 100.0      # the same runs
+    yaw = yaw_convergence(d["depth"], 0.5, "depth")
+    assert (s["yaw_converges"], s["yaw_reason"], s["n_runs"]) == (yaw["converges"], yaw["reason"], 2)
+    att = initial_attitude_report(landing)
+    assert s["initial_attitude_deg"] == att["paper_convention_deg"]
+    assert s["initial_tilt_deg"] == att["tilt_deg"] and s["single"] == {"n_plans": 7}
+    assert s["timing"]["checked_calls"] == int(tm["checked"].sum())
+    json.dumps(s, default=float)
+    alone = scenario_summary("interior", df[df["method"] == "depth"], {"depth": d["depth"]}, tm, {},
+                             landing, **kw)
+    assert alone["time_reduction_vs_svd_pct"] is None and np.isnan(alone["min_same_pick_vs_depth_pct"])
+    assert alone["pairs"] == {}
 
 
 def _descent_spying_on_H(landing, monkeypatch, iterations, oc=True):

@@ -273,15 +273,19 @@ def test_camera_scenario_puts_the_depth_optimum_inside_or_outside_the_image(scen
 
     cfg = camera_scenarios(load_config()["landing"])[scenario]
     scn_ = D.build_scenario(cfg)
-    seen = []
-    orig = D.plan
+    from opnav.landing.planner import PlanState
 
-    def spy(method, state, camera, *a, **k):
-        res = orig(method, state, camera, *a, **k)
-        seen.append((_unconstrained_inside(state, camera, scn_.planner), res.edge))
+    seen = []
+    orig = D.plan_batch
+
+    def spy(method, states, camera, *a, **k):       # the descent plans in lockstep batches
+        res = orig(method, states, camera, *a, **k)
+        for j, rs in enumerate(res):
+            state = PlanState(states.r[j], states.v[j], states.a[j], states.R_LtoB[j], states.P[j])
+            seen.append((_unconstrained_inside(state, camera, scn_.planner), rs.edge))
         return res
 
-    monkeypatch.setattr(D, "plan", spy)
+    monkeypatch.setattr(D, "plan_batch", spy)
     D.run_descent(scn_, "depth", 2)
     assert len(seen) > 30
     assert all(s[0] == inside for s in seen), [i for i, s in enumerate(seen) if s[0] != inside]

@@ -9,9 +9,10 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from opnav.config import load_config
-from opnav.landing import timing
+from opnav.landing import records, timing
 from opnav.landing.descent import build_scenario
-from opnav.landing.montecarlo import run_chunk, summary_table
+from opnav.landing.montecarlo import run_chunk
+from opnav.landing.report import summary_table
 from opnav.landing.scenario import camera_scenarios
 
 METHODS = ("depth", "svd", "random", "center")
@@ -31,8 +32,8 @@ def test_rng_words_restore_the_stream(seed, n_draws):
     g = np.random.default_rng(seed)
     g.integers(7, size=n_draws % 5)          # leave it mid-stream (has_uint32 either way)
     g.random(n_draws % 3)
-    w = timing.rng_words(g)
-    h = timing.rng_from_words(w)
+    w = records.rng_words(g)
+    h = records.rng_from_words(w)
     np.testing.assert_array_equal(g.integers(1000, size=n_draws), h.integers(1000, size=n_draws))
 
 

@@ -3,14 +3,14 @@ on, planning time beside the published 29.03 %) and its summary JSON (headline
 numbers for the manuscript and the scorecard)."""
 
 import json
-import math
 import sys
+
+import pandas as pd
 
 from opnav import published
 from opnav.landing import timing
-from opnav.landing.montecarlo import load, summary_table, yaw_convergence
-from opnav.landing.ranking import pair_table
-from opnav.landing.scenario import initial_attitude_report
+from opnav.landing.montecarlo import load
+from opnav.landing.report import scenario_summary, summary_table
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_json, write_table
 
@@ -40,28 +40,10 @@ with script_context(snakemake) as log:
                          f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
     with open(snakemake.input.single) as fh:
         single = json.load(fh)
-    yaw = yaw_convergence(data[methods[0]], float(snakemake.params.yaw_ratio), methods[0])
-    pairs = pair_table(data)
-    att = initial_attitude_report(snakemake.params.landing)
-    t = df.set_index("method")
-    out = {
-        "scenario": scn,
-        "single": single,
-        "methods": {r["method"]: dict(r) for r in df.to_dict("records")},
-        "pairs": {f"{r['method_a']}_vs_{r['method_b']}": dict(r) for r in pairs.to_dict("records")},
-        "time_reduction_vs_svd_pct": (float(t.loc["depth", "time_reduction_vs_svd_pct"])
-                                      if {"svd", "depth"} <= set(t.index) else None),
-        "eval_path": snakemake.params.eval_path,
-        "timing": timing.method_summary(tm),
-        "published_time_reduction_vs_svd_pct": pub["depth_time_reduction_vs_svd_pct"],
-        "initial_attitude_deg": att["paper_convention_deg"],
-        "initial_tilt_deg": att["tilt_deg"],
-        "initial_azimuth_deg": att["azimuth_deg"],
-        "yaw_converges": yaw["converges"],
-        "yaw_reason": yaw["reason"],
-        "n_runs": yaw["n_runs"],
-        "min_same_pick_vs_depth_pct": float(min((t.loc[m, "same_pick_as_depth_pct"] for m in methods
-                                                 if m != "depth"), default=math.nan)),
-    }
+    out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
+                           eval_path=snakemake.params.eval_path,
+                           yaw_ratio=float(snakemake.params.yaw_ratio),
+                           published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"])
     write_json(snakemake.output.summary, out)
-    log.info("B-T3 %s:\n%s\npairs:\n%s", scn, df.to_string(), pairs.to_string())
+    log.info("B-T3 %s:\n%s\npairs:\n%s", scn, df.to_string(),
+             pd.DataFrame(list(out["pairs"].values())).to_string())

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .ekf import FilterResult, Window, run_filter
-from .smoother import SmootherResult, bryson_frazier, rts  # noqa: F401
+from .smoother import SmootherResult, bryson_frazier
 
 EPS = np.zeros((3, 3, 3))
 EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0

@@ -11,10 +11,8 @@ of the Monte Carlo for that method exactly.
 from __future__ import annotations
 
 
-
 def _run(args) -> int:
     from opnav.cli import load_cli_config, print_json, with_flags
-    from opnav.config import load_config
     from opnav.landing.descent import build_scenario, run_descent
     from opnav.landing.montecarlo import summarize_run
 

@@ -60,12 +60,15 @@ its covariance the Jacobian of that cut plus ``depth_sigma_frac`` (10 %).
 Returned per run: errors (truth - estimate) of position, velocity (m, m/s),
 attitude (small-angle ``dtheta`` and roll/pitch/yaw differences, deg) at the
 filter times, 1-sigma of the filter, position and velocity NEES, and per
-planning call its time, optimum, pick, edge flag, pick ratio and evaluation
-count, and everything ``planner.plan`` took, to replay the call exactly
-(``opnav.landing.timing``): the filter step (the truth pose, hence the
-detected landmarks, follows from the scenario), the estimate (r, v, a,
-R_LtoB, P), the excluded current landmark (-1: none) and the picker stream's
-state.
+planning call (``opnav.landing.records``) its filter time, optimum, pick, edge
+flag, pick ratio and evaluation count, and everything the planning call took,
+to replay it exactly (``opnav.landing.timing``): the filter step (the truth
+pose, hence the detected landmarks, follows from the scenario), the estimate
+(r, v, a, R_LtoB, P), the excluded current landmark (-1: none) and the picker
+stream's state. The descent times nothing: every batch, the batch of one
+included, plans in lockstep (``planner.plan_batch``, the picks of the per-call
+``planner.plan``), and planning time is measured by replaying the recorded calls
+(``opnav.landing.timing``).
 """
 
 from __future__ import annotations
@@ -73,23 +76,15 @@ from __future__ import annotations
 import numpy as np
 
 from opnav.landing import ekf, imu
-from opnav.landing.metrics import H_METRICS, MetricContext
-from opnav.landing.planner import PlanState, plan, plan_batch
+from opnav.landing.metrics import MetricContext
+from opnav.landing.planner import PlanState, plan_batch
+from opnav.landing.records import append_call, new_calls, record_plan_inputs, stack_calls
 from opnav.landing.scenario import Scenario, build_scenario
-from opnav.landing.timing import RECORD_KEYS, record_plan_inputs, stack_plan_inputs
 from opnav.landing.trajectory import euler_rpy_deg
 from opnav.rotations import exp_so3, log_so3
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
            "yaw_sigma_rad", "tracking_step"]
-
-#: per planning call, in call order (lists per run)
-PLAN_KEYS = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index",
-             "plan_edge", "plan_ratio", "plan_ns_alt", "plan_cpu_ns_alt")
-_PLAN_DTYPES = {"plan_ns": np.int64, "plan_cpu_ns": np.int64, "plan_evals": np.int64,
-                "plan_t": float, "plan_beta": float, "plan_index": np.int64, "plan_edge": bool,
-                "plan_ratio": float, "plan_ns_alt": np.int64, "plan_cpu_ns_alt": np.int64}
-
 
 def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
     """Error state (truth - estimate) [dr, dv, dtheta] (9,), uniform per axis."""
@@ -204,8 +199,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     nees_r = np.empty((B, n + 1))
     nees_v = np.empty((B, n + 1))
     updated = np.zeros((B, n + 1), bool)
-    plans = [{k: [] for k in PLAN_KEYS} for _ in range(B)]
-    recs = [{k: [] for k in RECORD_KEYS} for _ in range(B)]     # planning inputs (timing.replay)
+    calls = [new_calls() for _ in range(B)]      # per planning call: inputs (replay) and results
     cur = np.full(B, -1, np.int64)
     n_obs = np.zeros(B, np.int64)
     n_used = np.zeros(B, np.int64)
@@ -265,19 +259,13 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             ip = np.flatnonzero(need)
             if ip.size:
                 for b in ip:
-                    record_plan_inputs(recs[b], k, st.r[b], st.v[b], a_est[b], st.R[b], st.P[b],
+                    record_plan_inputs(calls[b], k, st.r[b], st.v[b], a_est[b], st.R[b], st.P[b],
                                        cur[b], rng_pick[b])
                 states = PlanState(st.r[ip], st.v[ip], a_est[ip], st.R[ip], st.P[ip])
-                res = _plan_runs(scn, method, states, visible, cur[ip], [rng_pick[b] for b in ip],
-                                 np.flatnonzero(det), timed=B == 1)
+                res = plan_batch(method, states, cam, scn.field, visible, scn.planner, cur[ip],
+                                 [rng_pick[b] for b in ip], np.flatnonzero(det))
                 for b, rs in zip(ip, res):
-                    pl = plans[b]
-                    for key, val in (("plan_ns", rs.time_ns), ("plan_cpu_ns", rs.cpu_ns),
-                                     ("plan_ns_alt", rs.time_ns_alt), ("plan_cpu_ns_alt", rs.cpu_ns_alt),
-                                     ("plan_evals", rs.n_evals), ("plan_t", k * scn.Dt),
-                                     ("plan_beta", rs.beta), ("plan_index", rs.index),
-                                     ("plan_edge", rs.edge), ("plan_ratio", rs.pick_ratio)):
-                        pl[key].append(val)
+                    append_call(calls[b], k * scn.Dt, rs)
                 cur[ip] = [rs.index for rs in res]
                 n_obs[ip] = 0
                 ii = ip[cur[ip] >= 0]
@@ -323,37 +311,9 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             "nees_r": nees_r[b], "nees_v": nees_v[b], "updated": updated[b],
             "n_landmarks": int(n_used[b]), "init_error": e0[b],
         }
-        d.update({k: np.asarray(v, _PLAN_DTYPES[k]) for k, v in plans[b].items()})
-        d.update(stack_plan_inputs(recs[b]))
+        d.update(stack_calls(calls[b]))
         out.append(d)
     return out
-
-
-def _plan_runs(scn: Scenario, method: str, states: PlanState, visible, cur: np.ndarray,
-               rngs: list, detected: np.ndarray, timed: bool) -> list:
-    """Plan a new landmark for each run of ``states`` (batched arrays).
-
-    A descent flown alone (``timed``) is timed call by call (``planner.plan``, plus the H
-    baselines on the alternative evaluation path); larger batches plan in
-    lockstep (``planner.plan_batch``, not timed: same picks)."""
-    if timed:
-        one = PlanState(states.r[0], states.v[0], states.a[0], states.R_LtoB[0], states.P[0])
-        ex = {int(cur[0])} if cur[0] >= 0 else set()
-        res = plan(method, one, scn.camera, scn.field, visible, scn.planner, exclude=ex,
-                   rng=rngs[0], detected=detected)
-        res.time_ns_alt, res.cpu_ns_alt = res.time_ns, res.cpu_ns
-        if method in H_METRICS:
-            # the paper's baselines on the alternative evaluation path too
-            # (closed-form singular values vs H + LAPACK): timing only, same pick
-            alt = plan(method, one, scn.camera, scn.field, visible, scn.planner_alt, exclude=ex,
-                       rng=None, detected=detected, diagnose=False)
-            res.time_ns_alt, res.cpu_ns_alt = alt.time_ns, alt.cpu_ns
-        return [res]
-    res = plan_batch(method, states, scn.camera, scn.field, visible, scn.planner, cur, rngs,
-                     detected)
-    for rs in res:
-        rs.time_ns_alt, rs.cpu_ns_alt = rs.time_ns, rs.cpu_ns
-    return res
 
 
 def _est_rpy(R_true: np.ndarray, dth: np.ndarray) -> np.ndarray:

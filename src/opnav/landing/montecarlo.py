@@ -10,20 +10,18 @@ on how runs are grouped into Snakemake jobs or batches. :func:`run_chunk`
 flies a list of run indices (in batches of ``landing.mc.batch_size``) and
 stacks the per-run arrays; :func:`summarize_run` is one run's
 :func:`per_run_stats` row; :func:`gather` concatenates chunks
-in run order; :func:`summary_table` builds B-T3.
+in run order. (B-T3, the table of these statistics per method, is
+``opnav.landing.report.summary_table``.)
 
 Statistics (per method, over the runs): final (touchdown) and RMS (over time)
 error norms of position (m), velocity (m/s) and attitude (deg, small-angle
 ``dtheta``), each as mean and ``3 sigma`` (three sample standard deviations),
 and the position and velocity error at the last vision update (``lastvis_``:
 the filter then coasts on the IMU to touchdown); the median
-objective evaluations per call (the descent's count). Planning times come from
-the replay of the recorded planning calls (``opnav.landing.timing``), not from
-the descent: the median wall and CPU (``thread_time_ns``) time of a call (us)
-on the configured and the alternative metric path, and each method's time
-reduction against each other ``100 (1 - median_a / median_b)`` (%) on the same
-replayed calls, with a paired bootstrap standard deviation
-(``timing.time_reduction``).
+objective evaluations per call (the descent's count). The per-call records
+(``opnav.landing.records``) are concatenated over runs with their run index;
+planning times are not among them: they come from the replay of the recorded
+planning calls (``opnav.landing.timing``).
 """
 
 from __future__ import annotations
@@ -40,14 +38,13 @@ if TYPE_CHECKING:
 # The descent (scipy, CasADi) and pandas are imported by the functions that use them:
 # the workflow parses this module at start-up and the gather jobs only stack arrays.
 
-from opnav.landing.timing import RECORD_KEYS   # numpy only
+from opnav.landing import records   # numpy only
+from opnav.landing.records import CALL_KEYS, load
 
-__all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "summary_table", "per_run_stats",
+__all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality"]
 
-_PLAN = ("plan_ns", "plan_cpu_ns", "plan_evals", "plan_t", "plan_beta", "plan_index", "plan_edge",
-         "plan_ratio", "plan_ns_alt", "plan_cpu_ns_alt") + RECORD_KEYS   # (+ planning inputs, replay)
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
            "sig_yaw_deg", "nees_r", "nees_v", "updated")
 
@@ -110,7 +107,7 @@ def stack_runs(run_indices, runs: list[dict], t: np.ndarray) -> dict:
     out = {"run_index": np.asarray(list(run_indices), np.int64), "t": np.asarray(t).copy()}
     for k in _TRACKS:
         out[k] = np.stack([r[k] for r in runs])
-    for k in _PLAN:
+    for k in CALL_KEYS:
         out[k] = np.concatenate([r[k] for r in runs]) if runs else np.zeros(0)
     out["plan_run"] = np.concatenate([np.full(len(r["plan_t"]), int(i), np.int64)
                                       for i, r in zip(run_indices, runs)]) if runs else np.zeros(0, np.int64)
@@ -123,39 +120,21 @@ def summarize_run(run: dict, run_index: int = 0) -> dict:
     """One run of :func:`opnav.landing.descent.run_descent`: its
     :func:`per_run_stats` row (final, last-vision and RMS error norms, mean
     NEES, landmarks used) plus the final yaw error (deg), the number of
-    planning calls, their median time (us) and median evaluation count."""
+    planning calls and their median evaluation count (planning time: replay
+    the run's calls, ``opnav.landing.timing.replay_own``)."""
     data = stack_runs([run_index], [run], run["t"])
     out = {k: (int(v) if k == "n_landmarks" else float(v))
            for k, v in per_run_stats(data).iloc[0].items()}
     out["final_yaw_err_deg"] = float(run["err_rpy_deg"][-1, 2])
     out["n_plans"] = int(len(run["plan_t"]))
-    out["median_plan_time_us"] = _median_us(run["plan_ns"])
     out["median_plan_evals"] = float(np.median(run["plan_evals"])) if len(run["plan_evals"]) else math.nan
     return out
 
 
 def save(path, data: dict, method: str) -> None:
-    """Write a chunk or gathered result (``.npz``, atomically)."""
-    from opnav.tables import atomic_target
-
-    with atomic_target(path) as tmp:
-        np.savez_compressed(tmp, method=np.array(method), **data)
-
-
-def load(path) -> dict:
-    """Read a :func:`save` file; a truncated or corrupt one raises
-    :class:`opnav.snakeio.CorruptIntermediate` naming it and its rebuild command."""
-    import zipfile
-
-    from opnav.snakeio import corrupt_intermediate
-
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
-    except FileNotFoundError:
-        raise
-    except (zipfile.BadZipFile, EOFError, ValueError, OSError, KeyError) as exc:
-        raise corrupt_intermediate(path, exc) from exc
+    """Write a chunk or gathered result of ``method`` (``records.save``: ``.npz``,
+    atomically; read it with :func:`load`, ``records.load``)."""
+    records.save(path, {"method": np.array(method), **data})
 
 
 def gather(parts: list[dict]) -> dict:
@@ -174,7 +153,7 @@ def gather(parts: list[dict]) -> dict:
         out[k] = np.concatenate([p[k] for p in parts])[order]
     pr = np.concatenate([p["plan_run"] for p in parts])
     po = np.argsort(pr, kind="stable")
-    for k in _PLAN:
+    for k in CALL_KEYS:
         out[k] = np.concatenate([p[k] for p in parts])[po]
     out["plan_run"] = pr[po]
     if methods:
@@ -207,10 +186,6 @@ def last_update_index(updated: np.ndarray):
     last = u.shape[-1] - 1 - np.argmax(u[..., ::-1], axis=-1)
     out = np.where(u.any(axis=-1), last, 0)
     return int(out) if u.ndim == 1 else out
-
-
-def _median_us(ns: np.ndarray) -> float:
-    return float(np.median(ns) / 1e3) if len(ns) else math.nan
 
 
 def pick_quality(d: dict) -> dict:
@@ -250,82 +225,3 @@ def yaw_convergence(data: dict, ratio: float, method: str) -> dict:
             "reason": (f"yaw 3-sigma over the {yaw.shape[0]} runs ({method}): "
                        f"{s_first:.2f} deg at start, {s_last:.2f} deg at touchdown "
                        f"({'below' if converges else 'not below'} {ratio:.0%} of the start)")}
-
-
-def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_svd: float | None = None,
-                  converged_pos_err_m: float = 100.0) -> pd.DataFrame:
-    """B-T3: one row per method (see the module docstring for the columns);
-    ``timing``: the replay of the scenario's planning calls
-    (``opnav.landing.timing.replay``, every method of ``data`` timed);
-    ``converged_runs_pct`` counts the runs whose final position error is below
-    ``converged_pos_err_m`` (m)."""
-    import pandas as pd
-
-    from opnav.landing import timing as tmg
-
-    methods = list(data)
-    missing = [m for m in methods if tmg.times_ns(timing, m).size == 0 and len(timing["source"])]
-    if missing:
-        raise ValueError(f"the planning-time replay did not time {missing}")
-    rows = []
-    for m in methods:
-        st = per_run_stats(data[m])
-        row = {"method": m, "n_runs": len(st)}
-        for q in ("pos_err_m", "vel_err_mps", "att_err_deg"):
-            for kind in ("final", "rms"):
-                col = st[f"{kind}_{q}"]
-                row[f"{kind}_{q}_mean"] = float(col.mean())
-                row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
-        row["final_pos_err_m_median"] = float(st["final_pos_err_m"].median())
-        row["final_vel_err_mps_median"] = float(st["final_vel_err_mps"].median())
-        if "lastvis_pos_err_m" in st:   # at the last vision update, before the IMU-only coast
-            for q in ("pos_err_m", "vel_err_mps"):
-                col = st[f"lastvis_{q}"]
-                row[f"lastvis_{q}_mean"] = float(col.mean())
-                row[f"lastvis_{q}_median"] = float(col.median())
-                row[f"lastvis_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
-        row["converged_runs_pct"] = float(100.0 * (st["final_pos_err_m"] < converged_pos_err_m).mean())
-        row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
-        row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
-        row["landmarks_per_run"] = float(st["n_landmarks"].mean())
-        alt_m = "alt" if tmg.times_ns(timing, m, "alt").size else "main"
-        row["median_plan_time_us"] = tmg.median_us(timing, m)
-        row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
-        # the same replayed calls on the alternative metric path (the configured one
-        # for methods without it)
-        row["median_plan_time_alt_us"] = tmg.median_us(timing, m, alt_m)
-        row["median_plan_cpu_alt_us"] = tmg.median_us(timing, m, alt_m, clock="cpu")
-        row["timed_calls"] = int(len(timing["source"]))
-        ev = data[m]["plan_evals"]
-        row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
-        row["plan_calls"] = int(len(ev))
-        row.update(pick_quality(data[m]))
-        if m != methods[0]:
-            row[f"same_pick_as_{methods[0]}_pct"] = same_pick_pct(data[m], data[methods[0]])
-        for b in methods:
-            if b == m:
-                continue
-            from opnav.landing.ranking import pair_comparison
-
-            pc = pair_comparison(data[m], data[b])
-            row[f"same_pick_vs_{b}_pct"] = pc["same_pick_pct"]
-            row[f"median_abs_dbeta_vs_{b}_deg"] = pc["median_abs_dbeta_deg"]
-            for k in ("d_rms_pos", "d_final_pos"):
-                row[f"{k}_vs_{b}_m"] = pc[f"{k}_m"]
-                row[f"{k}_vs_{b}_lo_m"] = pc[f"{k}_lo_m"]
-                row[f"{k}_vs_{b}_hi_m"] = pc[f"{k}_hi_m"]
-            red, sd = tmg.time_reduction(timing, m, b)
-            row[f"time_reduction_vs_{b}_pct"] = red
-            row[f"time_reduction_vs_{b}_pct_std"] = sd
-            row[f"cpu_time_reduction_vs_{b}_pct"] = tmg.time_reduction(timing, m, b, clock="cpu",
-                                                                       n_boot=0)[0]
-            alt_b = "alt" if tmg.times_ns(timing, b, "alt").size else "main"
-            red, sd = tmg.time_reduction(timing, m, b, path_a=alt_m, path_b=alt_b)
-            row[f"time_reduction_vs_{b}_alt_pct"] = red
-            row[f"time_reduction_vs_{b}_alt_pct_std"] = sd
-        rows.append(row)
-    df = pd.DataFrame(rows)
-    if published_reduction_vs_svd is not None:
-        df["time_reduction_vs_svd_pct_published"] = [
-            float(published_reduction_vs_svd) if m == "depth" else math.nan for m in df["method"]]
-    return df

@@ -1,5 +1,9 @@
-"""Paper-B reporting pieces for the manuscript and the scorecard.
+"""Paper-B reporting pieces: B-T3, the summary JSON, and the pieces for the
+manuscript and the scorecard.
 
+:func:`summary_table` is B-T3 (per-method accuracy and replayed planning time of
+one camera scenario); :func:`scenario_summary` is that scenario's summary JSON
+(the headline numbers the manuscript and the scorecard read).
 :data:`COMPACT_VIEWS` are the page views of B-T3 and B-X1 (tables too wide for a
 page; :mod:`opnav.manuscript` gathers both papers'); :func:`rows_paper_b` are paper
 B's scorecard rows (timing claim, the "almost the same accuracy" claim read as an
@@ -11,10 +15,157 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pandas as pd
 
 from opnav.tables import cell_num, cell_pm
 from opnav.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
+
+
+def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_svd: float | None = None,
+                  converged_pos_err_m: float = 100.0) -> pd.DataFrame:
+    """B-T3 (paper B sec. 3, Table 3): one row per method of ``data`` (method ->
+    gathered Monte Carlo, ``opnav.landing.montecarlo.gather``).
+
+    Columns: over the runs, final (touchdown) and RMS (over time) error norms of
+    position (m), velocity (m/s) and attitude (deg), each as mean and ``3 sigma``
+    (three sample standard deviations), medians, the same at the last vision
+    update (``lastvis_``), the share of converged runs, mean NEES, landmarks per
+    run (``montecarlo.per_run_stats``); the median objective evaluations per
+    call (the descent's count), the edge-rule share and pick ratios
+    (``montecarlo.pick_quality``); per pair of methods the same-pick rate,
+    median ``|delta beta*|`` and the paired RMS / final position differences with
+    their intervals (``ranking.pair_comparison``). Planning times come from
+    ``timing`` (the replay of the scenario's planning calls,
+    ``opnav.landing.timing.replay``, every method of ``data`` timed), not from
+    the descent: the median wall and CPU (``thread_time_ns``) time of a call
+    (us) on the configured and the alternative metric path, and each method's
+    time reduction against each other ``100 (1 - median_a / median_b)`` (%) on
+    the same replayed calls, with a paired bootstrap standard deviation
+    (``timing.time_reduction``). ``converged_runs_pct`` counts the runs whose
+    final position error is below ``converged_pos_err_m`` (m); the published
+    reduction, if given, is a column labelled ``_published`` on the depth row."""
+    # imported here: the manuscript and scorecard jobs import this module for its
+    # page views and need neither scipy (ranking) nor the replay
+    from opnav.landing import timing as tmg
+    from opnav.landing.montecarlo import per_run_stats, pick_quality, same_pick_pct
+    from opnav.landing.ranking import pair_comparison
+
+    methods = list(data)
+    missing = [m for m in methods if tmg.times_ns(timing, m).size == 0 and len(timing["source"])]
+    if missing:
+        raise ValueError(f"the planning-time replay did not time {missing}")
+    rows = []
+    for m in methods:
+        st = per_run_stats(data[m])
+        row = {"method": m, "n_runs": len(st)}
+        for q in ("pos_err_m", "vel_err_mps", "att_err_deg"):
+            for kind in ("final", "rms"):
+                col = st[f"{kind}_{q}"]
+                row[f"{kind}_{q}_mean"] = float(col.mean())
+                row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
+        row["final_pos_err_m_median"] = float(st["final_pos_err_m"].median())
+        row["final_vel_err_mps_median"] = float(st["final_vel_err_mps"].median())
+        if "lastvis_pos_err_m" in st:   # at the last vision update, before the IMU-only coast
+            for q in ("pos_err_m", "vel_err_mps"):
+                col = st[f"lastvis_{q}"]
+                row[f"lastvis_{q}_mean"] = float(col.mean())
+                row[f"lastvis_{q}_median"] = float(col.median())
+                row[f"lastvis_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan
+        row["converged_runs_pct"] = float(100.0 * (st["final_pos_err_m"] < converged_pos_err_m).mean())
+        row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
+        row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
+        row["landmarks_per_run"] = float(st["n_landmarks"].mean())
+        alt_m = "alt" if tmg.times_ns(timing, m, "alt").size else "main"
+        row["median_plan_time_us"] = tmg.median_us(timing, m)
+        row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
+        # the same replayed calls on the alternative metric path (the configured one
+        # for methods without it)
+        row["median_plan_time_alt_us"] = tmg.median_us(timing, m, alt_m)
+        row["median_plan_cpu_alt_us"] = tmg.median_us(timing, m, alt_m, clock="cpu")
+        row["timed_calls"] = int(len(timing["source"]))
+        ev = data[m]["plan_evals"]
+        row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
+        row["plan_calls"] = int(len(ev))
+        row.update(pick_quality(data[m]))
+        if m != methods[0]:
+            row[f"same_pick_as_{methods[0]}_pct"] = same_pick_pct(data[m], data[methods[0]])
+        for b in methods:
+            if b == m:
+                continue
+            pc = pair_comparison(data[m], data[b])
+            row[f"same_pick_vs_{b}_pct"] = pc["same_pick_pct"]
+            row[f"median_abs_dbeta_vs_{b}_deg"] = pc["median_abs_dbeta_deg"]
+            for k in ("d_rms_pos", "d_final_pos"):
+                row[f"{k}_vs_{b}_m"] = pc[f"{k}_m"]
+                row[f"{k}_vs_{b}_lo_m"] = pc[f"{k}_lo_m"]
+                row[f"{k}_vs_{b}_hi_m"] = pc[f"{k}_hi_m"]
+            red, sd = tmg.time_reduction(timing, m, b)
+            row[f"time_reduction_vs_{b}_pct"] = red
+            row[f"time_reduction_vs_{b}_pct_std"] = sd
+            row[f"cpu_time_reduction_vs_{b}_pct"] = tmg.time_reduction(timing, m, b, clock="cpu",
+                                                                       n_boot=0)[0]
+            alt_b = "alt" if tmg.times_ns(timing, b, "alt").size else "main"
+            red, sd = tmg.time_reduction(timing, m, b, path_a=alt_m, path_b=alt_b)
+            row[f"time_reduction_vs_{b}_alt_pct"] = red
+            row[f"time_reduction_vs_{b}_alt_pct_std"] = sd
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    if published_reduction_vs_svd is not None:
+        df["time_reduction_vs_svd_pct_published"] = [
+            float(published_reduction_vs_svd) if m == "depth" else math.nan for m in df["method"]]
+    return df
+
+
+def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], timing: dict,
+                     single: dict, landing_cfg: dict, *, eval_path: str, yaw_ratio: float,
+                     published_reduction_vs_svd: float) -> dict:
+    """The summary JSON of one camera scenario (``B-summary.json`` per scenario,
+    read by the manuscript macros and the scorecard, :func:`rows_paper_b`).
+
+    ``table``: its B-T3 (:func:`summary_table` of ``data``, method -> gathered
+    Monte Carlo); ``timing``: the replay behind it; ``single``: the single
+    descent's summary; ``landing_cfg``: the scenario's ``landing`` config (the
+    initial attitude, ``scenario.initial_attitude_report``). Holds per method its
+    B-T3 row, per pair of methods ``ranking.pair_comparison``, the depth method's
+    time reduction against SVD (%, None unless both were flown) beside the
+    published one, the replay's method (``timing.method_summary``), the
+    initial attitude (deg) in the paper's convention and as thrust tilt and
+    azimuth, the yaw verdict (``montecarlo.yaw_convergence`` of the first
+    method: does the 3-sigma envelope fall below ``yaw_ratio`` of its start?),
+    the number of runs and the smallest same-pick rate of a method against
+    depth (%, the check that an accuracy comparison could fail; nan without one).
+    """
+    from opnav.landing import timing as tmg
+    from opnav.landing.montecarlo import yaw_convergence
+    from opnav.landing.ranking import pair_table
+    from opnav.landing.scenario import initial_attitude_report
+
+    methods = list(data)
+    yaw = yaw_convergence(data[methods[0]], float(yaw_ratio), methods[0])
+    pairs = pair_table(data)
+    att = initial_attitude_report(landing_cfg)
+    t = table.set_index("method")
+    same_pick = [float(t.loc[m, "same_pick_as_depth_pct"]) for m in methods
+                 if m != "depth" and "same_pick_as_depth_pct" in t.columns]
+    return {
+        "scenario": scenario,
+        "single": single,
+        "methods": {r["method"]: dict(r) for r in table.to_dict("records")},
+        "pairs": {f"{r['method_a']}_vs_{r['method_b']}": dict(r) for r in pairs.to_dict("records")},
+        "time_reduction_vs_svd_pct": (float(t.loc["depth", "time_reduction_vs_svd_pct"])
+                                      if {"svd", "depth"} <= set(t.index) else None),
+        "eval_path": eval_path,
+        "timing": tmg.method_summary(timing),
+        "published_time_reduction_vs_svd_pct": published_reduction_vs_svd,
+        "initial_attitude_deg": att["paper_convention_deg"],
+        "initial_tilt_deg": att["tilt_deg"],
+        "initial_azimuth_deg": att["azimuth_deg"],
+        "yaw_converges": yaw["converges"],
+        "yaw_reason": yaw["reason"],
+        "n_runs": yaw["n_runs"],
+        "min_same_pick_vs_depth_pct": min(same_pick, default=math.nan),
+    }
 
 
 def compact_b_t3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
