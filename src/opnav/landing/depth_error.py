@@ -51,7 +51,7 @@ Units: m, s, rad.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -59,7 +59,7 @@ __all__ = ["DegenerateGeometry", "depth", "depth_error", "PlaneGeometry", "plane
            "signed_alpha", "signed_depth_error", "ground_point", "baseline", "error_radius",
            "max_eig_sym3", "angles_to_landmarks", "depth_error_at_landmarks",
            "depth_error_scalar", "depth_error_at_points", "ground_point_scalar",
-           "depth_error_in_plane", "depth_error_of_points", "error_radius_batch"]
+           "depth_error_in_plane", "depth_error_of_points", "error_radius_batch", "plane_floats"]
 
 
 class DegenerateGeometry(ValueError):
@@ -117,6 +117,18 @@ class PlaneGeometry:
     w_hat: np.ndarray      # unit, in-plane, perpendicular to v_hat, toward the horizon side
     cd: float              # |CD|, m
     gamma: float           # flight-path angle below the horizon, rad (0, pi/2]
+    #: (C, v_hat, w_hat) as one flat 9-tuple of Python floats, the same values:
+    #: set by plane_geometry only (the planner's timed path); not an __init__
+    #: argument, so a constructed or ``dataclasses.replace``d geometry has None
+    #: and derives them from the arrays (:func:`plane_floats`)
+    floats: tuple | None = field(default=None, init=False, compare=False, repr=False)
+
+
+def plane_floats(geom: PlaneGeometry) -> tuple:
+    """``geom``'s (C, v_hat, w_hat) as a flat 9-tuple of floats (m, unit)."""
+    if geom.floats is not None:
+        return geom.floats
+    return tuple(_floats(geom.C)) + tuple(_floats(geom.v_hat)) + tuple(_floats(geom.w_hat))
 
 
 def plane_geometry(r_L, v_L, horizontal_ref=None) -> PlaneGeometry:
@@ -150,15 +162,23 @@ def plane_geometry(r_L, v_L, horizontal_ref=None) -> PlaneGeometry:
     hv = h0 * a0 + h1 * a1
     w0, w1, w2 = h0 - hv * a0, h1 - hv * a1, -hv * a2
     nw = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-    return PlaneGeometry(C=np.array([r0, r1, r2]), v_hat=np.array([a0, a1, a2]),
-                         w_hat=np.array([w0 / nw, w1 / nw, w2 / nw]), cd=r2 / -a2,
-                         gamma=math.asin(min(1.0, -a2)))
+    w0, w1, w2 = w0 / nw, w1 / nw, w2 / nw
+    # the frozen dataclass's __init__ (object.__setattr__ per field) costs 1.4 us,
+    # filling its __dict__ 0.3 us (measured): the same frozen object, built directly
+    geom = object.__new__(PlaneGeometry)
+    geom.__dict__.update(C=np.array([r0, r1, r2]), v_hat=np.array([a0, a1, a2]),
+                         w_hat=np.array([w0, w1, w2]), cd=r2 / -a2,
+                         gamma=math.asin(min(1.0, -a2)),
+                         floats=(r0, r1, r2, a0, a1, a2, w0, w1, w2))
+    return geom
 
 
 def _floats(x) -> list:
     """The elements of a small vector or matrix as (nested lists of) Python
     floats, the same values: ``ndarray.tolist`` costs ~0.05 us for 3 elements
     where ``float(x) for x in`` costs ~1 us (the planner's timed path)."""
+    if type(x) is np.ndarray and x.dtype.char == "d":
+        return x.tolist()
     return np.asarray(x, float).tolist()
 
 
@@ -187,7 +207,8 @@ def ground_point(beta_signed, geom: PlaneGeometry) -> np.ndarray:
 def baseline(v_L, a_L, t_s: float) -> float:
     """Estimated baseline ``|v t_s + a t_s^2/2|`` (m), eq. 19."""
     h = 0.5 * t_s * t_s
-    x, y, z = (v * t_s + a * h for v, a in zip(_floats(v_L), _floats(a_L)))
+    (v0, v1, v2), (a0, a1, a2) = _floats(v_L), _floats(a_L)
+    x, y, z = v0 * t_s + a0 * h, v1 * t_s + a1 * h, v2 * t_s + a2 * h
     return math.sqrt(x * x + y * y + z * z)
 
 
@@ -367,9 +388,7 @@ def ground_point_scalar(geom: PlaneGeometry):
     ``beta -> (x, y, z)`` (m) or None where the line of sight misses the ground
     (eq. 26 mapping of the planner's optimum; tested equal to
     :func:`ground_point`)."""
-    C0, C1, C2 = _floats(geom.C)
-    v0, v1, v2 = _floats(geom.v_hat)
-    w0, w1, w2 = _floats(geom.w_hat)
+    C0, C1, C2, v0, v1, v2, w0, w1, w2 = plane_floats(geom)
     cd, g = geom.cd, geom.gamma
     sin, cos, pi = math.sin, math.cos, math.pi
 

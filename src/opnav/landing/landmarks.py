@@ -46,6 +46,8 @@ class GridIndex:
     #: directly (a query point far from every member: the image's detected
     #: landmarks lie elsewhere)
     MAX_REJECTED = 64
+    #: member lists this short are scored one by one (no buckets)
+    FEW = 32
 
     def __init__(self, xy: np.ndarray, per_cell: float = 2.0):
         xy = np.asarray(xy, float).reshape(-1, 2)
@@ -65,6 +67,7 @@ class GridIndex:
                                           xy[:, 1].tolist())):
             cells[c].append((i, x, y))
         self.cells = [tuple(c) for c in cells]
+        x0, y0, inf, pad = float(lo[0]), float(lo[1]), math.inf, 1e-9 * h
         blocks = []
         for a in range(nx):
             for b in range(ny):
@@ -72,9 +75,15 @@ class GridIndex:
                 for aa in range(max(a - 1, 0), min(a + 2, nx)):
                     for bb in range(max(b - 1, 0), min(b + 2, ny)):
                         blk.extend(self.cells[aa * ny + bb])
-                blocks.append(tuple(blk))
+                # the block's sides beyond which buckets remain (else -+inf), moved
+                # inward by the pad
+                blocks.append((tuple(blk), x0 + (a - 1) * h + pad if a > 1 else -inf,
+                               x0 + (a + 2) * h - pad if a < nx - 2 else inf,
+                               y0 + (b - 1) * h + pad if b > 1 else -inf,
+                               y0 + (b + 2) * h - pad if b < ny - 2 else inf))
         self.blocks = blocks
-        self.x0, self.y0, self.h = float(lo[0]), float(lo[1]), float(h)
+        self.pts = [tuple(p) for p in xy.tolist()]
+        self.x0, self.y0, self.h = x0, y0, float(h)
         self.nx, self.ny = nx, ny
         self.xy = xy
 
@@ -99,24 +108,46 @@ class GridIndex:
         indices in increasing order, e.g. ``np.flatnonzero`` of a mask; None:
         every point) less ``exclude`` (a set of indices); -1 if none is left."""
         x, y = float(x), float(y)
-        if members is not None and len(members) == 0:
-            return -1
+        if members is not None and len(members) <= self.FEW:
+            return self._among(x, y, members.tolist(), exclude)
         h = self.h
         cx = min(max(int((x - self.x0) // h), 0), self.nx - 1)
         cy = min(max(int((y - self.y0) // h), 0), self.ny - 1)
         # fast path: the nearest of the 3 x 3 block, if accepted and conclusive
+        blk, xlo, xhi, ylo, yhi = self.blocks[cx * self.ny + cy]
         best_d2, best_i = math.inf, -1
-        for i, lx, ly in self.blocks[cx * self.ny + cy]:
+        for i, lx, ly in blk:
             dx = lx - x
             dy = ly - y
             d2 = dx * dx + dy * dy
             if d2 < best_d2 or (d2 == best_d2 and i < best_i):
                 best_d2, best_i = d2, i
-        if best_i >= 0 and self._accept(best_i, members, exclude):
-            lb = self._bound(cx, cy, 1, x, y) - 1e-9 * h
-            if lb == math.inf or (lb > 0 and best_d2 < lb * lb):
+        lb = min(x - xlo, xhi - x, y - ylo, yhi - y)   # (_bound at r = 1, padded)
+        if best_i >= 0 and (lb == math.inf or (lb > 0 and best_d2 < lb * lb)):
+            if self._accept(best_i, members, exclude):
                 return best_i
+            # the block's points nearer than the bound, nearest first (ties by index)
+            near = sorted((d2, i) for i, lx, ly in blk
+                          if (d2 := (lx - x) * (lx - x) + (ly - y) * (ly - y)) < lb * lb)
+            for d2, i in near[1:]:
+                if self._accept(i, members, exclude):
+                    return i
         return self._ring_search(x, y, cx, cy, members, exclude)
+
+    def _among(self, x: float, y: float, members: list, exclude) -> int:
+        """The nearest of a short list of members, scored one by one (-1 if none)."""
+        pts = self.pts
+        best_d2, best_i = math.inf, -1
+        for i in members:
+            if i in exclude:
+                continue
+            lx, ly = pts[i]
+            dx = lx - x
+            dy = ly - y
+            d2 = dx * dx + dy * dy
+            if d2 < best_d2 or (d2 == best_d2 and i < best_i):
+                best_d2, best_i = d2, i
+        return best_i
 
     @staticmethod
     def _accept(i: int, members, exclude) -> bool:

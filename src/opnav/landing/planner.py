@@ -165,10 +165,14 @@ def _split_at_zero(b0: float, b1: float) -> list[tuple[float, float]]:
     eps = 1e-9
     out = []
     if b0 < 0:
-        out.append((b0, min(b1, -eps)))
+        hi = min(b1, -eps)
+        if hi > b0:
+            out.append((b0, hi))
     if b1 > 0:
-        out.append((max(b0, eps), b1))
-    return [(a, b) for a, b in out if b > a]
+        lo = max(b0, eps)
+        if b1 > lo:
+            out.append((lo, b1))
+    return out
 
 
 def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n_grid: int,
@@ -191,15 +195,16 @@ def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera, n
 
 
 def _visible_exact(geom, R_LtoB, camera, margin_px):
-    # scalar floats after the two matrix-vector products: the planner's timed
-    # path (tiny lists, not arrays; the same arithmetic as the batched
-    # planner's _intervals)
-    M = camera.R_BtoC @ R_LtoB
-    a0, a1, a2 = (M @ geom.v_hat).tolist()
-    c0, c1, c2 = (M @ geom.w_hat).tolist()
+    # scalar floats after the two matrix-vector products, the planner's timed
+    # path (numpy's 3 x 3 products are kept: OpenBLAS fuses multiply-adds, so
+    # float arithmetic would round otherwise, and mineig's plateau picks
+    # follow rounding); the same rule as the batched planner's _intervals
     k = (camera.half_px - margin_px) / camera.focal_px
     if k <= 0:
         return []
+    M = camera.R_BtoC @ R_LtoB
+    a0, a1, a2 = (M @ geom.v_hat).tolist()
+    c0, c1, c2 = (M @ geom.w_hat).tolist()
     atan2, pi = math.atan2, math.pi
     # k z -+ x > 0, k z -+ y > 0 (camera axes); ground: -u_z(L) > 0
     phis = [atan2(k * c2 - c0, k * a2 - a0), atan2(k * c2 + c0, k * a2 + a0),
