@@ -30,8 +30,12 @@ Where they are used
   (``opnav.landing.descent``, :func:`log_so3`); the CasADi cross-check
   (``opnav.landing.casadi_model``) writes the same model symbolically with
   ``casadi.skew`` and a Cayley map (symbolic only, it lives there).
-* Paper A (approach): the misalignment ``A = I - [theta x]`` (eq. 5) and its
-  exact form ``Exp(-theta)`` (``opnav.approach.camera``; switched by its owner).
+* Paper A (approach): the small-angle misalignment ``A = I - [theta x]`` (eq. 5,
+  ``opnav.approach.camera``), its sensitivity ``[u x]`` (``opnav.approach.crlb``)
+  and the augmented filter's linearisation (``opnav.approach.augmented``), all
+  by :func:`skew`. (The truth's exact misalignment ``Exp(-theta)``,
+  ``camera.misalignment_exact``, is still scipy's ``Rotation``: the same
+  rotation to round-off, left so paper A's simulated data keep their bits.)
 
 Conventions: angles in rad; ``exp_so3`` is the active rotation (it rotates a
 vector by ``|phi|`` about ``phi / |phi|``); ``log_so3(exp_so3(phi)) == phi``

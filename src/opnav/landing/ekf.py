@@ -35,7 +35,10 @@ flies the runs of a chunk as one batch (``opnav.landing.descent``); a single
 run is the batch of shape ().
 
 Update: the stacked unit bearings of the known landmark and the unknown one
-(eq. 11-18), isotropic noise ``sigma_b`` rad per component, Joseph form.
+(eq. 11-18: ``measurement.bearing`` and ``measurement.bearing_jacobian``, their
+one home), isotropic noise ``sigma_b`` rad per component, Joseph form. The
+cross-product matrices and the attitude correction ``Exp`` are
+``opnav.rotations.skew`` / ``exp_so3``.
 
 Landmark initialisation (Fig. 3 strategy): from its first bearing ``b`` and a
 depth guess ``d`` (the estimated line of sight cut with the ground plane),
