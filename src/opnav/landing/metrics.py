@@ -334,6 +334,15 @@ def structural_singular_values(x, y, c, s2):
     return np.sqrt(np.stack(lam, axis=-1))
 
 
+def structural_scores(name: str, x, y, c, s2) -> np.ndarray:
+    """The paper's H baselines (``name`` in :data:`H_METRICS`: svd, gdop, cond;
+    larger is better) in closed form from the pair geometry of
+    :func:`structural_singular_values` (x = 1/rho_1, y = 1/rho_2 in 1/m, c = u . w,
+    s2 = |u x w|^2), broadcast over arrays: the scores of :meth:`Metric.batch`'s
+    fast path, for callers that hold the geometry already (the batched planner)."""
+    return _scores_from_sq(name, *_structural_sq(x, y, c, s2))
+
+
 def _structural_sq(x, y, c, s2):
     """(l1+, l1-, l2+, l2-) squared singular values, cancellation-free."""
     a = 1.0 + x * x
@@ -709,8 +718,8 @@ def _score_pairs(name: str, st: ContextStack, ri, p, d, rho) -> np.ndarray:
         cr = np.cross(u, w)
         # row sums (not w @ u): the bits of one candidate at a time, whatever the batch
         add = np.add.reduce
-        return _scores_from_sq(name, *_structural_sq(tk(st.x, ri), 1.0 / rho, add(w * u, axis=-1),
-                                                     add(cr * cr, axis=-1)))
+        return structural_scores(name, tk(st.x, ri), 1.0 / rho, add(w * u, axis=-1),
+                                 add(cr * cr, axis=-1))
     if name in WHITENED:
         Ci, L = st.stacked("whiten", _whitening)
         H = me.selection_jacobian(tk(st.r_L, ri), tk(st.R_LtoB, ri), tk(st.p_known_L, ri), p)

@@ -568,40 +568,45 @@ def _ground_points(beta, C, v_hat, w_hat, cd, gamma) -> tuple[np.ndarray, np.nda
 
 
 class _Contexts:
-    """The H baselines' planning contexts of a batch (one trusted
-    :class:`~opnav.landing.metrics.MetricContext` per run: lander, attitude, known
-    landmark, boresight; stacked once), for scoring many candidates of many runs
-    at once by :meth:`opnav.landing.metrics.Metric.batch` (its fast path: the
-    closed-form structural singular values of H, eq. 14-18)."""
+    """The H baselines' per-run context (lander, attitude, known landmark) of a
+    batch, for evaluating many candidates of many runs at once by the metrics
+    module's closed-form structural singular values of H (eq. 14-18,
+    ``metrics.structural_scores``: the scores of ``Metric.batch``'s fast path).
+    Not ``Metric.batch`` itself: its per-pair layout (gathers of every (run,
+    candidate) pair) costs 2-4x on the edge rule's runs x all detected landmarks
+    (e.g. 10 x 7403) here, where the geometry broadcasts."""
 
     def __init__(self, states: PlanState, cfg: PlannerConfig, camera: Camera):
-        p_known = np.asarray(cfg.p_known, float)
-        self.stack = metrics.stack_contexts([
-            metrics.MetricContext.trusted(r, v, R, p_known, boresight_B=camera.boresight_B)
-            for r, v, R in zip(states.r, states.v, states.R_LtoB)])
+        self.r, self.R = states.r, states.R_LtoB
+        self.p_known = np.asarray(cfg.p_known, float)
+        self.min_range = metrics.MetricContext.trusted(states.r[0], states.v[0], states.R_LtoB[0],
+                                                       self.p_known).min_range_m
+        d1 = self.p_known - self.r
+        rho1 = np.linalg.norm(d1, axis=1)
+        self.bs_L = np.einsum("bji,j->bi", self.R, camera.boresight_B)      # R^T boresight
+        self.known_ok = (rho1 > self.min_range) & (np.einsum("bi,bi->b", d1, self.bs_L) > 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.u = d1 / rho1[:, None]
+            self.x = 1.0 / rho1
+
+    def _valid(self, i, pts):
+        d2 = pts - self.r[i]
+        rho2 = np.sqrt(np.einsum("...k,...k->...", d2, d2))
+        ok = (rho2 > self.min_range) & (np.einsum("...k,...k->...", d2, self.bs_L[i]) > 0.0)
+        return d2, rho2, ok & self.known_ok[i]
 
     def closed_form(self, name: str, i, pts) -> np.ndarray:
         """Metric ``name`` (larger is better) of candidates ``pts`` (..., 3) of runs
-        ``i`` (broadcast against ``pts``' leading dimensions; -inf where invalid):
-        the (run, candidate) pairs laid out per run, padded and masked, for one
-        :meth:`~opnav.landing.metrics.Metric.batch` call."""
-        pts = np.asarray(pts, float)
-        runs = np.broadcast_to(np.asarray(i, np.intp)[..., None], np.broadcast_shapes(
-            np.shape(i) + (1,), pts.shape))[..., 0]
-        shape = runs.shape
-        p = np.broadcast_to(pts, shape + (3,)).reshape(-1, 3)
-        runs = runs.ravel()
-        if not runs.size:
-            return np.full(shape, -np.inf)
-        counts = np.bincount(runs, minlength=len(self.stack))
-        order = np.argsort(runs, kind="stable")
-        slot = np.empty_like(runs)
-        slot[order] = np.arange(runs.size) - (np.cumsum(counts) - counts)[runs[order]]
-        cand = np.zeros((len(self.stack), int(counts.max()), 3))
-        mask = np.zeros(cand.shape[:2], bool)
-        cand[runs, slot] = p
-        mask[runs, slot] = True
-        return metrics.Metric(name).batch(self.stack, cand, mask)[runs, slot].reshape(shape)
+        ``i`` (closed-form structural singular values; -inf where invalid)."""
+        d2, rho2, ok = self._valid(i, pts)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = d2 / rho2[..., None]
+            u = self.u[i]
+            cg = np.einsum("...k,...k->...", w, u)
+            cr = np.cross(u, w)
+            s2 = np.einsum("...k,...k->...", cr, cr)
+            sc = metrics.structural_scores(name, self.x[i], 1.0 / rho2, cg, s2)
+        return np.where(ok, sc, -np.inf)
 
 
 def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkField,
