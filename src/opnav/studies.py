@@ -134,8 +134,16 @@ class Study:
                 "keys": list(self.keys), "grid": self.grid, "methods": list(self.methods),
                 "variants": list(self.variants), "runs": self.runs, "metrics": list(self.metrics),
                 "statistic": self.statistic, "fixed": dict(self.fixed), "slopes": self.slopes,
-                "note": self.note,
+                "note": self.note, "runs_per_job": self.runs_per_job,
+                "timing_calls": self.timing_calls,
                 "instances": {i.label: i.values for i in self.instances}}
+
+    @property
+    def timing_calls(self) -> int | None:
+        """Paper B: the planning calls replayed per job for the timing metrics
+        (``landing.timing.max_calls`` of the simulation; 0 = all); None for paper A."""
+        t = self.instances[0].sim.get("timing") if self.instances else None
+        return int(t["max_calls"]) if isinstance(t, Mapping) and "max_calls" in t else None
 
 
 # ------------------------------------------------------------------ config paths
@@ -530,4 +538,23 @@ def caption(study: Mapping) -> str:
             f"median, the 95 % interval of the mean and the paired difference against {study['methods'][0]}"
             + (f"; the slopes table, the log-log slope of each against {study['keys'][0]}"
                if study.get("slopes") else "") + "."
+            + _timing_text(study)
             + (f" {study['note']}" if study.get("note") else ""))
+
+
+#: per-run metrics measured by replaying the runs' planning calls (opnav.landing.timing)
+TIMING_METRICS = ("median_plan_time_us", "median_plan_cpu_us")
+
+
+def _timing_text(study: Mapping) -> str:
+    """How the planning-time metrics were measured (empty if the study shows none)."""
+    if not set(study["metrics"]) & set(TIMING_METRICS):
+        return ""
+    n = study.get("timing_calls")
+    per_job = min(int(study.get("runs_per_job") or study["runs"]), int(study["runs"]))
+    budget = ("every recorded planning call" if not n else
+              f"at most {n} recorded planning calls per job of {per_job} runs (landing.timing.max_calls), "
+              f"evenly spaced over the job's calls, so a run's median rests on about "
+              f"{max(n // per_job, 1)} calls (none: not counted)")
+    return (f" Planning times by replay of {budget} through the run's method, one call at a time, "
+            "apart from the filter's work (time.perf_counter_ns; CPU: the thread clock).")

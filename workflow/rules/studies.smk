@@ -11,7 +11,8 @@ from opnav.landing.planner import available_methods as _planner_methods
 
 STUDIES_DIR = res("studies")
 STUDY_SHAPES = {
-    "landing": B_SIM,
+    # paper B: the Monte Carlo's view plus the replay budget of the planning times
+    "landing": {**B_SIM, "timing": {"max_calls": config["landing"]["timing"]["max_calls"]}},
     "approach": cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives"),
 }
 

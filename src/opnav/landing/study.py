@@ -6,8 +6,10 @@
 returns one row per run: the final and RMS error norms of position (m), velocity (m/s)
 and attitude (deg) and the mean NEES (:func:`opnav.landing.montecarlo.per_run_stats`),
 landmarks used, and per run the median wall / CPU time of a planning call (us; by replay
-of the run's recorded planning calls through its method, :func:`opnav.landing.timing.replay_own`,
-apart from the filter's work) and the share of planning calls that chose no landmark (%). :func:`add_derived` adds
+of recorded planning calls through the run's method, :func:`opnav.landing.timing.replay_own`,
+apart from the filter's work: at most ``landing.timing.max_calls`` calls of the job, evenly
+spaced over its runs' calls, so a run's median rests on about ``max_calls / runs`` calls and a
+run with none is NaN) and the share of planning calls that chose no landmark (%). :func:`add_derived` adds
 ``converged_pct`` (100 if the final position error is below ``converged_pos_err_m``, else
 0; its mean over runs is the converged share, as in B-T3).
 """
@@ -42,12 +44,14 @@ def per_run_metrics(data: dict, timing: dict, method: str) -> pd.DataFrame:
 
 
 def run_runs(landing_cfg: dict, method: str, run_indices) -> pd.DataFrame:
-    """Fly ``run_indices`` with ``method``; one row per run (module docstring)."""
+    """Fly ``run_indices`` with ``method``; one row per run (module docstring). The replay
+    budget is ``landing_cfg["timing"]["max_calls"]`` (0: every call)."""
     from opnav.landing.descent import build_scenario
     from opnav.landing.timing import replay_own
 
+    max_calls = int(landing_cfg["timing"]["max_calls"])
     data = run_chunk(landing_cfg, method, list(run_indices))
-    df = per_run_metrics(data, replay_own(build_scenario(landing_cfg), data, method), method)
+    df = per_run_metrics(data, replay_own(build_scenario(landing_cfg), data, method, max_calls), method)
     df.insert(1, "method", method)
     return df
 
