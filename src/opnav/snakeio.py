@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import resource
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -25,6 +26,9 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
 
     An exception inside the block is logged with its traceback to the log file
     and turned into ``SystemExit("<rule> failed: <error> (traceback in <log>)")``.
+    A job that succeeds ends its log with one :func:`resource_line` (the whole
+    process's CPU seconds and peak memory, start-up and imports included), which
+    ``benchmarks/job_costs.py`` sums per rule.
     """
     log_path = snakemake.log[0] if len(getattr(snakemake, "log", [])) else None
     logger = logging.getLogger("opnav")
@@ -42,6 +46,7 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         sys.stderr = sys.stdout = fh
         try:
             yield logger
+            logger.info(resource_line())
         except Exception as exc:
             # the traceback goes to the rule's log; Snakemake shows one line naming it
             logger.error("job failed", exc_info=True)
@@ -52,6 +57,18 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         finally:
             sys.stderr, sys.stdout = old_err, old_out
             logger.removeHandler(handler)
+
+
+#: prefix of the last log line of a successful job (:func:`resource_line`)
+RESOURCE_PREFIX = "job resources:"
+
+
+def resource_line() -> str:
+    """``job resources: cpu_s=<user+sys> user_s=... sys_s=... max_rss_mb=...`` of this
+    process so far (``resource.getrusage``; Linux reports ``ru_maxrss`` in KiB)."""
+    ru = resource.getrusage(resource.RUSAGE_SELF)
+    return (f"{RESOURCE_PREFIX} cpu_s={ru.ru_utime + ru.ru_stime:.3f} user_s={ru.ru_utime:.3f} "
+            f"sys_s={ru.ru_stime:.3f} max_rss_mb={ru.ru_maxrss / 1024:.1f}")
 
 
 def stand_in(input=None, output=None, params=None, log=None, wildcards=None,

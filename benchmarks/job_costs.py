@@ -1,0 +1,71 @@
+"""Where a Snakemake run's CPU time goes: per rule, from the jobs' logs.
+
+Every successful job ends its log with ``job resources: cpu_s=... max_rss_mb=...``
+(:func:`opnav.snakeio.resource_line`: the whole process, interpreter start-up and
+imports included). This script finds those lines under a results folder and prints,
+per group of logs (the part's folder and the log name's first word: ``landing/mc``,
+``studies/runs``, ...), the job count, total and largest CPU seconds and the largest
+peak memory, sorted by total CPU. Usage::
+
+    python benchmarks/job_costs.py results/quick
+    python benchmarks/job_costs.py results --top 20
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from pathlib import Path
+
+_LINE = re.compile(r"job resources: cpu_s=([0-9.]+) user_s=([0-9.]+) sys_s=([0-9.]+) max_rss_mb=([0-9.]+)")
+
+
+def costs(root: Path) -> list[tuple[str, float, float]]:
+    """(log path relative to ``root``, CPU seconds, max RSS MB) of every job log that has the line."""
+    out = []
+    for log in sorted(root.rglob("logs/*.log")):
+        m = None
+        for m in _LINE.finditer(log.read_text(errors="replace")):
+            pass
+        if m:
+            out.append((str(log.relative_to(root)), float(m.group(1)), float(m.group(4))))
+    return out
+
+
+def family(path: str) -> str:
+    """A group name for a log: its folder and the stem's first word (``mc``, ``runs``, ...)."""
+    p = Path(path)
+    head = re.split(r"[_.]", p.stem, maxsplit=1)[0]
+    return f"{p.parent.parent.name or '.'}/{head}"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("results", type=Path, help="results folder of a finished run")
+    ap.add_argument("--top", type=int, default=0, help="also list the N most expensive jobs")
+    a = ap.parse_args(argv)
+    if not a.results.is_dir():
+        print(f"job_costs: results folder {a.results} not found", file=sys.stderr)
+        return 2
+    rows = costs(a.results)
+    if not rows:
+        print(f"job_costs: no job log with a resource line under {a.results}", file=sys.stderr)
+        return 1
+    groups: dict[str, list] = {}
+    for path, cpu, rss in rows:
+        groups.setdefault(family(path), []).append((cpu, rss))
+    total = sum(c for _, c, _ in rows)
+    print(f"{'group':40s} {'jobs':>5s} {'cpu_s':>9s} {'share':>6s} {'max_cpu_s':>9s} {'max_rss_mb':>10s}")
+    for g, v in sorted(groups.items(), key=lambda kv: -sum(c for c, _ in kv[1])):
+        s = sum(c for c, _ in v)
+        print(f"{g:40s} {len(v):5d} {s:9.1f} {100 * s / total:5.1f}% {max(c for c, _ in v):9.2f} "
+              f"{max(r for _, r in v):10.0f}")
+    print(f"{'total':40s} {len(rows):5d} {total:9.1f}")
+    for path, cpu, rss in sorted(rows, key=lambda r: -r[1])[:a.top]:
+        print(f"  {cpu:8.2f} s {rss:6.0f} MB  {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
