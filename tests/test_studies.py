@@ -155,3 +155,18 @@ def test_instance_labels():
     # same leaf under two sections: one more component
     assert studies.instance_label({"landing.camera.pixels": 512, "approach.camera.pixels": 256}) == \
         "landing.camera.pixels~512_approach.camera.pixels~256"
+
+
+def test_gather_runs_keeps_the_study_units_and_refuses_missing_runs():
+    """A study job's chunk holds every unit of the studies sharing that value: a study
+    keeps its own (variant, method) rows; a chunk missing one of its runs is refused."""
+    spec = {"name": "s", "paper": "approach", "runs": 2, "methods": ["em"], "variants": ["roll"],
+            "keys": ["approach.camera.ifov_arcsec"], "instances": {"a": {"approach.camera.ifov_arcsec": 10.0}}}
+    rows = [{"run": r, "variant": v, "method": m, "err_x_arcsec": float(10 * r + len(v) + len(m))}
+            for r in (0, 1, 2) for v in ("literal", "roll") for m in ("em", "augmented")]
+    runs = studies.gather_runs([("a", pd.DataFrame(rows))], spec)
+    assert sorted(zip(runs["run"], runs["variant"], runs["method"])) == [(0, "roll", "em"), (1, "roll", "em")]
+    assert list(runs["err_x_arcsec"]) == [6.0, 16.0]
+    short = pd.DataFrame([r for r in rows if not (r["run"] == 1 and r["variant"] == "roll" and r["method"] == "em")])
+    with pytest.raises(ValueError, match="1 runs of roll/em, expected 2"):
+        studies.gather_runs([("a", short)], spec)

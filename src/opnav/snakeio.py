@@ -65,10 +65,19 @@ RESOURCE_PREFIX = "job resources:"
 
 def resource_line() -> str:
     """``job resources: cpu_s=<user+sys> user_s=... sys_s=... max_rss_mb=...`` of this
-    process so far (``resource.getrusage``; Linux reports ``ru_maxrss`` in KiB)."""
-    ru = resource.getrusage(resource.RUSAGE_SELF)
-    return (f"{RESOURCE_PREFIX} cpu_s={ru.ru_utime + ru.ru_stime:.3f} user_s={ru.ru_utime:.3f} "
-            f"sys_s={ru.ru_stime:.3f} max_rss_mb={ru.ru_maxrss / 1024:.1f}")
+    process so far, its finished child processes included (LaTeX, say):
+    ``resource.getrusage``; the peak memory is ``VmHWM`` of ``/proc/self/status``
+    (``ru_maxrss`` keeps the forking parent's peak across ``exec`` on Linux), else
+    ``ru_maxrss`` (KiB on Linux)."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    user, sys_ = me.ru_utime + kids.ru_utime, me.ru_stime + kids.ru_stime
+    rss_kib = float(me.ru_maxrss)
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                rss_kib = float(line.split()[1])
+    return (f"{RESOURCE_PREFIX} cpu_s={user + sys_:.3f} user_s={user:.3f} "
+            f"sys_s={sys_:.3f} max_rss_mb={rss_kib / 1024:.1f}")
 
 
 def stand_in(input=None, output=None, params=None, log=None, wildcards=None,

@@ -373,16 +373,29 @@ def table_metrics(study: Mapping) -> list[str]:
 def gather_runs(parts: Iterable[tuple[str, pd.DataFrame]], study: Mapping,
                 converged_pos_err_m: float | None = None) -> pd.DataFrame:
     """Every run of a study, one row per (instance, [variant,] method, run): the chunk
-    tables ``(instance label, frame)`` joined, runs beyond ``study["runs"]`` dropped (kept
-    chunks of a larger earlier study), paper-B derived metrics added, the swept values
-    beside each row."""
+    tables ``(instance label, frame)`` joined, the rows of the study's methods (and
+    variants) kept (a chunk also holds those of other studies of the same value), runs
+    beyond ``study["runs"]`` dropped (kept chunks of a larger earlier study), paper-B
+    derived metrics added, the swept values beside each row."""
     frames = []
     for label, df in parts:
         df = df.copy()
         df.insert(0, "instance", label)
         frames.append(df)
     runs = pd.concat(frames, ignore_index=True)
-    runs = runs[runs["run"] < study["runs"]]
+    keep = runs["method"].isin(study["methods"]) & (runs["run"] < study["runs"])
+    if study["variants"]:
+        keep &= runs["variant"].isin(study["variants"])
+    runs = runs[keep]
+    for label in study["instances"]:
+        got = runs[runs["instance"] == label]
+        for m in study["methods"]:
+            for v in study["variants"] or [None]:
+                n = int(((got["method"] == m) & (True if v is None else got["variant"] == v)).sum())
+                if n != study["runs"]:
+                    what = f"{v}/{m}" if v else m
+                    raise ValueError(f"study '{study['name']}': value {label}: {n} runs of {what}, "
+                                     f"expected {study['runs']} (rerun its study_runs jobs)")
     if study["paper"] == "landing":
         from opnav.landing.study import add_derived
 

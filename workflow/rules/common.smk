@@ -158,7 +158,21 @@ def _study_units(s):
 
 # studies.smk
 def _study_runs(s):
-    """(chunk file, instance label) for every run of every value and method of study s."""
+    """(chunk file, instance label) for every run chunk of every value of study s: one
+    job per (simulation config, chunk) flies every method (and variant) of the studies
+    that share that simulation, so a job's start-up is paid once per value, not per method."""
     chunks = [chunk_label(c) for c in mc_chunks(s.runs, s.runs_per_job)]
-    return [(f"{STUDIES_DIR}/runs/{s.paper}/{i.digest}/{u}/{c}.csv", i.label)
-            for i in s.instances for u in _study_units(s) for c in chunks]
+    return [(f"{STUDIES_DIR}/runs/{s.paper}/{i.digest}/{c}.csv", i.label)
+            for i in s.instances for c in chunks]
+
+
+# studies.smk
+def _study_job_units(studies):
+    """(paper, digest, chunk) -> the sorted methods (paper A: variant__method) that job
+    flies: the union over the studies reading that chunk."""
+    out = {}
+    for s in studies.values():
+        for i in s.instances:
+            for c in mc_chunks(s.runs, s.runs_per_job):
+                out.setdefault((s.paper, i.digest, chunk_label(c)), set()).update(_study_units(s))
+    return {k: sorted(v) for k, v in out.items()}

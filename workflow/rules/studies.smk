@@ -19,28 +19,30 @@ STUDY_SHAPES = {
 
 STUDIES = _studies.plan(config, STUDY_SHAPES, _check_study_config, _planner_methods())
 STUDY_SIMS = {i.digest: i.sim for s in STUDIES.values() for i in s.instances}
+STUDY_JOB_UNITS = _study_job_units(STUDIES)
 STUDY_SRC = {"landing": B_SRC + src("landing/study.py"),
              "approach": A_X2_SRC + src("approach/study.py")}
 
 
 rule study_runs:
-    """One study job: runs of one method (paper A: variant and estimator) at one value."""
+    """One study job: a chunk of runs at one value (simulation config), every method
+    (paper A: variant and estimator) that a study of that value compares."""
     input:
         lambda wc: STUDY_SRC[wc.spaper],
     output:
-        f"{STUDIES_DIR}/runs/{{spaper}}/{{sdigest}}/{{sunit}}/{{schunk}}.csv",
+        f"{STUDIES_DIR}/runs/{{spaper}}/{{sdigest}}/{{schunk}}.csv",
     wildcard_constraints:
         spaper="approach|landing",
         sdigest="[0-9a-f]+",
-        sunit="[a-z][a-z0-9_-]*",
         schunk=CHUNK_PATTERN,
     params:
         sim=lambda wc: STUDY_SIMS[wc.sdigest],
         runs=lambda wc: chunk_runs(wc.schunk),
+        units=lambda wc: STUDY_JOB_UNITS[(wc.spaper, wc.sdigest, wc.schunk)],
     log:
-        f"{STUDIES_DIR}/logs/runs_{{spaper}}_{{sdigest}}_{{sunit}}_{{schunk}}.log",
+        f"{STUDIES_DIR}/logs/runs_{{spaper}}_{{sdigest}}_{{schunk}}.log",
     benchmark:
-        f"{STUDIES_DIR}/benchmarks/runs_{{spaper}}_{{sdigest}}_{{sunit}}_{{schunk}}.tsv"
+        f"{STUDIES_DIR}/benchmarks/runs_{{spaper}}_{{sdigest}}_{{schunk}}.tsv"
     script:
         "../scripts/study_runs.py"
 

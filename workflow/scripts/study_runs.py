@@ -1,7 +1,10 @@
-"""One parameter-study job: runs `params.runs` of one (variant and) method with one
-study value's simulation config (opnav.studies; results keyed by that config's digest)."""
+"""One parameter-study job: runs `params.runs` of every unit in `params.units` (paper B:
+a method; paper A: variant__estimator) with one study value's simulation config
+(opnav.studies; results keyed by that config's digest)."""
 
 import sys
+
+import pandas as pd
 
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_target
@@ -14,13 +17,15 @@ with script_context(snakemake) as log:
     runs = list(snakemake.params.runs)
     if w.spaper == "landing":
         from opnav.landing.study import run_runs
-
-        df = run_runs(snakemake.params.sim, w.sunit, runs)
     else:
         from opnav.approach.study import run_runs
-
-        variant, method = w.sunit.split("__")
-        df = run_runs(snakemake.params.sim, variant, method, runs)
+    frames = []
+    for unit in snakemake.params.units:
+        if w.spaper == "landing":
+            frames.append(run_runs(snakemake.params.sim, unit, runs))
+        else:
+            variant, method = unit.split("__")
+            frames.append(run_runs(snakemake.params.sim, variant, method, runs))
+        log.info("%s %s %s: runs %d..%d", w.spaper, w.sdigest, unit, runs[0], runs[-1])
     with atomic_target(snakemake.output[0]) as tmp:
-        df.to_csv(tmp, index=False)
-    log.info("%s %s %s: runs %d..%d", w.spaper, w.sdigest, w.sunit, runs[0], runs[-1])
+        pd.concat(frames, ignore_index=True).to_csv(tmp, index=False)
