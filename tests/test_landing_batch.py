@@ -170,3 +170,22 @@ def test_tracking_step_is_the_fig3_strategy():
     np.testing.assert_array_equal(observe, [False, True, False, False, True, False])
     np.testing.assert_array_equal(cur2, [-1, 5, 5, 5, 5, -1])
     np.testing.assert_array_equal(n2, [0, 2, 3, 1, 4, 0])
+
+
+@pytest.mark.parametrize("method", ["depth", "logdet"])
+def test_skipping_the_pick_ratio_changes_nothing_else(scenarios, method):
+    """``pick_ratio=False`` (B-X1-only methods: no table shows it) leaves every pick, state and
+    error of the descent as it is and only blanks the diagnostic; with it on, ratios are >= 1."""
+    scn = scenarios["interior"]
+    on = run_descents(scn, method, [0, 1])
+    off = run_descents(scn, method, [0, 1], pick_ratio=False)
+    for a, b in zip(on, off):
+        assert set(a) == set(b)
+        for k in a:
+            if k == "plan_ratio":
+                continue
+            x, y = np.asarray(a[k]), np.asarray(b[k])
+            assert np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), k
+        r = np.asarray(a["plan_ratio"], float)
+        assert np.isfinite(r).any() and (r[np.isfinite(r)] >= 1 - 1e-12).all()
+        assert np.isnan(np.asarray(b["plan_ratio"], float)).all()

@@ -87,6 +87,9 @@ rule landing_mc_chunk:
     params:
         landing=lambda wc: B_SIMS[wc.bscn],
         runs=lambda wc: chunk_runs(wc.bchunk),
+        # the pick-ratio diagnostic scores every detected landmark once more per planning
+        # call (half an information metric's descent); only B-T3 (landing.mc.methods) shows it
+        pick_ratio=lambda wc: wc.bmethod in B_METHODS,
     log:
         f"{LANDING}/logs/mc_{{bscn}}_{{bmethod}}_chunk{{bchunk}}.log",
     benchmark:

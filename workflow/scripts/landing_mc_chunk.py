@@ -13,6 +13,7 @@ with script_context(snakemake) as log:
     runs = list(snakemake.params.runs)
     # in run order, the planning calls too (the batch records them step by step): as
     # gathered, so a method's single chunk is its Monte Carlo (rule landing_mc_gather)
-    data = gather([run_chunk(snakemake.params.landing, method, runs)])
+    data = gather([run_chunk(snakemake.params.landing, method, runs,
+                             pick_ratio=bool(snakemake.params.pick_ratio))])
     save(snakemake.output[0], data, method)
     log.info("%s: runs %s..%s, %d planning calls", method, runs[0], runs[-1], len(data["plan_index"]))

@@ -168,10 +168,12 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
 
 
 def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | None = None,
-                 imu_noise: bool = True, init_error: bool = True) -> list[dict]:
+                 imu_noise: bool = True, init_error: bool = True, pick_ratio: bool = True) -> list[dict]:
     """Fly the runs ``run_indices`` as one batch; one dict per run (module docstring).
 
-    A run's numbers do not depend on the batch it is flown in (to round-off)."""
+    A run's numbers do not depend on the batch it is flown in (to round-off).
+    ``pick_ratio = False`` skips the pick-ratio diagnostic (every detected landmark
+    scored once more per call; ``plan_ratio`` is NaN), which no pick depends on."""
     runs = [int(i) for i in run_indices]
     B = len(runs)
     if B == 0:
@@ -263,7 +265,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
                                        cur[b], rng_pick[b])
                 states = PlanState(st.r[ip], st.v[ip], a_est[ip], st.R[ip], st.P[ip])
                 res = plan_batch(method, states, cam, scn.field, visible, scn.planner, cur[ip],
-                                 [rng_pick[b] for b in ip], np.flatnonzero(det))
+                                 [rng_pick[b] for b in ip], np.flatnonzero(det), diagnose=pick_ratio)
                 for b, rs in zip(ip, res):
                     append_call(calls[b], k * scn.Dt, rs)
                 cur[ip] = [rs.index for rs in res]

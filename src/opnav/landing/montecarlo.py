@@ -81,11 +81,14 @@ def chunk_runs(label: str) -> list[int]:
 CHUNK_PATTERN = r"r[0-9]+-[0-9]+"
 
 
-def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | None = None) -> dict:
+def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | None = None,
+              pick_ratio: bool = True) -> dict:
     """Fly the runs ``run_indices`` with ``method``; stacked arrays (see module doc).
 
     Runs are flown in batches of ``batch_size`` (default ``landing.mc.batch_size``;
-    0 = all runs as one batch); the numbers do not depend on it (to round-off)."""
+    0 = all runs as one batch); the numbers do not depend on it (to round-off).
+    ``pick_ratio = False``: no pick-ratio diagnostic (``plan_ratio`` NaN; nothing
+    else changes), for methods no table shows it for (B-T3 lists ``landing.mc.methods``)."""
     from opnav.landing.descent import run_descents
     from opnav.landing.scenario import build_scenario
 
@@ -96,7 +99,7 @@ def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | Non
     size = len(idx) if batch_size <= 0 else int(batch_size)
     runs = []
     for a in range(0, len(idx), max(size, 1)):
-        runs.extend(run_descents(scn, method, idx[a:a + size]))
+        runs.extend(run_descents(scn, method, idx[a:a + size], pick_ratio=pick_ratio))
     return stack_runs(idx, runs, scn.truth.t)
 
 

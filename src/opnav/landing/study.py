@@ -50,7 +50,7 @@ def run_runs(landing_cfg: dict, method: str, run_indices) -> pd.DataFrame:
     from opnav.landing.timing import replay_own
 
     max_calls = int(landing_cfg["timing"]["max_calls"])
-    data = run_chunk(landing_cfg, method, list(run_indices))
+    data = run_chunk(landing_cfg, method, list(run_indices), pick_ratio=False)   # no study metric reads it
     df = per_run_metrics(data, replay_own(build_scenario(landing_cfg), data, method, max_calls), method)
     df.insert(1, "method", method)
     return df
