@@ -23,7 +23,8 @@ Every method runs the SAME search; only the scalar objective differs:
    from the estimated pose); no landmark only if the image holds none. One
    call asks the field's bucket index (``LandmarkField.grid``); the batched
    planner asks the ``cKDTree`` for the ``knn`` nearest of every run at once
-   and widens a run alone when they do not settle it.
+   and scores a run's detected landmarks directly when those do not settle it
+   (the same order: distance, then index).
 
 Objectives (minimised) are built by a table of factories, :data:`OBJECTIVES`:
 ``depth`` is the depth estimation error (eq. 23-25,
@@ -69,7 +70,7 @@ from opnav.landing import metrics
 from opnav.landing.depth_error import (DegenerateGeometry, PlaneGeometry, baseline, depth_error_at_points,
                                        depth_error_scalar, error_radius, ground_point_scalar,
                                        plane_geometry)
-from opnav.landing.landmarks import LandmarkField
+from opnav.landing.landmarks import LandmarkField, nearest_brute_force
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig",
            "plan", "plan_batch", "golden_section_batch", "OBJECTIVES", "PICKERS",
@@ -92,19 +93,20 @@ def golden_section(fun: Callable[[float], float], a: float, b: float, tol: float
         raise ValueError(f"golden_section: bad interval [{a}, {b}]")
     if not tol > 0:
         raise ValueError(f"golden_section: tolerance must be positive, got {tol}")
-    c = b - INVPHI * (b - a)
-    d = a + INVPHI * (b - a)
+    g = INVPHI                         # (a local: the loop is on the timed path)
+    c = b - g * (b - a)
+    d = a + g * (b - a)
     fc = fun(c)
     fd = fun(d)
     n = 2
     while (b - a) > tol:
         if fc <= fd:
             b, d, fd = d, c, fc
-            c = b - INVPHI * (b - a)
+            c = b - g * (b - a)
             fc = fun(c)
         else:
             a, c, fc = c, d, fd
-            d = a + INVPHI * (b - a)
+            d = a + g * (b - a)
             fd = fun(d)
         n += 1
     return (c, fc, n) if fc <= fd else (d, fd, n)
@@ -937,8 +939,9 @@ def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, detected: np.
     by the bucket index's order (``dx*dx + dy*dy``, ties by the smaller
     index); a point whose best there is not clearly nearer than the farthest
     of its ``knn`` (relative 1e-12: the tree's own distances may round
-    otherwise), or that has none, is answered by :func:`_pick_nearest` alone,
-    so every pick is the per-call planner's."""
+    otherwise), or that has none, is answered by a brute-force search over the
+    detected landmarks (``landmarks.nearest_brute_force``, the same order), so
+    every pick is the per-call planner's."""
     points = np.asarray(points, float)
     n_field = len(field_.xyz)
     k = min(max(int(knn), 1), n_field)
@@ -956,8 +959,10 @@ def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, detected: np.
     out = np.where(tie, idx, n_field).min(axis=1)
     sure = (best < d2.max(axis=1) * (1.0 - 1e-12)) | (k == n_field)
     out = np.where(ok.any(axis=1), out, -1)
-    for j in np.flatnonzero(~sure | (out < 0)):
-        out[j] = _pick_nearest(field_, points[j], det, {int(exclude[j])} if exclude[j] >= 0 else ())
+    xy = field_.xyz[:, :2]
+    for j in np.flatnonzero(~sure | (out < 0)):     # (brute force: no bucket index to build)
+        out[j] = nearest_brute_force(xy, points[j, 0], points[j, 1], det,
+                                     {int(exclude[j])} if exclude[j] >= 0 else ())
     return out.astype(np.int64)
 
 

@@ -48,7 +48,7 @@ import numpy as np
 from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 
 __all__ = ["select_calls", "variants", "replay", "save", "load", "times_ns", "median_us",
-           "time_reduction", "method_text", "summary_frame", "median_evals", "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us"]
+           "time_reduction", "method_text", "summary_frame", "median_evals", "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us", "STAGES"]
 
 
 # ----------------------------------------------------------------- replay
@@ -344,8 +344,59 @@ def summary_frame(tm: dict):
     return pd.DataFrame(rows)
 
 
+#: stages of a planning call (``planner._plan``) timed alone by :func:`call_overhead`
+STAGES = ("plane", "visible interval", "objective build", "search loop beyond evals",
+          "ground point", "edge candidate list", "nearest-landmark pick")
+
+
+def _hot_ns(fn, reps: int, repeats: int = 3) -> float:
+    """Thread CPU ns of one ``fn()`` called ``reps`` times in a row, the minimum of ``repeats``."""
+    best = math.inf
+    for _ in range(repeats):
+        c0 = time.thread_time_ns()
+        for _ in range(reps):
+            fn()
+        best = min(best, (time.thread_time_ns() - c0) / reps)
+    return best
+
+
+def _stage_ns(pl, method, state, cam, field_, cfg, det, exclude, geom, ivs, f, betas, res, cand,
+              reps: int) -> dict:
+    """One call's stages (:data:`STAGES`), the whole call and its evaluations,
+    each timed alone and hot (:func:`_hot_ns`), ns; the search loop is the
+    golden-section searches less their evaluations."""
+    from opnav.landing.depth_error import ground_point_scalar, plane_geometry
+
+    def search():
+        for a, b in ivs:
+            pl.golden_section(f, a, b, cfg.tol_rad)
+
+    def evals():
+        for b in betas:
+            f(b)
+
+    edge = res.edge and cand.size
+    ev = _hot_ns(evals, reps)
+    point = res.ground
+    return {
+        "call": _hot_ns(lambda: pl.plan(method, state, cam, field_, None, cfg, exclude=exclude,
+                                        detected=det, diagnose=False), reps),
+        "evaluations": ev + (_hot_ns(lambda: f.batch(field_.xyz[cand]), reps) if edge else 0.0),
+        "plane": _hot_ns(lambda: plane_geometry(state.r, state.v), reps),
+        "visible interval": _hot_ns(lambda: pl.visible_intervals(geom, state.R_LtoB, cam, cfg.n_grid,
+                                                                 cfg.margin_px), reps),
+        "objective build": _hot_ns(lambda: pl.OBJECTIVES[method](
+            state=state, geom=geom, cfg=cfg, camera=cam, sigma_b=cam.sigma_b), reps),
+        "search loop beyond evals": _hot_ns(search, reps) - ev,
+        "ground point": _hot_ns(lambda: np.array(ground_point_scalar(geom)(res.beta)), reps),
+        "edge candidate list": _hot_ns(lambda: pl._candidates(det, exclude), reps) if res.edge else 0.0,
+        "nearest-landmark pick": (0.0 if edge and np.isfinite(f.batch(field_.xyz[cand])).any() else
+                                  _hot_ns(lambda: pl._pick_nearest(field_, point, det, exclude), reps)),
+    }
+
+
 def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0,
-                  repeats: int = 3) -> dict:
+                  repeats: int = 3, stage_reps: int = 0) -> dict:
     """The planning call's overhead beyond its objective evaluations, by replay.
 
     For each selected recorded call of ``recorded[method]`` (evenly spaced,
@@ -359,6 +410,12 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     ``repeats`` (thread CPU clock, ns). Returns per call ``call_ns``,
     ``evals_ns``, ``n_evals`` (scalar evaluations plus landmarks scored),
     ``edge`` and ``overhead_ratio = (call - evals) / evals``.
+
+    ``stage_reps > 0``: also ``stages``, per call the thread CPU ns of each of
+    :data:`STAGES`, of the whole call and of its evaluations, each timed alone
+    and hot (``stage_reps`` calls in a row, minimum of 3): where the overhead
+    goes (the hot call less its hot evaluations and stages is the call's own
+    rest; a replayed call runs once, on colder caches).
     """
     from opnav.landing import planner as pl
     from opnav.landing.depth_error import plane_geometry
@@ -368,6 +425,7 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     cam, field_, tr, cfg = scn.camera, scn.field, scn.truth, scn.planner
     thread = time.thread_time_ns
     call_ns, evals_ns, n_ev, edges = [], [], [], []
+    stages: dict = {k: [] for k in STAGES + ("call", "evaluations")}
     build = pl.OBJECTIVES[method]
     gc_was = gc.isenabled()
     gc.disable()
@@ -416,11 +474,18 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
             evals_ns.append(best_eval)
             n_ev.append(len(betas) + (int(cand.size) if res.edge else 0))
             edges.append(bool(res.edge))
+            if stage_reps > 0:
+                for key, val in _stage_ns(pl, method, state, cam, field_, cfg, det, exclude, geom,
+                                          ivs, f, betas, res, cand, int(stage_reps)).items():
+                    stages[key].append(val)
     finally:
         if gc_was:
             gc.enable()
     call_ns, evals_ns = np.asarray(call_ns, np.int64), np.asarray(evals_ns, np.int64)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = (call_ns - evals_ns) / evals_ns
-    return {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": np.asarray(n_ev, np.int64),
-            "edge": np.asarray(edges, bool), "overhead_ratio": ratio}
+    out = {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": np.asarray(n_ev, np.int64),
+           "edge": np.asarray(edges, bool), "overhead_ratio": ratio}
+    if stage_reps > 0:
+        out["stages"] = {k: np.asarray(v, float) for k, v in stages.items()}
+    return out
