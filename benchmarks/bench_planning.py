@@ -16,7 +16,7 @@ plane, visible interval, objective build
 (eq. 19 and 22 constants), the search loop beyond its evaluations, the eq. 26
 ground point, the edge rule's candidate list (its batch scoring counts as
 evaluations), the nearest-landmark pick, the rest (the call's wrapper,
-result and clocks: the hot call less its hot evaluations and stages) and the
+glue and result: the hot call less its hot evaluations and stages) and the
 cold start (the overhead as replayed less the hot one: a replayed call runs
 once, on cold caches). The hot call's own ratio is printed too.
 
@@ -86,7 +86,7 @@ def main() -> None:
             print(f"    overhead by stage (each timed alone, hot: {a.reps} repeats, min of 3; median us):")
             for s in timing.STAGES:
                 print(f"      {s:32s}{np.median(br[s]) / 1e3:8.1f}")
-            print(f"      {'rest (wrapper, result, clocks)':32s}{np.median(rest):8.1f}"
+            print(f"      {'rest (wrapper, glue, result)':32s}{np.median(rest):8.1f}"
                   "   (hot call - hot evaluations - stages)")
             print(f"      {'cold start':32s}{np.median(call - ev - parts - rest):8.1f}"
                   "   (overhead as replayed - hot overhead)")

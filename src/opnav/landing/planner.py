@@ -146,7 +146,8 @@ class PlanResult:
     n_evals: int               # objective evaluations
     time_ns: int               # wall time of the planning call (perf_counter_ns)
     note: str = ""
-    cpu_ns: int = 0            # CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID)
+    cpu_ns: int = 0            # not measured by the call (0): the replay (timing.replay)
+                               # reads the thread CPU clock around it
     edge: bool = False         # in-plane optimum on an end of the visible interval:
                                # the detected landmarks were scored directly
     pick_ratio: float = math.nan  # picked landmark's metric / best detected one's (>= 1;
@@ -403,8 +404,11 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
          exclude: set = frozenset(), rng: np.random.Generator | None = None,
          detected: np.ndarray | None = None, diagnose: bool = True) -> PlanResult:
     """One planning call (see :func:`_plan`), with its wall time (``time_ns``,
-    ``perf_counter_ns``) and the CPU time of the calling thread (``cpu_ns``,
-    CLOCK_THREAD_CPUTIME_ID, insensitive to other processes on a shared machine).
+    ``perf_counter_ns``). Its CPU time is measured from outside, by the replay
+    (``timing.replay``: the calling thread's CPU clock around the call): the
+    thread CPU clock is a system call, and two reads inside the call cost
+    2-3 us of a 30 us depth call (measured, the code after a read runs slower
+    too), so ``cpu_ns`` stays 0.
 
     ``detected``: field indices, in increasing order, of the landmarks the
     image holds (the feature detector's list, the same for every method, as
@@ -414,10 +418,8 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
     detected landmark scored by the method's own metric, fastest path)."""
     if detected is None:
         detected = np.flatnonzero(visible(field_.xyz))
-    c0 = _thread_ns()
     res, fun, vals, cand = _plan(method, state, camera, field_, cfg, exclude, rng,
                                  np.asarray(detected, np.int64))
-    res.cpu_ns = _thread_ns() - c0
     if diagnose and fun is not None and res.index >= 0:
         if cand is None:
             cand = _candidates(detected, exclude)
@@ -429,11 +431,6 @@ def plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
                 f_pick = vals[np.searchsorted(cand, res.index)] if res.index in cand else math.nan
                 res.pick_ratio = float(fun.ratio(f_pick, float(vals[fin].min())))
     return res
-
-
-#: CPU time of the calling thread, ns (CLOCK_THREAD_CPUTIME_ID; measured 0.46 us
-#: per call here, clock_gettime_ns 0.55 us)
-_thread_ns = time.thread_time_ns
 
 
 def _plan(method: str, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
