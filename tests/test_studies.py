@@ -23,6 +23,7 @@ SIM_LANDING = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "imu", 
 def _shapes(cfg):
     land = {k: cfg["landing"][k] for k in SIM_LANDING}
     land["mc"] = {k: cfg["landing"]["mc"][k] for k in ("base_seed", "bounds")}
+    land["timing"] = {"max_calls": cfg["landing"]["timing"]["max_calls"]}
     appr = {k: cfg["approach"][k] for k in cfg["approach"] if k not in ("variants", "methods", "scatter")}
     return {"landing": land, "approach": appr}
 
@@ -170,3 +171,21 @@ def test_gather_runs_keeps_the_study_units_and_refuses_missing_runs():
     short = pd.DataFrame([r for r in rows if not (r["run"] == 1 and r["variant"] == "roll" and r["method"] == "em")])
     with pytest.raises(ValueError, match="1 runs of roll/em, expected 2"):
         studies.gather_runs([("a", short)], spec)
+
+
+def test_caption_states_the_replay_budget_of_the_planning_times(quick):
+    """Paper-B studies time planning calls by replay of at most landing.timing.max_calls
+    calls per job: the caption gives the budget and the calls a run's median rests on;
+    a study without a timing metric says nothing of it."""
+    cfg = _with_study(quick, "t", paper="landing", vary={"landing.camera.fov_deg": [45.0, 60.0]},
+                      metrics=["median_plan_time_us"], runs=6, runs_per_job=3)
+    spec = _plan(cfg)["t"].spec()
+    n = quick["landing"]["timing"]["max_calls"]
+    assert spec["timing_calls"] == n == 30
+    cap = studies.caption(spec)
+    assert f"at most {n} of a job's recorded planning calls" in cap
+    assert "jobs of 3 runs" in cap and "about 10 calls" in cap, cap
+    quiet = _with_study(quick, "q", paper="landing", vary={"landing.camera.fov_deg": [45.0, 60.0]},
+                        metrics=["final_pos_err_m"], runs=2, runs_per_job=2)
+    assert "replay" not in studies.caption(_plan(quiet)["q"].spec())
+    assert _plan(quick)["ifov"].timing_calls is None          # paper A: no planning calls

@@ -565,9 +565,9 @@ def _timing_text(study: Mapping) -> str:
         return ""
     n = study.get("timing_calls")
     per_job = min(int(study.get("runs_per_job") or study["runs"]), int(study["runs"]))
-    budget = ("every recorded planning call" if not n else
-              f"at most {n} recorded planning calls per job of {per_job} runs (landing.timing.max_calls), "
-              f"evenly spaced over the job's calls, so a run's median rests on about "
-              f"{max(n // per_job, 1)} calls (none: not counted)")
-    return (f" Planning times by replay of {budget} through the run's method, one call at a time, "
-            "apart from the filter's work (time.perf_counter_ns; CPU: the thread clock).")
+    which = ("every recorded planning call" if not n else
+             f"at most {n} of a job's recorded planning calls (landing.timing.max_calls; jobs of "
+             f"{per_job} runs), evenly spaced over them, so a run's median rests on about "
+             f"{max(n // per_job, 1)} calls (a run with none is left out)")
+    return (" Planning times: by replay through the run's method, one call at a time and apart "
+            "from the filter's work (time.perf_counter_ns; CPU: the thread clock), of " + which + ".")
