@@ -28,7 +28,6 @@ Units: km, rad (arcsec only at the edges).
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from opnav.rotations import skew
 
@@ -42,6 +41,8 @@ def misalignment_small(theta: np.ndarray) -> np.ndarray:
 
 def misalignment_exact(theta: np.ndarray) -> np.ndarray:
     """Exact rotation whose first-order form is eq. 5: ``exp(-[theta x])``."""
+    from scipy.spatial.transform import Rotation   # imported here: most jobs never call it
+
     return Rotation.from_rotvec(-np.asarray(theta, float)).as_matrix()
 
 

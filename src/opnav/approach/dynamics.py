@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 MU_SUN = 1.32712440018e11  # km^3/s^2
 MU_MARS = 4.282837e4  # km^3/s^2
@@ -104,6 +103,8 @@ def _rhs(el: KeplerElements):
 def propagate(X0: np.ndarray, t: np.ndarray, el: KeplerElements, rtol: float = 1e-13,
               atol: float = 1e-6) -> np.ndarray:
     """Truth states (len(t), 6) from ``X0`` at ``t[0]``, DOP853 with tight tolerances."""
+    from scipy.integrate import solve_ivp   # 0.3 s of import: only jobs that integrate pay it
+
     sol = solve_ivp(_rhs(el), (t[0], t[-1]), np.asarray(X0, float), method="DOP853",
                     t_eval=t, rtol=rtol, atol=atol)
     if not sol.success:  # pragma: no cover
@@ -130,6 +131,8 @@ def propagate_with_stm(X0: np.ndarray, t: np.ndarray, el: KeplerElements, rtol: 
         return np.concatenate([f(tt, X), (F @ Phi).ravel()])
 
     Y0 = np.concatenate([np.asarray(X0, float), np.eye(6).ravel()])
+    from scipy.integrate import solve_ivp
+
     sol = solve_ivp(rhs, (t[0], t[-1]), Y0, method="DOP853", t_eval=t, rtol=rtol, atol=atol)
     if not sol.success:  # pragma: no cover
         raise RuntimeError(f"STM propagation failed: {sol.message}")

@@ -15,15 +15,18 @@ import json
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from opnav import published
 from opnav.landing import ekf, imu
 from opnav.landing.camera import Camera, camera_from_config
 from opnav.landing.landmarks import LandmarkField, make_field
 from opnav.landing.planner import PlannerConfig, alternative_path
+
+if TYPE_CHECKING:  # pandas only for the B-T1/B-T2 tables: not imported by every Monte-Carlo job
+    import pandas as pd
 from opnav.landing.trajectory import Truth, truth_states
 
 
@@ -154,7 +157,7 @@ def initial_attitude_report(landing_cfg: dict) -> dict:
             "rpy_deg": [float(x) for x in derived_initial_attitude_deg(landing_cfg)]}
 
 
-def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
+def initial_state_table(landing_cfg: dict) -> "pd.DataFrame":
     """B-T1: the lander's initial state in {L} (paper Table 1), config beside
     published, and the simulation's initial state (the attitude derived from the
     guidance thrust direction)."""
@@ -167,6 +170,8 @@ def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
         ("attitude -(yaw, pitch, roll), Z-Y-X, roll 0", "deg", s["att_deg"], pub["att_deg"],
          np.round(att, 2)),
     ]
+    import pandas as pd
+
     return pd.DataFrame(
         {
             "state": [r[0] for r in rows],
@@ -179,7 +184,7 @@ def initial_state_table(landing_cfg: dict) -> pd.DataFrame:
     )
 
 
-def error_bounds_table(landing_cfg: dict) -> pd.DataFrame:
+def error_bounds_table(landing_cfg: dict) -> "pd.DataFrame":
     """B-T2: Monte-Carlo initial-error bounds (paper Table 2), uniform per axis."""
     b = landing_cfg["mc"]["bounds"]
     pub = published.paper_b()["table2_error_bounds"]
@@ -189,6 +194,8 @@ def error_bounds_table(landing_cfg: dict) -> pd.DataFrame:
         ("velocity", "m/s", b["v_mps"], pub["v_mps"]),
         ("attitude", "deg", b["att_deg"], pub["att_deg"]),
     ]
+    import pandas as pd
+
     return pd.DataFrame(
         {
             "state": [r[0] for r in rows],
