@@ -189,3 +189,19 @@ def test_skipping_the_pick_ratio_changes_nothing_else(scenarios, method):
         r = np.asarray(a["plan_ratio"], float)
         assert np.isfinite(r).any() and (r[np.isfinite(r)] >= 1 - 1e-12).all()
         assert np.isnan(np.asarray(b["plan_ratio"], float)).all()
+
+
+def test_a_chunk_is_already_in_gathered_order():
+    """A method's single chunk file stands for its gathered Monte Carlo (workflow
+    ``b_mc``): ``run_chunk`` holds runs and planning calls in run order, as ``gather``."""
+    from opnav.landing.montecarlo import gather, run_chunk
+
+    cfg = camera_scenarios(load_config(overlays=[Path(__file__).parents[1] / "config" / "quick.yaml"])
+                           ["landing"])["site-tilt"]
+    d = run_chunk(cfg, "depth", [0, 1, 2])
+    g = gather([d])
+    assert set(g) == set(d)
+    for k in d:
+        x = np.asarray(d[k])
+        assert np.array_equal(x, np.asarray(g[k]), equal_nan=x.dtype.kind == "f"), k
+    assert (np.diff(d["plan_run"]) >= 0).all() and len(set(d["plan_run"])) == 3

@@ -67,8 +67,8 @@ B_SCN_RE = "|".join(B_SCENARIOS)
 
 def b_mc(scn, methods):
     """Each method's Monte Carlo in scenario ``scn``: the gathered file, or the one chunk
-    itself when one job flies every run (no gather job to start; a chunk holds its runs and
-    their planning calls in run order, as gathered)."""
+    itself when one job flies every run (no gather job to start: ``montecarlo.stack_runs``
+    already holds the runs and their planning calls in run order, as gathered)."""
     if len(B_CHUNKS) == 1:
         return [f"{LANDING}/mc/{scn}/chunks/{m}/{B_CHUNKS[0]}.npz" for m in methods]
     return [f"{LANDING}/mc/{scn}/{m}.npz" for m in methods]

@@ -2,7 +2,7 @@
 
 import sys
 
-from opnav.landing.montecarlo import gather, run_chunk, save
+from opnav.landing.montecarlo import run_chunk, save
 from opnav.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -11,9 +11,6 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     method = snakemake.wildcards.bmethod
     runs = list(snakemake.params.runs)
-    # in run order, the planning calls too (the batch records them step by step): as
-    # gathered, so a method's single chunk is its Monte Carlo (rule landing_mc_gather)
-    data = gather([run_chunk(snakemake.params.landing, method, runs,
-                             pick_ratio=bool(snakemake.params.pick_ratio))])
+    data = run_chunk(snakemake.params.landing, method, runs, pick_ratio=bool(snakemake.params.pick_ratio))
     save(snakemake.output[0], data, method)
     log.info("%s: runs %s..%s, %d planning calls", method, runs[0], runs[-1], len(data["plan_index"]))
