@@ -387,15 +387,13 @@ def gather_runs(parts: Iterable[tuple[str, pd.DataFrame]], study: Mapping,
     if study["variants"]:
         keep &= runs["variant"].isin(study["variants"])
     runs = runs[keep]
-    for label in study["instances"]:
-        got = runs[runs["instance"] == label]
-        for m in study["methods"]:
-            for v in study["variants"] or [None]:
-                n = int(((got["method"] == m) & (True if v is None else got["variant"] == v)).sum())
-                if n != study["runs"]:
-                    what = f"{v}/{m}" if v else m
-                    raise ValueError(f"study '{study['name']}': value {label}: {n} runs of {what}, "
-                                     f"expected {study['runs']} (rerun its study_runs jobs)")
+    variants = list(study["variants"]) or [None]
+    counts = runs.groupby(["instance", "variant", "method"] if study["variants"] else ["instance", "method"]).size()
+    for label, v, m in itertools.product(study["instances"], variants, study["methods"]):
+        n = int(counts.get((label, v, m) if v else (label, m), 0))
+        if n != study["runs"]:
+            raise ValueError(f"study '{study['name']}': value {label}: {n} runs of {f'{v}/{m}' if v else m}, "
+                             f"expected {study['runs']} (rerun its study_runs jobs)")
     if study["paper"] == "landing":
         from opnav.landing.study import add_derived
 
