@@ -543,3 +543,41 @@ def test_batch_over_runs_equals_each_context_alone(name):
         n = int(mask[k].sum())
         assert np.array_equal(mat[k, :n], [m.matrix_scalar(ctx, p) for p in cand[k, :n]])
         assert np.all(mat[k, n:] == -np.inf)
+
+
+@pytest.mark.parametrize("name", METRIC_NAMES)
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(r=lander, R=quat, seed=seeds, aniso=st.booleans(), dormant=st.booleans())
+def test_screening_bounds_hold_the_explicit_score(name, r, R, seed, aniso, dormant):
+    """Metric.screen (the batched edge rule's screening) brackets the explicit
+    matrix path's score of every candidate (up to rounding), with the same
+    invalid candidates; with ``rtol`` the best candidate's bracket is that
+    narrow and holds the explicit best. Both kinds of noise (the tangent
+    forms need R_meas = sigma^2 I, else the fast path), correlated priors,
+    and a dormant landmark block (1e8 m^2 I: the eigenvalues at the top of
+    Sigma_k coincide, the loosest case for mineig's bounds)."""
+    rng = np.random.default_rng(seed)
+    P = _prior(rng)
+    if dormant:
+        P[9:, :] = 0.0
+        P[:, 9:] = 0.0
+        P[9:, 9:] = 1e8 * np.eye(3)
+    ctx = _ctx(r=r, R=R, P=P, rng=rng, R_meas=_aniso_R(rng) if aniso else None)
+    c = _ground(rng, 200)
+    m = make_metric(name)
+    ex = m.numpy_H(ctx, c)
+    lo, hi = m.screen(ctx, c)
+    fin = np.isfinite(ex)
+    np.testing.assert_array_equal(np.isfinite(lo) | np.isfinite(hi), fin)
+    if not fin.any():
+        return
+    e, l, h = ex[fin], lo[fin], hi[fin]
+    # logdet (nats): the explicit path's Cholesky jitter (12 eps on the equilibrated
+    # 12 x 12 information) shifts it by up to ~5e-7 nats on ill-conditioned priors
+    tol = 1e-8 * np.abs(e) + (2e-6 if name == "logdet" else 0.0)
+    assert np.all(l <= e + tol) and np.all(e <= h + tol), name
+    lo2, hi2 = m.screen(ctx, c, rtol=1e-7)
+    assert np.all(lo2[fin] <= e + tol) and np.all(e <= hi2[fin] + tol), name
+    b = int(np.argmax(lo2))                           # the best by its guaranteed score
+    assert hi2[b] - lo2[b] <= 1e-7 * abs(hi2[b]) * 1.01
+    assert ex[b] >= ex[fin].max() * (1 - 1e-6) if ex[b] > 0 else ex[b] >= ex[fin].max() - 1e-6 * abs(ex[b])

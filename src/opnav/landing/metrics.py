@@ -519,12 +519,166 @@ def _whitened_scores(name: str, Hw: np.ndarray, exact_svd: bool = False) -> np.n
         G = Hw @ np.swapaxes(Hw, -1, -2)
         lam = np.linalg.eigvalsh(0.5 * (G + np.swapaxes(G, -1, -2)))[..., ::-1][..., :STRUCTURAL_RANK]
         s = np.sqrt(np.maximum(lam, 0.0))
+    return _whitened_from_sv(name, s)
+
+
+def _whitened_from_sv(name: str, s: np.ndarray) -> np.ndarray:
+    """The ``WHITENED[name]`` score from the four structural singular values of
+    H_w (..., 4), descending."""
     base = WHITENED[name]
     if base == "svd":
         return s[..., -1]
     if base == "cond":
         return s[..., -1] / s[..., 0]
     return 1.0 / np.sum(1.0 / (s * s), axis=-1)
+
+
+# ---- screening: cheap scores or bounds of many candidates (the batched edge rule)
+
+def _whitened_tangent_setup(ctx: MetricContext):
+    """Per-context pieces of the whitened metrics' tangent form, or None unless
+    R_meas = sigma^2 I_6 (the descent case).
+
+    Then C^-1 = I / sigma and H_w H_w^T = H P H^T / sigma^2. Each 3-row block of
+    H has its bearing as left null vector (module docstring), so H = T T^T H
+    with T = blockdiag(T_k, T_c) (6 x 4, orthonormal tangent bases of the two
+    bearings), and the four nonzero eigenvalues of H_w H_w^T, the squared
+    structural singular values of H_w, are those of the 4 x 4
+
+        M = G P G^T,  G = [G_k; G_c] = T^T H / sigma (4 x 12),
+
+    G_k the known landmark's tangent rows (no landmark columns), G_c the
+    candidate's (``measurement.tangent_jacobian``). Returns (1/sigma, P, G_k P,
+    G_k P G_k^T)."""
+    c = ctx._cache
+    if "wtangent" not in c:
+        P, Rm, _, _ = ctx._info()
+        s2 = float(Rm[0, 0])
+        if s2 > 0 and np.array_equal(Rm, s2 * np.eye(6)):
+            sc = 1.0 / math.sqrt(s2)
+            # the known landmark's own rows: its bearing and range, no landmark columns
+            Gk = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, sc).copy()
+            Gk[:, 9:12] = 0.0
+            GkP = Gk @ P
+            c["wtangent"] = (sc, P, GkP, GkP @ Gk.T)
+        else:
+            c["wtangent"] = None
+    return c["wtangent"]
+
+
+def _whitened_tangent_scores(name: str, ctx: MetricContext, wt, p: np.ndarray) -> np.ndarray:
+    """Whitened scores of candidates ``p`` (n, 3) from the 4 x 4 tangent Gram
+    matrix M of :func:`_whitened_tangent_setup` (eigenvalues by batched LAPACK
+    dsyevd of a 4 x 4: ~3x cheaper than H_w H_w^T's 6 x 6, tested against the
+    explicit path)."""
+    sc, P, GkP, K = wt
+    n = len(p)
+    G = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, p, sc)           # (n, 2, 12)
+    G2 = G.reshape(2 * n, 12)                                     # one GEMM for all candidates
+    GP = (G2 @ P).reshape(n, 2, 12)
+    M = np.empty((n, 4, 4))
+    M[:, 0:2, 0:2] = K
+    Bt = (G2 @ GkP.T).reshape(n, 2, 2)                             # G_c P G_k^T
+    M[:, 2:4, 0:2] = Bt
+    M[:, 0:2, 2:4] = np.swapaxes(Bt, 1, 2)
+    D = np.einsum("nik,njk->nij", GP, G)
+    M[:, 2:4, 2:4] = 0.5 * (D + np.swapaxes(D, 1, 2))
+    lam = np.linalg.eigvalsh(M)[:, ::-1]
+    return _whitened_from_sv(name, np.sqrt(np.maximum(lam, 0.0)))
+
+
+def _mineig_top(tg):
+    """(k, s (12,) descending, V (12, 12)) of the known-landmark posterior
+    Sigma_k (:func:`_tangent_setup`), k the smallest count of its largest
+    eigenvalues with s_(k+1) <= s_1 / 2 (at most 4)."""
+    w, Sig, ld = tg
+    s, V = np.linalg.eigh(Sig)
+    s, V = s[::-1].copy(), V[:, ::-1].copy()
+    k = 1
+    while k < 4 and s[k] > 0.5 * s[0]:
+        k += 1
+    return k, s, V
+
+
+def _mineig_bounds(ctx: MetricContext, tg, p: np.ndarray, rtol: float | None = None
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds (lo, hi) on ``mineig`` = 1 / lambda_max(Sigma_post) of candidates
+    ``p`` (n, 3), from the tangent update of :func:`_tangent_setup` without a
+    12 x 12 eigenproblem per candidate.
+
+    In the eigenbasis V of Sigma_k (eigenvalues s_1 >= s_2 >= ...), Sigma_post
+    = diag(s) - W^T W with W = L^T G Sigma_k V (2 x 12), L L^T = M^-1 and
+    M = I + G Sigma_k G^T (a rank-2 downdate). Split V at the k largest
+    eigenvalues: the top block A = diag(s_t) - W_t^T W_t (k x k), the coupling
+    C = -W_t^T W_r and the rest B <= s_(k+1) I (Sigma_post <= Sigma_k).
+    Rayleigh-Ritz gives lambda_max >= lambda_max(A); for a unit x = (a, b),
+    x^T Sigma_post x <= lambda_max(A) |a|^2 + 2 |C|_F |a| |b| + s_(k+1) |b|^2,
+    so lambda_max <= the larger eigenvalue of [[lambda_max(A), |C|_F],
+    [|C|_F, s_(k+1)]] (and <= s_1).
+
+    ``rtol``: the brackets of the candidates that can still be the best (lower
+    bound of lambda_max not above the smallest upper bound) are then halved
+    until each is within ``rtol`` relative, by bisection on the inertia of
+    Sigma_post - lambda I: with D = diag(s - lambda), the number of its
+    eigenvalues above lambda is #(s_i > lambda) + #pos(I_2 - W D^-1 W^T) - 2
+    (Haynsworth inertia additivity on [[D, W^T], [W, I]]), a 2 x 2 test."""
+    c = ctx._cache
+    if "mineig_top" not in c:
+        c["mineig_top"] = _mineig_top(tg)
+    k, s, V = c["mineig_top"]
+    w, Sig, ld = tg
+    n = len(p)
+    G = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, p, math.sqrt(w))   # (n, 2, 12)
+    GS = (G.reshape(2 * n, 12) @ Sig).reshape(n, 2, 12)             # one GEMM for all candidates
+    Q = np.einsum("nik,njk->nij", GS, G)
+    a = 1.0 + Q[:, 0, 0]
+    b = 0.5 * (Q[:, 0, 1] + Q[:, 1, 0])
+    d = 1.0 + Q[:, 1, 1]
+    det = a * d - b * b
+    m00, m01, m11 = d / det, -b / det, a / det                      # M^-1
+    l00 = np.sqrt(m00)
+    l10 = m01 / l00
+    l11 = np.sqrt(np.maximum(m11 - l10 * l10, 0.0))
+    Y = (GS.reshape(2 * n, 12) @ V).reshape(n, 2, 12)
+    W0 = l00[:, None] * Y[:, 0] + l10[:, None] * Y[:, 1]            # W = L^T Y
+    W1 = l11[:, None] * Y[:, 1]
+    Wt = np.stack([W0[:, :k], W1[:, :k]], axis=1)                   # (n, 2, k)
+    A = np.diag(s[:k]) - np.swapaxes(Wt, 1, 2) @ Wt
+    lo = np.linalg.eigvalsh(0.5 * (A + np.swapaxes(A, 1, 2)))[:, -1] if k > 1 else A[:, 0, 0].copy()
+    Cw = np.swapaxes(Wt, 1, 2) @ np.stack([W0[:, k:], W1[:, k:]], axis=1)
+    c2 = np.einsum("nij,nij->n", Cw, Cw)
+    half = 0.5 * (lo - s[k])
+    hi = np.minimum(0.5 * (lo + s[k]) + np.sqrt(half * half + c2), s[0])
+    lo = np.minimum(lo, hi)
+    if rtol is not None:
+        _bisect_lambda_max(s, W0, W1, lo, hi, rtol)
+    with np.errstate(divide="ignore"):
+        return np.where(hi > 0, 1.0 / hi, -np.inf), np.where(lo > 0, 1.0 / lo, np.inf)
+
+
+def _bisect_lambda_max(s, W0, W1, lo, hi, rtol: float, max_iter: int = 64) -> None:
+    """Narrow the brackets lo <= lambda_max(diag(s) - W^T W) <= hi in place
+    (W rows W0, W1 (n, 12)) of the candidates that can still have the smallest
+    lambda_max, until each is within ``rtol`` (see :func:`_mineig_bounds`)."""
+    for _ in range(max_iter):
+        act = np.flatnonzero((lo <= hi.min()) & (hi - lo > rtol * np.abs(hi)))
+        if not act.size:
+            return
+        mid = 0.5 * (lo[act] + hi[act])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dinv = 1.0 / (s[None, :] - mid[:, None])
+        w0, w1 = W0[act], W1[act]
+        a = 1.0 - np.einsum("ni,ni->n", w0 * w0, dinv)
+        c = 1.0 - np.einsum("ni,ni->n", w1 * w1, dinv)
+        b = np.einsum("ni,ni->n", w0 * w1, dinv)
+        det = a * c - b * b
+        npos = np.where(det < 0, 1, np.where(a + c > 0, 2, 0))
+        above = (s[None, :] > mid[:, None]).sum(axis=1) + npos - 2 >= 1   # lambda_max > mid
+        ok = np.isfinite(det)
+        lo[act] = np.where(ok & above, mid, lo[act])
+        hi[act] = np.where(ok & ~above, mid, hi[act])
+        if not ok.all():                  # mid on an eigenvalue of Sigma_k: stop there
+            return
 
 
 def _candidate_H(ctx: MetricContext, d0: float, d1: float, d2: float, rho: float) -> np.ndarray:
@@ -821,6 +975,36 @@ class Metric:
         else:
             raise ValueError(f"Metric.batch: path must be 'fast' or 'matrix', got {path!r}")
         return out
+
+    def screen(self, ctx: MetricContext, cand_L, rtol: float | None = None
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """Cheap bounds ``(lo, hi)`` (n,) on the score of each candidate
+        ``cand_L`` (n, 3), for screening many candidates before the explicit
+        path (the batched planner's edge rule): the closed form (svd, gdop,
+        cond; lo = hi), the tangent-plane update (logdet; lo = hi), rigorous
+        bounds without a 12 x 12 eigenproblem per candidate (mineig,
+        :func:`_mineig_bounds`), the 4 x 4 tangent Gram matrix (whitened, when
+        R_meas = sigma^2 I, :func:`_whitened_tangent_setup`), else the fast
+        path. They hold for the explicit path's values up to rounding (tested);
+        the caller adds a tolerance. -inf where invalid (both). ``rtol``:
+        mineig narrows the bounds of the candidates that can be the best to
+        within ``rtol`` relative (the others keep their screening bounds)."""
+        c = _as_cands(cand_L)
+        self._count(c.shape[0])
+        _, _, ok = _valid(ctx, c)
+        lo = np.full(c.shape[0], -np.inf)
+        hi = lo.copy()
+        if ok.any():
+            p = c[ok]
+            tg = _tangent_setup(ctx) if self.name == "mineig" else None
+            wt = _whitened_tangent_setup(ctx) if self.name in WHITENED else None
+            if tg is not None:
+                lo[ok], hi[ok] = _mineig_bounds(ctx, tg, p, rtol)
+            elif wt is not None:
+                lo[ok] = hi[ok] = _whitened_tangent_scores(self.name, ctx, wt, p)
+            else:
+                lo[ok] = hi[ok] = self._batch(_single_stack(ctx), p[None], None)[0]
+        return lo, hi
 
     # ---- minimal-overhead single candidate (golden-section inner loop) ----
     def scalar(self, ctx: MetricContext, p_L) -> float:

@@ -333,6 +333,12 @@ def metric_objective(name: str) -> Callable:
         f.batch = batch
         f.ratio = _ratio_log if name == "logdet" else _ratio_negated
         f.diagnostic = lambda points: -m(ctx, np.asarray(points, float))   # fastest, same values
+
+        def screen(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            lo, hi = m.screen(ctx, np.asarray(points, float), rtol=_SHORTLIST_RTOL / 10)
+            return -hi, -lo                 # bounds on the minimised objective
+
+        f.screen = screen                   # the batched edge rule's screening (plan_batch)
         return f
 
     return build
@@ -881,7 +887,7 @@ def _batch_objective(method, states, G, cfg, camera, funs) -> Callable:
 #: objectives evaluated for many runs at once by :func:`_batch_objective`
 _VECTORISED = ("depth", "svd", "gdop", "cond")
 _SHORTLIST_RTOL = 1e-6      # candidates this close to the closed-form best get the explicit path
-_AGREE_RTOL = 1e-7          # closed form vs explicit path on the shortlist, else all explicit
+_AGREE_RTOL = _SHORTLIST_RTOL / 4   # screened vs explicit path on the shortlist, else all explicit
 
 
 def _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask):
@@ -901,31 +907,44 @@ def _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask):
             out_p.append(pp)
         return out_v, out_p
     if method in H_METRICS:
-        ctx = _Contexts(states, cfg, camera)
-        cf = -ctx.closed_form(method, ie[:, None], pts[None])
-        for q, j in enumerate(ie):
-            pp = np.flatnonzero(candmask[j])
-            v = cf[q, pp]
-            fin = np.isfinite(v)
-            if not fin.any():
-                out_v.append(v)
-                out_p.append(pp)
-                continue
-            fmin = v[fin].min()
-            sl = fin & (v <= fmin + _SHORTLIST_RTOL * abs(fmin))
-            ex = funs[j].batch(pts[pp[sl]])
-            if np.all(np.abs(ex - v[sl]) <= _AGREE_RTOL * np.abs(v[sl])):
-                out_v.append(ex)
-                out_p.append(pp[sl])
-            else:                           # paths disagree: score every candidate explicitly
-                out_v.append(funs[j].batch(pts[pp]))
-                out_p.append(pp)
-        return out_v, out_p
-    for j in ie:
+        cf = -_Contexts(states, cfg, camera).closed_form(method, ie[:, None], pts[None])
+    for q, j in enumerate(ie):
         pp = np.flatnonzero(candmask[j])
-        out_v.append(funs[j].batch(pts[pp]))
-        out_p.append(pp)
+        fun = funs[j]
+        if method in H_METRICS:
+            f_lo = f_hi = cf[q, pp]
+        elif hasattr(fun, "screen"):
+            f_lo, f_hi = fun.screen(pts[pp])
+        else:
+            out_v.append(fun.batch(pts[pp]))
+            out_p.append(pp)
+            continue
+        out_v_q, out_p_q = _screened(fun, pts, pp, f_lo, f_hi)
+        out_v.append(out_v_q)
+        out_p.append(out_p_q)
     return out_v, out_p
+
+
+def _screened(fun, pts, pp, f_lo, f_hi):
+    """The edge rule's explicit scores (``fun.batch``) of the candidates ``pp``
+    that can be the best given screening bounds ``f_lo <= f <= f_hi`` (minimised,
+    every candidate; from :meth:`metrics.Metric.screen` or the closed form):
+    those whose ``f_lo`` is within ``_SHORTLIST_RTOL`` of the smallest ``f_hi``.
+    If an explicit score falls outside its bounds by more than ``_AGREE_RTOL``
+    (a quarter of the shortlist margin, so no candidate left out could be
+    better), every candidate is scored explicitly. Returns (scores, positions)."""
+    fin = np.isfinite(f_lo) | np.isfinite(f_hi)
+    if not fin.any():
+        return np.where(fin, f_hi, np.inf), pp
+    top = np.min(np.where(np.isfinite(f_hi), f_hi, np.inf))
+    if not np.isfinite(top):
+        return fun.batch(pts[pp]), pp
+    sl = np.flatnonzero(fin & (f_lo <= top + _SHORTLIST_RTOL * abs(top)))
+    ex = fun.batch(pts[pp[sl]])
+    tol = _AGREE_RTOL * np.abs(ex)
+    if np.all((ex >= f_lo[sl] - tol) & (ex <= f_hi[sl] + tol)):
+        return ex, pp[sl]
+    return fun.batch(pts[pp]), pp          # paths disagree: score every candidate explicitly
 
 
 def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, detected: np.ndarray,
