@@ -111,3 +111,50 @@ def test_smoothed_covariances_no_larger_and_spd_on_the_approach():
         d = 1 / np.sqrt(np.diagonal(f.Pf, axis1=-2, axis2=-1))
         eig = np.linalg.eigvalsh(diff * d[..., :, None] * d[..., None, :])
         assert eig.min() > -1e-7
+
+
+def _approach_filter(S=4, n=120, seed=3):
+    from opnav.approach import scenario as sc
+    from approach_helpers import approach_cfg
+
+    cfg = approach_cfg()
+    geo = sc.build_geometry(cfg, "roll", n=n)
+    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    win = geo.window(Rvar)
+    z, _ = sc.simulate(geo, Rvar, sc.rad([10, 20, 10]), sc.seed_streams(seed, 1, range(S)))
+    theta = np.random.default_rng(seed).normal(size=(S, 3)) * 1e-4
+    return geo, win, z, theta
+
+
+def test_position_only_smoother_is_the_full_one_bit_for_bit():
+    """The E-step's fast path (position block only, no predicted moments kept) gives exactly
+    the entries of the full Bryson-Frazier moments, and those match the RTS smoother."""
+    geo, win, z, theta = _approach_filter()
+    x0 = np.random.default_rng(0).normal(size=(z.shape[0], 6))
+    f = ekf.run_filter(z, theta, x0, geo.P0, win)
+    lean = ekf.run_filter(z, theta, x0, geo.P0, win, predicted=False)
+    assert lean.xp is None and lean.Pp is None
+    for name in ("xf", "Pf", "loglik", "KH_last", "K", "Sinv", "nu", "Hr"):
+        assert np.array_equal(getattr(f, name), getattr(lean, name)), name
+    full = smoother.bryson_frazier(f, win)
+    pos = smoother.bryson_frazier(lean, win, ekf.POS)
+    assert pos.xs.shape == z.shape and pos.Ps.shape == z.shape + (3,)
+    assert np.array_equal(pos.xs, full.xs[..., :3])
+    assert np.array_equal(pos.Ps, full.Ps[..., :3, :3])
+    r = smoother.rts(f, win)
+    np.testing.assert_allclose(pos.Ps, r.Ps[..., :3, :3], rtol=1e-7, atol=1e-9 * np.abs(r.Ps[..., :3, :3]).max())
+    np.testing.assert_allclose(pos.xs, r.xs[..., :3], rtol=1e-7, atol=1e-7 * np.abs(r.xs[..., :3]).max())
+
+
+def test_prior_propagated_to_several_samples_in_one_pass_equals_separate_passes():
+    geo, win, z, _ = _approach_filter(n=60)
+    x0 = np.random.default_rng(1).normal(size=(z.shape[0], 6))
+    at = [0, 7, 7, 30, 60]
+    xs, Ps = ekf.predict_only(x0, geo.P0, win, at=at)
+    for a, x, P in zip(at, xs, Ps):
+        xa, Pa = ekf.predict_only(x0, geo.P0, win.slice(0, a))
+        assert np.array_equal(x, xa) and np.array_equal(P, Pa)
+    with pytest.raises(ValueError, match="must increase"):
+        ekf.predict_only(x0, geo.P0, win, at=[30, 7])
+    with pytest.raises(ValueError, match="must increase"):
+        ekf.predict_only(x0, geo.P0, win, at=[5, 61])

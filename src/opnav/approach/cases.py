@@ -148,13 +148,20 @@ def start_state(start: str, a: int, f0, dx_true: np.ndarray, dx0: np.ndarray, P_
     prior propagated to ``a`` without data; ``truth``: the true state with the
     filter's ``P_a`` (``reference-start`` diagnostic).
     """
+    return start_states(start, [a], f0, dx_true, dx0, P_X0, win)[0]
+
+
+def start_states(start: str, starts, f0, dx_true: np.ndarray, dx0: np.ndarray, P_X0: np.ndarray,
+                 win) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`start_state` at every window start of ``starts`` (increasing); the prior is
+    propagated once through them all."""
     S = dx0.shape[0]
     if start == "filter":
-        return f0.xf[:, a], f0.Pf[:, a]
+        return [(f0.xf[:, a], f0.Pf[:, a]) for a in starts]
     if start == "truth":
-        return np.broadcast_to(dx_true[a], (S, 6)).copy(), f0.Pf[:, a]
+        return [(np.broadcast_to(dx_true[a], (S, 6)).copy(), f0.Pf[:, a]) for a in starts]
     if start == "prior":
-        return predict_only(dx0, P_X0, win.slice(0, a))
+        return list(zip(*predict_only(dx0, P_X0, win, at=starts)))
     raise ValueError(f"unknown start rule {start!r}")
 
 
@@ -204,8 +211,8 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     seg_theta, it_theta, it_ll, it_data = [], [], [], []
     seg_lat, seg_rng, seg_lat3, seg_rng3 = [], [], [], []
     unobs = None
-    for (a, b) in windows:
-        x0, P0 = start_state(start, a, f0, dx_true, dx0, geo.P0, win)
+    starts = start_states(start, [a for (a, _) in windows], f0, dx_true, dx0, geo.P0, win)
+    for (a, b), (x0, P0) in zip(windows, starts):
         theta_seg_start = theta
         tr = em_window(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), M, method, tz_tol)
         theta = tr.theta[-1]

@@ -94,11 +94,13 @@ def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
 
 
 def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
-               win: Window) -> FilterResult:
+               win: Window, predicted: bool = True) -> FilterResult:
     """EKF over a window for every seed at once (eq. 6): :func:`kalman.predict` and
     :func:`kalman.condition_on` with the position block of ``H``.
 
     z (S, n+1, 3) (index 0 ignored), theta (S, 3) rad, x0 (S, 6), P0 (S, 6, 6) or (6, 6).
+    ``predicted=False``: ``xp, Pp`` are not kept (None; the RTS smoother needs them, the
+    Bryson-Frazier smoother and the E-step do not); every other output is the same.
     """
     S, n = z.shape[0], win.n
     A = misalignment_small(theta)
@@ -106,8 +108,8 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     Au = np.einsum("sij,kj->ski", A, win.u_ref)
     xf = np.empty((S, n + 1, 6))
     Pf = np.empty((S, n + 1, 6, 6))
-    xp = np.zeros((S, n + 1, 6))
-    Pp = np.zeros((S, n + 1, 6, 6))
+    xp = np.zeros((S, n + 1, 6)) if predicted else None
+    Pp = np.zeros((S, n + 1, 6, 6)) if predicted else None
     x = np.array(x0, float)
     P = np.broadcast_to(P0, (S, 6, 6)).copy()
     xf[:, 0], Pf[:, 0] = x, P
@@ -117,7 +119,8 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     dets = np.ones((S, n + 1))
     for k in range(1, n + 1):
         x, P = kalman.predict(x, P, win.Phi[k], win.Q)
-        xp[:, k], Pp[:, k] = x, P
+        if predicted:
+            xp[:, k], Pp[:, k] = x, P
         Hr = Hrs[:, k]
         nu = z[:, k] - Au[:, k] - (Hr @ x[:, :3, None])[..., 0]
         x, P, K, Sinv, det = kalman.condition_on(x, P, Hr, win.Rvar[k], nu, cols=POS)
@@ -131,9 +134,21 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     return FilterResult(xf, Pf, xp, Pp, ll, KH, Ks, Sinvs, nus, Hrs)
 
 
-def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window) -> tuple[np.ndarray, np.ndarray]:
-    """Prior mean and covariance propagated through the window without data."""
+def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window, at=None):
+    """Prior mean and covariance propagated through the window without data.
+
+    ``at``: increasing sample indices; then the moments at each of them, as lists
+    (one pass: the moments at ``at[i]`` are those of the window ``slice(0, at[i])``).
+    """
     x, P = np.array(x0, float), np.array(P0, float)
-    for k in range(1, win.n + 1):
-        x, P = kalman.predict(x, P, win.Phi[k], win.Q)
-    return x, P
+    stops = [win.n] if at is None else [int(a) for a in at]
+    if any(b < a for a, b in zip(stops, stops[1:])) or (stops and not 0 <= stops[0] <= stops[-1] <= win.n):
+        raise ValueError(f"predict_only: sample indices must increase within 0..{win.n}, got {stops}")
+    xs, Ps, done = [], [], 0
+    for stop in stops:
+        for k in range(done + 1, stop + 1):
+            x, P = kalman.predict(x, P, win.Phi[k], win.Q)
+        done = stop
+        xs.append(x)
+        Ps.append(P)
+    return (x, P) if at is None else (xs, Ps)

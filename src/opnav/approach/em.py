@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ekf import FilterResult, Window, run_filter
+from .ekf import POS, FilterResult, Window, run_filter
 from .smoother import SmootherResult, bryson_frazier
 
 EPS = np.zeros((3, 3, 3))
@@ -138,8 +138,8 @@ class EMTrace:
 
 def em_map(theta, z, x0, P0, win, tz_tol):
     """One EM map theta -> theta' (filter, smoother, E-step, M-step) and LL(theta)."""
-    f = run_filter(z, theta, x0, P0, win)
-    s = bryson_frazier(f, win)  # identical to rts() (tested), no 6x6 inverses
+    f = run_filter(z, theta, x0, P0, win, predicted=False)
+    s = bryson_frazier(f, win, POS)  # identical to rts() (tested), no 6x6 inverses; position only
     new, unobs = mstep(estep(z, s, win), theta, tz_tol)
     return new, f.loglik, unobs, f, s
 

@@ -81,7 +81,7 @@ def lag_one_recursive(f: FilterResult, s: SmootherResult, win: Window) -> np.nda
     return out
 
 
-def bryson_frazier(f: FilterResult, win: Window) -> SmootherResult:
+def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> SmootherResult:
     """The same smoothed moments by the modified Bryson-Frazier recursion (fast path).
 
     Backward adjoint recursion that needs no 6x6 inverse (Bierman 1977):
@@ -90,7 +90,9 @@ def bryson_frazier(f: FilterResult, win: Window) -> SmootherResult:
     ``Ct = I - K H``; ``X_{k|N} = X_k - P_k lh_k``, ``P_{k|N} = P_k - P_k Lh_k P_k``.
     Algebraically identical to :func:`rts` (a test checks it); used inside the
     EM iterations. The lag-one covariance is not formed (``Plag`` zeros); use
-    :func:`rts` where it is needed.
+    :func:`rts` where it is needed. ``cols``: only these state components of the
+    smoothed moments (``xs (S, n+1, c)``, ``Ps (S, n+1, c, c)``; the E-step needs the
+    position only); each entry is the one of the full moments, bit for bit.
     """
     S, n1 = f.xf.shape[:2]
     n = n1 - 1
@@ -101,19 +103,22 @@ def bryson_frazier(f: FilterResult, win: Window) -> SmootherResult:
     HtSi = np.swapaxes(f.Hr, -1, -2) @ f.Sinv  # (S,n+1,3,3)
     HSH = HtSi @ f.Hr
     HSnu = (HtSi @ f.nu[..., None])[..., 0]
-    Ct = np.broadcast_to(np.eye(6), (S, n + 1, 6, 6)).copy()
-    Ct[..., :3] -= f.K @ f.Hr
-    CtT = np.swapaxes(Ct, -1, -2)
+    KH = f.K @ f.Hr  # (S,n+1,6,3): the position columns of K H
+    I6 = np.broadcast_to(np.eye(6), (S, 6, 6))
     for k in range(n, 0, -1):
-        Lt = CtT[:, k] @ L @ Ct[:, k]
+        Ct = I6.copy()  # Ct = I - K H of sample k
+        Ct[..., :3] -= KH[:, k]
+        CtT = np.swapaxes(Ct, -1, -2)
+        Lt = CtT @ L @ Ct
         Lt[:, :3, :3] += HSH[:, k]
-        lt = (CtT[:, k] @ lv[..., None])[..., 0]
+        lt = (CtT @ lv[..., None])[..., 0]
         lt[:, :3] -= HSnu[:, k]
         Phi = win.Phi[k]
         L = Phi.T @ Lt @ Phi
         lv = lt @ Phi
         Lh[:, k - 1], lh[:, k - 1] = L, lv
-    xs = f.xf - np.einsum("skij,skj->ski", f.Pf, lh)
-    Ps = f.Pf - f.Pf @ Lh @ f.Pf
+    Pr = f.Pf[..., cols, :]
+    xs = f.xf[..., cols] - np.einsum("skij,skj->ski", Pr, lh)
+    Ps = f.Pf[..., cols, cols] - Pr @ Lh @ f.Pf[..., :, cols]
     Ps = 0.5 * (Ps + np.swapaxes(Ps, -1, -2))
-    return SmootherResult(xs, Ps, np.zeros_like(Ps), np.zeros_like(Ps))
+    return SmootherResult(xs, Ps, np.zeros(Ps.shape), np.zeros(Ps.shape))
