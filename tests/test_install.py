@@ -42,11 +42,12 @@ def installed(tmp_path_factory):
     assert r.returncode == 0, r.stderr
     (wheel,) = wheels.glob("opnav_repro-*.whl")
     venv = tmp / "venv"
-    r = _run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], tmp, env)
+    # no pip inside the venv (ensurepip is most of a venv's cost): this pip installs into it
+    r = _run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", str(venv)], tmp, env)
     assert r.returncode == 0, r.stderr
     bindir = venv / ("Scripts" if os.name == "nt" else "bin")
-    r = _run([str(bindir / "python"), "-m", "pip", "install", "-q", "--no-deps", "--no-index",
-              "--force-reinstall", str(wheel)], tmp, env)
+    r = _run([sys.executable, "-m", "pip", "--python", str(bindir / "python"), "install", "-q",
+              "--no-deps", "--no-index", "--force-reinstall", str(wheel)], tmp, env)
     assert r.returncode == 0, r.stderr
     outside = tmp / "elsewhere"
     outside.mkdir()

@@ -1,28 +1,23 @@
 """Byte-identical rebuilds and reruns that follow changes (dry-run job lists)."""
 
 import hashlib
-import re
-import shutil
-from pathlib import Path
+import os
 
 import matplotlib.pyplot as plt
 import numpy as np
+import pytest
 import yaml
 
-from conftest import run_snakemake
+from conftest import REPO, dry_run_jobs, dry_run_jobs_many, run_snakemake
 from opnav import figures
+from opnav.config import load_config
 
-TARGET = "results/landing/B-T1_initial_state.csv"
+QUICK = ("--configfile", "config/quick.yaml")
+QUICK_TARGET = "results/quick/landing/B-T1_initial_state.csv"
 
 
 def _digest(paths):
     return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in paths}
-
-
-def _planned_rules(workdir: Path, *args: str) -> set[str]:
-    proc = run_snakemake(workdir, "-n", "--cores", "1", *args)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return set(re.findall(r"^rule (\w+):", proc.stdout, flags=re.M))
 
 
 def test_figure_save_is_byte_identical(tmp_path):
@@ -40,35 +35,46 @@ def test_figure_save_is_byte_identical(tmp_path):
     assert b"CreationDate" not in a[0].read_bytes()
 
 
-def test_tables_rebuild_byte_identical(workdir):
-    out = workdir / "results" / "landing"
-    assert run_snakemake(workdir, "--cores", "1", TARGET).returncode == 0
-    first = _digest(sorted(out.glob("B-T*")))
-    shutil.rmtree(workdir / "results")
-    assert run_snakemake(workdir, "--cores", "1", TARGET).returncode == 0
-    assert _digest(sorted(out.glob("B-T*"))) == first
+@pytest.mark.slow
+def test_tables_rebuild_byte_identical(quick_results):
+    """B-T1/B-T2 deleted from the shared quick build and rebuilt: the same bytes.
+    (Their mtimes are put back, so the later tests on that build see it as it was.)"""
+    out = quick_results / "results" / "quick" / "landing"
+    files = sorted(f for t in ("B-T1_*", "B-T2_*") for f in out.glob(t))
+    first, mtimes = _digest(files), {f: f.stat().st_mtime_ns for f in files}
+    assert len(first) == 6, first                  # two tables, three formats each
+    for f in files:
+        f.unlink()
+    proc = run_snakemake(quick_results, "--cores", "1", QUICK_TARGET, *QUICK)
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
+    assert _digest(files) == first
+    for f, ns in mtimes.items():
+        os.utime(f, ns=(ns, ns))
 
 
-def test_reruns_follow_params_and_modules(workdir):
-    assert run_snakemake(workdir, "--cores", "1", TARGET).returncode == 0
-    assert _planned_rules(workdir, TARGET) == set()
-
-    # a parameter the rule uses -> it reruns
-    cfg_path = workdir / "config" / "config.yaml"
-    original = cfg_path.read_text()
-    cfg = yaml.safe_load(original)
-    cfg["landing"]["mc"]["bounds"]["r_m"] = 500.0
-    cfg_path.write_text(yaml.safe_dump(cfg))
-    assert _planned_rules(workdir, TARGET) == {"landing_tables"}
-
-    # a parameter it does not use -> nothing reruns
-    cfg = yaml.safe_load(original)
-    cfg["approach"]["base_seed"] = cfg["approach"]["base_seed"] + 1
-    cfg_path.write_text(yaml.safe_dump(cfg))
-    assert _planned_rules(workdir, TARGET) == set()
+@pytest.mark.slow
+def test_reruns_follow_params_and_modules(quick_results):
+    """On the shared quick build, B-T1's dry-run job list after an edit: a parameter
+    landing_tables uses reruns it, one it does not use reruns nothing, and so does an
+    edit of a module it depends on (restored afterwards, mtime included)."""
+    base_seed = load_config(overlays=[REPO / "config" / "quick.yaml"])["approach"]["base_seed"]
+    overlays = {"nothing": {}, "used": {"landing": {"mc": {"bounds": {"r_m": 500.0}}}},
+                "unused": {"approach": {"base_seed": base_seed + 1}}}
+    args = []
+    for name, overlay in overlays.items():
+        path = quick_results / f"rerun-{name}.yaml"
+        path.write_text(yaml.safe_dump(overlay))
+        args.append((QUICK_TARGET, *QUICK, str(path)))
+    planned = {name: {r for r, _ in jobs} for name, jobs in
+               zip(overlays, dry_run_jobs_many(quick_results, args))}
+    assert planned == {"nothing": set(), "used": {"landing_tables"}, "unused": set()}
 
     # a module the rule uses -> it reruns
-    cfg_path.write_text(original)
-    mod = workdir / "src" / "opnav" / "landing" / "scenario.py"
-    mod.write_text(mod.read_text() + "\n# edited\n")
-    assert _planned_rules(workdir, TARGET) == {"landing_tables"}
+    mod = quick_results / "src" / "opnav" / "landing" / "scenario.py"
+    text, st = mod.read_text(), mod.stat()
+    try:
+        mod.write_text(text + "\n# edited\n")
+        assert {r for r, _ in dry_run_jobs(quick_results, QUICK_TARGET, *QUICK)} == {"landing_tables"}
+    finally:
+        mod.write_text(text)
+        os.utime(mod, ns=(st.st_atime_ns, st.st_mtime_ns))

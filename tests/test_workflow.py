@@ -7,7 +7,7 @@ import pytest
 import yaml
 
 from conftest import REPO, run_snakemake
-from opnav.config import load_config
+from opnav.config import ConfigError, load_config, validate_config
 
 
 def _write_bad(workdir: Path, mutations, name: str) -> Path:
@@ -28,28 +28,34 @@ BAD_CONFIGS = [  # (mutation, key the refusal names, text of that key's line)
 ]
 
 
-def _one_run_per_key(cases):
-    """Cases packed into runs, no two in a run on one key: the refusal lists every
-    problem of a config, one line each, so a run checks several cases."""
-    runs: list[list] = []
-    for case in cases:
-        run = next((r for r in runs if case[1] not in {c[1] for c in r}), None)
-        run.append(case) if run is not None else runs.append([case])
-    return runs
-
-
-@pytest.mark.parametrize("cases", _one_run_per_key(BAD_CONFIGS),
-                         ids=lambda cases: "+".join(key for _, key, _ in cases))
-def test_bad_config_is_refused_naming_the_key(workdir, cases):
-    bad = _write_bad(workdir, [m for m, _, _ in cases], "bad.yaml")
-    proc = run_snakemake(workdir, "-n", "--cores", "1", "--configfile", str(bad))
-    out = proc.stdout + proc.stderr
-    assert proc.returncode != 0
-    lines = out.splitlines()
+def _refusal_lines_name(lines: list[str], cases, out: str) -> None:
     for _, key, fragment in cases:
         named = [line for line in lines if f"invalid config key '{key}'" in line]
         assert named, out[-2000:]
         assert any(fragment in line for line in named), (key, fragment, named)
+
+
+@pytest.mark.parametrize("case", BAD_CONFIGS, ids=lambda c: f"{c[1]}:{c[2]}")
+def test_bad_config_is_refused_naming_the_key(case):
+    """Each case, in process: the function the Snakefile calls before any job
+    (common.smk) refuses it with a line naming the key."""
+    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"])
+    case[0](cfg)
+    with pytest.raises(ConfigError) as err:
+        validate_config(cfg, root=REPO)
+    _refusal_lines_name(str(err.value).splitlines(), [case], str(err.value))
+
+
+def test_snakemake_refuses_a_bad_config_listing_every_problem(workdir):
+    """End to end: `snakemake -n` with a config holding one bad value per key
+    fails, one line per problem, each naming its key."""
+    cases = [c for i, c in enumerate(BAD_CONFIGS) if c[1] not in {d[1] for d in BAD_CONFIGS[:i]}]
+    assert len(cases) >= 4
+    bad = _write_bad(workdir, [m for m, _, _ in cases], "bad.yaml")
+    proc = run_snakemake(workdir, "-n", "--cores", "1", "--configfile", str(bad))
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0
+    _refusal_lines_name(out.splitlines(), cases, out)
 
 
 @pytest.mark.parametrize("configfile", ["config/config.yaml", "config/quick.yaml"])
