@@ -339,6 +339,7 @@ def metric_objective(name: str) -> Callable:
             return -hi, -lo                 # bounds on the minimised objective
 
         f.screen = screen                   # the batched edge rule's screening (plan_batch)
+        f.ctx, f.ground = ctx, ground       # for plan_batch's searches across runs
         return f
 
     return build
@@ -881,7 +882,29 @@ def _batch_objective(method, states, G, cfg, camera, funs) -> Callable:
             return out
 
         return f
+    if method in metrics.METRIC_NAMES and cfg.eval_path == "matrix_scalar":
+        return _matrix_batch_objective(_metric(method), funs)
     return lambda i, beta: np.array([funs[j](float(x)) for j, x in zip(i, beta)])
+
+
+def _matrix_batch_objective(m: metrics.Metric, funs) -> Callable:
+    """``f(runs, beta)`` of the per-call objective with ``eval_path =
+    matrix_scalar`` for many runs at once, with its bits: each run's ground
+    point by its own ``ground_point_scalar``, then ``Metric.batch(...,
+    path="matrix")`` (H of eq. 14-18 for all pairs at once, the per-pair LAPACK
+    of ``matrix_scalar``; tested bit-equal), so flat objectives (mineig's
+    plateau, decided by rounding) search alike."""
+
+    def f(i, beta):
+        out = np.full(len(i), math.inf)
+        pts = [funs[j].ground(x) for j, x in zip(i.tolist(), beta.tolist())]
+        k = [q for q, p in enumerate(pts) if p is not None]
+        if k:
+            st = metrics.stack_contexts([funs[int(i[q])].ctx for q in k])
+            out[k] = -m.batch(st, np.array([pts[q] for q in k])[:, None, :], path="matrix")[:, 0]
+        return out
+
+    return f
 
 
 #: objectives evaluated for many runs at once by :func:`_batch_objective`
