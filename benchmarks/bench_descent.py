@@ -15,9 +15,15 @@ default batch size over the same at batch size 1 (all cells pooled).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
+
+# one BLAS thread, as the workflow's jobs run (Snakemake sets OPENBLAS_NUM_THREADS to a job's
+# threads): OpenBLAS's own threads on a shared 2-core machine cost up to ~80x on the planner's
+# small batched GEMMs (measured); set before numpy is imported
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 

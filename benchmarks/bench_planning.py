@@ -24,7 +24,13 @@ Last line: ``depth overhead ratio: X`` (the largest scenario's median ratio).
 """
 
 import argparse
+import os
 import time
+
+# one BLAS thread, as the workflow's jobs run (Snakemake sets OPENBLAS_NUM_THREADS to a job's
+# threads): OpenBLAS's own threads on a shared 2-core machine cost up to ~80x on the planner's
+# small batched GEMMs (measured); set before numpy is imported
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
