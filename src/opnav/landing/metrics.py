@@ -130,6 +130,15 @@ with n > 1 it builds all H in numpy and applies batched LAPACK.
 ``metric.reference`` calls the compiled CasADi Function once per candidate
 (slow, obvious); ``metric.casadi_map`` uses ``Function.map(n)``.
 
+Screening (the batched planner's edge rule, which scores every detected
+landmark): ``metric.screen(ctx, cand_L, rtol=None) -> (lo, hi)`` bounds the
+explicit path's score of each candidate cheaply (logdet: the tangent update;
+mineig: Rayleigh-Ritz bounds on lambda_max of the posterior covariance, with
+``rtol`` narrowed by bisection on its inertia for the candidates that can be
+the best; whitened: the 4 x 4 tangent Gram matrix; H baselines: the closed
+form), so that only a short list needs the explicit path (tested: the bounds
+hold the explicit score on random contexts).
+
 Batch over planning contexts (runs): ``metric.batch(stack_contexts(ctxs),
 cand_L (R, n, 3), mask (R, n) or None) -> (R, n)`` scores n candidates for each
 of R contexts in one vectorised call (the batched descent's call; ragged

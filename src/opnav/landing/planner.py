@@ -629,10 +629,14 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
     The golden-section searches of all runs and sub-intervals run in lockstep
     (:func:`golden_section_batch`); the depth objective and the paper's H
     baselines are evaluated for all runs at once (other objectives run by run);
-    the edge rule of the H baselines scores every detected landmark by the
-    closed-form singular values and evaluates the explicit path only on those
-    within 1e-6 of the best (the paths agree to ~1e-9 relative, checked on
-    that shortlist; else all are evaluated), which gives the same pick."""
+    the B-X1 metrics' searches evaluate the per-call path for all runs at
+    once with its bits (:func:`_matrix_batch_objective`). The edge rule of
+    every metric screens every detected landmark cheaply (the closed-form
+    singular values for the H baselines, ``Metric.screen`` bounds for the
+    others) and evaluates the explicit path only on those that can be within
+    1e-6 of the best (the explicit scores are checked against their bounds on
+    that shortlist; else all are evaluated, :func:`_screened`), which gives
+    the same pick."""
     exclude = np.asarray(exclude, np.int64)
     m = exclude.size
     rngs = [None] * m if rngs is None else list(rngs)
