@@ -90,6 +90,9 @@ rule landing_mc_chunk:
         # the pick-ratio diagnostic scores every detected landmark once more per planning
         # call (half an information metric's descent); only B-T3 (landing.mc.methods) shows it
         pick_ratio=lambda wc: wc.bmethod in B_METHODS,
+    # the longest jobs, and the timing replay waits for them: started first, so
+    # that no core idles at the end of a run (speed only)
+    priority: 10
     log:
         f"{LANDING}/logs/mc_{{bscn}}_{{bmethod}}_chunk{{bchunk}}.log",
     benchmark:
