@@ -35,10 +35,10 @@ def costs(root: Path) -> list[tuple[str, float, float]]:
 
 def family(path: str) -> str:
     """A group name for a log: its part's folder and the stem's first word (``mc``,
-    ``runs``, ...); a study's ``<name>_table`` / ``<name>_figure`` logs group by that suffix."""
+    ``runs``, ...); a study's ``<name>_outputs`` (once ``_table`` / ``_figure``) logs group by that suffix."""
     p = Path(path)
     words = p.stem.split("_")
-    head = words[-1] if words[-1] in ("table", "figure") and len(words) > 1 else words[0]
+    head = words[-1] if words[-1] in ("table", "figure", "outputs") and len(words) > 1 else words[0]
     return f"{p.parent.parent.name or '.'}/{head}"
 
 

@@ -59,13 +59,13 @@ def test_editing_one_key_reruns_only_its_users(edits, edit, only):
 
 @pytest.mark.parametrize("study", ["fov", "ifov"])
 def test_editing_one_study_lists_only_its_new_value(quick_results, edits, study):
-    """Only the new value's runs are flown; only that study's table and figure are redone."""
+    """Only the new value's runs are flown; only that study's outputs job (table and figure) is redone."""
     jobs = edits[f"study_{study}"]
     sims = [(r, w) for r, w in jobs if r not in AGGREGATORS]
     runs = [w for r, w in sims if r == "study_runs"]
     assert runs, sims
     assert len({w["sdigest"] for w in runs}) == 1           # one new simulation config
-    assert {r for r, _ in sims} == {"study_runs", f"study_{study}_table", f"study_{study}_figure"}, sims
+    assert {r for r, _ in sims} == {"study_runs", f"study_{study}_outputs"}, sims
     cfg = yaml.safe_load((quick_results / "config" / "quick.yaml").read_text())["studies"][study]
     per_value = len(range(0, cfg["runs"], cfg.get("runs_per_job", 25)))
     paper = "approach" if study == "ifov" else "landing"
@@ -76,7 +76,7 @@ def test_editing_one_study_lists_only_its_new_value(quick_results, edits, study)
 def test_a_new_study_in_an_overlay_lists_only_its_jobs(edits):
     jobs = edits["new_study"]
     rules = {r for r, _ in jobs} - AGGREGATORS
-    assert rules == {"study_runs", "study_accel_table", "study_accel_figure"}
+    assert rules == {"study_runs", "study_accel_outputs"}
     runs = [w for r, w in jobs if r == "study_runs"]
     # 5.0e-4 is the configured value: the main-value simulation the fov/obs studies already
     # flew (both methods): one job, the new value's

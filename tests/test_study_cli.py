@@ -35,7 +35,7 @@ def test_opnav_study_runs_only_that_study(workdir):
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
     listed = {line.split()[-1].rstrip(":") for line in proc.stdout.splitlines()
               if line.startswith(("rule ", "localrule "))}
-    assert listed == {"study_runs", f"study_{name}_table", f"study_{name}_figure", f"study_{name}"}, listed
+    assert listed == {"study_runs", f"study_{name}_outputs", f"study_{name}"}, listed
     n_values = len(next(iter(spec["vary"].values())))
     assert proc.stdout.count("rule study_runs:") == n_values       # one job per value, every method
     out = json.loads(proc.stdout.strip().splitlines()[-1])

@@ -1,5 +1,5 @@
 # Parameter studies (opnav.studies): config section `studies`, one YAML block each.
-#   snakemake --cores 2 study_<name>                       one study (table + figure)
+#   snakemake --cores 2 study_<name>                       one study (table + figure, one job)
 #   snakemake --cores 2 studies                            every study
 # Included after the paper rules: each paper's simulation view (B_SIM; paper A's
 # scenario + EM + augmented-EKF keys) is what a swept value may change. A study
@@ -55,46 +55,34 @@ for _name, _s in STUDIES.items():
     _cap = _studies.caption(_s.spec())
     _files = _study_runs(_s)
 
+    # The table and the figure are one job (the figure is drawn from the table it
+    # has just written, read back as the figure alone would read it): one start-up
+    # of Python, pandas and matplotlib per study instead of two.
     rule:
         name:
-            f"study_{_name}_table"
+            f"study_{_name}_outputs"
         input:
             runs=[f for f, _ in _files],
-            code=src("studies.py", "landing/study.py", "tables.py"),
+            code=src("studies.py", "landing/study.py", "tables.py", "study_plots.py", "figures.py",
+                     "opnav.mplstyle"),
         output:
             table=[report(f"{_stem}.csv", caption=_caption("study"), category="Studies",
                           subcategory=_name), f"{_stem}.tex", f"{_stem}.md"],
             runs=f"{_dir}/runs.csv",
             caption=f"{_dir}/{_s.id}.rst",
             slopes=table_outputs(f"{_stem}_slopes") if _s.slopes else [],
+            fig=[f"{_stem}.pdf", report(f"{_stem}.png", caption=_caption("study"), category="Studies",
+                                        subcategory=_name)],
         params:
             study=_spec,
             labels=[lab for _, lab in _files],
             caption=_cap,
             converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
         log:
-            f"{STUDIES_DIR}/logs/{_name}_table.log",
+            f"{STUDIES_DIR}/logs/{_name}_outputs.log",
         localrule: True
         script:
-            "../scripts/study_table.py"
-
-    rule:
-        name:
-            f"study_{_name}_figure"
-        input:
-            table=f"{_stem}.csv",
-            code=src("study_plots.py", "studies.py", "figures.py", "opnav.mplstyle"),
-        output:
-            fig=[f"{_stem}.pdf", report(f"{_stem}.png", caption=_caption("study"), category="Studies",
-                                        subcategory=_name)],
-        params:
-            study=_spec,
-            caption=_cap,
-        log:
-            f"{STUDIES_DIR}/logs/{_name}_figure.log",
-        localrule: True
-        script:
-            "../scripts/study_figure.py"
+            "../scripts/study_outputs.py"
 
     STUDY_TARGETS[_name] = [*table_outputs(_stem), *(table_outputs(f"{_stem}_slopes") if _s.slopes else []),
                             f"{_dir}/runs.csv", f"{_dir}/{_s.id}.rst", *figure_outputs(_stem)]

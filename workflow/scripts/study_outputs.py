@@ -1,17 +1,19 @@
-"""A parameter study's tables: every run (tidy), the summary (tidy: one row per value,
-method and metric) and its page view, the log-log slopes if asked, and the generated
-caption (opnav.studies)."""
+"""A parameter study's outputs: its tables (every run, tidy; the summary, tidy: one row
+per value, method and metric, and its page view; the log-log slopes if asked), the
+generated caption (opnav.studies), and its figure: each metric against the swept value,
+one line per method, drawn from the summary table as written."""
 
 import sys
 
 import pandas as pd
 
-from opnav import studies
+from opnav import figures, studies
 from opnav.snakeio import mock_snakemake, script_context
+from opnav.study_plots import fig_study
 from opnav.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
-    snakemake = mock_snakemake("study_fov_table", argv=sys.argv[1:])
+    snakemake = mock_snakemake("study_fov_outputs", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     study = snakemake.params.study
@@ -27,3 +29,7 @@ with script_context(snakemake) as log:
                     caption=f"{study['id']} {study['name']}: log-log slopes against {study['keys'][0]}.")
     atomic_write_text(snakemake.output.caption, cap + "\n")
     log.info("study %s: %d runs, %d summary rows", study["name"], len(runs), len(tidy))
+    # the figure reads the summary back from its CSV, as a user of the table would
+    shown = pd.read_csv(snakemake.output.table[0], keep_default_na=False, na_values=[""])
+    figures.save(fig_study(shown, study), snakemake.output.fig)
+    log.info("study %s figure", study["name"])
