@@ -294,16 +294,22 @@ def _metric(name: str) -> metrics.Metric:
     return _METRIC_CACHE[name]
 
 
+def _metric_context(state: PlanState, cfg: PlannerConfig, camera: Camera,
+                    sigma_b: float) -> metrics.MetricContext:
+    """The metrics' context of a planning state (bearing noise sigma_b^2 I, rad^2);
+    inputs validated once per descent (descent.run_descent), not per call."""
+    return metrics.MetricContext.trusted(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
+                                         p_known_L=np.asarray(cfg.p_known, float), P=state.P,
+                                         R_meas=(sigma_b**2) * _EYE6, boresight_B=camera.boresight_B)
+
+
 def metric_objective(name: str) -> Callable:
     """Factory: the negated metric ``name`` at the ground point of beta."""
 
     def build(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, camera: Camera,
               sigma_b: float, **_) -> Callable:
         m = _metric(name)
-        # inputs validated once per descent (descent.run_descent), not per call
-        ctx = metrics.MetricContext.trusted(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
-                                    p_known_L=np.asarray(cfg.p_known, float), P=state.P,
-                                    R_meas=(sigma_b**2) * _EYE6, boresight_B=camera.boresight_B)
+        ctx = _metric_context(state, cfg, camera, sigma_b)
         ground = ground_point_scalar(geom)
         path = cfg.eval_path
         # batch scoring of landmarks (edge rule): the same computation as the search's
@@ -635,7 +641,7 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
     singular values for the H baselines, ``Metric.screen`` bounds for the
     others) and evaluates the explicit path only on those that can be within
     1e-6 of the best (the explicit scores are checked against their bounds on
-    that shortlist; else all are evaluated, :func:`_screened`), which gives
+    that shortlist; else all are evaluated, :func:`_shortlist`), which gives
     the same pick."""
     exclude = np.asarray(exclude, np.int64)
     m = exclude.size
@@ -768,6 +774,13 @@ class _LazyObjectives:
             self._funs[j] = self._build(state=self._state_of(j), geom=geom, cfg=self._cfg,
                                         camera=self._camera, sigma_b=self._camera.sigma_b)
         return self._funs[j]
+
+    def ctx(self, j) -> metrics.MetricContext:
+        """Run ``j``'s metric context (its objective's, if built)."""
+        j = int(j)
+        if j in self._funs:
+            return self._funs[j].ctx
+        return _metric_context(self._state_of(j), self._cfg, self._camera, self._camera.sigma_b)
 
     def ratio(self, j):
         """The method's pick-ratio rule (the same for every run)."""
@@ -935,43 +948,59 @@ def _edge_scores(method, ie, states, G, cfg, camera, funs, pts, candmask):
         return out_v, out_p
     if method in H_METRICS:
         cf = -_Contexts(states, cfg, camera).closed_form(method, ie[:, None], pts[None])
+    m = _metric(method) if method in metrics.METRIC_NAMES else None
+    out_v, out_p = [None] * len(ie), [None] * len(ie)
+    single = []                # runs whose short list is one candidate (matrix path, below)
     for q, j in enumerate(ie):
         pp = np.flatnonzero(candmask[j])
-        fun = funs[j]
-        if method in H_METRICS:
-            f_lo = f_hi = cf[q, pp]
-        elif hasattr(fun, "screen"):
-            f_lo, f_hi = fun.screen(pts[pp])
-        else:
-            out_v.append(fun.batch(pts[pp]))
-            out_p.append(pp)
+        if m is None:          # no screening for this objective: every candidate explicitly
+            out_v[q], out_p[q] = funs[j].batch(pts[pp]), pp
             continue
-        out_v_q, out_p_q = _screened(fun, pts, pp, f_lo, f_hi)
-        out_v.append(out_v_q)
-        out_p.append(out_p_q)
+        f_lo, f_hi = (cf[q, pp], cf[q, pp]) if method in H_METRICS else funs[j].screen(pts[pp])
+        sl = _shortlist(f_lo, f_hi)
+        if sl is None:
+            out_v[q], out_p[q] = funs[j].batch(pts[pp]), pp
+        elif not sl.size:      # no valid candidate
+            out_v[q], out_p[q] = np.full(pp.size, np.inf), pp
+        elif sl.size == 1 and cfg.eval_path == "matrix_scalar":
+            single.append((q, j, pp, f_lo[sl], f_hi[sl], sl))
+        else:
+            ex = funs[j].batch(pts[pp[sl]])
+            out_v[q], out_p[q] = ((ex, pp[sl]) if _agree(ex, f_lo[sl], f_hi[sl])
+                                  else (funs[j].batch(pts[pp]), pp))
+    if single:
+        # the explicit path (matrix_scalar, what fun.batch gives one candidate) of all
+        # these runs' candidate at once: Metric.batch path="matrix", the same bits
+        st = metrics.stack_contexts([funs.ctx(j) for _, j, *_ in single])
+        cand = np.array([pts[pp[sl[0]]] for _, _, pp, _, _, sl in single])[:, None, :]
+        ex = -m.batch(st, cand, path="matrix")[:, 0]
+        for (q, j, pp, lo, hi, sl), e in zip(single, ex):
+            e = np.array([e])
+            out_v[q], out_p[q] = (e, pp[sl]) if _agree(e, lo, hi) else (funs[j].batch(pts[pp]), pp)
     return out_v, out_p
 
 
-def _screened(fun, pts, pp, f_lo, f_hi):
-    """The edge rule's explicit scores (``fun.batch``) of the candidates ``pp``
-    that can be the best given screening bounds ``f_lo <= f <= f_hi`` (minimised,
-    every candidate; from :meth:`metrics.Metric.screen` or the closed form):
-    those whose ``f_lo`` is within ``_SHORTLIST_RTOL`` of the smallest ``f_hi``.
-    If an explicit score falls outside its bounds by more than ``_AGREE_RTOL``
-    (a quarter of the shortlist margin, so no candidate left out could be
-    better), every candidate is scored explicitly. Returns (scores, positions)."""
+def _shortlist(f_lo, f_hi):
+    """The edge rule's short list given screening bounds ``f_lo <= f <= f_hi``
+    (minimised, every candidate; from :meth:`metrics.Metric.screen` or the
+    closed form): the positions whose ``f_lo`` is within ``_SHORTLIST_RTOL``
+    of the smallest ``f_hi`` (empty: no valid candidate; None: no finite upper
+    bound, score every candidate)."""
     fin = np.isfinite(f_lo) | np.isfinite(f_hi)
     if not fin.any():
-        return np.where(fin, f_hi, np.inf), pp
+        return np.zeros(0, np.int64)
     top = np.min(np.where(np.isfinite(f_hi), f_hi, np.inf))
     if not np.isfinite(top):
-        return fun.batch(pts[pp]), pp
-    sl = np.flatnonzero(fin & (f_lo <= top + _SHORTLIST_RTOL * abs(top)))
-    ex = fun.batch(pts[pp[sl]])
+        return None
+    return np.flatnonzero(fin & (f_lo <= top + _SHORTLIST_RTOL * abs(top)))
+
+
+def _agree(ex, f_lo, f_hi) -> bool:
+    """Explicit scores within their screening bounds to ``_AGREE_RTOL`` (a
+    quarter of the short-list margin, so no candidate left out could be
+    better); else the caller scores every candidate explicitly."""
     tol = _AGREE_RTOL * np.abs(ex)
-    if np.all((ex >= f_lo[sl] - tol) & (ex <= f_hi[sl] + tol)):
-        return ex, pp[sl]
-    return fun.batch(pts[pp]), pp          # paths disagree: score every candidate explicitly
+    return bool(np.all((ex >= f_lo - tol) & (ex <= f_hi + tol)))
 
 
 def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, detected: np.ndarray,
