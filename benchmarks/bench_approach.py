@@ -1,28 +1,70 @@
 """Paper-A benchmark (printed figures, not a timed test).
 
-    python benchmarks/bench_approach.py            # EM iteration timings
-    python benchmarks/bench_approach.py --workflow # also the whole part-A workflow, full profile
+    python benchmarks/bench_approach.py                       # EM iteration timings
+    python benchmarks/bench_approach.py --before 870b400      # jobs: CPU-s before/after + equality
+    python benchmarks/bench_approach.py --before 870b400 --quick --mc all --x2 roll literal
+    python benchmarks/bench_approach.py --workflow            # also the whole part-A workflow
 
-Reports the wall time of one EM iteration (EKF + smoother + E/M step) on a
-250-sample segment for a batch of seeds, per seed count, and optionally the
-wall time of `snakemake --cores 2` for every part-A output from an empty
-results directory (in a temporary copy of the workflow).
+``--before REV``: every job named by ``--mc`` (``variant:group:scheme``, or ``all`` for
+every Monte-Carlo job of the profile) and ``--x2`` (variants) runs in its own process,
+once with the package of git revision ``REV`` (``git archive``) and once with this
+checkout's, one after the other, as the workflow's jobs would (one process each; an
+A-X2 variant is one job now, its case groups were one job each before). It prints
+the CPU seconds of each, of the job's work (after the imports; children included:
+the JIT compiler) and of its whole process (start-up and imports included), their
+ratios, and the largest relative difference between the two results (run-time
+fields aside), which must be 0 or round-off.
+
+Without ``--before``: the CPU time of one EM iteration (EKF + smoother + E/M step)
+on a 250-sample segment per seed count, and with ``--workflow`` the wall time of
+``snakemake --cores 2`` for every part-A output from an empty results directory
+(in a temporary copy of the workflow).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import pickle
+import resource
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
+from io import BytesIO
 from pathlib import Path
 
 import numpy as np
 
-from opnav.snakeio import copy_workflow
-
 REPO = Path(__file__).resolve().parents[1]
+
+# one job, run in a fresh interpreter: argv = kind spec quick out.pkl; prints {"cpu_s": ...}
+_JOB = r"""
+import json, os, pickle, sys, time
+kind, spec, quick, out = sys.argv[1:5]
+from opnav.config import load_config
+from opnav.approach.setup import Setup
+cfg = load_config(overlays=["config/quick.yaml"] if quick == "1" else [])["approach"]
+setup = Setup.from_config(cfg)
+t0 = os.times()
+if kind == "mc":
+    from opnav.approach.pipeline import run_group
+    v, g, m = spec.split(":")
+    mode, _, meth = m.rpartition("-")
+    res = run_group(setup, v, g, meth, mode or "sliding")
+else:
+    from opnav.approach import alternatives as alt, scenario as sc
+    v, g = spec.split(":")
+    res = alt.run_group_alternatives(setup, v, g, geo=sc.build_geometry(setup, v))
+t1 = os.times()
+cpu = (t1.user - t0.user) + (t1.system - t0.system) + (t1.children_user - t0.children_user) \
+    + (t1.children_system - t0.children_system)
+with open(out, "wb") as fh:
+    pickle.dump(res, fh)
+print(json.dumps({"cpu_s": cpu}))
+"""
 
 
 def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int = 5) -> list[dict]:
@@ -41,9 +83,9 @@ def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int =
         em.em_map(theta, z, x0, geo.P0, win, 1e-6)  # warm-up
         t = []
         for _ in range(repeats):
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             em.em_map(theta, z, x0, geo.P0, win, 1e-6)
-            t.append(time.perf_counter() - t0)
+            t.append(time.process_time() - t0)
         best = min(t)
         rows.append({"seeds": S, "samples": n_samples, "em_iteration_s": best,
                      "per_seed_ms": 1e3 * best / S})
@@ -51,6 +93,8 @@ def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int =
 
 
 def workflow_timing(configfile: str | None = None) -> float:
+    from opnav.snakeio import copy_workflow
+
     with tempfile.TemporaryDirectory() as d:
         dst = copy_workflow(REPO, Path(d))
         targets = ["results/approach/A-T1_table1.csv", "results/approach/A-X1_crlb.pdf"] + [
@@ -63,12 +107,131 @@ def workflow_timing(configfile: str | None = None) -> float:
         return time.perf_counter() - t0
 
 
+def _export_src(rev: str, dest: Path) -> Path:
+    """The package (src/) of git revision ``rev`` under ``dest``."""
+    blob = subprocess.run(["git", "-C", str(REPO), "archive", rev, "src"], check=True, capture_output=True).stdout
+    with tarfile.open(fileobj=BytesIO(blob)) as tf:
+        tf.extractall(dest, filter="data")
+    return dest / "src"
+
+
+def _run_job(src: Path, kind: str, spec: str, quick: bool, out: Path) -> tuple[float, float]:
+    """CPU seconds of the job's work and of its whole process (start-up and imports included)."""
+    env = dict(os.environ, PYTHONPATH=str(src))
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.run([sys.executable, "-c", _JOB, kind, spec, "1" if quick else "0", str(out)],
+                       cwd=REPO, env=env, check=True, capture_output=True, text=True)
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    whole = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    return json.loads(p.stdout.strip().splitlines()[-1])["cpu_s"], whole
+
+
+def _strip(x):
+    """Results without their wall-clock fields (run times differ from run to run)."""
+    if isinstance(x, dict):
+        return {k: _strip(v) for k, v in x.items() if not (k.startswith("runtime") or k == "em_times")}
+    if isinstance(x, (list, tuple)):
+        return [_strip(v) for v in x]
+    return x
+
+
+def max_rel_diff(a, b, path: str = "") -> tuple[float, str]:
+    """Largest relative difference between two result structures (nested dicts/lists of arrays):
+    ``|a - b| / max(|a|, |b|)`` per entry (0 where both are 0); booleans, integers, strings
+    and NaN positions must match exactly (else ``inf``)."""
+    import dataclasses
+
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        return (0.0, path) if a == b else (float("inf"), path)
+    if isinstance(a, dict):
+        if set(a) != set(b):
+            return float("inf"), f"{path}: keys differ"
+        return max((max_rel_diff(a[k], b[k], f"{path}.{k}") for k in a), default=(0.0, path))
+    if isinstance(a, (list, tuple)) and not (a and np.isscalar(a[0])):
+        if len(a) != len(b):
+            return float("inf"), f"{path}: lengths differ"
+        return max((max_rel_diff(x, y, f"{path}[{i}]") for i, (x, y) in enumerate(zip(a, b))), default=(0.0, path))
+    x, y = np.asarray(a), np.asarray(b)
+    if x.shape != y.shape:
+        return float("inf"), f"{path}: shapes differ"
+    if x.dtype.kind not in "fc":
+        return (0.0, path) if np.array_equal(x, y) else (float("inf"), path)
+    if not np.array_equal(np.isnan(x), np.isnan(y)):
+        return float("inf"), f"{path}: NaN positions differ"
+    ok = ~np.isnan(x)
+    d = np.abs(x - y)[ok]
+    s = np.maximum(np.abs(x), np.abs(y))[ok]
+    r = np.where(s > 0, d / np.where(s > 0, s, 1.0), 0.0)
+    return (float(r.max()) if r.size else 0.0), path
+
+
+def mc_specs(quick: bool) -> list[str]:
+    from opnav.approach.pipeline import groups_for
+    from opnav.approach.setup import Setup
+    from opnav.config import load_config
+
+    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if quick else [])["approach"]
+    setup = Setup.from_config(cfg)
+    schemes = list(cfg["methods"]) + [f"growing-{m}" for m in cfg["growing"]["methods"]]
+    return [f"{v}:{g}:{m}" for v in cfg["variants"] for g in groups_for(setup, v) for m in schemes]
+
+
+def compare_revisions(rev: str, mc: list[str], x2: list[str], quick: bool, x2_groups_before: list[str]) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        d = Path(d)
+        old_src, new_src = _export_src(rev, d / "before"), REPO / "src"
+        print(f"CPU-s per job (process + children), before = {rev}, after = this checkout; "
+              f"profile {'quick' if quick else 'full'}")
+        print(f"{'job':42s} {'work before':>11s} {'after':>7s} {'ratio':>6s} {'process before':>14s} "
+              f"{'after':>7s} {'ratio':>6s} {'max rel diff':>12s}")
+        totals = {}
+        jobs = [("mc", s, [s], s) for s in mc] + [("x2", v, [f"{v}:{g}" for g in x2_groups_before], f"{v}:all")
+                                                   for v in x2]
+        for kind, name, before_specs, after_spec in jobs:
+            wb = pb = 0.0
+            res_b = []
+            for i, s in enumerate(before_specs):
+                out = d / f"b_{kind}_{i}.pkl"
+                w, p = _run_job(old_src, kind, s, quick, out)
+                wb, pb = wb + w, pb + p
+                with open(out, "rb") as fh:
+                    res_b.extend(pickle.load(fh))
+            out = d / f"a_{kind}.pkl"
+            wa, pa = _run_job(new_src, kind, after_spec, quick, out)
+            with open(out, "rb") as fh:
+                res_a = pickle.load(fh)
+            diff, where = max_rel_diff(_strip(res_b), _strip(res_a))
+            t = totals.setdefault(kind, np.zeros(4))
+            t += (wb, wa, pb, pa)
+            label = f"{kind} {name}" + (f" ({len(before_specs)} jobs before)" if len(before_specs) > 1 else "")
+            print(f"{label:42s} {wb:11.2f} {wa:7.2f} {wa / wb:6.3f} {pb:14.2f} {pa:7.2f} {pa / pb:6.3f} "
+                  f"{diff:12.3g}" + (f"  at {where}" if diff > 0 else ""), flush=True)
+        for kind, (wb, wa, pb, pa) in totals.items():
+            print(f"{'total ' + kind:42s} {wb:11.2f} {wa:7.2f} {wa / wb:6.3f} {pb:14.2f} {pa:7.2f} {pa / pb:6.3f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--workflow", action="store_true", help="also time the whole part-A workflow")
     ap.add_argument("--configfile", default=None, help="overlay config for the workflow run (e.g. config/quick.yaml)")
+    ap.add_argument("--before", metavar="REV", help="compare jobs against the package of git revision REV")
+    ap.add_argument("--quick", action="store_true", help="jobs of the quick profile (config/quick.yaml)")
+    ap.add_argument("--mc", nargs="*", default=["roll:size:plain", "roll:size:squarem", "roll:size:growing-squarem",
+                                                "prior:headline:growing-squarem"],
+                    help="Monte-Carlo jobs variant:group:scheme, or 'all'")
+    ap.add_argument("--x2", nargs="*", default=[], help="A-X2 variants (one job each)")
     args = ap.parse_args()
-    print("one EM iteration (EKF + RTS/Bryson-Frazier smoother + E-step + closed-form M-step), 250 samples:")
+    if args.before:
+        from opnav.approach import cases
+        from opnav.approach.setup import Setup
+        from opnav.config import load_config
+
+        mc = mc_specs(args.quick) if args.mc == ["all"] else args.mc
+        cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if args.quick else [])["approach"]
+        groups = list(cases.GROUPS) if Setup.from_config(cfg).scatter == "group" else ["all"]
+        compare_revisions(args.before, mc, args.x2, args.quick, groups)
+        return
+    print("one EM iteration (EKF + Bryson-Frazier smoother + E-step + closed-form M-step), 250 samples, CPU:")
     for r in em_iteration_timing():
         print(f"  seeds={r['seeds']:4d}: {r['em_iteration_s'] * 1e3:8.1f} ms  ({r['per_seed_ms']:.2f} ms per seed)")
     if args.workflow:

@@ -34,7 +34,7 @@ if HAVE_BSK:
         input:
             peer=expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
             mc=[A_MC[(v, a_groups(v)[0], m)] for v in A_P1_VARIANTS for m in A_METHODS],
-            x2=[A_X2[(v, a_groups(v)[0])] for v in A_P1_VARIANTS],
+            x2=[A_X2[v] for v in A_P1_VARIANTS],
             code=src("approach/peers.py", "approach/report.py", "tables.py"),
         output:
             table=report_table(f"{APPROACH}/A-P1_peer_ukf", "A-P1", "Paper A"),
