@@ -3,6 +3,7 @@
     python benchmarks/bench_approach.py                       # EM iteration timings
     python benchmarks/bench_approach.py --before 870b400      # jobs: CPU-s before/after + equality
     python benchmarks/bench_approach.py --before 870b400 --quick --mc all --x2 roll literal
+    python benchmarks/bench_approach.py --against /work/main/results --mc all --x2 literal roll
     python benchmarks/bench_approach.py --workflow            # also the whole part-A workflow
 
 ``--before REV``: every job named by ``--mc`` (``variant:group:scheme``, or ``all`` for
@@ -15,7 +16,10 @@ the JIT compiler) and of its whole process (start-up and imports included), thei
 ratios, and the largest relative difference between the two results (run-time
 fields aside), which must be 0 or round-off.
 
-Without ``--before``: the CPU time of one EM iteration (EKF + smoother + E/M step)
+``--against RESULTS``: the same jobs with this checkout only, against the work pickles
+of a finished run of that profile; "before" is the ``cpu_time`` of its benchmark files.
+
+Without either: the CPU time of one EM iteration (EKF + smoother + E/M step)
 on a 250-sample segment per seed count, and with ``--workflow`` the wall time of
 ``snakemake --cores 2`` for every part-A output from an empty results directory
 (in a temporary copy of the workflow).
@@ -210,17 +214,62 @@ def compare_revisions(rev: str, mc: list[str], x2: list[str], quick: bool, x2_gr
             print(f"{'total ' + kind:42s} {wb:11.2f} {wa:7.2f} {wa / wb:6.3f} {pb:14.2f} {pa:7.2f} {pa / pb:6.3f}")
 
 
+def _bench_cpu(tsv: Path) -> float:
+    """cpu_time of a Snakemake benchmark file (the job's process tree)."""
+    head, row = tsv.read_text().splitlines()[:2]
+    return float(dict(zip(head.split("\t"), row.split("\t")))["cpu_time"])
+
+
+def compare_with_run(results: Path, mc: list[str], x2: list[str], quick: bool) -> None:
+    """This checkout's jobs against a finished run's work pickles (``results``/approach/work),
+    "before" CPU-s from that run's benchmark files (its load may differ from now)."""
+    a = results / "approach"
+    print(f"CPU-s per job against the run in {results}: before = its benchmark file (cpu_time), "
+          f"after = this checkout (whole process)")
+    print(f"{'job':42s} {'before':>8s} {'after':>8s} {'ratio':>6s} {'max rel diff':>12s}")
+    totals = {}
+    with tempfile.TemporaryDirectory() as d:
+        jobs = [("mc", s, [a / "work" / "mc" / f"{s.replace(':', '__')}.pkl"],
+                 [a / "benchmarks" / f"mc_{s.replace(':', '__')}.tsv"]) for s in mc]
+        for v in x2:
+            pk = sorted((a / "work" / "x2").glob(f"{v}__*.pkl"))
+            jobs.append(("x2", f"{v}:all", pk, [a / "benchmarks" / f"x2_{p.stem}.tsv" for p in pk]))
+        for kind, spec, pickles, tsvs in jobs:
+            before = []
+            for p in pickles:
+                with open(p, "rb") as fh:
+                    r = pickle.load(fh)
+                before.extend(r["results"] if kind == "x2" else r)
+            cpu_b = sum(_bench_cpu(t) for t in tsvs)
+            out = Path(d) / "a.pkl"
+            _, cpu_a = _run_job(REPO / "src", kind, spec, quick, out)
+            with open(out, "rb") as fh:
+                after = pickle.load(fh)
+            diff, where = max_rel_diff(_strip(before), _strip(after))
+            t = totals.setdefault(kind, np.zeros(3))
+            t += (cpu_b, cpu_a, len(tsvs))
+            print(f"{kind + ' ' + spec:42s} {cpu_b:8.2f} {cpu_a:8.2f} {cpu_a / cpu_b:6.3f} {diff:12.3g}"
+                  + (f"  at {where}" if diff > 0 else ""), flush=True)
+    for kind, (tb, ta, n) in totals.items():
+        print(f"{'total ' + kind + f' ({int(n)} jobs before)':42s} {tb:8.2f} {ta:8.2f} {ta / tb:6.3f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--workflow", action="store_true", help="also time the whole part-A workflow")
     ap.add_argument("--configfile", default=None, help="overlay config for the workflow run (e.g. config/quick.yaml)")
     ap.add_argument("--before", metavar="REV", help="compare jobs against the package of git revision REV")
+    ap.add_argument("--against", metavar="RESULTS", type=Path,
+                    help="compare jobs with a finished run's results folder (its pickles and benchmark files)")
     ap.add_argument("--quick", action="store_true", help="jobs of the quick profile (config/quick.yaml)")
     ap.add_argument("--mc", nargs="*", default=["roll:size:plain", "roll:size:squarem", "roll:size:growing-squarem",
                                                 "prior:headline:growing-squarem"],
                     help="Monte-Carlo jobs variant:group:scheme, or 'all'")
     ap.add_argument("--x2", nargs="*", default=[], help="A-X2 variants (one job each)")
     args = ap.parse_args()
+    if args.against:
+        compare_with_run(args.against, mc_specs(args.quick) if args.mc == ["all"] else args.mc, args.x2, args.quick)
+        return
     if args.before:
         from opnav.approach import cases
         from opnav.approach.setup import Setup

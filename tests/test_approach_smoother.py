@@ -158,3 +158,13 @@ def test_prior_propagated_to_several_samples_in_one_pass_equals_separate_passes(
         ekf.predict_only(x0, geo.P0, win, at=[30, 7])
     with pytest.raises(ValueError, match="must increase"):
         ekf.predict_only(x0, geo.P0, win, at=[5, 61])
+
+
+def test_filter_measurement_jacobian_is_minus_A_C_at_every_sample():
+    geo, win, z, theta = _approach_filter(S=3, n=40)
+    f = ekf.run_filter(z, theta, np.zeros((3, 6)), geo.P0, win)
+    for s in range(3):
+        for k in (1, 17, 40):
+            H = ekf.measurement_jacobian(theta[s:s + 1], win.C[k])[0]
+            np.testing.assert_allclose(f.Hr[s, k], H[:, :3], rtol=1e-15, atol=0)
+            assert not H[:, 3:].any()

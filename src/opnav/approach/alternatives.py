@@ -98,7 +98,7 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
     win = geo.window(Rvar)
     S = z.shape[0]
     start = sc.START_OF[variant]
-    f0 = None if start == "prior" else run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
+    f0 = None if start == "prior" else run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0), predicted=False)
     x0, P0 = cases.start_state(start, N0, f0, geo.dx_true, dx0, geo.P0, win)
     P0 = np.broadcast_to(P0, (S, 6, 6))  # one per seed (the prior's is shared)
     wwin = win.slice(N0, N0 + L * N)
@@ -112,7 +112,7 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
            "seg_data_used": seg_data, "methods": {}}
 
     def nav_after(theta_rad):
-        f = run_filter(z, theta_rad, dx0, geo.P0, win)
+        f = run_filter(z, theta_rad, dx0, geo.P0, win, predicted=False)
         err = np.linalg.norm(f.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
         return cases.rms_last(err, frac)
 

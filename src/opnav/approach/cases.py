@@ -201,7 +201,7 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     dx_true = geo.dx_true
     tz_tol = em_set.tz_tol
 
-    f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win)
+    f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win, predicted=False)
     err_before = np.linalg.norm(f0.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
 
     start = sc.START_OF[variant]
@@ -240,7 +240,7 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     stall = stalled(moved, rate, dist_ml, em_set.stall_move_tol_arcsec, em_set.stall_rate,
                     em_set.converge_tol_arcsec)
 
-    f1 = run_filter(z, theta, dx0, geo.P0, win)
+    f1 = run_filter(z, theta, dx0, geo.P0, win, predicted=False)
     err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
     frac = setup.nav_last_fraction
     seg_theta_as = sc.arcsec(np.stack(seg_theta, 1))
@@ -310,7 +310,7 @@ def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indice
     Rvar, z, dx0 = simulate_case(setup, geo, case, seed_indices, init_mode)
     win = geo.window(Rvar)
     S = z.shape[0]
-    f0 = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
+    f0 = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0), predicted=False)
     x0, P0 = start_state(sc.START_OF[variant], N0, f0, geo.dx_true, dx0, geo.P0, win)
     a, b = N0, N0 + data_samples
     wz, ww = z[:, a:b + 1], win.slice(a, b)

@@ -104,7 +104,10 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     """
     S, n = z.shape[0], win.n
     A = misalignment_small(theta)
-    Hrs = -np.einsum("sij,kjl->skil", A, win.C)  # (S, n+1, 3, 3) position block of H
+    # (S, n+1, 3, 3) position block of H, -A_m C: the sum over j in order (bit for bit the
+    # einsum "sij,kjl->skil", several times faster)
+    Hrs = -(A[:, None, :, 0, None] * win.C[None, :, None, 0, :] + A[:, None, :, 1, None] * win.C[None, :, None, 1, :]
+            + A[:, None, :, 2, None] * win.C[None, :, None, 2, :])
     Au = np.einsum("sij,kj->ski", A, win.u_ref)
     xf = np.empty((S, n + 1, 6))
     Pf = np.empty((S, n + 1, 6, 6))

@@ -63,7 +63,7 @@ def inv_sym3(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _t(A: np.ndarray) -> np.ndarray:
-    return np.swapaxes(A, -1, -2)
+    return A.mT
 
 
 def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray

@@ -39,7 +39,7 @@ def _start_covariances(geo: sc.Geometry, win: Window, variant: str) -> np.ndarra
     n = win.n
     if sc.START_OF[variant] == "truth":
         z = np.zeros((1, n + 1, 3))
-        return run_filter(z, np.zeros((1, 3)), np.zeros((1, 6)), geo.P0, win).Pf[0]
+        return run_filter(z, np.zeros((1, 3)), np.zeros((1, 6)), geo.P0, win, predicted=False).Pf[0]
     out = np.empty((n + 1, 6, 6))
     P = geo.P0.copy()
     out[0] = P
