@@ -75,3 +75,20 @@ def test_segment_bounds_of_many_items_equal_each_alone(variant):
         np.testing.assert_allclose(seg, pipeline.segment_bounds(cfg, geo, R, th, variant, zq), rtol=1e-12)
         np.testing.assert_allclose(curve, pipeline.bound_curve(cfg, geo, R, th, variant, zq), rtol=1e-12)
     assert not np.allclose(many[0], many[1])  # the items differ: a batch that mixed them up would fail
+
+
+@pytest.mark.parametrize("shape", [(1,), (7,), (40,), (3, 11)])
+def test_shared_matrix_products_equal_the_stacked_ones_bit_for_bit(shape):
+    """The time update's single-product form of F P F^T (one F for the batch) must give the
+    stacked product's numbers exactly, so batching never changes a result."""
+    rng = np.random.default_rng(len(shape) * 100 + shape[-1])
+    F = rng.standard_normal((6, 6)) * np.logspace(-3, 3, 6)
+    P = rng.standard_normal(shape + (6, 6))
+    P = P @ np.swapaxes(P, -1, -2) * np.logspace(4, -6, 6)  # stiff scales, as km^2 beside (km/s)^2
+    assert np.array_equal(kalman.shared_left(F, P), F @ P)
+    assert np.array_equal(kalman.shared_right(P, F.T), P @ F.T)
+    X = rng.standard_normal(shape + (3, 6))
+    assert np.array_equal(kalman.shared_right(X, F), X @ F)
+    Q = np.diag(rng.random(6))
+    _, Pp = kalman.predict(None, P, F, Q)
+    assert np.array_equal(Pp, F @ P @ F.T + Q)

@@ -66,6 +66,22 @@ def _t(A: np.ndarray) -> np.ndarray:
     return A.mT
 
 
+def shared_left(F: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """``F @ P`` for one ``F (d, d)`` and a stack ``P (..., d, d)`` as a single matrix product
+    (``F [P_1 P_2 ...]``): every entry is the one of the stacked product, bit for bit (the
+    same sum over the inner index; a test checks it), without one small product per member."""
+    if P.ndim == 2:
+        return F @ P
+    Pm = np.moveaxis(P, -2, 0)
+    return np.moveaxis((F @ Pm.reshape(Pm.shape[0], -1)).reshape((F.shape[0],) + Pm.shape[1:]), 0, -2)
+
+
+def shared_right(X: np.ndarray, G: np.ndarray) -> np.ndarray:
+    """``X @ G`` for a stack ``X (..., a, d)`` and one ``G (d, e)`` as a single matrix product
+    (rows of every member stacked), bit for bit the stacked product (see :func:`shared_left`)."""
+    return (X.reshape(-1, X.shape[-1]) @ G).reshape(X.shape[:-1] + (G.shape[-1],))
+
+
 def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray
             ) -> tuple[np.ndarray | None, np.ndarray]:
     """Time update ``(F m, F P F^T + Q)`` (module docstring); ``m`` may be None.
@@ -73,6 +89,8 @@ def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray
     Ft = _t(F)
     if m is not None:
         m = m @ Ft if F.ndim == 2 else (m[..., None, :] @ Ft)[..., 0, :]
+    if F.ndim == 2:
+        return m, shared_right(shared_left(F, P), Ft) + Q
     return m, F @ P @ Ft + Q
 
 

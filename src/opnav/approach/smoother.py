@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kalman
 from .ekf import FilterResult, Window
 
 
@@ -114,7 +115,7 @@ def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> S
         lt = (CtT @ lv[..., None])[..., 0]
         lt[:, :3] -= HSnu[:, k]
         Phi = win.Phi[k]
-        L = Phi.T @ Lt @ Phi
+        L = kalman.shared_right(kalman.shared_left(Phi.T, Lt), Phi)  # Phi^T Lt Phi
         lv = lt @ Phi
         Lh[:, k - 1], lh[:, k - 1] = L, lv
     Pr = f.Pf[..., cols, :]
