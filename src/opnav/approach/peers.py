@@ -285,18 +285,24 @@ def run_ukf(circles: np.ndarray, circle_var: np.ndarray, t_s: np.ndarray, sigma_
     cscale = np.ones((9, 9))
     cscale[:6, :] = 1e-6  # rows 0..5 are scaled by the module (and the first 6 of row 6)
     cscale[6, :6] = 1e-6
+    # the inputs as Python floats for all samples at once; one payload of each kind, refilled
+    # per sample (write() copies it into the message)
+    tns_all = [int(round(t * 1e9)) for t in np.asarray(t_s, float)[: n + 1]]
+    sig_all = np.asarray(sigma_BN, float)[: n + 1].tolist()
+    circ_all = np.asarray(circles, float)[: n + 1].tolist()
+    unc_all = (np.asarray(circle_var, float)[: n + 1, :, None] * np.eye(3)).reshape(-1, 9).tolist()
+    att = messaging.NavAttMsgPayload()
+    c = messaging.OpNavCirclesMsgPayload()
+    c.valid = 1
+    c.planetIds = [BSK_PLANET_ID_MARS]
     for k in range(1, n + 1):
-        tns = int(round(t_s[k] * 1e9))
-        att = messaging.NavAttMsgPayload()
-        att.sigma_BN = list(map(float, sigma_BN[k]))
+        tns = tns_all[k]
+        att.sigma_BN = sig_all[k]
         att_msg.write(att, tns)
-        c = messaging.OpNavCirclesMsgPayload()
-        c.valid = 1
         c.timeTag = tns
-        c.planetIds = [BSK_PLANET_ID_MARS]
-        c.circlesCenters = [float(circles[k, 0]), float(circles[k, 1])]
-        c.circlesRadii = [float(circles[k, 2])]
-        c.uncertainty = np.diag(circle_var[k]).ravel().tolist()
+        c.circlesCenters = circ_all[k][:2]
+        c.circlesRadii = circ_all[k][2:]
+        c.uncertainty = unc_all[k]
         circ_msg.write(c, tns)
         sim.ConfigureStopTime(tns)
         sim.ExecuteSimulation()
