@@ -138,7 +138,7 @@ def mock_snakemake(rule: str, *, configfiles=(), root: str | Path | None = None,
     ``NAME=VALUE`` wildcards, which override the script's defaults::
 
         python workflow/scripts/landing_tables.py --configfile config/quick.yaml
-        python workflow/scripts/approach_mc.py variant=roll group=headline method=plain
+        python workflow/scripts/approach_mc.py variant=roll group=headline
 
     See ``workflow/scripts/README.md``.
     """
