@@ -6,11 +6,13 @@
     python benchmarks/bench_approach.py --against /work/main/results --mc all --x2 literal roll
     python benchmarks/bench_approach.py --workflow            # also the whole part-A workflow
 
-``--before REV``: every job named by ``--mc`` (``variant:group:scheme``, or ``all`` for
-every Monte-Carlo job of the profile) and ``--x2`` (variants) runs in its own process,
+``--before REV``: every job named by ``--mc`` (``variant:group``: every EM scheme, one
+job now and one per scheme before; ``variant:group:scheme``; or ``all`` for every
+Monte-Carlo job of the profile) and ``--x2`` (variants) runs in its own process,
 once with the package of git revision ``REV`` (``git archive``) and once with this
 checkout's, one after the other, as the workflow's jobs would (one process each; an
-A-X2 variant is one job now, its case groups were one job each before). It prints
+A-X2 variant is one job now, its case groups were one job each before; likewise
+the EM schemes of a Monte-Carlo job). It prints
 the CPU seconds of each, of the job's work (after the imports; children included:
 the JIT compiler) and of its whole process (start-up and imports included), their
 ratios, and the largest relative difference between the two results (run-time
@@ -53,11 +55,14 @@ from opnav.approach.setup import Setup
 cfg = load_config(overlays=["config/quick.yaml"] if quick == "1" else [])["approach"]
 setup = Setup.from_config(cfg)
 t0 = os.times()
-if kind == "mc":
+if kind == "mc":  # variant:group:scheme, or variant:group = every scheme in one process (as the job now)
     from opnav.approach.pipeline import run_group
-    v, g, m = spec.split(":")
-    mode, _, meth = m.rpartition("-")
-    res = run_group(setup, v, g, meth, mode or "sliding")
+    v, g, *m = spec.split(":")
+    schemes = m or list(cfg["methods"]) + [f"growing-{x}" for x in cfg["growing"]["methods"]]
+    res = []
+    for sch in schemes:
+        mode, _, meth = sch.rpartition("-")
+        res.extend(run_group(setup, v, g, meth, mode or "sliding"))
 else:
     from opnav.approach import alternatives as alt, scenario as sc
     v, g = spec.split(":")
@@ -169,18 +174,26 @@ def max_rel_diff(a, b, path: str = "") -> tuple[float, str]:
     return (float(r.max()) if r.size else 0.0), path
 
 
+def schemes_of(quick: bool) -> list[str]:
+    from opnav.config import load_config
+
+    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if quick else [])["approach"]
+    return list(cfg["methods"]) + [f"growing-{m}" for m in cfg["growing"]["methods"]]
+
+
 def mc_specs(quick: bool) -> list[str]:
+    """Every Monte-Carlo job of the profile, ``variant:group`` (all EM schemes)."""
     from opnav.approach.pipeline import groups_for
     from opnav.approach.setup import Setup
     from opnav.config import load_config
 
     cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if quick else [])["approach"]
     setup = Setup.from_config(cfg)
-    schemes = list(cfg["methods"]) + [f"growing-{m}" for m in cfg["growing"]["methods"]]
-    return [f"{v}:{g}:{m}" for v in cfg["variants"] for g in groups_for(setup, v) for m in schemes]
+    return [f"{v}:{g}" for v in cfg["variants"] for g in groups_for(setup, v)]
 
 
-def compare_revisions(rev: str, mc: list[str], x2: list[str], quick: bool, x2_groups_before: list[str]) -> None:
+def compare_revisions(rev: str, mc: list[str], x2: list[str], quick: bool, x2_groups_before: list[str],
+                      schemes: list[str]) -> None:
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
         old_src, new_src = _export_src(rev, d / "before"), REPO / "src"
@@ -189,8 +202,8 @@ def compare_revisions(rev: str, mc: list[str], x2: list[str], quick: bool, x2_gr
         print(f"{'job':42s} {'work before':>11s} {'after':>7s} {'ratio':>6s} {'process before':>14s} "
               f"{'after':>7s} {'ratio':>6s} {'max rel diff':>12s}")
         totals = {}
-        jobs = [("mc", s, [s], s) for s in mc] + [("x2", v, [f"{v}:{g}" for g in x2_groups_before], f"{v}:all")
-                                                   for v in x2]
+        jobs = [("mc", s, [s] if s.count(":") == 2 else [f"{s}:{m}" for m in schemes], s) for s in mc]
+        jobs += [("x2", v, [f"{v}:{g}" for g in x2_groups_before], f"{v}:all") for v in x2]
         for kind, name, before_specs, after_spec in jobs:
             wb = pb = 0.0
             res_b = []
@@ -214,42 +227,49 @@ def compare_revisions(rev: str, mc: list[str], x2: list[str], quick: bool, x2_gr
             print(f"{'total ' + kind:42s} {wb:11.2f} {wa:7.2f} {wa / wb:6.3f} {pb:14.2f} {pa:7.2f} {pa / pb:6.3f}")
 
 
-def _bench_cpu(tsv: Path) -> float:
-    """cpu_time of a Snakemake benchmark file (the job's process tree)."""
-    head, row = tsv.read_text().splitlines()[:2]
-    return float(dict(zip(head.split("\t"), row.split("\t")))["cpu_time"])
+def _log_cpu(log: Path) -> float:
+    """The CPU seconds a job's log ends with (``job resources: cpu_s=...``: the job's whole process)."""
+    last = [ln for ln in log.read_text().splitlines() if "job resources: cpu_s=" in ln][-1]
+    return float(last.split("cpu_s=")[1].split()[0])
 
 
-def compare_with_run(results: Path, mc: list[str], x2: list[str], quick: bool) -> None:
+GROUP_ORDER = ["size", "polarity", "initial", "pixel", "install", "all", "headline"]
+
+
+def compare_with_run(results: Path, mc: list[str], x2: list[str], quick: bool, schemes: list[str]) -> None:
     """This checkout's jobs against a finished run's work pickles (``results``/approach/work),
     "before" CPU-s from that run's benchmark files (its load may differ from now)."""
     a = results / "approach"
-    print(f"CPU-s per job against the run in {results}: before = its benchmark file (cpu_time), "
-          f"after = this checkout (whole process)")
+    print(f"CPU-s per job against the run in {results}: before = its jobs' logs (job resources: cpu_s), "
+          f"after = this checkout, one process per job (whole process; the load may differ)")
     print(f"{'job':42s} {'before':>8s} {'after':>8s} {'ratio':>6s} {'max rel diff':>12s}")
     totals = {}
     with tempfile.TemporaryDirectory() as d:
-        jobs = [("mc", s, [a / "work" / "mc" / f"{s.replace(':', '__')}.pkl"],
-                 [a / "benchmarks" / f"mc_{s.replace(':', '__')}.tsv"]) for s in mc]
+        jobs = []
+        for s in mc:
+            v, g, *m = s.split(":")
+            names = [f"{v}__{g}__{x}" for x in (m or schemes)]
+            jobs.append(("mc", s, [a / "work" / "mc" / f"{x}.pkl" for x in names],
+                         [a / "logs" / f"mc_{x}.log" for x in names]))
         for v in x2:
-            pk = sorted((a / "work" / "x2").glob(f"{v}__*.pkl"))
-            jobs.append(("x2", f"{v}:all", pk, [a / "benchmarks" / f"x2_{p.stem}.tsv" for p in pk]))
-        for kind, spec, pickles, tsvs in jobs:
+            pk = sorted((a / "work" / "x2").glob(f"{v}__*.pkl"), key=lambda p: GROUP_ORDER.index(p.stem.split("__")[1]))
+            jobs.append(("x2", f"{v}:all", pk, [a / "logs" / f"x2_{p.stem}.log" for p in pk]))
+        for kind, spec, pickles, logs in jobs:
             before = []
             for p in pickles:
                 with open(p, "rb") as fh:
                     r = pickle.load(fh)
                 before.extend(r["results"] if kind == "x2" else r)
-            cpu_b = sum(_bench_cpu(t) for t in tsvs)
+            cpu_b = sum(_log_cpu(t) for t in logs)
             out = Path(d) / "a.pkl"
             _, cpu_a = _run_job(REPO / "src", kind, spec, quick, out)
             with open(out, "rb") as fh:
                 after = pickle.load(fh)
             diff, where = max_rel_diff(_strip(before), _strip(after))
             t = totals.setdefault(kind, np.zeros(3))
-            t += (cpu_b, cpu_a, len(tsvs))
-            print(f"{kind + ' ' + spec:42s} {cpu_b:8.2f} {cpu_a:8.2f} {cpu_a / cpu_b:6.3f} {diff:12.3g}"
-                  + (f"  at {where}" if diff > 0 else ""), flush=True)
+            t += (cpu_b, cpu_a, len(logs))
+            print(f"{kind + ' ' + spec + f' ({len(logs)} jobs before)':42s} {cpu_b:8.2f} {cpu_a:8.2f} "
+                  f"{cpu_a / cpu_b:6.3f} {diff:12.3g}" + (f"  at {where}" if diff > 0 else ""), flush=True)
     for kind, (tb, ta, n) in totals.items():
         print(f"{'total ' + kind + f' ({int(n)} jobs before)':42s} {tb:8.2f} {ta:8.2f} {ta / tb:6.3f}")
 
@@ -262,13 +282,14 @@ def main() -> None:
     ap.add_argument("--against", metavar="RESULTS", type=Path,
                     help="compare jobs with a finished run's results folder (its pickles and benchmark files)")
     ap.add_argument("--quick", action="store_true", help="jobs of the quick profile (config/quick.yaml)")
-    ap.add_argument("--mc", nargs="*", default=["roll:size:plain", "roll:size:squarem", "roll:size:growing-squarem",
-                                                "prior:headline:growing-squarem"],
-                    help="Monte-Carlo jobs variant:group:scheme, or 'all'")
+    ap.add_argument("--mc", nargs="*", default=["roll:size", "prior:headline"],
+                    help="Monte-Carlo jobs variant:group (every EM scheme: one job now, one per scheme "
+                         "before) or variant:group:scheme, or 'all'")
     ap.add_argument("--x2", nargs="*", default=[], help="A-X2 variants (one job each)")
     args = ap.parse_args()
     if args.against:
-        compare_with_run(args.against, mc_specs(args.quick) if args.mc == ["all"] else args.mc, args.x2, args.quick)
+        compare_with_run(args.against, mc_specs(args.quick) if args.mc == ["all"] else args.mc, args.x2, args.quick,
+                         schemes_of(args.quick))
         return
     if args.before:
         from opnav.approach import cases
@@ -278,7 +299,7 @@ def main() -> None:
         mc = mc_specs(args.quick) if args.mc == ["all"] else args.mc
         cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if args.quick else [])["approach"]
         groups = list(cases.GROUPS) if Setup.from_config(cfg).scatter == "group" else ["all"]
-        compare_revisions(args.before, mc, args.x2, args.quick, groups)
+        compare_revisions(args.before, mc, args.x2, args.quick, groups, schemes_of(args.quick))
         return
     print("one EM iteration (EKF + Bryson-Frazier smoother + E-step + closed-form M-step), 250 samples, CPU:")
     for r in em_iteration_timing():
