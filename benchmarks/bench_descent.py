@@ -15,6 +15,7 @@ default batch size over the same at batch size 1 (all cells pooled).
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
@@ -99,12 +100,13 @@ def main(argv=None) -> int:
             tot["b"] += tb
             n_cells += 1
             n = len(runs)
-            print(f"{name:10s} {m:7s} {n / tr:12.1f} {n / t1:10.1f} {n / tb:10.1f} {t1 / tb:7.1f} "
+            print(f"{name:10s} {m:7s} {n / tr if tr == tr else math.nan:12.1f} {n / t1:10.1f} {n / tb:10.1f} {t1 / tb:7.1f} "
                   f"{tr / tb:8.1f} {diff:12.2e}", flush=True)
     n = len(runs) * n_cells
-    print(f"all cells: per-run reference {n / tot['ref']:.1f}, batch 1 {n / tot['1']:.1f}, "
-          f"batched {n / tot['b']:.1f} descents per CPU-second; batched vs per-run reference "
-          f"{tot['ref'] / tot['b']:.1f}x")
+    vs_ref = (f"per-run reference {n / tot['ref']:.1f}, " if ref is not None else "")
+    print(f"all cells: {vs_ref}batch 1 {n / tot['1']:.1f}, batched {n / tot['b']:.1f} descents per "
+          f"CPU-second" + (f"; batched vs per-run reference {tot['ref'] / tot['b']:.1f}x"
+                           if ref is not None else ""))
     print(f"batch speedup: {tot['1'] / tot['b']:.1f}")
     return 0
 
