@@ -111,38 +111,87 @@ def results_dir_problems(results_dir: str, root: str | Path | None = None,
 
 def _approach_min_range_km(a: dict, T: float) -> float:
     """Closest range to Mars over [0, T] (s) of the arc that
-    :func:`opnav.approach.scenario.initial_truth` starts, km: the Mars-centred
-    two-body motion (DOP853), stopped at the surface if it gets there. (The
-    Sun's tide over an approach arc moves it by far less than Mars' radius.)"""
-    from scipy.integrate import solve_ivp
-    from scipy.optimize import minimize_scalar
-
+    :func:`opnav.approach.scenario.initial_truth` starts, km: Mars-centred two-body
+    motion, in closed form (Vallado, *Fundamentals of Astrodynamics*, 4th ed., sec.
+    2.2-2.3). The arc is a hyperbola (its energy is v_inf^2 / 2 > 0): the range
+    falls until periapsis and rises after it, so the minimum is the periapsis radius
+    p / (1 + e) if periapsis comes within [0, T], else the range at the nearer end
+    (at T from the hyperbolic Kepler equation e sinh H - H = M). At or below Mars'
+    radius the arc has reached the surface: Mars' radius. (The Sun's tide over an
+    approach arc moves it by far less than Mars' radius.) This runs in every
+    Snakemake parse, where importing scipy.integrate cost more than the check; a
+    nearly parabolic arc (energy lost in round-off) is integrated instead
+    (:func:`_integrated_min_range_km`)."""
     from opnav.approach import dynamics, scenario
 
     X0 = scenario.initial_truth(a) - dynamics.kepler_state(
         dynamics.KeplerElements.from_config(a["mars_elements"]), 0.0)
-    mu = dynamics.MU_MARS
+    args = (X0[:3], X0[3:], T, dynamics.MU_MARS, dynamics.R_MARS_KM)
+    try:
+        return _hyperbola_min_range_km(*args)
+    except ValueError:                               # nearly parabolic
+        return _integrated_min_range_km(*args)
+
+
+def _hyperbola_min_range_km(r0, v0, T: float, mu: float, r_surface: float) -> float:
+    """Closest range over [0, T] s of the two-body hyperbola through (r0 km, v0 km/s)
+    about a body of ``mu`` (km^3/s^2), floored to ``r_surface`` km (see
+    :func:`_approach_min_range_km`)."""
+    r0, v0 = np.asarray(r0, float), np.asarray(v0, float)
+    r, v2, rv = float(np.linalg.norm(r0)), float(v0 @ v0), float(r0 @ v0)
+    energy = v2 / 2.0 - mu / r
+    if not energy > 1e-6 * mu / r:                   # relative to its two ~equal terms
+        raise ValueError("not a well-conditioned hyperbola (nearly parabolic)")
+    a = mu / (2.0 * energy)                              # |semi-major axis|, km
+    h2 = float(np.sum(np.cross(r0, v0) ** 2))
+    e = math.sqrt(1.0 + 2.0 * energy * h2 / mu ** 2)
+    n = math.sqrt(mu / a ** 3)                           # mean motion, rad/s
+    # hyperbolic anomaly now: r = a (e cosh H - 1), r . v = sqrt(mu a) e sinh H
+    H0 = math.asinh(rv / (math.sqrt(mu * a) * e))
+    M0 = e * math.sinh(H0) - H0
+    if rv >= 0.0:                                        # receding already
+        rmin = r
+    elif -M0 / n <= T:                                   # periapsis within the arc
+        rmin = h2 / mu / (1.0 + e)
+    else:                                                # still approaching at T
+        M, H = M0 + n * T, H0
+        for _ in range(100):                             # Newton; f' = e cosh H - 1 > 0
+            step = (e * math.sinh(H) - H - M) / (e * math.cosh(H) - 1.0)
+            H -= step
+            if abs(step) <= 1e-14 * max(1.0, abs(H)):
+                break
+        rmin = min(r, a * (e * math.cosh(H) - 1.0))
+    return r_surface if rmin <= r_surface else rmin
+
+
+def _integrated_min_range_km(r0, v0, T: float, mu: float, r_surface: float) -> float:
+    """:func:`_hyperbola_min_range_km` by scipy's DOP853 integration of the same
+    two-body motion (stopped at the surface) and a bounded search around the
+    closest sample: any conic, and the reference the closed form is tested against."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import minimize_scalar
 
     def rhs(t, X):
-        r = X[:3]
-        return np.concatenate([X[3:], -mu * r / np.linalg.norm(r) ** 3])
+        return np.concatenate([X[3:], -mu * X[:3] / np.linalg.norm(X[:3]) ** 3])
 
     def surface(t, X):
-        return np.linalg.norm(X[:3]) - dynamics.R_MARS_KM
+        return np.linalg.norm(X[:3]) - r_surface
 
     surface.terminal = True
-    sol = solve_ivp(rhs, (0.0, T), X0, method="DOP853", rtol=1e-10, atol=1e-6,
-                    dense_output=True, events=surface)
+    sol = solve_ivp(rhs, (0.0, T), np.concatenate([r0, v0]), method="DOP853", rtol=1e-11,
+                    atol=1e-7, dense_output=True, events=surface)
     if sol.status == 1:                              # reached the surface
-        return dynamics.R_MARS_KM
+        return r_surface
     rng = np.linalg.norm(sol.y[:3], axis=0)
     i = int(np.argmin(rng))
     lo, hi = sol.t[max(i - 1, 0)], sol.t[min(i + 1, len(sol.t) - 1)]
-    if hi <= lo:
-        return float(rng[i])
-    best = minimize_scalar(lambda t: np.linalg.norm(sol.sol(t)[:3]), bounds=(lo, hi),
-                           method="bounded", options={"xatol": 1e-6 * max(T, 1.0)})
-    return float(min(rng[i], best.fun))
+    rmin = float(rng[i])
+    if hi > lo:
+        best = minimize_scalar(lambda t: np.linalg.norm(sol.sol(t)[:3]), bounds=(lo, hi),
+                               method="bounded", options={"xatol": 1e-7 * max(T, 1.0)})
+        rmin = min(rmin, float(best.fun))
+    # a grazing dip below the surface within one step has no sign change for the event
+    return r_surface if rmin <= r_surface else rmin
 
 
 def approach_problems(a: dict) -> list[str]:
