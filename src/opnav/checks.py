@@ -112,8 +112,8 @@ def results_dir_problems(results_dir: str, root: str | Path | None = None,
 def _approach_min_range_km(a: dict, T: float) -> float:
     """Closest range to Mars over [0, T] (s) of the arc that
     :func:`opnav.approach.scenario.initial_truth` starts, km: Mars-centred two-body
-    motion, in closed form (Vallado, *Fundamentals of Astrodynamics*, 4th ed., sec.
-    2.2-2.3). The arc is a hyperbola (its energy is v_inf^2 / 2 > 0): the range
+    motion, in closed form (the hyperbolic Kepler equation; e.g. Vallado,
+    *Fundamentals of Astrodynamics and Applications*, ch. 2). The arc is a hyperbola (its energy is v_inf^2 / 2 > 0): the range
     falls until periapsis and rises after it, so the minimum is the periapsis radius
     p / (1 + e) if periapsis comes within [0, T], else the range at the nearer end
     (at T from the hyperbolic Kepler equation e sinh H - H = M). At or below Mars'
