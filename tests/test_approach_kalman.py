@@ -90,5 +90,5 @@ def test_shared_matrix_products_equal_the_stacked_ones_bit_for_bit(shape):
     X = rng.standard_normal(shape + (3, 6))
     assert np.array_equal(kalman.shared_right(X, F), X @ F)
     Q = np.diag(rng.random(6))
-    _, Pp = kalman.predict(None, P, F, Q)
+    _, Pp = kalman.predict(None, P, F, Q, single=True)
     assert np.array_equal(Pp, F @ P @ F.T + Q)

@@ -9,7 +9,7 @@ A_X2_VARIANTS = config["approach"]["table1_variants"]
 
 
 # One job per variant, every Table-1 case ("all", whatever approach.scatter says): the cases
-# share the batch-ML NLP builds and their JIT compilation (the pixel noise is an NLP parameter).
+# share the batch-ML NLP builds and their JIT compilation (one build per pixel noise).
 A_X2 = {v: f"{A_WORK}/x2/{v}__all.pkl" for v in A_X2_VARIANTS}
 
 

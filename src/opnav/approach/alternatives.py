@@ -71,8 +71,8 @@ def checkpoint_samples(seg_data: np.ndarray, stride: int) -> np.ndarray:
 
 
 class _BatchCache:
-    """BatchML objects per checkpoint set: the NLP depends on the geometry only (the pixel
-    noise of a case enters as a parameter), so every case of a variant shares them."""
+    """BatchML objects per (checkpoints, pixel noise): the NLP depends on the geometry only;
+    one cache per geometry (variant), shared by its cases."""
 
     def __init__(self):
         self.store = {}
@@ -137,9 +137,10 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
     # (b) batch ML: final window for every seed; growing checkpoints for the first few seeds
     b = alt.batch_ml
     sig = sc.rad(b.theta_prior_sigma_arcsec)
-    bm, t_build = cache.get("final", lambda: BatchML(wwin, [L * N], sig, jit=b.jit, tol=b.tol))
+    key = (tuple(case.sigma3_px), "final")
+    bm, t_build = cache.get(key, lambda: BatchML(wwin, [L * N], sig, jit=b.jit, tol=b.tol))
     t = time.perf_counter()
-    rb = bm.solve(zw, x0, P0, th0, wwin.u_ref, rvar=wwin.Rvar)
+    rb = bm.solve(zw, x0, P0, th0, wwin.u_ref)
     t_solve = time.perf_counter() - t
     ncp = min(b.checkpoint_seeds, S)
     res_b = {
@@ -154,9 +155,10 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
     }
     if ncp > 0:
         cp = checkpoint_samples(seg_data, b.checkpoint_stride)
-        bmc, t_build_c = cache.get("checkpoints", lambda: BatchML(wwin, cp, sig, jit=b.jit, tol=b.tol))
+        bmc, t_build_c = cache.get((tuple(case.sigma3_px), "checkpoints"),
+                                   lambda: BatchML(wwin, cp, sig, jit=b.jit, tol=b.tol))
         t = time.perf_counter()
-        rc = bmc.solve(zw[:ncp], x0[:ncp], P0[:ncp], th0[:ncp], wwin.u_ref, rvar=wwin.Rvar)
+        rc = bmc.solve(zw[:ncp], x0[:ncp], P0[:ncp], th0[:ncp], wwin.u_ref)
         t_cp = time.perf_counter() - t
         cth = sc.arcsec(rc.theta)
         res_b.update({

@@ -121,7 +121,7 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     nus = np.zeros((S, n + 1, 3))
     dets = np.ones((S, n + 1))
     for k in range(1, n + 1):
-        x, P = kalman.predict(x, P, win.Phi[k], win.Q)
+        x, P = kalman.predict(x, P, win.Phi[k], win.Q, single=True)
         if predicted:
             xp[:, k], Pp[:, k] = x, P
         Hr = Hrs[:, k]
@@ -150,7 +150,7 @@ def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window, at=None):
     xs, Ps, done = [], [], 0
     for stop in stops:
         for k in range(done + 1, stop + 1):
-            x, P = kalman.predict(x, P, win.Phi[k], win.Q)
+            x, P = kalman.predict(x, P, win.Phi[k], win.Q, single=True)
         done = stop
         xs.append(x)
         Ps.append(P)

@@ -68,8 +68,10 @@ def _t(A: np.ndarray) -> np.ndarray:
 
 def shared_left(F: np.ndarray, P: np.ndarray) -> np.ndarray:
     """``F @ P`` for one ``F (d, d)`` and a stack ``P (..., d, d)`` as a single matrix product
-    (``F [P_1 P_2 ...]``): every entry is the one of the stacked product, bit for bit (the
-    same sum over the inner index; a test checks it), without one small product per member."""
+    (``F [P_1 P_2 ...]``), without one small product per member. For d = 6 (the EM-EKF's
+    state) every entry is the stacked product's, bit for bit, with the pinned numpy's
+    OpenBLAS (a test checks it); not for every size (d = 9 differs in the last bits), so
+    only the 6-state filter and smoother use it."""
     if P.ndim == 2:
         return F @ P
     Pm = np.moveaxis(P, -2, 0)
@@ -78,18 +80,20 @@ def shared_left(F: np.ndarray, P: np.ndarray) -> np.ndarray:
 
 def shared_right(X: np.ndarray, G: np.ndarray) -> np.ndarray:
     """``X @ G`` for a stack ``X (..., a, d)`` and one ``G (d, e)`` as a single matrix product
-    (rows of every member stacked), bit for bit the stacked product (see :func:`shared_left`)."""
+    (rows of every member stacked); bit for bit the stacked product for d = 6 (see :func:`shared_left`)."""
     return (X.reshape(-1, X.shape[-1]) @ G).reshape(X.shape[:-1] + (G.shape[-1],))
 
 
-def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray
+def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray, single: bool = False
             ) -> tuple[np.ndarray | None, np.ndarray]:
     """Time update ``(F m, F P F^T + Q)`` (module docstring); ``m`` may be None.
-    ``F`` (d, d) is shared by the batch, or (..., d, d) one per batch member."""
+    ``F`` (d, d) is shared by the batch, or (..., d, d) one per batch member.
+    ``single``: a shared ``F``'s products as single matrix products (:func:`shared_left`;
+    the 6-state filter)."""
     Ft = _t(F)
     if m is not None:
         m = m @ Ft if F.ndim == 2 else (m[..., None, :] @ Ft)[..., 0, :]
-    if F.ndim == 2:
+    if single and F.ndim == 2:
         return m, shared_right(shared_left(F, P), Ft) + Q
     return m, F @ P @ Ft + Q
 
