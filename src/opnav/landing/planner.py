@@ -912,13 +912,18 @@ def _matrix_batch_objective(m: metrics.Metric, funs) -> Callable:
     of ``matrix_scalar``; tested bit-equal), so flat objectives (mineig's
     plateau, decided by rounding) search alike."""
 
+    stacks: dict = {}          # per set of runs: their contexts stacked once, not per iteration
+
     def f(i, beta):
         out = np.full(len(i), math.inf)
         pts = [funs[j].ground(x) for j, x in zip(i.tolist(), beta.tolist())]
         k = [q for q, p in enumerate(pts) if p is not None]
         if k:
-            st = metrics.stack_contexts([funs[int(i[q])].ctx for q in k])
-            out[k] = -m.batch(st, np.array([pts[q] for q in k])[:, None, :], path="matrix")[:, 0]
+            runs = tuple(int(i[q]) for q in k)
+            if runs not in stacks:
+                stacks[runs] = metrics.stack_contexts([funs[j].ctx for j in runs])
+            out[k] = -m.batch(stacks[runs], np.array([pts[q] for q in k])[:, None, :],
+                              path="matrix")[:, 0]
         return out
 
     return f
