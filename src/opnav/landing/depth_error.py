@@ -222,11 +222,12 @@ def max_eig_sym3(A: np.ndarray) -> float:
 def _max_eig_sym3(a00: float, a11: float, a22: float, a01: float, a02: float, a12: float) -> float:
     """:func:`max_eig_sym3` of the symmetric matrix with these entries, in scalar
     floats (~1 us; the planner's timed path)."""
-    p1 = a01 ** 2 + a02 ** 2 + a12 ** 2
-    q = (a00 + a11 + a22) / 3.0
-    if p1 <= 1e-30 * max(1.0, q * q):
+    p1 = a01 * a01 + a02 * a02 + a12 * a12          # (x * x: correctly rounded, where
+    q = (a00 + a11 + a22) / 3.0                       # libm's pow(x, 2) is off by an ulp
+    if p1 <= 1e-30 * max(1.0, q * q):                 # in ~0.1 % of cases, and slower)
         return max(a00, a11, a22)
-    p2 = (a00 - q) ** 2 + (a11 - q) ** 2 + (a22 - q) ** 2 + 2.0 * p1
+    d0, d1, d2 = a00 - q, a11 - q, a22 - q
+    p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * p1
     p = math.sqrt(p2 / 6.0)
     b00, b11, b22 = (a00 - q) / p, (a11 - q) / p, (a22 - q) / p
     b01, b02, b12 = a01 / p, a02 / p, a12 / p
