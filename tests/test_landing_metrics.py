@@ -545,6 +545,49 @@ def test_batch_over_runs_equals_each_context_alone(name):
         assert np.all(mat[k, n:] == -np.inf)
 
 
+@pytest.mark.parametrize("name", ["svd_w", "cond_w"])
+@pytest.mark.parametrize("seed", range(4))
+def test_whitened_screen_scores_only_the_contenders_exactly(name, seed):
+    """svd_w / cond_w screening: the crude 2 x 2 bounds decide most candidates (a
+    minority gets the exact 4 x 4 eigenvalues, lo = hi), they bracket the explicit
+    score, and every candidate within the planner's short-list margin of the best
+    is among the exact ones, with the values the 4 x 4 eigenvalues give them all."""
+    from opnav.landing import metrics as mt
+
+    rng = np.random.default_rng(seed)
+    ctx = _ctx(r=R0 * (1 + seed), R=Rotation.random(random_state=seed).as_matrix(), rng=rng)
+    c = _ground(rng, 200)
+    m = make_metric(name)
+    ex = m.numpy_H(ctx, c)
+    lo, hi = m.screen(ctx, c)
+    fin = np.isfinite(ex)
+    assert fin.sum() > 100
+    exact = lo == hi
+    assert 0 < exact.sum() < 0.5 * fin.sum()
+    tol = 1e-8 * np.abs(ex[fin])
+    assert np.all(lo[fin] <= ex[fin] + tol) and np.all(ex[fin] <= hi[fin] + tol)
+    near = fin & (ex >= ex[fin].max() * (1 - 1e-5))
+    assert np.all(exact[near])
+    # the exact ones: the values of the 4 x 4 eigenvalues of every candidate
+    wt = mt._whitened_tangent_setup(ctx)
+    sc, P, GkP, K = wt
+    p = c[fin]
+    G = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, p, sc)
+    n = len(p)
+    G2 = G.reshape(2 * n, 12)
+    Bt = (G2 @ GkP.T).reshape(n, 2, 2)
+    D = np.einsum("nik,njk->nij", (G2 @ P).reshape(n, 2, 12), G)
+    D = 0.5 * (D + np.swapaxes(D, 1, 2))
+    M = np.empty((n, 4, 4))
+    M[:, 0:2, 0:2], M[:, 2:4, 0:2], M[:, 0:2, 2:4], M[:, 2:4, 2:4] = K, Bt, np.swapaxes(Bt, 1, 2), D
+    want = mt._whitened_from_sv(name, np.sqrt(np.maximum(np.linalg.eigvalsh(M)[:, ::-1], 0.0)))
+    assert np.array_equal(lo[fin][exact[fin]], want[exact[fin]])
+    # so the planner's short list (minimised scores) is the one exact values give
+    from opnav.landing.planner import _shortlist
+
+    assert np.array_equal(_shortlist(-hi[fin], -lo[fin]), _shortlist(-want, -want))
+
+
 @pytest.mark.parametrize("name", METRIC_NAMES)
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(r=lander, R=quat, seed=seeds, aniso=st.booleans(), dormant=st.booleans())
