@@ -516,19 +516,15 @@ def _whitening(ctx: MetricContext):
     return c["whiten"]
 
 
-def _whitened_scores(name: str, Hw: np.ndarray, exact_svd: bool = False) -> np.ndarray:
-    """The ``WHITENED[name]`` score of whitened H_w = C^-1 H L (..., 6, 12);
-    ``exact_svd``: one LAPACK SVD (the single-candidate matrix path, Hw (1, 6, 12))."""
-    if exact_svd:
-        s = _dgesvd(Hw[0], compute_uv=0)[1][None, :STRUCTURAL_RANK]
-    else:
-        # batch: the singular values squared are the eigenvalues of the 6 x 6 Gram
-        # matrix Hw Hw^T (LAPACK dsyevd, ~5x faster than a 6 x 12 SVD per candidate;
-        # relative error of s4 ~ eps (s1 / s4)^2, tested against the SVD)
-        G = Hw @ np.swapaxes(Hw, -1, -2)
-        lam = np.linalg.eigvalsh(0.5 * (G + np.swapaxes(G, -1, -2)))[..., ::-1][..., :STRUCTURAL_RANK]
-        s = np.sqrt(np.maximum(lam, 0.0))
-    return _whitened_from_sv(name, s)
+def _whitened_scores(name: str, Hw: np.ndarray) -> np.ndarray:
+    """The ``WHITENED[name]`` score of whitened H_w = C^-1 H L (..., 6, 12), batched
+    (the single-candidate matrix path, :func:`_matrix_score`, takes one LAPACK SVD)."""
+    # the singular values squared are the eigenvalues of the 6 x 6 Gram matrix
+    # Hw Hw^T (LAPACK dsyevd, ~5x faster than a 6 x 12 SVD per candidate; relative
+    # error of s4 ~ eps (s1 / s4)^2, tested against the SVD)
+    G = Hw @ np.swapaxes(Hw, -1, -2)
+    lam = np.linalg.eigvalsh(0.5 * (G + np.swapaxes(G, -1, -2)))[..., ::-1][..., :STRUCTURAL_RANK]
+    return _whitened_from_sv(name, np.sqrt(np.maximum(lam, 0.0)))
 
 
 def _whitened_from_sv(name: str, s: np.ndarray) -> np.ndarray:
@@ -822,7 +818,10 @@ def _matrix_score(name: str, ctx: MetricContext, H: np.ndarray) -> float:
     """The explicit matrix computation on one 6 x 12 H (see :func:`_matrix_scalar`)."""
     if name in WHITENED:
         Ci, L = _whitening(ctx)
-        return float(_whitened_scores(name, (Ci @ H @ L)[None], exact_svd=True)[0])
+        # (ndarray.dot: the same BLAS gemm as @ on one pair, without the matmul
+        # ufunc's dispatch; this is the per-pair explicit path of every search)
+        sv = _dgesvd(Ci.dot(H).dot(L), compute_uv=0)[1]
+        return float(_whitened_from_sv(name, sv[None, :STRUCTURAL_RANK])[0])
     if name not in H_METRICS:
         return _info_scalar(name, ctx, H)
     sv = _dgesvd(H, compute_uv=0)[1]
@@ -840,18 +839,18 @@ def _info_scalar(name: str, ctx: MetricContext, H: np.ndarray) -> float:
     with direct LAPACK calls.  Same formulas as the batch path."""
     P, Rm, Pinv, W = ctx._info()
     if name == "logdet":
-        Lam = Pinv + H.T @ W @ H
+        Lam = Pinv + H.T.dot(W).dot(H)
         s = 1.0 / np.sqrt(np.diagonal(Lam))
         As = Lam * (s[:, None] * s[None, :]) + _JITTER12
         Lc, info = _dpotrf(As, lower=1)  # reads the lower triangle only
         if info != 0:
             return float(chol_logdet(Lam[None])[0])
         return float(2.0 * (np.log(np.diagonal(Lc)).sum() - np.log(s).sum()))
-    HP = H @ P
-    _, K, info = _dposv(HP @ H.T + Rm, HP)  # S^-1 H P, S = R + H P H^T
+    HP = H.dot(P)
+    _, K, info = _dposv(HP.dot(H.T) + Rm, HP)  # S^-1 H P, S = R + H P H^T
     if info != 0:
         return -math.inf
-    Ppost = P - HP.T @ K
+    Ppost = P - HP.T.dot(K)
     w, _, info = _dsyev(Ppost + Ppost.T, compute_v=0)
     lmax = 0.5 * w[-1]
     return 1.0 / lmax if info == 0 and lmax > 0 else -math.inf
