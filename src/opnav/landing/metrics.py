@@ -135,9 +135,10 @@ landmark): ``metric.screen(ctx, cand_L, rtol=None) -> (lo, hi)`` bounds the
 explicit path's score of each candidate cheaply (logdet: the tangent update;
 mineig: Rayleigh-Ritz bounds on lambda_max of the posterior covariance, with
 ``rtol`` narrowed by bisection on its inertia for the candidates that can be
-the best; whitened: the 4 x 4 tangent Gram matrix; H baselines: the closed
-form), so that only a short list needs the explicit path (tested: the bounds
-hold the explicit score on random contexts).
+the best; whitened: the 4 x 4 tangent Gram matrix, its eigenvalues bounded by
+2 x 2 algebra and computed only for the candidates near the best; H baselines:
+the closed form), so that only a short list needs the explicit path (tested:
+the bounds hold the explicit score on random contexts).
 
 Batch over planning contexts (runs): ``metric.batch(stack_contexts(ctxs),
 cand_L (R, n, 3), mask (R, n) or None) -> (R, n)`` scores n candidates for each
