@@ -122,6 +122,35 @@ def test_jit_gives_the_same_objective(roll_case):
     np.testing.assert_allclose(vals[0], vals[1], rtol=1e-10)
 
 
+def test_compiled_fold_gives_the_virtual_machines_numbers_bit_for_bit(roll_case):
+    """The JIT-compiled fold of the step (and its reverse derivative, IPOPT's gradient) must
+    give exactly the numbers of CasADi's virtual machine calling the compiled step, so that
+    compiling it never moves an IPOPT iterate."""
+    import casadi as ca
+
+    from opnav.approach import batch_ml
+
+    step = batch_ml.kf_step(True)
+    if step.name() != "kf_step_jit":
+        pytest.skip("no working C compiler: nothing is compiled")
+    _, geo, win, _ = roll_case
+    z, dx0 = _data(geo, win, TRUTH, [0])
+    d = 40
+    sl = slice(1, d + 1)
+    th = ca.MX.sym("th", 3)
+    args = (dx0[0], geo.P0, 0.0, th, np.hstack(list(win.Phi[sl])), np.hstack(list(win.C[sl])),
+            win.u_ref[sl].T, win.Rvar[sl].T, (z[0, sl] - win.u_ref[sl]).T, win.Q)
+    vals = []
+    for fold in (step.mapaccum("kf_vm", d, [0, 1, 2], [0, 1, 2]), batch_ml.kf_accum(d, True)):
+        out = fold(*args)
+        nll = out[2][-1]
+        f = ca.Function("f", [th], [nll, ca.gradient(nll, th), out[0][:, -1], out[1][:, -6:]])
+        vals.append([np.asarray(v) for v in f(sc.rad(TRUTH))])
+    assert batch_ml.kf_accum(d, True).name() == f"kf_{d}_jit"
+    for a, b in zip(*vals):
+        assert a.tobytes() == b.tobytes()
+
+
 def test_linear_augmented_filter_attains_the_crlb():
     """On the linear-Gaussian model the augmented Kalman filter's theta covariance equals the
     Bayesian CRLB from the dense joint information of X_0..X_n and theta."""

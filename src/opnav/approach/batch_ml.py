@@ -35,8 +35,8 @@ Description
     as the EM's M-step does by holding unobservable directions fixed.
 
 Implementation
-    One filter step is written once in CasADi SX (optionally JIT-compiled with
-    the system C compiler), folded over the samples with ``mapaccum``, and the
+    One filter step is written once in CasADi SX, folded over the samples with
+    ``mapaccum`` (both optionally JIT-compiled with the system C compiler), and the
     gradient comes from CasADi's reverse mode. The decision variable is theta
     in arcsec (O(1-10)); the objective is in nats. IPOPT runs with a
     limited-memory Hessian (3 unknowns; the exact Hessian costs ~10 gradients).
@@ -62,6 +62,7 @@ from .ekf import Window
 from .kalman import LOG2PI
 
 _STEP: dict[bool, ca.Function] = {}
+_ACCUM: dict[tuple[int, bool], ca.Function] = {}
 _JIT_DIRS: list[str] = []
 
 
@@ -110,18 +111,23 @@ def kf_step_sx() -> ca.Function:
                        ["x_next", "P_next", "nll_next"])
 
 
+def _jit_options() -> dict:
+    """CasADi options that JIT-compile a function with the system C compiler (-O2), in a
+    temporary directory removed at exit."""
+    d = tempfile.mkdtemp(prefix="opnav_jit_")
+    _JIT_DIRS.append(d)
+    return {"jit": True, "compiler": "shell", "jit_cleanup": False,
+            "jit_options": {"flags": ["-O2"], "directory": d + "/", "verbose": False, "cleanup": False}}
+
+
 def kf_step(jit: bool = True) -> ca.Function:
     """The step function, JIT-compiled once per process when ``jit`` and a C compiler work."""
     if jit in _STEP:
         return _STEP[jit]
     f = kf_step_sx()
     if jit:
-        d = tempfile.mkdtemp(prefix="opnav_jit_")
-        _JIT_DIRS.append(d)
         try:
-            jo = {"jit": True, "compiler": "shell", "jit_cleanup": False,
-                  "jit_options": {"flags": ["-O2"], "directory": d + "/", "verbose": False,
-                                  "cleanup": False}}
+            jo = _jit_options()
             # derivative functions (IPOPT's reverse-mode gradient) are compiled too
             f = ca.Function("kf_step_jit", f.sx_in(), f.call(f.sx_in()),
                             dict(jo, jit_name="kf_step", der_options=dict(jo)))
@@ -129,6 +135,27 @@ def kf_step(jit: bool = True) -> ca.Function:
             f = kf_step_sx()
     _STEP[jit] = f
     return f
+
+
+def kf_accum(d: int, jit: bool = True) -> ca.Function:
+    """The step folded over ``d`` samples (``mapaccum``: x, P, nll carried; per-sample inputs
+    side by side), once per process and length. With ``jit`` (and a working compiler) the
+    fold and its derivatives are compiled too: the same calls of the compiled step in the
+    same order as CasADi's virtual machine makes them (the same numbers, bit for bit; a test
+    checks it), without the machine's cost per call (about half of an IPOPT solve)."""
+    key = (int(d), bool(jit))
+    if key not in _ACCUM:
+        step = kf_step(jit)
+        f = step.mapaccum(f"kf_{d}", int(d), [0, 1, 2], [0, 1, 2])
+        if jit and step.name() == "kf_step_jit":
+            try:
+                jo = _jit_options()
+                f = ca.Function(f"kf_{d}_jit", f.mx_in(), f.call(f.mx_in()),
+                                dict(jo, jit_name=f"kf_{d}", der_options=dict(jo)))
+            except RuntimeError:  # pragma: no cover - the step compiled, so the fold does
+                pass
+        _ACCUM[key] = f
+    return _ACCUM[key]
 
 
 @dataclass
@@ -164,7 +191,6 @@ class BatchML:
             raise ValueError(f"checkpoints must increase within 1..{win.n}, got {cps}")
         self.checkpoints = cps
         self.n = cps[-1]
-        step = kf_step(jit)
         self.sig = theta_prior_sigma_rad / ARCSEC  # arcsec
         eta = ca.MX.sym("eta", 3)
         th_s = ca.MX.sym("theta_start_as", 3)
@@ -178,15 +204,11 @@ class BatchML:
         Qd = ca.DM(win.Q)
         x, P, nll = x0, P0, ca.MX(0.0)
         prior = 0.5 * ca.sumsqr(th - th0) / self.sig**2
-        accs: dict[int, ca.Function] = {}
         objectives = []
         a = 0
         for b in cps:
-            d = b - a
-            if d not in accs:
-                accs[d] = step.mapaccum(f"kf_{d}", d, [0, 1, 2], [0, 1, 2])
             sl = slice(a + 1, b + 1)
-            out = accs[d](x, P, nll, th * ARCSEC,
+            out = kf_accum(b - a, jit)(x, P, nll, th * ARCSEC,
                           ca.DM(np.hstack(list(win.Phi[sl]))), ca.DM(np.hstack(list(win.C[sl]))),
                           ca.DM(win.u_ref[sl].T), ca.DM(win.Rvar[sl].T), e[:, a:b], Qd)
             x, P, nll = out[0][:, -1], out[1][:, -6:], out[2][-1]
@@ -197,7 +219,10 @@ class BatchML:
                 "ipopt.limited_memory_initialization": "constant",
                 "ipopt.limited_memory_init_val": 1.0,
                 "ipopt.nlp_scaling_method": "none",
-                "ipopt.tol": tol, "ipopt.max_iter": max_iter}
+                "ipopt.tol": tol, "ipopt.max_iter": max_iter,
+                # no multipliers after the solve (nothing reads them; the bound-free NLP's lam_p
+                # costs one more reverse sweep through the whole window per solve)
+                "calc_lam_p": False, "calc_lam_x": False}
         self.solvers = [ca.nlpsol(f"batch_ml_{j}", "ipopt", {"x": eta, "p": p, "f": f}, opts)
                         for j, f in enumerate(objectives)]
         # objective and gradient in theta (arcsec) for the stationarity check; L = I, theta_s = 0
