@@ -59,10 +59,13 @@ if kind == "mc":  # variant:group:scheme, or variant:group = every scheme in one
     from opnav.approach.pipeline import run_group
     v, g, *m = spec.split(":")
     schemes = m or list(cfg["methods"]) + [f"growing-{x}" for x in cfg["growing"]["methods"]]
-    res = []
+    res, shared = [], {}
     for sch in schemes:
         mode, _, meth = sch.rpartition("-")
-        res.extend(run_group(setup, v, g, meth, mode or "sliding"))
+        try:  # the schemes of a job share the simulation (run_group's shared=, since this change)
+            res.extend(run_group(setup, v, g, meth, mode or "sliding", shared=shared))
+        except TypeError:
+            res.extend(run_group(setup, v, g, meth, mode or "sliding"))
 else:
     from opnav.approach import alternatives as alt, scenario as sc
     v, g = spec.split(":")

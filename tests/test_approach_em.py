@@ -185,6 +185,24 @@ def test_stacking_cases_in_one_batch_equals_separate_runs():
         np.testing.assert_allclose(r["nav_err_after_km"], alone["nav_err_after_km"], rtol=1e-9)
 
 
+def test_em_schemes_sharing_a_jobs_simulation_equal_separate_runs():
+    """run_group's shared cache (one Snakemake job, every EM scheme) gives each scheme the
+    numbers of its own run, bit for bit."""
+    import pickle
+
+    cfg = approach_cfg(N0=20, N=20, M=2, L=2)
+    cfg["n_seeds"] = 2
+    cfg["growing"]["N"] = 20
+    shared = {}
+    for mode, method in (("sliding", "plain"), ("sliding", "squarem"), ("growing", "squarem")):
+        alone = pipeline.run_group(cfg, "prior", "pixel", method, mode)
+        together = pipeline.run_group(cfg, "prior", "pixel", method, mode, shared=shared)
+        assert pickle.dumps(together) == pickle.dumps(alone)
+    assert len([k for k in shared if k[0] == "bounds"]) == 2  # one per segment mode
+    with pytest.raises(ValueError, match="one setup, variant and group"):
+        pipeline.run_group(cfg, "prior", "size", "plain", shared=shared)
+
+
 # ------------------------------------------------ the central readings (issue 11 item 4)
 def _segment_run(variant, method="plain", seeds=range(4), **seg):
     cfg = approach_cfg(**{**dict(N0=200, N=50, M=5, L=6), **seg})

@@ -13,8 +13,9 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     w = snakemake.wildcards
     setup = Setup.from_config(snakemake.params.approach)
+    shared = {}  # the schemes share the simulation, the theta = 0 filter and a mode's bounds
     for scheme, out in zip(snakemake.params.schemes, snakemake.output):
         mode, _, method = scheme.rpartition("-")  # "growing-squarem" -> growing windows, SQUAREM
-        res = run_group(setup, w.variant, w.group, method, mode or "sliding", log=log)
+        res = run_group(setup, w.variant, w.group, method, mode or "sliding", log=log, shared=shared)
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         save_pickle(out, res)

@@ -19,13 +19,13 @@ with script_context(snakemake) as log:
         from opnav.landing.study import run_runs
     else:
         from opnav.approach.study import run_runs
-    frames = []
+    frames, shared = [], {}  # paper A: the estimators of a variant share its geometry and bounds
     for unit in snakemake.params.units:
         if w.spaper == "landing":
             frames.append(run_runs(snakemake.params.sim, unit, runs))
         else:
             variant, method = unit.split("__")
-            frames.append(run_runs(snakemake.params.sim, variant, method, runs))
+            frames.append(run_runs(snakemake.params.sim, variant, method, runs, shared=shared))
         log.info("%s %s %s: runs %d..%d", w.spaper, w.sdigest, unit, runs[0], runs[-1])
     with atomic_target(snakemake.output[0]) as tmp:
         pd.concat(frames, ignore_index=True).to_csv(tmp, index=False)

@@ -171,15 +171,33 @@ def run_case(setup: Setup | dict, variant: str, case: Case, seed_indices, geo: s
     return run_cases(setup, variant, [case], seed_indices, geo, method, init_mode)[0]
 
 
-def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
-              geo: sc.Geometry | None = None, method: str | None = None, init_mode: str | None = None
-              ) -> list[dict]:
-    """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
-    of the stacked filter arrays (runs are independent; each keeps its own stream)."""
+@dataclass
+class CaseData:
+    """What every EM scheme of :func:`run_cases` shares for one variant, case list and seed
+    set: the stacked measurements ``z (S, n+1, 3)``, prior mean deviations ``dx0 (S, 6)``,
+    variances ``Rvar`` ((n+1, 3), or (n+1, S, 3) when the cases' pixel noise differs),
+    initial theta (S, 3) rad, the window of the whole arc, the theta = 0 filter over it
+    (``f0``) with its position errors and consistency, and the start states of the
+    windows, per start list (filled by :func:`run_cases`). Built by :func:`prepare_cases`."""
+
+    geo: sc.Geometry
+    z: np.ndarray
+    dx0: np.ndarray
+    Rvar: np.ndarray
+    theta0: np.ndarray
+    win: object
+    f0: object
+    err_before: np.ndarray
+    cons_before: dict
+    starts: dict
+
+
+def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
+                  geo: sc.Geometry | None = None, init_mode: str | None = None) -> CaseData:
+    """Simulate every (case, seed) run of ``case_list`` (one row each of the stacked filter
+    arrays; each keeps its own stream) and run the theta = 0 filter over the whole arc."""
     setup = Setup.of(setup)
     geo = geo or sc.build_geometry(setup, variant)
-    em_set = setup.em
-    method = method or em_set.method
     init_mode = init_mode or setup.initial_error.mode
     seed_indices = list(seed_indices)
     ns = len(seed_indices)
@@ -198,11 +216,29 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     theta = np.concatenate(inits).copy()
     win = geo.window(Rvar)
     S = z.shape[0]
+    f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win, predicted=False)
+    err_before = np.linalg.norm(f0.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
+    return CaseData(geo, z, dx0, Rvar, theta, win, f0, err_before, consistency(f0, geo.dx_true), {})
+
+
+def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
+              geo: sc.Geometry | None = None, method: str | None = None, init_mode: str | None = None,
+              data: CaseData | None = None) -> list[dict]:
+    """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
+    of the stacked filter arrays (runs are independent; each keeps its own stream).
+    ``data``: the :func:`prepare_cases` of these arguments, shared by several EM schemes
+    (``method``, ``setup.segments``)."""
+    setup = Setup.of(setup)
+    em_set = setup.em
+    method = method or em_set.method
+    seed_indices = list(seed_indices)
+    ns = len(seed_indices)
+    if data is None:
+        data = prepare_cases(setup, variant, case_list, seed_indices, geo, init_mode)
+    geo, z, dx0, theta, win, f0 = data.geo, data.z, data.dx0, data.theta0.copy(), data.win, data.f0
+    err_before = data.err_before
     dx_true = geo.dx_true
     tz_tol = em_set.tz_tol
-
-    f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win, predicted=False)
-    err_before = np.linalg.norm(f0.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
 
     start = sc.START_OF[variant]
     windows = setup.segments.windows()
@@ -211,7 +247,10 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     seg_theta, it_theta, it_ll, it_data = [], [], [], []
     seg_lat, seg_rng, seg_lat3, seg_rng3 = [], [], [], []
     unobs = None
-    starts = start_states(start, [a for (a, _) in windows], f0, dx_true, dx0, geo.P0, win)
+    key = (start, tuple(a for (a, _) in windows))
+    if key not in data.starts:
+        data.starts[key] = start_states(start, list(key[1]), f0, dx_true, dx0, geo.P0, win)
+    starts = data.starts[key]
     for (a, b), (x0, P0) in zip(windows, starts):
         theta_seg_start = theta
         tr = em_window(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), M, method, tz_tol)
@@ -252,7 +291,7 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     seg_lat, seg_rng = np.stack(seg_lat, 1), np.stack(seg_rng, 1)
     seg_lat3, seg_rng3 = np.stack(seg_lat3, 1), np.stack(seg_rng3, 1)
     nb, na = rms_last(err_before, frac), rms_last(err_after, frac)
-    cons = {"before": consistency(f0, dx_true), "after": consistency(f1, dx_true)}
+    cons = {"before": data.cons_before, "after": consistency(f1, dx_true)}
     out = []
     for i, case in enumerate(case_list):
         sl = slice(i * ns, (i + 1) * ns)

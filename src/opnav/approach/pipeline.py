@@ -136,22 +136,39 @@ def cases_in(setup: Setup | dict, group: str) -> list[cases.Case]:
 
 
 def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: str = "sliding",
-              log=None) -> list[dict]:
+              log=None, shared: dict | None = None) -> list[dict]:
     """Monte Carlo of every case of ``group`` under ``variant``, EM ``method`` and segment
     ``mode``, each case with the bound of the data its estimate used (``crlb_arcsec``; per
     segment ``crlb_seg_arcsec``; the same with Q = 0 beside), the bound of all data
     (``crlb_total_arcsec``) and, for the headline case, a rerun with the initial error drawn
-    from the prior (``sampled``: the only spread that may be set beside a Bayesian bound)."""
-    setup = Setup.of(setup).scheme(mode)
-    geo = sc.build_geometry(setup, variant)
+    from the prior (``sampled``: the only spread that may be set beside a Bayesian bound).
+
+    ``shared``: one dict passed to the calls of every EM scheme (``method``, ``mode``) of the
+    same ``setup``, ``variant`` and ``group`` (one Snakemake job): they then share the
+    geometry, the simulated measurements, the theta = 0 filter and the bounds of a mode,
+    computed by the first call (the same numbers as computed by each)."""
+    base = Setup.of(setup)
+    setup = base.scheme(mode)
+    shared = {} if shared is None else shared
+    if shared.setdefault("key", (base, variant, group)) != (base, variant, group):
+        raise ValueError("run_group: a shared cache is for one setup, variant and group")
+    n = setup.segments.n_samples
+    if ("geo", n) not in shared:
+        shared[("geo", n)] = sc.build_geometry(setup, variant)
+    geo = shared[("geo", n)]
     seeds = range(setup.n_seeds)
     out = []
     clist = cases_in(setup, group)
     head = [c for c in clist if c.case_index == 1]
-    runs = cases.run_cases(setup, variant, clist + [replace(c, init_mode="sampled") for c in head],
-                           seeds, geo=geo, method=method)
+    runs_list = clist + [replace(c, init_mode="sampled") for c in head]
+    if ("data", n) not in shared:
+        shared[("data", n)] = cases.prepare_cases(setup, variant, runs_list, seeds, geo=geo)
+    runs = cases.run_cases(setup, variant, runs_list, seeds, geo=geo, method=method, data=shared[("data", n)])
     sampled = runs[len(clist):]
-    bounds = case_bounds(setup, geo, clist, variant)
+    bkey = ("bounds", setup.segments)
+    if bkey not in shared:
+        shared[bkey] = case_bounds(setup, geo, clist, variant)
+    bounds = shared[bkey]
     for case, r, b in zip(clist, runs, bounds):
         r.update(b)
         r.update(method=method, group=group, case=case)

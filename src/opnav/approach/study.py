@@ -31,19 +31,27 @@ from .pipeline import segment_bounds, total_bound
 from .setup import Setup
 
 
-def run_runs(setup: Setup | dict, variant: str, method: str, seeds) -> pd.DataFrame:
-    """One row per seed (module docstring)."""
+def run_runs(setup: Setup | dict, variant: str, method: str, seeds, shared: dict | None = None) -> pd.DataFrame:
+    """One row per seed (module docstring). ``shared``: one dict for the calls of one job (same
+    ``setup``): the estimators of a variant then share its geometry and bounds."""
     setup = Setup.of(setup)
     seeds = [int(s) for s in seeds]
     case = cases.headline_case(setup)
-    geo = sc.build_geometry(setup, variant)
+    shared = {} if shared is None else shared
+    key = (setup, variant)
+    if key not in shared:
+        geo = sc.build_geometry(setup, variant)
+        Rvar = geo.measurement_variance(case.sigma3_px)
+        shared[key] = {"geo": geo, "crlb": total_bound(setup, geo, Rvar, case.truth_arcsec, variant)}
+    geo, crlb = shared[key]["geo"], shared[key]["crlb"]
     used = setup.segments.data_samples
-    crlb = total_bound(setup, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec, variant)
     if method.startswith("em"):
         scheme = setup.em.method if method == "em" else method.removeprefix("em_")
         r = cases.run_case(setup, variant, case, seeds, geo=geo, method=scheme)
-        crlb_used = segment_bounds(setup, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec,
-                                   variant)[-1]
+        if "crlb_used" not in shared[key]:
+            shared[key]["crlb_used"] = segment_bounds(setup, geo, geo.measurement_variance(case.sigma3_px),
+                                                      case.truth_arcsec, variant)[-1]
+        crlb_used = shared[key]["crlb_used"]
         stalled = 100.0 * np.asarray(r["stalled"], float)
     elif method == "augmented":
         r = alt.run_case_alternatives(setup, variant, case, seeds, geo, methods=("augmented",))
