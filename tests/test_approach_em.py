@@ -185,6 +185,25 @@ def test_stacking_cases_in_one_batch_equals_separate_runs():
         np.testing.assert_allclose(r["nav_err_after_km"], alone["nav_err_after_km"], rtol=1e-9)
 
 
+def test_los_moments_are_the_einsums_bits():
+    """E[u u^T] summed elementwise in the einsum's order gives its numbers bit for bit
+    (the E-step's numbers must not move with the faster form)."""
+    cfg = pipeline.Setup.of(approach_cfg(N0=20, N=30, M=1, L=1))
+    case = cases.headline_case(cfg)
+    for variant in ("literal", "roll"):
+        geo = sc.build_geometry(cfg, variant)
+        Rvar, z, dx0 = cases.simulate_case(cfg, geo, case, range(3), "sampled")
+        win = geo.window(Rvar).slice(20, 50)
+        f = ekf.run_filter(z[:, 20:51], np.full((3, 3), 2e-5), dx0, geo.P0, win, predicted=False)
+        s = smoother.bryson_frazier(f, win, ekf.POS)
+        m, Mom = em.los_moments(s, win)
+        C = win.C[1:]
+        ref = (np.einsum("kij,skjl,kml->skim", C, s.Ps[:, 1:, :3, :3], C)
+               + np.einsum("ski,skj->skij", m, m))
+        assert Mom.shape == ref.shape and Mom.strides == ref.strides
+        assert Mom.tobytes() == ref.tobytes()
+
+
 def test_em_schemes_sharing_a_jobs_simulation_equal_separate_runs():
     """run_group's shared cache (one Snakemake job, every EM scheme) gives each scheme the
     numbers of its own run, bit for bit."""

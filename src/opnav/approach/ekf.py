@@ -108,7 +108,7 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     # einsum "sij,kjl->skil", several times faster)
     Hrs = -(A[:, None, :, 0, None] * win.C[None, :, None, 0, :] + A[:, None, :, 1, None] * win.C[None, :, None, 1, :]
             + A[:, None, :, 2, None] * win.C[None, :, None, 2, :])
-    Au = np.einsum("sij,kj->ski", A, win.u_ref)
+    d = z - np.einsum("sij,kj->ski", A, win.u_ref)  # z_k - A_m u_ref,k of every sample
     xf = np.empty((S, n + 1, 6))
     Pf = np.empty((S, n + 1, 6, 6))
     xp = np.zeros((S, n + 1, 6)) if predicted else None
@@ -121,11 +121,11 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     nus = np.zeros((S, n + 1, 3))
     dets = np.ones((S, n + 1))
     for k in range(1, n + 1):
-        x, P = kalman.predict(x, P, win.Phi[k], win.Q, single=True)
+        x, P = kalman.predict(x, P, win.Phi[k], win.Q)
         if predicted:
             xp[:, k], Pp[:, k] = x, P
         Hr = Hrs[:, k]
-        nu = z[:, k] - Au[:, k] - (Hr @ x[:, :3, None])[..., 0]
+        nu = d[:, k] - (Hr @ x[:, :3, None])[..., 0]
         x, P, K, Sinv, det = kalman.condition_on(x, P, Hr, win.Rvar[k], nu, cols=POS)
         xf[:, k], Pf[:, k] = x, P
         Ks[:, k], Sinvs[:, k], nus[:, k], dets[:, k] = K, Sinv, nu, det
@@ -150,7 +150,7 @@ def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window, at=None):
     xs, Ps, done = [], [], 0
     for stop in stops:
         for k in range(done + 1, stop + 1):
-            x, P = kalman.predict(x, P, win.Phi[k], win.Q, single=True)
+            x, P = kalman.predict(x, P, win.Phi[k], win.Q)
         done = stop
         xs.append(x)
         Ps.append(P)

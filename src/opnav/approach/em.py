@@ -51,11 +51,27 @@ class EStats:
 
 
 def los_moments(s: SmootherResult, win: Window) -> tuple[np.ndarray, np.ndarray]:
-    """Mean (S,n,3) and second moment E[u u^T] (S,n,3,3) of u_k, samples 1..n."""
+    """Mean (S,n,3) and second moment E[u u^T] (S,n,3,3) of u_k, samples 1..n.
+
+    ``E[u u^T] = C P_rr C^T + m m^T`` with ``(C P C^T)_im = sum_j sum_l (C_ij P_jl) C_ml``,
+    summed in that order (j outer, l inner) from zero: the bits of
+    ``numpy.einsum("kij,skjl,kml->skim", C, P, C)`` (a test checks it), as whole-array
+    products over (seed, sample), about four times faster than the einsum."""
     C = win.C[1:]
     m = win.u_ref[1:] - np.einsum("kij,skj->ski", C, s.xs[:, 1:, :3])
-    Cu = np.einsum("kij,skjl,kml->skim", C, s.Ps[:, 1:, :3, :3], C)
-    return m, Cu + np.einsum("ski,skj->skij", m, m)
+    Ct = np.ascontiguousarray(C.transpose(1, 2, 0))  # (i, j, k)
+    Pt = np.ascontiguousarray(s.Ps[:, 1:, :3, :3].transpose(2, 3, 0, 1))  # (j, l, s, k)
+    mt = np.ascontiguousarray(m.transpose(2, 0, 1))  # (i, s, k)
+    Mom = np.empty(m.shape + (3,))
+    for i in range(3):
+        a = [[Ct[i, j] * Pt[j, l] for l in range(3)] for j in range(3)]
+        for k in range(3):
+            acc = 0.0
+            for j in range(3):
+                for l in range(3):
+                    acc = acc + a[j][l] * Ct[k, l]
+            Mom[..., i, k] = acc + mt[i] * mt[k]
+    return m, Mom
 
 
 def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:

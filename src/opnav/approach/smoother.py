@@ -24,7 +24,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kalman
 from .ekf import FilterResult, Window
 
 
@@ -115,9 +114,8 @@ def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> S
         lt = (CtT @ lv[..., None])[..., 0]
         lt[:, :3] -= HSnu[:, k]
         Phi = win.Phi[k]
-        L = kalman.shared_right(kalman.shared_left(Phi.T, Lt), Phi)  # Phi^T Lt Phi
-        lv = lt @ Phi
-        Lh[:, k - 1], lh[:, k - 1] = L, lv
+        L = np.matmul(Phi.T @ Lt, Phi, out=Lh[:, k - 1])  # Phi^T Lt Phi, stored in place
+        lv = np.matmul(lt, Phi, out=lh[:, k - 1])
     Pr = f.Pf[..., cols, :]
     xs = f.xf[..., cols] - np.einsum("skij,skj->ski", Pr, lh)
     Ps = f.Pf[..., cols, cols] - Pr @ Lh @ f.Pf[..., :, cols]
