@@ -37,6 +37,35 @@ def test_paired_t_matches_scipy_ttest_rel():
     assert p == pytest.approx(ref.pvalue, rel=1e-10)
 
 
+@settings(max_examples=300, deadline=None)
+@given(n=st.integers(2, 2_000_000), level=st.floats(1e-6, 1 - 1e-6),
+       d=st.floats(-1e6, 1e6, allow_subnormal=False), s=st.floats(1e-9, 1e6))
+def test_paired_t_is_scipy_stats_t_bit_for_bit(n, level, d, s):
+    # paired_t_interval calls scipy.special (stdtrit, stdtr) rather than importing
+    # scipy.stats (0.4 CPU-s a job); its quantile and p-value are scipy.stats.t's bits
+    from opnav.landing import ranking
+
+    q_ref = float(stats.t.ppf(0.5 + level / 2.0, n - 1))
+    p_ref = float(2.0 * stats.t.sf(abs(d) / s, n - 1))
+    assert float(ranking.special.stdtrit(n - 1, 0.5 + level / 2.0)) == q_ref or math.isnan(q_ref)
+    assert float(2.0 * ranking.special.stdtr(n - 1, -(abs(d) / s))) == p_ref
+
+
+@settings(max_examples=100, deadline=None)
+@given(x=st.lists(st.floats(-1e3, 1e3, allow_subnormal=False), min_size=2, max_size=50),
+       level=st.floats(0.5, 0.999))
+def test_paired_t_interval_uses_scipy_stats_bits(x, level):
+    m, lo, hi, p = paired_t_interval(x, level)
+    d = np.asarray(x, float)
+    sd = float(d.std(ddof=1))
+    if sd == 0.0:
+        return
+    se = sd / math.sqrt(d.size)
+    q = float(stats.t.ppf(0.5 + level / 2.0, d.size - 1))
+    assert (lo, hi) == (m - q * se, m + q * se)
+    assert p == float(2.0 * stats.t.sf(abs(m) / se, d.size - 1))
+
+
 def test_paired_t_degenerate_and_errors():
     assert paired_t_interval([2.0, 2.0, 2.0]) == (2.0, 2.0, 2.0, 0.0)
     assert paired_t_interval([0.0, 0.0]) == (0.0, 0.0, 0.0, 1.0)

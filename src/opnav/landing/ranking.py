@@ -29,7 +29,9 @@ import math
 
 import numpy as np
 import pandas as pd
-from scipy import stats
+# Student's t by its special functions (what scipy.stats.t calls, same bits, tested):
+# importing scipy.stats costs a job about 0.4 CPU-s more than scipy.special.
+from scipy import special
 
 from opnav.landing.montecarlo import per_run_stats, same_pick_pct
 
@@ -57,8 +59,8 @@ def paired_t_interval(d, level: float = 0.95) -> tuple[float, float, float, floa
     if s == 0.0:
         return m, m, m, 1.0 if m == 0.0 else 0.0
     se = s / math.sqrt(n)
-    q = float(stats.t.ppf(0.5 + level / 2.0, n - 1))
-    p = float(2.0 * stats.t.sf(abs(m) / se, n - 1))
+    q = float(special.stdtrit(n - 1, 0.5 + level / 2.0))  # t_{n-1} quantile: stats.t.ppf
+    p = float(2.0 * special.stdtr(n - 1, -(abs(m) / se)))  # upper tail: stats.t.sf
     return m, m - q * se, m + q * se, p
 
 
