@@ -12,6 +12,7 @@ for debugging, e.g.::
 from __future__ import annotations
 
 import contextlib
+import gc
 import logging
 import resource
 import sys
@@ -37,6 +38,10 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         yield logger
         return
     Path(log_path).parent.mkdir(parents=True, exist_ok=True)
+    # A job is one short-lived process whose imported libraries' objects (numpy, scipy,
+    # pandas, matplotlib, CasADi) live until it ends: frozen, the cyclic collector no
+    # longer walks them at every full collection nor at exit (about 0.2 CPU-s a job).
+    gc.freeze()
     with open(log_path, "w") as fh:
         handler = logging.StreamHandler(fh)
         handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"))
@@ -57,6 +62,7 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         finally:
             sys.stderr, sys.stdout = old_err, old_out
             logger.removeHandler(handler)
+            gc.freeze()  # and what the job imported or made since: the process ends now
 
 
 #: prefix of the last log line of a successful job (:func:`resource_line`)
