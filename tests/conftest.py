@@ -114,3 +114,14 @@ def _dry_run_jobs(proc: subprocess.CompletedProcess) -> list[tuple[str, dict]]:
         pairs = dict(kv.split("=", 1) for kv in wc.group(1).split(", ")) if wc else {}
         jobs.append((m.group(1), pairs))
     return jobs
+
+
+# ------------------------------------------------------------ hypothesis
+# The same examples on every run (CI included): a property test that fails on one
+# clone fails on every clone, and a green suite stays green. `HYPOTHESIS_PROFILE=explore
+# pytest` draws fresh examples (more of them) to hunt for new counterexamples.
+from hypothesis import settings as _hyp_settings  # noqa: E402
+
+_hyp_settings.register_profile("repro", derandomize=True)
+_hyp_settings.register_profile("explore", derandomize=False, max_examples=200)
+_hyp_settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repro"))
