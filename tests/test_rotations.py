@@ -5,7 +5,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 
-from opnav.rotations import exp_so3, log_so3, skew
+from opnav.rotations import cross, exp_so3, log_so3, skew
 
 
 def _vectors(seed, shape, scale):
@@ -49,3 +49,19 @@ def test_skew_is_the_cross_product_and_exp_is_first_order_i_plus_skew():
     np.testing.assert_allclose(exp_so3(d), np.eye(3) + skew(d), atol=1e-13)
     # exp of the rotation vector rotates about it (active): axis fixed, e_x -> e_y for +90 deg about z
     np.testing.assert_allclose(exp_so3(np.array([0, 0, np.pi / 2])) @ [1.0, 0, 0], [0, 1, 0], atol=1e-15)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from([(), (5,), (4, 1), (3, 7)]), st.sampled_from([(), (7,), (1, 7), (3, 7)]))
+def test_cross_is_numpys_bit_for_bit_under_broadcasting(seed, sa, sb):
+    """rotations.cross: np.cross's values to the bit, on broadcast shapes (the batched
+    planner's (runs, 1, 3) x (runs, n, 3)), with exact zeros among the components."""
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=sa + (3,)), rng.normal(size=sb + (3,))
+    a[..., 2] = 0.0 if seed % 2 else a[..., 2]
+    try:
+        want = np.cross(a, b)
+    except ValueError:                 # shapes that do not broadcast
+        return
+    got = cross(a, b)
+    assert got.shape == want.shape and np.array_equal(got, want)

@@ -46,9 +46,20 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["skew", "exp_so3", "log_so3"]
+__all__ = ["skew", "cross", "exp_so3", "log_so3"]
 
 _EYE3 = np.eye(3)
+
+
+def cross(a, b) -> np.ndarray:
+    """``np.cross(a, b)`` of broadcast (..., 3) arrays, its arithmetic (``a1 b2 - a2
+    b1``, ...: the same bits, tested) without its broadcasting copies: ~8x faster on
+    the batched planner's runs x detected landmarks (measured, 10 x 7000)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def skew(a) -> np.ndarray:

@@ -166,6 +166,7 @@ from scipy.linalg.lapack import dsyev as _dsyev
 
 from opnav.landing import casadi_model as cm
 from opnav.landing import measurement as me
+from opnav.rotations import cross
 
 METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig", "svd_w", "gdop_w", "cond_w")
 H_METRICS = ("svd", "gdop", "cond")
@@ -1037,7 +1038,7 @@ def _score_pairs(name: str, st: ContextStack, ri, p, d, rho) -> np.ndarray:
     if name in H_METRICS:
         u = tk(st.u, ri)
         w = d / rho[:, None]
-        cr = np.cross(u, w)
+        cr = cross(u, w)
         # row sums (not w @ u): the bits of one candidate at a time, whatever the batch
         add = np.add.reduce
         return structural_scores(name, tk(st.x, ri), 1.0 / rho, add(w * u, axis=-1),

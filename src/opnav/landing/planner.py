@@ -71,6 +71,7 @@ from opnav.landing.depth_error import (DegenerateGeometry, PlaneGeometry, baseli
                                        depth_error_scalar, error_radius, ground_point_scalar,
                                        plane_geometry)
 from opnav.landing.landmarks import LandmarkField, nearest_brute_force
+from opnav.rotations import cross
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig",
            "plan", "plan_batch", "golden_section_batch", "OBJECTIVES", "PICKERS",
@@ -621,7 +622,7 @@ class _Contexts:
             w = d2 / rho2[..., None]
             u = self.u[i]
             cg = np.einsum("...k,...k->...", w, u)
-            cr = np.cross(u, w)
+            cr = cross(u, w)
             s2 = np.einsum("...k,...k->...", cr, cr)
             sc = metrics.structural_scores(name, self.x[i], 1.0 / rho2, cg, s2)
         return np.where(ok, sc, -np.inf)
