@@ -66,7 +66,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from . import camera
@@ -176,6 +175,8 @@ def two_body_check(geo: sc.Geometry) -> dict:
     over the arc; ``two_body_pos_err_km``: max |r_2body - r_true| (Mars-centred)
     of a two-body propagation from the true state at t0 over the arc.
     """
+    from scipy.integrate import solve_ivp  # 0.3 s of import: only the jobs that call this pay it
+
     r_rel = geo.X_true[:, :3] - geo.X_mars[:, :3]
 
     def a_sun(r):
