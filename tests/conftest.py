@@ -1,13 +1,20 @@
 import os
-import re
-import signal
-import subprocess
-import sys
-from pathlib import Path
 
-import pytest
+# One BLAS thread, before anything imports numpy: as every workflow job (Snakemake sets
+# OPENBLAS_NUM_THREADS to a job's threads, 1), so the in-process numerics compute what the
+# jobs compute, and share the two cores with the background quick build without OpenBLAS
+# threads spinning against it. Inherited by the snakemake runs the tests start.
+os.environ["OPENBLAS_NUM_THREADS"] = "1"
 
-from opnav.snakeio import copy_workflow as _copy_workflow
+import re  # noqa: E402
+import signal  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import pytest  # noqa: E402
+
+from opnav.snakeio import copy_workflow as _copy_workflow  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 
