@@ -35,6 +35,18 @@ onstart:
     compileall.compile_dir(str(Path(opnav.__file__).parent), quiet=1)
 
 
+# Snakemake's scheduler re-checks its job-rate limit with a timer per scheduling round
+# (a pending timer, restarted at every round, for each finished job: thousands of rounds
+# in a quick run; snakemake/snakemake#3744). profiles/default checks it every 10 s,
+# and these handlers cancel the timers still pending, which would hold the exit.
+onsuccess:
+    stop_rate_limit_timers()
+
+
+onerror:
+    stop_rate_limit_timers()
+
+
 rule all:
     default_target: True
     input:

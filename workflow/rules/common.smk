@@ -24,6 +24,16 @@ SRC = Path(workflow.basedir) / "src" / "opnav"
 
 
 
+def stop_rate_limit_timers():
+    """Cancel the scheduler's pending job-rate re-check timers (threading.Timer, not
+    daemon threads: Python would wait for them at exit); see the Snakefile."""
+    import threading
+
+    for t in threading.enumerate():
+        if isinstance(t, threading.Timer):
+            t.cancel()
+
+
 def res(*parts):
     """Path under the results directory."""
     return str(Path(RESULTS, *parts))
