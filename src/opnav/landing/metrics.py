@@ -467,7 +467,10 @@ def _tangent_scores(name: str, G: np.ndarray, Sig: np.ndarray, ld) -> np.ndarray
     """logdet / mineig from the whitened tangent rows G (..., 2, 12)
     (``measurement.tangent_jacobian``) and the known-landmark posterior Sigma_k
     (..., 12, 12) with its log det ``ld`` (...), see :func:`_tangent_setup`."""
-    GS = G @ Sig  # (..., 2, 12)
+    if Sig.ndim == 2:   # one context: one GEMM for all candidates (the bits of the
+        GS = (G.reshape(-1, 12) @ Sig).reshape(G.shape)     # broadcast matmul, 6x faster)
+    else:
+        GS = G @ Sig  # (..., 2, 12)
     Q = GS @ np.swapaxes(G, -1, -2)
     a = 1.0 + Q[..., 0, 0]
     b = 0.5 * (Q[..., 0, 1] + Q[..., 1, 0])
