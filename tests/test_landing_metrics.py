@@ -589,7 +589,7 @@ def test_whitened_screen_scores_only_the_contenders_exactly(name, seed):
     n = len(p)
     G2 = G.reshape(2 * n, 12)
     Bt = (G2 @ GkP.T).reshape(n, 2, 2)
-    D = np.einsum("nik,njk->nij", (G2 @ P).reshape(n, 2, 12), G)
+    D = (G2 @ P).reshape(n, 2, 12) @ np.swapaxes(G, 1, 2)
     D = 0.5 * (D + np.swapaxes(D, 1, 2))
     M = np.empty((n, 4, 4))
     M[:, 0:2, 0:2], M[:, 2:4, 0:2], M[:, 0:2, 2:4], M[:, 2:4, 2:4] = K, Bt, np.swapaxes(Bt, 1, 2), D

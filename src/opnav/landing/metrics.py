@@ -667,7 +667,7 @@ def _whitened_tangent_scores(name: str, ctx: MetricContext, wt, p: np.ndarray
     G2 = G.reshape(2 * n, 12)                                     # one GEMM for all candidates
     GP = (G2 @ P).reshape(n, 2, 12)
     Bt = (G2 @ GkP.T).reshape(n, 2, 2)                             # B^T = G_c P G_k^T
-    D = np.einsum("nik,njk->nij", GP, G)
+    D = GP @ np.swapaxes(G, 1, 2)           # (stacked matmul: ~4x einsum's speed here)
     D = 0.5 * (D + np.swapaxes(D, 1, 2))
     c = ctx._cache
     if "wtangent_Kinv" not in c:
@@ -742,7 +742,7 @@ def _mineig_bounds(ctx: MetricContext, tg, p: np.ndarray, rtol: float | None = N
     n = len(p)
     G = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, p, math.sqrt(w))   # (n, 2, 12)
     GS = (G.reshape(2 * n, 12) @ Sig).reshape(n, 2, 12)             # one GEMM for all candidates
-    Q = np.einsum("nik,njk->nij", GS, G)
+    Q = GS @ np.swapaxes(G, 1, 2)           # (stacked matmul: ~4x einsum's speed here)
     a = 1.0 + Q[:, 0, 0]
     b = 0.5 * (Q[:, 0, 1] + Q[:, 1, 0])
     d = 1.0 + Q[:, 1, 1]
