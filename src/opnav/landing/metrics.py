@@ -670,9 +670,9 @@ def _whitened_tangent_scores(name: str, ctx: MetricContext, wt, p: np.ndarray
     D = GP @ np.swapaxes(G, 1, 2)           # (stacked matmul: ~4x einsum's speed here)
     D = 0.5 * (D + np.swapaxes(D, 1, 2))
     c = ctx._cache
-    if "wtangent_Kinv" not in c:
-        c["wtangent_Kinv"] = (np.linalg.inv(K), np.linalg.eigvalsh(K))
-    Kinv, kap = c["wtangent_Kinv"]
+    if "wtangent_K" not in c:
+        c["wtangent_K"] = (np.linalg.inv(K), np.linalg.eigvalsh(K))
+    Kinv, kap = c["wtangent_K"]                                  # K^-1, eig(K)
     if WHITENED[name] == "gdop":
         X = Kinv @ np.swapaxes(Bt, 1, 2)                           # K^-1 B (n, 2, 2)
         S = D - Bt @ X

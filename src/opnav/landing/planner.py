@@ -1052,7 +1052,7 @@ def _pick_nearest_batch(field_: LandmarkField, points: np.ndarray, detected: np.
 
 #: metrics whose screening (:meth:`metrics.Metric.screen`) is cheaper than their
 #: fastest explicit path: mineig (bounds, no 12 x 12 eigenproblem per candidate)
-#: and the whitened ones (4 x 4 tangent Gram instead of 6 x 6); for logdet the
+#: and the whitened ones (2 x 2 bounds, a 4 x 4 Gram near the best); for logdet the
 #: screen is the fast path itself
 _SCREEN_FIRST = ("mineig",) + tuple(metrics.WHITENED)
 
