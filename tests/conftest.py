@@ -6,10 +6,15 @@ import os
 # threads spinning against it. Inherited by the snakemake runs the tests start.
 os.environ["OPENBLAS_NUM_THREADS"] = "1"
 
+import atexit  # noqa: E402
+import json  # noqa: E402
 import re  # noqa: E402
+import shutil  # noqa: E402
 import signal  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tempfile  # noqa: E402
+import threading  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import pytest  # noqa: E402
@@ -33,9 +38,80 @@ def _snakemake_cmd(cwd: Path, *args: str) -> tuple[list[str], dict]:
 
 
 def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.CompletedProcess:
-    """Run snakemake in ``cwd`` (see :func:`_snakemake_cmd`)."""
+    """Run snakemake in ``cwd`` (see :func:`_snakemake_cmd`): ``python -m snakemake``'s
+    main() on ``args``, forked from the session's snakemake server (tests/snakemake_server.py:
+    the same code, its imports paid once), or a fresh ``python -m snakemake`` with
+    OPNAV_TESTS_FORKSERVER=0."""
     cmd, env = _snakemake_cmd(cwd, *args)
-    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, check=check, env=env)
+    if os.environ.get("OPNAV_TESTS_FORKSERVER", "1") == "0":
+        return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, check=check, env=env)
+    rc, out, err = _SnakemakeServer.get().run(Path(cwd), list(args), env)
+    proc = subprocess.CompletedProcess(cmd, rc, out, err)
+    if check:
+        proc.check_returncode()
+    return proc
+
+
+class _SnakemakeServer:
+    """Client of tests/snakemake_server.py: one server per session, started at the
+    first run, requests from any thread (each its own forked child), stopped at exit."""
+
+    _instance = None
+    _start_lock = threading.Lock()
+
+    @classmethod
+    def get(cls) -> "_SnakemakeServer":
+        with cls._start_lock:
+            if cls._instance is None or cls._instance.proc.poll() is not None:
+                cls._instance = cls()
+            return cls._instance
+
+    def __init__(self):
+        self.proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name("snakemake_server.py"))],
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        assert "ready" in json.loads(self.proc.stdout.readline())
+        self.tmp = Path(tempfile.mkdtemp(prefix="snakemake-server-"))
+        self.lock = threading.Lock()
+        self.next_id = 0
+        self.replies: dict[int, int] = {}
+        self.events: dict[int, threading.Event] = {}
+        threading.Thread(target=self._read, daemon=True).start()
+        atexit.register(self.close)
+
+    def _read(self):
+        for line in self.proc.stdout:
+            msg = json.loads(line)
+            with self.lock:
+                self.replies[msg["id"]] = msg["rc"]
+                self.events[msg["id"]].set()
+        with self.lock:                      # the server died: wake every waiter
+            for ev in self.events.values():
+                ev.set()
+
+    def run(self, cwd: Path, args: list[str], env: dict) -> tuple[int, str, str]:
+        with self.lock:
+            rid = self.next_id
+            self.next_id += 1
+            ev = self.events[rid] = threading.Event()
+            out, err = self.tmp / f"{rid}.out", self.tmp / f"{rid}.err"
+            self.proc.stdin.write(json.dumps({"id": rid, "cwd": str(cwd), "argv": args, "env": env,
+                                              "stdout": str(out), "stderr": str(err)}) + "\n")
+            self.proc.stdin.flush()
+        ev.wait()
+        with self.lock:
+            rc = self.replies.pop(rid, None)
+            del self.events[rid]
+        assert rc is not None, "the snakemake server died"
+        texts = [p.read_text(errors="replace") for p in (out, err)]
+        out.unlink()
+        err.unlink()
+        return rc, *texts
+
+    def close(self):
+        if self.proc.poll() is None:
+            self.proc.stdin.close()
+            self.proc.wait(timeout=600)
+        shutil.rmtree(self.tmp, ignore_errors=True)
 
 
 @pytest.fixture()
