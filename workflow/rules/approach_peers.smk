@@ -12,20 +12,22 @@ HAVE_BSK = sys.modules.get("Basilisk", True) is not None and importlib.util.find
 if HAVE_BSK:
 
     rule approach_peer_ukf:
-        """Basilisk's pixelLineBiasUKF on the headline case's measurements of one variant
-        (same seeds as the EM-EKF), plus the zero-misalignment and truth-start runs."""
+        """Basilisk's pixelLineBiasUKF on the headline case's measurements of each A-P1 variant
+        (same seeds as the EM-EKF), plus the zero-misalignment and truth-start runs; every
+        variant in one job (they share the start-up and Basilisk's import, about 2 CPU-s)."""
         input:
             A_SRC + src("approach/peers.py"),
         output:
-            f"{A_WORK}/peers/{{variant}}.pkl",
+            expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
         params:
             approach=cfg("approach", "base_seed", "dt_s", "n_seeds", "mars_elements", "geometry",
                          "initial_error", "prior_sigma", "process_noise_diag", "camera",
                          "truth_bias_arcsec", "theta_init_arcsec", "segments", "roll", "peers"),
+            variants=A_P1_VARIANTS,
         log:
-            f"{APPROACH}/logs/peer_ukf_{{variant}}.log",
+            f"{APPROACH}/logs/peer_ukf.log",
         benchmark:
-            f"{APPROACH}/benchmarks/peer_ukf_{{variant}}.tsv"
+            f"{APPROACH}/benchmarks/peer_ukf.tsv"
         script:
             "../scripts/approach_peer_ukf.py"
 

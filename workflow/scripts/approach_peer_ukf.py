@@ -1,4 +1,4 @@
-"""A-P1: Basilisk's pixelLineBiasUKF on one variant's headline-case measurements (one Snakemake job)."""
+"""A-P1: Basilisk's pixelLineBiasUKF on each A-P1 variant's headline-case measurements (one Snakemake job)."""
 
 import sys
 from pathlib import Path
@@ -8,9 +8,11 @@ from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
-    snakemake = mock_snakemake("approach_peer_ukf", argv=sys.argv[1:], variant="roll")
+    snakemake = mock_snakemake("approach_peer_ukf", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
-    res = run_variant(Setup.from_config(snakemake.params.approach), snakemake.wildcards.variant, log=log)
-    Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
-    save_pickle(snakemake.output[0], res)
+    setup = Setup.from_config(snakemake.params.approach)
+    for variant, out in zip(snakemake.params.variants, snakemake.output):
+        res = run_variant(setup, variant, log=log)
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        save_pickle(out, res)
