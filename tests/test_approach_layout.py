@@ -121,14 +121,3 @@ def test_filter_smoother_and_em_map_of_a_row_do_not_depend_on_the_other_rows(row
     s_full = bryson_frazier(run_filter(z, theta, x0, P0, win, predicted=False), win)
     s_one = bryson_frazier(run_filter(z[rows], theta[rows], x0[rows], P0[rows], win, predicted=False), win)
     assert np.array_equal(s_one.xs, s_full.xs[rows]) and np.array_equal(s_one.Ps, s_full.Ps[rows])
-
-
-@pytest.mark.parametrize("S,n,shared_w", [(1, 3, True), (10, 50, True), (7, 20, False)])
-def test_estep_einsum_with_a_cached_path_equals_optimize_true_bit_for_bit(S, n, shared_w):
-    rng = np.random.default_rng(S + n)
-    w = np.broadcast_to(rng.random((n, 3)), (S, n, 3)) if shared_w else rng.random((S, n, 3))
-    Mom, m, zz = rng.random((S, n, 3, 3)), rng.random((S, n, 3)), rng.random((S, n, 3))
-    for spec, ops in (("ijk,sti,inl,stjn->skl", (em.EPS, w, em.EPS, Mom)), ("ijk,stj,sti,sti->sk", (em.EPS, m, w, zz)),
-                      ("ijk,sti,stji->sk", (em.EPS, w, Mom))):
-        ref = np.einsum(spec, *ops, optimize=True)
-        assert np.array_equal(em._einsum(spec, *ops), ref) and np.array_equal(em._einsum(spec, *ops), ref)  # found, cached

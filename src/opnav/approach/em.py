@@ -74,27 +74,14 @@ def los_moments(s: SmootherResult, win: Window) -> tuple[np.ndarray, np.ndarray]
     return m, Mom
 
 
-_PATHS: dict = {}
-
-
-def _einsum(spec: str, *ops: np.ndarray) -> np.ndarray:
-    """``numpy.einsum(spec, *ops, optimize=True)`` with the contraction path found once per
-    operand shapes (the path search costs about as much as a short window's contraction;
-    it depends on the shapes only, so the same path and the same bits)."""
-    key = (spec,) + tuple(o.shape for o in ops)
-    path = _PATHS.get(key)
-    if path is None:
-        path = _PATHS[key] = np.einsum_path(spec, *ops, optimize=True)[0]
-    return np.einsum(spec, *ops, optimize=path)
-
-
 def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:
     """E-step statistics of eq. 23/26 for the closed-form M-step (see module docstring)."""
     m, Mom = los_moments(s, win)
     w = win.weights(z.shape[0])  # (S,n,3)
     zz = z[:, 1:]
-    N = _einsum("ijk,sti,inl,stjn->skl", EPS, w, EPS, Mom)
-    b = _einsum("ijk,stj,sti,sti->sk", EPS, m, w, zz) - _einsum("ijk,sti,stji->sk", EPS, w, Mom)
+    N = np.einsum("ijk,sti,inl,stjn->skl", EPS, w, EPS, Mom, optimize=True)
+    b = (np.einsum("ijk,stj,sti,sti->sk", EPS, m, w, zz, optimize=True)
+         - np.einsum("ijk,sti,stji->sk", EPS, w, Mom, optimize=True))
     return EStats(N, b)
 
 
