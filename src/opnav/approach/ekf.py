@@ -72,10 +72,10 @@ class FilterResult:
     Pp: np.ndarray  # (S, n+1, 6, 6)
     loglik: np.ndarray  # (S,)
     KH_last: np.ndarray  # (S, 6, 6)
-    K: np.ndarray | None = None  # (S, n+1, 6, 3) gains (run_filter: a view of a time-major array)
+    K: np.ndarray | None = None  # (S, n+1, 6, 3) gains
     Sinv: np.ndarray | None = None  # (S, n+1, 3, 3) inverse innovation covariances
     nu: np.ndarray | None = None  # (S, n+1, 3) innovations
-    Hr: np.ndarray | None = None  # (S, n+1, 3, 3) position block of H (likewise a view)
+    Hr: np.ndarray | None = None  # (S, n+1, 3, 3) position block of H
 
 
 def predicted_measurement(theta: np.ndarray, C: np.ndarray, u_ref: np.ndarray,
@@ -104,51 +104,37 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     """
     S, n = z.shape[0], win.n
     A = misalignment_small(theta)
-    # (n+1, S, 3, 3) position block of H, -A_m C: the sum over j in order (bit for bit the
-    # einsum "sij,kjl->skil", several times faster). The recursion works time-major (each
-    # sample's (S, ...) block contiguous for its products and stores) and hands out the
-    # usual seed-major arrays (the same values; K and Hr as views).
-    Hrs = -(A[None, :, :, 0, None] * win.C[:, None, None, 0, :] + A[None, :, :, 1, None] * win.C[:, None, None, 1, :]
-            + A[None, :, :, 2, None] * win.C[:, None, None, 2, :])
-    d = _time_major(z - np.einsum("sij,kj->ski", A, win.u_ref))  # z_k - A_m u_ref,k of every sample
-    xf = np.empty((n + 1, S, 6))
-    Pf = np.empty((n + 1, S, 6, 6))
-    xp = np.zeros((n + 1, S, 6)) if predicted else None
-    Pp = np.zeros((n + 1, S, 6, 6)) if predicted else None
+    # (S, n+1, 3, 3) position block of H, -A_m C: the sum over j in order (bit for bit the
+    # einsum "sij,kjl->skil", several times faster)
+    Hrs = -(A[:, None, :, 0, None] * win.C[None, :, None, 0, :] + A[:, None, :, 1, None] * win.C[None, :, None, 1, :]
+            + A[:, None, :, 2, None] * win.C[None, :, None, 2, :])
+    d = z - np.einsum("sij,kj->ski", A, win.u_ref)  # z_k - A_m u_ref,k of every sample
+    xf = np.empty((S, n + 1, 6))
+    Pf = np.empty((S, n + 1, 6, 6))
+    xp = np.zeros((S, n + 1, 6)) if predicted else None
+    Pp = np.zeros((S, n + 1, 6, 6)) if predicted else None
     x = np.array(x0, float)
     P = np.broadcast_to(P0, (S, 6, 6)).copy()
-    xf[0], Pf[0] = x, P
-    Ks = np.zeros((n + 1, S, 6, 3))
-    Sinvs = np.zeros((n + 1, S, 3, 3))
-    nus = np.zeros((n + 1, S, 3))
-    dets = np.ones((n + 1, S))
+    xf[:, 0], Pf[:, 0] = x, P
+    Ks = np.zeros((S, n + 1, 6, 3))
+    Sinvs = np.zeros((S, n + 1, 3, 3))
+    nus = np.zeros((S, n + 1, 3))
+    dets = np.ones((S, n + 1))
     for k in range(1, n + 1):
         x, P = kalman.predict(x, P, win.Phi[k], win.Q)
         if predicted:
-            xp[k], Pp[k] = x, P
-        Hr = Hrs[k]
-        nu = d[k] - (Hr @ x[:, :3, None])[..., 0]
+            xp[:, k], Pp[:, k] = x, P
+        Hr = Hrs[:, k]
+        nu = d[:, k] - (Hr @ x[:, :3, None])[..., 0]
         x, P, K, Sinv, det = kalman.condition_on(x, P, Hr, win.Rvar[k], nu, cols=POS)
-        xf[k], Pf[k] = x, P
-        Ks[k], Sinvs[k], nus[k], dets[k] = K, Sinv, nu, det
+        xf[:, k], Pf[:, k] = x, P
+        Ks[:, k], Sinvs[:, k], nus[:, k], dets[:, k] = K, Sinv, nu, det
     if np.any(dets <= 0):
         raise FloatingPointError("innovation covariance not positive definite")
-    xf, Pf, Sinvs, nus, dets = map(_seed_major, (xf, Pf, Sinvs, nus, dets))
-    Ks, Hrs = np.swapaxes(Ks, 0, 1), np.swapaxes(Hrs, 0, 1)  # views: only matrix products read them
-    if predicted:
-        xp, Pp = _seed_major(xp), _seed_major(Pp)
     ll = kalman.innovation_loglik(nus[:, 1:], Sinvs[:, 1:], dets[:, 1:]).sum(1)
     KH = np.zeros((S, 6, 6))
     KH[:, :, :3] = Ks[:, n] @ Hrs[:, n]
     return FilterResult(xf, Pf, xp, Pp, ll, KH, Ks, Sinvs, nus, Hrs)
-
-
-def _time_major(a: np.ndarray) -> np.ndarray:
-    """(S, n+1, ...) -> (n+1, S, ...) contiguous (a copy)."""
-    return np.ascontiguousarray(np.swapaxes(a, 0, 1))
-
-
-_seed_major = _time_major  # the inverse swap: (n+1, S, ...) -> (S, n+1, ...)
 
 
 def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window, at=None):

@@ -42,25 +42,23 @@ import numpy as np
 LOG2PI = np.log(2.0 * np.pi)
 
 
-_INV3_TERMS = np.array([[4, 2, 1, 0, 1, 0], [8, 5, 5, 8, 2, 4], [5, 1, 2, 2, 0, 1], [5, 8, 4, 2, 5, 1]])
-_INV3_OUT = np.array([0, 1, 2, 1, 3, 4, 2, 4, 5])
-
-
 def inv_sym3(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Inverse and determinant of stacked symmetric 3x3 matrices ``M (..., 3, 3)``
-    (cofactors; faster than ``numpy.linalg.inv`` for small stacks).
-
-    With ``M = [[a, b, c], [b, d, e], [c, e, f]]`` the six cofactors ``A00 = d f - e e``,
-    ``A01 = c e - b f``, ``A02 = b e - c d``, ``A11 = a f - c c``, ``A12 = b c - a e``,
-    ``A22 = a d - b b`` are formed as one ``X Y - U V`` over the six (the operands gathered
-    from the flat matrix by ``_INV3_TERMS``), ``det = a A00 + b A01 + c A02`` (summed in
-    that order) and ``M^-1 = A / det``."""
-    flat = M.reshape(M.shape[:-2] + (9,))
-    g = flat[..., _INV3_TERMS]  # (..., 4, 6): X, Y, U, V of the six cofactors
-    cof = g[..., 0, :] * g[..., 1, :] - g[..., 2, :] * g[..., 3, :]
-    p = flat[..., :3] * cof[..., :3]
-    det = p[..., 0] + p[..., 1] + p[..., 2]
-    return (cof * (1.0 / det)[..., None])[..., _INV3_OUT].reshape(M.shape), det
+    (cofactors; faster than ``numpy.linalg.inv`` for small stacks)."""
+    a, b, c = M[..., 0, 0], M[..., 0, 1], M[..., 0, 2]
+    d, e, f = M[..., 1, 1], M[..., 1, 2], M[..., 2, 2]
+    A00, A01, A02 = d * f - e * e, c * e - b * f, b * e - c * d
+    A11, A12, A22 = a * f - c * c, b * c - a * e, a * d - b * b
+    det = a * A00 + b * A01 + c * A02
+    out = np.empty_like(M)
+    r = 1.0 / det
+    out[..., 0, 0] = A00 * r
+    out[..., 0, 1] = out[..., 1, 0] = A01 * r
+    out[..., 0, 2] = out[..., 2, 0] = A02 * r
+    out[..., 1, 1] = A11 * r
+    out[..., 1, 2] = out[..., 2, 1] = A12 * r
+    out[..., 2, 2] = A22 * r
+    return out, det
 
 
 def _t(A: np.ndarray) -> np.ndarray:
@@ -76,10 +74,7 @@ def predict(m: np.ndarray | None, P: np.ndarray, F: np.ndarray, Q: np.ndarray
     Ft = _t(F)
     if m is not None:
         m = m @ Ft if F.ndim == 2 else (m[..., None, :] @ Ft)[..., 0, :]
-    FP = F @ P
-    if F.ndim == 2 and FP.ndim > 2:  # (F P) F^T of every batch member as one product (same bits)
-        return m, (FP.reshape(-1, FP.shape[-1]) @ Ft).reshape(FP.shape) + Q
-    return m, FP @ Ft + Q
+    return m, F @ P @ Ft + Q
 
 
 class Update(NamedTuple):

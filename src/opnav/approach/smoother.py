@@ -96,31 +96,26 @@ def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> S
     """
     S, n1 = f.xf.shape[:2]
     n = n1 - 1
-    Lh_t = np.zeros((n + 1, S, 6, 6))  # time-major: each sample's block is contiguous
-    lh_t = np.zeros((n + 1, S, 6))
+    Lh = np.zeros((S, n + 1, 6, 6))
+    lh = np.zeros((S, n + 1, 6))
     L = np.zeros((S, 6, 6))
     lv = np.zeros((S, 6))
-    # time-major (n+1, S, ...): each sample's block contiguous for the backward pass
-    Hr, K = np.swapaxes(f.Hr, 0, 1), np.swapaxes(f.K, 0, 1)
-    HtSi = np.swapaxes(Hr, -1, -2) @ np.swapaxes(f.Sinv, 0, 1)  # (n+1,S,3,3)
-    HSH = HtSi @ Hr
-    HSnu = (HtSi @ np.swapaxes(f.nu, 0, 1)[..., None])[..., 0]
-    KH = K @ Hr  # (n+1,S,6,3): the position columns of K H
+    HtSi = np.swapaxes(f.Hr, -1, -2) @ f.Sinv  # (S,n+1,3,3)
+    HSH = HtSi @ f.Hr
+    HSnu = (HtSi @ f.nu[..., None])[..., 0]
+    KH = f.K @ f.Hr  # (S,n+1,6,3): the position columns of K H
     I6 = np.broadcast_to(np.eye(6), (S, 6, 6))
     for k in range(n, 0, -1):
         Ct = I6.copy()  # Ct = I - K H of sample k
-        Ct[..., :3] -= KH[k]
+        Ct[..., :3] -= KH[:, k]
         CtT = np.swapaxes(Ct, -1, -2)
         Lt = CtT @ L @ Ct
-        Lt[:, :3, :3] += HSH[k]
+        Lt[:, :3, :3] += HSH[:, k]
         lt = (CtT @ lv[..., None])[..., 0]
-        lt[:, :3] -= HSnu[k]
+        lt[:, :3] -= HSnu[:, k]
         Phi = win.Phi[k]
-        L = Lh_t[k - 1]  # Phi^T Lt Phi, the right product of every seed as one, stored in place
-        np.matmul((Phi.T @ Lt).reshape(-1, 6), Phi, out=L.reshape(-1, 6))
-        lv = np.matmul(lt, Phi, out=lh_t[k - 1])
-    Lh = Lh_t.swapaxes(0, 1)
-    lh = np.ascontiguousarray(lh_t.swapaxes(0, 1))  # the einsum below on the layout it always had
+        L = np.matmul(Phi.T @ Lt, Phi, out=Lh[:, k - 1])  # Phi^T Lt Phi, stored in place
+        lv = np.matmul(lt, Phi, out=lh[:, k - 1])
     Pr = f.Pf[..., cols, :]
     xs = f.xf[..., cols] - np.einsum("skij,skj->ski", Pr, lh)
     Ps = f.Pf[..., cols, cols] - Pr @ Lh @ f.Pf[..., :, cols]
