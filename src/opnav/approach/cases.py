@@ -358,7 +358,7 @@ def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indice
 
     # SQUAREM cycles from theta0 until the step is below 1e-4 arcsec: its end point is the
     # reference theta* (the ML estimate), its history the SQUAREM convergence record
-    th, _, sq = ml_estimate(wz, theta0, x0, P0, ww, tz_tol, max(max_maps, 30))
+    th, _, sq = ml_estimate(wz, theta0, x0, P0, ww, tz_tol, max(max_maps, 30), per_seed=False)
     sq_theta, sq_ll = sq.theta, sq.loglik
     ref_as = sc.arcsec(th)
     traces = {"squarem": (sq_theta, sq_ll)}

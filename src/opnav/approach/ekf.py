@@ -52,6 +52,12 @@ class Window:
         return Window(self.Phi[a:b + 1], self.C[a:b + 1], self.u_ref[a:b + 1],
                       self.Rvar[a:b + 1], self.Q)
 
+    def rows(self, idx: np.ndarray) -> "Window":
+        """The window of the seeds ``idx`` (only per-seed variances have a seed axis)."""
+        if self.Rvar.ndim == 2:
+            return self
+        return Window(self.Phi, self.C, self.u_ref, self.Rvar[:, idx], self.Q)
+
     def weights(self, S: int) -> np.ndarray:
         """R^-1 diagonals of samples 1..n for every seed, (S, n, 3)."""
         w = 1.0 / self.Rvar[1:]

@@ -196,27 +196,53 @@ def maps_per_segment(method: str, iterations: int) -> int:
 
 
 def ml_estimate(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray, win: Window,
-                tz_tol: float = 1e-6, max_maps: int = 60, step_tol_rad: float = 1e-4 * np.pi / 648000.0
-                ) -> tuple[np.ndarray, np.ndarray, EMTrace]:
+                tz_tol: float = 1e-6, max_maps: int = 60, step_tol_rad: float = 1e-4 * np.pi / 648000.0,
+                per_seed: bool = True) -> tuple[np.ndarray, np.ndarray, EMTrace]:
     """Maximum-likelihood theta of one window's data: SQUAREM cycles from ``theta0`` until
-    the cycle step in (tx, ty) is below ``step_tol_rad`` for every seed, or ``max_maps`` maps.
+    the cycle step in (tx, ty) is below ``step_tol_rad``, or ``max_maps`` maps.
+
+    ``per_seed`` (default): each seed stops at its own first cycle that meets the step
+    criterion and only the seeds still moving are iterated, so the other seeds of the batch
+    (a Snakemake job's cases, ``approach.scatter``) no longer decide how long a seed iterates
+    (they still touch its last bits, which SQUAREM amplifies to ~1e-4 arcsec on flat
+    likelihoods), and stopped seeds cost nothing more. ``per_seed=False``: every seed is
+    iterated until all meet it in the same cycle (the whole history of every seed, for the
+    convergence study).
 
     Returns theta_ML (S,3), a per-seed flag that the step criterion was met, and the
-    trace of every map (its last entries are the reference iterates).
+    trace of every map (its last entries are the reference iterates; with ``per_seed``, a
+    stopped seed keeps its estimate in ``theta`` and has NaN ``loglik``).
     """
     th = np.array(theta0, float)
+    S = th.shape[0]
     tr = EMTrace()
-    done = np.zeros(th.shape[0], bool)
-    while len(tr.theta) < max_maps:
-        t = em_window(z, th, x0, P0, win, 3, "squarem", tz_tol)
-        tr.theta.extend(t.theta)
-        tr.loglik.extend(t.loglik)
-        tr.unobservable = t.unobservable
+    done = np.zeros(S, bool)
+    act = np.arange(S)
+    P0 = np.asarray(P0, float)
+    while len(tr.theta) < max_maps and act.size:
+        if per_seed and act.size < S:
+            t = em_window(z[act], th[act], x0[act], P0[act] if P0.ndim == 3 else P0, win.rows(act),
+                          3, "squarem", tz_tol)
+        else:
+            t = em_window(z, th, x0, P0, win, 3, "squarem", tz_tol)
+        for th_m, ll_m in zip(t.theta, t.loglik):
+            full, ll = th.copy(), np.full(S, np.nan)
+            full[act], ll[act] = th_m, ll_m
+            tr.theta.append(full)
+            tr.loglik.append(ll)
+        if tr.unobservable is None:
+            tr.unobservable = np.zeros((S, 3), bool)
+        tr.unobservable[act] = t.unobservable
         new = t.theta[-1]
-        done = np.abs(new - th)[:, :2].max(1) < step_tol_rad
-        th = new
-        if done.all():
-            break
+        step_ok = np.abs(new - th[act])[:, :2].max(1) < step_tol_rad
+        th[act] = new
+        if per_seed:
+            done[act] = step_ok
+            act = act[~step_ok]
+        else:
+            done[:] = step_ok
+            if done.all():
+                break
     return th, done, tr
 
 
