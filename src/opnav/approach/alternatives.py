@@ -71,8 +71,8 @@ def checkpoint_samples(seg_data: np.ndarray, stride: int) -> np.ndarray:
 
 
 class _BatchCache:
-    """BatchML objects per (checkpoints, pixel noise): the NLP depends on the geometry only;
-    one cache per geometry (variant), shared by its cases."""
+    """BatchML objects per checkpoint set: the NLP depends on the geometry only (the pixel
+    noise enters as parameters); one cache per geometry (variant), shared by its cases."""
 
     def __init__(self):
         self.store = {}
@@ -137,10 +137,10 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
     # (b) batch ML: final window for every seed; growing checkpoints for the first few seeds
     b = alt.batch_ml
     sig = sc.rad(b.theta_prior_sigma_arcsec)
-    key = (tuple(case.sigma3_px), "final")
+    key = "final"
     bm, t_build = cache.get(key, lambda: BatchML(wwin, [L * N], sig, jit=b.jit, tol=b.tol))
     t = time.perf_counter()
-    rb = bm.solve(zw, x0, P0, th0, wwin.u_ref)
+    rb = bm.solve(zw, x0, P0, th0, wwin.u_ref, rvar=wwin.Rvar)
     t_solve = time.perf_counter() - t
     ncp = min(b.checkpoint_seeds, S)
     res_b = {
@@ -155,10 +155,10 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
     }
     if ncp > 0:
         cp = checkpoint_samples(seg_data, b.checkpoint_stride)
-        bmc, t_build_c = cache.get((tuple(case.sigma3_px), "checkpoints"),
+        bmc, t_build_c = cache.get("checkpoints",
                                    lambda: BatchML(wwin, cp, sig, jit=b.jit, tol=b.tol))
         t = time.perf_counter()
-        rc = bmc.solve(zw[:ncp], x0[:ncp], P0[:ncp], th0[:ncp], wwin.u_ref)
+        rc = bmc.solve(zw[:ncp], x0[:ncp], P0[:ncp], th0[:ncp], wwin.u_ref, rvar=wwin.Rvar)
         t_cp = time.perf_counter() - t
         cth = sc.arcsec(rc.theta)
         res_b.update({

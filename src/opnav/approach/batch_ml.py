@@ -199,7 +199,13 @@ class BatchML:
         x0 = ca.MX.sym("x0", 6)
         P0 = ca.MX.sym("P0", 6, 6)
         e = ca.MX.sym("e", 3, self.n)
-        p = ca.vertcat(th_s, ca.vec(Lm), th0, x0, ca.vec(P0), ca.vec(e))
+        # measurement variances: IPOPT parameters too (default: the window's), so one NLP
+        # serves every pixel noise of the geometry (the fold takes them as inputs either way)
+        rv = ca.MX.sym("rvar", 3, self.n)
+        if np.ndim(win.Rvar) != 2:
+            raise ValueError("BatchML: one measurement variance per sample, (n+1, 3), not per seed")
+        self.rvar = np.array(win.Rvar[1:self.n + 1], float)
+        p = ca.vertcat(th_s, ca.vec(Lm), th0, x0, ca.vec(P0), ca.vec(e), ca.vec(rv))
         th = th_s + Lm @ eta
         Qd = ca.DM(win.Q)
         x, P, nll = x0, P0, ca.MX(0.0)
@@ -210,7 +216,7 @@ class BatchML:
             sl = slice(a + 1, b + 1)
             out = kf_accum(b - a, jit)(x, P, nll, th * ARCSEC,
                           ca.DM(np.hstack(list(win.Phi[sl]))), ca.DM(np.hstack(list(win.C[sl]))),
-                          ca.DM(win.u_ref[sl].T), ca.DM(win.Rvar[sl].T), e[:, a:b], Qd)
+                          ca.DM(win.u_ref[sl].T), rv[:, a:b], e[:, a:b], Qd)
             x, P, nll = out[0][:, -1], out[1][:, -6:], out[2][-1]
             objectives.append(nll + prior)
             a = b
@@ -236,15 +242,19 @@ class BatchML:
         self._thv, self._p, self._fe, self._eta = thv, p, objectives, eta
 
     def params(self, e: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0_rad: np.ndarray,
-               theta_start_rad: np.ndarray | None = None, L_rad: np.ndarray | None = None
-               ) -> np.ndarray:
-        """IPOPT parameter vector of one seed: e (n, 3) = z - u_ref for samples 1..n."""
+               theta_start_rad: np.ndarray | None = None, L_rad: np.ndarray | None = None,
+               rvar: np.ndarray | None = None) -> np.ndarray:
+        """IPOPT parameter vector of one seed: e (n, 3) = z - u_ref for samples 1..n; ``rvar``
+        (n, 3) km^2 their measurement variances (default: the window's)."""
         e = np.asarray(e, float)[: self.n]
+        rv = self.rvar if rvar is None else np.asarray(rvar, float)[: self.n]
+        if rv.shape != (self.n, 3):
+            raise ValueError(f"BatchML.params: rvar must be ({self.n}, 3), got {rv.shape}")
         ths = np.zeros(3) if theta_start_rad is None else np.asarray(theta_start_rad, float)
         L = np.eye(3) * ARCSEC if L_rad is None else np.asarray(L_rad, float)
         return np.concatenate([ths / ARCSEC, (L / ARCSEC).ravel(order="F"),
                                np.asarray(theta0_rad, float) / ARCSEC, np.asarray(x0, float),
-                               np.asarray(P0, float).ravel(order="F"), e.ravel()])
+                               np.asarray(P0, float).ravel(order="F"), e.ravel(), rv.ravel()])
 
     def hessian(self, j: int = -1) -> ca.Function:
         """Exact Hessian of checkpoint ``j``'s objective w.r.t. theta (arcsec)."""
@@ -278,22 +288,25 @@ class BatchML:
         return out
 
     def solve(self, z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndarray,
-              u_ref: np.ndarray, metric: np.ndarray | None = None) -> BatchMLResult:
+              u_ref: np.ndarray, metric: np.ndarray | None = None,
+              rvar: np.ndarray | None = None) -> BatchMLResult:
         """Solve every checkpoint for every seed.
 
         z (S, n+1, 3) km (index 0 ignored); x0 (S, 6); P0 (6, 6) or (S, 6, 6);
         theta0 (S, 3) or (3,) rad, the prior mean and the first starting point;
         u_ref (n+1, 3) of the window; metric (J, 3, 3) or (S, J, 3, 3), rad^2:
         covariance used to scale IPOPT's unknown (default: :meth:`metric` of
-        the first seed at its ``theta0``, shared by all seeds).
+        the first seed at its ``theta0``, shared by all seeds); rvar (n+1, 3) km^2 the
+        measurement variances (index 0 ignored; default: the window's).
         """
+        rv = None if rvar is None else np.asarray(rvar, float)[1:]
         z = np.asarray(z, float)
         S, J = z.shape[0], len(self.checkpoints)
         P0 = np.broadcast_to(P0, (S, 6, 6))
         th0 = np.broadcast_to(np.asarray(theta0, float), (S, 3))
         x0 = np.broadcast_to(np.asarray(x0, float), (S, 6))
         if metric is None:
-            metric = self.metric(self.params(z[0, 1:] - u_ref[1:], x0[0], P0[0], th0[0]), th0[0])
+            metric = self.metric(self.params(z[0, 1:] - u_ref[1:], x0[0], P0[0], th0[0], rvar=rv), th0[0])
         Ls = np.linalg.cholesky(np.broadcast_to(metric, (S, J, 3, 3)))
         out = BatchMLResult(np.empty((S, J, 3)), np.empty((S, J)), np.zeros((S, J), int),
                             np.zeros((S, J), bool), np.empty((S, J)))
@@ -301,7 +314,7 @@ class BatchML:
             e = z[s, 1:] - u_ref[1:]
             start = th0[s]
             for j, solver in enumerate(self.solvers):
-                p = self.params(e, x0[s], P0[s], th0[s], start, Ls[s, j])
+                p = self.params(e, x0[s], P0[s], th0[s], start, Ls[s, j], rv)
                 sol = solver(x0=np.zeros(3), p=p)
                 st = solver.stats()
                 eta = np.asarray(sol["x"]).ravel()
