@@ -164,7 +164,6 @@ from scipy.linalg.lapack import dposv as _dposv
 from scipy.linalg.lapack import dpotrf as _dpotrf
 from scipy.linalg.lapack import dsyev as _dsyev
 
-from opnav.landing import casadi_model as cm
 from opnav.landing import measurement as me
 from opnav.rotations import cross
 
@@ -1274,6 +1273,9 @@ class Metric:
     def reference(self, ctx: MetricContext, cand_L) -> np.ndarray:
         """One compiled CasADi Function call and one explicit linear-algebra
         evaluation (SVD / pinv / 12 x 12 information) per candidate."""
+        # CasADi (its import ~15-20 ms) only on the cross-check paths: no pipeline job uses them
+        from opnav.landing import casadi_model as cm
+
         f = cm.jacobian_function()
 
         def build(c):
@@ -1287,6 +1289,7 @@ class Metric:
 
     def casadi_map(self, ctx: MetricContext, cand_L, parallelization: str = "serial") -> np.ndarray:
         """H for all candidates via ``Function.map(n)``, then batched linear algebra."""
+        from opnav.landing import casadi_model as cm  # CasADi only on the cross-check paths
 
         def build(c):
             H = cm.jacobian_casadi_batch(ctx.r_L, ctx.v_L, ctx.p_known_L, c, ctx.R_LtoB, parallelization)
