@@ -66,7 +66,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from . import camera
 from . import scenario as sc
@@ -161,6 +160,9 @@ def theta_from_bias_px(b_px: np.ndarray, cam: PeerCamera) -> np.ndarray:
 def mrp_from_dcm(C: np.ndarray) -> np.ndarray:
     """MRP (..., 3) of the direction cosine matrix ``C`` = [BN] (maps N components to B),
     shadow set chosen so that |sigma| <= 1 (Basilisk's ``C2MRP`` convention)."""
+    # scipy.spatial (~0.17 s of import) here: only the UKF job calls this, not the table/figure jobs
+    from scipy.spatial.transform import Rotation
+
     # [BN] is the passive matrix of the rotation that takes N's axes onto B's: R = C^T
     s = Rotation.from_matrix(np.swapaxes(np.asarray(C, float), -1, -2)).as_mrp()
     return s
