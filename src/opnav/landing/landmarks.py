@@ -21,9 +21,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 __all__ = ["LandmarkField", "make_field", "GridIndex", "nearest_brute_force"]
 
@@ -241,4 +244,8 @@ def make_field(half_width_m: float, count: int, seed: int) -> LandmarkField:
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 0xB1A7]))
     xy = rng.uniform(-half_width_m, half_width_m, size=(int(count), 2))
     xyz = np.column_stack([xy, np.zeros(len(xy))])
+    # scipy.spatial imported here: the Snakefile parse imports this module (through the
+    # planner's method registry) and builds no field
+    from scipy.spatial import cKDTree
+
     return LandmarkField(xyz=xyz, tree=cKDTree(xy))

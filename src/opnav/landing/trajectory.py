@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 __all__ = ["guidance_coefficients", "Truth", "truth_states", "euler_rpy_deg"]
 
@@ -105,6 +104,10 @@ def truth_states(t: np.ndarray, r0, v0, T: float, g, yaw_deg: float = 0.0, a_T=N
 def euler_rpy_deg(R_LtoB: np.ndarray) -> np.ndarray:
     """Roll, pitch, yaw (deg) of ``R_BtoL = Rz(yaw) Ry(pitch) Rx(roll)`` (aerospace
     Z-Y-X sequence), for (3, 3) or (n, 3, 3) input; returns (3,) or (n, 3)."""
+    # scipy.spatial (~0.1-0.2 s of import) here: truth_states, which config validation
+    # at every Snakefile parse calls, does not need it
+    from scipy.spatial.transform import Rotation
+
     R = np.asarray(R_LtoB, float)
     single = R.ndim == 2
     R_BtoL = np.swapaxes(R.reshape(-1, 3, 3), 1, 2)
