@@ -20,14 +20,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from opnav import published
-from opnav.landing import ekf, imu
-from opnav.landing.camera import Camera, camera_from_config
-from opnav.landing.landmarks import LandmarkField, make_field
-from opnav.landing.planner import PlannerConfig, alternative_path
+from opnav.landing.trajectory import Truth, truth_states
 
 if TYPE_CHECKING:  # pandas only for the B-T1/B-T2 tables: not imported by every Monte-Carlo job
     import pandas as pd
-from opnav.landing.trajectory import Truth, truth_states
+
+    from opnav.landing.camera import Camera
+    from opnav.landing.landmarks import LandmarkField
+    from opnav.landing.planner import PlannerConfig
 
 
 @dataclass(frozen=True)
@@ -59,6 +59,13 @@ class Scenario:
 
 
 def _scenario_from_json(text: str) -> Scenario:
+    # the simulation's parts imported here, where a scenario is built: the B-T1/B-T2 and
+    # B-T3 summary jobs and the Snakefile parse use this module's config-only functions
+    from opnav.landing import ekf, imu
+    from opnav.landing.camera import camera_from_config
+    from opnav.landing.landmarks import make_field
+    from opnav.landing.planner import PlannerConfig, alternative_path
+
     c = json.loads(text)
     T = float(c["duration_s"])
     Dt = float(c["filter"]["dt_s"])
