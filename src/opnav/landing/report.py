@@ -14,12 +14,17 @@ scored by :mod:`opnav.scorecard` with the rule of :mod:`opnav.verdicts`.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from opnav.tables import cell_num, cell_pm
 from opnav.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
+
+# pandas is imported by the functions that build frames: the jobs that only combine the
+# scenarios' summaries (combine_scenarios) do without its ~0.13 s of import
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_svd: float | None = None,
@@ -45,6 +50,8 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
     (``timing.time_reduction``). ``converged_runs_pct`` counts the runs whose
     final position error is below ``converged_pos_err_m`` (m); the published
     reduction, if given, is a column labelled ``_published`` on the depth row."""
+    import pandas as pd
+
     # imported here: the manuscript and scorecard jobs import this module for its
     # page views and need neither scipy (ranking) nor the replay
     from opnav.landing import timing as tmg
@@ -170,6 +177,8 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
 
 def compact_b_t3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     """B-T3 for the page: per method final/RMS errors (mean, 3-sigma), NEES, timing."""
+    import pandas as pd
+
     rows = []
     for _, r in df.iterrows():
         row = {"method": r["method"]}
@@ -190,6 +199,8 @@ def compact_b_t3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
 
 def compact_b_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     """B-X1 for the page: every selection rule ranked, paired difference against depth."""
+    import pandas as pd
+
     rows = []
     for _, r in df.iterrows():
         lo, hi = r.get("d_rms_pos_vs_ref_boot_lo"), r.get("d_rms_pos_vs_ref_boot_hi")
@@ -308,6 +319,8 @@ def rows_paper_b(t3: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
     timing claim and the accuracy claims; once, the initial attitude scored as
     thrust tilt and azimuth separately (the paper's triple read as
     -(yaw, pitch, roll), Z-Y-X, roll 0)."""
+    import pandas as pd
+
     rows: list[dict] = []
     scen = summary.get("scenarios") if isinstance(summary, dict) else None
     if scen:
