@@ -37,19 +37,63 @@ def _snakemake_cmd(cwd: Path, *args: str) -> tuple[list[str], dict]:
     return [sys.executable, "-m", "snakemake", *args], env
 
 
-def run_snakemake(cwd: Path, *args: str, check: bool = False) -> subprocess.CompletedProcess:
+def run_snakemake(cwd: Path, *args: str, check: bool = False, hide: tuple[str, ...] = (),
+                  timeout: float | None = None) -> subprocess.CompletedProcess:
     """Run snakemake in ``cwd`` (see :func:`_snakemake_cmd`): ``python -m snakemake``'s
     main() on ``args``, forked from the session's snakemake server (tests/snakemake_server.py:
     the same code, its imports paid once), or a fresh ``python -m snakemake`` with
-    OPNAV_TESTS_FORKSERVER=0."""
-    cmd, env = _snakemake_cmd(cwd, *args)
-    if os.environ.get("OPNAV_TESTS_FORKSERVER", "1") == "0":
-        return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, check=check, env=env)
-    rc, out, err = _SnakemakeServer.get().run(Path(cwd), list(args), env)
-    proc = subprocess.CompletedProcess(cmd, rc, out, err)
+    OPNAV_TESTS_FORKSERVER=0. ``hide``: modules the run sees as not installed; past
+    ``timeout`` seconds, subprocess.TimeoutExpired."""
+    proc = start_snakemake(cwd, *args, hide=hide).wait(timeout)
     if check:
         proc.check_returncode()
     return proc
+
+
+class SnakemakeRun:
+    """A snakemake run started by :func:`start_snakemake`: ``pid`` (it leads its own
+    process group when started with ``new_session``), ``poll()``, ``wait(timeout)`` -> the
+    CompletedProcess (stdout and stderr apart; subprocess.TimeoutExpired past ``timeout``)."""
+
+    def __init__(self, cmd, popen=None, server=None, rid=None):
+        self.cmd, self._popen, self._server, self._rid = cmd, popen, server, rid
+        self._done = None
+        self.pid = popen.pid if popen is not None else server.pid_of(rid)
+
+    def poll(self):
+        if self._done is not None:
+            return self._done.returncode
+        if self._popen is not None:
+            return self._popen.poll()
+        return None if not self._server.finished(self._rid) else self.wait().returncode
+
+    def wait(self, timeout: float | None = None) -> subprocess.CompletedProcess:
+        if self._done is None:
+            if self._popen is not None:
+                out, err = self._popen.communicate(timeout=timeout)
+                rc = self._popen.returncode
+            else:
+                if not self._server.events[self._rid].wait(timeout):
+                    raise subprocess.TimeoutExpired(self.cmd, timeout)
+                rc, out, err = self._server.result(self._rid)
+            self._done = subprocess.CompletedProcess(self.cmd, rc, out, err)
+        return self._done
+
+
+def start_snakemake(cwd: Path, *args: str, new_session: bool = False, hide: tuple[str, ...] = ()) -> SnakemakeRun:
+    """Start snakemake in ``cwd`` as :func:`run_snakemake` runs it, without waiting for it."""
+    cmd, env = _snakemake_cmd(cwd, *args)
+    if os.environ.get("OPNAV_TESTS_FORKSERVER", "1") == "0":
+        if hide:
+            code = (f"import sys; sys.modules.update(dict.fromkeys({list(hide)!r})); "
+                    "from snakemake.cli import main; sys.argv[0] = 'snakemake'; main()")
+            cmd = [sys.executable, "-c", code, *args]
+        popen = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 text=True, start_new_session=new_session)
+        return SnakemakeRun(cmd, popen=popen)
+    server = _SnakemakeServer.get()
+    return SnakemakeRun(cmd, server=server,
+                        rid=server.start(Path(cwd), list(args), env, session=new_session, hide=list(hide)))
 
 
 class _SnakemakeServer:
@@ -74,7 +118,9 @@ class _SnakemakeServer:
         self.lock = threading.Lock()
         self.next_id = 0
         self.replies: dict[int, int] = {}
-        self.events: dict[int, threading.Event] = {}
+        self.events: dict[int, threading.Event] = {}      # set when a request's child ends
+        self.forked: dict[int, threading.Event] = {}      # set when it is forked (pid known)
+        self.pids: dict[int, int] = {}
         threading.Thread(target=self._read, daemon=True).start()
         atexit.register(self.close)
 
@@ -82,26 +128,48 @@ class _SnakemakeServer:
         for line in self.proc.stdout:
             msg = json.loads(line)
             with self.lock:
-                self.replies[msg["id"]] = msg["rc"]
-                self.events[msg["id"]].set()
+                if "pid" in msg:
+                    self.pids[msg["id"]] = msg["pid"]
+                    self.forked[msg["id"]].set()
+                else:
+                    self.replies[msg["id"]] = msg["rc"]
+                    self.events[msg["id"]].set()
         with self.lock:                      # the server died: wake every waiter
-            for ev in self.events.values():
+            for ev in (*self.forked.values(), *self.events.values()):
                 ev.set()
 
-    def run(self, cwd: Path, args: list[str], env: dict) -> tuple[int, str, str]:
+    def start(self, cwd: Path, args: list[str], env: dict, session: bool = False, hide=()) -> int:
+        """Send one request; its id."""
         with self.lock:
             rid = self.next_id
             self.next_id += 1
-            ev = self.events[rid] = threading.Event()
+            self.events[rid], self.forked[rid] = threading.Event(), threading.Event()
             out, err = self.tmp / f"{rid}.out", self.tmp / f"{rid}.err"
             self.proc.stdin.write(json.dumps({"id": rid, "cwd": str(cwd), "argv": args, "env": env,
-                                              "stdout": str(out), "stderr": str(err)}) + "\n")
+                                              "stdout": str(out), "stderr": str(err),
+                                              "session": session, "hide": list(hide)}) + "\n")
             self.proc.stdin.flush()
-        ev.wait()
+        return rid
+
+    def pid_of(self, rid: int) -> int:
+        self.forked[rid].wait()
+        with self.lock:
+            pid = self.pids.get(rid)
+        assert pid is not None, "the snakemake server died"
+        return pid
+
+    def finished(self, rid: int) -> bool:
+        return self.events[rid].is_set()
+
+    def result(self, rid: int) -> tuple[int, str, str]:
+        """Wait for request ``rid``: (exit code, stdout, stderr)."""
+        self.events[rid].wait()
         with self.lock:
             rc = self.replies.pop(rid, None)
-            del self.events[rid]
+            del self.events[rid], self.forked[rid]
+            self.pids.pop(rid, None)
         assert rc is not None, "the snakemake server died"
+        out, err = self.tmp / f"{rid}.out", self.tmp / f"{rid}.err"
         texts = [p.read_text(errors="replace") for p in (out, err)]
         out.unlink()
         err.unlink()

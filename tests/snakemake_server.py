@@ -11,8 +11,12 @@ The child is the same code on the same arguments as ``python -m snakemake``; onl
 the import is shared.
 
 Protocol (one JSON object a line): request on stdin
-``{"id", "cwd", "argv", "env", "stdout", "stderr"}``; reply on stdout
-``{"id", "rc"}`` when that child ends (children run concurrently).
+``{"id", "cwd", "argv", "env", "stdout", "stderr"}`` and optionally ``"session": true``
+(the child leads a new session and process group, as ``Popen(start_new_session=True)``,
+so that a test can signal it and its jobs) and ``"hide": [module, ...]`` (those modules
+set to None in ``sys.modules``: ``import`` fails as if they were not installed); replies
+on stdout ``{"id", "pid"}`` when the child is forked and ``{"id", "rc"}`` when it ends
+(children run concurrently).
 """
 
 import json
@@ -48,6 +52,10 @@ def _child(req: dict) -> None:
     """In the forked child: become ``python -m snakemake`` of the request; never returns."""
     code = 1
     try:
+        if req.get("session"):
+            os.setsid()
+        for name in req.get("hide", ()):
+            sys.modules[name] = None
         os.chdir(req["cwd"])
         os.environ.clear()
         os.environ.update(req["env"])
@@ -102,6 +110,7 @@ def main() -> None:
                     if pid == 0:
                         _child(req)
                     running[pid] = req["id"]
+                    print(json.dumps({"id": req["id"], "pid": pid}), flush=True)
         else:
             select.select([], [], [], 0.02)
         while running:

@@ -247,13 +247,9 @@ def test_peer_variants_outside_table1_variants_are_refused():
 def test_without_basilisk_the_workflow_skips_a_p1_with_one_line(workdir):
     """Basilisk hidden (None in sys.modules, as `import` treats it): the dry run still plans
     everything else, no A-P1 job, and says so in one line."""
-    import subprocess
-    import sys
+    from conftest import run_snakemake
 
-    code = ("import sys; sys.modules['Basilisk'] = None; from snakemake.cli import main; "
-            "sys.argv = ['snakemake', '-n', '--cores', '1', '--configfile', 'config/quick.yaml']; main()")
-    env = dict(__import__("os").environ, PYTHONPATH=str(workdir / "src"))
-    proc = subprocess.run([sys.executable, "-c", code], cwd=workdir, capture_output=True, text=True, env=env)
+    proc = run_snakemake(workdir, "-n", "--cores", "1", "--configfile", "config/quick.yaml", hide=("Basilisk",))
     out = proc.stdout + proc.stderr
     assert proc.returncode == 0, out[-3000:]
     lines = [ln for ln in out.splitlines() if "skipping A-P1" in ln]

@@ -4,20 +4,11 @@ records no clock: planning time is measured by replay, opnav.landing.timing)."""
 
 import os
 import signal
-import subprocess
-import sys
 import time
 
 import numpy as np
 
-from conftest import REPO, copy_workflow
-
-
-def _snakemake(wd, *args):
-    env = dict(os.environ, PYTHONPATH=str(wd / "src"))
-    return subprocess.Popen([sys.executable, "-m", "snakemake", *args], cwd=wd, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                            start_new_session=True)
+from conftest import REPO, copy_workflow, run_snakemake, start_snakemake
 
 
 def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
@@ -32,24 +23,24 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     args = [target, "--cores", "1", "--configfile", "config/quick.yaml", "small.yaml"]
     chunks = wd / "results" / "quick" / "landing" / "mc" / "site-tilt" / "chunks" / "depth"
 
-    proc = _snakemake(wd, *args)
+    # its own process group (as Popen(start_new_session=True)): SIGINT reaches it and its jobs
+    proc = start_snakemake(wd, *args, new_session=True)
     deadline = time.time() + 240
     while time.time() < deadline and proc.poll() is None:
         done = list(chunks.glob("r*.npz")) if chunks.is_dir() else []
         if done:                                   # one chunk written, the next in flight
             break
         time.sleep(0.2)
-    assert proc.poll() is None, "the workflow ended before it could be interrupted:\n" + proc.stdout.read()
+    assert proc.poll() is None, "the workflow ended before it could be interrupted:\n" + proc.wait().stderr
     os.killpg(proc.pid, signal.SIGINT)
-    proc.communicate(timeout=120)
+    proc.wait(timeout=120)
     assert not (wd / target).exists()
     for f in chunks.iterdir():                     # nothing half-written is left as an output
         if f.name.startswith("r"):
             load(f)
 
-    rerun = _snakemake(wd, *args)
-    out, _ = rerun.communicate(timeout=600)
-    assert rerun.returncode == 0, out
+    rerun = run_snakemake(wd, *args, timeout=600)
+    assert rerun.returncode == 0, rerun.stdout + rerun.stderr
 
     from opnav.landing.scenario import camera_scenarios
 
@@ -68,8 +59,8 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     # the rebuild command, the traceback is in the rule's log, and Snakemake names the log
     chunk = sorted(chunks.glob("r*.npz"))[1]
     chunk.write_bytes(chunk.read_bytes()[:100])
-    again = _snakemake(wd, *args)
-    out, _ = again.communicate(timeout=600)
+    again = run_snakemake(wd, *args, timeout=600)
+    out = again.stdout + again.stderr
     assert again.returncode != 0
     log = wd / "results" / "quick" / "landing" / "logs" / "mc_site-tilt_depth_gather.log"
     assert str(log.relative_to(wd)) in out, out
