@@ -2,8 +2,9 @@
 
 Importing Snakemake's command line and collecting its plugins costs about 1.1 CPU-s
 of the 2.4 CPU-s of a dry run, in every one of the suite's ~25 snakemake runs. This
-process pays it once: it imports ``snakemake.cli`` and the plugin registries (nothing
-of the workflow: no ``opnav``, no numpy), then forks one child per request, which
+process pays it once: it imports ``snakemake.cli``, the plugin registries and the
+installed libraries a run goes on to import (``PRELOAD``; nothing of the workflow: no
+``opnav``), then forks one child per request, which
 runs ``snakemake.cli.main()`` with the request's argv, working directory,
 environment and ``sys.path`` (what ``python -m snakemake`` in that directory with
 that environment would have), its stdout and stderr sent to the request's files.
@@ -32,6 +33,7 @@ BASE_PATH = [p for p in sys.path if p and os.path.abspath(p) not in _OWN]
 
 from pathlib import Path  # noqa: E402
 
+import importlib  # noqa: E402
 import importlib.util  # noqa: E402
 
 import snakemake.cli  # noqa: E402
@@ -46,6 +48,21 @@ MAIN = importlib.util.find_spec("snakemake.__main__").origin
 
 for _registry in (ExecutorPluginRegistry, StoragePluginRegistry, ReportPluginRegistry, LoggerPluginRegistry):
     _registry()  # singletons: collected once, inherited by every child
+
+#: Installed libraries every run imports after main() starts (Snakemake's lazy imports:
+#: smart_open to read the Snakefile, the report modules; and what parsing the Snakefile
+#: imports through ``opnav``: jsonschema, scipy, casadi), about 0.45 CPU-s a run, paid
+#: here once. Never anything of the workflow (``opnav`` is each request's own copy under
+#: its cwd): only site-packages, which every request shares. numpy (with the
+#: OPENBLAS_NUM_THREADS=1 of tests/conftest.py) and pandas are already imported by
+#: snakemake.cli above.
+PRELOAD = ("smart_open", "snakemake.report.html_reporter", "jsonschema",
+           "scipy.linalg", "scipy.spatial", "scipy.special", "casadi")
+for _name in PRELOAD:
+    try:
+        importlib.import_module(_name)
+    except ImportError:  # not installed: the run imports (or misses) it as before
+        pass
 
 
 def _child(req: dict) -> None:
