@@ -191,7 +191,7 @@ def test_each_seed_stops_its_ml_iteration_at_its_own_step_criterion():
     seed's estimate depends on the seeds beside it only through round-off (SQUAREM amplifies
     the batch's last bits on these flat likelihoods to ~1e-4 arcsec, so a seed alone may meet
     the criterion a cycle earlier or later). The old rule, every seed iterated until all meet
-    it (per_seed=False), fails the first check."""
+    it (per_seed=False), fails the check that the seeds stop apart."""
     cfg, geo, z, x0, P0, win = _approach_window("roll", n=150, seeds=range(4))
     S = z.shape[0]
     tol = 1e-4 * ARCSEC

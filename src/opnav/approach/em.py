@@ -220,7 +220,7 @@ def ml_estimate(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarra
     act = np.arange(S)
     P0 = np.asarray(P0, float)
     while len(tr.theta) < max_maps and act.size:
-        if per_seed and act.size < S:
+        if act.size < S:               # (only per_seed ever drops seeds)
             t = em_window(z[act], th[act], x0[act], P0[act] if P0.ndim == 3 else P0, win.rows(act),
                           3, "squarem", tz_tol)
         else:
