@@ -79,6 +79,14 @@ def _is_number(checker, instance) -> bool:
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
+def read_yaml(path: str | Path) -> Any:
+    """The YAML document in the package file ``path`` (schemas, published values), read
+    with libyaml's safe loader where available (the pure-Python one is ~10x slower, and
+    every workflow parse reads these files). User config files go through
+    :func:`load_config`, whose error messages name the line and column."""
+    return yaml.load(Path(path).read_text(), Loader=_YAML_LOADER)
+
+
 @functools.lru_cache(maxsize=8)
 def _validator(schema_path: Path):
     import jsonschema
@@ -91,7 +99,7 @@ def _validator(schema_path: Path):
         # kept for referenced section files too: jsonschema otherwise switches
         # to the plain Draft 2020-12 validator for every schema naming its
         # dialect, and nested sections were never filled.
-        contents = yaml.load(path.read_text(), Loader=_YAML_LOADER)
+        contents = read_yaml(path)
         contents.pop("$schema", None)
         return contents
 

@@ -17,7 +17,8 @@ PUBLISHED_FILE = Path(__file__).with_name("data") / "published.yaml"
 @lru_cache(maxsize=1)
 def load() -> dict:
     """All published values: ``{"paper_a": {...}, "paper_b": {...}}``."""
-    return yaml.safe_load(PUBLISHED_FILE.read_text())
+    # libyaml's safe loader where PyYAML has it (same document; the pure-Python one is ~7x slower)
+    return yaml.load(PUBLISHED_FILE.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
 
 
 def paper_a() -> dict:

@@ -33,6 +33,7 @@ the first method (mean and 95 % interval of the per-run differences).
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import itertools
 import json
@@ -272,16 +273,18 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping],
     return out
 
 
+@functools.lru_cache(maxsize=1)
+def _schema_spec_defaults() -> dict:
+    from opnav.config import SCHEMA_PATH, read_yaml
+
+    props = read_yaml(SCHEMA_PATH.parent / "studies.schema.yaml")["additionalProperties"]["properties"]
+    return {k: v["default"] for k, v in props.items() if "default" in v}
+
+
 def _spec_defaults() -> dict:
     """Per-study defaults from the schema (validators fill ``properties`` defaults only,
-    not those of a map's ``additionalProperties``)."""
-    import yaml
-
-    from opnav.config import SCHEMA_PATH
-
-    schema = yaml.safe_load((SCHEMA_PATH.parent / "studies.schema.yaml").read_text())
-    props = schema["additionalProperties"]["properties"]
-    return {k: v["default"] for k, v in props.items() if "default" in v}
+    not those of a map's ``additionalProperties``); the file is read once per process."""
+    return copy.deepcopy(_schema_spec_defaults())
 
 
 def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
