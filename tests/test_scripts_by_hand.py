@@ -43,4 +43,4 @@ def test_a_missing_wildcard_is_named(tmp_path):
     from opnav.snakeio import mock_snakemake
 
     with pytest.raises(SystemExit, match="needs the wildcard.*variant"):
-        mock_snakemake("approach_figures", root=REPO)
+        mock_snakemake("approach_mc", root=REPO)

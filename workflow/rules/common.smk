@@ -96,7 +96,7 @@ def result_outputs():
     (not the manuscript's own files): what the manuscript floats and macros draw from.
     Reads the rules at call time, so call it once the rule files are included."""
     a = [*rules.approach_tables.output, *rules.approach_x1_figure.output,
-         *expand(rules.approach_figures.output, variant=A_VARIANTS),
+         *rules.approach_figures.output,
          *rules.approach_x2_tables.output.table, rules.approach_x2_tables.output.summary,
          *rules.approach_x2_figure.output]
     if HAVE_BSK:
@@ -135,12 +135,12 @@ def a_groups(variant):
 
 
 # approach.smk
-def a_headline_mc(wildcards):
+def a_headline_mc_of(variant):
     """The headline group's Monte-Carlo pickles of a variant: every sliding scheme and every
     growing one (A_MC_GROWING, approach.smk)."""
-    g = a_groups(wildcards.variant)[0]  # the group holding T1-01
-    return [A_MC[(wildcards.variant, g, m)] for m in A_METHODS] + [
-        p for (v, gg, m), p in A_MC_GROWING.items() if v == wildcards.variant and gg == g]
+    g = a_groups(variant)[0]  # the group holding T1-01
+    return [A_MC[(variant, g, m)] for m in A_METHODS] + [
+        p for (v, gg, m), p in A_MC_GROWING.items() if v == variant and gg == g]
 
 
 # paper.smk
