@@ -154,38 +154,21 @@ rule landing_single:
         "../scripts/landing_single.py"
 
 
-rule landing_mc_figures:
-    """B-F6 (3-sigma envelopes per axis) and B-F7 (planning-time box plots) of one scenario."""
-    input:
-        mc=lambda wc: b_mc(wc.bscn, B_METHODS),
-        timing=f"{LANDING}/timing/{{bscn}}.npz",
-        code=src("landing/plots.py", "landing/montecarlo.py", "landing/timing.py", "figures.py",
-                 "opnav.mplstyle", "published.py", "data/published.yaml"),
-    output:
-        f6=report_figure(f"{LANDING}/B-F6_nav_error_envelopes_{{bscn}}", "B-F6", "Paper B", "{bscn}"),
-        f7=report_figure(f"{LANDING}/B-F7_planning_time_{{bscn}}", "B-F7", "Paper B", "{bscn}"),
-    wildcard_constraints:
-        bscn=B_SCN_RE,
-    params:
-        methods=B_METHODS,
-    log:
-        f"{LANDING}/logs/mc_figures_{{bscn}}.log",
-    localrule: True
-    script:
-        "../scripts/landing_mc_figures.py"
-
-
 rule landing_summary:
-    """B-T3 of one scenario beside the published 29.03 %, and its summary JSON."""
+    """B-T3 of one scenario beside the published 29.03 %, its summary JSON, and B-F6
+    (3-sigma envelopes per axis) and B-F7 (planning-time box plots): one job reads the
+    scenario's Monte Carlo and planning times once for the table and the figures."""
     input:
         mc=lambda wc: b_mc(wc.bscn, B_METHODS),
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         single=f"{LANDING}/single/summary_{{bscn}}.json",
-        code=src("landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "tables.py",
-                 "published.py", "data/published.yaml"),
+        code=src("landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
+                 "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml"),
     output:
         t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),
         summary=f"{LANDING}/summaries/B-summary_{{bscn}}.json",
+        f6=report_figure(f"{LANDING}/B-F6_nav_error_envelopes_{{bscn}}", "B-F6", "Paper B", "{bscn}"),
+        f7=report_figure(f"{LANDING}/B-F7_planning_time_{{bscn}}", "B-F7", "Paper B", "{bscn}"),
     wildcard_constraints:
         bscn=B_SCN_RE,
     params:

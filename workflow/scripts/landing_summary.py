@@ -1,14 +1,15 @@
 """B-T3 of one camera scenario (per-method accuracy, what the comparison rests
-on, planning time beside the published 29.03 %) and its summary JSON (headline
-numbers for the manuscript and the scorecard)."""
+on, planning time beside the published 29.03 %), its summary JSON (headline
+numbers for the manuscript and the scorecard), B-F6 (navigation-error 3-sigma
+envelopes) and B-F7 (planning-time box plots)."""
 
 import json
 import sys
 
 import pandas as pd
 
-from opnav import published
-from opnav.landing import timing
+from opnav import figures, published
+from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
 from opnav.landing.report import scenario_summary, summary_table
 from opnav.snakeio import mock_snakemake, script_context
@@ -45,5 +46,9 @@ with script_context(snakemake) as log:
                            yaw_ratio=float(snakemake.params.yaw_ratio),
                            published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"])
     write_json(snakemake.output.summary, out)
+    t = next(iter(data.values()))["t"]
+    figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f6)
+    figures.save(plots.fig_planning_time(tm, methods, pub["depth_time_reduction_vs_svd_pct"]),
+                 snakemake.output.f7)
     log.info("B-T3 %s:\n%s\npairs:\n%s", scn, df.to_string(),
              pd.DataFrame(list(out["pairs"].values())).to_string())
