@@ -35,6 +35,27 @@ def test_figure_save_is_byte_identical(tmp_path):
     assert b"CreationDate" not in a[0].read_bytes()
 
 
+def test_a_layout_solved_once_for_both_formats_is_the_one_each_format_gets_alone(tmp_path):
+    """figures.save solves a constrained layout once for the PDF and the PNG (then saves
+    without the engine): the PNG is the one saved alone with the engine, and the layout
+    did move the axes (a long label needs room)."""
+    def make(layout=True):
+        with figures.style():
+            fig, axs = plt.subplots(1, 2, constrained_layout=layout)
+            for ax in axs:
+                ax.plot(np.arange(10), np.arange(10) ** 2)
+                ax.set_ylabel("a long label\nover two lines [m/s]")
+            return fig
+
+    both = figures.save(make(), tmp_path / "both")
+    alone = figures.save(make(), [tmp_path / "alone.png"])
+    assert both[1].read_bytes() == alone[0].read_bytes()
+    fig, plain = make(), make(layout=False)
+    figures.save(fig, tmp_path / "moved")
+    moved = np.abs(fig.axes[0].get_position().extents - plain.axes[0].get_position().extents).max()
+    assert fig.get_layout_engine() is None and moved > 0.02
+
+
 @pytest.mark.slow
 def test_tables_rebuild_byte_identical(quick_results):
     """B-T1/B-T2 deleted from the shared quick build and rebuilt: the same bytes.
