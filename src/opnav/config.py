@@ -80,10 +80,11 @@ _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 def read_yaml(path: str | Path) -> Any:
-    """The YAML document in the package file ``path`` (schemas, published values), read
-    with libyaml's safe loader where available (the pure-Python one is ~10x slower, and
-    every workflow parse reads these files). User config files go through
-    :func:`load_config`, whose error messages name the line and column."""
+    """The YAML document in the package file ``path`` (the config schemas), read with
+    libyaml's safe loader where available (the pure-Python one is ~10x slower, and every
+    workflow parse reads these files). User config files go through :func:`load_config`,
+    whose error messages name the line and column. (``opnav.published``, a lower layer,
+    makes the same loader choice for the published values.)"""
     return yaml.load(Path(path).read_text(), Loader=_YAML_LOADER)
 
 

@@ -274,17 +274,14 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping],
 
 
 @functools.lru_cache(maxsize=1)
-def _schema_spec_defaults() -> dict:
+def _spec_defaults() -> dict:
+    """Per-study defaults from the schema (validators fill ``properties`` defaults only,
+    not those of a map's ``additionalProperties``); read once per process, shared: callers
+    merge it into a new dict and never change it."""
     from opnav.config import SCHEMA_PATH, read_yaml
 
     props = read_yaml(SCHEMA_PATH.parent / "studies.schema.yaml")["additionalProperties"]["properties"]
     return {k: v["default"] for k, v in props.items() if "default" in v}
-
-
-def _spec_defaults() -> dict:
-    """Per-study defaults from the schema (validators fill ``properties`` defaults only,
-    not those of a map's ``additionalProperties``); the file is read once per process."""
-    return copy.deepcopy(_schema_spec_defaults())
 
 
 def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
