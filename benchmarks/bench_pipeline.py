@@ -21,6 +21,15 @@ Targets (issue 14): quick <= 45 s, full <= 5 min wall, pytest <= 90 s on two
 cores. Ratios are the thing to compare on a loaded machine: run what you
 compare in one invocation.
 
+Machine reference (:func:`machine_reference`, printed first and last): the
+thread CPU time of two fixed kernels shaped like the pipeline's own work, a
+scalar-float Python loop (the landing planner's call) and stacked 6 x 6 numpy
+products (paper A's batched filter). The VMs this project is measured on
+differ by more than 2x in speed between sessions (the same commit's full
+profile: 445 s on one, 1009 s on another), so a total is quoted with the
+reference beside it, and totals from different sessions are compared as
+``wall / reference`` ("reference units"), never as seconds.
+
 Use::
 
     python benchmarks/bench_pipeline.py                       # quick profile
@@ -59,6 +68,50 @@ def _env(wd: Path) -> dict:
 def _children_cpu() -> float:
     ru = resource.getrusage(resource.RUSAGE_CHILDREN)
     return ru.ru_utime + ru.ru_stime
+
+
+def machine_reference(repeats: int = 5) -> dict:
+    """Thread CPU ms of two fixed kernels (module docstring), each the minimum of
+    ``repeats``: ``python_ms``, 200 000 steps of a scalar-float loop (math calls,
+    branches, as ``opnav.landing.planner``'s golden-section search), and
+    ``numpy_ms``, 2 000 products ``A @ B`` of (60, 6, 6) stacks (as paper A's
+    batched EKF); ``ref_ms`` is their sum."""
+    import math
+
+    import numpy as np
+
+    def py():
+        x, acc, sin, sqrt = 0.3, 0.0, math.sin, math.sqrt
+        for _ in range(200_000):
+            s = sin(x)
+            acc += sqrt(1.0 + s * s) if s > 0 else -s
+            x += 1e-5
+        return acc
+
+    rng = np.random.default_rng(0)
+    A, B = rng.standard_normal((2, 60, 6, 6))
+
+    def npy():
+        for _ in range(2_000):
+            A @ B
+
+    out = {}
+    for key, fn in (("python_ms", py), ("numpy_ms", npy)):
+        best = math.inf
+        for _ in range(repeats):
+            c0 = time.thread_time_ns()
+            fn()
+            best = min(best, (time.thread_time_ns() - c0) / 1e6)
+        out[key] = best
+    out["ref_ms"] = out["python_ms"] + out["numpy_ms"]
+    return out
+
+
+def report_reference(tag: str) -> dict:
+    ref = machine_reference()
+    print(f"machine reference ({tag}): python {ref['python_ms']:.1f} ms, numpy {ref['numpy_ms']:.1f} ms, "
+          f"sum {ref['ref_ms']:.1f} ms (thread CPU, min of 5)")
+    return ref
 
 
 def timed(cmd: list[str], cwd: Path, env: dict) -> dict:
@@ -143,7 +196,7 @@ def run_profile(name: str, cores: int, keep: Path | None) -> dict:
             "bench": benchmark_seconds(wd / "results")}
 
 
-def report_profile(r: dict, cores: int) -> None:
+def report_profile(r: dict, cores: int, ref_ms: float) -> None:
     run, jobs = r["run"], r["jobs"]
     print(f"\n== {r['name']} profile (snakemake --cores {cores}{' ' + ' '.join(PROFILE_ARGS[r['name']]) if PROFILE_ARGS[r['name']] else ''}), scratch copy {r['wd']}")
     print(f"dry run: {jobs.get('total', 0)} jobs, parse + DAG {r['dry']['wall_s']:.1f} s wall, {r['dry']['cpu_s']:.1f} CPU-s")
@@ -162,10 +215,11 @@ def report_profile(r: dict, cores: int) -> None:
           f"{(run['cpu_s'] - bench_cpu) / n:.2f} CPU-s per job for the rest (other jobs, imports, snakemake)")
     print(f"load average {run['load_before']:.1f} before, {run['load_after']:.1f} after")
     print(f"{r['name']} profile: {run['wall_s']:.1f} s wall, {run['cpu_s']:.0f} CPU-s, "
-          f"{jobs.get('total', 0)} jobs (target {TARGET_S[r['name']]:.0f} s wall)")
+          f"{jobs.get('total', 0)} jobs (target {TARGET_S[r['name']]:.0f} s wall); "
+          f"{run['wall_s'] / (ref_ms / 1e3):.0f} reference units wall")
 
 
-def run_pytest() -> dict:
+def run_pytest(ref_ms: float) -> dict:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         p for p in (str(REPO / "src"), os.environ.get("PYTHONPATH", "")) if p))
     with tempfile.TemporaryDirectory(prefix="bench_pytest_") as base:
@@ -174,7 +228,8 @@ def run_pytest() -> dict:
     tail = [line for line in r["out"].splitlines() if line.strip()][-1:]
     print(f"\n== pytest ({tail[0] if tail else 'no output'})")
     print(f"load average {r['load_before']:.1f} before, {r['load_after']:.1f} after")
-    print(f"pytest: {r['wall_s']:.1f} s wall, {r['cpu_s']:.0f} CPU-s (target {TARGET_S['pytest']:.0f} s wall)")
+    print(f"pytest: {r['wall_s']:.1f} s wall, {r['cpu_s']:.0f} CPU-s (target {TARGET_S['pytest']:.0f} s wall); "
+          f"{r['wall_s'] / (ref_ms / 1e3):.0f} reference units wall")
     return r
 
 
@@ -189,10 +244,15 @@ def main(argv=None) -> int:
     if args.cores < 1:
         ap.error("--cores must be >= 1")
     print(f"{os.cpu_count()} CPUs; load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    ref_ms = report_reference("before")["ref_ms"]
     for name in args.profile:
-        report_profile(run_profile(name, args.cores, Path(args.keep) if args.keep else None), args.cores)
+        report_profile(run_profile(name, args.cores, Path(args.keep) if args.keep else None), args.cores,
+                       ref_ms)
     if args.pytest:
-        run_pytest()
+        run_pytest(ref_ms)
+    after = report_reference("after")["ref_ms"]
+    print(f"machine reference drift over the benchmark: {100 * (after / ref_ms - 1):+.0f} % "
+          "(units above use the 'before' reference)")
     return 0
 
 
