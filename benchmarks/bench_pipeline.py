@@ -26,7 +26,7 @@ thread CPU time of two fixed kernels shaped like the pipeline's own work, a
 scalar-float Python loop (the landing planner's call) and stacked 6 x 6 numpy
 products (paper A's batched filter). The VMs this project is measured on
 differ by more than 2x in speed between sessions (the same commit's full
-profile: 445 s on one, 1009 s on another), so a total is quoted with the
+profile's outputs, the same scorecard: 445 s on one, 1009 s on another), so a total is quoted with the
 reference beside it, and totals from different sessions are compared as
 ``wall / reference`` ("reference units"), never as seconds.
 
@@ -107,11 +107,16 @@ def machine_reference(repeats: int = 5) -> dict:
     return out
 
 
-def report_reference(tag: str) -> dict:
-    ref = machine_reference()
+def report_reference(tag: str, repeats: int = 5) -> dict:
+    ref = machine_reference(repeats)
     print(f"machine reference ({tag}): python {ref['python_ms']:.1f} ms, numpy {ref['numpy_ms']:.1f} ms, "
-          f"sum {ref['ref_ms']:.1f} ms (thread CPU, min of 5)")
+          f"sum {ref['ref_ms']:.1f} ms (thread CPU, min of {repeats})")
     return ref
+
+
+def units(wall_s: float, ref_ms: float) -> str:
+    """A wall time in reference units (wall / machine reference), as printed."""
+    return f"{wall_s / (ref_ms / 1e3):.0f} reference units wall"
 
 
 def timed(cmd: list[str], cwd: Path, env: dict) -> dict:
@@ -216,7 +221,7 @@ def report_profile(r: dict, cores: int, ref_ms: float) -> None:
     print(f"load average {run['load_before']:.1f} before, {run['load_after']:.1f} after")
     print(f"{r['name']} profile: {run['wall_s']:.1f} s wall, {run['cpu_s']:.0f} CPU-s, "
           f"{jobs.get('total', 0)} jobs (target {TARGET_S[r['name']]:.0f} s wall); "
-          f"{run['wall_s'] / (ref_ms / 1e3):.0f} reference units wall")
+          f"{units(run['wall_s'], ref_ms)}")
 
 
 def run_pytest(ref_ms: float) -> dict:
@@ -229,7 +234,7 @@ def run_pytest(ref_ms: float) -> dict:
     print(f"\n== pytest ({tail[0] if tail else 'no output'})")
     print(f"load average {r['load_before']:.1f} before, {r['load_after']:.1f} after")
     print(f"pytest: {r['wall_s']:.1f} s wall, {r['cpu_s']:.0f} CPU-s (target {TARGET_S['pytest']:.0f} s wall); "
-          f"{r['wall_s'] / (ref_ms / 1e3):.0f} reference units wall")
+          f"{units(r['wall_s'], ref_ms)}")
     return r
 
 
