@@ -18,6 +18,11 @@ def test_cli_runs_one_case_and_prints_json(capsys):
     crlb = out["crlb_arcsec"]["tx"]
     assert abs(est[0] - 10.0) < 5 * max(crlb, 0.05) + 0.5
     assert out["nav_err_after_km"] < out["nav_err_before_km"]
+    # the bound of the data used with Q = 0 beside it: no process noise can only add information
+    for used, q0 in (("crlb_arcsec", "crlb_q0_arcsec"), ("crlb_all_data_arcsec", "crlb_all_data_q0_arcsec")):
+        assert 0 < out[q0]["tx"] <= out[used]["tx"] * (1 + 1e-9)
+    assert out["label"] in ("converged", "stalled", "not converged")
+    assert out["reading"].startswith(out["label"])
 
 
 def test_cli_rejects_bad_values(capsys):

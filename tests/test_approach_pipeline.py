@@ -73,11 +73,15 @@ def test_verdict_text_comes_from_the_numbers(small):
     assert np.isfinite(summ["variants"]["literal"]["crlb_x_arcsec"])
 
 
-def _summary_row(scenario, est, bound, stalled, dist=0.0, k=None):
+def _summary_row(scenario, est, bound, label, dist=0.0, rate=0.2):
+    counts = {"converged": 0, "not converged": 0, "stalled": 0, label: 4}
     return {"scenario": scenario, "method": "plain", "est_x_mean": est[0], "est_y_mean": est[1],
             "est_x_std": 0.1, "est_y_std": 0.1, "crlb_x_arcsec": bound, "crlb_y_arcsec": bound,
-            "crlb_all_x_arcsec": bound, "stalled": stalled, "stalled_seeds": 4 if stalled else 0,
-            "n_seeds": 4, "dist_to_ml_arcsec": dist, "data_to_converge_samples": 250.0}
+            "crlb_all_x_arcsec": bound, "label": label, "stalled": label == "stalled",
+            "stalled_seeds": 4 if label == "stalled" else 0, "n_seeds": 4, "dist_to_ml_arcsec": dist,
+            "data_to_converge_samples": 250.0,
+            "reading": report.reading_text(label, counts, 4, bound, 2.0, dist, rate,
+                                           report.bound_cause(sc.START_OF[scenario], "sliding", 50))}
 
 
 @pytest.mark.parametrize("lit_bound, roll_stalled", [(20.6, True), (1.0, False)])
@@ -85,19 +89,24 @@ def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalle
     """The finding sentences come out the other way when the numbers do (nothing fixed)."""
     cfg = approach_cfg()
     summ = {"prior_bound_arcsec": report.prior_bound_arcsec(cfg), "convergence_max_maps": 40, "variants": {
-        "literal": _summary_row("literal", (0.0, 0.0), lit_bound, True),
+        "literal": _summary_row("literal", (0.0, 0.0), lit_bound, "converged"),
         "roll": _summary_row("roll", (0.02, 0.07) if roll_stalled else (10.0, 20.0), 8.2 if roll_stalled else 0.1,
-                             roll_stalled, dist=16.6 if roll_stalled else 0.0),
+                             "stalled" if roll_stalled else "converged", dist=16.6 if roll_stalled else 0.0,
+                             rate=0.999 if roll_stalled else 0.2),
     }}
     pub = published.paper_a()["headline"]
     txt = report.findings(cfg, summ, pub)
     assert ("no variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
     assert ("add almost nothing to the prior" in txt["bound"]) is bool(lit_bound > 0.8 * summ["prior_bound_arcsec"])
-    assert ("STALLED" in txt["headline_roll"]) is roll_stalled
-    assert "16.6 arcsec from the maximum-likelihood" in txt["headline_roll"] if roll_stalled else \
-        "not stalled" in txt["headline_roll"]
-    assert ("not stalled: roll." in txt["reading"]) is (not roll_stalled)
-    assert ("No row is both unstalled" in txt["reading"]) is roll_stalled
+    assert ("stalled (4/4)" in txt["headline_roll"]) is roll_stalled
+    assert "16.6 arcsec from the ML estimate" in txt["headline_roll"] if roll_stalled else \
+        "converged (4/4)" in txt["headline_roll"]
+    # the literal row converged either way; whether it means anything is the bound's reading
+    assert "converged (4/4)" in txt["headline_literal"]
+    assert ("not identifiable from this data (bound 20.6 arcsec)" in txt["headline_literal"]) is (lit_bound > 2.0)
+    assert "stalled" not in txt["headline_literal"]
+    assert ("within 3 bound-sigma of the truth: roll." in txt["reading"]) is (not roll_stalled)
+    assert ("No row is converged, identifiable" in txt["reading"]) is roll_stalled
     assert f"{report.prior_bound_arcsec(cfg):.3g} arcsec" in txt["bound"]
 
 

@@ -135,16 +135,19 @@ def test_rows_paper_b_per_scenario_from_the_summary():
 def test_a_stalled_em_row_says_so_in_the_reason_and_never_converged():
     import pandas as pd
 
-    from opnav.approach.report import rows_paper_a
+    from opnav.approach.report import reading_text, rows_paper_a
 
     base = {"variant": "roll", "case_id": "T1-01", "truth_x_arcsec": 10.0, "truth_y_arcsec": 20.0,
             "est_x_mean": 0.02, "est_x_std": 0.002, "crlb_x_arcsec": 8.2, "crlb_y_arcsec": 8.2,
             "data_to_converge_samples": float("nan"), "dist_to_ml_arcsec": 16.6, "n_seeds": 20,
             "pub_est_x_mean": 11.43, "pub_data_to_converge_samples": 250.0}
-    for stalled, k in ((True, 20), (False, 0)):
-        t1 = pd.DataFrame([{**base, "stalled": stalled, "stalled_seeds": k}])
+    for label in ("stalled", "converged"):
+        reading = reading_text(label, {label: 20}, 20, 8.2, 2.0, 16.6 if label == "stalled" else 0.0, 0.999)
+        t1 = pd.DataFrame([{**base, "label": label, "stalled": label == "stalled", "reading": reading}])
         df = score_rows(rows_paper_a(t1, {}, {}))
         reasons = dict(zip(df["item"], df["reason"]))
-        assert ("STALLED" in reasons["T1 roll T1-01: est_x"]) is stalled
+        stalled = label == "stalled"
+        assert ("stalled (20/20)" in reasons["T1 roll T1-01: est_x"]) is stalled
         assert ("16.6 arcsec from the ML" in reasons["T1 roll T1-01: data_to_converge_samples"]) is stalled
+        assert ("not identifiable from this data (bound 8.2 arcsec)" in reasons["T1 roll T1-01: est_x"]) is not stalled
         assert dict(zip(df["item"], df["verdict"]))["T1 roll T1-01: data_to_converge_samples"] != REPRODUCED

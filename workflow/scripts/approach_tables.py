@@ -25,7 +25,8 @@ with script_context(snakemake) as log:
     t1 = report.table1_frame(results, pub, snakemake.params.profile)
     csv, tex, md = snakemake.output.t1
     cap = ("A-T1: paper A Table 1 reproduced; mean and sd over Monte-Carlo seeds; CRLB of the data each "
-           "estimate used; stalled runs never count as converged; pub_* = published.")
+           "estimate used (Q = 0 beside); EM label from the ML estimate of the data each run used (converged / "
+           "stalled / not converged), identifiable when that bound is at most the published accuracy; pub_* = published.")
     write_table(t1, [csv], caption=cap)  # every column
     write_table(report.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
     x1 = report.crlb_rows(setup, curves["Q"], conv, t1, curves["Q0"])

@@ -28,8 +28,8 @@ sec. 2.3   segment-wise EM-EKF (N0, N, M, L), Table 1                  cases.run
                                                                        em.em_window
 SPEC A.3b  Cramér-Rao bound of theta with the unknown state            crlb.crlb_curve (the augmented filter's         rad (1-sigma)
                                                                        covariance via kalman.*), crlb.batch_crlb
-SPEC A.3c  stall rule: contraction per map toward the ML estimate      em.ml_estimate, em.contraction_per_map,         arcsec
-                                                                       em.stalled
+SPEC A.3c  convergence labels: distance to the ML estimate of the      em.ml_estimate, em.contraction_per_map,         arcsec
+           data used, contraction per map toward it                    em.convergence_labels
 SPEC A.4   A-X2 alternatives: augmented EKF, batch ML (CasADi/IPOPT)   augmented.run_augmented, batch_ml.BatchML,      rad, arcsec
                                                                        alternatives.run_case_alternatives
 =========  ==========================================================  ==============================================  ====================

@@ -22,7 +22,11 @@ Written rules (Table 1 columns)
     *Data needed to converge* (samples): for each seed, the smallest amount
     of data ``(l+1) N`` such that after segment l and after every later
     segment both |tx - tx_final| and |ty - ty_final| are at most
-    ``em.converge_tol_arcsec``; the table reports the median over seeds.
+    ``em.converge_tol_arcsec``; the table reports the median over seeds. Only a
+    run labelled *converged* has one (:func:`opnav.approach.em.convergence_labels`:
+    within ``em.converge_tol_arcsec`` of the ML estimate of its last segment's data;
+    *stalled* when not and its contraction per map toward it is ``em.stall_rate`` or
+    more; else *not converged*). The label reads the data, not the start.
     *Navigation error before / after compensation* (km): for each seed, the
     RMS of the position-error norm |r_hat - r_true| of the full-arc EKF
     (step 2 with theta = 0, step 4 with the final estimate) over the last
@@ -39,7 +43,7 @@ import numpy as np
 
 from . import scenario as sc
 from .ekf import predict_only, run_filter
-from .em import contraction_per_map, em_window, maps_per_segment, ml_estimate, stalled
+from .em import CONVERGED, STALLED, contraction_per_map, convergence_labels, em_window, maps_per_segment, ml_estimate
 from .setup import Setup
 
 GROUPS = ("size", "polarity", "initial", "pixel", "install")
@@ -268,16 +272,15 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
         seg_lat3.append(lat3)
         seg_rng3.append(rng3)
 
-    # the stall rule (SPEC A.3c) on the last segment: the ML estimate of that segment's data
-    # (one window when sliding, the cumulative data when growing), reached from the final
-    # estimate by SQUAREM, and the measured contraction factor per map toward it
+    # the convergence label (SPEC A.3c) from the last segment's data (one window when sliding,
+    # the cumulative data when growing): its ML estimate, reached from the final estimate by
+    # SQUAREM, the distance to it and the measured contraction factor per map toward it
     theta_ml, ml_done, _ = ml_estimate(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), tz_tol,
                                        em_set.ml_max_maps)
     rate = contraction_per_map(theta_seg_start, theta, theta_ml, maps_per_segment(method, M))
     dist_ml = np.abs(sc.arcsec(theta - theta_ml))[:, :2].max(1)
     moved = np.abs(sc.arcsec(theta - theta_init))[:, :2].max(1)
-    stall = stalled(moved, rate, dist_ml, em_set.stall_move_tol_arcsec, em_set.stall_rate,
-                    em_set.converge_tol_arcsec)
+    label = convergence_labels(dist_ml, rate, em_set.converge_tol_arcsec, em_set.stall_rate)
 
     f1 = run_filter(z, theta, dx0, geo.P0, win, predicted=False)
     err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
@@ -285,7 +288,7 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     seg_theta_as = sc.arcsec(np.stack(seg_theta, 1))
     seg_data = np.array([b - windows[0][0] for (_, b) in windows])
     conv = data_to_converge(seg_theta_as, seg_data, em_set.converge_tol_arcsec).astype(float)
-    conv[stall] = np.nan  # a stalled run has not converged, whatever its last segments did
+    conv[label != CONVERGED] = np.nan  # not at the ML estimate of its data: no 'data to converge'
     theta_iter = sc.arcsec(np.stack(it_theta, 1))
     ll_iter = np.stack(it_ll, 1)
     seg_lat, seg_rng = np.stack(seg_lat, 1), np.stack(seg_rng, 1)
@@ -313,7 +316,9 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
             "seg_lat_3sig_km": seg_lat3[sl], "seg_rng_3sig_km": seg_rng3[sl],
             "tz_unobservable": bool(np.all(unobs[sl, 0])) if unobs is not None else False,
             "data_to_converge": conv[sl],
-            "stalled": stall[sl],
+            "label": label[sl],
+            "stalled": label[sl] == STALLED,
+            "converged": label[sl] == CONVERGED,
             "moved_arcsec": moved[sl],
             "contraction_per_map": rate[sl],
             "theta_ml_arcsec": sc.arcsec(theta_ml[sl]),

@@ -261,14 +261,27 @@ def contraction_per_map(theta_start: np.ndarray, theta_end: np.ndarray, theta_ml
     return np.where(d0 > floor_rad, rate, np.nan)
 
 
-def stalled(moved_arcsec: np.ndarray, rate: np.ndarray, dist_ml_arcsec: np.ndarray,
-            move_tol_arcsec: float, rate_max: float, ml_tol_arcsec: float) -> np.ndarray:
-    """The stall rule (SPEC A.3c), per seed: the estimate never moved more than
-    ``move_tol_arcsec`` from its start, *or* its contraction factor per map toward the
-    ML estimate of the same data is at least ``rate_max`` while it is still farther
-    than ``ml_tol_arcsec`` from it. A stalled run is never reported as converged."""
-    slow = np.nan_to_num(rate, nan=0.0) >= rate_max
-    return (moved_arcsec <= move_tol_arcsec) | (slow & (dist_ml_arcsec > ml_tol_arcsec))
+#: Convergence labels of an EM run (SPEC A.3c as read in issue 28): from the data, not the start.
+CONVERGED, STALLED, UNFINISHED = "converged", "stalled", "not converged"
+
+
+def convergence_labels(dist_ml_arcsec: np.ndarray, rate: np.ndarray, ml_tol_arcsec: float,
+                       rate_max: float) -> np.ndarray:
+    """Per seed, what the EM run reached, read from the data it used (S,) str:
+
+    * ``converged``: within ``ml_tol_arcsec`` (in tx and ty) of the maximum-likelihood
+      estimate of that data, wherever it started;
+    * ``stalled``: farther than that, and its measured contraction factor per map toward
+      the ML estimate is at least ``rate_max`` (about 1: the iteration does not approach
+      its fixed point);
+    * ``not converged``: farther than that but still contracting (its map budget ran out).
+
+    Whether a converged estimate means anything is the bound's reading, not this label's
+    (:func:`opnav.approach.report.identifiability_reading`). Two starts on the same data
+    reach the same ML estimate, hence the same label."""
+    dist = np.asarray(dist_ml_arcsec, float)
+    slow = np.nan_to_num(np.asarray(rate, float), nan=0.0) >= rate_max
+    return np.where(dist <= ml_tol_arcsec, CONVERGED, np.where(slow, STALLED, UNFINISHED))
 
 
 def squarem_cycle(theta0: np.ndarray, F) -> np.ndarray:

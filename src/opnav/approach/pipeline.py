@@ -174,33 +174,35 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
         r.update(method=method, group=group, case=case)
         if case.case_index == 1:
             smp = sampled[0]
-            r["sampled"] = {k: smp[k] for k in ("theta_final_arcsec", "stalled", "dist_to_ml_arcsec",
+            r["sampled"] = {k: smp[k] for k in ("theta_final_arcsec", "label", "stalled", "dist_to_ml_arcsec",
                                                 "consistency_t", "nav_err_after_km", "nav_err_before_km")}
         else:  # time series only for the headline case (figures)
             for k in ("err_before_t_km", "err_after_t_km", "consistency_t"):
                 r.pop(k)
         out.append(r)
         if log:
-            log.info("%s %s %s/%s %s: est %s, bound %s, stalled %d/%d", variant, group, mode, method,
-                     case.case_id, np.round(r["theta_final_arcsec"].mean(0), 3),
-                     np.round(r["crlb_arcsec"][:2], 3), r["stalled"].sum(), r["stalled"].size)
+            log.info("%s %s %s/%s %s: est %s, bound %s, converged %d/%d, stalled %d", variant, group, mode,
+                     method, case.case_id, np.round(r["theta_final_arcsec"].mean(0), 3),
+                     np.round(r["crlb_arcsec"][:2], 3), r["converged"].sum(), r["converged"].size,
+                     r["stalled"].sum())
     return out
 
 
 def case_bounds(setup: Setup, geo: sc.Geometry, case_list: list[cases.Case], variant: str) -> list[dict]:
     """Per case, the bound of the data its estimate used (``crlb_arcsec``; per segment
     ``crlb_seg_arcsec``; with Q = 0: ``crlb_q0_arcsec``, ``crlb_seg_q0_arcsec``) and of all
-    the segments' data (``crlb_total_arcsec``), arcsec, 1-sigma; every case and both Q at once."""
+    the segments' data (``crlb_total_arcsec``; Q = 0: ``crlb_total_q0_arcsec``), arcsec,
+    1-sigma; every case and both Q at once."""
     items = [(geo.measurement_variance(c.sigma3_px), c.truth_arcsec, zq) for c in case_list for zq in (False, True)]
     need_curves = setup.segments.mode == "growing" or sc.START_OF[variant] == "filter"
-    curves = bound_curves(setup, geo, items if need_curves else items[::2], variant)
+    curves = bound_curves(setup, geo, items, variant)
     segs = segment_bounds_many(setup, geo, items, variant, curves if need_curves else None)
     out = []
     for i in range(len(case_list)):
         seg, seg0 = segs[2 * i], segs[2 * i + 1]
-        curve = curves[2 * i] if need_curves else curves[i]
         out.append({"crlb_seg_arcsec": seg, "crlb_seg_q0_arcsec": seg0, "crlb_arcsec": seg[-1],
-                    "crlb_q0_arcsec": seg0[-1], "crlb_total_arcsec": _at_total(setup, curve)})
+                    "crlb_q0_arcsec": seg0[-1], "crlb_total_arcsec": _at_total(setup, curves[2 * i]),
+                    "crlb_total_q0_arcsec": _at_total(setup, curves[2 * i + 1])})
     return out
 
 

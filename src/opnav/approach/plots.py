@@ -35,12 +35,16 @@ def _band_log(ax, x, y, color, label, ls="-"):
 
 
 def run_label(r: dict) -> str:
-    """Legend label of one EM run: scheme, and the stall rule's verdict (never 'converged')."""
+    """Legend label of one EM run: scheme, and its convergence label from the ML estimate of
+    the data it used (seeds per label), with the bound of that data."""
     mode = r.get("mode", "sliding")
     lab = f"EM ({r['method']}{', growing' if mode == 'growing' else ''})"
-    st = np.asarray(r.get("stalled", []), bool)
-    if st.size and st.any():
-        lab += f", STALLED {st.sum()}/{st.size}"
+    labels = np.asarray(r.get("label", []), str)
+    if labels.size:
+        counts = [(k, int(np.sum(labels == k))) for k in ("converged", "not converged", "stalled")]
+        lab += ", " + ", ".join(f"{k} {n}/{labels.size}" for k, n in counts if n)
+    if "crlb_arcsec" in r:
+        lab += f'; bound {r["crlb_arcsec"][0]:.3g}"'
     return lab
 
 
@@ -96,9 +100,10 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
         axes[2].text(0.01, 0.05, "$\\theta_z$: unobservable (held at its initial value)",
                      transform=axes[2].transAxes, fontsize=7)
         axes[-1].set_xlabel("data used (samples); EM iterations spread over each segment")
-        axes[0].legend(loc="best", fontsize=6, ncol=3)
+        h, lab = axes[0].get_legend_handles_labels()
+        fig.legend(h, lab, loc="lower center", fontsize=6, ncol=2, frameon=False)
         axes[0].set_title(f"A-F4 bias estimate, variant: {variant}", fontsize=8)
-        fig.tight_layout()
+        fig.tight_layout(rect=(0, 0.02 + 0.025 * ((len(lab) + 1) // 2), 1, 1))
     return fig
 
 

@@ -31,21 +31,71 @@ def _sd(x: np.ndarray) -> float:
     return float(x.std(ddof=1)) if x.shape[0] > 1 else math.nan
 
 
-def stall_columns(r: dict) -> dict:
-    """A-T1 stall-rule columns of one run (SPEC A.3c): a row is *stalled* when more than
-    half of its seeds are; data to converge is the median over the seeds that are not."""
-    st = np.asarray(r["stalled"], bool)
+LABEL_ORDER = ("converged", "not converged", "stalled")  # em.CONVERGED, em.UNFINISHED, em.STALLED
+
+
+def row_label(labels) -> tuple[str, dict]:
+    """A row's convergence label from its seeds' (:func:`opnav.approach.em.convergence_labels`):
+    the label more than half of the seeds carry, else ``not converged``; and the count of each."""
+    labels = np.asarray(labels, str)
+    counts = {lab: int(np.sum(labels == lab)) for lab in LABEL_ORDER}
+    major = [lab for lab in LABEL_ORDER if counts[lab] > labels.size / 2]
+    return (major[0] if major else "not converged"), counts
+
+
+def bound_cause(start: str, mode: str, window: int) -> str:
+    """Why the data used cannot tell theta apart (the cause half of the identifiability reading)."""
+    if start == "filter":
+        return "the window's start, from the theta = 0 filter, has absorbed rho*theta"
+    if mode == "sliding":
+        return f"one {window}-sample window holds too little information"
+    return "the data and prior cannot separate theta from a lateral position error"
+
+
+def reading_text(label: str, counts: dict, n: int, bound_arcsec: float, target_arcsec: float,
+                 dist_ml_arcsec: float, rate: float, cause: str = "") -> str:
+    """One run's reading: its convergence label (what the iteration reached on its data) and,
+    for a converged one, what the bound of that data says the estimate can mean:
+    ``converged (3/3); not identifiable from this data (bound 20.6 arcsec): <cause>``."""
+    k = counts.get(label, 0)
+    if label == "converged":
+        if bound_arcsec > target_arcsec:
+            return (f"converged ({k}/{n}); not identifiable from this data (bound {bound_arcsec:.3g} arcsec)"
+                    + (f": {cause}" if cause else ""))
+        return f"converged ({k}/{n}); bound {bound_arcsec:.3g} arcsec"
+    rate_txt = "n/a" if rate is None or not math.isfinite(rate) else f"{rate:.4g}"
+    return (f"{label} ({k}/{n}): {dist_ml_arcsec:.3g} arcsec from the ML estimate of its data, "
+            f"contraction {rate_txt} per map")
+
+
+def label_columns(r: dict, target_arcsec: float) -> dict:
+    """A-T1 label columns of one run (SPEC A.3c, labels from the data): the row label and the
+    seeds of each label, ``stalled`` (kept for readers of the old column), the distance to and
+    the ML estimate of the data used, the contraction per map, whether the bound of the data
+    used reaches ``target_arcsec`` (``identifiable``), the reading sentence, and the data to
+    converge (median over the converged seeds)."""
+    lab, counts = row_label(r["label"])
     conv = np.asarray(r["data_to_converge"], float)
-    ok = conv[~st]
+    ok = conv[np.isfinite(conv)]
+    bound = float(max(r["crlb_arcsec"][0], r["crlb_arcsec"][1]))
+    rate = (float(np.nanmedian(r["contraction_per_map"])) if np.isfinite(r["contraction_per_map"]).any()
+            else math.nan)
+    dist = float(np.mean(r["dist_to_ml_arcsec"]))
+    seg = np.asarray(r["seg_data_used"])
+    mode = r.get("mode", "sliding")
+    cause = bound_cause(sc.START_OF[r["variant"]], mode, int(seg[0]))
     return {
-        "stalled": bool(st.mean() > 0.5),
-        "stalled_seeds": int(st.sum()),
+        "label": lab,
+        "converged_seeds": counts["converged"],
+        "stalled": lab == "stalled",
+        "stalled_seeds": counts["stalled"],
         "moved_arcsec": float(np.mean(r["moved_arcsec"])),
-        "contraction_per_map": float(np.nanmedian(r["contraction_per_map"]))
-        if np.isfinite(r["contraction_per_map"]).any() else math.nan,
-        "dist_to_ml_arcsec": float(np.mean(r["dist_to_ml_arcsec"])),
+        "contraction_per_map": rate,
+        "dist_to_ml_arcsec": dist,
         "ml_x_mean": float(np.mean(r["theta_ml_arcsec"][:, 0])),
         "ml_y_mean": float(np.mean(r["theta_ml_arcsec"][:, 1])),
+        "identifiable": bound <= target_arcsec,
+        "reading": reading_text(lab, counts, len(conv), bound, target_arcsec, dist, rate, cause),
         "data_to_converge_samples": float(np.median(ok)) if ok.size else math.nan,
     }
 
@@ -53,6 +103,7 @@ def stall_columns(r: dict) -> dict:
 def table1_frame(results: list[dict], published: dict, profile: str = "") -> pd.DataFrame:
     """A-T1 long form: one row per case x variant x EM scheme, published values beside."""
     pub = {r["case_id"]: r for r in published["table1"]}
+    target = float(published["headline"]["accuracy_claim_arcsec"])
     rows = []
     for r in results:
         c: cases.Case = r["case"]
@@ -83,11 +134,12 @@ def table1_frame(results: list[dict], published: dict, profile: str = "") -> pd.
             "crlb_q0_x_arcsec": r["crlb_q0_arcsec"][0], "crlb_q0_y_arcsec": r["crlb_q0_arcsec"][1],
             "crlb_all_x_arcsec": r["crlb_total_arcsec"][0], "crlb_all_y_arcsec": r["crlb_total_arcsec"][1],
             "tz_observable": not r["tz_unobservable"],
-            **stall_columns(r),
+            **label_columns(r, target),
             # initial error drawn from the prior (headline case only): the spread to set beside the bound
             "est_x_mean_sampled": smp["theta_final_arcsec"][:, 0].mean() if smp else math.nan,
             "est_x_std_sampled": _sd(smp["theta_final_arcsec"][:, 0]) if smp else math.nan,
             "est_y_std_sampled": _sd(smp["theta_final_arcsec"][:, 1]) if smp else math.nan,
+            "label_sampled": row_label(smp["label"])[0] if smp and "label" in smp else "",
             "rmse_x_sampled": float(np.sqrt(np.mean((smp["theta_final_arcsec"][:, 0] - truth[0]) ** 2)))
             if smp else math.nan,
             # filter consistency (sampled initial error): mean over time and seeds, 3 dof each
@@ -114,7 +166,8 @@ COMPACT_COLUMNS = {
     "variant": "variant", "case_id": "case", "truth_x_arcsec": "truth x", "truth_y_arcsec": "truth y",
     "est_x_mean": "est x", "est_x_std": "sd x", "pub_est_x_mean": "pub x",
     "est_y_mean": "est y", "est_y_std": "sd y", "pub_est_y_mean": "pub y",
-    "crlb_x_arcsec": "CRLB x (data used)", "stalled": "stalled", "dist_to_ml_arcsec": "to ML",
+    "crlb_x_arcsec": "CRLB x (data used)", "crlb_q0_x_arcsec": "CRLB x Q=0", "label": "EM label",
+    "identifiable": "identifiable", "dist_to_ml_arcsec": "to ML",
     "data_to_converge_samples": "conv", "pub_data_to_converge_samples": "pub conv",
     "nav_err_before_km": "before km", "pub_nav_err_before_km": "pub before",
     "nav_err_after_km": "after km", "pub_nav_err_after_km": "pub after",
@@ -162,7 +215,9 @@ def crlb_rows(setup: Setup | dict, curves: dict, conv: dict, t1: pd.DataFrame, c
             row[f"em_{tag}_est_x_std"] = r["est_x_std_sampled"] if sampled else r["est_x_std"]
             row[f"em_{tag}_rmse_x_arcsec"] = r["rmse_x_sampled"] if sampled else r["rmse_x_arcsec"]
             row[f"em_{tag}_crlb_x_arcsec"] = r["crlb_x_arcsec"]  # the bound of the data it used
-            row[f"em_{tag}_stalled"] = bool(r["stalled"])
+            row[f"em_{tag}_crlb_q0_x_arcsec"] = r["crlb_q0_x_arcsec"]
+            row[f"em_{tag}_label"] = (r["label_sampled"] if sampled and r.get("label_sampled") else r["label"])
+            row[f"em_{tag}_stalled"] = row[f"em_{tag}_label"] == "stalled"
         c = conv.get(v)
         if c is not None:
             ts, tr = c["theta_star_arcsec"], c["truth_arcsec"]
@@ -248,11 +303,13 @@ def identifiability_text(setup: Setup | dict, x1: pd.DataFrame) -> str:
         for tag, name in (("plain", "plain EM (paper's sliding segments)"),
                           ("growing_squarem", "SQUAREM on growing windows")):
             if f"em_{tag}_est_x_mean" in r and not pd.isna(r.get(f"em_{tag}_est_x_mean")):
-                st = " and is STALLED (never converged)" if r.get(f"em_{tag}_stalled") is True else ""
+                lab = r.get(f"em_{tag}_label")
+                st = f"; labelled {lab} (from the ML estimate of the data it used)" if isinstance(lab, str) and lab else ""
                 extra.append(f"{name} ends at tx = {_fmt(r[f'em_{tag}_est_x_mean'])} +- "
                              f"{_fmt(r[f'em_{tag}_est_x_std'])} arcsec (initial error drawn from the prior; "
                              f"RMS error {_fmt(r[f'em_{tag}_rmse_x_arcsec'])}, bound of the data it used "
-                             f"{_fmt(r[f'em_{tag}_crlb_x_arcsec'])}){st}")
+                             f"{_fmt(r[f'em_{tag}_crlb_x_arcsec'])}, "
+                             f"{_fmt(r.get(f'em_{tag}_crlb_q0_x_arcsec', math.nan))} with Q = 0){st}")
         if "maps_plain_median" in r and not pd.isna(r.get("maps_plain_median")):
             mp = r["maps_plain_median"]
             mp_txt = (f"more than the {int(r['max_maps'])} run (about {r['maps_plain_extrapolated_median']:.3g} "
@@ -290,7 +347,9 @@ def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame) -> dict:
             "crlb_x_arcsec": r["crlb_x_arcsec"], "crlb_y_arcsec": r["crlb_y_arcsec"],
             "crlb_q0_x_arcsec": _num(r, "crlb_q0_x_arcsec"),
             "crlb_all_x_arcsec": _num(r, "crlb_all_x_arcsec"), "crlb_all_y_arcsec": _num(r, "crlb_all_y_arcsec"),
+            "label": r["label"], "converged_seeds": int(r["converged_seeds"]),
             "stalled": bool(r["stalled"]), "stalled_seeds": int(r["stalled_seeds"]), "n_seeds": int(r["n_seeds"]),
+            "identifiable": bool(r["identifiable"]), "reading": r["reading"],
             **{f"{q}_{k}_mean": _num(r, f"{q}_{k}_mean") for q in ("nees_pos", "nis") for k in ("before", "after")},
             "contraction_per_map": _num(r, "contraction_per_map"),
             "dist_to_ml_arcsec": _num(r, "dist_to_ml_arcsec"),
@@ -327,7 +386,8 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
 
     ``bound``    which variants' all-data bound supports the claimed accuracy, and how the
                  literal bound compares with what the prior alone gives (sigma_r / rho);
-    ``stall``    which schemes the stall rule flags, per variant;
+    ``stall``    the convergence labels (converged / stalled / not converged, from the ML
+                 estimate of the data each run used) per scheme and variant;
     ``reading``  where the published error is below the bound of the data the estimator
                  used (not reproducible there), which schemes reach their bound, and which
                  of our rows lies closest to the published estimates.
@@ -360,35 +420,38 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
               + ("add almost nothing to the prior." if r > 0.8 else "add information beyond the prior."))
     out["bound"] = s
 
-    stalled_by = {}
+    by_scheme = {}
     for k, v in var.items():
         lab = k[len(v["scenario"]):].lstrip("+") or "plain EM, sliding windows"
-        stalled_by.setdefault(lab, []).append((v["scenario"], bool(v.get("stalled"))))
+        by_scheme.setdefault(lab, []).append((v["scenario"], v.get("label", "stalled" if v.get("stalled") else "")))
     parts = []
-    for lab, lst in stalled_by.items():
-        st = [s_ for s_, f in lst if f]
-        parts.append(f"{lab.replace('+', ' ')}: stalled in {len(st)} of {len(lst)} variants"
-                     + (f" ({_join(st)})" if st else ""))
-    out["stall"] = ("The stall rule (estimate never moved, or contraction per EM map about 1 away from the "
-                    "maximum-likelihood estimate of the same data) flags " + "; ".join(parts) + ".")
+    for lab, lst in by_scheme.items():
+        groups = {}
+        for scen, l_ in lst:
+            groups.setdefault(l_ or "unlabelled", []).append(scen)
+        parts.append(f"{lab.replace('+', ' ')}: " + "; ".join(f"{l_} in {_join(sc_)}" for l_, sc_ in groups.items()))
+    out["stall"] = ("An EM run is labelled converged when it ends within "
+                    f"{setup.em.converge_tol_arcsec:g} arcsec of the maximum-likelihood estimate of the data it "
+                    "used, stalled when it does not and its contraction per map toward that estimate is about 1 "
+                    f"(at least {setup.em.stall_rate:g}), whatever its start; whether a converged estimate means "
+                    "anything is read from the bound of that data. Headline rows: " + " | ".join(parts) + ".")
 
     for k, v in var.items():
-        d_ml = v.get("dist_to_ml_arcsec")
-        at_ml = d_ml is not None and d_ml <= setup.em.converge_tol_arcsec
-        st = (f"STALLED in {v['stalled_seeds']} of {v['n_seeds']} seeds: not converged, "
-              f"{nice(d_ml)} arcsec from the maximum-likelihood estimate of the same data"
-              + (" (its start already is that estimate: the data do not move it)" if at_ml else "")
-              if v.get("stalled") else
-              f"not stalled; data to converge {nice(v.get('data_to_converge_samples'), 4)} samples")
+        reading = v.get("reading") or ""
+        conv = (f"; data to converge {nice(v.get('data_to_converge_samples'), 4)} samples"
+                if v.get("label") == "converged" else "")
+        q0 = v.get("crlb_q0_x_arcsec")
         out[f"headline_{k}"] = (f"{k}: tx = {nice(v['est_x_mean'], 4)} +- {nice(v['est_x_std'], 2)}, "
                                 f"ty = {nice(v['est_y_mean'], 4)} +- {nice(v['est_y_std'], 2)} arcsec, "
-                                f"bound of the data it used {nice(v['crlb_x_arcsec'])} arcsec; {st}")
+                                f"bound of the data it used {nice(v['crlb_x_arcsec'])} arcsec "
+                                f"({nice(q0)} with Q = 0); {reading}{conv}")
 
     truth = pub_headline.get("truth_arcsec", [math.nan] * 3)
     pe = max(abs(pub_headline.get("est_x_arcsec", math.nan) - truth[0]),
              abs(pub_headline.get("est_y_arcsec", math.nan) - truth[1]))
     nr = [k for k, v in var.items() if max(v["crlb_x_arcsec"], v["crlb_y_arcsec"]) > pe]
-    reach = [k for k, v in var.items() if not v.get("stalled")
+    reach = [k for k, v in var.items() if v.get("label", "converged") == "converged" and not v.get("stalled")
+             and max(v["crlb_x_arcsec"], v["crlb_y_arcsec"]) <= target
              and abs(v["est_x_mean"] - truth[0]) <= 3 * v["crlb_x_arcsec"] + 0.1
              and abs(v["est_y_mean"] - truth[1]) <= 3 * v["crlb_y_arcsec"] + 0.1]
     dist = {k: math.hypot(v["est_x_mean"] - pub_headline.get("est_x_arcsec", math.nan),
@@ -398,13 +461,14 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
          f"{len(nr)} of {len(var)} headline rows ({_join(nr)}): there no unbiased estimator with the stated "
          "measurements and prior can know the misalignment that well, and we mark them not reproducible "
          "under stated assumptions. ")
-    s += (f"Estimates within 3 bound-sigma of the truth and not stalled: {_join(reach)}. " if reach
-          else "No row is both unstalled and within 3 bound-sigma of the truth. ")
+    s += (f"Estimates converged, identifiable (bound at most {target:g} arcsec) and within 3 bound-sigma of "
+          f"the truth: {_join(reach)}. " if reach
+          else "No row is converged, identifiable and within 3 bound-sigma of the truth. ")
     if closest is not None:
         c = var[closest]
         s += (f"The row closest to the published estimates is {closest} ({nice(dist[closest])} arcsec away"
               + ("; a diagnostic that needs the true state" if c["scenario"] == "reference-start" else "")
-              + (f"; it is stalled" if c.get("stalled") else "") + ").")
+              + (f"; it is {c['label']}" if c.get("label", "converged") != "converged" else "") + ").")
     out["reading"] = s
 
     parts = []
@@ -438,12 +502,17 @@ def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) 
     ``em_results``: the EM-EKF Monte-Carlo dicts (:func:`opnav.approach.pipeline.run_group`);
     ``em_times``: {variant: {"em_plain": s, ...}} measured on the headline case.
     """
+    nan3 = np.full(3, np.nan)
     crlb = {(r["variant"], r["case_id"]): r["crlb_total_arcsec"] for r in em_results}
+    crlb0 = {(r["variant"], r["case_id"]): r.get("crlb_total_q0_arcsec", nan3) for r in em_results}
     rows = []
 
-    def add(variant, case, method, truth, th, nav, data, runtime, extra=None):
+    def add(variant, case, method, truth, th, nav, data, runtime, extra=None, used=None, used_q0=None):
+        """``used``/``used_q0``: the bound of the data the estimate used (default: all the data)."""
         err = th[:, :2] - truth[:2]
-        cb = crlb.get((variant, case.case_id), np.full(3, np.nan))
+        key = (variant, case.case_id)
+        cb = crlb.get(key, nan3) if used is None else used
+        cb0 = crlb0.get(key, nan3) if used_q0 is None else used_q0
         row = {
             "variant": variant, "method": method, "method_label": METHOD_LABELS[method],
             "group": case.group, "case_id": case.case_id,
@@ -452,7 +521,11 @@ def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) 
             "err_x_mean_arcsec": float(err[:, 0].mean()), "err_x_std_arcsec": _sd(err[:, 0]),
             "err_y_mean_arcsec": float(err[:, 1].mean()), "err_y_std_arcsec": _sd(err[:, 1]),
             "rmse_xy_arcsec": float(np.sqrt(np.mean(err**2))),
+            # the bound of the data this estimate used (one window for sliding EM; all the data for
+            # the augmented EKF and batch ML), Q = 0 beside it (the truth has no process noise)
             "crlb_x_arcsec": float(cb[0]), "crlb_y_arcsec": float(cb[1]),
+            "crlb_q0_x_arcsec": float(cb0[0]), "crlb_q0_y_arcsec": float(cb0[1]),
+            "crlb_all_x_arcsec": float(crlb.get(key, nan3)[0]),
             "nav_err_after_km": float(np.mean(nav)),
             "data_to_converge_samples": float(np.median(data)) if data is not None else math.nan,
             "runtime_s_per_seed": runtime,
@@ -470,8 +543,8 @@ def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) 
         add(r["variant"], r["case"], m, np.asarray(r["truth_arcsec"], float), r["theta_final_arcsec"],
             r["nav_err_after_km"], r["data_to_converge"], rt,
             {"nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
-             # sliding EM rests on its last window: that bound, and the stall rule's verdict
-             "crlb_used_x_arcsec": float(r["crlb_arcsec"][0]), "stalled_seeds": int(np.sum(r["stalled"]))})
+             "label": row_label(r["label"])[0], "stalled_seeds": int(np.sum(r["stalled"]))},
+            used=r["crlb_arcsec"], used_q0=r["crlb_q0_arcsec"])
     for r in alt_results:
         for m, d in r["methods"].items():
             extra = {}
@@ -505,7 +578,10 @@ def summary_frame(long: pd.DataFrame) -> pd.DataFrame:
             "T1-01 err_x sd": h["err_x_std_arcsec"] if h is not None else math.nan,
             "T1-01 err_y mean": h["err_y_mean_arcsec"] if h is not None else math.nan,
             "T1-01 err_y sd": h["err_y_std_arcsec"] if h is not None else math.nan,
-            "T1-01 CRLB_x": h["crlb_x_arcsec"] if h is not None else math.nan,
+            "T1-01 CRLB_x": h["crlb_x_arcsec"] if h is not None else math.nan,  # of the data used
+            "T1-01 CRLB_x Q=0": h["crlb_q0_x_arcsec"] if h is not None else math.nan,
+            "T1-01 CRLB_x all data": h["crlb_all_x_arcsec"] if h is not None else math.nan,
+            "T1-01 label": (h["label"] if h is not None and isinstance(h.get("label"), str) else ""),
             "RMSE_xy all cases": float(np.sqrt(np.mean(g["rmse_xy_arcsec"] ** 2))),
             "median sd all cases": float(np.median(np.r_[g["err_x_std_arcsec"], g["err_y_std_arcsec"]])),
             "median CRLB all cases": float(np.median(np.r_[g["crlb_x_arcsec"], g["crlb_y_arcsec"]])),
@@ -528,7 +604,8 @@ def summary_json(long: pd.DataFrame, table: pd.DataFrame, setup: Setup | dict) -
         out["variants"].setdefault(r["variant"], {})[key] = {
             "err_x_mean_arcsec": r["T1-01 err_x mean"], "err_x_sd_arcsec": r["T1-01 err_x sd"],
             "err_y_mean_arcsec": r["T1-01 err_y mean"], "err_y_sd_arcsec": r["T1-01 err_y sd"],
-            "crlb_x_arcsec": r["T1-01 CRLB_x"],
+            "crlb_x_arcsec": r["T1-01 CRLB_x"], "crlb_q0_x_arcsec": r["T1-01 CRLB_x Q=0"],
+            "crlb_all_x_arcsec": r["T1-01 CRLB_x all data"], "label": r["T1-01 label"],
             "rmse_xy_all_cases_arcsec": r["RMSE_xy all cases"],
             "nav_err_after_km": r["nav err after km (T1-01)"],
             "data_to_converge_samples": r["data needed (T1-01)"],
@@ -548,13 +625,12 @@ def summary_json(long: pd.DataFrame, table: pd.DataFrame, setup: Setup | dict) -
 # ------------------------------------------------------------ manuscript and scorecard
 # (the page views of paper A's wide tables, opnav.manuscript.COMPACT_VIEWS; paper A's
 # scorecard rows, scored by opnav.scorecard)
-def _stall_or(r, text: str) -> str:
-    """'stalled (k/n)' for a row the stall rule flags (SPEC A.3c), else ``text``."""
-    st = r.get("stalled")
-    if isinstance(st, str):
-        st = st.strip().lower() == "true"
-    if st:
-        return f"stalled ({cell_num(r.get('stalled_seeds'), '{:.0f}')}/{cell_num(r.get('n_seeds'), '{:.0f}')})"
+def _label_or(r, text: str) -> str:
+    """``text`` (the data to converge) for a converged row, else its label with the seed count."""
+    lab = r.get("label")
+    if isinstance(lab, str) and lab and lab != "converged":
+        k = r.get("stalled_seeds") if lab == "stalled" else r.get("n_seeds", 0) - r.get("converged_seeds", 0)
+        return f"{lab} ({cell_num(k, '{:.0f}')}/{cell_num(r.get('n_seeds'), '{:.0f}')})"
     return text
 
 
@@ -575,7 +651,9 @@ def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
                 'est. x (")': cell_pm(r["est_x_mean"], r.get("est_x_std")),
                 'est. y (")': cell_pm(r["est_y_mean"], r.get("est_y_std")),
                 'CRLB x, y, data used (")': f"{cell_num(r['crlb_x_arcsec'], '{:.3g}')}, {cell_num(r['crlb_y_arcsec'], '{:.3g}')}",
-                "data (samples)": _stall_or(r, cell_num(r["data_to_converge_samples"], "{:.0f}")),
+                'CRLB x Q = 0 (")': cell_num(r.get("crlb_q0_x_arcsec"), "{:.3g}"),
+                "data (samples)": _label_or(r, cell_num(r["data_to_converge_samples"], "{:.0f}")),
+                "identifiable": "yes" if str(r.get("identifiable")).lower() == "true" else "no",
                 'to ML (")': cell_num(r.get("dist_to_ml_arcsec"), "{:.3g}"),
                 "nav. before / after (km)": f"{cell_num(r['nav_err_before_km'], '{:.1f}')} / {cell_num(r['nav_err_after_km'], '{:.1f}')}",
                 'published est. x, y (")': f"{cell_num(r.get('pub_est_x_mean'), '{:g}')}, {cell_num(r.get('pub_est_y_mean'), '{:g}')}",
@@ -594,7 +672,9 @@ def compact_a_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
             "variant": r["variant"],
             'CRLB x, 1 segment (")': cell_num(r.get("crlb_x_window_arcsec"), "{:.3g}"),
             'CRLB x, all data (")': cell_num(r.get("crlb_x_total_arcsec"), "{:.3g}"),
+            'CRLB x, all data, Q = 0 (")': cell_num(r.get("crlb_q0_x_total_arcsec"), "{:.3g}"),
             "reaches 2\"": "yes" if bool(r.get("bound_reaches_target")) else "no",
+            "EM plain label": r.get("em_plain_label") if isinstance(r.get("em_plain_label"), str) else "",
             'EM plain RMSE x (")': cell_num(r.get("em_plain_rmse_x_arcsec"), "{:.3g}"),
             'EM SQUAREM RMSE x (")': cell_num(r.get("em_squarem_rmse_x_arcsec"), "{:.3g}"),
             'ML RMSE x (")': cell_num(r.get("mle_rmse_x_arcsec"), "{:.3g}"),
@@ -611,7 +691,9 @@ def compact_a_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
             "variant": r["variant"], "method": r["method"],
             'T1-01 error x (")': cell_pm(r.get("T1-01 err_x mean"), r.get("T1-01 err_x sd")),
             'T1-01 error y (")': cell_pm(r.get("T1-01 err_y mean"), r.get("T1-01 err_y sd")),
-            'CRLB x (")': cell_num(r.get("T1-01 CRLB_x"), "{:.3g}"),
+            'CRLB x, data used (")': cell_num(r.get("T1-01 CRLB_x"), "{:.3g}"),
+            'CRLB x, Q = 0 (")': cell_num(r.get("T1-01 CRLB_x Q=0"), "{:.3g}"),
+            "label": r.get("T1-01 label") if isinstance(r.get("T1-01 label"), str) else "",
             'RMSE all cases (")': cell_num(r.get("RMSE_xy all cases"), "{:.3g}"),
             "nav. after (km)": cell_num(r.get("nav err after km (T1-01)"), "{:.1f}"),
             "data (samples)": cell_num(r.get("data needed (T1-01)"), "{:.0f}"),
@@ -688,7 +770,7 @@ def rows_paper_a(table1: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
             if axis and f"truth_{axis}_arcsec" in table1.columns and f"crlb_{axis}_arcsec" in table1.columns:
                 row["truth"] = float(r[f"truth_{axis}_arcsec"])
                 row["crlb"] = float(r[f"crlb_{axis}_arcsec"])  # the bound of the data the estimate used
-            row["reason_note"] = _stall_note(r)
+            row["reason_note"] = _reading_note(r)
             rows.append(row)
     rows += _rows_paper_a_headline(summary, pub.get("headline", {}))
     head = pub.get("headline", {})
@@ -702,18 +784,12 @@ def rows_paper_a(table1: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
     return rows
 
 
-def _stall_note(r) -> str:
-    """Reason suffix for a row whose EM run the stall rule flags (A-T1 ``stalled``): such a
-    run is never 'converged', and the distance to the ML estimate of the same data is given."""
-    st = r.get("stalled")
-    if isinstance(st, str):
-        st = st.strip().lower() == "true"
-    if not st:
-        return ""
-    d = r.get("dist_to_ml_arcsec", float("nan"))
-    k, n = r.get("stalled_seeds", float("nan")), r.get("n_seeds", float("nan"))
-    return (f"; EM STALLED in {k:.0f}/{n:.0f} seeds (not converged; {d:.3g} arcsec from the ML "
-            "estimate of the same data)")
+def _reading_note(r) -> str:
+    """Reason suffix of a scorecard row: the run's reading (A-T1 ``reading``: its convergence
+    label from the ML estimate of the data it used and, when converged, whether that data's
+    bound lets the estimate mean anything); '' for a row without one."""
+    reading = r.get("reading")
+    return f"; EM {reading}" if isinstance(reading, str) and reading else ""
 
 
 def _rows_paper_a_headline(summary: dict, head: dict) -> list[dict]:
@@ -736,7 +812,7 @@ def _rows_paper_a_headline(summary: dict, head: dict) -> list[dict]:
             verdict, reason = NOT_REPRODUCED, f"RMS axis error {err:.3g} arcsec although the CRLB is {crlb:.3g}"
         rows.append({"paper": "A", "item": f"claim [{name}]: bias accuracy better than {target:g} arcsec",
                      "published": target, "ours": err, "unit": "arcsec", "verdict": verdict, "reason": reason,
-                     "reason_note": _stall_note(v)})
+                     "reason_note": _reading_note(v)})
         if "nav_err_before_km_text" in head and "nav_err_before_km" in v:
             rows.append({"paper": "A", "item": f"claim [{name}]: nav. error before compensation (sec. 3 text)",
                          "published": float(head["nav_err_before_km_text"]), "ours": float(v["nav_err_before_km"]),

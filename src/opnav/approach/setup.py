@@ -180,13 +180,13 @@ class Segments(_Section):
 
 @dataclass(frozen=True)
 class EMSettings(_Section):
-    """``em``: scheme (plain / squarem), unobservable-direction tolerance, the convergence and
-    stall rules (arcsec, contraction per map) and the map budget of the ML reference."""
+    """``em``: scheme (plain / squarem), unobservable-direction tolerance, the convergence
+    labels' tolerance to the ML estimate (arcsec) and stall rate (contraction per map), and
+    the map budget of the ML reference."""
 
     method: str
     tz_tol: float
     converge_tol_arcsec: float
-    stall_move_tol_arcsec: float
     stall_rate: float
     ml_max_maps: int
 
