@@ -382,16 +382,21 @@ def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec
             "truth_bias_px": bias_px_from_theta(sc.rad(truth[:2].tolist() + [0.0]), cam)}
 
 
-def peer_bound(setup: Setup | dict, geo: sc.Geometry, case, truth_arcsec=None) -> np.ndarray:
+def peer_bound(setup: Setup | dict, geo: sc.Geometry, case, truth_arcsec=None, zero_q: bool = False) -> np.ndarray:
     """1-sigma CRLB (tx, ty, tz) in arcsec on the peer's information: every sample from t0
-    with the prior ``P_X0`` and the peer's bias prior (the EM-EKF's ``literal`` set)."""
+    with the prior ``P_X0`` and the peer's bias prior (the EM-EKF's ``literal`` set);
+    ``zero_q``: the same without process noise (the truth has none)."""
+    from dataclasses import replace
+
     from .crlb import crlb_curve
 
     cam, settings = peer_settings(Setup.of(setup))
     truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
     Rvar = geo.measurement_variance(case.sigma3_px)
     sig = settings.bias_prior_sigma_px * cam.pitch
-    return sc.arcsec(crlb_curve(geo.window(Rvar), geo.u_true, geo.P0, sc.rad(truth), sig)[-1])
+    win = geo.window(Rvar)
+    win = replace(win, Q=np.zeros_like(win.Q)) if zero_q else win
+    return sc.arcsec(crlb_curve(win, geo.u_true, geo.P0, sc.rad(truth), sig)[-1])
 
 
 #: The A-P1 runs per variant: (name, truth override, prior-mean rule).
@@ -412,6 +417,7 @@ def run_variant(setup: Setup | dict, variant: str, log=None) -> dict:
     for name, truth, start in RUNS:
         r = run_peer(setup, variant, case, seeds, truth_arcsec=truth, geo=geo, start=start)
         r["crlb_peer_arcsec"] = peer_bound(setup, geo, case, truth)
+        r["crlb_peer_q0_arcsec"] = peer_bound(setup, geo, case, truth, zero_q=True)
         out["runs"][name] = r
         if log:
             log.info("A-P1 %s %s: UKF (tx, ty) %s +- %s arcsec (3 sigma, seed mean); truth %s",
@@ -421,8 +427,9 @@ def run_variant(setup: Setup | dict, variant: str, log=None) -> dict:
 
 
 # ------------------------------------------------------------ A-P1 table
-def _row(variant, method, run, truth, th, own3=None, crlb3=None, n_seeds=None) -> dict:
-    """One table row: seed mean and sd of (tx, ty), own 3-sigma, CRLB 3-sigma, coverage."""
+def _row(variant, method, run, truth, th, own3=None, crlb3=None, n_seeds=None, crlb3_q0=None) -> dict:
+    """One table row: seed mean and sd of (tx, ty), own 3-sigma, CRLB 3-sigma of the data the
+    estimate used (and with Q = 0: ``crlb3_q0``), coverage."""
     th = np.asarray(th, float)[:, :2]
     err = th - np.asarray(truth, float)[:2]
     sd = th.std(0, ddof=1) if len(th) > 1 else np.full(2, np.nan)
@@ -443,6 +450,8 @@ def _row(variant, method, run, truth, th, own3=None, crlb3=None, n_seeds=None) -
     c = np.full(2, np.nan) if crlb3 is None else np.asarray(crlb3, float)[:2]
     row.update(crlb_3sigma_x_arcsec=float(c[0]), crlb_3sigma_y_arcsec=float(c[1]),
                within_crlb_3sigma=float(np.mean(np.all(np.abs(err) <= c, axis=1))) if crlb3 is not None else np.nan)
+    c0 = np.full(2, np.nan) if crlb3_q0 is None else np.asarray(crlb3_q0, float)[:2]
+    row.update(crlb_q0_3sigma_x_arcsec=float(c0[0]), crlb_q0_3sigma_y_arcsec=float(c0[1]))
     return row
 
 
@@ -452,9 +461,11 @@ def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id:
 
     ``peer``: :func:`run_variant` outputs; ``em``: EM-EKF Monte-Carlo dicts
     (:func:`opnav.approach.pipeline.run_group`); ``alt``: A-X2 dicts
-    (:func:`opnav.approach.alternatives.run_case_alternatives`). The CRLB of the
-    paper's estimators is their variant's bound on the segment data
-    (``crlb_total_arcsec``); the peer's is :func:`peer_bound` on all data from t0.
+    (:func:`opnav.approach.alternatives.run_case_alternatives`). Each estimate is set
+    beside the bound of the data it used, with Q = 0 beside: the EM-EKF's last window when
+    sliding (``crlb_arcsec``, ``crlb_q0_arcsec``), all the segments' data for the augmented
+    EKF and batch ML (``crlb_total_arcsec``, ``crlb_total_q0_arcsec``); the peer's is
+    :func:`peer_bound` on all data from t0.
     """
     import pandas as pd
 
@@ -465,17 +476,21 @@ def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id:
         v = p["variant"]
         ems = [r for r in em if r["variant"] == v and r["case_id"] == case_id]
         bound = 3.0 * np.asarray(ems[0]["crlb_total_arcsec"], float) if ems else None
+        nan3 = np.full(3, np.nan)
+        bound0 = 3.0 * np.asarray(ems[0].get("crlb_total_q0_arcsec", nan3), float) if ems else None
         for r in ems:
             rows.append(_row(v, METHOD_LABELS.get(f"em_{r['method']}", r["method"]), "headline case",
-                             r["truth_arcsec"], r["theta_final_arcsec"], None, bound))
+                             r["truth_arcsec"], r["theta_final_arcsec"], None, 3.0 * np.asarray(r["crlb_arcsec"]),
+                             crlb3_q0=3.0 * np.asarray(r.get("crlb_q0_arcsec", nan3))))
         for a in (a for a in alt if a["variant"] == v and a["case_id"] == case_id):
             for m, d in a["methods"].items():
                 own = 3.0 * d["sigma_final_arcsec"] if "sigma_final_arcsec" in d else None
                 rows.append(_row(v, METHOD_LABELS[m], "headline case", a["truth_arcsec"],
-                                 d["theta_final_arcsec"], own, bound))
+                                 d["theta_final_arcsec"], own, bound, crlb3_q0=bound0))
         for name, r in p["runs"].items():
             rows.append(_row(v, "Basilisk pixelLineBiasUKF", RUN_LABELS[name], r["truth_arcsec"],
-                             r["theta_final_arcsec"], r["sigma3_final_arcsec"], 3.0 * r["crlb_peer_arcsec"]))
+                             r["theta_final_arcsec"], r["sigma3_final_arcsec"], 3.0 * r["crlb_peer_arcsec"],
+                             crlb3_q0=3.0 * np.asarray(r.get("crlb_peer_q0_arcsec", np.full(3, np.nan)))))
     return pd.DataFrame(rows)
 
 
@@ -490,7 +505,8 @@ def summary(table, peer: list[dict]) -> dict:
         out["variants"].setdefault(r["variant"], {})[k] = {
             c: r[c] for c in ("est_x_mean_arcsec", "est_x_sd_arcsec", "est_y_mean_arcsec", "est_y_sd_arcsec",
                               "own_3sigma_x_arcsec", "own_3sigma_y_arcsec", "within_own_3sigma",
-                              "crlb_3sigma_x_arcsec", "crlb_3sigma_y_arcsec", "rmse_xy_arcsec",
+                              "crlb_3sigma_x_arcsec", "crlb_3sigma_y_arcsec", "crlb_q0_3sigma_x_arcsec",
+                              "rmse_xy_arcsec",
                               "within_own_3sigma_text")}
     for p in peer:
         v = out["variants"].setdefault(p["variant"], {})

@@ -713,7 +713,8 @@ def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
             'ty (")': cell_pm(r.get("est_y_mean_arcsec"), r.get("est_y_sd_arcsec")),
             'own 3-sigma x (")': cell_num(r.get("own_3sigma_x_arcsec"), "{:.3g}"),
             "truth in own 3-sigma": str(r.get("within_own_3sigma_text", "--")),
-            '3 CRLB x (")': cell_num(r.get("crlb_3sigma_x_arcsec"), "{:.3g}"),
+            '3 CRLB x, data used (")': cell_num(r.get("crlb_3sigma_x_arcsec"), "{:.3g}"),
+            '3 CRLB x, Q = 0 (")': cell_num(r.get("crlb_q0_3sigma_x_arcsec"), "{:.3g}"),
         })
     return [("", pd.DataFrame(rows))]
 
