@@ -3,7 +3,8 @@ batched descent): ``run_descent`` and the per-run EKF steps exactly as they were
 kept under tests/ only to check that the batched descent
 (``opnav.landing.descent.run_descents``) gives the same numbers to round-off
 (tests/test_landing_batch.py, benchmarks/bench_descent.py). Not part of the
-package; do not edit except to follow renamed imports."""
+package; do not edit except to follow renamed imports (and the vision cut-off margin of
+issue 29, a change of specification)."""
 
 from __future__ import annotations
 
@@ -319,7 +320,8 @@ def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | 
         C_prior = st.R
         a_est = (st.v - v_prev) / scn.Dt
         k = j + 1
-        if k < n and st.r[2] > scn.min_update_alt:
+        # issue 29: the cut-off has a margin on the estimated altitude (spec change)
+        if k < n and st.r[2] - scn.update_margin_m > scn.min_update_alt:
             r_t, R_t = tr.r[k], tr.R_LtoB[k]
 
             def visible(pts, margin=scn.planner.margin_px, r_t=r_t, R_t=R_t):

@@ -223,7 +223,9 @@ def test_tied_order_is_by_method_name_not_timing():
     df2, h2 = build({"svd": 10.0, "depth": 700.0, "mineig": 800.0, "cond": 5.0, "gdop": 900.0})
     assert list(df1["method"]) == list(df2["method"]) == ["cond", "depth", "svd", "gdop", "mineig"]
     assert h1["ranking_by_accuracy"] == h2["ranking_by_accuracy"] == list(df1["method"])
-    assert h1["best_accuracy_method"] == h2["best_accuracy_method"] == "cond"
+    # a three-way tie is reported as a tie, never as the alphabetically first name
+    assert h1["best_accuracy_method"] == h2["best_accuracy_method"] == "cond = depth = svd"
+    assert h1["best_accuracy_methods"] == ["cond", "depth", "svd"] and h1["best_accuracy_tie"]
     assert h1["reference_more_accurate_than_text"] == h2["reference_more_accurate_than_text"] == "gdop, mineig"
 
 

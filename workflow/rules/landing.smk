@@ -45,6 +45,10 @@ except ValueError as exc:
 # the headline scenario's numbers also at its top level.
 B_SCENARIOS = list(B_SCENARIO_CFG)
 B_METHODS = list(config["landing"]["mc"]["methods"])
+_BEQ = config["landing"]["equivalence"]
+# the equivalence test's methods, reference and negative controls beyond B_METHODS
+B_EQ_METHODS = [m for m in dict.fromkeys([_BEQ["reference"], *_BEQ["methods"], *_BEQ["controls"]])
+                if m not in B_METHODS]
 B_CHUNKS = [chunk_label(c) for c in mc_chunks(config["landing"]["mc"]["n_runs"],
                                                config["landing"]["mc"]["runs_per_job"])]
 _B_SIM_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu", "camera",
@@ -155,14 +159,17 @@ rule landing_single:
 
 
 rule landing_summary:
-    """B-T3 of one scenario beside the published 29.03 %, its summary JSON, and B-F6
+    """B-T3 of one scenario beside the published 29.03 %, its summary JSON (with the
+    equivalence test of "almost the same accuracy" and its negative controls), and B-F6
     (3-sigma envelopes per axis) and B-F7 (planning-time box plots): one job reads the
     scenario's Monte Carlo and planning times once for the table and the figures."""
     input:
         mc=lambda wc: b_mc(wc.bscn, B_METHODS),
+        mc_eq=lambda wc: b_mc(wc.bscn, B_EQ_METHODS),
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         single=f"{LANDING}/single/summary_{{bscn}}.json",
         code=src("landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
+                 "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
                  "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml"),
     output:
         t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),
@@ -173,6 +180,8 @@ rule landing_summary:
         bscn=B_SCN_RE,
     params:
         methods=B_METHODS,
+        eq_methods=B_EQ_METHODS,
+        equivalence=canonical(_BEQ),
         yaw_ratio=config["landing"]["mc"]["yaw_ratio"],
         converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
         eval_path=config["landing"]["planner"]["eval_path"],

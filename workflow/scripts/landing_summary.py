@@ -11,7 +11,7 @@ import pandas as pd
 from opnav import figures, published
 from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
-from opnav.landing.report import scenario_summary, summary_table
+from opnav.landing.report import accuracy_tests, scenario_summary, summary_table
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_json, write_table
 
@@ -41,10 +41,13 @@ with script_context(snakemake) as log:
                          f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
     with open(snakemake.input.single) as fh:
         single = json.load(fh)
+    every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
+    acc = accuracy_tests(every, snakemake.params.equivalence, float(snakemake.params.converged_pos_err_m))
     out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
                            eval_path=snakemake.params.eval_path,
                            yaw_ratio=float(snakemake.params.yaw_ratio),
-                           published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"])
+                           published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
+                           accuracy=acc)
     write_json(snakemake.output.summary, out)
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f6)

@@ -27,10 +27,12 @@ with script_context(snakemake) as log:
                        converged_pos_err_m=conv)
     write_table(df, snakemake.output.t,
                 caption=(f"B-X1: all planning methods on the same paired Monte Carlo, ranked by mean "
-                         f"RMS position error (rank_accuracy) and by median planning-call CPU time "
+                         f"position error at the last landmark update (rank_accuracy; ties share "
+                         f"a rank) and by median planning-call CPU time "
                          f"(rank_time; methods within {100 * rtol:g} % of each other share the best "
                          f"rank); paired differences method minus "
-                         f"{ref} of the per-run RMS and final position errors (m) with 95 % paired-t "
+                         f"{ref} of the per-run position errors (m) at the last landmark update (lastlm), "
+                         f"RMS over the landmark phase (lmrms), RMS over the descent and at touchdown (final) with 95 % paired-t "
                          f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
                          f"error below {conv:g} m. " + timing.method_text(tm)))
     t = next(iter(data.values()))["t"]

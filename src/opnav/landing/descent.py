@@ -16,7 +16,9 @@ the batch of one (the same code path):
 * initial estimate = truth minus an error uniform within the Table 2 bounds
   per axis, initial covariance diag(bound^2 / 3);
 * every ``dt_s`` the IMU increments propagate the filter; while the estimated
-  altitude exceeds ``min_update_altitude_m`` the camera measures the landing
+  altitude less ``update_altitude_margin_m`` (:func:`vision_cutoff_altitude`,
+  filter quantities only, never the truth)
+  exceeds ``min_update_altitude_m`` the camera measures the landing
   site (known landmark, {L} origin) and the current unknown landmark. The
   observation strategy of Fig. 3 (:func:`tracking_step`): a landmark is
   observed ``obs_per_landmark`` times (its first bearing initialises it), then
@@ -24,7 +26,9 @@ the batch of one (the same code path):
   leaves the image before that is replaced at once. Below the altitude limit
   the filter coasts on the IMU (the site is then metres away and bearings are
   no longer linear in the position error; our guidance creeps the last ~30 s
-  at a few metres).
+  at a few metres). ``lm_updated`` marks the updates holding a landmark
+  bearing (the landmark-tracking phase ends at its last one), ``cut_alt_m``
+  the cut-off quantity at each image.
 
 Batching: the state, covariance and errors of every run of the batch are
 arrays (runs x ...); the filter steps of ``opnav.landing.ekf`` work on the
@@ -84,7 +88,7 @@ from opnav.landing.trajectory import euler_rpy_deg
 from opnav.rotations import exp_so3, log_so3
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
-           "yaw_sigma_rad", "tracking_step"]
+           "yaw_sigma_rad", "tracking_step", "vision_cutoff_altitude"]
 
 def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
     """Error state (truth - estimate) [dr, dv, dtheta] (9,), uniform per axis."""
@@ -110,6 +114,18 @@ def yaw_sigma_rad(R_LtoB: np.ndarray, P: np.ndarray) -> np.ndarray:
     u = R_LtoB[..., :, 2]
     q = np.einsum("...i,...ij,...j->...", u, P[..., 6:9, 6:9], u)
     return np.sqrt(np.maximum(q, 0.0))
+
+
+def vision_cutoff_altitude(r_est: np.ndarray, margin_m: float) -> np.ndarray:
+    """The quantity the vision cut-off compares with ``min_update_altitude_m``:
+    the filter's estimated altitude less a margin, ``z_est - margin_m`` (m),
+    per run. Only filter quantities: the truth never decides when the camera
+    stops. The margin covers the estimate's altitude error near the ground
+    (without it, runs whose estimate sits a few metres high took site bearings
+    with the lander on the ground). A margin in filter 1-sigmas was tried and
+    rejected: a filter that cannot tell its altitude (e.g. the random picker's,
+    sigma_z ~ 300 m at 1 km) then stops vision at 1 km."""
+    return r_est[..., 2] - float(margin_m)
 
 
 def tracking_step(cur: np.ndarray, n_obs: np.ndarray, still: np.ndarray, other: np.ndarray,
@@ -201,6 +217,8 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     nees_r = np.empty((B, n + 1))
     nees_v = np.empty((B, n + 1))
     updated = np.zeros((B, n + 1), bool)
+    lm_updated = np.zeros((B, n + 1), bool)      # a landmark bearing among the update's
+    cut_alt = np.full((B, n + 1), np.nan)        # the cut-off quantity at each image, m
     calls = [new_calls() for _ in range(B)]      # per planning call: inputs (replay) and results
     cur = np.full(B, -1, np.int64)
     n_obs = np.zeros(B, np.int64)
@@ -235,7 +253,8 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
         C_prior = st.R.copy()      # st is updated in place below
         a_est = (st.v - v_prev) / scn.Dt
         k = j + 1
-        act = (st.r[:, 2] > scn.min_update_alt) if k < n else np.zeros(B, bool)
+        cut_alt[:, k] = vision_cutoff_altitude(st.r, scn.update_margin_m)
+        act = (cut_alt[:, k] > scn.min_update_alt) if k < n else np.zeros(B, bool)
         if act.any():
             r_t, R_t = tr.r[k], tr.R_LtoB[k]
 
@@ -299,6 +318,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
                 new, _ = ekf.update(st.take(ig), meas, sb, N[ig] if scn.oc else None, scn.iterations)
                 st.put(ig, new)
                 updated[ig, k] = True
+                lm_updated[ig, k] = with_lm
         record(k)
 
     rpy_t = euler_rpy_deg(tr.R_LtoB)
@@ -311,6 +331,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             "sig_r": sig[b, :, 0:3], "sig_v": sig[b, :, 3:6], "sig_th_deg": np.degrees(sig[b, :, 6:9]),
             "sig_yaw_deg": np.degrees(sig_yaw[b]),
             "nees_r": nees_r[b], "nees_v": nees_v[b], "updated": updated[b],
+            "lm_updated": lm_updated[b], "cut_alt_m": cut_alt[b],
             "n_landmarks": int(n_used[b]), "init_error": e0[b],
         }
         d.update(stack_calls(calls[b]))

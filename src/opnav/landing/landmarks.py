@@ -1,8 +1,10 @@
 """Landmark field on flat ground and nearest-landmark queries (SPEC B.2).
 
 Landmarks are drawn uniformly on the plane z = 0 of {L} over the square
-``[-half_width, +half_width]^2`` (m), from their own seed (the same field for
-every Monte-Carlo run and every method). Two spatial indexes on (x, y), both
+``[-half_width, +half_width]^2`` (m), plus optionally a part around the site
+whose density grows as the inverse square of the distance to it
+(:func:`near_site_xy`, config ``landing.landmarks.near_site``), from their own
+seed (the same field for every Monte-Carlo run and every method). Two spatial indexes on (x, y), both
 built once per field:
 
 * a 2-D ``scipy.spatial.cKDTree`` (``tree``): the batched planner's query of
@@ -28,7 +30,7 @@ import numpy as np
 if TYPE_CHECKING:
     from scipy.spatial import cKDTree
 
-__all__ = ["LandmarkField", "make_field", "GridIndex", "nearest_brute_force"]
+__all__ = ["LandmarkField", "make_field", "near_site_xy", "GridIndex", "nearest_brute_force"]
 
 
 class GridIndex:
@@ -236,13 +238,38 @@ class LandmarkField:
         return GridIndex(self.xyz[:, :2])
 
 
-def make_field(half_width_m: float, count: int, seed: int) -> LandmarkField:
-    """Uniform random field of ``count`` landmarks; ``seed`` fixes it."""
+def near_site_xy(count: int, r_min_m: float, r_max_m: float, rng: np.random.Generator) -> np.ndarray:
+    """``count`` landmarks (x, y) (m) around the site at the {L} origin whose
+    horizontal distance ``r`` is log-uniform on ``[r_min_m, r_max_m]`` and whose
+    azimuth is uniform: density ``count / (2 pi r^2 ln(r_max / r_min))`` per m^2.
+    A camera at altitude ``h`` near the site sees a ground patch of size ~``h``
+    at distances ~``h``, so it holds about the same number of these landmarks at
+    every altitude down to ~``r_min_m``: the field follows the descent, and
+    landmarks stay in view until the vision updates end."""
+    if count < 0 or not 0 < r_min_m < r_max_m:
+        raise ValueError(f"landing.landmarks.near_site: need count >= 0 and 0 < r_min_m < "
+                         f"half_width_m, got {count}, {r_min_m}, {r_max_m}")
+    r = r_min_m * (r_max_m / r_min_m) ** rng.uniform(0.0, 1.0, int(count))
+    az = rng.uniform(-math.pi, math.pi, int(count))
+    return np.column_stack([r * np.cos(az), r * np.sin(az)])
+
+
+def make_field(half_width_m: float, count: int, seed: int, near_site: dict | None = None
+               ) -> LandmarkField:
+    """Random field: ``count`` landmarks uniform on the square of half width
+    ``half_width_m`` (m), plus, if ``near_site`` (``{count, r_min_m}``) has a
+    positive count, that many around the site (:func:`near_site_xy`, out to
+    ``half_width_m``); ``seed`` fixes both (the uniform part is the same with
+    or without the near-site part)."""
     if half_width_m <= 0 or count < 1:
         raise ValueError(f"landing.landmarks: need half_width_m > 0 and count >= 1, got "
                          f"{half_width_m}, {count}")
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 0xB1A7]))
     xy = rng.uniform(-half_width_m, half_width_m, size=(int(count), 2))
+    if near_site and int(near_site["count"]) > 0:
+        rng_near = np.random.default_rng(np.random.SeedSequence([int(seed), 0xB1A8]))
+        xy = np.vstack([xy, near_site_xy(int(near_site["count"]), float(near_site["r_min_m"]),
+                                         float(half_width_m), rng_near)])
     xyz = np.column_stack([xy, np.zeros(len(xy))])
     # scipy.spatial imported here: the Snakefile parse imports this module (through the
     # planner's method registry) and builds no field

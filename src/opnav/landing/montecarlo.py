@@ -16,8 +16,10 @@ in run order. (B-T3, the table of these statistics per method, is
 Statistics (per method, over the runs): final (touchdown) and RMS (over time)
 error norms of position (m), velocity (m/s) and attitude (deg, small-angle
 ``dtheta``), each as mean and ``3 sigma`` (three sample standard deviations),
-and the position and velocity error at the last vision update (``lastvis_``:
-the filter then coasts on the IMU to touchdown); the median
+the position and velocity error at the last vision update (``lastvis_``:
+the filter then coasts on the IMU to touchdown), at the last update with a
+landmark bearing (``lastlm_``) and RMS over the landmark-tracking phase
+(``lmrms_``, :func:`landmark_phase`): what a landmark choice can move; the median
 objective evaluations per call (the descent's count). The per-call records
 (``opnav.landing.records``) are concatenated over runs with their run index;
 planning times are not among them: they come from the replay of the recorded
@@ -43,10 +45,10 @@ from opnav.landing.records import CALL_KEYS, load
 
 __all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
-           "same_pick_pct", "pick_quality"]
+           "same_pick_pct", "pick_quality", "landmark_phase", "phase_rms", "time_below", "nees_band", "nees_consistency"]
 
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
-           "sig_yaw_deg", "nees_r", "nees_v", "updated")
+           "sig_yaw_deg", "nees_r", "nees_v", "updated", "lm_updated", "cut_alt_m")
 
 
 def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
@@ -174,11 +176,71 @@ def per_run_stats(data: dict) -> pd.DataFrame:
         rows[f"final_{name}"] = nrm[:, -1]
         if "updated" in data:      # at the last vision update (then the IMU-only coast)
             rows[f"lastvis_{name}"] = nrm[np.arange(len(nrm)), last_update_index(data["updated"])]
+        if "lm_updated" in data:   # what selection can move: the landmark-tracking phase
+            first, last = landmark_phase(data["lm_updated"])
+            rows[f"lastlm_{name}"] = nrm[np.arange(len(nrm)), last]
+            rows[f"lmrms_{name}"] = phase_rms(nrm, first, last)
         rows[f"rms_{name}"] = np.sqrt(np.mean(nrm**2, axis=1))
     rows["mean_nees_pos"] = data["nees_r"].mean(axis=1)
     rows["mean_nees_vel"] = data["nees_v"].mean(axis=1)
     rows["n_landmarks"] = data["n_landmarks"]
     return pd.DataFrame(rows, index=pd.Index(data["run_index"], name="run"))
+
+
+def landmark_phase(lm_updated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per run (``lm_updated``: runs x times), the indices of the first and the
+    last filter time whose update held a landmark bearing: the landmark-tracking
+    phase, the part of the descent a landmark choice can act on (before it the
+    initial error, after it the site bearings and the IMU coast). A run with no
+    landmark update has the phase (0, 0)."""
+    u = np.asarray(lm_updated, bool)
+    first = np.where(u.any(axis=-1), np.argmax(u, axis=-1), 0)
+    return first, last_update_index(u)
+
+
+def phase_rms(nrm: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """Per run, the RMS of the error norms ``nrm`` (runs x times) over the times
+    ``first..last`` (inclusive), same unit as ``nrm``."""
+    k = np.arange(nrm.shape[1])[None, :]
+    w = (k >= np.asarray(first)[:, None]) & (k <= np.asarray(last)[:, None])
+    return np.sqrt((nrm**2 * w).sum(axis=1) / w.sum(axis=1))
+
+
+def time_below(data: dict, threshold_m: float) -> np.ndarray:
+    """Per run, the first filter time (s) at which the position error norm is
+    below ``threshold_m`` (m); NaN if never. "Converges faster" is a paired
+    comparison of these times (``opnav.landing.equivalence.converges_faster``)."""
+    below = np.linalg.norm(data["err_r"], axis=2) < float(threshold_m)
+    t = np.asarray(data["t"], float)
+    return np.where(below.any(axis=1), t[np.argmax(below, axis=1)], np.nan)
+
+
+def nees_band(n_runs: int, dof: int = 3, level: float = 0.95) -> tuple[float, float]:
+    """Two-sided ``level`` band of the mean of ``n_runs`` independent NEES
+    values of a consistent filter (each chi-square with ``dof`` degrees of
+    freedom): ``chi2_{n dof}`` quantiles over ``n_runs``."""
+    from scipy import special
+
+    v = int(n_runs) * int(dof)
+    a = (1.0 - level) / 2.0
+    return float(special.chdtri(v, 1.0 - a)) / n_runs, float(special.chdtri(v, a)) / n_runs
+
+
+def nees_consistency(data: dict, level: float = 0.95) -> dict:
+    """Filter consistency on the Monte Carlo (held-out evidence when the tuning
+    was chosen on other runs): per state (position, velocity; 3 dof each) the
+    NEES averaged over the runs at each filter time after the start, the share
+    of those times whose average lies in the :func:`nees_band` of an
+    ``n_runs`` mean (%), its time average and median, and the band."""
+    out = {"n_runs": int(len(data["nees_r"])), "level": float(level)}
+    lo, hi = nees_band(out["n_runs"], 3, level)
+    out["band"] = [lo, hi]
+    for key, name in (("nees_r", "pos"), ("nees_v", "vel")):
+        avg = np.asarray(data[key], float)[:, 1:].mean(axis=0)
+        out[f"{name}_in_band_pct"] = float(100.0 * np.mean((avg >= lo) & (avg <= hi)))
+        out[f"{name}_mean"] = float(avg.mean())
+        out[f"{name}_median"] = float(np.median(avg))
+    return out
 
 
 def last_update_index(updated: np.ndarray):

@@ -373,9 +373,20 @@ def _pick_center(field_, cand, state, camera, rng) -> int:
     return int(np.argmax(cosang))
 
 
+def _pick_closest(field_, cand, state, camera, rng) -> int:
+    """The detected landmark nearest the estimated lander by range (m): no
+    search, no metric; exact ties go to the smaller field index (``cand`` is
+    sorted). The control that tells how much of a metric's edge is picking a
+    close landmark (a short range is what ``svd`` mostly rewards)."""
+    d = field_.xyz[cand] - state.r
+    return int(np.argmin(np.einsum("ij,ij->i", d, d)))
+
+
 #: method name -> direct picker without search: f(field, candidate indices (k,),
-#: state, camera, rng) -> chosen position in the candidates (B-X1 baselines)
-PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center}
+#: state, camera, rng) -> chosen position in the candidates (B-X1 baselines and
+#: the equivalence test's negative controls)
+PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center,
+                                "closest": _pick_closest}
 
 
 def alternative_path(cfg: PlannerConfig) -> PlannerConfig:

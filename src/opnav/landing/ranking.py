@@ -17,7 +17,9 @@ timing. :func:`ranking_table` builds the B-X1 table: per method the
 accuracy (mean and 3-sigma of final and RMS position and velocity error
 norms, NEES, landmarks used, share of planning calls that chose no landmark), planning time (median wall and CPU time of a planning call, us, and
 the ratio to the reference's, from the replay of the recorded planning calls,
-:mod:`opnav.landing.timing`), ranks by accuracy (mean RMS position error)
+:mod:`opnav.landing.timing`), ranks by accuracy (mean position error at the
+last landmark update, :data:`RANK_BY`; ties share a rank and the headline names
+every method of rank 1)
 and by time (median CPU time, which other processes on a shared machine do
 not inflate), and the paired comparison against the reference method.
 All functions are pure (no I/O).
@@ -167,12 +169,26 @@ def competition_rank(values, rtol: float = 0.0) -> np.ndarray:
     return ranks
 
 
+#: the accuracy ranking's statistic (mean over runs): the position error at the
+#: last landmark update, what a landmark choice can move (the RMS over the whole
+#: descent is set by the 1 km initial error, the touchdown error by what follows
+#: the landmark phase)
+RANK_BY = "lastlm_pos"
+
+
+def _rank_by(stats: pd.DataFrame) -> str:
+    """:data:`RANK_BY`, or the RMS over the descent for records without the
+    landmark-update flags (``lm_updated``, e.g. hand-made runs)."""
+    return RANK_BY if f"{RANK_BY}_err_m" in stats else "rms_pos"
+
+
 def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth", n_boot: int = 2000,
                   seed: int = 0, level: float = 0.95, rtol: float = 0.0,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-X1: one row per method of ``data`` (gathered Monte-Carlo dicts, same
     runs), ranked; see the module docstring for the columns. Paired columns
-    ``d_rms_pos_vs_ref_*`` / ``d_final_pos_vs_ref_*`` are method minus
+    ``d_rms_pos_vs_ref_*`` / ``d_final_pos_vs_ref_*`` / ``d_lastlm_pos_vs_ref_*``
+    / ``d_lmrms_pos_vs_ref_*`` are method minus
     reference (m; negative = the method is more accurate); ``converged_runs_pct``
     counts runs whose final position error is below ``converged_pos_err_m`` (m),
     as in B-T3. Time columns (median wall and CPU time of a planning call, us)
@@ -189,17 +205,21 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
             raise ValueError(f"method {m!r} flew runs {list(s.index)[:5]}..., reference "
                              f"{reference!r} flew {list(ref_runs)[:5]}...: not paired")
     ref_cpu = tmg.median_us(timing, reference, clock="cpu")
+    rank_by = _rank_by(st[reference])
     rows = []
     for m, d in data.items():
         s = st[m]
         n = len(s)
         row = {"method": m, "n_runs": n}
         for q in ("pos_err_m", "vel_err_mps"):    # attitude: see the envelopes (yaw unobservable)
-            for kind in ("rms", "final"):
+            for kind in ("rms", "final", "lastlm", "lmrms"):
+                if f"{kind}_{q}" not in s:
+                    continue
                 col = s[f"{kind}_{q}"]
                 row[f"{kind}_{q}_mean"] = float(col.mean())
                 row[f"{kind}_{q}_3sigma"] = float(3.0 * col.std(ddof=1)) if n > 1 else math.nan
-        row["final_pos_err_m_median"] = float(s["final_pos_err_m"].median())
+                if q == "pos_err_m":
+                    row[f"{kind}_{q}_median"] = float(col.median())
         row["converged_runs_pct"] = float(100.0 * (s["final_pos_err_m"] < converged_pos_err_m).mean())
         row["mean_nees_pos"] = float(s["mean_nees_pos"].mean())
         row["landmarks_per_run"] = float(s["n_landmarks"].mean())
@@ -209,25 +229,29 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
         row["median_plan_time_us"] = tmg.median_us(timing, m)
         row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
         row["cpu_time_ratio_to_ref"] = row["median_plan_cpu_us"] / ref_cpu
-        for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos")):
+        for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos"),
+                          ("lastlm_pos_err_m", "lastlm_pos"), ("lmrms_pos_err_m", "lmrms_pos")):
+            if key not in s:
+                continue
             pdiff = paired_difference(s[key].to_numpy(), st[reference][key].to_numpy(),
                                       n_boot=n_boot, seed=seed, level=level)
             for k in ("mean", "t_lo", "t_hi", "boot_lo", "boot_hi", "p"):
                 row[f"d_{name}_vs_ref_{k}"] = pdiff[k]
-            if name == "rms_pos":
+            if name == rank_by:
                 row["ref_better_pct"] = 100.0 - pdiff["a_lower_pct"] - pdiff["equal_pct"]
                 row["equal_to_ref_pct"] = pdiff["equal_pct"]
         row["same_pick_as_ref_pct"] = (100.0 if m == reference
                                        else same_pick_pct(d, data[reference]))
         row["median_abs_dbeta_vs_ref_deg"] = (0.0 if m == reference
                                               else median_abs_dbeta_deg(d, data[reference]))
-        lo, hi = row["d_rms_pos_vs_ref_t_lo"], row["d_rms_pos_vs_ref_t_hi"]
+        lo, hi = row[f"d_{rank_by}_vs_ref_t_lo"], row[f"d_{rank_by}_vs_ref_t_hi"]
         row["vs_ref"] = ("reference" if m == reference else
                          "n/a" if math.isnan(lo) else
                          "worse" if lo > 0 else "better" if hi < 0 else "not significant")
         rows.append(row)
     df = pd.DataFrame(rows)
-    df.insert(1, "rank_accuracy", competition_rank(df["rms_pos_err_m_mean"], rtol))
+    df.insert(1, "rank_accuracy", competition_rank(df[f"{rank_by}_err_m_mean"], rtol))
+    df["rank_accuracy_by"] = f"{rank_by}_err_m_mean"
     df.insert(2, "rank_time", competition_rank(df["median_plan_cpu_us"], rtol))
     # ties broken by method name, never by a timing (identical rebuilds, same order)
     return df.sort_values(["rank_accuracy", "method"], kind="stable").reset_index(drop=True)
@@ -254,7 +278,11 @@ def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
         "methods": {m: {k: clean(v) for k, v in t.loc[m].items()} for m in t.index},
         "ranking_by_accuracy": by_acc,
         "ranking_by_time": by_time,
-        "best_accuracy_method": by_acc[0],
+        # ties are ties: every method of rank 1, never one chosen by its name
+        "best_accuracy_methods": [m for m in by_acc if int(t.loc[m, "rank_accuracy"]) == 1],
+        "best_accuracy_tie": sum(int(t.loc[m, "rank_accuracy"]) == 1 for m in by_acc) > 1,
+        "best_accuracy_method": " = ".join(m for m in by_acc if int(t.loc[m, "rank_accuracy"]) == 1),
+
         "fastest_method": by_time[0],
         "reference_rank_accuracy": int(ref["rank_accuracy"]),
         "reference_rank_time": int(ref["rank_time"]),

@@ -51,6 +51,7 @@ class Scenario:
     obs_per_landmark: int
     depth_sigma_frac: float
     min_update_alt: float
+    update_margin_m: float     # vision cut-off margin on the estimated altitude, m
     oc: bool                   # observability-constrained EKF (ekf.oc_transition)
     iterations: int            # iterated-EKF relinearisations per update
     noise_scale: float         # filter bearing noise / true pixel noise
@@ -98,10 +99,12 @@ def _scenario_from_json(text: str) -> Scenario:
     return Scenario(truth=tr, truth_imu=tr_imu, f=f, w=w, g=g, dt_imu=dt, n_sub=n_sub, Dt=Dt,
                     n_steps=n_steps, Q=ekf.process_noise(sa, sw, dt, n_sub), sigma_a=sa, sigma_w=sw,
                     camera=camera_from_config(c["camera"]),
-                    field=make_field(float(lm["half_width_m"]), int(lm["count"]), int(lm["seed"])),
+                    field=make_field(float(lm["half_width_m"]), int(lm["count"]), int(lm["seed"]),
+                                     near_site=lm["near_site"]),
                     planner=pcfg, planner_alt=alternative_path(pcfg), obs_per_landmark=int(fl["obs_per_landmark"]),
                     depth_sigma_frac=float(fl["depth_sigma_frac"]),
                     min_update_alt=float(fl["min_update_altitude_m"]),
+                    update_margin_m=float(fl["update_altitude_margin_m"]),
                     oc=bool(fl["observability_constrained"]),
                     iterations=int(fl["iterations"]),
                     noise_scale=float(fl["meas_noise_scale"]),

@@ -1,0 +1,178 @@
+"""Paper B's accuracy claims as tests that can fail: "almost the same accuracy"
+(depth vs the SVD baseline) as a paired equivalence test with negative
+controls, and "converges a bit faster" as a paired time-to-threshold rule.
+
+Description
+-----------
+Every method flies the same runs (paired design, ``opnav.landing.descent``),
+so per-run differences ``d_i = x_a,i - x_b,i`` of a per-run error ``x`` (m)
+remove the run-to-run spread of the initial errors.
+
+Equivalence (:func:`tost`): two one-sided paired t-tests at level ``alpha``
+(Schuirmann's TOST): ``a`` and ``b`` are *equivalent* within the margin
+``delta`` (m) when both ``H0: mean d <= -delta`` and ``H0: mean d >= +delta``
+are rejected, i.e. when the ``1 - 2 alpha`` paired-t interval of the mean
+difference lies inside ``(-delta, +delta)``. Not rejecting is "not shown
+equivalent" (the test must show equivalence, not fail to refute it).
+
+Margin (:func:`margins`): a fixed fraction ``margin_frac`` of the gap between
+the best method's mean and the ``random`` picker's mean of the same metric
+(m): the effect that selection has on that metric in that scenario. A method
+"equivalent" to the reference keeps all but that fraction of the selection
+effect; a method that is as bad as picking at random is not, whenever the
+reference is better than random by more than the margin. If random is not
+worse than the best method the margin is 0 and nothing is shown equivalent
+(selection does not move the metric: the claim is then not testable).
+
+Metrics (per run, ``montecarlo.per_run_stats``): the position error norm at
+the last update with a landmark bearing (``lastlm_pos_err_m``) and its RMS
+over the landmark-tracking phase (``lmrms_pos_err_m``), the errors a landmark
+choice can move; the verdict needs both. The touchdown error
+(``final_pos_err_m``), set mostly by what follows the landmark phase, is
+tested beside them and reported, not part of the verdict.
+
+Negative controls: the same rule applied to ``random``, ``center`` and
+``closest`` (pickers without a metric, ``opnav.landing.planner.PICKERS``)
+against the same reference; if a control is "equivalent" the test cannot tell
+a metric from no metric and the claim is not reproduced.
+
+Converges faster (:func:`converges_faster`): per run, the first time the
+position error is below a threshold (``montecarlo.time_below``); the paired
+difference ``a - b`` over runs where both get there, with its two-sided
+``1 - alpha`` paired-t interval: "faster" if the interval is below 0, "slower"
+if above, else "no difference shown".
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import special
+
+__all__ = ["tost", "margins", "equivalence", "converges_faster", "PRIMARY_METRICS",
+           "TOUCHDOWN_METRIC", "METRIC_TEXT"]
+
+#: the per-run metrics the equivalence verdict needs (both), m
+PRIMARY_METRICS = ("lastlm_pos_err_m", "lmrms_pos_err_m")
+#: reported beside them, not part of the verdict, m
+TOUCHDOWN_METRIC = "final_pos_err_m"
+METRIC_TEXT = {"lastlm_pos_err_m": "position error at the last landmark update",
+               "lmrms_pos_err_m": "RMS position error over the landmark-tracking phase",
+               "final_pos_err_m": "position error at touchdown"}
+
+
+def _t_interval(d: np.ndarray, level: float) -> tuple[float, float, float, float]:
+    """(mean, standard error, lo, hi) of the two-sided paired-t interval."""
+    n = d.size
+    m = float(d.mean())
+    se = float(d.std(ddof=1)) / math.sqrt(n)
+    q = float(special.stdtrit(n - 1, 0.5 + level / 2.0)) if se > 0 else 0.0
+    return m, se, m - q * se, m + q * se
+
+
+def tost(d, margin: float, alpha: float = 0.05) -> dict:
+    """Paired two-one-sided test of ``|mean d| < margin`` (``d``: per-run
+    differences, m; ``margin``: m). Returns ``mean``, the ``1 - 2 alpha``
+    interval ``lo``/``hi``, ``p`` (the larger one-sided p-value; equivalence
+    shown iff ``p < alpha``), ``equivalent`` (bool), ``margin`` and ``n``.
+    Zero spread: equivalent iff ``|mean| < margin``. A margin <= 0 is never
+    met."""
+    d = np.asarray(d, float).ravel()
+    if d.size < 2 or not np.all(np.isfinite(d)):
+        raise ValueError("tost: need at least two finite paired differences")
+    if not 0.0 < alpha < 0.5:
+        raise ValueError(f"tost: alpha must be in (0, 0.5), got {alpha}")
+    m, se, lo, hi = _t_interval(d, 1.0 - 2.0 * alpha)
+    margin = float(margin)
+    if se == 0.0:
+        p = 0.0 if abs(m) < margin else 1.0
+    else:
+        p_low = float(special.stdtr(d.size - 1, -((m + margin) / se)))   # H0: mean <= -margin
+        p_high = float(special.stdtr(d.size - 1, (m - margin) / se))     # H0: mean >= +margin
+        p = max(p_low, p_high)
+    ok = margin > 0.0 and p < alpha
+    return {"mean": m, "lo": lo, "hi": hi, "p": p, "equivalent": bool(ok), "margin": margin,
+            "n": int(d.size)}
+
+
+def margins(means: dict[str, float], margin_frac: float, control: str = "random") -> dict:
+    """The equivalence margin of one metric (m): ``margin_frac`` times the gap
+    between ``control``'s mean and the best (smallest) mean of ``means``
+    (method -> mean, m), 0 if that gap is not positive. Returns ``margin``,
+    ``gap``, ``best`` (the methods sharing the smallest mean, a list: ties are
+    ties) and ``frac``."""
+    if control not in means:
+        raise ValueError(f"equivalence margin: the control {control!r} was not flown "
+                         f"(methods: {sorted(means)})")
+    lo = min(means.values())
+    best = sorted(m for m, v in means.items() if v == lo)
+    gap = float(means[control] - lo)
+    return {"margin": float(margin_frac) * gap if gap > 0 else 0.0, "gap": gap, "best": best,
+            "frac": float(margin_frac)}
+
+
+def equivalence(stats: dict, reference: str, tested: list[str], margin_frac: float,
+                alpha: float = 0.05, same_pick_pct: dict | None = None,
+                control: str = "random") -> dict:
+    """Equivalence of each method of ``tested`` with ``reference`` on paired
+    runs. ``stats``: method -> per-run table (``montecarlo.per_run_stats``, the
+    same runs in the same order) of every method flown (the margin's best
+    method is taken over all of them); ``same_pick_pct``: method -> share of
+    planning calls picking the reference's landmark (%). Returns per metric its
+    margin (:func:`margins`), and per tested method the :func:`tost` of every
+    metric (primary and touchdown), ``equivalent`` (both primary metrics),
+    ``same_pick_pct`` and a ``text`` naming margin, metric and same-pick rate."""
+    if reference not in stats:
+        raise ValueError(f"equivalence: reference {reference!r} not among {sorted(stats)}")
+    runs = stats[reference].index
+    for m, s in stats.items():
+        if not s.index.equals(runs):
+            raise ValueError(f"equivalence: {m!r} did not fly the runs of {reference!r}")
+    same_pick_pct = same_pick_pct or {}
+    out = {"reference": reference, "alpha": float(alpha), "margin_frac": float(margin_frac),
+           "control": control, "metrics": {}, "methods": {}}
+    for q in PRIMARY_METRICS + (TOUCHDOWN_METRIC,):
+        means = {m: float(s[q].mean()) for m, s in stats.items()}
+        out["metrics"][q] = {**margins(means, margin_frac, control), "means": means,
+                             "text": METRIC_TEXT[q]}
+    ref = stats[reference]
+    for m in tested:
+        res = {q: tost(stats[m][q].to_numpy() - ref[q].to_numpy(), out["metrics"][q]["margin"], alpha)
+               for q in out["metrics"]}
+        eq = all(res[q]["equivalent"] for q in PRIMARY_METRICS)
+        sp = same_pick_pct.get(m, math.nan)
+        parts = "; ".join(
+            f"{METRIC_TEXT[q]} {res[q]['mean']:+.3g} m [{res[q]['lo']:+.3g}, {res[q]['hi']:+.3g}] "
+            f"vs margin +-{res[q]['margin']:.3g} m" for q in PRIMARY_METRICS)
+        out["methods"][m] = {
+            **{q: res[q] for q in res}, "equivalent": bool(eq), "same_pick_pct": sp,
+            "verdict": "equivalent" if eq else "not equivalent",
+            "text": (f"{m} vs {reference}: {'equivalent' if eq else 'not equivalent'} "
+                     f"({100 * (1 - 2 * alpha):.0f} % paired intervals, {m} minus {reference}: {parts}; "
+                     f"margin {margin_frac:g} x the best-vs-{control} gap; same landmark as "
+                     f"{reference} in {sp:.3g} % of the planning calls)")}
+    return out
+
+
+def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float = 0.05) -> dict:
+    """Paired comparison of the first times below ``threshold_m`` (s; NaN:
+    never) of methods ``a`` and ``b`` on the same runs: mean of ``t_a - t_b``
+    over the runs where both get there, its two-sided ``1 - alpha`` paired-t
+    interval (s), the runs used, and ``verdict``: "faster" (interval below 0:
+    ``a`` converges faster), "slower" (above 0) or "no difference shown"."""
+    t_a, t_b = np.asarray(t_a, float), np.asarray(t_b, float)
+    if t_a.shape != t_b.shape:
+        raise ValueError("converges_faster: the two methods must have flown the same runs")
+    both = np.isfinite(t_a) & np.isfinite(t_b)
+    d = t_a[both] - t_b[both]
+    if d.size < 2:
+        m, lo, hi = (float(d.mean()) if d.size else math.nan), math.nan, math.nan
+    else:
+        m, _, lo, hi = _t_interval(d, 1.0 - alpha)
+    verdict = ("faster" if hi < 0 else "slower" if lo > 0 else "no difference shown")
+    return {"mean_s": m, "lo_s": lo, "hi_s": hi, "n_runs": int(d.size), "n_total": int(t_a.size),
+            "threshold_m": float(threshold_m), "verdict": verdict,
+            "text": (f"first time below {threshold_m:g} m, {a} minus {b}: {m:+.3g} s "
+                     f"[{lo:+.3g}, {hi:+.3g}] ({100 * (1 - alpha):.0f} % paired interval, "
+                     f"{d.size} of {t_a.size} runs): {verdict}")}
