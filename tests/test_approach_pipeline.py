@@ -122,3 +122,19 @@ def test_chi2_band_is_scipy_stats_chi2_bit_for_bit(dof, n_runs, p):
     a = (1.0 - p) / 2.0
     ref = (chi2.ppf(a, dof * n_runs) / n_runs, chi2.ppf(1.0 - a, dof * n_runs) / n_runs)
     assert chi2_band(dof, n_runs, p) == ref
+
+
+def test_nav_error_split_range_is_set_by_the_range_channel_not_theta():
+    """A small misalignment turns the Mars vector sideways only: the range part of the position
+    error is the same whether the filter assumes theta = 0, the estimate or the true theta,
+    while the lateral part with the true theta falls far below the theta = 0 filter's (about
+    rho * |theta|). The split recombines into the total error."""
+    cfg = approach_cfg(N0=100, N=50, M=2, L=2)
+    case = cases.headline_case(cfg)
+    r = cases.run_case(cfg, "literal", case, range(2))
+    rb, ra, rt = (r[f"nav_err_{k}_rng_km"] for k in ("before", "after", "true_theta"))
+    np.testing.assert_allclose(ra, rb, rtol=0.02)
+    np.testing.assert_allclose(rt, rb, rtol=0.02)
+    assert np.all(r["nav_err_true_theta_lat_km"] < 0.1 * r["nav_err_before_lat_km"])
+    lat, rng = r["err_split_t_km"]["after"]
+    np.testing.assert_allclose(np.hypot(lat, rng), r["err_after_t_km"], rtol=1e-9)

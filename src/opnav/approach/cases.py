@@ -120,6 +120,13 @@ def lateral_range_errors(x: np.ndarray, P: np.ndarray, dx_true: np.ndarray, C: n
             3.0 * np.sqrt(Pc[:, 0, 0] + Pc[:, 1, 1]), 3.0 * np.sqrt(Pc[:, 2, 2]))
 
 
+def lateral_range_t(xf: np.ndarray, dx_true: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Position error of a filter run over time split across the line of sight (lateral,
+    the camera x-y plane of ``C`` = A_c^i) and along it (range, |camera z|), km, (S, n+1) each."""
+    e = np.einsum("kij,skj->ski", C, xf[:, :, :3] - dx_true[None, :, :3])
+    return np.hypot(e[..., 0], e[..., 1]), np.abs(e[..., 2])
+
+
 def consistency(f, dx_true: np.ndarray) -> dict:
     """Position NEES (3 dof) and NIS (3 dof) of a filter run over time, (S, n+1) each:
     ``e^T P_rr^-1 e`` with ``e`` the filtered position error, and ``nu^T S^-1 nu`` with the
@@ -182,7 +189,9 @@ class CaseData:
     variances ``Rvar`` ((n+1, 3), or (n+1, S, 3) when the cases' pixel noise differs),
     initial theta (S, 3) rad, the window of the whole arc, the theta = 0 filter over it
     (``f0``) with its position errors and consistency, and the start states of the
-    windows, per start list (filled by :func:`run_cases`). Built by :func:`prepare_cases`."""
+    windows, per start list (filled by :func:`run_cases`), and the filter run with the *true*
+    theta (``f_true``, a diagnostic: the navigation-error floor that compensation could reach).
+    Built by :func:`prepare_cases`."""
 
     geo: sc.Geometry
     z: np.ndarray
@@ -194,6 +203,7 @@ class CaseData:
     err_before: np.ndarray
     cons_before: dict
     starts: dict
+    f_true: object = None
 
 
 def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
@@ -222,7 +232,11 @@ def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed
     S = z.shape[0]
     f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win, predicted=False)
     err_before = np.linalg.norm(f0.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
-    return CaseData(geo, z, dx0, Rvar, theta, win, f0, err_before, consistency(f0, geo.dx_true), {})
+    # diagnostic floor: the same filter with the true misalignment (truth used on purpose; no
+    # estimate reads it)
+    truth = np.concatenate([np.broadcast_to(sc.rad(c.truth_arcsec), (ns, 3)) for c in case_list])
+    f_true = run_filter(z, truth, dx0, geo.P0, win, predicted=False)
+    return CaseData(geo, z, dx0, Rvar, theta, win, f0, err_before, consistency(f0, geo.dx_true), {}, f_true)
 
 
 def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
@@ -294,6 +308,13 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     seg_lat, seg_rng = np.stack(seg_lat, 1), np.stack(seg_rng, 1)
     seg_lat3, seg_rng3 = np.stack(seg_lat3, 1), np.stack(seg_rng3, 1)
     nb, na = rms_last(err_before, frac), rms_last(err_after, frac)
+    # the same errors split across / along the line of sight, and the floor with the true theta
+    split_t = {"before": lateral_range_t(f0.xf, dx_true, geo.C), "after": lateral_range_t(f1.xf, dx_true, geo.C),
+               "true_theta": lateral_range_t(data.f_true.xf, dx_true, geo.C)}
+    err_true = np.linalg.norm(data.f_true.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
+    split = {f"nav_err_{k}_{part}_km": rms_last(v[j], frac) for k, v in split_t.items()
+             for j, part in enumerate(("lat", "rng"))}
+    split["nav_err_true_theta_km"] = rms_last(err_true, frac)
     cons = {"before": data.cons_before, "after": consistency(f1, dx_true)}
     out = []
     for i, case in enumerate(case_list):
@@ -328,6 +349,8 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
             "nav_err_after_km": na[sl],
             "err_before_t_km": err_before[sl],
             "err_after_t_km": err_after[sl],
+            **{k: v[sl] for k, v in split.items()},
+            "err_split_t_km": {k: (v[0][sl], v[1][sl]) for k, v in split_t.items()},  # (lateral, range)
             "consistency_t": {k: {q: v[q][sl] for q in v} for k, v in cons.items()},
             "t_s": geo.t,
         })

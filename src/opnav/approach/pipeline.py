@@ -175,9 +175,10 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
         if case.case_index == 1:
             smp = sampled[0]
             r["sampled"] = {k: smp[k] for k in ("theta_final_arcsec", "label", "stalled", "dist_to_ml_arcsec",
-                                                "consistency_t", "nav_err_after_km", "nav_err_before_km")}
+                                                "consistency_t", "nav_err_after_km", "nav_err_before_km",
+                                                "nav_err_true_theta_km")}
         else:  # time series only for the headline case (figures)
-            for k in ("err_before_t_km", "err_after_t_km", "consistency_t"):
+            for k in ("err_before_t_km", "err_after_t_km", "err_split_t_km", "consistency_t"):
                 r.pop(k)
         out.append(r)
         if log:

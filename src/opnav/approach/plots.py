@@ -178,29 +178,47 @@ def fig_consistency(runs: dict, variant: str):
 
 
 def fig_compensation(runs: dict, variant: str, pub: dict):
-    """A-F6: |r error| over time before (theta = 0) and after compensation, mean over seeds."""
+    """A-F6: position error over time before (theta = 0) and after compensation, mean over seeds:
+    |r error| and its lateral (across the line of sight) and range (along it) parts, with the
+    filter given the true theta (diagnostic floor) beside them."""
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.6))
+        fig, axes = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 2.7), sharey=True)
         first = True
         for method, r in runs.items():
             t = r["t_s"]
+            split = r.get("err_split_t_km", {})
             if first:
-                ax.plot(t, r["err_before_t_km"].mean(0), color="k", ls="--", lw=1.2, zorder=3,
-                        label="before (theta = 0)")
+                axes[0].plot(t, r["err_before_t_km"].mean(0), color="k", ls="--", lw=1.2, zorder=3,
+                             label="before (theta = 0)")
+                if "true_theta" in split:
+                    lat, rng = split["true_theta"]
+                    axes[0].plot(t, np.hypot(lat, rng).mean(0), color="0.5", ls=":", lw=1.2, zorder=3,
+                                 label="true theta (diagnostic floor)")
+                for j, ax in enumerate(axes[1:]):
+                    if "before" in split:
+                        ax.plot(t, split["before"][j].mean(0), color="k", ls="--", lw=1.2, zorder=3)
+                    if "true_theta" in split:
+                        ax.plot(t, split["true_theta"][j].mean(0), color="0.5", ls=":", lw=1.2, zorder=3)
                 first = False
-            ax.plot(t, r["err_after_t_km"].mean(0), color=_color(r), label=f"after, {run_label(r)}")
+            axes[0].plot(t, r["err_after_t_km"].mean(0), color=_color(r), label=f"after, {run_label(r)}")
+            for j, ax in enumerate(axes[1:]):
+                if "after" in split:
+                    ax.plot(t, split["after"][j].mean(0), color=_color(r))
         hp = pub["headline"]
-        ax.plot([t[-1]], [hp["nav_err_before_km"]], **{**figures.PUBLISHED_STYLE, "label": "published before/after"})
-        ax.plot([t[-1]], [hp["nav_err_after_km"]], **{**figures.PUBLISHED_STYLE, "label": None})
-        ax.set_yscale("log")
-        _plain_log_ticks(ax)
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("position error (km)")
-        ax.legend(fontsize=6)
-        ax.set_title(f"A-F6 before vs after compensation, {variant}", fontsize=8)
-        fig.tight_layout()
+        axes[0].plot([t[-1]], [hp["nav_err_before_km"]], **{**figures.PUBLISHED_STYLE, "label": "published before/after"})
+        axes[0].plot([t[-1]], [hp["nav_err_after_km"]], **{**figures.PUBLISHED_STYLE, "label": None})
+        for ax, name in zip(axes, ("|r error|", "lateral (across line of sight)", "range (along line of sight)")):
+            ax.set_yscale("log")
+            _plain_log_ticks(ax)
+            ax.set_xlabel("time (s)")
+            ax.set_title(name, fontsize=7)
+        axes[0].set_ylabel("position error (km)")
+        h, lab = axes[0].get_legend_handles_labels()
+        fig.legend(h, lab, loc="lower center", fontsize=6, ncol=2, frameon=False)
+        fig.suptitle(f"A-F6 before vs after compensation, {variant}", fontsize=8)
+        fig.tight_layout(rect=(0, 0.02 + 0.04 * ((len(lab) + 1) // 2), 1, 1))
     return fig
 
 
