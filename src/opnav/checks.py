@@ -35,6 +35,7 @@ it follows them when they change. Units as in the config.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
@@ -74,37 +75,168 @@ def _duplicates(items) -> list:
 
 
 def config_problems(config: dict, root: str | Path | None = None,
-                    workdir: str | Path | None = None) -> list[str]:
+                    workdir: str | Path | None = None, *, skip=(), sections=None) -> list[str]:
     """Every problem of a schema-valid ``config`` (defaults filled), one line each,
-    naming the key(s). ``root`` is the checkout (default: the working directory),
-    ``workdir`` where relative outputs go (default: ``root``)."""
-    out = results_dir_problems(config.get("results_dir", "results"), root, workdir)
-    if "approach" in config:
-        out += approach_problems(config["approach"])
-    if "landing" in config:
-        out += landing_problems(config["landing"])
+    naming the key(s): ``results_dir``, the ``approach`` and ``landing`` sections, the
+    ``studies`` (each value checked as its own config, :func:`opnav.studies.plan`) and
+    the job-graph bounds (:func:`job_problems`). ``root`` is the checkout (default: the
+    working directory), ``workdir`` where relative outputs go (default: ``root``);
+    sections in ``skip`` (their schema failed) are not read; ``sections`` (default all)
+    limits the checks to those sections."""
+    want = set(sections) if sections is not None else {"results_dir", "approach", "landing", "studies",
+                                                        "limits"}
+    todo = want - set(skip)
+    out: list[str] = []
+    if "results_dir" in todo:
+        out += results_dir_problems(config, root, workdir)
+    for name, check in (("approach", approach_problems), ("landing", landing_problems)):
+        if name in todo and name in config:
+            out += check(config[name])
+    if out or set(skip) & {"approach", "landing", "limits"}:
+        return out                      # studies and bounds read sound sections only
+    if "studies" in todo and config.get("studies"):
+        from opnav.studies import plan
+
+        try:
+            plan(config)
+        except ValueError as exc:        # ConfigError: one line per problem
+            out += str(exc).splitlines()
+    if "limits" in todo and not out:
+        out += job_problems(config)
     return out
 
 
-def results_dir_problems(results_dir: str, root: str | Path | None = None,
+def _jobs(config: dict) -> dict[str, int]:
+    """The jobs the config's scattered parts make, by part, without building the DAG
+    (an upper bound: study values sharing a simulation count apart): paper B's Monte
+    Carlo (scenarios x methods x chunks, plus one gather per scenario and method when
+    chunked), the studies (values x chunks, plus their table jobs), and the rest of
+    the workflow (a fixed ~100)."""
+    c = config["landing"]
+    n_runs, per = c["mc"]["n_runs"], c["mc"]["runs_per_job"]
+    chunks = -(-n_runs // max(per, 1))
+    methods = len(dict.fromkeys([*c["mc"]["methods"], *c["extra"]["methods"]]))
+    scen = len(c.get("scenarios") or {"default": {}})
+    out = {"landing Monte Carlo (landing.scenarios x landing.mc.methods + extra.methods x "
+           "landing.mc.n_runs / runs_per_job)": scen * methods * (chunks + (chunks > 1))}
+    for name, spec in (config.get("studies") or {}).items():
+        vary = list((spec.get("vary") or {}).values())
+        lens = [len(v) for v in vary if isinstance(v, list)] or [0]
+        values = math.prod(lens) if spec.get("grid") else max(lens)
+        runs, rpj = spec.get("runs", 10), spec.get("runs_per_job", 10)
+        out[f"study {name} (values x runs / runs_per_job)"] = values * -(-runs // max(min(rpj, runs), 1)) + 2
+    return out
+
+
+#: The workflow's jobs besides those :func:`_jobs` counts (tables, figures, paper A's
+#: Monte Carlo by variant and group, manuscript): ~70 in the full profile.
+OTHER_JOBS = 100
+
+
+def job_problems(config: dict) -> list[str]:
+    """The job graph within ``limits.max_jobs`` (Snakemake takes ~10 ms a job to build
+    it, at every call), counted before it is built (:func:`_jobs`)."""
+    limit = (config.get("limits") or {}).get("max_jobs", 2000)
+    parts = _jobs(config)
+    total = OTHER_JOBS + sum(parts.values())
+    if total <= limit:
+        return []
+    top = sorted(parts.items(), key=lambda kv: -kv[1])[:2]
+    what = "; ".join(f"{k}: {v}" for k, v in top)
+    return [f"invalid config key 'limits.max_jobs': the config makes about {total} jobs, over the limit "
+            f"{limit} ({what}); raise runs_per_job, shrink the study, or raise limits.max_jobs to mean it"]
+
+
+def results_dir_problems(config_or_dir, root: str | Path | None = None,
                          workdir: str | Path | None = None) -> list[str]:
-    """``results_dir`` must be non-empty, not the checkout ``root`` (default: the
-    working directory) and not inside one of its tracked folders; a relative
-    ``results_dir`` is taken from ``workdir`` (where Snakemake writes; default
-    ``root``)."""
-    if not str(results_dir).strip():
-        return ["invalid config key 'results_dir': empty (generated files would land in the checkout)"]
+    """``results_dir`` (the key of ``config_or_dir``, a config mapping, or the path
+    itself): non-empty, no NUL byte, at most :data:`MAX_PATH_CHARS` characters (and
+    255 per component), ``~`` expanded (in the config, in place) or refused if it
+    names no home; a writable directory (or creatable in a writable one), not a
+    file; not the checkout ``root`` (default: the working directory) nor a folder
+    holding it; not inside a folder of tracked files (:func:`tracked_dirs`; a
+    relative path is taken from ``workdir``, where Snakemake writes; default ``root``)."""
+    import os
+
+    cfg = config_or_dir if isinstance(config_or_dir, dict) else None
+    results_dir = str(cfg.get("results_dir", "results") if cfg is not None else config_or_dir)
+    k = "invalid config key 'results_dir': "
+    if not results_dir.strip():
+        return [k + "empty (generated files would land in the checkout)"]
+    if "\0" in results_dir:
+        return [k + "contains a NUL byte"]
+    if len(results_dir) > MAX_PATH_CHARS or any(len(x) > 255 for x in Path(results_dir).parts):
+        return [k + f"{len(results_dir)} characters (at most {MAX_PATH_CHARS}, and 255 per folder name)"]
+    if results_dir.startswith("~"):
+        expanded = os.path.expanduser(results_dir)
+        if expanded.startswith("~"):
+            return [k + f"{results_dir[:60]!r}: '~' names no home folder here; give the path"]
+        results_dir = expanded
+        if cfg is not None:
+            cfg["results_dir"] = expanded
     base = Path(root or Path.cwd()).resolve()
     p = Path(results_dir)
     p = (p if p.is_absolute() else Path(workdir or base) / p).resolve()
+    shown = repr(results_dir if len(results_dir) <= 80 else results_dir[:77] + "...")
     if p == base:
-        return [f"invalid config key 'results_dir': {results_dir!r} is the checkout itself"]
-    for d in TRACKED_DIRS:
-        t = base / d
-        if p == t or t in p.parents:
-            return [f"invalid config key 'results_dir': {results_dir!r} is inside the tracked "
-                    f"folder {d}/ (choose e.g. 'results')"]
+        return [k + f"{shown} is the checkout itself"]
+    if p in base.parents:
+        return [k + f"{shown} holds the checkout (choose e.g. 'results')"]
+    try:
+        rel = p.relative_to(base)
+    except ValueError:
+        rel = None
+    if rel is not None:
+        for d in tracked_dirs(base):
+            if rel == d or d in rel.parents:
+                return [k + f"{shown} is inside the tracked folder {d.as_posix()}/ (choose e.g. 'results')"]
+    q = p
+    while not q.exists():
+        q = q.parent
+    if q == p and not p.is_dir():
+        return [k + f"{shown} is an existing file, not a folder"]
+    if not q.is_dir():
+        return [k + f"{shown}: {q} is a file, so the folder cannot be made"]
+    if not os.access(q, os.W_OK | os.X_OK):
+        return [k + f"{shown}: {q} is not writable"]
     return []
+
+
+#: results_dir's length limit (characters).
+MAX_PATH_CHARS = 1024
+
+
+def tracked_dirs(root: Path) -> tuple[Path, ...]:
+    """The folders of checkout ``root`` (relative) that hold tracked files, from
+    ``git ls-files`` (a folder whose tracked files are only README placeholders, such as
+    results/, does not count), always with .git and .snakemake; outside git, every
+    top-level folder but results*/ and :data:`TRACKED_DIRS`."""
+    return _tracked_dirs(str(Path(root).resolve()))
+
+
+@functools.lru_cache(maxsize=4)
+def _tracked_dirs(root: str) -> tuple[Path, ...]:
+    import subprocess
+
+    base = Path(root)
+    dirs = {Path(".git"), Path(".snakemake")}
+    files = None
+    if (base / ".git").exists():
+        try:
+            r = subprocess.run(["git", "-C", root, "ls-files", "-z"], capture_output=True, timeout=20)
+            if r.returncode == 0:
+                files = [Path(f) for f in r.stdout.decode("utf-8", "replace").split("\0") if f]
+        except (OSError, subprocess.SubprocessError):
+            files = None
+    if files is None:
+        dirs |= {Path(d) for d in TRACKED_DIRS}
+        dirs |= {Path(e.name) for e in base.iterdir() if e.is_dir() and not e.name.startswith("results")}
+        return tuple(sorted(dirs))
+    for f in files:
+        if f.name.lower() in ("readme.md", ".gitkeep", "readme"):
+            continue
+        dirs.update(a for a in f.parents if a != Path("."))
+    return tuple(sorted(dirs))
 
 
 # --------------------------------------------------------------------- paper A
@@ -241,6 +373,10 @@ def approach_problems(a: dict) -> list[str]:
     dup = _duplicates(peers)
     if dup:
         out.append(f"{k}peers.variants': duplicated {', '.join(map(str, dup))}")
+    grow, LN = a["growing"], s["L"] * s["N"]
+    if grow["methods"] and LN % grow["N"]:
+        out.append(f"{k}growing.N': {grow['N']} does not divide approach.segments.L x N = {LN} "
+                   "(growing windows cover the same data as the sliding ones)")
     g = a["geometry"]
     d = np.asarray(g["v_inf_dir"], float)
     dn = float(np.linalg.norm(d))
@@ -280,7 +416,6 @@ def approach_problems(a: dict) -> list[str]:
 
 def landing_problems(c: dict) -> list[str]:
     """Cross-key problems of the ``landing`` section (see module docstring)."""
-    from opnav.landing.camera import camera_from_config
     from opnav.landing.planner import available_methods
     from opnav.landing.trajectory import truth_states
 
@@ -333,10 +468,10 @@ def landing_problems(c: dict) -> list[str]:
     if c["mc"]["bounds"]["r_m"] >= r0[2]:
         out.append(f"{k}mc.bounds.r_m': initial position errors up to {c['mc']['bounds']['r_m']:g} m "
                    f"would start estimates below the ground (the lander starts at {r0[2]:g} m)")
-    half = c["camera"]["pixels"] / 2.0
-    if c["planner"]["margin_px"] >= half:
-        out.append(f"{k}planner.margin_px': {c['planner']['margin_px']:g} px leaves no part of the "
-                   f"{c['camera']['pixels']} px detector to plan landmarks in (must be < {half:g})")
+    out += _margin_problems(c["planner"]["margin_px"], c["camera"], f"{k}planner.margin_px'")
+    scenarios = _scenario_cameras(c, out)
+    for name, cam in scenarios.items():
+        out += _margin_problems(c["planner"]["margin_px"], cam, f"{k}scenarios.{name}'")
     if r0[2] <= alt_min:
         out.append(f"{k}initial_state.r_m': the lander starts at {r0[2]:g} m, not above "
                    f"filter.min_update_altitude_m = {alt_min:g} m (no measurement would be taken)")
@@ -354,19 +489,55 @@ def landing_problems(c: dict) -> list[str]:
         return out
     measuring = tr.r[:, 2] > alt_min                 # where the filter takes bearings
     to_site_B = np.einsum("kij,kj->ki", tr.R_LtoB, -tr.r)
-    key = "camera"
-    fov = c["camera"]["fov_deg"]
+    for key, cam in {"camera": c["camera"], **{f"scenarios.{n}": v for n, v in scenarios.items()}}.items():
+        out += _view_problems(cam, f"{k}{key}'", t, to_site_B, measuring)
+    return out
+
+
+def _scenario_cameras(c: dict, out: list[str]) -> dict[str, dict]:
+    """``{scenario: merged camera}`` of the camera scenarios (``landing.scenarios``) whose
+    camera differs from ``landing.camera`` (each is checked as the base camera is); a
+    ``landing.headline_scenario`` that names none of them is appended to ``out``."""
+    from opnav.landing.scenario import camera_scenarios
+
+    scen = c.get("scenarios") or {}
+    head = c.get("headline_scenario")
+    if head is not None and scen and head not in scen:
+        out.append(f"invalid config key 'landing.headline_scenario': {head!r} is not one of "
+                   f"landing.scenarios ({', '.join(scen)})")
+        return {}
     try:
-        cam = camera_from_config(c["camera"])
+        merged = camera_scenarios(c)
     except ValueError as exc:
-        return [*out, f"{k}{key}': {exc}"]
+        out.append(f"invalid config key 'landing.scenarios': {exc}")
+        return {}
+    return {n: s["camera"] for n, s in merged.items() if s["camera"] != c["camera"]}
+
+
+def _margin_problems(margin: float, cam: dict, key: str) -> list[str]:
+    half = cam["pixels"] / 2.0
+    if margin >= half:
+        return [f"{key}: landing.planner.margin_px = {margin:g} px leaves no part of the "
+                f"{cam['pixels']} px detector to plan landmarks in (must be < {half:g})"]
+    return []
+
+
+def _view_problems(camera: dict, key: str, t, to_site_B, measuring) -> list[str]:
+    """The landing site in ``camera``'s view at the start and while the filter measures."""
+    from opnav.landing.camera import camera_from_config
+
+    fov = camera["fov_deg"]
+    try:
+        cam = camera_from_config(camera)
+    except ValueError as exc:
+        return [f"{key}: {exc}"]
     seen = cam.in_view(to_site_B)
     if not seen[0]:
-        out.append(f"{k}{key}': the landing site is not in the camera's view at t = 0 "
-                   f"(fov_deg {fov:g}, tilt_deg {c['camera']['tilt_deg']:g}, "
-                   f"tilt_azimuth_deg {c['camera']['tilt_azimuth_deg']:g})")
-    elif not np.all(seen[measuring]):
+        return [f"{key}: the landing site is not in the camera's view at t = 0 "
+                f"(fov_deg {fov:g}, tilt_deg {camera['tilt_deg']:g}, "
+                f"tilt_azimuth_deg {camera['tilt_azimuth_deg']:g})"]
+    if not np.all(seen[measuring]):
         t_out = t[np.nonzero(measuring & ~seen)[0][0]]
-        out.append(f"{k}{key}': the landing site leaves the camera's view at t = {t_out:g} s "
-                   f"of the nominal descent (fov_deg {fov:g})")
-    return out
+        return [f"{key}: the landing site leaves the camera's view at t = {t_out:g} s "
+                f"of the nominal descent (fov_deg {fov:g}, tilt_deg {camera['tilt_deg']:g})"]
+    return []

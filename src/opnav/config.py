@@ -174,16 +174,21 @@ def _copy(value: Any) -> Any:
 
 
 def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: bool = True,
-                    root: str | Path | None = None, workdir: str | Path | None = None) -> dict:
+                    root: str | Path | None = None, workdir: str | Path | None = None,
+                    sections: tuple[str, ...] | None = None) -> dict:
     """Validate ``config`` in place (filling defaults); raise :class:`ConfigError`
-    with one line per problem, each naming its key.
+    with one line per problem, each naming its key: every problem of every layer
+    in one pass, before any job runs.
 
-    Three layers, all before any job runs: every number anywhere must be finite
-    (:func:`non_finite_keys`); the JSON schema (integer keys take ints only);
-    and, with ``physics``, the cross-key consistency checks of
-    :func:`opnav.checks.config_problems` (durations, rates, geometry, method
-    names, ...; ``root`` is the checkout, ``workdir`` where a relative
-    ``results_dir`` lands, default ``root``).
+    The layers: every number anywhere must be finite (:func:`non_finite_keys`);
+    the JSON schema (integer keys take ints only); and, with ``physics``, on each
+    section the schema passed, the cross-key checks of
+    :func:`opnav.checks.config_problems` (``results_dir``; durations, rates,
+    geometry, camera scenarios, method names, ...; the parameter studies, each value
+    checked as its own config; the job-graph bounds). ``root`` is the checkout,
+    ``workdir`` where a relative ``results_dir`` lands (default ``root``);
+    ``sections`` limits the physics checks to those sections (a study value's
+    config: its paper's).
     """
     bad = non_finite_keys(config)
     lines = [f"invalid config key '{k}': {v} is not a finite number "
@@ -194,15 +199,138 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
         if key not in bad:
             where = f"config key '{key}'" if key else "config (top level)"
             lines.append(f"invalid {where}: {err.message}")
-    if lines:
-        raise ConfigError("\n".join(dict.fromkeys(lines)))
     if physics:
         from opnav.checks import config_problems
 
-        problems = config_problems(config, root, workdir)
-        if problems:
-            raise ConfigError("\n".join(problems))
+        broken = {_top(line) for line in lines}
+        if "" not in broken:        # a top-level schema error: no section is safe to read
+            lines += config_problems(config, root, workdir, skip=broken, sections=sections)
+    if lines:
+        raise ConfigError("\n".join(dict.fromkeys(lines)))
     return config
+
+
+def _top(line: str) -> str:
+    """The top-level section a problem line names ('' for the top level itself)."""
+    m = re.match(r"invalid config key '([^'.\[]+)", line)
+    return m.group(1) if m else ""
+
+
+#: Upper bound on the nodes of a config file once its aliases are expanded (a "billion
+#: laughs" file of a few lines expands to 10^9; every config of the project has < 5,000).
+MAX_YAML_NODES = 100_000
+
+
+class _StrictLoader(_YAML_LOADER):  # type: ignore[misc, valid-type]
+    """The safe loader, refusing a key given twice in one mapping (YAML keeps the
+    last silently: a duplicated ``landing:`` block would drop the first)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen: dict = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            try:
+                hash(key)
+            except TypeError:
+                continue                 # SafeConstructor raises its own error below
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r} (first given on line {seen[key] + 1})",
+                    key_node.start_mark)
+            seen[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep=deep)
+
+
+def _expanded_nodes(node, budget: int) -> int:
+    """The number of nodes of the document once every alias is expanded, counting
+    stops past ``budget``; raises ``ValueError`` for a recursive alias."""
+    memo: dict[int, int] = {}
+    active: set[int] = set()
+
+    def size(n) -> int:
+        i = id(n)
+        if i in memo:
+            return memo[i]
+        if i in active:
+            raise ValueError("a recursive alias (an anchor used inside itself)")
+        active.add(i)
+        total = 1
+        if isinstance(n, yaml.SequenceNode):
+            for c in n.value:
+                total += size(c)
+                if total > budget:
+                    break
+        elif isinstance(n, yaml.MappingNode):
+            for k, v in n.value:
+                total += size(k) + size(v)
+                if total > budget:
+                    break
+        active.discard(i)
+        memo[i] = total
+        return total
+
+    return size(node)
+
+
+def read_config_file(path: str | Path) -> dict:
+    """The mapping in the user config file ``path`` (a YAML document), or
+    :class:`ConfigError` naming the file and, for a parse error, the line: the file
+    missing, unreadable, not UTF-8 text, empty, not valid YAML (a tab in the
+    indentation, an unknown ``!!tag``), a key given twice, aliases expanding past
+    :data:`MAX_YAML_NODES` nodes, or a top level that is not a mapping. The loader of
+    every user config: the ``opnav`` CLI's and the Snakefile's (which re-reads the
+    ``--configfile`` files Snakemake has read)."""
+    f = Path(path)
+    if not f.exists():
+        raise ConfigError(f"config file {f}: not found")
+    if not f.is_file():
+        raise ConfigError(f"config file {f}: not a regular file")
+    try:
+        raw = f.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"config file {f}: cannot be read ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ConfigError(f"config file {f}, line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); "
+                          "a YAML config is expected") from None
+    if "\0" in text:
+        line = text[:text.index("\0")].count("\n") + 1
+        raise ConfigError(f"config file {f}, line {line}: a NUL byte (binary data); a YAML config is expected")
+    loader = _StrictLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            raise ConfigError(f"config file {f}: empty (no config keys); give a mapping such as "
+                              "'landing: {mc: {n_runs: 10}}'")
+        try:
+            n = _expanded_nodes(node, MAX_YAML_NODES)
+        except ValueError as exc:
+            raise ConfigError(f"config file {f}, line {node.start_mark.line + 1}: {exc}") from None
+        if n > MAX_YAML_NODES:
+            raise ConfigError(f"config file {f}: its aliases expand to more than {MAX_YAML_NODES} "
+                              "nodes (an alias bomb?); write the values out")
+        if not isinstance(node, yaml.MappingNode):
+            kind = "a list" if isinstance(node, yaml.SequenceNode) else f"the scalar {node.value[:40]!r}"
+            raise ConfigError(f"config file {f}, line {node.start_mark.line + 1}: the top level must be a "
+                              f"mapping of config keys (approach, landing, ...), not {kind}")
+        data = loader.construct_document(node)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        what = " ".join(filter(None, [getattr(exc, "context", None), getattr(exc, "problem", None)])) \
+            or str(exc).splitlines()[0]
+        lines = text.splitlines()
+        if mark and mark.line < len(lines) and "\t" in lines[mark.line][:mark.column + 1]:
+            what += " (a tab: YAML indents with spaces)"
+        raise ConfigError(f"config file {f}{where}: not valid YAML: {what}") from None
+    finally:
+        loader.dispose()
+    bad = [k for k in data if not isinstance(k, str)]
+    if bad:
+        raise ConfigError(f"config file {f}: top-level key {bad[0]!r} is not a name")
+    return data
 
 
 def load_config(path: str | Path | None = None, overlays: list[str | Path] = ()) -> dict:
@@ -213,8 +341,8 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = ())
     does), validate, return.
 
     ``config/quick.yaml`` is an overlay: ``load_config(overlays=[quick])``.
-    Raises :class:`ConfigError` naming the file if it is missing, or the key if
-    a value is invalid.
+    Every file is read by :func:`read_config_file` (errors name the file and
+    line); a bad value raises :class:`ConfigError` naming the key.
     """
     if path is None:
         try:
@@ -224,20 +352,7 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = ())
     files = [*([Path(path)] if path is not None else []), *map(Path, overlays)]
     config: dict = {}
     for f in files:
-        if not f.is_file():
-            raise ConfigError(f"config file not found: {f}")
-        try:
-            data = yaml.safe_load(f.read_text()) or {}
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ConfigError(f"config file {f} cannot be read: {exc}") from None
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
-            what = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-            raise ConfigError(f"config file {f} is not valid YAML{where}: {what}") from None
-        if not isinstance(data, dict):
-            raise ConfigError(f"config file {f} must hold a mapping at the top level")
-        _merge(config, data)
+        _merge(config, read_config_file(f))
     # results_dir is relative to the checkout that holds config/config.yaml
     root = Path(path).resolve().parents[1] if path is not None and Path(path).parent.name == "config" else None
     return validate_config(config, SCHEMA_PATH, root=root)

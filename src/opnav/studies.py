@@ -47,7 +47,8 @@ import pandas as pd
 
 from opnav.config import ConfigError
 
-__all__ = ["METRICS", "CONSTANT_METRICS", "APPROACH_METHODS", "Study", "plan", "config_digest",
+__all__ = ["METRICS", "CONSTANT_METRICS", "APPROACH_METHODS", "SIM_KEYS", "Study", "plan", "simulation_shapes",
+           "config_digest",
            "instance_label", "get_path", "set_path", "project", "summarize", "table_metrics", "wide_table",
            "caption", "ci95", "gather_runs", "tidy_table", "shown_statistic", "loglog_slopes"]
 
@@ -243,6 +244,42 @@ def instance_label(values: Mapping[str, Any]) -> str:
 
 
 # ------------------------------------------------------------------ planning
+#: The simulation's view of each paper's config section (what its Monte-Carlo rule passes
+#: as ``params``): the keys a study may sweep or fix. studies.smk checks that these
+#: equal the rules' own (B_SIM of landing.smk, A_SCENARIO of approach.smk).
+SIM_KEYS = {
+    "landing": ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu",
+                "camera", "landmarks", "filter", "planner", "mc.base_seed", "mc.bounds", "timing.max_calls"),
+    "approach": ("base_seed", "dt_s", "mars_elements", "geometry", "initial_error", "prior_sigma",
+                 "process_noise_diag", "camera", "truth_bias_arcsec", "theta_init_arcsec", "segments",
+                 "roll", "crlb", "em", "nav_error", "alternatives"),
+}
+
+
+def simulation_shapes(config: Mapping) -> dict[str, dict]:
+    """``{paper: the config section projected on SIM_KEYS[paper]}`` (keys sorted)."""
+    out: dict[str, dict] = {}
+    for paper, keys in SIM_KEYS.items():
+        view: dict = {}
+        for dotted in keys:
+            *parents, last = dotted.split(".")
+            src, dst = config[paper], view
+            for part in parents:
+                src, dst = src[part], dst.setdefault(part, {})
+            dst[last] = copy.deepcopy(src[last])
+        out[paper] = _sorted(view)
+    return out
+
+
+def _sorted(x):
+    return {k: _sorted(x[k]) for k in sorted(x)} if isinstance(x, Mapping) else x
+
+
+def _n_value_sets(spec: Mapping) -> int:
+    lens = [len(v) for v in spec["vary"].values()]
+    return math.prod(lens) if spec.get("grid", False) else (max(lens) if lens else 0)
+
+
 def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
     vary = spec["vary"]
     keys = list(vary)
@@ -252,25 +289,63 @@ def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
     else:
         if len({len(v) for v in lists}) != 1:
             lens = ", ".join(f"{k}: {len(v)}" for k, v in zip(keys, lists))
-            raise ConfigError(f"study '{name}': the vary lists have different lengths ({lens}); "
-                              "give them the same length or set grid: true")
+            raise ConfigError(f"invalid config key 'studies.{name}.vary' (study '{name}'): the vary lists have "
+                              f"different lengths ({lens}); give them the same length or set grid: true")
         combos = list(zip(*lists))
     return [dict(zip(keys, c)) for c in combos]
 
 
-def plan(config: Mapping, shapes: Mapping[str, Mapping],
-         validate: Callable[[dict], Any], landing_methods: Iterable[str] = ()) -> dict[str, Study]:
+#: Default upper bound on a study's value sets (config ``limits.max_study_values``).
+MAX_STUDY_VALUES = 100
+
+_PLANS: dict[str, dict] = {}
+
+
+def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
+         validate: Callable[[dict], Any] | None = None,
+         landing_methods: Iterable[str] | None = None) -> dict[str, Study]:
     """Every study of ``config["studies"]``, checked and expanded (module docstring).
 
-    ``shapes[paper]`` is the simulation's view of ``config[paper]`` (what its
-    Monte-Carlo rule passes as ``params``); ``validate(cfg)`` raises
-    :class:`ConfigError` (or ``ValueError``) for a bad merged config;
-    ``landing_methods`` are the planner's method names.
+    ``shapes[paper]`` is the simulation's view of ``config[paper]`` (default
+    :func:`simulation_shapes`); ``validate(cfg)`` raises :class:`ConfigError` (or
+    ``ValueError``) for a bad merged config (default: the schema and the physics
+    checks of that paper's section); ``landing_methods`` are the planner's method names
+    (default: its registry). Raises one :class:`ConfigError` with one line per
+    problem of every study, each naming ``studies.<name>...``. With every default the
+    plan is cached per config (the Snakefile's validation and studies.smk plan once).
     """
-    out = {}
+    key = None
+    if shapes is None and validate is None and landing_methods is None:
+        key = json.dumps(config, sort_keys=True, default=repr)
+        if key in _PLANS:
+            return _PLANS[key]
+    if shapes is None:
+        shapes = simulation_shapes(config)
+    if validate is None:
+        validate = _validate_paper
+    if landing_methods is None:
+        from opnav.landing.planner import available_methods
+
+        landing_methods = available_methods()
+    out, problems = {}, []
+    limit = int((config.get("limits") or {}).get("max_study_values", MAX_STUDY_VALUES))
     for name, spec in (config.get("studies") or {}).items():
-        out[name] = _plan_one(name, spec, config, shapes, validate, tuple(landing_methods))
+        try:
+            out[name] = _plan_one(name, spec, config, shapes, validate, tuple(landing_methods), limit)
+        except ConfigError as exc:
+            problems += str(exc).splitlines()
+    if problems:
+        raise ConfigError("\n".join(dict.fromkeys(problems)))
+    if key is not None:
+        _PLANS.clear()
+        _PLANS[key] = out
     return out
+
+
+def _validate_paper(merged: dict) -> None:
+    from opnav.config import validate_config
+
+    validate_config(merged, sections=(merged.pop("_paper"),))
 
 
 @functools.lru_cache(maxsize=1)
@@ -284,62 +359,91 @@ def _spec_defaults() -> dict:
     return {k: v["default"] for k, v in props.items() if "default" in v}
 
 
-def _plan_one(name, spec, config, shapes, validate, landing_methods) -> Study:
+def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_STUDY_VALUES) -> Study:
     spec = {**_spec_defaults(), **spec}
     paper = spec["paper"]
     where = f"study '{name}'"
+    problems: list[str] = []
+
+    def bad(field: str, msg: str) -> None:
+        problems.append(f"invalid config key 'studies.{name}.{field}' ({where}): {msg}")
+
     fixed = dict(spec.get("fixed") or {})
-    for key in [*spec["vary"], *fixed]:
-        parts = key.split(".")
-        if parts[0] != paper:
-            raise ConfigError(f"{where}: key '{key}' is not under '{paper}.' (the study's paper)")
-        try:
-            get_path(config, key)
-        except KeyError:
-            raise ConfigError(f"{where}: key '{key}' is not a config key") from None
-        if not _in_shape(shapes[paper], parts[1:]):
-            raise ConfigError(f"{where}: key '{key}' is not read by the {paper} simulation, so setting "
-                              f"it changes nothing (it reads: {', '.join(sorted(shapes[paper]))})")
+    for field, keys in (("vary", spec["vary"]), ("fixed", fixed)):
+        for key in keys:
+            parts = key.split(".")
+            if parts[0] != paper:
+                bad(f"{field}.{key}", f"key '{key}' is not under '{paper}.' (the study's paper)")
+                continue
+            try:
+                get_path(config, key)
+            except KeyError:
+                bad(f"{field}.{key}", f"key '{key}' is not a config key")
+                continue
+            if not _in_shape(shapes[paper], parts[1:]):
+                bad(f"{field}.{key}", f"key '{key}' is not read by the {paper} simulation, so setting "
+                                      f"it changes nothing (it reads: {', '.join(sorted(shapes[paper]))})")
     both = sorted(set(spec["vary"]) & set(fixed))
     if both:
-        raise ConfigError(f"{where}: key(s) {both} are both swept (vary) and fixed")
+        bad("fixed", f"key(s) {both} are both swept (vary) and fixed")
     methods = list(spec.get("methods") or DEFAULT_METHODS[paper])
     allowed = APPROACH_METHODS if paper == "approach" else landing_methods
     if allowed:
-        bad = [m for m in methods if m not in allowed]
-        if bad:
-            raise ConfigError(f"{where}: unknown method(s) {bad} for paper {paper}; "
-                              f"available: {', '.join(allowed)}")
+        unknown = [m for m in methods if m not in allowed]
+        if unknown:
+            bad("methods", f"unknown method(s) {unknown} for paper {paper}; available: {', '.join(allowed)}")
     if paper == "landing" and spec.get("variants"):
-        raise ConfigError(f"{where}: 'variants' are paper-A scenario variants; paper B has none")
+        bad("variants", "'variants' are paper-A scenario variants; paper B has none")
     variants = list(spec.get("variants") or (["literal", "roll"] if paper == "approach" else []))
     metrics = list(spec.get("metrics") or DEFAULT_METRICS[paper])
-    bad = [m for m in metrics if m not in METRICS[paper]]
-    if bad:
-        raise ConfigError(f"{where}: unknown metric(s) {bad}; available for {paper}: "
-                          f"{', '.join(METRICS[paper])}")
+    unknown = [m for m in metrics if m not in METRICS[paper]]
+    if unknown:
+        bad("metrics", f"unknown metric(s) {unknown}; available for {paper}: {', '.join(METRICS[paper])}")
+    n_sets = _n_value_sets(spec)
+    if n_sets > limit:
+        lens = " x ".join(str(len(v)) for v in spec["vary"].values())
+        bad("vary", f"{lens} = {n_sets} value sets exceed limits.max_study_values = {limit} "
+                    "(each is a Monte Carlo; raise the limit to mean it)")
+    if problems:
+        raise ConfigError("\n".join(problems))
     statistic = spec.get("statistic", "mean")
     instances, seen = [], {}
     for values in _value_sets(name, spec):
         merged = copy.deepcopy(dict(config))
         merged.pop("studies", None)
+        if paper == "landing":
+            # a study flies the base camera (no scenario overlay): its value is checked so
+            merged["landing"]["scenarios"] = {"study": {}}
+            merged["landing"]["headline_scenario"] = "study"
         for k, v in {**fixed, **values}.items():
             set_path(merged, k, v)
+        shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         try:
+            if validate is _validate_paper:
+                merged["_paper"] = paper
             validate(merged)
         except (ConfigError, ValueError) as exc:
-            shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
-            raise ConfigError(f"{where}: value {shown} refused: {exc}") from None
+            for line in str(exc).splitlines():
+                bad("vary", f"value {shown} refused: {line}")
+            continue
         if paper == "approach":  # one job holds runs_per_job seeds of the whole arc in memory
-            _check_approach_job_size(where, merged["approach"], min(int(spec["runs_per_job"]), int(spec["runs"])))
+            try:
+                _check_approach_job_size(where, merged["approach"],
+                                         min(int(spec["runs_per_job"]), int(spec["runs"])))
+            except ConfigError as exc:
+                bad("runs_per_job", str(exc).removeprefix(f"{where}: "))
+                break
         # the validated (defaults filled, possibly normalised) values
         values = {k: get_path(merged, k) for k in values}
         label = instance_label(values)
         if label in seen:
-            raise ConfigError(f"{where}: values {seen[label]} and {values} coincide (label {label!r})")
+            bad("vary", f"values {seen[label]} and {values} coincide (label {label!r})")
+            continue
         seen[label] = values
         sim = project(merged[paper], shapes[paper])
         instances.append(Instance(label, values, sim, config_digest({"paper": paper, "sim": sim})))
+    if problems:
+        raise ConfigError("\n".join(dict.fromkeys(problems)))
     keys = tuple(spec["vary"])
     letter = _LETTER[paper]
     return Study(name=name, paper=paper, id=spec.get("id") or f"{letter}-S",

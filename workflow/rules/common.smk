@@ -1,21 +1,20 @@
 # Shared helpers: config validation, output paths, and the final outputs (final_outputs).
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(workflow.basedir) / "src"))
 from opnav.config import ConfigError, validate_config  # noqa: E402
 from opnav.snakeio import compact_params_change_reasons  # noqa: E402
 
 # "Params have changed" reasons name the changed keys, not whole config sections.
 compact_params_change_reasons()
 
-# The schema (defaults filled in place, finite numbers, strict integers) and the
-# cross-key physics checks of opnav.checks, before any job: the same function
-# the `opnav` CLI uses. A ConfigError lists one line per problem, naming the key.
+# Every config problem before any job, in one pass, one line each naming the key (and
+# the study or scenario): the schema (defaults filled in place, finite numbers, strict
+# integers), the cross-key physics checks of opnav.checks (camera scenarios, growing
+# windows, headline scenario, results_dir), every parameter study's values, and the
+# job-graph bounds (limits), before the DAG is built: the same function the `opnav`
+# CLI uses. config_exit (Snakefile) is the one way out for them.
 try:
     validate_config(config, root=workflow.basedir, workdir=Path.cwd())
 except ConfigError as exc:
-    sys.exit(f"ConfigError (no job was run):\n{exc}")
+    config_exit(exc)
 
 RESULTS = config["results_dir"]
 
@@ -153,12 +152,6 @@ def _floats(part):
     studies = [t for name, s in sorted(STUDIES.items(), key=lambda kv: (kv[1].id, kv[0]))
                if s.paper == part for t in STUDY_TARGETS[name] if t.endswith((".pdf", ".tex"))]
     return own + studies
-
-
-# studies.smk
-def _check_study_config(c):
-    """A swept value's merged config: the schema and the config-time physics checks."""
-    validate_config(c, root=workflow.basedir)
 
 
 # studies.smk

@@ -7,7 +7,6 @@
 # simulations are flown once, and editing one study's values queues only the new
 # values' jobs. Outputs: results/studies/<name>/.
 from opnav import studies as _studies
-from opnav.landing.planner import available_methods as _planner_methods
 
 STUDIES_DIR = res("studies")
 STUDY_SHAPES = {
@@ -17,7 +16,15 @@ STUDY_SHAPES = {
 }
 
 
-STUDIES = _studies.plan(config, STUDY_SHAPES, _check_study_config, _planner_methods())
+# The shapes the rules pass must be those opnav.studies plans with (validate_config
+# checked every study with them, before any rule file was read).
+if STUDY_SHAPES != _studies.simulation_shapes(config):
+    raise RuntimeError("opnav.studies.SIM_KEYS differs from the rules' simulation keys (B_SIM, "
+                       "A_SCENARIO): update it")
+try:
+    STUDIES = _studies.plan(config)            # planned (cached) by validate_config
+except ConfigError as exc:
+    config_exit(exc)
 STUDY_SIMS = {i.digest: i.sim for s in STUDIES.values() for i in s.instances}
 STUDY_JOB_UNITS = _study_job_units(STUDIES)
 STUDY_SRC = {"landing": B_SRC + src("landing/study.py"),
