@@ -33,15 +33,28 @@ def test_opnav_study_runs_only_that_study(workdir):
     assert cmd[-5:] == ["--configfile", "a.yaml", "b.yaml", "--", f"study_{name}"]
     proc = _opnav(workdir, "study", name, "--config", "config/quick.yaml", "--config", "my-study.yaml", "-n")
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
-    listed = {line.split()[-1].rstrip(":") for line in proc.stdout.splitlines()
+    # Snakemake's output goes to stderr; stdout holds the JSON summary alone
+    listed = {line.split()[-1].rstrip(":") for line in proc.stderr.splitlines()
               if line.startswith(("rule ", "localrule "))}
     assert listed == {"study_runs", f"study_{name}_outputs", f"study_{name}"}, listed
     n_values = len(next(iter(spec["vary"].values())))
-    assert proc.stdout.count("rule study_runs:") == n_values       # one job per value, every method
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert proc.stderr.count("rule study_runs:") == n_values       # one job per value, every method
+    out = json.loads(proc.stdout)
     assert out["study"] == name and out["outputs"].endswith(f"results/quick/studies/{name}")
     bad = _opnav(workdir, "study", "nope", "--config", "config/quick.yaml")
     assert bad.returncode == 2 and "no study 'nope'" in bad.stderr and "fov" in bad.stderr
     val = _opnav(workdir, "study", name, "--config", "config/quick.yaml", "--config", "my-study.yaml",
                  "--set", f"studies.{name}.runs=0", "-n")
     assert val.returncode == 2 and f"studies.{name}.runs" in val.stderr
+
+
+def test_opnav_study_forwards_snakemake_config_errors_as_user_errors():
+    """A failed Snakemake run's config lines reach stderr as `opnav: error:` lines with
+    exit 2; a failed job is a numerical failure (3)."""
+    from opnav.cli import EXIT_NUMERICAL, EXIT_USER, snakemake_error
+
+    out = ["Using workflow specific profile profiles/default", "ConfigError (no job was run):",
+           "invalid config key 'studies.s.vary' (study 's'): values coincide"]
+    assert snakemake_error(out) == (["invalid config key 'studies.s.vary' (study 's'): values coincide"], EXIT_USER)
+    out = ["Error in rule study_runs:", "    jobid: 3", "Exiting because a job execution failed."]
+    assert snakemake_error(out) == (["Error in rule study_runs"], EXIT_NUMERICAL)

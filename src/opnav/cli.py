@@ -90,8 +90,12 @@ def with_flags(config: dict, flags: dict[str, tuple[str, Any]]) -> dict:
         for line in str(exc).splitlines():
             m = _KEY_RE.search(line)
             bad = m.group(1) if m else ""
+            # the flag of the key the line names (or a parent or child of it), else of a
+            # key the line mentions (approach.table1_variants ... not in approach.variants)
             names = [flag for key, (flag, _) in given.items()
                      if bad and (bad == key or key.startswith(bad + ".") or bad.startswith(key + "."))]
+            names = names or [flag for key, (flag, _) in given.items()
+                              if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", line)]
             lines.append(f"{'/'.join(dict.fromkeys(names))}: {line}" if names else line)
         raise ConfigError("\n".join(lines)) from None
 
@@ -214,8 +218,11 @@ def study_command(name: str, overlays, cores: int = 2, dry_run: bool = False) ->
 
 
 def run_study(args) -> int:
-    """``opnav study NAME``: validate the merged config and the study (before any job),
-    then run its Snakemake target in the checkout."""
+    """``opnav study NAME``: validate the merged config and every study (the checks the
+    Snakefile runs, before any job), then run the study's Snakemake target in the
+    checkout. Snakemake's output goes to stderr (stdout holds the JSON summary only); if
+    it fails, its error lines follow as ``opnav: error:`` lines: exit 2 for a config
+    problem it found, 3 for a failed job."""
     import os
     import subprocess
     import tempfile
@@ -225,13 +232,13 @@ def run_study(args) -> int:
 
     from opnav.config import repo_root
 
-    config = load_cli_config(args)  # every overlay and --set validated, errors name the key
+    if args.cores < 1:
+        raise ConfigError("--cores: must be at least 1")
+    config = load_cli_config(args)  # every overlay and --set, every study, validated: errors name the key
     studies = config.get("studies") or {}
     if args.name not in studies:
         raise ConfigError(f"no study '{args.name}' in the config (studies: {', '.join(sorted(studies)) or 'none'}); "
                           "declare it in an overlay given with --config")
-    if args.cores < 1:
-        raise ConfigError("--cores: must be at least 1")
     root = repo_root()
     overlays = [Path(f).resolve() for f in [*([args.config] if getattr(args, "config", None) else []),
                                             *args.overlays]]
@@ -246,14 +253,40 @@ def run_study(args) -> int:
             overlays.append(extra)
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             p for p in (str(root / "src"), os.environ.get("PYTHONPATH", "")) if p))
-        proc = subprocess.run(study_command(args.name, overlays, args.cores, args.dry_run), cwd=root, env=env)
-    if proc.returncode:
-        print(f"opnav: error: snakemake failed for study '{args.name}' (exit {proc.returncode})", file=sys.stderr)
-        return EXIT_NUMERICAL
+        proc = subprocess.Popen(study_command(args.name, overlays, args.cores, args.dry_run), cwd=root, env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
+        tail: list[str] = []
+        for line in proc.stdout:            # streamed: a study runs for minutes
+            sys.stderr.write(line)
+            tail = (tail + [line.rstrip("\n")])[-200:]
+        rc = proc.wait()
+    if rc:
+        lines, code = snakemake_error(tail)
+        for line in lines:
+            print(f"opnav: error: {line}", file=sys.stderr)
+        print(f"opnav: error: snakemake failed for study '{args.name}' (exit {rc})", file=sys.stderr)
+        return code
     out = Path(config["results_dir"]) / "studies" / args.name
     print_json({"study": args.name, "dry_run": bool(args.dry_run),
                 "outputs": str(out if out.is_absolute() else root / out)})
     return 0
+
+
+def snakemake_error(output: list[str]) -> tuple[list[str], int]:
+    """The error lines of a failed Snakemake run's ``output`` and the exit code they mean:
+    the config problems after the Snakefile's ``ConfigError (no job was run):`` (a user
+    error, :data:`EXIT_USER`), else Snakemake's own error line (``WorkflowError``, ``Error in
+    rule ...``, a missing input; :data:`EXIT_NUMERICAL` for a failed job)."""
+    for i, line in enumerate(output):
+        if line.startswith("ConfigError (no job was run):"):
+            rest = [ln for ln in output[i + 1:] if ln.startswith(("invalid config", "config file"))]
+            return rest or [line], EXIT_USER
+    for i, line in enumerate(output):
+        if line.startswith(("WorkflowError", "MissingInputException", "SyntaxError")):
+            detail = next((ln.strip() for ln in output[i + 1:] if ln.strip()), "")
+            return [f"{line.strip()} {detail}".strip()], EXIT_USER
+    rules = [ln.strip().rstrip(":") for ln in output if ln.startswith("Error in rule")]
+    return (rules[:3] or ["see the Snakemake output above"]), EXIT_NUMERICAL
 
 
 def main(argv: list[str] | None = None) -> int:
