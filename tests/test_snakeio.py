@@ -74,3 +74,38 @@ def test_chunk_names_cover_any_number_of_chunks():
     for c, lab in zip(parts[::997] + parts[-2:], labels[::997] + labels[-2:]):
         assert re.fullmatch(CHUNK_PATTERN, lab), lab
         assert chunk_runs(lab) == list(c)
+
+
+def test_intermediate_csv_refuses_a_cut_or_edited_file(tmp_path):
+    """A study chunk CSV cut inside its last row still parses with pandas (a NaN column);
+    the stamp (rows, checksum) refuses it, and an edited value, naming the file and the
+    rebuild command, as a truncated .npz or pickle is refused."""
+    import numpy as np
+    import pandas as pd
+
+    from opnav.snakeio import CorruptIntermediate, load_csv, save_csv
+
+    df = pd.DataFrame({"method": ["depth", "svd"] * 3, "run": np.arange(6),
+                       "final_pos_err_m": np.linspace(0.1, 9.9, 6) / 3.0})
+    f = tmp_path / "0-5.csv"
+    save_csv(f, df)
+    back = load_csv(f)
+    pd.testing.assert_frame_equal(back, df)
+    good = f.read_bytes()
+    cut = good[:-9]
+    assert len(pd.read_csv(__import__("io").BytesIO(cut.split(b"\n", 1)[1]))) == 6   # pandas alone accepts it
+    for bad in (cut, good.replace(b"depth", b"dapth", 1), good.split(b"\n", 1)[1], b""):
+        f.write_bytes(bad)
+        with pytest.raises(CorruptIntermediate, match=r"0-5\.csv.*snakemake --cores 2 --force"):
+            load_csv(f)
+
+
+def test_intermediate_json_refuses_a_truncated_file(tmp_path):
+    from opnav.snakeio import CorruptIntermediate, load_json
+
+    f = tmp_path / "s.json"
+    f.write_text('{"a": [1, 2, 3], "b": {"c": 1.5}}')
+    assert load_json(f) == {"a": [1, 2, 3], "b": {"c": 1.5}}
+    f.write_text('{"a": [1, 2, 3], "b": {"c": 1.')
+    with pytest.raises(CorruptIntermediate, match=r"s\.json.*--force"):
+        load_json(f)

@@ -225,6 +225,65 @@ def load_pickle(path):
         raise corrupt_intermediate(path, exc) from exc
 
 
+#: First line of an intermediate CSV written by :func:`save_csv`: its data rows and the
+#: SHA-256 of the text after this line (a CSV cut inside its last row still parses).
+CSV_STAMP = "# opnav-csv"
+
+
+def save_csv(path, df) -> None:
+    """Write the intermediate table ``df`` to ``path`` atomically, stamped (:data:`CSV_STAMP`)
+    with its row count and checksum, which :func:`load_csv` checks."""
+    import hashlib
+
+    from opnav.tables import atomic_target
+
+    body = df.to_csv(index=False, lineterminator="\n")
+    head = f"{CSV_STAMP} rows={len(df)} sha256={hashlib.sha256(body.encode()).hexdigest()}\n"
+    with atomic_target(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
+        fh.write(head + body)
+
+
+def load_csv(path, **kw):
+    """Read an intermediate table written by :func:`save_csv`; a missing or wrong stamp,
+    row count or checksum (a cut, an edit, an older writer) raises
+    :class:`CorruptIntermediate` naming the file and the rebuild command."""
+    import hashlib
+    import io
+    import re
+
+    import pandas as pd
+
+    try:
+        text = Path(path).read_bytes().decode("utf-8")
+        head, _, body = text.partition("\n")
+        m = re.fullmatch(re.escape(CSV_STAMP) + r" rows=(\d+) sha256=([0-9a-f]{64})", head)
+        if not m:
+            raise ValueError(f"no '{CSV_STAMP} rows=... sha256=...' first line")
+        if hashlib.sha256(body.encode()).hexdigest() != m.group(2):
+            raise ValueError("checksum mismatch")
+        df = pd.read_csv(io.StringIO(body), **kw)
+        if len(df) != int(m.group(1)):
+            raise ValueError(f"{len(df)} rows, {m.group(1)} written")
+        return df
+    except FileNotFoundError:
+        raise
+    except (OSError, UnicodeDecodeError, ValueError, pd.errors.ParserError) as exc:
+        raise corrupt_intermediate(path, exc) from exc
+
+
+def load_json(path):
+    """Read an intermediate JSON file; a truncated or corrupt one raises
+    :class:`CorruptIntermediate` naming it and the rebuild command."""
+    import json
+
+    try:
+        return json.loads(Path(path).read_bytes().decode("utf-8"))
+    except FileNotFoundError:
+        raise
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise corrupt_intermediate(path, exc) from exc
+
+
 class _Named(list):
     """A list whose items are also attributes, like Snakemake's Namedlist."""
 

@@ -8,7 +8,7 @@ import sys
 import pandas as pd
 
 from opnav import figures, studies
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.snakeio import load_csv, mock_snakemake, script_context
 from opnav.study_plots import fig_study
 from opnav.tables import atomic_write_text, write_table
 
@@ -17,7 +17,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     study = snakemake.params.study
-    parts = [(label, pd.read_csv(path)) for path, label in zip(snakemake.input.runs, snakemake.params.labels)]
+    parts = [(label, load_csv(path)) for path, label in zip(snakemake.input.runs, snakemake.params.labels)]
     runs = studies.gather_runs(parts, study, snakemake.params.converged_pos_err_m)
     tidy = studies.tidy_table(runs, study)
     cap = snakemake.params.caption
