@@ -1,20 +1,29 @@
 """``pip install .`` (not editable) gives a working ``opnav`` without the checkout.
 
 Builds a wheel from a copy of the sources, installs it into a temporary venv
-that sees the already-installed dependencies (``--system-site-packages``,
-``--no-deps``, ``--no-build-isolation``: no network), and runs the installed
+that sees the already-installed dependencies of the running interpreter
+(``--no-deps``, ``--no-build-isolation``: no network), and runs the installed
 command from a folder outside any checkout, where only package data can supply
 the schemas, defaults, published values and figure style.
+
+The running interpreter may itself be a venv (how most users run README's test
+command): ``--system-site-packages`` would then see the base interpreter's
+packages, not the venv's, so the nested venv gets the running interpreter's
+site-packages folders through a ``.pth`` file instead (plain paths: their own
+``.pth`` files, e.g. an editable install of this checkout, are not run).
 """
 
 import json
 import os
+import site
 import shutil
 import subprocess
 import sys
 import zipfile
 
 import pytest
+
+from pathlib import Path
 
 from conftest import REPO
 
@@ -23,6 +32,15 @@ pytestmark = pytest.mark.slow
 
 def _run(cmd, cwd, env):
     return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+
+
+def _outer_site_dirs() -> list[str]:
+    """The running interpreter's site-packages folders (a venv's, and its base's when the
+    venv sees them), as on its ``sys.path``, without this checkout's ``src``."""
+    dirs = [*site.getsitepackages(), site.getusersitepackages()]
+    dirs += [p for p in sys.path if p.endswith(("site-packages", "dist-packages"))]
+    src = str(REPO / "src")
+    return [d for d in dict.fromkeys(dirs) if os.path.isdir(d) and d != src]
 
 
 @pytest.fixture(scope="module")
@@ -43,9 +61,13 @@ def installed(tmp_path_factory):
     (wheel,) = wheels.glob("opnav_repro-*.whl")
     venv = tmp / "venv"
     # no pip inside the venv (ensurepip is most of a venv's cost): this pip installs into it
-    r = _run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", str(venv)], tmp, env)
+    r = _run([sys.executable, "-m", "venv", "--without-pip", str(venv)], tmp, env)
     assert r.returncode == 0, r.stderr
     bindir = venv / ("Scripts" if os.name == "nt" else "bin")
+    r = _run([str(bindir / "python"), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+             tmp, env)
+    assert r.returncode == 0, r.stderr
+    (Path(r.stdout.strip()) / "outer-env.pth").write_text("\n".join(_outer_site_dirs()) + "\n")
     r = _run([sys.executable, "-m", "pip", "--python", str(bindir / "python"), "install", "-q",
               "--no-deps", "--no-index", "--force-reinstall", str(wheel)], tmp, env)
     assert r.returncode == 0, r.stderr
