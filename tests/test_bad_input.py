@@ -108,6 +108,60 @@ BAD_CONFIGS = [
     ("results_dir: paper", "results_dir"),
     ("results_dir: paper/out", "results_dir"),
     ("results_dir: results/../config", "results_dir"),
+    # round two (issue 33): where outputs go
+    ("results_dir: docs/out", "tracked folder docs/"),
+    ("results_dir: .ci", "tracked folder .ci/"),
+    ("results_dir: .snakemake/x", "tracked folder .snakemake/"),
+    ("results_dir: README.md", "'results_dir': 'README.md' is an existing file"),
+    ("results_dir: '" + "a" * 5000 + "'", "'results_dir': 5000 characters"),
+    ('results_dir: "res\\0ults"', "'results_dir': contains a NUL byte"),
+    ("results_dir: '~nosuchuser33/out'", "'results_dir': '~nosuchuser33/out': '~' names no home"),
+    ("results_dir: ..", "'results_dir': '..' holds the checkout"),
+    ("results_dir: 7", "'results_dir': 7 is not of type 'string'"),
+    # camera scenarios get the landing physics checks of landing.camera
+    ("landing: {scenarios: {interior: {fov_deg: 10, tilt_deg: 0}}}", "'landing.scenarios.interior': the landing site"),
+    ("landing: {scenarios: {interior: {tilt_azimuth_deg: 73}}}", "'landing.scenarios.interior': the landing site"),
+    ("landing: {scenarios: {interior: {pixels: 16}}, planner: {margin_px: 40}}",
+     "'landing.scenarios.interior': landing.planner.margin_px = 40 px"),
+    ("landing: {scenarios: {wide: {fov_deg: 170, tilt_deg: 0, pixels: 8}}, planner: {margin_px: 4}}",
+     "'landing.scenarios.wide.pixels'"),
+    ("landing: {scenarios: {interior: {sigma_px: 1.0e-300}}}", "landing.scenarios.interior.sigma_px"),
+    ("landing: {scenarios: {interior: {zoom: 2}}}", "landing.scenarios.interior"),
+    ("landing: {scenarios: {Wide_1: {}}}", "landing.scenarios"),
+    ("landing: {headline_scenario: nadir}", "'landing.headline_scenario': 'nadir' is not one of"),
+    ("approach: {growing: {N: 7}}", "'approach.growing.N': 7 does not divide"),
+    ("approach: {camera: {sigma3_px: [1.0e-300, 1.0e-300, 2.0e-300]}}", "approach.camera.sigma3_px[0]"),
+    # the studies planner: one line per problem, naming studies.<name> and the key
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: 45.0}}}", "'studies.s.vary.landing.camera.fov_deg'"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, colour: red}}", "'studies.s'"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0, 60.0], landing.imu.rate_hz: [10.0]}}}",
+     "'studies.s.vary' (study 's'): the vary lists have different lengths"),
+    ("studies: {s: {paper: landing, vary: {approach.camera.ifov_arcsec: [10.0]}}}",
+     "'studies.s.vary.approach.camera.ifov_arcsec' (study 's')"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, fixed: {landing.camera.fov_deg: 50.0}}}",
+     "'studies.s.fixed' (study 's'): key(s) ['landing.camera.fov_deg'] are both swept"),
+    ("studies: {s: {paper: landing, vary: {landing.mc.n_runs: [5, 6]}}}",
+     "'studies.s.vary.landing.mc.n_runs' (study 's'): key 'landing.mc.n_runs' is not read"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.pixels: [512.0]}}}",
+     "'studies.s.vary' (study 's'): value landing.camera.pixels = 512.0 refused"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, methods: [depth, oracle]}}",
+     "'studies.s.methods' (study 's'): unknown method(s) ['oracle']"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, metrics: [happiness]}}",
+     "'studies.s.metrics' (study 's'): unknown metric(s) ['happiness']"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}", "'studies.s.vary' (study 's'): values"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.tilt_azimuth_deg: [73.0]}}}",
+     "'studies.s.vary' (study 's'): value landing.camera.tilt_azimuth_deg = 73.0 refused: invalid config key "
+     "'landing.camera': the landing site"),
+    ("studies: {s: {paper: approach, vary: {approach.segments.N: [7]}}}", "'studies.s.vary' (study 's'): value approach.segments.N = 7"),
+    ("studies: {s: {paper: landing, variants: [roll], vary: {landing.camera.fov_deg: [45.0]}}}", "'studies.s.variants'"),
+    # bounds on the job graph, before it is built
+    ("studies: {s: {paper: landing, grid: true, vary: {landing.camera.fov_deg: [" + ", ".join(
+        f"{40 + 0.1 * i:.1f}" for i in range(100)) + "], landing.filter.obs_per_landmark: ["
+     + ", ".join(str(i) for i in range(1, 101)) + "]}}}",
+     "'studies.s.vary' (study 's'): 100 x 100 = 10000 value sets exceed limits.max_study_values"),
+    ("landing: {mc: {n_runs: 25000, runs_per_job: 1}}", "'limits.max_jobs': the config makes about"),
+    ("limits: {max_jobs: 10}", "'limits.max_jobs'"),
+    ("limits: {max_jobs: 0}", "limits.max_jobs"),
 ]
 
 
@@ -184,6 +238,141 @@ def test_snakefile_refuses_before_any_job(tmp_path):
     assert not (wd / "results").exists()
 
 
+def test_all_problems_in_one_pass():
+    """Schema and physics problems of different sections, and of studies, in one error."""
+    with pytest.raises(ConfigError) as err:
+        validate_config(_overlaid(
+            "approach: {dt_s: .nan}\nlanding: {headline_scenario: nadir, duration_s: 197.5}\n"
+            "results_dir: docs/out\nstudies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}"),
+            root=REPO)
+    text = str(err.value)
+    for key in ("approach.dt_s", "landing.headline_scenario", "landing.duration_s", "results_dir"):
+        assert f"'{key}'" in text, text
+    with pytest.raises(ConfigError) as err:          # the studies once the papers' sections are sound
+        validate_config(_overlaid("results_dir: docs/out\nstudies: {s: {paper: landing, vary: "
+                                  "{landing.camera.fov_deg: [45, 45.0]}}, t: {paper: landing, vary: "
+                                  "{landing.mc.n_runs: [3]}}}"), root=REPO)
+    text = str(err.value)
+    assert all(k in text for k in ("'results_dir'", "'studies.s.vary'", "'studies.t.vary.landing.mc.n_runs'")), text
+
+
+def test_results_dir_tilde_is_expanded():
+    import os
+
+    cfg = validate_config(_overlaid("results_dir: ~/opnav-out"), root=REPO)
+    assert cfg["results_dir"] == os.path.expanduser("~/opnav-out") and "~" not in cfg["results_dir"]
+
+
+def test_tracked_folders_come_from_git(tmp_path):
+    """A folder that holds tracked files is refused whatever its name; a folder of
+    placeholders only (results/README.md) or of untracked files is not."""
+    import subprocess
+
+    from opnav.checks import results_dir_problems, tracked_dirs
+
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    for f in ("notes/a.txt", "results/README.md", "scratch/x.txt"):
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / f).write_text("x")
+    subprocess.run(["git", "-C", str(tmp_path), "add", "notes/a.txt", "results/README.md"], check=True)
+    assert {d.as_posix() for d in tracked_dirs(tmp_path)} == {".git", ".snakemake", "notes"}
+    assert results_dir_problems("notes/out", tmp_path) and not results_dir_problems("results", tmp_path)
+    assert not results_dir_problems("scratch/out", tmp_path)
+
+
+def test_yaml_anchors_and_merge_keys_still_work(tmp_path):
+    from opnav.config import read_config_file
+
+    f = tmp_path / "ok.yaml"
+    f.write_text("x: &c {fov_deg: 45.0}\nlanding: {camera: {<<: *c, tilt_deg: 40.0}}\n")
+    assert read_config_file(f)["landing"]["camera"] == {"fov_deg": 45.0, "tilt_deg": 40.0}
+
+
+def _bomb(levels=9):
+    lines = ['a0: &a0 ["x", "x", "x", "x", "x", "x", "x", "x", "x"]']
+    for i in range(1, levels):
+        lines.append(f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]")
+    return "\n".join(lines) + "\n"
+
+
+# (file content (str or bytes, None: absent), text the one-line error must contain)
+BAD_FILES = [
+    ("landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n",
+     "{f}, line 3, column 1: not valid YAML: duplicate key 'landing' (first given on line 1)"),
+    ("landing:\n  mc: {n_runs: 8, n_runs: 9}\n", "{f}, line 2"),
+    ("landing:\n\tmc: {n_runs: 8}\n", "{f}, line 2, column 1: not valid YAML"),
+    ("- landing\n- approach\n", "{f}, line 1: the top level must be a mapping of config keys (approach, landing, ...), not a list"),
+    ("", "{f}: empty (no config keys)"),
+    ("# nothing but a comment\n", "{f}: empty (no config keys)"),
+    ("42\n", "{f}, line 1: the top level must be a mapping"),
+    ("landing: !!python/object/apply:os.system ['true']\n", "{f}, line 1, column 10: not valid YAML"),
+    ("landing: !custom {a: 1}\n", "{f}, line 1"),
+    (b"\x7fELF\x02\x01\x01\x00\x00\x00\xff\xfe", "{f}, line 1: not UTF-8 text"),
+    (b"landing: {}\x00\n", "{f}, line 1: a NUL byte"),
+    (None, "{f}: not found"),
+    (_bomb(), "{f}: its aliases expand to more than 100000 nodes"),
+    ("a: &a [*a]\n", "{f}, line 1: a recursive alias"),
+    ("a: 1\n---\nb: 2\n", "{f}, line 2, column 1: not valid YAML"),
+    ("landing: {mc: {n_runs: [1, 2}\n", "{f}, line 1"),
+    ("1: {a: 2}\n", "{f}: top-level key 1 is not a name"),
+]
+
+
+@pytest.mark.parametrize("content,expected", BAD_FILES, ids=[str(c)[:40] for c, _ in BAD_FILES])
+def test_bad_config_file_refused_naming_file_and_line(content, expected, tmp_path, capsys, no_work):
+    """Through the CLI (`opnav --config FILE`): one line naming the file (and the line)."""
+    from opnav.cli import EXIT_USER, main
+
+    f = tmp_path / "over.yaml"
+    if isinstance(content, bytes):
+        f.write_bytes(content)
+    elif content is not None:
+        f.write_text(content)
+    assert main(["landing", "--config", str(f)]) == EXIT_USER
+    cap = capsys.readouterr()
+    lines = cap.err.strip().splitlines()
+    assert len(lines) == 1 and expected.format(f=f) in lines[0], cap.err
+    assert cap.out == ""
+
+
+def test_a_directory_is_not_a_config_file(tmp_path):
+    from opnav.config import read_config_file
+
+    with pytest.raises(ConfigError, match="not a regular file"):
+        read_config_file(tmp_path)
+
+
+def test_snakefile_reports_every_problem_in_one_line_each(tmp_path):
+    """Problems found by the studies planner, the scenario checks, the growing windows,
+    the headline scenario and the job bound all leave through the Snakefile's one wrapper:
+    a line each, no Snakemake frames; a duplicated key in a --configfile names file and line."""
+    from conftest import copy_workflow
+
+    (tmp_path / "wf").mkdir()
+    wd = copy_workflow(tmp_path / "wf")
+    (wd / "bad.yaml").write_text(
+        "approach: {growing: {N: 7}}\n"
+        "landing: {headline_scenario: nadir, scenarios: {interior: {fov_deg: 10, tilt_deg: 0}, site-tilt: {}}}\n"
+        "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}\n")
+    proc = run_snakemake(wd, "-n", "--cores", "1", "--configfile", "config/quick.yaml", "bad.yaml")
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0
+    assert "'approach.growing.N'" in out and "'landing.headline_scenario'" in out, out
+    assert "Traceback" not in out and ".smk\", line" not in out, out
+    (wd / "good-scenario.yaml").write_text(
+        "landing: {scenarios: {interior: {fov_deg: 10, tilt_deg: 0}, site-tilt: {}}}\n"
+        "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}\n")
+    proc = run_snakemake(wd, "-n", "--cores", "1", "--configfile", "config/quick.yaml", "good-scenario.yaml")
+    out = proc.stdout + proc.stderr
+    problems = [ln for ln in out.splitlines() if ln.startswith("invalid config key")]
+    assert [ln.split("'")[1] for ln in problems] == ["landing.scenarios.interior", "studies.s.vary"], out
+    (wd / "dup.yaml").write_text("landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n")
+    proc = run_snakemake(wd, "-n", "--cores", "1", "--configfile", "config/quick.yaml", "dup.yaml")
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "dup.yaml, line 3, column 1: not valid YAML: duplicate key 'landing'" in out, out
+    assert not (wd / "results").exists()
+
+
 # ------------------------------------------------------------------ the CLI
 
 def _write(tmp_path, name, text):
@@ -227,6 +416,23 @@ BAD_CLI = [
     (["--config", "{tmp}/broken.yaml", "landing"], "broken.yaml"),
     (["--config", "{tmp}/nan.yaml", "approach"], "approach.dt_s"),
     (["--config", "{tmp}/tilt.yaml", "landing"], "landing.camera"),
+    # round two (issue 33)
+    (["approach", "--pixel-sigma", "1e-300"], "--pixel-sigma: invalid config key 'approach.camera.sigma3_px[0]'"),
+    (["approach", "--set", "approach.variants=[literal]"],
+     "--set approach.variants: invalid config key 'approach.table1_variants'"),
+    (["approach", "--set", "approach.nosuch=1"], "--set approach.nosuch: no config key"),
+    (["approach", "--set", "approach.dt_s"], "expected KEY.PATH=VALUE"),
+    (["approach", "--set", "approach.dt_s=[1"], "--set approach.dt_s: the value '[1' is not valid YAML"),
+    (["landing", "--set", "landing.headline_scenario=nadir"], "--set landing.headline_scenario"),
+    (["landing", "--set", "landing.scenarios.interior.fov_deg=10"], "landing.scenarios.interior"),
+    (["landing", "--set", "results_dir=docs/out"], "--set results_dir: invalid config key 'results_dir'"),
+    (["landing", "--set", "landing.mc.runs_per_job=1", "--set", "landing.mc.n_runs=25000"], "limits.max_jobs"),
+    (["landing", "--config", "{tmp}/dup.yaml"], "dup.yaml, line 3"),
+    (["study", "nope", "--config", "{tmp}/nan.yaml"], "approach.dt_s"),
+    (["study", "s", "--config", "{tmp}/study.yaml"], "'studies.s.vary' (study 's'): values"),
+    (["study", "s", "--config", "{tmp}/study.yaml", "--cores", "0"], "--cores"),
+    (["study", "s", "--config", "{tmp}/study.yaml", "--cores", "x"], "--cores"),
+    (["study"], "NAME"),
 ]
 
 
@@ -252,6 +458,8 @@ def test_bad_cli_refused_naming_flag(argv, named, tmp_path, capsys, no_work):
     _write(tmp_path, "broken.yaml", "approach: {dt_s: [1, 2\n")
     _write(tmp_path, "nan.yaml", "approach: {dt_s: .nan}\n")
     _write(tmp_path, "tilt.yaml", "landing: {camera: {tilt_deg: 0}}\n")
+    _write(tmp_path, "dup.yaml", "landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n")
+    _write(tmp_path, "study.yaml", "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}\n")
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     try:
         rc = main(argv)

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -89,19 +90,23 @@ def config_problems(config: dict, root: str | Path | None = None,
     out: list[str] = []
     if "results_dir" in todo:
         out += results_dir_problems(config, root, workdir)
+    unsound = set(skip)                 # sections whose values the later checks cannot trust
     for name, check in (("approach", approach_problems), ("landing", landing_problems)):
         if name in todo and name in config:
-            out += check(config[name])
-    if out or set(skip) & {"approach", "landing", "limits"}:
-        return out                      # studies and bounds read sound sections only
-    if "studies" in todo and config.get("studies"):
+            found = check(config[name])
+            out += found
+            # camera scenarios and the headline scenario are not what a study flies
+            if any(not re.match(r"invalid config key 'landing\.(scenarios|headline_scenario)\b", ln)
+                   for ln in found):
+                unsound.add(name)
+    if "studies" in todo and config.get("studies") and not unsound & {"approach", "landing", "limits"}:
         from opnav.studies import plan
 
         try:
             plan(config)
         except ValueError as exc:        # ConfigError: one line per problem
             out += str(exc).splitlines()
-    if "limits" in todo and not out:
+    if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
         out += job_problems(config)
     return out
 

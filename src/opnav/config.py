@@ -228,6 +228,8 @@ class _StrictLoader(_YAML_LOADER):  # type: ignore[misc, valid-type]
     def construct_mapping(self, node, deep=False):
         seen: dict = {}
         for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue                 # `<<: *anchor`: its keys may be overridden
             key = self.construct_object(key_node, deep=True)
             try:
                 hash(key)
