@@ -152,7 +152,8 @@ BAD_CONFIGS = [
     ("studies: {s: {paper: landing, vary: {landing.camera.tilt_azimuth_deg: [73.0]}}}",
      "'studies.s.vary' (study 's'): value landing.camera.tilt_azimuth_deg = 73.0 refused: invalid config key "
      "'landing.camera': the landing site"),
-    ("studies: {s: {paper: approach, vary: {approach.segments.N: [7]}}}", "'studies.s.vary' (study 's'): value approach.segments.N = 7"),
+    ("studies: {s: {paper: approach, vary: {approach.camera.ifov_arcsec: [10.0, 0.1]}}}",
+     "'studies.s.vary' (study 's'): value approach.camera.ifov_arcsec = 0.1 refused: invalid config key 'approach.camera'"),
     ("studies: {s: {paper: landing, variants: [roll], vary: {landing.camera.fov_deg: [45.0]}}}", "'studies.s.variants'"),
     # bounds on the job graph, before it is built
     ("studies: {s: {paper: landing, grid: true, vary: {landing.camera.fov_deg: [" + ", ".join(
@@ -174,7 +175,7 @@ def _overlaid(overlay: str) -> dict:
 @pytest.mark.parametrize("overlay,key", BAD_CONFIGS, ids=[c[0] for c in BAD_CONFIGS])
 def test_bad_config_refused_naming_key(overlay, key):
     with pytest.raises(ConfigError) as err:
-        validate_config(_overlaid(overlay), root=REPO)
+        validate_config(_overlaid(overlay), root=REPO, workflow=True)
     text = str(err.value)
     assert key in text, text
     assert all(line.startswith("invalid config key") or line.startswith("invalid config (top")
@@ -182,10 +183,10 @@ def test_bad_config_refused_naming_key(overlay, key):
 
 
 def test_quick_and_full_profiles_pass():
-    validate_config(_overlaid("{}"), root=REPO)
+    validate_config(_overlaid("{}"), root=REPO, workflow=True)
     # a slow, nearly parabolic approach that does not reach Mars is legal
-    validate_config(_overlaid("approach: {geometry: {v_inf_kms: 1.0e-9}}"), root=REPO)
-    validate_config(yaml.safe_load((REPO / "config" / "config.yaml").read_text()), root=REPO)
+    validate_config(_overlaid("approach: {geometry: {v_inf_kms: 1.0e-9}}"), root=REPO, workflow=True)
+    validate_config(yaml.safe_load((REPO / "config" / "config.yaml").read_text()), root=REPO, workflow=True)
 
 
 def test_every_problem_gets_its_own_line():
@@ -244,14 +245,14 @@ def test_all_problems_in_one_pass():
         validate_config(_overlaid(
             "approach: {dt_s: .nan}\nlanding: {headline_scenario: nadir, duration_s: 197.5}\n"
             "results_dir: docs/out\nstudies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}"),
-            root=REPO)
+            root=REPO, workflow=True)
     text = str(err.value)
     for key in ("approach.dt_s", "landing.headline_scenario", "landing.duration_s", "results_dir"):
         assert f"'{key}'" in text, text
     with pytest.raises(ConfigError) as err:          # the studies once the papers' sections are sound
         validate_config(_overlaid("results_dir: docs/out\nstudies: {s: {paper: landing, vary: "
                                   "{landing.camera.fov_deg: [45, 45.0]}}, t: {paper: landing, vary: "
-                                  "{landing.mc.n_runs: [3]}}}"), root=REPO)
+                                  "{landing.mc.n_runs: [3]}}}"), root=REPO, workflow=True)
     text = str(err.value)
     assert all(k in text for k in ("'results_dir'", "'studies.s.vary'", "'studies.t.vary.landing.mc.n_runs'")), text
 
@@ -426,7 +427,8 @@ BAD_CLI = [
     (["landing", "--set", "landing.headline_scenario=nadir"], "--set landing.headline_scenario"),
     (["landing", "--set", "landing.scenarios.interior.fov_deg=10"], "landing.scenarios.interior"),
     (["landing", "--set", "results_dir=docs/out"], "--set results_dir: invalid config key 'results_dir'"),
-    (["landing", "--set", "landing.mc.runs_per_job=1", "--set", "landing.mc.n_runs=25000"], "limits.max_jobs"),
+    (["study", "fov", "--set", "landing.mc.runs_per_job=1", "--set", "landing.mc.n_runs=25000"], "limits.max_jobs"),
+    (["study", "fov", "--set", "approach.growing.N=7"], "--set approach.growing.N: invalid config key"),
     (["landing", "--config", "{tmp}/dup.yaml"], "dup.yaml, line 3"),
     (["study", "nope", "--config", "{tmp}/nan.yaml"], "approach.dt_s"),
     (["study", "s", "--config", "{tmp}/study.yaml"], "'studies.s.vary' (study 's'): values"),

@@ -76,14 +76,16 @@ def _duplicates(items) -> list:
 
 
 def config_problems(config: dict, root: str | Path | None = None,
-                    workdir: str | Path | None = None, *, skip=(), sections=None) -> list[str]:
+                    workdir: str | Path | None = None, *, skip=(), sections=None,
+                    workflow: bool = False) -> list[str]:
     """Every problem of a schema-valid ``config`` (defaults filled), one line each,
-    naming the key(s): ``results_dir``, the ``approach`` and ``landing`` sections, the
-    ``studies`` (each value checked as its own config, :func:`opnav.studies.plan`) and
-    the job-graph bounds (:func:`job_problems`). ``root`` is the checkout (default: the
-    working directory), ``workdir`` where relative outputs go (default: ``root``);
-    sections in ``skip`` (their schema failed) are not read; ``sections`` (default all)
-    limits the checks to those sections."""
+    naming the key(s): ``results_dir``, the ``approach`` and ``landing`` sections and,
+    with ``workflow`` (the Snakefile, ``opnav study``), what only the workflow reads:
+    paper A's growing windows, the ``studies`` (each value checked as its own config,
+    :func:`opnav.studies.plan`) and the job-graph bounds (:func:`job_problems`).
+    ``root`` is the checkout (default: the working directory), ``workdir`` where
+    relative outputs go (default: ``root``); sections in ``skip`` (their schema failed)
+    are not read; ``sections`` (default all) limits the checks to those sections."""
     want = set(sections) if sections is not None else {"results_dir", "approach", "landing", "studies",
                                                         "limits"}
     todo = want - set(skip)
@@ -99,6 +101,10 @@ def config_problems(config: dict, root: str | Path | None = None,
             if any(not re.match(r"invalid config key 'landing\.(scenarios|headline_scenario)\b", ln)
                    for ln in found):
                 unsound.add(name)
+    if not workflow:
+        return out
+    if "approach" in todo and "approach" not in set(skip):
+        out += growing_problems(config["approach"])
     if "studies" in todo and config.get("studies") and not unsound & {"approach", "landing", "limits"}:
         from opnav.studies import plan
 
@@ -109,6 +115,16 @@ def config_problems(config: dict, root: str | Path | None = None,
     if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
         out += job_problems(config)
     return out
+
+
+def growing_problems(a: dict) -> list[str]:
+    """Table 1 in growing windows (``approach.growing``, the workflow's rows) covers the
+    sliding windows' data: its N must divide ``segments.L x N``."""
+    grow, LN = a["growing"], a["segments"]["L"] * a["segments"]["N"]
+    if grow["methods"] and LN % grow["N"]:
+        return [f"invalid config key 'approach.growing.N': {grow['N']} does not divide approach.segments.L x N "
+                f"= {LN} (growing windows cover the same data as the sliding ones)"]
+    return []
 
 
 def _jobs(config: dict) -> dict[str, int]:
@@ -378,10 +394,6 @@ def approach_problems(a: dict) -> list[str]:
     dup = _duplicates(peers)
     if dup:
         out.append(f"{k}peers.variants': duplicated {', '.join(map(str, dup))}")
-    grow, LN = a["growing"], s["L"] * s["N"]
-    if grow["methods"] and LN % grow["N"]:
-        out.append(f"{k}growing.N': {grow['N']} does not divide approach.segments.L x N = {LN} "
-                   "(growing windows cover the same data as the sliding ones)")
     g = a["geometry"]
     d = np.asarray(g["v_inf_dir"], float)
     dn = float(np.linalg.norm(d))

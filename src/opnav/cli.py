@@ -71,7 +71,7 @@ def _set(config: dict, dotted: str, value: Any) -> None:
 _KEY_RE = re.compile(r"config key '([^'\[]+)")
 
 
-def with_flags(config: dict, flags: dict[str, tuple[str, Any]]) -> dict:
+def with_flags(config: dict, flags: dict[str, tuple[str, Any]], *, workflow: bool = False) -> dict:
     """Set config keys from command-line flags and validate the result.
 
     ``flags`` maps a dotted config key to ``(flag, value)``; ``None`` values are
@@ -84,7 +84,7 @@ def with_flags(config: dict, flags: dict[str, tuple[str, Any]]) -> dict:
     for key, (_, value) in given.items():
         _set(config, key, value)
     try:
-        return validate_config(config)
+        return validate_config(config, workflow=workflow)
     except ConfigError as exc:
         lines = []
         for line in str(exc).splitlines():
@@ -171,15 +171,16 @@ def parse_set(text: str) -> tuple[str, Any]:
     return key, value
 
 
-def load_cli_config(args) -> dict:
+def load_cli_config(args, *, workflow: bool = False) -> dict:
     """The config of one subcommand run: the defaults (``config/config.yaml``), the top-level
     ``opnav --config`` overlay, the subcommand's ``--config`` overlays, then its ``--set``
-    keys, validated by the same schema and physics checks as the pipeline's config. A
-    ``--set`` key must exist; its errors name the flag."""
+    keys, validated by the same schema and physics checks as the pipeline's config (with
+    ``workflow``, also the workflow's: studies, growing windows, job bounds). A ``--set``
+    key must exist; its errors name the flag."""
     from opnav.config import load_config
 
     overlays = [*([args.config] if getattr(args, "config", None) else []), *getattr(args, "overlays", [])]
-    config = load_config(overlays=overlays)
+    config = load_config(overlays=overlays, workflow=workflow and not getattr(args, "sets", []))
     flags = {}
     for text in getattr(args, "sets", []):
         key, value = parse_set(text)
@@ -191,7 +192,7 @@ def load_cli_config(args) -> dict:
                 raise ConfigError(f"--set {key}: no config key '{key}' ({where} has: {have})")
             node = node[part]
         flags[key] = (f"--set {key}", value)
-    return with_flags(config, flags) if flags else config
+    return with_flags(config, flags, workflow=workflow) if flags else config
 
 
 def _register_study(sub) -> None:
@@ -234,7 +235,7 @@ def run_study(args) -> int:
 
     if args.cores < 1:
         raise ConfigError("--cores: must be at least 1")
-    config = load_cli_config(args)  # every overlay and --set, every study, validated: errors name the key
+    config = load_cli_config(args, workflow=True)  # every overlay and --set, every study: errors name the key
     studies = config.get("studies") or {}
     if args.name not in studies:
         raise ConfigError(f"no study '{args.name}' in the config (studies: {', '.join(sorted(studies)) or 'none'}); "

@@ -175,7 +175,7 @@ def _copy(value: Any) -> Any:
 
 def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: bool = True,
                     root: str | Path | None = None, workdir: str | Path | None = None,
-                    sections: tuple[str, ...] | None = None) -> dict:
+                    sections: tuple[str, ...] | None = None, workflow: bool = False) -> dict:
     """Validate ``config`` in place (filling defaults); raise :class:`ConfigError`
     with one line per problem, each naming its key: every problem of every layer
     in one pass, before any job runs.
@@ -188,7 +188,8 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
     checked as its own config; the job-graph bounds). ``root`` is the checkout,
     ``workdir`` where a relative ``results_dir`` lands (default ``root``);
     ``sections`` limits the physics checks to those sections (a study value's
-    config: its paper's).
+    config: its paper's); ``workflow`` adds what only the workflow reads (the studies,
+    growing windows, job-graph bounds): the Snakefile and ``opnav study`` set it.
     """
     bad = non_finite_keys(config)
     lines = [f"invalid config key '{k}': {v} is not a finite number "
@@ -204,7 +205,7 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
 
         broken = {_top(line) for line in lines}
         if "" not in broken:        # a top-level schema error: no section is safe to read
-            lines += config_problems(config, root, workdir, skip=broken, sections=sections)
+            lines += config_problems(config, root, workdir, skip=broken, sections=sections, workflow=workflow)
     if lines:
         raise ConfigError("\n".join(dict.fromkeys(lines)))
     return config
@@ -335,7 +336,8 @@ def read_config_file(path: str | Path) -> dict:
     return data
 
 
-def load_config(path: str | Path | None = None, overlays: list[str | Path] = ()) -> dict:
+def load_config(path: str | Path | None = None, overlays: list[str | Path] = (), *,
+                workflow: bool = False) -> dict:
     """Read ``path`` (default: the checkout's ``config/config.yaml``, or, for an
     installed package run outside a checkout, nothing: the schema's defaults,
     which a test keeps equal to ``config/config.yaml``), merge the
@@ -357,7 +359,7 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = ())
         _merge(config, read_config_file(f))
     # results_dir is relative to the checkout that holds config/config.yaml
     root = Path(path).resolve().parents[1] if path is not None and Path(path).parent.name == "config" else None
-    return validate_config(config, SCHEMA_PATH, root=root)
+    return validate_config(config, SCHEMA_PATH, root=root, workflow=workflow)
 
 
 def _merge(base: dict, new: dict) -> None:

@@ -12,7 +12,7 @@ compact_params_change_reasons()
 # job-graph bounds (limits), before the DAG is built: the same function the `opnav`
 # CLI uses. config_exit (Snakefile) is the one way out for them.
 try:
-    validate_config(config, root=workflow.basedir, workdir=Path.cwd())
+    validate_config(config, root=workflow.basedir, workdir=Path.cwd(), workflow=True)
 except ConfigError as exc:
     config_exit(exc)
 
