@@ -173,6 +173,24 @@ def test_gather_runs_keeps_the_study_units_and_refuses_missing_runs():
         studies.gather_runs([("a", short)], spec)
 
 
+def test_gathered_runs_do_not_depend_on_the_chunking():
+    """The same runs in one chunk or in one chunk per run (runs_per_job 1) gather to the
+    same table, row order included."""
+    spec = {"name": "s", "paper": "landing", "runs": 3, "methods": ["svd", "depth"], "variants": [],
+            "keys": ["landing.camera.fov_deg"], "instances": {"a": {"landing.camera.fov_deg": 45.0},
+                                                              "b": {"landing.camera.fov_deg": 60.0}}}
+    rows = {(i, r, m): {"run": r, "method": m, "final_pos_err_m": 100 * len(i) + 10 * r + len(m) / 7}
+            for i in ("a", "b") for r in range(3) for m in ("depth", "svd")}
+
+    def chunk(i, runs):  # a job flies every method of its chunk, methods in job order
+        return pd.DataFrame([rows[(i, r, m)] for m in ("depth", "svd") for r in runs])
+
+    one = studies.gather_runs([("a", chunk("a", [0, 1, 2])), ("b", chunk("b", [0, 1, 2]))], spec)
+    per_run = studies.gather_runs([(i, chunk(i, [r])) for i in ("a", "b") for r in range(3)], spec)
+    pd.testing.assert_frame_equal(one, per_run)
+    assert list(one["method"][:3]) == ["svd"] * 3 and list(one["run"][:3]) == [0, 1, 2]
+
+
 def test_caption_states_the_replay_budget_of_the_planning_times(quick):
     """Paper-B studies time planning calls by replay of at most landing.timing.max_calls
     calls per job: the caption gives the budget and the calls a run's median rests on;

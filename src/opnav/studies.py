@@ -480,7 +480,8 @@ def gather_runs(parts: Iterable[tuple[str, pd.DataFrame]], study: Mapping,
     tables ``(instance label, frame)`` joined, the rows of the study's methods (and
     variants) kept (a chunk also holds those of other studies of the same value), runs
     beyond ``study["runs"]`` dropped (kept chunks of a larger earlier study), paper-B
-    derived metrics added, the swept values beside each row."""
+    derived metrics added, the swept values beside each row; rows in (value, [variant,]
+    method, run) order, whatever the chunking."""
     frames = []
     for label, df in parts:
         df = df.copy()
@@ -504,6 +505,13 @@ def gather_runs(parts: Iterable[tuple[str, pd.DataFrame]], study: Mapping,
         runs = add_derived(runs, converged_pos_err_m)
     for key in study["keys"]:
         runs.insert(1, key, [str(study["instances"][i][key]) for i in runs["instance"]])
+    # one row order whatever the chunking (runs_per_job): value, [variant,] method, run
+    order = {c: {v: i for i, v in enumerate(vals)} for c, vals in
+             (("instance", list(study["instances"])), ("variant", list(study["variants"])),
+              ("method", list(study["methods"])))}
+    cols = ["instance", *(["variant"] if study["variants"] else []), "method", "run"]
+    runs = runs.sort_values(cols, key=lambda col: col.map(order[col.name]) if col.name in order else col,
+                            kind="stable")
     return runs.reset_index(drop=True)
 
 
