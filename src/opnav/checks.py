@@ -105,16 +105,18 @@ def config_problems(config: dict, root: str | Path | None = None,
         return out
     if "approach" in todo and "approach" not in set(skip):
         out += growing_problems(config["approach"])
-    if "studies" in todo and config.get("studies") and not unsound & {"approach", "landing", "limits"}:
+    jobs = []                           # counted, not built: first, as planning a study costs per value
+    if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
+        jobs = job_problems(config)
+    if ("studies" in todo and config.get("studies") and not jobs
+            and not unsound & {"approach", "landing", "limits"}):
         from opnav.studies import plan
 
         try:
             plan(config)
         except ValueError as exc:        # ConfigError: one line per problem
             out += str(exc).splitlines()
-    if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
-        out += job_problems(config)
-    return out
+    return out + jobs
 
 
 def growing_problems(a: dict) -> list[str]:
@@ -156,16 +158,22 @@ OTHER_JOBS = 100
 
 def job_problems(config: dict) -> list[str]:
     """The job graph within ``limits.max_jobs`` (Snakemake takes ~10 ms a job to build
-    it, at every call), counted before it is built (:func:`_jobs`)."""
-    limit = (config.get("limits") or {}).get("max_jobs", 2000)
+    it, at every call) and each study within ``limits.max_study_values``, counted before
+    anything is built or planned (:func:`_jobs`)."""
+    from opnav.studies import MAX_STUDY_VALUES, size_problem
+
+    limits = config.get("limits") or {}
+    out = [line for name, spec in (config.get("studies") or {}).items()
+           if (line := size_problem(name, spec, limits.get("max_study_values", MAX_STUDY_VALUES)))]
+    limit = limits.get("max_jobs", 2000)
     parts = _jobs(config)
     total = OTHER_JOBS + sum(parts.values())
-    if total <= limit:
-        return []
-    top = sorted(parts.items(), key=lambda kv: -kv[1])[:2]
-    what = "; ".join(f"{k}: {v}" for k, v in top)
-    return [f"invalid config key 'limits.max_jobs': the config makes about {total} jobs, over the limit "
-            f"{limit} ({what}); raise runs_per_job, shrink the study, or raise limits.max_jobs to mean it"]
+    if total > limit:
+        top = sorted(parts.items(), key=lambda kv: -kv[1])[:2]
+        what = "; ".join(f"{k}: {v}" for k, v in top)
+        out.append(f"invalid config key 'limits.max_jobs': the config makes about {total} jobs, over the limit "
+                   f"{limit} ({what}); raise runs_per_job, shrink the study, or raise limits.max_jobs to mean it")
+    return out
 
 
 def results_dir_problems(config_or_dir, root: str | Path | None = None,

@@ -280,6 +280,17 @@ def _n_value_sets(spec: Mapping) -> int:
     return math.prod(lens) if spec.get("grid", False) else (max(lens) if lens else 0)
 
 
+def size_problem(name: str, spec: Mapping, limit: int) -> str | None:
+    """The line refusing study ``name`` if it has more than ``limit`` value sets
+    (``limits.max_study_values``), counted without expanding them."""
+    n_sets = _n_value_sets(spec)
+    if n_sets <= limit:
+        return None
+    lens = " x ".join(str(len(v)) for v in spec["vary"].values())
+    return (f"invalid config key 'studies.{name}.vary' (study '{name}'): {lens} = {n_sets} value sets exceed "
+            f"limits.max_study_values = {limit} (each is a Monte Carlo; raise the limit to mean it)")
+
+
 def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
     vary = spec["vary"]
     keys = list(vary)
@@ -399,11 +410,9 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
     unknown = [m for m in metrics if m not in METRICS[paper]]
     if unknown:
         bad("metrics", f"unknown metric(s) {unknown}; available for {paper}: {', '.join(METRICS[paper])}")
-    n_sets = _n_value_sets(spec)
-    if n_sets > limit:
-        lens = " x ".join(str(len(v)) for v in spec["vary"].values())
-        bad("vary", f"{lens} = {n_sets} value sets exceed limits.max_study_values = {limit} "
-                    "(each is a Monte Carlo; raise the limit to mean it)")
+    too_many = size_problem(name, spec, limit)
+    if too_many:
+        problems.append(too_many)
     if problems:
         raise ConfigError("\n".join(problems))
     statistic = spec.get("statistic", "mean")
