@@ -138,3 +138,24 @@ def test_nav_error_split_range_is_set_by_the_range_channel_not_theta():
     assert np.all(r["nav_err_true_theta_lat_km"] < 0.1 * r["nav_err_before_lat_km"])
     lat, rng = r["err_split_t_km"]["after"]
     np.testing.assert_allclose(np.hypot(lat, rng), r["err_after_t_km"], rtol=1e-9)
+
+
+def test_roll_rate_bounds_agree_with_the_roll_variant_and_the_target_rate_meets_the_target():
+    """The roll-rate study re-rolls the same arc: at the configured rate its bound equals the roll
+    variant's bound curve; the bound falls with the rate; at the rate found for the target the
+    worse of (tx, ty) is the target (bisection), and a slower roll stays above it."""
+    cfg = approach_cfg(N0=100, N=50, M=2, L=4)
+    setup = pipeline.Setup.of(cfg)
+    case = cases.headline_case(setup)
+    geo = sc.build_geometry(setup, "roll")
+    Rvar = geo.measurement_variance(case.sigma3_px)
+    rate0 = setup.roll.rate_deg_s
+    b = pipeline.roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, [0.5 * rate0, rate0, 2 * rate0], 150)
+    curve = pipeline.bound_curve(setup, geo, Rvar, case.truth_arcsec, "roll")
+    np.testing.assert_allclose(b[1], curve[150], rtol=1e-9)
+    assert np.all(np.diff(b[:, 0]) < 0)
+    target = 0.5 * b[1, :2].max()
+    rate = pipeline.rate_to_target(setup, geo, Rvar, case.truth_arcsec, 150, target, (0.01, 20.0))
+    at = pipeline.roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, [rate, 0.99 * rate], 150)[:, :2].max(1)
+    assert at[0] <= target < at[1]
+    assert rate > rate0

@@ -77,13 +77,15 @@ rule approach_convergence:
 
 
 rule approach_crlb:
-    """CRLB of (tx, ty) vs data length per variant (headline case)."""
+    """CRLB of (tx, ty) vs data length per variant (headline case), and the roll variant's bound
+    against the roll rate with the rate that reaches the claimed accuracy in the published data."""
     input:
         A_SRC,
+        src("published.py", "data/published.yaml"),
     output:
         f"{A_WORK}/crlb.pkl",
     params:
-        approach=cfg("approach", *A_SCENARIO, "variants"),
+        approach=cfg("approach", *A_SCENARIO, "variants", "roll_rate_study", "accuracy_target_arcsec"),
     log:
         f"{APPROACH}/logs/crlb.log",
     benchmark:

@@ -1,11 +1,13 @@
-"""CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case), with Q and Q = 0."""
+"""CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case), with Q and Q = 0;
+the roll variant's bound against the roll rate (pipeline.roll_rate_study)."""
 
 import sys
 from pathlib import Path
 
+from opnav import published
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
-from opnav.approach.pipeline import bound_curve
+from opnav.approach.pipeline import bound_curve, roll_rate_study
 from opnav.approach.setup import Setup
 from opnav.snakeio import mock_snakemake, save_pickle, script_context
 
@@ -22,5 +24,10 @@ with script_context(snakemake) as log:
         curves["Q"][v] = bound_curve(setup, geo, Rvar, case.truth_arcsec, v)
         curves["Q0"][v] = bound_curve(setup, geo, Rvar, case.truth_arcsec, v, zero_q=True)
         log.info("%s: CRLB at end %s arcsec (Q = 0: %s)", v, curves["Q"][v][-1], curves["Q0"][v][-1])
+    if "roll" in setup.variants:  # the roll rows depend on the roll rate: the bound against it
+        samples = int(published.paper_a()["headline"]["data_to_converge_samples"])
+        curves["roll_rate"] = roll_rate_study(setup, samples, setup.accuracy_target_arcsec)
+        log.info("roll rate reaching %g arcsec in %d samples: %s deg/s", setup.accuracy_target_arcsec, samples,
+                 curves["roll_rate"]["rate_to_target_deg_s"])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], curves)

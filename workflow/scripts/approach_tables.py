@@ -33,7 +33,7 @@ with script_context(snakemake) as log:
     write_table(x1, snakemake.output.x1,
                 caption="A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.")
     atomic_write_text(snakemake.output.verdict, report.identifiability_text(setup, x1))
-    summ = report.summary(setup, t1, x1)
+    summ = report.summary(setup, t1, x1, curves.get("roll_rate"))
     summ["profile"] = snakemake.params.profile
     summ["text"] = report.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
     write_json(snakemake.output.summary, summ)

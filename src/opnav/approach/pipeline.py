@@ -214,3 +214,78 @@ def _at_total(setup: Setup, curve: np.ndarray) -> np.ndarray:
 def total_bound(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str) -> np.ndarray:
     """The bound of all the segments' data, L N samples after N0 (3,), arcsec, 1-sigma."""
     return _at_total(setup, bound_curve(setup, geo, Rvar, theta_arcsec, variant))
+
+
+# ------------------------------------------------------------ the roll rate (issue 28, item 4)
+def _head(geo: sc.Geometry, n: int) -> sc.Geometry:
+    """The first ``n`` samples of a geometry (arrays cut to n + 1 rows)."""
+    cut = {k: getattr(geo, k)[:n + 1] for k in ("t", "X_true", "X_ref", "X_mars", "Phi", "C", "u_ref", "u_true",
+                                               "rho_ref")}
+    return replace(geo, **cut)
+
+
+def roll_rate_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, rates_deg_s,
+                     samples: int, zero_q: bool = False) -> np.ndarray:
+    """1-sigma CRLB (arcsec) of the ``roll`` variant after ``samples`` samples from N0, with the
+    camera rolling at each rate of ``rates_deg_s`` (R, 3): the same arc and prior
+    (:func:`opnav.approach.scenario.with_roll_rate`), every rate in one batched recursion."""
+    setup = Setup.of(setup)
+    n = setup.segments.N0 + samples
+    if n >= geo.t.shape[0]:
+        raise ValueError(f"roll_rate_bounds: {samples} samples after N0 need an arc of {n} samples, "
+                         f"the geometry has {geo.t.shape[0] - 1}")
+    g = _head(geo, n)
+    Rv = Rvar[:n + 1]
+    geos = [sc.with_roll_rate(g, r) for r in rates_deg_s]
+    wins = _window(g, Rv, zero_q)
+    P = _start_covariances(g, wins.slice(0, setup.segments.N0), "roll")[-1]
+    N0 = setup.segments.N0
+    B = len(geos)
+    c = crlb.crlb_curves(np.broadcast_to(g.Phi[N0:], (B, n + 1 - N0, 6, 6)), np.stack([x.C[N0:] for x in geos]),
+                         np.broadcast_to(wins.Rvar[N0:], (B, n + 1 - N0, 3)), wins.Q,
+                         np.stack([x.u_true[N0:] for x in geos]), np.broadcast_to(P, (B, 6, 6)),
+                         sc.rad(theta_arcsec), setup.crlb_prior_sigma_rad)
+    return sc.arcsec(c[:, -1])
+
+
+def rate_to_target(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, samples: int,
+                   target_arcsec: float, bracket_deg_s, iterations: int = 40) -> float:
+    """The smallest roll rate (deg/s) at which the bound of both tx and ty after ``samples``
+    samples from N0 is at most ``target_arcsec``: bisection on log(rate) inside ``bracket_deg_s``
+    (the bound falls with the rate there); NaN when even the upper end does not reach it."""
+    lo, hi = (float(x) for x in bracket_deg_s)
+
+    def worst(rate):
+        return float(roll_rate_bounds(setup, geo, Rvar, theta_arcsec, [rate], samples)[0, :2].max())
+
+    if worst(hi) > target_arcsec:
+        return float("nan")
+    if worst(lo) <= target_arcsec:
+        return lo
+    for _ in range(iterations):
+        mid = float(np.sqrt(lo * hi))
+        lo, hi = (lo, mid) if worst(mid) <= target_arcsec else (mid, hi)
+    return hi
+
+
+def roll_rate_study(setup: Setup | dict, samples: int, target_arcsec: float) -> dict:
+    """The roll rows' dependence on the roll rate (headline case): the bound of tx, ty after
+    ``samples`` samples and after all the data, with and without process noise, at each rate
+    of ``roll_rate_study.rates_deg_s``; the log-log slope of the all-data bound against the
+    rate; and the rate that brings the bound to ``target_arcsec`` within ``samples`` samples."""
+    setup = Setup.of(setup)
+    case = cases.headline_case(setup)
+    total = setup.segments.data_samples
+    geo = sc.build_geometry(setup, "roll", n=setup.segments.N0 + max(samples, total))  # the arc may be shorter
+    Rvar = geo.measurement_variance(case.sigma3_px)
+    rates = np.asarray(setup.roll_rate_study.rates_deg_s, float)
+    at_n = roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, rates, samples)
+    at_all = roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, rates, total)
+    at_all0 = roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, rates, total, zero_q=True)
+    slope = float(np.polyfit(np.log(rates), np.log(at_all[:, :2].max(1)), 1)[0])
+    rate = rate_to_target(setup, geo, Rvar, case.truth_arcsec, samples, target_arcsec,
+                          setup.roll_rate_study.search_deg_s)
+    return {"rates_deg_s": rates, "samples": samples, "total_samples": total,
+            "bound_at_samples_arcsec": at_n, "bound_all_arcsec": at_all, "bound_all_q0_arcsec": at_all0,
+            "slope_all": slope, "rate_to_target_deg_s": rate, "target_arcsec": target_arcsec,
+            "config_rate_deg_s": setup.roll.rate_deg_s}

@@ -359,12 +359,44 @@ def nav_note(r) -> str:
                if nees is not None else ""))
 
 
-def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame) -> dict:
-    """Headline numbers per variant and EM scheme for the manuscript macros."""
+def roll_rate_summary(study: dict) -> dict:
+    """The roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`) for the summary:
+    per rate the worse of (tx, ty) bounds after the published data and after all the data (with
+    Q and Q = 0), arcsec; the log-log slope; the rate reaching the target in that data, deg/s."""
+    worst = {k: np.asarray(study[k])[:, :2].max(1) for k in
+             ("bound_at_samples_arcsec", "bound_all_arcsec", "bound_all_q0_arcsec")}
+    rate = study["rate_to_target_deg_s"]
+    return {"rates_deg_s": [float(r) for r in study["rates_deg_s"]], "samples": int(study["samples"]),
+            "total_samples": int(study["total_samples"]),
+            **{k: [float(v) for v in w] for k, w in worst.items()},
+            "slope_all": float(study["slope_all"]),
+            "rate_to_target_deg_s": None if not math.isfinite(rate) else float(rate),
+            "target_arcsec": float(study["target_arcsec"]), "config_rate_deg_s": float(study["config_rate_deg_s"])}
+
+
+def roll_rate_text(rr: dict) -> str:
+    """The manuscript's roll-rate sentence, from :func:`roll_rate_summary`."""
+    rates = rr["rates_deg_s"]
+    parts = [f"{b:.3g} arcsec at {r:g} deg/s" for r, b in zip(rates, rr["bound_all_arcsec"])]
+    rate = rr["rate_to_target_deg_s"]
+    reach = (f"the bound reaches the claimed {rr['target_arcsec']:g} arcsec within the paper's {rr['samples']} samples "
+             f"from a roll rate of {rate:.3g} deg/s" if rate is not None else
+             f"no rate in the searched range brings the bound to {rr['target_arcsec']:g} arcsec within "
+             f"{rr['samples']} samples")
+    return (f"The roll rows depend on the roll rate, which is our choice ({rr['config_rate_deg_s']:g} deg/s): the "
+            f"bound of all {rr['total_samples']} samples is " + _join(parts)
+            + f" (about rate^{rr['slope_all']:.2g}); {reach}.")
+
+
+def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame, roll_rate: dict | None = None) -> dict:
+    """Headline numbers per variant and EM scheme for the manuscript macros; ``roll_rate``:
+    the roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`), if run."""
     setup = Setup.of(setup)
     out = {"profile_segments": setup.segments.as_dict(), "accuracy_target_arcsec": setup.accuracy_target_arcsec,
            "prior_bound_arcsec": prior_bound_arcsec(setup),
            "convergence_max_maps": setup.convergence_study.max_maps, "variants": {}}
+    if roll_rate is not None:
+        out["roll_rate"] = roll_rate_summary(roll_rate)
     for _, r in t1[t1["case_id"] == "T1-01"].iterrows():
         x = x1[x1["variant"] == r["scenario"]]
         x = x.iloc[0] if len(x) else {}
@@ -501,6 +533,7 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
               + ("; a diagnostic that needs the true state" if c["scenario"] == "reference-start" else "")
               + (f"; it is {c['label']}" if c.get("label", "converged") != "converged" else "") + ").")
     out["reading"] = s
+    out["roll_rate"] = roll_rate_text(summ["roll_rate"]) if "roll_rate" in summ else ""
 
     parts = [f"{diag.get(k, k)}: {v['nav_note']}" for k, v in base.items() if v.get("nav_note")]
     out["nav"] = ("Navigation error (RMS over the last part of the arc) after compensation, split across and "

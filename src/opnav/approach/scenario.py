@@ -121,12 +121,27 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
     if disc_px > cam.pixels:
         raise ValueError(f"approach.camera: Mars ({disc_px:.0f} px across) does not fit the "
                          f"{cam.pixels} px detector; raise camera.ifov_arcsec or the range")
-    C = camera.tracking_attitude(los, roll)
-    u_ref = np.einsum("kij,kj->ki", C, X_mars[:, :3] - X_ref[:, :3])
-    u_true = np.einsum("kij,kj->ki", C, los)
+    C, u_ref, u_true = _camera_frame(X_true, X_ref, X_mars, roll)
     return Geometry(t, X_true, X_ref, X_mars, Phi, C, u_ref, u_true,
                     np.linalg.norm(u_ref, axis=1), setup.Q, setup.prior_sigma.P0, e_fixed, variant,
                     cam.ifov_arcsec)
+
+
+def _camera_frame(X_true, X_ref, X_mars, roll_rad):
+    """``A_c^i`` tracking Mars, rolled by ``roll_rad``, and the Mars vector in it at the
+    reference and at the truth (paper eq. 3)."""
+    los = X_mars[:, :3] - X_true[:, :3]
+    C = camera.tracking_attitude(los, roll_rad)
+    return C, np.einsum("kij,kj->ki", C, X_mars[:, :3] - X_ref[:, :3]), np.einsum("kij,kj->ki", C, los)
+
+
+def with_roll_rate(geo: Geometry, rate_deg_s: float) -> Geometry:
+    """The same arc with the camera rolling about its boresight at ``rate_deg_s`` (the
+    ``roll`` variant's attitude at another rate; the orbit is not propagated again)."""
+    from dataclasses import replace
+
+    C, u_ref, u_true = _camera_frame(geo.X_true, geo.X_ref, geo.X_mars, camera.roll_angle(geo.t, rate_deg_s))
+    return replace(geo, C=C, u_ref=u_ref, u_true=u_true, rho_ref=np.linalg.norm(u_ref, axis=1), variant="roll")
 
 
 def measurement_variance(geo: Geometry, setup: Setup | dict, sigma3_px) -> np.ndarray:

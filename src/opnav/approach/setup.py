@@ -150,6 +150,14 @@ class Roll(_Section):
 
 
 @dataclass(frozen=True)
+class RollRateStudy(_Section):
+    """``roll_rate_study``: roll rates of the bound table and the bracket of the rate search, deg/s."""
+
+    rates_deg_s: tuple
+    search_deg_s: tuple
+
+
+@dataclass(frozen=True)
 class Segments(_Section):
     """``segments``: N0 samples before the first window, L windows of N samples, M EM maps each;
     ``sliding`` windows or ``growing`` ones (all data from N0)."""
@@ -279,6 +287,7 @@ _FIELDS: dict[str, tuple[str, Any]] = {
     "growing": ("growing", Growing.from_config),
     "methods": ("methods", lambda v: tuple(str(m) for m in v)),
     "roll": ("roll", Roll.from_config),
+    "roll_rate_study": ("roll_rate_study", RollRateStudy.from_config),
     "variants": ("variants", tuple),
     "table1_variants": ("table1_variants", tuple),
     "nav_last_fraction": ("nav_error", lambda c: float(c["last_fraction"])),
@@ -316,6 +325,7 @@ class Setup:
     growing: Growing
     methods: tuple
     roll: Roll
+    roll_rate_study: RollRateStudy
     variants: tuple
     table1_variants: tuple
     nav_last_fraction: float
