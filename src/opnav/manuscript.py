@@ -87,7 +87,7 @@ def latex_escape(text: str) -> str:
 def macros_from_summary(summary: Mapping[str, Any], prefix: str) -> dict[str, str]:
     """Flatten a nested summary into ``{macro name: LaTeX text}``.
 
-    Numbers are formatted by :func:`format_number`; strings are escaped; lists
+    Numbers are formatted by :func:`format_number`; strings become prose (:func:`prose_tex`); lists
     are indexed (``One``, ``Two``...). Keys that would collide raise ``ValueError``.
     """
     out: dict[str, str] = {}
@@ -106,7 +106,7 @@ def macros_from_summary(summary: Mapping[str, Any], prefix: str) -> dict[str, st
             if node is None or isinstance(node, (numbers.Real, bool, *np_bool_types())):
                 out[name] = format_number(node)
             else:
-                out[name] = no_nan_text(latex_escape(str(node)))
+                out[name] = prose_tex(str(node))
 
     walk(summary, [])
     return out
@@ -207,3 +207,133 @@ def _compact_views() -> dict:
 
 
 COMPACT_VIEWS = _compact_views()
+
+
+# ------------------------------------------------------------ prose typography
+_PROSE = [
+    (re.compile(r"\brho\*theta\b"), r"$\\rho\\theta$"),
+    (re.compile(r"(?<=\d) ?arcsec\b"), r"\\arcsec{}"),
+    (re.compile(r"\+-"), r"$\\pm$"),
+    (re.compile(r"(?<!\\)\btheta\b"), r"$\\theta$"),
+    (re.compile(r"(?<!\\)\brho\b"), r"$\\rho$"),
+    (re.compile(r"\bsigma\\_r\b"), r"$\\sigma_r$"),
+    (re.compile(r"\bt([xyz])\b"), r"$t_\1$"),
+    (re.compile(r"\b1e\+0?(\d+)\b"), r"$10^{\1}$"),
+    (re.compile(r"(?<=\d)e\+0?(\d+)\b"), r"$\\times10^{\1}$"),
+    (re.compile(r"(?<=\d) %"), r"\\,\\%"),
+    (re.compile(r"\bus\b"), r"\\textmu s"),
+]
+
+
+def prose_tex(text: str) -> str:
+    """Generated plain text as LaTeX prose: escaped, with typography (``+-`` as ±,
+    ``theta`` as θ, ``1e+06`` as 10⁶, ``tx`` as t_x, ``10 arcsec`` as 10″)."""
+    out = latex_escape(no_nan_text(" ".join(str(text).split())))
+    out = out.replace(r"\%", "%")
+    for pat, rep in _PROSE:
+        out = pat.sub(rep, out)
+    out = re.sub(r"(?<!\\)%", r"\\%", out)
+    return out
+
+
+# ------------------------------------------------------------ paper A, Table 1 on one page
+#: the A-T1 variants shown as column groups (those present, in this order); the CSV has all
+TABLE1_GROUPS = ("literal", "roll", "roll+squarem", "roll+growing+squarem")
+
+
+def table1_grouped_latex(t1: "pd.DataFrame", groups: Iterable[str] = TABLE1_GROUPS) -> str:
+    """Paper A's Table 1 as one LaTeX table: a row per case, the published values and each
+    variant as a column group (t_x, t_y in arcsec, navigation error after compensation in
+    km); a variant's cell is marked where its run did not converge (the A-T1 label)."""
+    import pandas as pd
+
+    groups = [g for g in groups if (t1["variant"] == g).any()]
+    cases = list(dict.fromkeys(t1.loc[t1["variant"] == groups[0], "case_id"])) if groups else []
+    by = {(r["variant"], r["case_id"]): r for _, r in t1.iterrows()}
+
+    def num(x, f="{:.1f}"):
+        return MISSING if x is None or pd.isna(x) else f.format(float(x))
+
+    cols = "ll" + "rrr" * (len(groups) + 1)
+    head1 = ["", "", r"\multicolumn{3}{c}{published}"] + [rf"\multicolumn{{3}}{{c}}{{{latex_escape(g)}}}" for g in groups]
+    rules = "".join(rf"\cmidrule(lr){{{3 + 3 * i}-{5 + 3 * i}}}" for i in range(len(groups) + 1))
+    head2 = ["case", r"truth ($''$)"] + [r"$t_x$ ($''$)", r"$t_y$ ($''$)", "after (km)"] * (len(groups) + 1)
+    lines = [rf"\begin{{tabular}}{{@{{}}{cols}@{{}}}}", r"\toprule", " & ".join(head1) + r" \\", rules,
+             " & ".join(head2) + r" \\", r"\midrule"]
+    for c in cases:
+        p = by[(groups[0], c)]
+        cells = [c, f"{num(p['truth_x_arcsec'], '{:g}')}, {num(p['truth_y_arcsec'], '{:g}')}", num(p["pub_est_x_mean"], "{:g}"), num(p["pub_est_y_mean"], "{:g}"), num(p["pub_nav_err_after_km"], "{:g}")]
+        for g in groups:
+            r = by.get((g, c))
+            if r is None:
+                cells += [MISSING] * 3
+                continue
+            lab = str(r.get("label", "converged" if str(r.get("stalled")).lower() != "true" else "stalled"))
+            mark = "" if lab == "converged" else r"$^\dagger$"
+            cells += [num(r["est_x_mean"]) + mark, num(r["est_y_mean"]) + mark, num(r["nav_err_after_km"])]
+        lines.append(" & ".join(cells) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}"]
+    return "\n".join(lines) + "\n"
+
+
+def in_pdf(path: str | Path, drop_variants: Iterable[str]) -> bool:
+    """Whether a generated float goes into the PDF: not the variants listed (their outputs
+    stay in results/ and the HTML report), not a parameter study's table (its figure
+    shows it; the CSV holds the numbers), not A-T1 (shown as one grouped table)."""
+    p = Path(path)
+    stem = p.stem
+    if output_id(p) == "A-T1":
+        return False
+    if p.suffix == ".tex" and "studies" in p.parts:
+        return False
+    return not any(stem.endswith("_" + v) for v in drop_variants)
+
+
+def format_sci(x: float) -> str:
+    """A number for prose in scientific form: ``1e6`` -> ``$10^{6}$``, ``2.5e5`` -> ``$2.5\\times10^{5}$``."""
+    x = float(x)
+    if x == 0 or not math.isfinite(x):
+        return format_number(x)
+    e = math.floor(math.log10(abs(x)))
+    m = x / 10 ** e
+    ms = f"{m:.3g}"
+    return f"$10^{{{e}}}$" if ms == "1" else f"${ms}\\times10^{{{e}}}$"
+
+
+# ------------------------------------------------------------ the claims table in LaTeX
+
+def claims_glance_latex(df: pd.DataFrame) -> str:
+    """The at-a-glance table as a LaTeX tabular (wrapping text columns, one row per claim)."""
+    from opnav.claims import VERDICT_TEXT
+
+    lines = [r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.36\linewidth}"
+             r">{\raggedright\arraybackslash}p{0.15\linewidth}>{\raggedright\arraybackslash}p{0.22\linewidth}"
+             r">{\raggedright\arraybackslash}p{0.14\linewidth}@{}}", r"\toprule",
+             r"id & claim & published & ours, as written & verdict \\", r"\midrule"]
+    for i, r in enumerate(df.itertuples()):
+        if i and r.paper != df.iloc[i - 1]["paper"]:
+            lines.append(r"\midrule")
+        lines.append(" & ".join([r.claim_id, prose_tex(r.claim), prose_tex(r.published), prose_tex(r.ours_as_written),
+                                 r"\textit{" + prose_tex(VERDICT_TEXT[r.verdict]) + "}"]) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}"]
+    return "\n".join(lines) + "\n"
+
+
+def claims_detail_latex(df: pd.DataFrame) -> str:
+    """Every claim with all its columns, as a LaTeX description list (the claims table in full)."""
+    from opnav.claims import VERDICT_TEXT
+
+    out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
+    for r in df.itertuples():
+        parts = [rf"\item[{r.claim_id}] {prose_tex(r.claim)}. \textit{{{prose_tex(VERDICT_TEXT[r.verdict])}}}"
+                 + (f" ({prose_tex(r.named)})" if r.named else "") + "."]
+        parts.append(f"Published: {prose_tex(r.published)}; ours as written: {prose_tex(r.ours_as_written) or '--'}")
+        if r.best_variant:
+            parts[-1] += f"; best faithful variant ({prose_tex(r.best_variant)}): {prose_tex(r.ours_best)}"
+        if r.bound:
+            parts[-1] += f"; bound: {prose_tex(r.bound)}"
+        parts[-1] += "."
+        parts.append(prose_tex(r.cause) + f" \\emph{{Evidence:}} {prose_tex(r.evidence)}.")
+        out.append(" ".join(parts))
+    out.append(r"\end{description}")
+    return "\n".join(out) + "\n"

@@ -3,7 +3,7 @@
 import os
 import shutil
 
-from opnav import provenance
+from opnav import manuscript, provenance
 
 PAPER = res("paper")
 PAPER_DIR = Path(workflow.basedir) / "paper"
@@ -33,12 +33,41 @@ SCORE_INPUTS = {
 }
 
 
-rule paper_floats:
-    """Figure and table floats for the manuscript, captions from workflow/report/."""
+rule paper_claims:
+    """The claims table (one row per published claim, opnav.claims) and the generated
+    abstract, conclusion and limitations (claims.json)."""
     input:
-        approach=_floats("approach"),
-        landing=_floats("landing"),
-        tables_csv=[c for c in (t[:-4] + ".csv" for t in _floats("approach") + _floats("landing")) if c in _targets],
+        **{f"summary_{k}": p for k, p in SUMMARIES.items() if k in ("A", "B")},
+        **{k: p for k, p in SCORE_INPUTS.items() if k == "a_table1"},
+        published=src("data/published.yaml"),
+        code=src("claims.py", "approach/claims.py", "landing/claims.py", "verdicts.py", "manuscript.py",
+                 "published.py"),
+    output:
+        csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="1. Claims"),
+        md=f"{PAPER}/claims.md",
+        tex=f"{PAPER}/claims_glance.tex",
+        detail=f"{PAPER}/claims_detail.tex",
+        json=f"{PAPER}/claims.json",
+    log:
+        f"{PAPER}/logs/paper_claims.log",
+    localrule: True
+    script:
+        "../scripts/paper_claims.py"
+
+
+#: outputs of these variants stay in results/ and the HTML report, not the PDF
+PDF_DROP = [v for v in A_VARIANTS if v not in ("literal", "roll")] + [s for s in B_SCENARIOS if s != B_HEADLINE]
+PDF_FLOATS = {part: [p for p in _floats(part) if manuscript.in_pdf(p, PDF_DROP)] for part in ("approach", "landing")}
+
+
+rule paper_floats:
+    """Figure and table floats for the manuscript (headline variants only, opnav.manuscript.in_pdf),
+    captions from workflow/report/; paper A's Table 1 as one grouped table."""
+    input:
+        approach=PDF_FLOATS["approach"],
+        landing=PDF_FLOATS["landing"],
+        a_table1=[t for t in [res("approach", "A-T1_table1.csv")] if t in _targets],
+        tables_csv=[c for c in (t[:-4] + ".csv" for t in PDF_FLOATS["approach"] + PDF_FLOATS["landing"]) if c in _targets],
         captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
         study_captions=[t for ts in STUDY_TARGETS.values() for t in ts if t.endswith(".rst")],
         code=src("manuscript.py", "approach/report.py", "landing/report.py", "tables.py"),
@@ -46,6 +75,7 @@ rule paper_floats:
         approach=f"{PAPER}/floats_approach.tex",
         landing=f"{PAPER}/floats_landing.tex",
         compact=directory(f"{PAPER}/compact"),
+        table1=f"{PAPER}/A-T1_grouped.tex",
     params:
         paper_dir=str(PAPER_DIR),
         captions_dir=lambda wildcards, input: str(Path(input.captions[0]).parent),
@@ -81,6 +111,7 @@ rule paper_macros:
     input:
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         scorecard=rules.paper_scorecard.output.json,
+        claims=rules.paper_claims.output.json,
         published=src("data/published.yaml"),
         code=src("manuscript.py", "published.py"),
     output:
@@ -117,7 +148,7 @@ rule provenance:
 
 
 PAPER_INPUTS = [rules.paper_floats.output, rules.paper_macros.output, rules.paper_scorecard.output,
-                rules.provenance.output]
+                rules.paper_claims.output, rules.provenance.output]
 
 LATEX_HINT = (
     "opnav: LaTeX not found, skipping results/paper/main.pdf; to build it install: "

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from opnav.manuscript import COMPACT_VIEWS, float_block, output_id
+from opnav.manuscript import COMPACT_VIEWS, float_block, output_id, table1_grouped_latex
 from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import atomic_write_text, write_table
 
@@ -34,3 +34,6 @@ with script_context(snakemake) as log:
         text = float_block(paths, snakemake.params.captions_dir, relative_to=snakemake.params.paper_dir)
         atomic_write_text(snakemake.output[part], text or "% no outputs yet\n")
         log.info("%s: %d floats", part, len(paths))
+    a_t1 = list(snakemake.input.a_table1) if "a_table1" in snakemake.input.keys() else []
+    atomic_write_text(snakemake.output.table1, table1_grouped_latex(pd.read_csv(a_t1[0])) if a_t1
+                      else "% paper A Table 1 not built\n")
