@@ -19,6 +19,24 @@ def test_cli_flies_one_descent(capsys, method):
                 "mean_nees_pos", "mean_nees_vel"):
         assert key in out
     assert out["method"] == method and out["seed"] == 2
+    assert out["scenario"] == "interior"                      # the headline scenario by default
+
+
+def test_cli_scenario_flag_flies_that_camera(capsys):
+    from opnav.config import load_config
+    from opnav.landing.descent import build_scenario, run_descent
+    from opnav.landing.montecarlo import summarize_run
+    from opnav.landing.scenario import camera_scenarios
+
+    quick = str(REPO / "config" / "quick.yaml")
+    assert main(["--config", quick, "landing", "--scenario", "site-tilt", "--seed", "1"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    cfg = camera_scenarios(load_config(overlays=[quick])["landing"])["site-tilt"]
+    want = summarize_run(run_descent(build_scenario(cfg), "depth", 1))
+    assert out["scenario"] == "site-tilt"
+    assert out["final_pos_err_m"] == pytest.approx(want["final_pos_err_m"], rel=1e-9)
+    assert main(["landing", "--scenario", "nope"]) == 2
+    assert "--scenario 'nope'" in capsys.readouterr().err
     assert out["n_landmarks"] > 10 and out["median_plan_time_us"] > 0
 
 

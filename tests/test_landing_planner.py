@@ -173,6 +173,13 @@ def _reference_objective(method, st, scn, pts):
     if method == "depth":
         r_e = error_radius(st.P[3:6, 3:6], scn.planner.t_s, scn.planner.n_sigma_v)
         return depth_error_at_landmarks(st.r, st.v, st.a, pts, scn.planner.t_s, r_e)
+    if method == "logdet_nav":          # one landmark at a time (tested in test_landing_planned_info)
+        from opnav.landing.planned_info import planned_nav_logdet
+
+        return np.array([-planned_nav_logdet(
+            st.r, st.v, st.a, st.R_LtoB, st.P, np.zeros(3), p[None], scn.camera.sigma_b * scn.noise_scale,
+            scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt, scn.g, scn.oc, scn.camera.boresight_B)[0]
+            for p in pts])
     ctx = MetricContext(r_L=st.r, v_L=st.v, R_LtoB=st.R_LtoB, p_known_L=np.zeros(3), P=st.P,
                         R_meas=scn.camera.sigma_b**2 * np.eye(6),
                         boresight_B=scn.camera.boresight_B)

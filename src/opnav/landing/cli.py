@@ -2,6 +2,10 @@
 
     opnav landing --method depth --seed 0
     opnav landing --method svd --seed 3 --config config/quick.yaml
+    opnav landing --scenario site-tilt --method closest
+
+``--scenario NAME`` is a camera scenario of ``landing.scenarios`` (default: the
+headline scenario, ``landing.headline_scenario``), flown as its Monte Carlo is.
 
 ``--seed N`` is the Monte-Carlo run index ``N`` (random stream
 ``SeedSequence([landing.mc.base_seed, N])``), so the command reproduces run N
@@ -19,16 +23,24 @@ def _run(args) -> int:
     config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
     # the planner's registry and the seed's limits are checked as the config's
     # landing.single.method / run_index (opnav.checks), naming the flag
-    cfg = with_flags(config, {"landing.single.method": ("--method", args.method),
-                              "landing.single.run_index": ("--seed", args.seed)})["landing"]
-    scn = build_scenario(cfg)
+    from opnav.config import ConfigError
+    from opnav.landing.scenario import camera_scenarios, headline_scenario
+
+    landing = with_flags(config, {"landing.single.method": ("--method", args.method),
+                                  "landing.single.run_index": ("--seed", args.seed)})["landing"]
+    scenarios = camera_scenarios(landing)
+    name = headline_scenario(landing) if args.scenario is None else args.scenario
+    if name not in scenarios:
+        raise ConfigError(f"--scenario {name!r}: not a camera scenario of landing.scenarios "
+                          f"({', '.join(scenarios)})")
+    scn = build_scenario(scenarios[name])
     run = run_descent(scn, args.method, args.seed)
     s = summarize_run(run)
     from opnav.landing.timing import median_us, replay_own
 
     tm = replay_own(scn, run, args.method)       # planning time by replay of the run's calls
     s["median_plan_time_us"] = median_us(tm, args.method)
-    s.update(method=args.method, seed=args.seed,
+    s.update(method=args.method, seed=args.seed, scenario=name,
              final_pos_err_m_xyz=[round(float(x), 4) for x in run["err_r"][-1]],
              final_vel_err_mps_xyz=[round(float(x), 5) for x in run["err_v"][-1]],
              final_rpy_err_deg=[round(float(x), 5) for x in run["err_rpy_deg"][-1]])
@@ -45,4 +57,6 @@ def register(subparsers) -> None:
                    help="landmark planner, a name of opnav.landing.planner.available_methods() "
                         "(depth, svd, gdop, cond, ...; default depth)")
     p.add_argument("--seed", type=integer, default=0, help="Monte-Carlo run index (>= 0, default 0)")
+    p.add_argument("--scenario", default=None,
+                   help="camera scenario (a key of landing.scenarios; default: landing.headline_scenario)")
     p.set_defaults(func=_run)

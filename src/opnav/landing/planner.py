@@ -135,6 +135,12 @@ class PlannerConfig:
     knn: int = 16                    # nearest-landmark candidates checked
     eval_path: str = "matrix_scalar"  # how baseline metrics are evaluated
     p_known: tuple = (0.0, 0.0, 0.0)  # known landmark (landing site), m
+    # the filter's model, for the planned-information metric (logdet_nav, planned_info)
+    noise_scale: float = 1.0         # filter bearing noise / true pixel noise
+    depth_sigma_frac: float = 0.1    # a new landmark's depth guess 1-sigma / depth
+    obs_per_landmark: int = 3        # observations of a landmark (Fig. 3 strategy)
+    oc: bool = True                  # observability-constrained updates
+    g: tuple = (0.0, 0.0, -3.711)    # gravity in {L}, m/s^2 (the filter's transition)
 
 
 @dataclass(slots=True)
@@ -355,8 +361,36 @@ def metric_objective(name: str) -> Callable:
     return build
 
 
+def planned_info_objective(state: PlanState, geom: PlaneGeometry, cfg: PlannerConfig, camera: Camera,
+                           sigma_b: float, **_) -> Callable:
+    """``logdet_nav``: minus the planned navigation information of the ground
+    point of beta (:func:`opnav.landing.planned_info.planned_nav_logdet`: the
+    candidate's own initialisation, the filter's noise model ``noise_scale *
+    sigma_b``, ``obs_per_landmark`` observations ``t_s`` apart from the predicted
+    poses, marginalised on [r, v, theta])."""
+    from opnav.landing.planned_info import planned_nav_logdet
+
+    ground = ground_point_scalar(geom)
+    kw = dict(sigma_f=sigma_b * cfg.noise_scale, depth_sigma_frac=cfg.depth_sigma_frac,
+              n_obs=cfg.obs_per_landmark, dt=cfg.t_s, g=cfg.g, oc=cfg.oc,
+              boresight_B=camera.boresight_B)
+    p_known = np.asarray(cfg.p_known, float)
+
+    def batch(points: np.ndarray) -> np.ndarray:
+        return -planned_nav_logdet(state.r, state.v, state.a, state.R_LtoB, state.P, p_known, points,
+                                   **kw)
+
+    def f(beta: float) -> float:
+        p = ground(beta)
+        return math.inf if p is None else float(batch(np.asarray(p)[None])[0])
+
+    f.batch = batch
+    f.ratio = _ratio_log
+    return f
+
+
 #: method name -> objective factory (minimised over signed beta)
-OBJECTIVES: dict[str, Callable] = {"depth": depth_objective}
+OBJECTIVES: dict[str, Callable] = {"depth": depth_objective, "logdet_nav": planned_info_objective}
 OBJECTIVES.update({n: metric_objective(n) for n in metrics.METRIC_NAMES})
 
 def _pick_random(field_, cand, state, camera, rng) -> int:
@@ -914,6 +948,26 @@ def _batch_objective(method, states, G, cfg, camera, funs) -> Callable:
             out = np.full(len(i), math.inf)
             if ok.any():
                 out[ok] = -score(method, i[ok], p[ok])
+            return out
+
+        return f
+    if method == "logdet_nav":
+        # planned information of every run's ground point at once (each run's state)
+        from opnav.landing.planned_info import planned_nav_logdet
+
+        kw = dict(sigma_f=camera.sigma_b * cfg.noise_scale, depth_sigma_frac=cfg.depth_sigma_frac,
+                  n_obs=cfg.obs_per_landmark, dt=cfg.t_s, g=cfg.g, oc=cfg.oc,
+                  boresight_B=camera.boresight_B)
+        p_known = np.asarray(cfg.p_known, float)
+
+        def f(i, beta):
+            p, ok = _ground_points(beta, G["C"][i], G["v_hat"][i], G["w_hat"][i], G["cd"][i],
+                                   G["gamma"][i])
+            out = np.full(len(i), math.inf)
+            if ok.any():
+                j = i[ok]
+                out[ok] = -planned_nav_logdet(states.r[j], states.v[j], states.a[j], states.R_LtoB[j],
+                                              states.P[j], p_known, p[ok], **kw)
             return out
 
         return f

@@ -18,7 +18,8 @@ __all__ = ["fig_true_states", "fig_depth_error_map", "fig_nav_error_envelopes",
 
 METHOD_LABELS = {"depth": "depth error", "svd": "SVD", "gdop": "GDOP", "cond": "cond. number",
                  "logdet": "log-det", "mineig": "min. eigenvalue", "svd_w": "SVD (whitened)",
-                 "gdop_w": "GDOP (whitened)", "cond_w": "cond. (whitened)"}
+                 "gdop_w": "GDOP (whitened)", "cond_w": "cond. (whitened)",
+                 "logdet_nav": "log-det (planned, nav.)", "closest": "closest (range)"}
 
 
 def _label(m):

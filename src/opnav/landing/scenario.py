@@ -92,7 +92,12 @@ def _scenario_from_json(text: str) -> Scenario:
     pl = c["planner"]
     pcfg = PlannerConfig(t_s=Dt, n_sigma_v=float(pl["n_sigma_v"]), tol_rad=float(pl["tol_rad"]),
                          n_grid=int(pl["n_grid"]), margin_px=float(pl["margin_px"]),
-                         knn=int(pl["knn"]), eval_path=str(pl["eval_path"]))
+                         knn=int(pl["knn"]), eval_path=str(pl["eval_path"]),
+                         noise_scale=float(c["filter"]["meas_noise_scale"]),
+                         depth_sigma_frac=float(c["filter"]["depth_sigma_frac"]),
+                         obs_per_landmark=int(c["filter"]["obs_per_landmark"]),
+                         oc=bool(c["filter"]["observability_constrained"]),
+                         g=tuple(float(x) for x in g))
     lm = c["landmarks"]
     b = c["mc"]["bounds"]
     fl = c["filter"]

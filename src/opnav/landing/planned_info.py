@@ -1,0 +1,121 @@
+"""The information a candidate landmark would give the filter, specified as the
+filter would get it (B-X1 method ``logdet_nav``; beyond paper B).
+
+Description
+-----------
+The B-X1 information metrics of :mod:`opnav.landing.metrics` (``logdet``,
+``mineig``) score one two-bearing observation of the candidate with the
+current landmark's covariance in the landmark block and the true pixel noise.
+This module scores what the Fig. 3 strategy would actually do with the
+candidate ``p_c`` (m, {L}) from the current estimate (r, v, R_LtoB, P):
+
+1. **its own initialisation**: the prior covariance ``P0`` (12 x 12) is the
+   filter's ``ekf.init_landmark`` for the candidate's (noise-free) bearing: the
+   ground cut of the line of sight, its Jacobian cross-covariance with the
+   navigation states, the depth guess ``(depth_sigma_frac d)^2`` along the line
+   of sight and the bearing noise across it;
+2. **the filter's noise model**: bearing noise ``sigma_f = meas_noise_scale *
+   sigma_px / f`` rad per component (``Scenario.camera.sigma_b`` times the
+   filter's scale), not the true one;
+3. **the planned observations**: the landmark is seen ``n_obs`` times
+   (``obs_per_landmark``), one image every ``dt`` s, from the poses the
+   estimate predicts (``r + v t + a t^2 / 2``, attitude held); its first
+   bearing initialises it (already in ``P0``), the other ``n_obs - 1`` are
+   updates, and the site is seen at each of the ``n_obs`` images. Each update's
+   tangent-plane whitened bearing rows ``G`` (``measurement.tangent_jacobian``,
+   2 x 12 per bearing: a unit bearing has two degrees of freedom) are taken at
+   its predicted pose and mapped to the planning instant by the filter's
+   transition ``Phi`` (``ekf.transition_matrix``, eq. 6-10), projected on the
+   complement of the unobservable yaw direction (``ekf.nullspace``) as the
+   OC-EKF's update does, and the posterior covariance follows by Woodbury.
+   Motion matters: seen again from the same point, a landmark initialised from
+   its own bearing adds nothing to the navigation states (every candidate would
+   score the same; tested), as with the paper's depth error, the information
+   comes from the parallax of the predicted motion. Process noise over the
+   ``(n_obs - 1) dt`` horizon is neglected;
+4. **marginalised on the navigation states**: the score is
+   ``-log det Sigma_post[:9, :9]`` (position m, velocity m/s, attitude rad;
+   nats, larger is better): the landmark's own uncertainty does not count, only
+   what it does for the lander.
+
+Candidates behind the camera or whose line of sight
+misses the ground score ``-inf``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from opnav.landing import ekf
+from opnav.landing.measurement import tangent_jacobian
+from opnav.landing.metrics import chol_logdet
+
+__all__ = ["planned_nav_logdet", "planned_posterior"]
+
+
+def _states(r, v, R_LtoB, P, n: int) -> ekf.NavState:
+    """One filter state per candidate: (3,)/(3, 3)/(12, 12) inputs repeated, or
+    (n, ...) inputs (one planning state per candidate) taken as they are."""
+    return ekf.NavState(r=np.broadcast_to(np.asarray(r, float), (n, 3)).copy(),
+                        v=np.broadcast_to(np.asarray(v, float), (n, 3)).copy(),
+                        R=np.broadcast_to(np.asarray(R_LtoB, float), (n, 3, 3)).copy(),
+                        p=np.zeros((n, 3)),
+                        P=np.broadcast_to(np.asarray(P, float), (n, 12, 12)).copy())
+
+
+def planned_posterior(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
+                      n_obs: int, dt: float, g, oc: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """``(Sigma_post (n, 12, 12), ok (n,))``: the planned posterior covariance of
+    ``[dr, dv, dtheta, dp]`` at the planning instant after observing each
+    candidate of ``cand`` (n, 3) ``n_obs`` times, one image every ``dt`` s
+    (module docstring), from one planning state (r (3,), ...: position m,
+    velocity m/s, acceleration m/s^2 with gravity ``g``, R_LtoB, P) or one per
+    candidate (r (n, 3), ...); ``ok`` False where the candidate cannot be
+    initialised (its line of sight misses the ground)."""
+    cand = np.asarray(cand, float).reshape(-1, 3)
+    n = len(cand)
+    st = _states(r, v, R_LtoB, P, n)
+    acc = np.broadcast_to(np.asarray(a, float), (n, 3))
+    d = np.einsum("nij,nj->ni", st.R, cand - st.r)
+    b = d / np.linalg.norm(d, axis=1, keepdims=True)
+    new, ok = ekf.init_landmark(st, b, depth_sigma_frac, sigma_f)     # its own initialisation
+    P0 = new.P
+    p_known = np.asarray(p_known, float)
+    rows = []
+    for k in range(int(n_obs)):
+        t = k * float(dt)
+        r_k = st.r + st.v * t + 0.5 * acc * t * t
+        Gs = tangent_jacobian(r_k, st.R, p_known, 1.0 / sigma_f)
+        Gs[..., 9:12] = 0.0                                             # the site is known
+        G = Gs if k == 0 else np.concatenate([Gs, tangent_jacobian(r_k, st.R, new.p, 1.0 / sigma_f)],
+                                             axis=1)
+        if k:
+            G = G @ ekf.transition_matrix(st.r, st.v, st.R, r_k, st.v + acc * t, st.R, t, g)
+        rows.append(G)
+    A = np.concatenate(rows, axis=1)                                    # (n, 2 + 4 (n_obs - 1), 12)
+    if oc:
+        N = ekf.nullspace(new.r, new.v, new.R, new.p)
+        N = N / np.linalg.norm(N, axis=-1, keepdims=True)
+        A = A - np.einsum("nij,nj,nk->nik", A, N, N)
+    AP = A @ P0
+    S = np.eye(A.shape[1]) + AP @ np.swapaxes(A, 1, 2)
+    Sig = P0 - np.swapaxes(AP, 1, 2) @ np.linalg.solve(S, AP)
+    return 0.5 * (Sig + np.swapaxes(Sig, 1, 2)), ok
+
+
+def planned_nav_logdet(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
+                       n_obs: int, dt: float, g, oc: bool = True, boresight_B=None) -> np.ndarray:
+    """``-log det`` (nats) of the navigation block (9 x 9) of
+    :func:`planned_posterior`, per candidate (n,); larger is better; ``-inf``
+    for candidates that cannot be initialised or lie behind the camera
+    (``boresight_B``: the camera axis in {B}, None = no check). The
+    transition to the last image has unit determinant on the navigation block,
+    so the score is the same at the planning instant and at the last image."""
+    cand = np.asarray(cand, float).reshape(-1, 3)
+    Sig, ok = planned_posterior(r, v, a, R_LtoB, P, p_known, cand, sigma_f, depth_sigma_frac, n_obs,
+                                dt, g, oc)
+    out = -chol_logdet(Sig[:, :9, :9])
+    if boresight_B is not None:
+        st = _states(r, v, R_LtoB, np.eye(12), len(cand))
+        ok = ok & (np.einsum("nij,nj->ni", st.R, cand - st.r) @ boresight_B > 0)
+    return np.where(ok, out, -np.inf)

@@ -1,0 +1,106 @@
+"""The planned-information metric logdet_nav (opnav.landing.planned_info): the
+candidate's own initialisation, the filter's noise model, obs_per_landmark
+observations, marginalised on the navigation states; against a direct
+information-form computation and with invariants that a mis-specification breaks."""
+
+import numpy as np
+import pytest
+
+from opnav.landing import ekf
+from opnav.landing.measurement import selection_jacobian
+from opnav.landing.planned_info import planned_nav_logdet, planned_posterior
+from opnav.rotations import exp_so3
+
+
+G = np.array([0.0, 0.0, -3.711])
+
+
+def _state(seed=0):
+    rng = np.random.default_rng(seed)
+    r = np.array([800.0, -400.0, 1500.0]) + rng.normal(0, 20, 3)
+    v = np.array([-20.0, 10.0, -40.0])
+    a = np.array([0.3, -0.2, 1.0])
+    # camera looking down: body z along -{L} z roughly (boresight body -z)
+    R = exp_so3(rng.normal(0, 0.05, 3)) @ np.diag([1.0, -1.0, -1.0])
+    A = rng.normal(size=(12, 12))
+    P = np.diag(np.r_[np.full(3, 50.0**2), np.full(3, 2.0**2), np.full(3, 0.01**2), np.full(3, 1e4)])
+    P = P + 1e-3 * np.sqrt(np.outer(np.diag(P), np.diag(P))) * (A @ A.T) / 12
+    cand = np.column_stack([r[0] + rng.uniform(-600, 600, 6), r[1] + rng.uniform(-600, 600, 6), np.zeros(6)])
+    return r, v, a, R, P, cand
+
+
+def test_posterior_is_the_information_form_of_the_planned_updates():
+    from opnav.landing.ekf import transition_matrix
+
+    r, v, a, R, P, cand = _state()
+    sf, frac, n_obs, dt = 2.5e-3, 0.1, 3, 1.0
+    Sig, ok = planned_posterior(r, v, a, R, P, np.zeros(3), cand, sf, frac, n_obs, dt, G, oc=False)
+    assert ok.all()
+    for c, S in zip(cand, Sig):
+        # its own initialisation: the filter's init_landmark for the candidate's bearing
+        st = ekf.NavState(r=r.copy(), v=v.copy(), R=R.copy(), p=np.zeros(3), P=P.copy())
+        b = R @ (c - r)
+        new, ok1 = ekf.init_landmark(st, b / np.linalg.norm(b), frac, sf)
+        assert ok1 and np.allclose(new.p, c, atol=1e-6)
+        # the full 6 x 12 bearing Jacobians (noise sf^2 I: the radial rows carry nothing)
+        # at the predicted poses, mapped back by the filter's transition
+        Lam = np.linalg.inv(new.P)
+        for k in range(n_obs):
+            t = k * dt
+            rk = r + v * t + 0.5 * a * t * t
+            H = selection_jacobian(rk, R, np.zeros(3), c)
+            if k == 0:
+                H[3:6] = 0.0                     # the initialising bearing is in P0
+            Phi = transition_matrix(r, v, R, rk, v + a * t, R, t, G) if k else np.eye(12)
+            H = H @ Phi
+            Lam = Lam + H.T @ H / sf**2
+        np.testing.assert_allclose(S, np.linalg.inv(Lam), rtol=1e-5, atol=1e-9 * np.abs(S).max())
+
+
+def test_score_is_the_navigation_marginal_and_moves_with_the_model():
+    r, v, a, R, P, cand = _state(1)
+    kw = dict(depth_sigma_frac=0.1, oc=True, dt=1.0, g=G)
+    s3 = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=3, **kw)
+    Sig, _ = planned_posterior(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, 0.1, 3, 1.0, G, True)
+    np.testing.assert_allclose(s3, [-np.linalg.slogdet(S[:9, :9])[1] for S in Sig], rtol=1e-9)
+    # one observation (the initialising one): no landmark update, so the candidate
+    # cannot matter to the navigation states: every candidate scores the same
+    s1 = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=1, **kw)
+    np.testing.assert_allclose(s1, s1[0], rtol=1e-9)
+    # ... nor without motion: seen again from the same point it adds nothing
+    still = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=3, **{**kw, "dt": 0.0})
+    np.testing.assert_allclose(still, still[0], rtol=1e-9)
+    assert np.ptp(s3) > 1e-3                                # with parallax it does matter
+    assert np.all(planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=5, **kw) > s3)
+    # the filter's (larger) noise model gives less information than the true noise
+    assert np.all(planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 5 * 2.5e-3, n_obs=3, **kw) < s3)
+
+
+def test_oc_keeps_yaw_unobservable():
+    r, v, a, R, P, cand = _state(2)
+    Sig, _ = planned_posterior(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, 0.1, 3, 1.0, G, oc=True)
+    N = ekf.nullspace(r, v, R, cand[0])
+    st0 = ekf.NavState(r=r.copy(), v=v.copy(), R=R.copy(), p=np.zeros(3), P=P.copy())
+    b = R @ (cand[0] - r)
+    P0 = ekf.init_landmark(st0, b / np.linalg.norm(b), 0.1, 2.5e-3)[0].P
+    # the planned updates add no information along the unobservable direction
+    dLam = np.linalg.inv(Sig[0]) - np.linalg.inv(P0)
+    assert np.linalg.norm(dLam @ N) < 1e-6 * np.linalg.norm(dLam) * np.linalg.norm(N)
+
+
+def test_planner_objective_uses_the_filter_noise_model_and_strategy():
+    from opnav.config import load_config
+    from opnav.landing.depth_error import plane_geometry
+    from opnav.landing.planner import OBJECTIVES, PlanState
+    from opnav.landing.scenario import build_scenario, camera_scenarios
+
+    scn = build_scenario(camera_scenarios(load_config()["landing"])["interior"])
+    cfg = scn.planner
+    assert (cfg.noise_scale, cfg.obs_per_landmark) == (scn.noise_scale, scn.obs_per_landmark) != (1.0, 1)
+    r, v, a, R, P, cand = _state(3)
+    st = PlanState(r, v, a, R, P)
+    f = OBJECTIVES["logdet_nav"](st, plane_geometry(r, v), cfg, scn.camera, scn.camera.sigma_b)
+    want = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, scn.camera.sigma_b * scn.noise_scale,
+                              scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt, scn.g, scn.oc,
+                              scn.camera.boresight_B)
+    np.testing.assert_allclose(-f.batch(cand), want, rtol=1e-12)
