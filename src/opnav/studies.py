@@ -252,7 +252,7 @@ SIM_KEYS = {
                 "camera", "landmarks", "filter", "planner", "mc.base_seed", "mc.bounds", "timing.max_calls"),
     "approach": ("base_seed", "dt_s", "mars_elements", "geometry", "initial_error", "prior_sigma",
                  "process_noise_diag", "camera", "truth_bias_arcsec", "theta_init_arcsec", "segments",
-                 "roll", "crlb", "em", "nav_error", "alternatives"),
+                 "roll", "crlb", "stars", "em", "nav_error", "alternatives"),
 }
 
 

@@ -8,7 +8,7 @@ A_WORK = f"{APPROACH}/work"
 # the scenario and cases (scenario.build_geometry, cases.table1_cases, pipeline.bound_curve) ...
 A_SCENARIO = ("base_seed", "dt_s", "mars_elements", "geometry", "initial_error", "prior_sigma",
               "process_noise_diag", "camera", "truth_bias_arcsec", "theta_init_arcsec", "segments",
-              "roll", "crlb")
+              "roll", "crlb", "stars")
 # ... and the EM-EKF Monte Carlo on top of it (cases.run_cases).
 A_EM = A_SCENARIO + ("n_seeds", "em", "nav_error")
 A_GROUPS = ["size", "polarity", "initial", "pixel", "install"]
@@ -16,7 +16,8 @@ A_VARIANTS = config["approach"]["variants"]
 A_METHODS = config["approach"]["methods"]
 A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
             "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
-            "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py")
+            "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py",
+            "approach/stars.py")
 
 
 A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
@@ -33,7 +34,7 @@ A_SCHEMES = list(A_METHODS) + [f"growing-{m}" for m in config["approach"]["growi
 
 
 wildcard_constraints:
-    variant="literal|prior|roll|reference-start",
+    variant="literal|prior|roll|reference-start|stars",
     group="size|polarity|initial|pixel|install|headline|all",
     method="plain|squarem|growing-plain|growing-squarem",
 
@@ -94,12 +95,30 @@ rule approach_crlb:
         "../scripts/approach_crlb.py"
 
 
+rule approach_stars:
+    """The stars variant (beyond the paper): per stars.study_per_image, the bound of (tx, ty, tz),
+    the data to reach the claimed accuracy, and the EM-EKF and augmented-EKF estimates."""
+    input:
+        A_SRC + src("approach/alternatives.py", "approach/batch_ml.py"),
+    output:
+        f"{A_WORK}/stars.pkl",
+    params:
+        approach=cfg("approach", *A_EM, "growing", "alternatives", "accuracy_target_arcsec"),
+    log:
+        f"{APPROACH}/logs/stars.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/stars.tsv"
+    script:
+        "../scripts/approach_stars.py"
+
+
 rule approach_tables:
     """A-T1 (Table 1 with published values), A-X1 table and verdict, A-summary.json."""
     input:
         mc=list(A_MC.values()) + list(A_MC_GROWING.values()),
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
+        stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
         code=src("approach/report.py", "approach/setup.py", "tables.py", "published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),

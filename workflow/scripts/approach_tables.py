@@ -34,6 +34,8 @@ with script_context(snakemake) as log:
                 caption="A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.")
     atomic_write_text(snakemake.output.verdict, report.identifiability_text(setup, x1))
     summ = report.summary(setup, t1, x1, curves.get("roll_rate"))
+    if snakemake.input.stars:  # the stars variant (beyond the paper)
+        summ["stars"] = report.stars_summary(load_pickle(snakemake.input.stars))
     summ["profile"] = snakemake.params.profile
     summ["text"] = report.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
     write_json(snakemake.output.summary, summ)

@@ -95,7 +95,7 @@ def run_case_alternatives(setup: Setup | dict, variant: str, case: cases.Case, s
     cache = cache or _BatchCache()
     seeds = list(seed_indices)
     Rvar, z, dx0 = cases.simulate_case(setup, geo, case, seeds, setup.initial_error.mode)
-    win = geo.window(Rvar)
+    win = geo.window(Rvar, geo.simulate_stars(sc.rad(case.truth_arcsec), setup.base_seed, case.case_index, seeds))
     S = z.shape[0]
     start = sc.START_OF[variant]
     f0 = None if start == "prior" else run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0), predicted=False)
@@ -205,4 +205,48 @@ def time_em(setup: Setup | dict, variant: str, case: cases.Case, seed_indices, g
         t = time.perf_counter()
         cases.run_case(setup, variant, case, seed_indices, geo=geo, method=m)
         out[f"em_{m}"] = (time.perf_counter() - t) / S
+    return out
+
+
+def stars_study(setup: Setup | dict, log=None) -> list[dict]:
+    """The ``stars`` variant (beyond the paper) with ``stars.study_per_image`` stars per image,
+    headline case, ``n_seeds`` seeds: per star count, the bound of (tx, ty, tz) after all the data
+    (with Q and Q = 0) and the data to reach ``accuracy_target_arcsec`` (samples after N0; the
+    first sample whose bound of tx and ty is at or below it), beside the estimates of the
+    EM-EKF (growing windows with SQUAREM, and the paper's sliding plain EM) and of the
+    augmented EKF on the same measurements (arcsec)."""
+    from dataclasses import replace
+
+    from .pipeline import bound_curves
+
+    setup = Setup.of(setup)
+    case = cases.headline_case(setup)
+    seeds = range(setup.n_seeds)
+    target = setup.accuracy_target_arcsec
+    out = []
+    for m in setup.stars.study_per_image:
+        s_m = setup.replace(stars=replace(setup.stars, per_image=int(m)))
+        geo = sc.build_geometry(s_m, "stars")
+        Rvar = geo.measurement_variance(case.sigma3_px)
+        c, c0 = bound_curves(s_m, geo, [(Rvar, case.truth_arcsec, False), (Rvar, case.truth_arcsec, True)], "stars")
+        d = min(s_m.segments.data_samples, len(c) - 1)
+        below = np.nonzero(c[:, :2].max(1) <= target)[0]
+        row = {"per_image": int(m), "every_K": s_m.stars.every_K, "images": int(np.sum(geo.stars.idx <= geo.t.size - 1)),
+               "truth_arcsec": np.asarray(case.truth_arcsec, float), "total_samples": int(d),
+               "crlb_all_arcsec": c[d], "crlb_all_q0_arcsec": c0[d],
+               "samples_to_target": float(below[0]) if below.size else float("nan"), "estimators": {}}
+        for name, st, method in (("em_growing_squarem", s_m.scheme("growing"), "squarem"),
+                                 ("em_plain", s_m, "plain")):
+            r = cases.run_case(st, "stars", case, seeds, geo=geo, method=method)
+            row["estimators"][name] = {"theta_final_arcsec": r["theta_final_arcsec"], "label": r["label"],
+                                       "data_to_converge": r["data_to_converge"]}
+        a = run_case_alternatives(s_m, "stars", case, seeds, geo, methods=("augmented",))["methods"]["augmented"]
+        row["estimators"]["augmented"] = {"theta_final_arcsec": a["theta_final_arcsec"],
+                                          "sigma_final_arcsec": a["sigma_final_arcsec"],
+                                          "data_to_converge": a["data_to_converge"]}
+        if log:
+            log.info("stars %d per image: bound %s arcsec, EM growing %s, augmented %s", m, np.round(c[d], 3),
+                     np.round(row["estimators"]["em_growing_squarem"]["theta_final_arcsec"].mean(0), 3),
+                     np.round(a["theta_final_arcsec"].mean(0), 3))
+        out.append(row)
     return out

@@ -14,7 +14,9 @@ Description
         z_k = A_m(theta) (u_ref,k - C_k dr_k) + v_k,   A_m = I - [theta x],
         H_k = [ -A_m(theta) C_k,  0_3x3,  [u_k x] ],   u_k = u_ref,k - C_k dr_k,
 
-    since ``-[theta x] u = [u x] theta``. The update uses the Joseph form.
+    since ``-[theta x] u = [u x] theta``. The update uses the Joseph form. Star images
+    (``stars`` variant) are linear measurements of theta alone, ``y = G theta + noise``
+    (:mod:`opnav.approach.stars`), added in information form after the Mars update.
     Internally theta is carried in arcsec, so that its column of ``H``
     (``[u x]`` times one arcsec, a few km) is of the same order as the
     position columns; inputs and outputs are in rad.
@@ -50,6 +52,7 @@ from opnav.rotations import skew
 from .dynamics import ARCSEC
 from . import kalman
 from .ekf import Window
+from .stars import theta_information_update
 
 
 @dataclass
@@ -107,6 +110,8 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
     if u_lin is not None:
         A_lin = np.eye(3) - skew(y[0, 6:] * ARCSEC)
         U_lin = skew(np.asarray(u_lin, float)) * ARCSEC
+    star_at = ({} if win.stars is None or win.star_y is None
+               else {int(k): i for i, k in enumerate(win.stars.idx)})
     for k in range(1, n + 1):
         F[:6, :6] = win.Phi[k]
         y, P = kalman.predict(y, P, F, Qa)
@@ -123,6 +128,14 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
         nu = z[:, k] - zhat
         y, P, _, Sinv, det = kalman.condition_on(y, P, H, win.Rvar[k], nu, joseph=True)
         ll += kalman.innovation_loglik(nu, Sinv, det)
+        if k in star_at:  # a star image: a linear measurement of theta alone (opnav.approach.stars)
+            i = star_at[k]
+            G = win.stars.G[i] * ARCSEC  # per arcsec
+            Wd = win.stars.w[i]
+            J = np.einsum("ak,a,al->kl", G, Wd, G)
+            P = theta_information_update(P, np.broadcast_to(J, (S, 3, 3)))
+            g = np.einsum("ak,a,sa->sk", G, Wd, win.star_y[:, i] - y[:, 6:] @ G.T)
+            y = y + np.einsum("sij,sj->si", P[:, :, 6:], g)
         store(k)
     return AugmentedResult(th_out * ARCSEC, Pth_out * ARCSEC**2, xf, ptr, ll)
 

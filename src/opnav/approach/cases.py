@@ -215,9 +215,10 @@ def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed
     init_mode = init_mode or setup.initial_error.mode
     seed_indices = list(seed_indices)
     ns = len(seed_indices)
-    zs, dx0s, Rvs, inits = [], [], [], []
+    zs, dx0s, Rvs, inits, ys = [], [], [], [], []
     for case in case_list:
         Rvar, z, dx0 = simulate_case(setup, geo, case, seed_indices, case.init_mode or init_mode)
+        ys.append(geo.simulate_stars(sc.rad(case.truth_arcsec), setup.base_seed, case.case_index, seed_indices))
         zs.append(z)
         dx0s.append(dx0)
         Rvs.append(np.broadcast_to(Rvar[:, None, :], (Rvar.shape[0], ns, 3)))
@@ -228,7 +229,7 @@ def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed
     if all(np.array_equal(c.sigma3_px, case_list[0].sigma3_px) for c in case_list):
         Rvar = Rvar[:, 0]  # shared by every run: the cheaper broadcast form
     theta = np.concatenate(inits).copy()
-    win = geo.window(Rvar)
+    win = geo.window(Rvar, None if geo.stars is None else np.concatenate(ys))
     S = z.shape[0]
     f0 = run_filter(z, np.zeros((S, 3)), dx0, geo.P0, win, predicted=False)
     err_before = np.linalg.norm(f0.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
@@ -375,7 +376,8 @@ def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indice
     geo = geo or sc.build_geometry(setup, variant, n=N0 + data_samples)
     init_mode = init_mode or setup.initial_error.mode
     Rvar, z, dx0 = simulate_case(setup, geo, case, seed_indices, init_mode)
-    win = geo.window(Rvar)
+    win = geo.window(Rvar, geo.simulate_stars(sc.rad(case.truth_arcsec), setup.base_seed, case.case_index,
+                                              seed_indices))
     S = z.shape[0]
     f0 = run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0), predicted=False)
     x0, P0 = start_state(sc.START_OF[variant], N0, f0, geo.dx_true, dx0, geo.P0, win)

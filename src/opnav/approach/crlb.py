@@ -33,6 +33,7 @@ from . import kalman
 from .augmented import augmented_jacobian, augmented_noise
 from .camera import misalignment_small
 from .ekf import Window
+from .stars import theta_information_update
 
 
 def theta_sensitivity(u: np.ndarray) -> np.ndarray:
@@ -52,13 +53,16 @@ def crlb_curve(win: Window, u_true: np.ndarray, P_start: np.ndarray, theta: np.n
 
 
 def crlb_curves(Phi: np.ndarray, C: np.ndarray, Rvar: np.ndarray, Q: np.ndarray, u_true: np.ndarray,
-                P_start: np.ndarray, theta: np.ndarray, sigma_theta: float = 1.0) -> np.ndarray:
+                P_start: np.ndarray, theta: np.ndarray, sigma_theta: float = 1.0,
+                star_info: np.ndarray | None = None) -> np.ndarray:
     """:func:`crlb_curve` for a batch of B windows of equal length at once, (B, n+1, 3), rad.
 
     Phi (B, n+1, 6, 6), C (B, n+1, 3, 3), Rvar (B, n+1, 3), Q (6, 6), u_true (B, n+1, 3),
     P_start (B, 6, 6), theta (3,) or (B, 3) rad. The covariance recursion of the linear
     augmented Kalman filter of ``[dX; theta]`` (:func:`kalman.predict`,
-    :func:`kalman.condition_on`, Joseph form), with theta constant.
+    :func:`kalman.condition_on`, Joseph form), with theta constant. ``star_info``
+    (B, n+1, 3, 3), rad^-2: information on theta of star images at each sample (``stars``
+    variant), added to the theta block after that sample's Mars update.
     """
     B, n = Phi.shape[0], Phi.shape[1] - 1
     P = np.zeros((B, 9, 9))
@@ -75,6 +79,8 @@ def crlb_curves(Phi: np.ndarray, C: np.ndarray, Rvar: np.ndarray, Q: np.ndarray,
         _, P = kalman.predict(None, P, Fa, Qa)
         H = augmented_jacobian(A, C[:, k], Us[:, k])
         P = kalman.condition_on(None, P, H, Rvar[:, k], None, joseph=True).P
+        if star_info is not None and star_info[:, k].any():
+            P = theta_information_update(P, star_info[:, k])
         out[:, k] = np.sqrt(np.diagonal(P, axis1=1, axis2=2)[:, 6:])
     return out
 

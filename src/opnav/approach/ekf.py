@@ -46,17 +46,24 @@ class Window:
     u_ref: np.ndarray  # (n+1, 3) A_c^i (X_M - r_ref), km
     Rvar: np.ndarray  # (n+1, 3) or per seed (n+1, S, 3) measurement variances, km^2
     Q: np.ndarray  # (6, 6) process noise per step
+    stars: object = None  # stars.StarField of the window's star images (``stars`` variant), or None
+    star_y: np.ndarray | None = None  # (S, I, 2m) star measurements, rad
 
     def slice(self, a: int, b: int) -> "Window":
-        """Samples a..b (inclusive; a becomes the start sample 0)."""
+        """Samples a..b (inclusive; a becomes the start sample 0; star images a+1..b)."""
+        st, y = self.stars, self.star_y
+        if st is not None:
+            keep = (st.idx > a) & (st.idx <= b)
+            st, y = st.select(a, b), (None if y is None else y[:, keep])
         return Window(self.Phi[a:b + 1], self.C[a:b + 1], self.u_ref[a:b + 1],
-                      self.Rvar[a:b + 1], self.Q)
+                      self.Rvar[a:b + 1], self.Q, st, y)
 
     def rows(self, idx: np.ndarray) -> "Window":
-        """The window of the seeds ``idx`` (only per-seed variances have a seed axis)."""
+        """The window of the seeds ``idx`` (per-seed variances and star data have a seed axis)."""
+        y = None if self.star_y is None else self.star_y[idx]
         if self.Rvar.ndim == 2:
-            return self
-        return Window(self.Phi, self.C, self.u_ref, self.Rvar[:, idx], self.Q)
+            return Window(self.Phi, self.C, self.u_ref, self.Rvar, self.Q, self.stars, y)
+        return Window(self.Phi, self.C, self.u_ref, self.Rvar[:, idx], self.Q, self.stars, y)
 
     def weights(self, S: int) -> np.ndarray:
         """R^-1 diagonals of samples 1..n for every seed, (S, n, 3)."""

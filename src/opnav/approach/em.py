@@ -48,6 +48,7 @@ class EStats:
 
     N: np.ndarray
     b: np.ndarray
+    J_stars: np.ndarray | None = None  # (3, 3) the star images' part of N (``stars`` variant)
 
 
 def los_moments(s: SmootherResult, win: Window) -> tuple[np.ndarray, np.ndarray]:
@@ -82,6 +83,11 @@ def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:
     N = np.einsum("ijk,sti,inl,stjn->skl", EPS, w, EPS, Mom, optimize=True)
     b = (np.einsum("ijk,stj,sti,sti->sk", EPS, m, w, zz, optimize=True)
          - np.einsum("ijk,sti,stji->sk", EPS, w, Mom, optimize=True))
+    if win.stars is not None and win.star_y is not None:  # star images: a direct measurement of theta
+        from .stars import normal_equations
+
+        J, h = normal_equations(win.stars, win.star_y)
+        return EStats(N + J, b + h, J)
     return EStats(N, b)
 
 
@@ -93,6 +99,10 @@ def mstep(st: EStats, theta: np.ndarray, tz_tol: float = 1e-6) -> tuple[np.ndarr
     """
     lam, V = np.linalg.eigh(st.N)
     keep = lam > tz_tol * lam[:, -1:]
+    if st.J_stars is not None:  # star images observe every direction they inform (tz too), however
+        # weakly next to the Mars vector's lateral information: held only where they add nothing
+        sj = np.einsum("sik,ij,sjk->sk", V, st.J_stars, V)
+        keep |= sj > tz_tol * np.linalg.eigvalsh(st.J_stars)[-1]
     inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
     r = st.b - np.einsum("sij,sj->si", st.N, theta)
     step = np.einsum("sij,sj,skj,sk->si", V, inv, V, r)
@@ -157,7 +167,12 @@ def em_map(theta, z, x0, P0, win, tz_tol):
     f = run_filter(z, theta, x0, P0, win, predicted=False)
     s = bryson_frazier(f, win, POS)  # identical to rts() (tested), no 6x6 inverses; position only
     new, unobs = mstep(estep(z, s, win), theta, tz_tol)
-    return new, f.loglik, unobs, f, s
+    ll = f.loglik
+    if win.stars is not None and win.star_y is not None:
+        from .stars import loglik
+
+        ll = ll + loglik(win.stars, win.star_y, theta)
+    return new, ll, unobs, f, s
 
 
 def em_window(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray, win: Window,

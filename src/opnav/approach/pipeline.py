@@ -74,8 +74,15 @@ def bound_curves(setup: Setup | dict, geo: sc.Geometry, items, variant: str) -> 
     curves = crlb.crlb_curves(np.broadcast_to(geo.Phi[a:], (B, n1, 6, 6)), np.broadcast_to(geo.C[a:], (B, n1, 3, 3)),
                               np.stack([w.Rvar[a:] for w in wins]), np.stack([w.Q for w in wins]),
                               np.broadcast_to(geo.u_true[a:], (B, n1, 3)), np.stack(P),
-                              np.stack([sc.rad(th) for _, th, _ in items]), setup.crlb_prior_sigma_rad)
+                              np.stack([sc.rad(th) for _, th, _ in items]), setup.crlb_prior_sigma_rad,
+                              _star_info(geo, slice(a, None), B))
     return [sc.arcsec(c[N0 - a:]) for c in curves]
+
+
+def _star_info(geo: sc.Geometry, idx, B: int) -> np.ndarray | None:
+    """The star images' information on theta at the samples ``idx`` for a batch of B (``stars``)."""
+    info = geo.star_info()
+    return None if info is None else np.broadcast_to(info[idx], (B,) + info[idx].shape)
 
 
 def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
@@ -113,7 +120,9 @@ def segment_bounds_many(setup: Setup | dict, geo: sc.Geometry, items, variant: s
                            np.repeat(np.stack([w.Q for w in wins]), L, axis=0),
                            np.broadcast_to(geo.u_true[idx], (len(items), L, n1, 3)).reshape(B, n1, 3),
                            np.concatenate(Pa), np.repeat(np.stack([sc.rad(th) for _, th, _ in items]), L, axis=0),
-                           setup.crlb_prior_sigma_rad)[:, -1]
+                           setup.crlb_prior_sigma_rad,
+                           None if geo.stars is None else
+                           _star_info(geo, idx, len(items)).reshape(B, n1, 3, 3))[:, -1]
     return list(sc.arcsec(out).reshape(len(items), L, 3))
 
 
@@ -126,10 +135,17 @@ def groups_for(setup: Setup | dict, variant: str) -> list[str]:
     return list(cases.GROUPS) if setup.scatter == "group" else ["all"]
 
 
-def cases_in(setup: Setup | dict, group: str) -> list[cases.Case]:
+#: Variants whose "headline" job also runs other Table-1 groups (the stars variant, beyond the
+#: paper, shows its headline and polarity rows).
+HEADLINE_EXTRA = {"stars": ("polarity",)}
+
+
+def cases_in(setup: Setup | dict, group: str, variant: str = "") -> list[cases.Case]:
+    """The Table-1 cases of a Snakemake job's ``group`` (``headline``: T1-01, and for the
+    variants of :data:`HEADLINE_EXTRA` their extra groups)."""
     allc = cases.table1_cases(setup)
     if group == "headline":
-        return [allc[0]]
+        return [allc[0]] + [c for c in allc if c.group in HEADLINE_EXTRA.get(variant, ())]
     if group == "all":
         return allc
     return [c for c in allc if c.group == group]
@@ -158,7 +174,7 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
     geo = shared[("geo", n)]
     seeds = range(setup.n_seeds)
     out = []
-    clist = cases_in(setup, group)
+    clist = cases_in(setup, group, variant)
     head = [c for c in clist if c.case_index == 1]
     runs_list = clist + [replace(c, init_mode="sampled") for c in head]
     if ("data", n) not in shared:

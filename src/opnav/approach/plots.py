@@ -97,8 +97,9 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
             span = max(abs(truth[i]), 5.0) * 3
             ax.set_ylim(max(lo, truth[i] - span), min(hi, truth[i] + span))
         axes[0].plot([], [], color="k", ls=":", lw=0.8, label="truth +- 1-sigma bound of the data used")
-        axes[2].text(0.01, 0.05, "$\\theta_z$: unobservable (held at its initial value)",
-                     transform=axes[2].transAxes, fontsize=7)
+        if all(r.get("tz_unobservable", True) for r in runs.values()):
+            axes[2].text(0.01, 0.05, "$\\theta_z$: unobservable (held at its initial value)",
+                         transform=axes[2].transAxes, fontsize=7)
         axes[-1].set_xlabel("data used (samples); EM iterations spread over each segment")
         h, lab = axes[0].get_legend_handles_labels()
         fig.legend(h, lab, loc="lower center", fontsize=6, ncol=2, frameon=False)

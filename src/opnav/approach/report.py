@@ -388,6 +388,49 @@ def roll_rate_text(rr: dict) -> str:
             + f" (about rate^{rr['slope_all']:.2g}); {reach}.")
 
 
+def stars_summary(study: list[dict]) -> dict:
+    """The stars study (:func:`opnav.approach.alternatives.stars_study`) for the summary, per
+    stars per image (key ``m<k>``): bound of tx, ty, tz after all the data (Q and Q = 0), samples
+    to the target, and per estimator the seed mean and sd of (tx, ty, tz) and its label (EM)."""
+    out = {}
+    for row in study:
+        est = {}
+        for name, e in row["estimators"].items():
+            th = np.asarray(e["theta_final_arcsec"], float)
+            d = {"mean_arcsec": [float(x) for x in th.mean(0)],
+                 "sd_arcsec": [float(x) for x in (th.std(0, ddof=1) if th.shape[0] > 1 else np.full(3, np.nan))]}
+            if "label" in e:
+                d["label"] = row_label(e["label"])[0]
+            est[name] = d
+        out[f"m{row['per_image']}"] = {
+            "per_image": row["per_image"], "every_K": row["every_K"], "images": row["images"],
+            "total_samples": row["total_samples"],
+            "crlb_arcsec": [float(x) for x in row["crlb_all_arcsec"]],
+            "crlb_q0_arcsec": [float(x) for x in row["crlb_all_q0_arcsec"]],
+            "samples_to_target": _num(row, "samples_to_target"), "estimators": est}
+    return out
+
+
+def stars_text(st: dict, target: float) -> str:
+    """The manuscript's stars sentence, from :func:`stars_summary`."""
+    parts = []
+    for v in st.values():
+        b, g, a = v["crlb_arcsec"], v["estimators"].get("em_growing_squarem"), v["estimators"].get("augmented")
+        need = v["samples_to_target"]
+        txt = (f"{v['per_image']} stars per image ({v['images']} images, one every {v['every_K']} samples): bound "
+               f"(tx, ty, tz) = ({b[0]:.3g}, {b[1]:.3g}, {b[2]:.3g}) arcsec, "
+               + (f"{target:g} arcsec reached after {need:.0f} samples" if need is not None else
+                  f"{target:g} arcsec not reached"))
+        for name, e in (("EM-EKF (growing, SQUAREM)", g), ("augmented EKF", a)):
+            if e:
+                m, sd = e["mean_arcsec"], e["sd_arcsec"]
+                txt += (f"; {name} ({m[0]:.3g} +- {sd[0]:.2g}, {m[1]:.3g} +- {sd[1]:.2g}, {m[2]:.3g} +- {sd[2]:.2g})"
+                        + (f", {e['label']}" if e.get("label") else ""))
+        parts.append(txt)
+    return ("Beyond the paper, star images calibrate the camera the way flight teams do: "
+            + "; ".join(parts) + ". Stars off the boresight also observe the roll tz." if parts else "")
+
+
 def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame, roll_rate: dict | None = None) -> dict:
     """Headline numbers per variant and EM scheme for the manuscript macros; ``roll_rate``:
     the roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`), if run."""
@@ -534,6 +577,7 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
               + (f"; it is {c['label']}" if c.get("label", "converged") != "converged" else "") + ").")
     out["reading"] = s
     out["roll_rate"] = roll_rate_text(summ["roll_rate"]) if "roll_rate" in summ else ""
+    out["stars"] = stars_text(summ["stars"], target) if "stars" in summ else ""
 
     parts = [f"{diag.get(k, k)}: {v['nav_note']}" for k, v in base.items() if v.get("nav_note")]
     out["nav"] = ("Navigation error (RMS over the last part of the arc) after compensation, split across and "

@@ -24,6 +24,9 @@ Scenario variants (SPEC A.3b)
     ``reference-start``  DIAGNOSTIC: windows start from the *true* state with
                          the filter's ``P_N0``; information the measurements do
                          not hold.
+    ``stars``            beyond the paper: as prior (no roll), plus star-field images every
+                         ``stars.every_K`` samples (:mod:`opnav.approach.stars`), which
+                         measure the camera attitude directly.
 Units: km, km/s, s, rad.
 """
 
@@ -38,8 +41,8 @@ from .dynamics import ARCSEC
 from .ekf import Window
 from .setup import Setup
 
-VARIANTS = ("literal", "prior", "roll", "reference-start")
-START_OF = {"literal": "filter", "prior": "prior", "roll": "prior", "reference-start": "truth"}
+VARIANTS = ("literal", "prior", "roll", "reference-start", "stars")
+START_OF = {"literal": "filter", "prior": "prior", "roll": "prior", "reference-start": "truth", "stars": "prior"}
 
 
 @dataclass
@@ -58,14 +61,34 @@ class Geometry:
     e_fixed: np.ndarray  # (6,) the paper's initial error (prior mean - truth)
     variant: str
     ifov_arcsec: float = 10.0  # pixel size of the camera the variances are made for
+    stars: object = None  # stars.StarField (``stars`` variant), else None
+    star_sigma_rad: float = 0.0  # star centroid 1-sigma, rad
 
     @property
     def dx_true(self) -> np.ndarray:
         """True deviation from the reference (n+1, 6)."""
         return self.X_true - self.X_ref
 
-    def window(self, Rvar: np.ndarray) -> Window:
-        return Window(self.Phi, self.C, self.u_ref, Rvar, self.Q)
+    def window(self, Rvar: np.ndarray, star_y: np.ndarray | None = None) -> Window:
+        """The model arrays of the whole arc; ``star_y``: the seeds' star measurements."""
+        return Window(self.Phi, self.C, self.u_ref, Rvar, self.Q, self.stars, star_y)
+
+    def star_info(self) -> np.ndarray | None:
+        """Information on theta of the star image at each sample (n+1, 3, 3), or None."""
+        return None if self.stars is None else self.stars.info_per_sample(self.t.shape[0] - 1)
+
+    def simulate_stars(self, theta_true_rad: np.ndarray, base_seed: int, case_index: int,
+                       seed_indices) -> np.ndarray | None:
+        """Star measurements of the seeds (S, I, 2m), each from its own stream
+        ``SeedSequence([base_seed, case_index, seed_index, 1])`` (apart from the Mars noise's),
+        or None without star images."""
+        if self.stars is None:
+            return None
+        from . import stars
+
+        rngs = [np.random.default_rng(np.random.SeedSequence([base_seed, case_index, int(i), 1]))
+                for i in seed_indices]
+        return stars.simulate(self.stars, theta_true_rad, rngs, self.star_sigma_rad)
 
     def measurement_variance(self, sigma3_px) -> np.ndarray:
         """Rvar (n+1, 3), km^2, from the pinhole camera at the reference range (paper eq. 3-4)."""
@@ -122,9 +145,18 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
         raise ValueError(f"approach.camera: Mars ({disc_px:.0f} px across) does not fit the "
                          f"{cam.pixels} px detector; raise camera.ifov_arcsec or the range")
     C, u_ref, u_true = _camera_frame(X_true, X_ref, X_mars, roll)
+    field, sig = None, 0.0
+    if variant == "stars":
+        from . import stars
+
+        st = setup.stars
+        sig = stars.sigma_rad(st.sigma_px, cam.ifov_arcsec)
+        field = stars.star_field(C, setup.segments.N0, st.every_K, st.per_image, st.mag_limit, st.slew_deg,
+                                 0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC, sig,
+                                 stars.catalogue(st.catalogue_seed, st.catalogue_size))
     return Geometry(t, X_true, X_ref, X_mars, Phi, C, u_ref, u_true,
                     np.linalg.norm(u_ref, axis=1), setup.Q, setup.prior_sigma.P0, e_fixed, variant,
-                    cam.ifov_arcsec)
+                    cam.ifov_arcsec, field, sig)
 
 
 def _camera_frame(X_true, X_ref, X_mars, roll_rad):

@@ -150,6 +150,22 @@ class Roll(_Section):
 
 
 @dataclass(frozen=True)
+class Stars(_Section):
+    """``stars``: star images every ``every_K`` samples, ``per_image`` brightest stars up to
+    ``mag_limit``, the star-mode slew (deg), centroid 1-sigma (px), the synthetic catalogue's
+    size and seed, and the stars study's stars per image."""
+
+    every_K: int
+    per_image: int
+    mag_limit: float
+    slew_deg: float
+    sigma_px: float
+    catalogue_size: int
+    catalogue_seed: int
+    study_per_image: tuple
+
+
+@dataclass(frozen=True)
 class RollRateStudy(_Section):
     """``roll_rate_study``: roll rates of the bound table and the bracket of the rate search, deg/s."""
 
@@ -288,6 +304,7 @@ _FIELDS: dict[str, tuple[str, Any]] = {
     "methods": ("methods", lambda v: tuple(str(m) for m in v)),
     "roll": ("roll", Roll.from_config),
     "roll_rate_study": ("roll_rate_study", RollRateStudy.from_config),
+    "stars": ("stars", Stars.from_config),
     "variants": ("variants", tuple),
     "table1_variants": ("table1_variants", tuple),
     "nav_last_fraction": ("nav_error", lambda c: float(c["last_fraction"])),
@@ -326,6 +343,7 @@ class Setup:
     methods: tuple
     roll: Roll
     roll_rate_study: RollRateStudy
+    stars: Stars
     variants: tuple
     table1_variants: tuple
     nav_last_fraction: float
