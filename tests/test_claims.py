@@ -142,3 +142,12 @@ def test_row_rejects_unknown_verdict_and_missing_name():
         C.row("A", "A-C0", "c", "p", C.DEPENDS, "x.", "A-T1")
     with pytest.raises(ValueError, match="one sentence"):
         C.row("A", "A-C0", "c", "p", C.REPRODUCED, "One. Two.", "A-T1")
+
+
+def test_true_theta_floor_above_the_limit_makes_compensation_not_reproducible():
+    t = table(literal={"after": 118.0}, roll={"after": 88.0}, diag={"after": 41.8})
+    floor = {**SUMMARY_A, "variants": {"literal": {"nav_err_true_theta_km": 41.8, "nav_err_true_theta_rng_km": 41.0}}}
+    r = by_id(rows_a(floor, t, PUB["paper_a"]))["A-C7"]
+    assert r["verdict"] == C.NOT_REPRODUCIBLE and "41.8" in r["named"]
+    low = {**SUMMARY_A, "variants": {"literal": {"nav_err_true_theta_km": 12.0, "nav_err_true_theta_rng_km": 10.0}}}
+    assert by_id(rows_a(low, t, PUB["paper_a"]))["A-C7"]["verdict"] == C.NOT_REPRODUCED

@@ -108,3 +108,50 @@ def test_every_figure_draws_a_label_in_its_palette_colour():
         plt.close(fig)
     assert {"roll", "literal", "depth", "svd", "augmented"} <= set(seen)
     assert all(len(c) == 1 for c in seen.values()), seen
+
+
+def test_saved_png_is_200_dpi_and_tight_even_outside_the_style(tmp_path):
+    """save() applies the style's savefig settings itself: a figure drawn in the style and
+    saved after the context closed is still >= 200 dpi with a tight bounding box."""
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from opnav import figures
+
+    with figures.style():
+        fig, ax = plt.subplots()
+        ax.plot([0, 1], [0, 1])
+        ax.set_xlabel("x (km)")
+    w_in, h_in = fig.get_size_inches()
+    figures.save(fig, tmp_path / "f.png")
+    im = Image.open(tmp_path / "f.png")
+    assert im.info["dpi"][0] >= 199.5
+    # tight: the white margins of the default layout are cut (smaller than the full canvas)
+    assert im.size[0] < w_in * 200 and im.size[1] <= h_in * 200 + 1
+    assert im.size[0] > 0.6 * w_in * 200  # and it is the 200-dpi canvas, not a 100-dpi one
+
+
+def test_paper_a_study_plots_rms_error_with_symbols_and_drops_constant_panels():
+    """A stalled estimate has a tiny spread and a large error: paper-A error panels draw the
+    RMS about the truth even when the study's statistic is sd; labels are symbols with
+    units, never config keys; a panel with one value everywhere is left to the table."""
+    import matplotlib.pyplot as plt
+
+    a = _study("approach", ["literal"], ["em"], ["err_x_arcsec", "stalled_pct"])
+    a["statistic"] = "sd"
+    a["title"] = "centroid pixel error, 3-sigma (px)"
+    tidy = _study_tidy("approach", a["variants"], a["methods"], a["metrics"])
+    tidy.loc[tidy["metric"] == "err_x_arcsec", "sd"] = 0.01      # spread tiny ...
+    tidy.loc[tidy["metric"] == "err_x_arcsec", "rms"] = [9.0, 10.0]  # ... error large
+    tidy.loc[tidy["metric"] == "stalled_pct", "mean"] = 100.0       # constant panel
+    fig = study_plots.fig_study(tidy, a)
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(axes) == 1
+    ax = axes[0]
+    assert "RMS" in ax.get_ylabel() and "t_x" in ax.get_ylabel()
+    assert ax.get_xlabel().replace("\n", " ") == "centroid pixel error, 3-sigma (px)"
+    ys = [y for line in ax.get_lines() if line.get_label().startswith("literal: em") for y in line.get_ydata()]
+    assert sorted(ys) == [9.0, 10.0]
+    for lab in (ax.get_xlabel(), ax.get_ylabel()):
+        assert "approach." not in lab and "_" not in lab.replace("t_x", "")
+    plt.close(fig)

@@ -68,6 +68,19 @@ def color(label: str) -> str:
     return f"C{zlib.crc32(key.encode()) % 10}"
 
 
+def _save_settings() -> dict:
+    """The style file's ``savefig.*`` settings as ``savefig`` keywords. They are passed
+    explicitly because a figure is often saved after the :func:`style` context has
+    closed, where matplotlib's defaults (100 dpi, no tight box) would apply instead."""
+    rc = matplotlib.rc_params_from_file(str(STYLE), use_default_template=False)
+    return {"dpi": float(rc["savefig.dpi"]), "bbox_inches": rc["savefig.bbox"],
+            "pad_inches": float(rc["savefig.pad_inches"])}
+
+
+#: ``savefig`` keywords of every saved figure (dpi >= 200, tight bounding box)
+SAVE_KW = _save_settings()
+
+
 @contextlib.contextmanager
 def style() -> Iterator[None]:
     """Context in which figures use the project style."""
@@ -105,7 +118,7 @@ def save(fig: "matplotlib.figure.Figure", paths: Iterable[str | Path] | str | Pa
             else:
                 meta = {}
             with atomic_target(p) as tmp:
-                fig.savefig(tmp, format=fmt, metadata=meta)
+                fig.savefig(tmp, format=fmt, metadata=meta, **SAVE_KW)
             out.append(p)
     finally:
         plt.close(fig)

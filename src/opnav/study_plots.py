@@ -3,8 +3,10 @@
 One panel per metric, one line per method (paper A: per scenario variant and
 estimator, the variant's colour and the estimator's line style; colours are
 :func:`opnav.figures.color`'s, as in every figure). ``statistic: mean`` draws the mean over runs with its 95 %
-confidence interval as error bars; ``sd`` / ``rms`` draw the spread or RMS over
-runs, and for paper-A errors the 1-sigma CRLB beside it (dashed, black). A
+confidence interval as error bars (a share's within 0..100 %); ``sd`` / ``rms`` draw the spread or RMS over
+runs, paper-A estimate errors always as their RMS about the truth, with the 1-sigma CRLB beside it
+(dashed, black). Axis labels are symbols with units; the x label is the study's title. A panel
+whose values are all the same number is left to the table. A
 single numeric swept key gives a numeric x axis (log scale when the values span
 a decade or more); otherwise the values are categories, in the study's order.
 """
@@ -58,11 +60,64 @@ def _x_axis(study: Mapping):
             ", ".join(k.split(".")[-1] for k in keys))
 
 
+#: axis labels with symbols and units (the study tables keep opnav.studies.METRICS' names)
+PLOT_LABELS = {
+    "err_x_arcsec": r"$\hat t_x - t_x$ (arcsec)", "err_y_arcsec": r"$\hat t_y - t_y$ (arcsec)",
+    "err_z_arcsec": r"$\hat t_z - t_z$ (arcsec)",
+    "crlb_x_arcsec": r"CRLB $\sigma_{t_x}$, all data (arcsec)", "crlb_y_arcsec": r"CRLB $\sigma_{t_y}$, all data (arcsec)",
+    "crlb_used_x_arcsec": r"CRLB $\sigma_{t_x}$, data used (arcsec)",
+    "crlb_used_y_arcsec": r"CRLB $\sigma_{t_y}$, data used (arcsec)",
+    "median_plan_time_us": "median planning time (µs)", "median_plan_cpu_us": "median planning CPU time (µs)",
+}
+
+
+#: metrics that cannot be negative (norms, counts, NEES, times): their intervals stop at 0
+NONNEGATIVE = {"landing": frozenset(METRICS["landing"]),
+               "approach": frozenset(m for m in METRICS["approach"] if not m.startswith("err_"))}
+
+
+def axis_label(metric: str, paper: str, stat: str) -> str:
+    """The y label of a metric's panel: symbol and unit; 'RMS error' for paper-A estimate
+    errors (RMS about the truth), the statistic's name otherwise."""
+    base = PLOT_LABELS.get(metric, METRICS[paper][metric][0].replace("(us)", "(µs)"))
+    if stat == "rms" and metric.startswith("err_"):
+        return f"RMS of {base}"
+    if stat == "sd":
+        return f"sd of {base}"
+    return base
+
+
+def plotted_statistic(study: Mapping, metric: str) -> str:
+    """What a panel draws: paper A's estimate errors as their RMS about the truth (a stalled
+    estimate that never moved has a tiny spread but a large error), else
+    :func:`opnav.studies.shown_statistic`."""
+    stat = shown_statistic(study, metric)
+    if study["paper"] == "approach" and metric.startswith("err_") and stat == "sd":
+        return "rms"
+    return stat
+
+
+def _wrap(text: str, width: int) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)) if "$" not in text else text
+
+
+def _constant(tidy: pd.DataFrame, metric: str, stat: str) -> bool:
+    """A panel whose every plotted value is the same number (e.g. 100 % everywhere): it
+    shows nothing a sentence cannot, so the figure leaves it to the table."""
+    v = tidy.loc[tidy["metric"] == metric, stat].to_numpy(float)
+    v = v[np.isfinite(v)]
+    return v.size > 1 and float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.abs(v).max()))
+
+
 def fig_study(tidy: pd.DataFrame, study: Mapping):
     import matplotlib.pyplot as plt
 
-    metrics = list(study["metrics"])
+    metrics = [m for m in study["metrics"] if not _constant(tidy, m, plotted_statistic(study, m))] \
+        or list(study["metrics"])
     xmap, ticks, xlabel = _x_axis(study)
+    xlabel = _wrap(study.get("title") or xlabel, 28)
     ncol = min(3, len(metrics))
     nrow = math.ceil(len(metrics) / ncol)
     units = [(v, m) for v in (study["variants"] or [""]) for m in study["methods"]]
@@ -70,8 +125,8 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
         fig, axs = plt.subplots(nrow, ncol, figsize=(figures.PAGE_WIDTH_IN, 2.3 * nrow + 0.6),
                                 squeeze=False, constrained_layout=True)
         for ax, metric in zip(axs.ravel(), metrics):
-            label, bound = METRICS[study["paper"]][metric]
-            stat = shown_statistic(study, metric)
+            bound = METRICS[study["paper"]][metric][1]
+            stat = plotted_statistic(study, metric)
             d = tidy[tidy["metric"] == metric]
             for variant, method in units:
                 dm = d[d["method"] == method]
@@ -88,11 +143,15 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
                 if stat == "mean":
                     lo = dm["ci95_low"].to_numpy(float)[order]
                     hi = dm["ci95_high"].to_numpy(float)[order]
+                    if metric.endswith("_pct"):  # a share's interval stays within 0..100 %
+                        lo, hi = np.clip(lo, 0.0, 100.0), np.clip(hi, 0.0, 100.0)
+                    elif metric in NONNEGATIVE[study["paper"]]:  # an error norm, count or time: >= 0
+                        lo = np.clip(lo, 0.0, None)
                     err = np.vstack([y - lo, hi - y])
                     err = np.where(np.isfinite(err), err, 0.0)
                     ax.errorbar(x, y, yerr=err, fmt="o", ls=ls, color=col, ms=3, capsize=2, label=name)
                 else:
-                    ax.plot(x, y, "o", ls=ls, color=col, ms=3, label=f"{name} ({stat})")
+                    ax.plot(x, y, "o", ls=ls, color=col, ms=3, label=name)
             if bound and stat != "mean":
                 b = tidy[(tidy["metric"] == bound)]
                 for j, variant in enumerate(study["variants"] or [""]):
@@ -102,8 +161,10 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
                     o = np.argsort(xb, kind="stable")
                     ax.plot(xb[o], bv["mean"].to_numpy(float)[o], "--", color="k" if j == 0 else "0.55",
                             lw=1.2, label=f"{variant}: CRLB" if variant else "CRLB")
-            ax.set_ylabel(label if stat == "mean" else f"{stat} of {label}")
+            ax.set_ylabel(_wrap(axis_label(metric, study["paper"], stat), 30))
             ax.set_xlabel(xlabel)
+            if metric.endswith(("_us", "_s")) and np.nanmin(d[stat].to_numpy(float)) > 0:
+                ax.set_yscale("log")  # times span decades between methods
             if ticks is not None:
                 ax.set_xticks(range(len(ticks)), ticks, rotation=30 if len(ticks) > 4 else 0)
             else:
@@ -114,5 +175,5 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
             ax.set_visible(False)
         handles, labels = axs.ravel()[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)), fontsize=7)
-        fig.suptitle(f"{study['id']} {study['name']}: {study['title']}", fontsize=9)
+        fig.suptitle(f"{study['id']}: {study['name']} study", fontsize=9)
     return fig
