@@ -50,6 +50,11 @@ VERDICTS = (REPRODUCED, WITH_ADDITION, NOT_REPRODUCED, NOT_REPRODUCIBLE, DEPENDS
 NEEDS_NAMED = (WITH_ADDITION, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED)
 
 #: how each verdict reads in running text (abstract, conclusion)
+#: the verdicts as the at-a-glance table prints them
+VERDICT_SHORT = {
+    "reproduced": "reproduced", "reproduced_with_addition": "with an addition", "not_reproduced": "not reproduced",
+    "not_reproducible": "not reproducible", "depends_on_choice": "depends on a choice", "not_tested": "not tested",
+}
 VERDICT_TEXT = {
     REPRODUCED: "reproduced",
     WITH_ADDITION: "reproduced only with an addition",
@@ -191,18 +196,17 @@ def _with_short(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def key_numbers(df: pd.DataFrame, headline_ids: Iterable[str]) -> list[str]:
-    """One sentence per headline claim with its key numbers: published, ours as written,
-    the best faithful variant and what the verdict names (bound, addition, choice)."""
+    """One sentence per headline claim with its verdict and key numbers: published, ours as
+    written, the best faithful variant, and what the verdict names (bound, addition, choice)."""
     out = []
     for r in _with_short(df).itertuples():
         if r.claim_id not in headline_ids:
             continue
-        s = (f"{r.claim_short[0].upper() + r.claim_short[1:]} ({r.claim_id}): published {r.published}, "
-             f"ours as written {r.ours_as_written}")
+        verb = VERDICT_TEXT[r.verdict] if r.verdict == DEPENDS else "is " + VERDICT_TEXT[r.verdict]
+        s = (f"{r.claim_short[0].upper() + r.claim_short[1:]} ({r.claim_id}) {verb}"
+             + (f" ({r.named})" if r.named else "") + f": published {r.published}, ours {r.ours_as_written}")
         if r.best_variant and r.ours_best:
-            s += f", best faithful variant ({r.best_variant}) {r.ours_best}"
-        if r.named:
-            s += f"; {VERDICT_TEXT[r.verdict]}: {r.named}"
+            s += f", with {r.best_variant} {r.ours_best}"
         out.append(s + ".")
     return out
 

@@ -221,6 +221,7 @@ _PROSE = [
     (re.compile(r"\b1e\+0?(\d+)\b"), r"$10^{\1}$"),
     (re.compile(r"(?<=\d)e\+0?(\d+)\b"), r"$\\times10^{\1}$"),
     (re.compile(r"(?<=\d) %"), r"\\,\\%"),
+    (re.compile(r"\\\^\{\}(-?[0-9.]*[0-9])"), r"$^{\1}$"),
     (re.compile(r"\bus\b"), r"\\textmu s"),
 ]
 
@@ -252,7 +253,10 @@ def table1_grouped_latex(t1: "pd.DataFrame", groups: Iterable[str] = TABLE1_GROU
     by = {(r["variant"], r["case_id"]): r for _, r in t1.iterrows()}
 
     def num(x, f="{:.1f}"):
-        return MISSING if x is None or pd.isna(x) else f.format(float(x))
+        if x is None or pd.isna(x):
+            return MISSING
+        t = f.format(float(x))
+        return t[1:] if t.startswith("-") and float(t) == 0 else t  # no "-0.0"
 
     cols = "ll" + "rrr" * (len(groups) + 1)
     head1 = ["", "", r"\multicolumn{3}{c}{published}"] + [rf"\multicolumn{{3}}{{c}}{{{latex_escape(g)}}}" for g in groups]
@@ -286,6 +290,8 @@ def in_pdf(path: str | Path, drop_variants: Iterable[str]) -> bool:
         return False
     if p.suffix == ".tex" and "studies" in p.parts:
         return False
+    if "studies" in p.parts:  # a study's name is not a variant (the "prior" study)
+        return True
     return not any(stem.endswith("_" + v) for v in drop_variants)
 
 
@@ -302,24 +308,24 @@ def format_sci(x: float) -> str:
 
 # ------------------------------------------------------------ the claims table in LaTeX
 
-def claims_glance_latex(df: pd.DataFrame) -> str:
+def claims_glance_latex(df: "pd.DataFrame") -> str:
     """The at-a-glance table as a LaTeX tabular (wrapping text columns, one row per claim)."""
-    from opnav.claims import VERDICT_TEXT
+    from opnav.claims import VERDICT_SHORT
 
-    lines = [r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.36\linewidth}"
-             r">{\raggedright\arraybackslash}p{0.15\linewidth}>{\raggedright\arraybackslash}p{0.22\linewidth}"
-             r">{\raggedright\arraybackslash}p{0.14\linewidth}@{}}", r"\toprule",
+    lines = [r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.38\linewidth}"
+             r">{\raggedright\arraybackslash}p{0.16\linewidth}>{\raggedright\arraybackslash}p{0.25\linewidth}"
+             r">{\raggedright\arraybackslash}p{0.1\linewidth}@{}}", r"\toprule",
              r"id & claim & published & ours, as written & verdict \\", r"\midrule"]
     for i, r in enumerate(df.itertuples()):
         if i and r.paper != df.iloc[i - 1]["paper"]:
             lines.append(r"\midrule")
         lines.append(" & ".join([r.claim_id, prose_tex(r.claim), prose_tex(r.published), prose_tex(r.ours_as_written),
-                                 r"\textit{" + prose_tex(VERDICT_TEXT[r.verdict]) + "}"]) + r" \\")
+                                 r"\textit{" + prose_tex(VERDICT_SHORT[r.verdict]) + "}"]) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}"]
     return "\n".join(lines) + "\n"
 
 
-def claims_detail_latex(df: pd.DataFrame) -> str:
+def claims_detail_latex(df: "pd.DataFrame") -> str:
     """Every claim with all its columns, as a LaTeX description list (the claims table in full)."""
     from opnav.claims import VERDICT_TEXT
 

@@ -43,7 +43,7 @@ rule paper_claims:
         code=src("claims.py", "approach/claims.py", "landing/claims.py", "verdicts.py", "manuscript.py",
                  "published.py"),
     output:
-        csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="1. Claims"),
+        csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims"),
         md=f"{PAPER}/claims.md",
         tex=f"{PAPER}/claims_glance.tex",
         detail=f"{PAPER}/claims_detail.tex",
@@ -166,7 +166,7 @@ rule paper_pdf:
         generated=PAPER_INPUTS,
         results=[t for t in _targets if t.endswith((".pdf", ".tex"))],
     output:
-        f"{PAPER}/main.pdf",
+        report(f"{PAPER}/main.pdf", caption=_caption("manuscript"), category="Claims"),
     params:
         paper_dir=lambda wildcards, input: str(Path(input.main).parent),
         build=f"{PAPER}/build",
