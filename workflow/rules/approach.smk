@@ -24,8 +24,8 @@ A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
         for v in A_VARIANTS for g in a_groups(v) for m in A_METHODS}
 _a_seg, _a_grow = config["approach"]["segments"], config["approach"]["growing"]
 if _a_grow["methods"] and (_a_seg["L"] * _a_seg["N"]) % _a_grow["N"]:
-    raise ValueError(f"config approach.growing.N = {_a_grow['N']} must divide approach.segments.L * N = "
-                     f"{_a_seg['L'] * _a_seg['N']} (growing windows cover the same data)")
+    config_exit(f"invalid config key 'approach.growing.N': {_a_grow['N']} does not divide approach.segments.L x N "
+                f"= {_a_seg['L'] * _a_seg['N']}")  # checked before (opnav.checks.growing_problems)
 # Table 1 again with growing windows (approach.growing), as its own rows: scheme "growing-<method>"
 A_MC_GROWING = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__growing-{m}.pkl"
                 for v in A_VARIANTS for g in a_groups(v) for m in config["approach"]["growing"]["methods"]}

@@ -38,7 +38,7 @@ try:
     B_SCENARIO_CFG = camera_scenarios(config["landing"])
     B_HEADLINE = headline_scenario(config["landing"])
 except ValueError as exc:
-    raise ConfigError(str(exc)) from None
+    config_exit(exc)  # checked before (opnav.checks): the one way out, should it happen
 # Camera scenarios (landing.scenarios): each flies its own Monte Carlo under
 # results/landing/mc/{bscn}/ and gets its own B-F5, B-F6, B-F7, B-T3, B-X1 (file
 # stems end in _{bscn}, as paper A's variants); B-summary.json gathers them all,
