@@ -77,7 +77,7 @@ def _duplicates(items) -> list:
 
 def config_problems(config: dict, root: str | Path | None = None,
                     workdir: str | Path | None = None, *, skip=(), sections=None,
-                    workflow: bool = False) -> list[str]:
+                    workflow: bool = False, plan_studies=None) -> list[str]:
     """Every problem of a schema-valid ``config`` (defaults filled), one line each,
     naming the key(s): ``results_dir``, the ``approach`` and ``landing`` sections and,
     with ``workflow`` (the Snakefile, ``opnav study``), what only the workflow reads:
@@ -85,7 +85,9 @@ def config_problems(config: dict, root: str | Path | None = None,
     :func:`opnav.studies.plan`) and the job-graph bounds (:func:`job_problems`).
     ``root`` is the checkout (default: the working directory), ``workdir`` where
     relative outputs go (default: ``root``); sections in ``skip`` (their schema failed)
-    are not read; ``sections`` (default all) limits the checks to those sections."""
+    are not read; ``sections`` (default all) limits the checks to those sections;
+    ``plan_studies(config)`` plans the studies, raising :class:`ConfigError` (handed in
+    by :func:`opnav.config.validate_config`: :mod:`opnav.studies` imports this module)."""
     want = set(sections) if sections is not None else {"results_dir", "approach", "landing", "studies",
                                                         "limits"}
     todo = want - set(skip)
@@ -108,15 +110,29 @@ def config_problems(config: dict, root: str | Path | None = None,
     jobs = []                           # counted, not built: first, as planning a study costs per value
     if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
         jobs = job_problems(config)
-    if ("studies" in todo and config.get("studies") and not jobs
+    if ("studies" in todo and config.get("studies") and not jobs and plan_studies is not None
             and not unsound & {"approach", "landing", "limits"}):
-        from opnav.studies import plan
-
         try:
-            plan(config)
+            plan_studies(config)
         except ValueError as exc:        # ConfigError: one line per problem
             out += str(exc).splitlines()
     return out + jobs
+
+
+#: Default upper bound on a study's value sets (config ``limits.max_study_values``).
+MAX_STUDY_VALUES = 100
+
+
+def study_size_problem(name: str, spec: Mapping, limit: int) -> str | None:
+    """The line refusing study ``name`` if it has more than ``limit`` value sets
+    (``limits.max_study_values``), counted without expanding them."""
+    lens = [len(v) for v in spec["vary"].values()]
+    n_sets = math.prod(lens) if spec.get("grid", False) else max(lens, default=0)
+    if n_sets <= limit:
+        return None
+    lens = " x ".join(str(len(v)) for v in spec["vary"].values())
+    return (f"invalid config key 'studies.{name}.vary' (study '{name}'): {lens} = {n_sets} value sets exceed "
+            f"limits.max_study_values = {limit} (each is a Monte Carlo; raise the limit to mean it)")
 
 
 def growing_problems(a: dict) -> list[str]:
@@ -160,11 +176,9 @@ def job_problems(config: dict) -> list[str]:
     """The job graph within ``limits.max_jobs`` (Snakemake takes ~10 ms a job to build
     it, at every call) and each study within ``limits.max_study_values``, counted before
     anything is built or planned (:func:`_jobs`)."""
-    from opnav.studies import MAX_STUDY_VALUES, size_problem
-
     limits = config.get("limits") or {}
     out = [line for name, spec in (config.get("studies") or {}).items()
-           if (line := size_problem(name, spec, limits.get("max_study_values", MAX_STUDY_VALUES)))]
+           if (line := study_size_problem(name, spec, limits.get("max_study_values", MAX_STUDY_VALUES)))]
     limit = limits.get("max_jobs", 2000)
     parts = _jobs(config)
     total = OTHER_JOBS + sum(parts.values())

@@ -18,8 +18,9 @@ from typing import Any
 import yaml
 
 
-class ConfigError(ValueError):
-    """A configuration value is missing, of the wrong type or out of range."""
+from opnav.errors import ConfigError  # noqa: E402  (defined in the base layer; its home for users)
+
+__all__ = ["ConfigError", "validate_config", "load_config", "read_config_file", "validate_study_value"]
 
 
 _INSTANCE_RE = re.compile(r"On instance((?:\[[^\]]+\])*)")
@@ -205,10 +206,23 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
 
         broken = {_top(line) for line in lines}
         if "" not in broken:        # a top-level schema error: no section is safe to read
-            lines += config_problems(config, root, workdir, skip=broken, sections=sections, workflow=workflow)
+            lines += config_problems(config, root, workdir, skip=broken, sections=sections, workflow=workflow,
+                                     plan_studies=_plan_studies)
     if lines:
         raise ConfigError("\n".join(dict.fromkeys(lines)))
     return config
+
+
+def _plan_studies(config: dict) -> None:
+    from opnav.studies import plan
+
+    plan(config, validate_paper=validate_study_value)
+
+
+def validate_study_value(merged: dict, paper: str) -> None:
+    """A parameter study's value: its merged config (every study removed) through the
+    schema and the physics checks of the study's paper section (:func:`opnav.studies.plan`)."""
+    validate_config(merged, sections=(paper,))
 
 
 def _top(line: str) -> str:

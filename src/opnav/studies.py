@@ -45,7 +45,8 @@ from typing import Any, Callable, Iterable, Mapping
 import numpy as np
 import pandas as pd
 
-from opnav.config import ConfigError
+from opnav.checks import MAX_APPROACH_SEED_SAMPLES, MAX_STUDY_VALUES, study_size_problem
+from opnav.errors import ConfigError
 
 __all__ = ["METRICS", "CONSTANT_METRICS", "APPROACH_METHODS", "SIM_KEYS", "Study", "plan", "simulation_shapes",
            "config_digest",
@@ -275,22 +276,6 @@ def _sorted(x):
     return {k: _sorted(x[k]) for k in sorted(x)} if isinstance(x, Mapping) else x
 
 
-def _n_value_sets(spec: Mapping) -> int:
-    lens = [len(v) for v in spec["vary"].values()]
-    return math.prod(lens) if spec.get("grid", False) else (max(lens) if lens else 0)
-
-
-def size_problem(name: str, spec: Mapping, limit: int) -> str | None:
-    """The line refusing study ``name`` if it has more than ``limit`` value sets
-    (``limits.max_study_values``), counted without expanding them."""
-    n_sets = _n_value_sets(spec)
-    if n_sets <= limit:
-        return None
-    lens = " x ".join(str(len(v)) for v in spec["vary"].values())
-    return (f"invalid config key 'studies.{name}.vary' (study '{name}'): {lens} = {n_sets} value sets exceed "
-            f"limits.max_study_values = {limit} (each is a Monte Carlo; raise the limit to mean it)")
-
-
 def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
     vary = spec["vary"]
     keys = list(vary)
@@ -306,25 +291,26 @@ def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
     return [dict(zip(keys, c)) for c in combos]
 
 
-#: Default upper bound on a study's value sets (config ``limits.max_study_values``).
-MAX_STUDY_VALUES = 100
-
 _PLANS: dict[str, dict] = {}
 
 
 def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
          validate: Callable[[dict], Any] | None = None,
-         landing_methods: Iterable[str] | None = None) -> dict[str, Study]:
+         landing_methods: Iterable[str] | None = None, *,
+         validate_paper: Callable[[dict, str], Any] | None = None) -> dict[str, Study]:
     """Every study of ``config["studies"]``, checked and expanded (module docstring).
 
     ``shapes[paper]`` is the simulation's view of ``config[paper]`` (default
     :func:`simulation_shapes`); ``validate(cfg)`` raises :class:`ConfigError` (or
-    ``ValueError``) for a bad merged config (default: the schema and the physics
-    checks of that paper's section); ``landing_methods`` are the planner's method names
-    (default: its registry). Raises one :class:`ConfigError` with one line per
-    problem of every study, each naming ``studies.<name>...``. With every default the
+    ``ValueError``) for a bad merged config, or ``validate_paper(cfg, paper)`` (the
+    workflow's: :func:`opnav.config.validate_study_value`, which checks that paper's
+    section alone); ``landing_methods`` are the planner's method names (default: its
+    registry). Raises one :class:`ConfigError` with one line per problem of every
+    study, each naming ``studies.<name>...``. Without shapes, validate and methods the
     plan is cached per config (the Snakefile's validation and studies.smk plan once).
     """
+    if validate is None and validate_paper is None:
+        raise TypeError("plan() needs validate or validate_paper")
     key = None
     if shapes is None and validate is None and landing_methods is None:
         key = json.dumps(config, sort_keys=True, default=repr)
@@ -332,17 +318,16 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
             return _PLANS[key]
     if shapes is None:
         shapes = simulation_shapes(config)
-    if validate is None:
-        validate = _validate_paper
     if landing_methods is None:
         from opnav.landing.planner import available_methods
 
         landing_methods = available_methods()
+    check = validate_paper if validate is None else (lambda cfg, paper: validate(cfg))
     out, problems = {}, []
     limit = int((config.get("limits") or {}).get("max_study_values", MAX_STUDY_VALUES))
     for name, spec in (config.get("studies") or {}).items():
         try:
-            out[name] = _plan_one(name, spec, config, shapes, validate, tuple(landing_methods), limit)
+            out[name] = _plan_one(name, spec, config, shapes, check, tuple(landing_methods), limit)
         except ConfigError as exc:
             problems += str(exc).splitlines()
     if problems:
@@ -353,20 +338,18 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
     return out
 
 
-def _validate_paper(merged: dict) -> None:
-    from opnav.config import validate_config
-
-    validate_config(merged, sections=(merged.pop("_paper"),))
-
-
 @functools.lru_cache(maxsize=1)
 def _spec_defaults() -> dict:
     """Per-study defaults from the schema (validators fill ``properties`` defaults only,
     not those of a map's ``additionalProperties``); read once per process, shared: callers
     merge it into a new dict and never change it."""
-    from opnav.config import SCHEMA_PATH, read_yaml
+    from pathlib import Path
 
-    props = read_yaml(SCHEMA_PATH.parent / "studies.schema.yaml")["additionalProperties"]["properties"]
+    import yaml
+
+    schema = Path(__file__).resolve().parent / "schemas" / "studies.schema.yaml"
+    props = yaml.load(schema.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    props = props["additionalProperties"]["properties"]
     return {k: v["default"] for k, v in props.items() if "default" in v}
 
 
@@ -410,7 +393,7 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
     unknown = [m for m in metrics if m not in METRICS[paper]]
     if unknown:
         bad("metrics", f"unknown metric(s) {unknown}; available for {paper}: {', '.join(METRICS[paper])}")
-    too_many = size_problem(name, spec, limit)
+    too_many = study_size_problem(name, spec, limit)
     if too_many:
         problems.append(too_many)
     if problems:
@@ -420,17 +403,15 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
     for values in _value_sets(name, spec):
         merged = copy.deepcopy(dict(config))
         merged.pop("studies", None)
-        if paper == "landing":
-            # a study flies the base camera (no scenario overlay): its value is checked so
-            merged["landing"]["scenarios"] = {"study": {}}
-            merged["landing"]["headline_scenario"] = "study"
         for k, v in {**fixed, **values}.items():
             set_path(merged, k, v)
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+        checked = merged
+        if paper == "landing":  # a study flies the base camera (no scenario overlay): checked so
+            checked = {**merged, "landing": {**merged["landing"], "scenarios": {"study": {}},
+                                             "headline_scenario": "study"}}
         try:
-            if validate is _validate_paper:
-                merged["_paper"] = paper
-            validate(merged)
+            validate(checked, paper)
         except (ConfigError, ValueError) as exc:
             for line in str(exc).splitlines():
                 bad("vary", f"value {shown} refused: {line}")
@@ -467,7 +448,6 @@ def _check_approach_job_size(where: str, approach: Mapping, seeds_per_job: int) 
     """A paper-A study job runs its seeds batched over the whole arc: the same memory
     limit as the Monte Carlo's (:data:`opnav.checks.MAX_APPROACH_SEED_SAMPLES`)."""
     from opnav.approach.scenario import n_samples
-    from opnav.checks import MAX_APPROACH_SEED_SAMPLES
 
     n = n_samples(approach)
     if seeds_per_job * n > MAX_APPROACH_SEED_SAMPLES:
