@@ -1,0 +1,174 @@
+"""The quick profile through a real single-node SLURM (``.ci/slurm-cluster``) and the
+executor plugin (``--workflow-profile profiles/slurm``), compared with the local build.
+
+Runs where the cluster can be started: Linux, as root, with slurm-wlm installed or
+apt-get to install it (CI). Elsewhere it is skipped with one line saying why. Deselect
+with ``-m "not cluster"``. The cluster is started by the test and stopped at its end
+(if it was not already running), by the daemons' pid files; one cluster test at a time
+per machine (a lock file), so two sessions never share or stop each other's daemons.
+"""
+
+import fcntl
+import os
+import re
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from conftest import REPO, _snakemake_cmd, copy_workflow
+
+pytestmark = [pytest.mark.cluster, pytest.mark.slow]
+
+SCRIPT = REPO / ".ci" / "slurm-cluster"
+# What a cluster without accounting (no slurmdbd) needs: job status from squeue (the
+# plugin would ask sacct, which answers nothing, and wait forever), and the logs of
+# successful jobs kept, to see that the jobs went through sbatch. A private one-node
+# cluster can be polled every 10 s instead of the plugin's 40 s (docs/cluster.md).
+CLUSTER_ARGS = ("--workflow-profile", "profiles/slurm", "--configfile", "config/quick.yaml",
+                "--slurm-status-command", "squeue", "--slurm-keep-successful-logs",
+                "--slurm-init-seconds-before-status-checks", "10")
+RUN_TIMEOUT_S = 1800
+# Measured times differ between any two runs (on a shared node more so): columns named
+# for a time or CPU time ("timed_calls" is a count), and rows of long tables whose text
+# names one (metric "median_plan_time_us", the scorecard's planning-time rows). Every
+# other cell must be equal.
+TIMING = re.compile(r"time(?!d)|cpu", re.IGNORECASE)
+
+
+def _why_not() -> str | None:
+    if not sys.platform.startswith("linux"):
+        return "SLURM cluster test: Linux only"
+    if os.geteuid() != 0:
+        return "SLURM cluster test: needs root to start munged/slurmctld/slurmd (.ci/slurm-cluster)"
+    if not any(os.access(os.path.join(d, b), os.X_OK) for d in os.environ.get("PATH", "").split(os.pathsep)
+               for b in ("apt-get", "slurmctld")):
+        return "SLURM cluster test: neither slurm-wlm nor apt-get to install it"
+    return None
+
+
+def _script(cmd: str, timeout: float = 900) -> subprocess.CompletedProcess:
+    return subprocess.run(["bash", str(SCRIPT), cmd], capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def slurm_cluster():
+    """A running single-node SLURM; stopped afterwards if this fixture started it."""
+    why = _why_not()
+    if why:
+        pytest.skip(why)
+    with open("/run/opnav-slurm-test.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)           # another session's cluster test first
+        was_up = _script("status").returncode == 0
+        started = False
+        try:
+            if not was_up:
+                p = _script("start")
+                if p.returncode == 3:              # cannot run here: one line says why
+                    pytest.skip("SLURM cluster test: " + p.stderr.strip().splitlines()[-1])
+                assert p.returncode == 0, p.stdout + p.stderr
+                started = True
+            yield
+        finally:
+            if started:
+                p = _script("stop", timeout=120)
+                assert p.returncode == 0, p.stdout + p.stderr
+
+
+def _run_through_slurm(wd: Path) -> subprocess.CompletedProcess:
+    cmd, env = _snakemake_cmd(wd, *CLUSTER_ARGS)
+    proc = subprocess.Popen(cmd, cwd=wd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=RUN_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+        subprocess.run(["scancel", "--user", "root"], check=False)
+        pytest.fail(f"the run through SLURM did not end in {RUN_TIMEOUT_S} s:\n{out[-4000:]}")
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, "")
+
+
+def _sbatch_ids(log: str) -> list[int]:
+    """The SLURM job ids of the plugin's submissions (single, group and array jobs)."""
+    return [int(m.group(1) or m.group(2)) for m in re.finditer(
+        r"has been submitted with SLURM jobid (\d+)|Submitted array job with .* SLURM job ID (\d+)", log)]
+
+
+def _job_outputs(log: str, kinds: tuple[str, ...]) -> dict[str, str]:
+    """{output file: rule} of the job blocks of a Snakemake log ("rule X:" blocks are
+    jobs for the executor, "localrule X:" jobs run in that process; a group job's
+    blocks are indented); ``kinds`` picks "rule" and/or "localrule"."""
+    outs = {}
+    for m in re.finditer(r"^( *)(rule|localrule) (\w+):\n((?:\1 {4}.*\n)+)", log, re.MULTILINE):
+        o = re.search(r"^ *output: (.*)$", m.group(4), re.MULTILINE)
+        if m.group(2) in kinds and o:
+            outs.update(dict.fromkeys(o.group(1).split(", "), m.group(3)))
+    return outs
+
+
+def _tables(root: Path) -> dict[str, pd.DataFrame]:
+    return {p.relative_to(root).as_posix(): pd.read_csv(p) for p in sorted(root.rglob("*.csv"))
+            if "benchmarks" not in p.parts}
+
+
+def _untimed(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` without its timing columns and timing rows (see TIMING)."""
+    text = df.select_dtypes(exclude="number").astype(str)
+    timed_row = text.apply(lambda col: col.str.contains(TIMING)).any(axis=1)
+    return df.loc[~timed_row, [c for c in df.columns if not TIMING.search(str(c))]]
+
+
+def _differing(local: pd.DataFrame, slurm: pd.DataFrame) -> list[str]:
+    """The columns whose untimed cells differ (or a shape mismatch)."""
+    if list(local.columns) != list(slurm.columns) or local.shape != slurm.shape:
+        return [f"shape {local.shape} vs {slurm.shape}"]
+    a, b = _untimed(local), _untimed(slurm)
+    if a.shape != b.shape:
+        return [f"timing rows {a.shape} vs {b.shape}"]
+    bad = []
+    for c in a.columns:
+        if pd.api.types.is_numeric_dtype(a[c]) and pd.api.types.is_numeric_dtype(b[c]):
+            same = np.array_equal(a[c].to_numpy(float), b[c].to_numpy(float), equal_nan=True)
+        else:
+            same = list(a[c].fillna("").astype(str)) == list(b[c].fillna("").astype(str))
+        if not same:
+            bad.append(c)
+    return bad
+
+
+def test_quick_profile_through_slurm_equals_the_local_build(slurm_cluster, quick_results, tmp_path):
+    wd = copy_workflow(tmp_path)
+    proc = _run_through_slurm(wd)
+    log = proc.stdout
+    assert proc.returncode == 0, log[-6000:]
+
+    # The cluster rules went through sbatch: SLURM wrote a log for every submission, and
+    # the jobs run inside the SLURM jobs (their logs) are exactly the jobs Snakemake
+    # handed to the executor.
+    remote = _job_outputs(log, ("rule",))
+    assert remote, "no job went to the SLURM executor:\n" + log[-3000:]
+    ids = _sbatch_ids(log)
+    logs = list((wd / ".snakemake" / "slurm_logs").rglob("*.log"))
+    assert set(ids) <= {int(re.match(r"\d+", p.name).group()) for p in logs}, (ids, logs)
+    inside = {}
+    for p in logs:
+        inside.update(_job_outputs(p.read_text(errors="replace"), ("rule", "localrule")))
+    assert inside == remote, sorted(set(inside.items()) ^ set(remote.items()))
+    # ... and they are the rules the profile sends to the cluster (the measured ones)
+    profile = yaml.safe_load((wd / "profiles" / "slurm" / "config.yaml").read_text())
+    assert set(remote.values()) == set(profile["set-resources"]), sorted(set(remote.values()))
+    print(f"through SLURM: {len(remote)} output files of {len(set(remote.values()))} rules, "
+          f"{len(ids)} sbatch calls")
+
+    # Every table equals the local build's, apart from measured times.
+    results = "results/quick"
+    local, slurm = _tables(quick_results / results), _tables(wd / results)
+    assert local and sorted(local) == sorted(slurm), sorted(set(local) ^ set(slurm))
+    differ = {name: cols for name in local if (cols := _differing(local[name], slurm[name]))}
+    assert not differ, differ
