@@ -73,7 +73,7 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     # same (batch size changes numbers only at round-off, tests/test_landing_batch.py)
     clean = run_chunk(cfg, "depth", [0, 1, 2], batch_size=1)
     got = load(wd / target)
-    assert set(got) - {"method"} == set(clean)
+    assert set(got) - {"method", "reuse_key"} == set(clean)
     differ = {k for k in clean if not np.array_equal(np.asarray(got[k]), np.asarray(clean[k]),
                                                      equal_nan=np.asarray(clean[k]).dtype.kind == "f")}
     assert not differ, differ

@@ -2,8 +2,9 @@
 
 import sys
 
-from opnav.landing.montecarlo import run_chunk, save
+from opnav.landing.montecarlo import run_chunk_reusing, save
 from opnav.snakeio import mock_snakemake, script_context
+from opnav.studies import config_digest
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_mc_chunk", argv=sys.argv[1:], bscn="site-tilt", bmethod="depth", bchunk="r0000-0001")
@@ -11,6 +12,12 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     method = snakemake.wildcards.bmethod
     runs = list(snakemake.params.runs)
-    data = run_chunk(snakemake.params.landing, method, runs, pick_ratio=bool(snakemake.params.pick_ratio))
+    pick_ratio = bool(snakemake.params.pick_ratio)
+    # runs of an earlier, smaller chunk beside this one are taken over, not flown again,
+    # when flown with the same simulation, method and diagnostics (the reuse key)
+    key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio})
+    data, flown = run_chunk_reusing(snakemake.output[0], key, snakemake.params.landing, method, runs,
+                                    pick_ratio=pick_ratio)
     save(snakemake.output[0], data, method)
-    log.info("%s: runs %s..%s, %d planning calls", method, runs[0], runs[-1], len(data["plan_index"]))
+    log.info("%s: runs %s..%s (%d flown, %d taken from earlier chunks), %d planning calls", method,
+             runs[0], runs[-1], len(flown), len(runs) - len(flown), len(data["plan_index"]))

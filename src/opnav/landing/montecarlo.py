@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 
 from typing import TYPE_CHECKING
 
@@ -44,7 +45,7 @@ from opnav.landing import records   # numpy only
 from opnav.landing.records import CALL_KEYS, load
 
 __all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
-           "chunks", "chunk_label", "chunk_runs", "CHUNK_PATTERN",
+           "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality", "landmark_phase", "phase_rms", "time_below", "nees_band", "nees_consistency"]
 
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
@@ -62,8 +63,9 @@ def chunk_label(run_indices) -> str:
     """A chunk's name from its (consecutive) run indices: ``[4, 5]`` -> ``"r0004-0005"``.
 
     Chunk files are named by the runs they hold, not by their position, so
-    raising ``n_runs`` keeps every full chunk (same name, same runs) and only
-    the new runs (and a formerly partial last chunk) are flown.
+    raising ``n_runs`` keeps every full chunk (same name, same runs); a formerly
+    partial last chunk's runs are taken over by the chunk that replaces it
+    (:func:`earlier_chunks`), so only the new runs are flown.
     """
     runs = [int(i) for i in run_indices]
     if not runs or runs != list(range(runs[0], runs[0] + len(runs))):
@@ -77,6 +79,53 @@ def chunk_runs(label: str) -> list[int]:
     if not m or int(m.group(2)) < int(m.group(1)):
         raise ValueError(f"not a Monte-Carlo chunk label: {label!r} (expected e.g. 'r0000-0024')")
     return list(range(int(m.group(1)), int(m.group(2)) + 1))
+
+
+def earlier_chunks(path, run_indices) -> list[tuple[Path, list[int]]]:
+    """Chunk files beside ``path`` (same folder and suffix, :func:`chunk_label`
+    names, not ``path`` itself) holding only runs of ``run_indices``: what a
+    smaller ``n_runs`` (or study ``runs``) left, e.g. ``r0000-0003`` when
+    ``r0000-0005`` is asked for. Disjoint, the largest first; (path, runs) pairs.
+    Each run's random stream depends on its index only, so their runs need not be
+    flown again; the caller checks that they were flown with the same config."""
+    path = Path(path)
+    want = {int(i) for i in run_indices}
+    found = []
+    for p in path.parent.glob(f"r*{path.suffix}"):
+        try:
+            runs = chunk_runs(p.name[:-len(path.suffix)] if path.suffix else p.name)
+        except ValueError:
+            continue
+        if p.name != path.name and set(runs) <= want:
+            found.append((p, runs))
+    taken, out = set(), []
+    for p, runs in sorted(found, key=lambda f: (-len(f[1]), f[1][0])):
+        if not taken & set(runs):
+            out.append((p, runs))
+            taken |= set(runs)
+    return out
+
+
+def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_indices,
+                      pick_ratio: bool = True) -> tuple[dict, list[int]]:
+    """:func:`run_chunk` for the chunk file ``path``, taking the runs already
+    flown in :func:`earlier_chunks` whose stored ``reuse_key`` (a digest of
+    everything the runs depend on, given by the caller) equals ``reuse_key``:
+    (the chunk, as :func:`run_chunk` would return it, with ``reuse_key``; the run
+    indices actually flown). Gathering in run order makes it the same chunk
+    whatever was reused (:func:`gather`)."""
+    idx = [int(i) for i in run_indices]
+    parts = []
+    for p, _ in earlier_chunks(path, idx):
+        old = load(p)
+        if str(old.get("reuse_key", "")) == reuse_key:
+            parts.append({k: v for k, v in old.items() if k not in ("method", "reuse_key")})
+    have = {int(i) for part in parts for i in part["run_index"]}
+    todo = [i for i in idx if i not in have]
+    if todo:
+        parts.append(run_chunk(landing_cfg, method, todo, pick_ratio=pick_ratio))
+    data = parts[0] if len(parts) == 1 else gather(parts)
+    return {**data, "reuse_key": np.array(reuse_key)}, todo
 
 
 #: Snakemake wildcard pattern of :func:`chunk_label`.
