@@ -139,10 +139,10 @@ def test_slurm_workflow_profile_dry_run_account_and_measured_resources(workdir):
                          "--default-resources", "slurm_account=acct42", "slurm_partition=part7",
                          "--configfile", "config/quick.yaml")
     assert proc.returncode == 0, proc.stderr[-3000:]
-    jobs = re.split(r"\n(?=(?:local)?rule \w+:)", proc.stdout)
+    jobs = re.split(r"\n(?= *(?:local)?rule \w+:)", proc.stdout)   # a group job's rules are indented
     seen = set()
     for block in jobs:
-        m = re.match(r"(?:local)?rule (\w+):", block)
+        m = re.match(r" *(?:local)?rule (\w+):", block)
         res = re.search(r"resources: (.*)", block)
         if not m or not res:
             continue

@@ -1,6 +1,8 @@
 """One Monte-Carlo job of paper B: runs `params.runs` of `wildcards.method` (scatter)."""
 
+import hashlib
 import sys
+from pathlib import Path
 
 from opnav.landing.montecarlo import run_chunk_reusing, save
 from opnav.snakeio import mock_snakemake, script_context
@@ -14,8 +16,11 @@ with script_context(snakemake) as log:
     runs = list(snakemake.params.runs)
     pick_ratio = bool(snakemake.params.pick_ratio)
     # runs of an earlier, smaller chunk beside this one are taken over, not flown again,
-    # when flown with the same simulation, method and diagnostics (the reuse key)
-    key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio})
+    # when flown with the same simulation, method, diagnostics and source code (the
+    # rule's inputs are the src modules): the reuse key
+    code = sorted(hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in snakemake.input)
+    key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio,
+                         "code": code})
     data, flown = run_chunk_reusing(snakemake.output[0], key, snakemake.params.landing, method, runs,
                                     pick_ratio=pick_ratio)
     save(snakemake.output[0], data, method)
