@@ -151,3 +151,14 @@ def test_true_theta_floor_above_the_limit_makes_compensation_not_reproducible():
     assert r["verdict"] == C.NOT_REPRODUCIBLE and "41.8" in r["named"]
     low = {**SUMMARY_A, "variants": {"literal": {"nav_err_true_theta_km": 12.0, "nav_err_true_theta_rng_km": 10.0}}}
     assert by_id(rows_a(low, t, PUB["paper_a"]))["A-C7"]["verdict"] == C.NOT_REPRODUCED
+
+
+def test_variants_beyond_the_paper_never_earn_a_verdict_but_are_named():
+    t = table(literal={"err": 10.0, "bound": 20.6}, roll={"err": 8.0, "bound": 9.0})
+    stars = _row("stars", "T1-01", "size", 0.1, err=0.2, bound=0.2)
+    stars["tz_observable"] = True
+    t = pd.concat([t, pd.DataFrame([stars])], ignore_index=True)
+    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))
+    assert r["A-C1"]["verdict"] == C.NOT_REPRODUCIBLE and r["A-C1"]["best_variant"] == "roll"
+    assert "beyond the paper, stars reaches it" in r["A-C1"]["cause"]
+    assert r["A-C9"]["verdict"] == C.REPRODUCED and "stars" in r["A-C9"]["cause"]

@@ -92,3 +92,42 @@ def test_no_nan_text_reaches_the_manuscript():
     df = pd.DataFrame({"x": [1.0, np.nan, np.inf], "s": ["a", None, "b"]})
     for out in (to_latex(df), to_markdown(df)):
         assert not nanword.search(out), out
+
+
+def test_prose_typography():
+    from opnav.manuscript import prose_tex
+
+    t = prose_tex("tx = 1.2 +- 0.3 arcsec, theta from 1e+06 km, rho*theta, 29 % less, 5 us, rate^-0.99, a_b")
+    assert r"$t_x$" in t and r"$\pm$" in t and r"1.2" in t and r"0.3\arcsec{}" in t
+    assert r"$\theta$" in t and r"$10^{6}$" in t and r"$\rho\theta$" in t
+    assert r"29\,\%" in t and r"\textmu s" in t and r"$^{-0.99}$" in t and r"a\_b" in t
+    assert "+-" not in t and "theta" not in t.replace(r"\theta", "")
+
+
+def test_table1_grouped_has_one_column_group_per_variant_and_marks_unconverged():
+    import pandas as pd
+
+    from opnav.manuscript import table1_grouped_latex
+
+    rows = []
+    for v, lab in (("literal", "converged"), ("roll", "stalled")):
+        for c in ("T1-01", "T1-02"):
+            rows.append({"variant": v, "case_id": c, "truth_x_arcsec": 10, "truth_y_arcsec": 20,
+                         "pub_est_x_mean": 11.43, "pub_est_y_mean": 21.21, "pub_nav_err_after_km": 18.43,
+                         "est_x_mean": -0.01, "est_y_mean": 19.9, "nav_err_after_km": 100.0, "label": lab})
+    tex = table1_grouped_latex(pd.DataFrame(rows), groups=("literal", "roll", "absent"))
+    assert r"\multicolumn{3}{c}{literal}" in tex and r"\multicolumn{3}{c}{roll}" in tex and "absent" not in tex
+    body = [line for line in tex.splitlines() if line.startswith("T1-01")][0]
+    assert body.count(r"$^\dagger$") == 2  # roll's t_x and t_y, not literal's
+    assert "-0.0" not in tex and "11.43" in tex
+
+
+def test_pdf_selection_drops_variants_not_studies():
+    from opnav.manuscript import in_pdf
+
+    drop = ["prior", "reference-start"]
+    assert in_pdf("results/approach/A-F4_bias_estimate_literal.pdf", drop)
+    assert not in_pdf("results/approach/A-F4_bias_estimate_prior.pdf", drop)
+    assert in_pdf("results/studies/prior/A-X5_prior.pdf", drop)       # the 'prior' study stays
+    assert not in_pdf("results/studies/prior/A-X5_prior.tex", drop)   # a study's table: CSV only
+    assert not in_pdf("results/approach/A-T1_table1.tex", drop)       # shown grouped

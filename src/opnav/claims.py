@@ -95,6 +95,7 @@ class Outcome:
     text: str                 # our value, as text with units
     score: float = math.inf   # lower is better (to pick the best variant)
     diagnostic: bool = False  # uses the truth: never earns "reproduced"
+    beyond: bool = False      # beyond the paper (what practitioners do): never earns "reproduced" either
     extra: dict = field(default_factory=dict)
 
 
@@ -107,7 +108,7 @@ def decide(outcomes: Mapping[str, Outcome], as_written: str, describe: Callable[
     text) when an information bound of the as-written variant excludes the claim.
     Returns (verdict, as-written outcome, best faithful outcome or None, named)."""
     lit = outcomes.get(as_written)
-    faithful = [o for k, o in outcomes.items() if k != as_written and not o.diagnostic]
+    faithful = [o for k, o in outcomes.items() if k != as_written and not o.diagnostic and not o.beyond]
     best = min(faithful, key=lambda o: (not o.ok, o.score, o.label), default=None)
     if lit is not None and lit.ok:
         return REPRODUCED, lit, None, ""
@@ -119,13 +120,19 @@ def decide(outcomes: Mapping[str, Outcome], as_written: str, describe: Callable[
 
 
 def diagnostic_note(outcomes: Mapping[str, Outcome]) -> str:
-    """'what it would take': the best diagnostic (truth-using) variant, as a clause."""
+    """'what it would take': the best diagnostic (truth-using) variant and the best variant
+    beyond the paper, as clauses (never a verdict)."""
+    out = []
+    beyond = [o for o in outcomes.values() if o.beyond]
+    if beyond:
+        b = min(beyond, key=lambda o: (not o.ok, o.score, o.label))
+        out.append(f"beyond the paper, {b.label} " + ("reaches it" if b.ok else "comes closest") + f" ({b.text})")
     diag = [o for o in outcomes.values() if o.diagnostic]
-    if not diag:
-        return ""
-    d = min(diag, key=lambda o: (not o.ok, o.score, o.label))
-    return (f"only the {d.label} diagnostic, which is given the true state, "
-            + ("reaches it" if d.ok else "comes closest") + f" ({d.text})")
+    if diag:
+        d = min(diag, key=lambda o: (not o.ok, o.score, o.label))
+        out.append(f"the {d.label} diagnostic, which is given the true state, "
+                   + ("reaches it" if d.ok else "comes closest") + f" ({d.text})")
+    return "; ".join(out)
 
 
 def row(paper: str, claim_id: str, claim: str, published: str, verdict: str, cause: str,
@@ -223,6 +230,16 @@ def abstract(df: pd.DataFrame, headline_ids: Iterable[str] = ("A-C1", "B-C1", "B
     return " ".join(s)
 
 
+#: the conclusion's sentence per verdict: (verdict, opening, one claim, closing)
+_CONCLUSION = [
+    (WITH_ADDITION, "With an addition the papers do not state: ", "{s} ({i}, with {n})", "."),
+    (NOT_REPRODUCIBLE, "Excluded by the information in the stated measurements and prior: ", "{s} ({i}; {n})", "."),
+    (NOT_REPRODUCED, "Not reproduced: ", "{s} ({i})", "; the claims table gives each cause."),
+    (DEPENDS, "Decided by a choice the paper leaves open: ", "{s} ({i}: {n})", "."),
+    (NOT_TESTED, "Not tested by our runs: ", "{s} ({i}: {n})", "."),
+]
+
+
 def conclusion(df: pd.DataFrame) -> str:
     """The conclusion (plain text): what reproduced, what needed an addition (named), what
     the bound excludes, what depends on an open choice, generated from the verdicts."""
@@ -233,26 +250,11 @@ def conclusion(df: pd.DataFrame) -> str:
     rep = d[d["verdict"] == REPRODUCED]
     out.append(("As written, the papers give " + join([f"{r.claim_short} ({r.claim_id})" for r in rep.itertuples()])
                 + ".") if len(rep) else "No claim reproduced from the papers as written.")
-    add = d[d["verdict"] == WITH_ADDITION]
-    if len(add):
-        out.append("With an addition the papers do not state: "
-                   + join([f"{r.claim_short} ({r.claim_id}, with {r.named})" for r in add.itertuples()]) + ".")
-    nrp = d[d["verdict"] == NOT_REPRODUCIBLE]
-    if len(nrp):
-        out.append("Excluded by the information in the stated measurements and prior: "
-                   + join([f"{r.claim_short} ({r.claim_id}; {r.named})" for r in nrp.itertuples()]) + ".")
-    nr = d[d["verdict"] == NOT_REPRODUCED]
-    if len(nr):
-        out.append("Not reproduced: " + join([f"{r.claim_short} ({r.claim_id})" for r in nr.itertuples()])
-                   + "; the claims table gives each cause.")
-    dep = d[d["verdict"] == DEPENDS]
-    if len(dep):
-        out.append("Decided by a choice the paper leaves open: "
-                   + join([f"{r.claim_short} ({r.claim_id}: {r.named})" for r in dep.itertuples()]) + ".")
-    nt = d[d["verdict"] == NOT_TESTED]
-    if len(nt):
-        out.append("Not tested by our runs: "
-                   + join([f"{r.claim_short} ({r.claim_id}: {r.named})" for r in nt.itertuples()]) + ".")
+    for verdict, head, item, tail in _CONCLUSION:
+        sel = d[d["verdict"] == verdict]
+        if len(sel):
+            out.append(head + join([item.format(s=r.claim_short, i=r.claim_id, n=r.named) for r in sel.itertuples()])
+                       + tail)
     return " ".join(out)
 
 

@@ -77,17 +77,20 @@ def _caption(caption_id):
     return str(path)
 
 
-def report_table(stem, caption_id, category):
-    """Table outputs; the CSV goes into `snakemake --report` with its caption."""
+def report_table(stem, caption_id, category, subcategory=None):
+    """Table outputs; the CSV goes into `snakemake --report` with its caption, under its
+    output id as subcategory unless one is given (never the report's catch-all "Other")."""
     csv, tex, md = table_outputs(stem)
-    return [report(csv, caption=_caption(caption_id), category=category), tex, md]
+    return [report(csv, caption=_caption(caption_id), category=category,
+                   subcategory=subcategory or caption_id), tex, md]
 
 
 def report_figure(stem, caption_id, category, subcategory=None):
-    """Figure outputs; the PNG goes into `snakemake --report` with its caption."""
+    """Figure outputs; the PNG goes into `snakemake --report` with its caption, under its
+    output id as subcategory unless one is given."""
     pdf, png = figure_outputs(stem)
-    kw = {"subcategory": subcategory} if subcategory else {}
-    return [pdf, report(png, caption=_caption(caption_id), category=category, **kw)]
+    return [pdf, report(png, caption=_caption(caption_id), category=category,
+                        subcategory=subcategory or caption_id)]
 
 
 def result_outputs():

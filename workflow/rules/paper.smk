@@ -43,7 +43,7 @@ rule paper_claims:
         code=src("claims.py", "approach/claims.py", "landing/claims.py", "verdicts.py", "manuscript.py",
                  "published.py"),
     output:
-        csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims"),
+        csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
         md=f"{PAPER}/claims.md",
         tex=f"{PAPER}/claims_glance.tex",
         detail=f"{PAPER}/claims_detail.tex",
@@ -134,7 +134,8 @@ rule provenance:
     input:
         code=src("provenance.py"),
     output:
-        csv=report(res("provenance.csv"), caption=_caption("provenance"), category="Provenance"),
+        csv=report(res("provenance.csv"), caption=_caption("provenance"), category="Provenance",
+                   subcategory="environment"),
         md=res("provenance.md"),
         json=res("provenance.json"),
         tex=f"{PAPER}/provenance.tex",
@@ -166,7 +167,7 @@ rule paper_pdf:
         generated=PAPER_INPUTS,
         results=[t for t in _targets if t.endswith((".pdf", ".tex"))],
     output:
-        report(f"{PAPER}/main.pdf", caption=_caption("manuscript"), category="Claims"),
+        report(f"{PAPER}/main.pdf", caption=_caption("manuscript"), category="Claims", subcategory="manuscript"),
     params:
         paper_dir=lambda wildcards, input: str(Path(input.main).parent),
         build=f"{PAPER}/build",
