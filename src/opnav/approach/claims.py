@@ -133,7 +133,7 @@ def _claim_headline_accuracy(t1, head_pub, target, summary) -> dict:
               if lit_bound > target else "")
     verdict, lo, best, named = C.decide(outs, AS_WRITTEN, addition, blocks)
     faithful_bounds = {v: max(float(_head(t1, v)["crlb_x_arcsec"]), float(_head(t1, v)["crlb_y_arcsec"]))
-                       for v in outs if not _is_diag(v)}
+                       for v in outs if not _is_diag(v) and not _is_beyond(v)}
     bb = min(faithful_bounds, key=lambda v: (faithful_bounds[v], v))
     cause = (f"As written EM ends with {lo.text} against the published {fmt(pe[0])}, {fmt(pe[1])} arcsec, "
              f"and the bound of the data it uses is {fmt(lit_bound)} arcsec "
