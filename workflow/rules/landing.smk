@@ -158,6 +158,25 @@ rule landing_single:
         "../scripts/landing_single.py"
 
 
+rule landing_tuning:
+    """Out-of-sample filter tuning: every candidate on runs of landing.tuning's own seed
+    stream in every camera scenario; the one tuning for all, checked against the config."""
+    input:
+        B_SRC,
+        src("landing/tuning.py"),
+    output:
+        f"{LANDING}/tuning.json",
+    params:
+        scenarios=B_SIMS,
+        tuning=canonical(config["landing"]["tuning"]),
+    log:
+        f"{LANDING}/logs/tuning.log",
+    benchmark:
+        f"{LANDING}/benchmarks/tuning.tsv"
+    script:
+        "../scripts/landing_tuning.py"
+
+
 rule landing_summary:
     """B-T3 of one scenario beside the published 29.03 %, its summary JSON (with the
     equivalence test of "almost the same accuracy" and its negative controls), and B-F6
@@ -168,6 +187,7 @@ rule landing_summary:
         mc_eq=lambda wc: b_mc(wc.bscn, B_EQ_METHODS),
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         single=f"{LANDING}/single/summary_{{bscn}}.json",
+        tuning=f"{LANDING}/tuning.json",
         code=src("landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
                  "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
                  "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml"),

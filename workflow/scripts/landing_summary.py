@@ -48,6 +48,8 @@ with script_context(snakemake) as log:
                            yaw_ratio=float(snakemake.params.yaw_ratio),
                            published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
                            accuracy=acc)
+    with open(snakemake.input.tuning) as fh:
+        out["tuning"] = json.load(fh)        # chosen on a separate seed stream: out["nees"] is held out
     write_json(snakemake.output.summary, out)
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f6)

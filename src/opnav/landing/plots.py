@@ -106,8 +106,12 @@ def fig_depth_error_map(dm: dict):
         ax.set_ylabel("y (km)")
         ax.set_title("(b) whole field, no image constraint", fontsize="small")
         ax.legend(loc="lower left", fontsize=4.5, framealpha=0.8)
-        fig.colorbar(sc, ax=axs[:2], label="depth estimation error (m)", shrink=0.7,
-                     location="bottom", pad=0.02)
+        cb = fig.colorbar(sc, ax=axs[:2], label="depth estimation error (m)", shrink=0.7,
+                          location="bottom", pad=0.02)
+        # a log range of less than a decade gets one major tick: five labelled ones instead
+        ticks = np.geomspace(norm.vmin, norm.vmax, 5)
+        cb.set_ticks(ticks, labels=[f"{x:.3g}" for x in ticks])
+        cb.ax.minorticks_off()
         ax = axs[2]
         ax.semilogy(dm["beta_deg"], dm["curve_dr"], color="C0")
         for lo, hi in dm["interval_deg"]:
@@ -123,40 +127,69 @@ def fig_depth_error_map(dm: dict):
         return fig
 
 
-def fig_nav_error_envelopes(t, data: dict[str, dict]):
-    """B-F6: 3-sigma envelopes (3 x sample standard deviation over the runs) of
-    the position (m), velocity (m/s) and attitude (roll/pitch/yaw, deg) errors
-    per axis, one line per method (log scale)."""
+def _phase_ends(t, data: dict[str, dict]) -> dict:
+    """Median over the runs (of the first method that has them) of the time (s) of
+    the last update with a landmark bearing and of the last vision update."""
+    from opnav.landing.montecarlo import last_update_index
+
+    for d in data.values():
+        if "lm_updated" in d:
+            return {"last landmark update": float(np.median(t[last_update_index(d["lm_updated"])])),
+                    "last vision update": float(np.median(t[last_update_index(d["updated"])]))}
+    return {}
+
+
+def fig_nav_error_envelopes(t, data: dict[str, dict], legend_outside: bool = False):
+    """B-F6 / B-X1: error envelopes over the runs, per axis, of the position (m),
+    velocity (m/s) and attitude (roll/pitch/yaw, deg) errors, one line per method
+    (log scale): 3 x the RMS about zero over the runs, ``3 sqrt(mean_runs e^2)``,
+    which keeps any bias (3 x the standard deviation about the mean would drop
+    it). The phases are marked: the median time of the last landmark update
+    (after it, site bearings only) and of the last vision update (after it, the
+    IMU-only coast). ``legend_outside``: the legend below the panels (many
+    methods)."""
     import matplotlib.pyplot as plt
 
     rows = (("err_r", "position", "m", ("x", "y", "z")),
             ("err_v", "velocity", "m/s", ("x", "y", "z")),
             ("err_rpy_deg", "attitude", "deg", ("roll", "pitch", "yaw")))
+    ends = _phase_ends(np.asarray(t, float), data)
     with figures.style():
-        fig, axs = plt.subplots(3, 3, figsize=(figures.PAGE_WIDTH_IN, 6.2), sharex=True,
-                                constrained_layout=True)
+        fig, axs = plt.subplots(3, 3, figsize=(figures.PAGE_WIDTH_IN, 6.6 if legend_outside else 6.2),
+                                sharex=True, constrained_layout=True)
         for i, (key, name, unit, axes) in enumerate(rows):
             for j in range(3):
                 ax = axs[i, j]
                 for k, (m, d) in enumerate(data.items()):
                     e = d[key][:, :, j]
-                    s3 = 3.0 * e.std(axis=0, ddof=1) if e.shape[0] > 1 else np.abs(e[0])
-                    ax.plot(t, s3, color=figures.color(m), lw=1.0, label=_label(m),
+                    env = 3.0 * np.sqrt(np.mean(e**2, axis=0))
+                    ax.plot(t, env, color=figures.color(m), lw=1.0, label=_label(m),
                             ls=("-", "--", "-.", ":")[k % 4])
                 ax.set_yscale("log")
+                for (lab, x), ls in zip(ends.items(), (":", "--")):
+                    ax.axvline(x, color="0.4", lw=0.7, ls=ls, label=f"{lab} (median, {x:.0f} s)")
+                if "last vision update" in ends:
+                    ax.axvspan(ends["last vision update"], float(t[-1]), color="0.92", zorder=0)
                 ax.set_title(f"{name} {axes[j]}", fontsize="medium")
                 if j == 0:
-                    ax.set_ylabel(f"3-sigma error ({unit})")
+                    ax.set_ylabel(f"3 x RMS error ({unit})")
                 if i == 2:
                     ax.set_xlabel("time (s)")
-        axs[0, 0].legend(loc="lower left", fontsize="small")
+        h, lab = axs[0, 0].get_legend_handles_labels()
+        if legend_outside:
+            fig.legend(h, lab, loc="outside lower center", ncol=min(5, len(lab)), fontsize="x-small")
+        else:
+            axs[0, 0].legend(h, lab, loc="lower left", fontsize="x-small")
+        fig.suptitle("3 x RMS over the runs about zero (bias included); grey: IMU-only coast",
+                     fontsize="small")
         return fig
 
 
 def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float | None = None):
     """B-F7: planning-call wall time (us) per method on the replayed planning
     calls (``timing``: ``opnav.landing.timing.replay``, the same calls for every
-    method), box = quartiles, whiskers = min/max (as the paper's Fig. 7),
+    method), box = quartiles, whiskers = 5th and 95th percentiles (the paper's
+    Fig. 7 draws min/max; a replay's extremes are machine noise),
     medians and evaluations per call annotated. Methods timed on the
     alternative metric evaluation path too get a second, hatched box."""
     import matplotlib.pyplot as plt
@@ -182,7 +215,9 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                 vals.append(va)
                 cols.append(figures.color(m))
                 hatch.append("///")
-        bp = ax.boxplot(vals, positions=pos, whis=(0, 100), showfliers=False, patch_artist=True,
+        # whiskers at the 5th and 95th percentiles: the extremes of a replay are
+        # machine noise (a shared machine's 10-130 ms interruptions), not planning work
+        bp = ax.boxplot(vals, positions=pos, whis=(5, 95), showfliers=False, patch_artist=True,
                         widths=0.32)
         for patch, c, h in zip(bp["boxes"], cols, hatch):
             patch.set_facecolor(c)
@@ -200,8 +235,9 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                 ax.annotate(f"{med:.0f}", (p_, med), xytext=(0, 3), textcoords="offset points",
                             ha="center", va="bottom", fontsize="xx-small")
         ax.set_ylabel("planning-call time (us)")
-        ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; plain: {main_name}"
-                      + (f"; hatched: {alt_name}" if alt_name else ""), fontsize="small")
+        ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"
+                      f"whiskers: 5-95 %; plain: {main_name}"
+                      + (f"; hatched: {alt_name}" if alt_name else ""), fontsize="x-small")
         if published_reduction_vs_svd is not None and {"depth", "svd"} <= set(methods):
             ours = tmg.time_reduction(timing, "depth", "svd", n_boot=0)[0]
             title = f"depth vs SVD: {ours:.1f} % less ({main_name})"

@@ -1,0 +1,18 @@
+"""Out-of-sample filter tuning of paper B (opnav.landing.tuning): the candidates on
+a separate seed stream in every camera scenario, the one tuning for all, checked
+against the configured landing.filter."""
+
+import sys
+
+from opnav.landing.tuning import tuning_report
+from opnav.snakeio import mock_snakemake, script_context
+from opnav.tables import write_json
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_tuning", argv=sys.argv[1:])
+
+with script_context(snakemake) as log:
+    out = tuning_report(dict(snakemake.params.scenarios), dict(snakemake.params.tuning))
+    write_json(snakemake.output[0], out)
+    log.info("tuning: chosen %s (configured %s, matches: %s)", out["chosen"], out["configured"],
+             out["config_matches"])
