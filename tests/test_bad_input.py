@@ -424,6 +424,7 @@ BAD_CLI = [
     (["approach", "--set", "approach.nosuch=1"], "--set approach.nosuch: no config key"),
     (["approach", "--set", "approach.dt_s"], "expected KEY.PATH=VALUE"),
     (["approach", "--set", "approach.dt_s=[1"], "--set approach.dt_s: the value '[1' is not valid YAML"),
+    (["landing", "--set", "landing.camera={fov_deg: 45, fov_deg: 50}"], "duplicate key 'fov_deg'"),
     (["landing", "--set", "landing.headline_scenario=nadir"], "--set landing.headline_scenario"),
     (["landing", "--set", "landing.scenarios.interior.fov_deg=10"], "landing.scenarios.interior"),
     (["landing", "--set", "results_dir=docs/out"], "--set results_dir: invalid config key 'results_dir'"),

@@ -163,8 +163,10 @@ def parse_set(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not sep or not _SET_KEY_RE.fullmatch(key):
         raise ConfigError(f"--set {text!r}: expected KEY.PATH=VALUE, e.g. --set landing.camera.fov_deg=75")
+    from opnav.config import _StrictLoader
+
     try:
-        value = yaml.safe_load(raw)
+        value = yaml.load(raw, Loader=_StrictLoader)    # a key twice in a {...} value is refused too
     except yaml.YAMLError as exc:
         what = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ConfigError(f"--set {key}: the value {raw!r} is not valid YAML: {what}") from None
