@@ -135,6 +135,18 @@ def study_size_problem(name: str, spec: Mapping, limit: int) -> str | None:
             f"limits.max_study_values = {limit} (each is a Monte Carlo; raise the limit to mean it)")
 
 
+@functools.lru_cache(maxsize=1)
+def study_spec_defaults() -> dict:
+    """Per-study defaults from the schema (validators fill ``properties`` defaults only,
+    not those of a map's ``additionalProperties``); read once per process, shared: callers
+    merge it into a new dict and never change it."""
+    import yaml
+
+    schema = Path(__file__).resolve().parent / "schemas" / "studies.schema.yaml"
+    props = yaml.load(schema.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    return {k: v["default"] for k, v in props["additionalProperties"]["properties"].items() if "default" in v}
+
+
 def growing_problems(a: dict) -> list[str]:
     """Table 1 in growing windows (``approach.growing``, the workflow's rows) covers the
     sliding windows' data: its N must divide ``segments.L x N``."""
@@ -162,7 +174,7 @@ def _jobs(config: dict) -> dict[str, int]:
         vary = list((spec.get("vary") or {}).values())
         lens = [len(v) for v in vary if isinstance(v, list)] or [0]
         values = math.prod(lens) if spec.get("grid") else max(lens)
-        runs, rpj = spec.get("runs", 10), spec.get("runs_per_job", 10)
+        runs, rpj = (spec.get(k, study_spec_defaults()[k]) for k in ("runs", "runs_per_job"))
         out[f"study {name} (values x runs / runs_per_job)"] = values * -(-runs // max(min(rpj, runs), 1)) + 2
     return out
 

@@ -33,7 +33,6 @@ the first method (mean and 95 % interval of the per-run differences).
 from __future__ import annotations
 
 import copy
-import functools
 import hashlib
 import itertools
 import json
@@ -45,7 +44,7 @@ from typing import Any, Callable, Iterable, Mapping
 import numpy as np
 import pandas as pd
 
-from opnav.checks import MAX_APPROACH_SEED_SAMPLES, MAX_STUDY_VALUES, study_size_problem
+from opnav.checks import MAX_APPROACH_SEED_SAMPLES, MAX_STUDY_VALUES, study_size_problem, study_spec_defaults
 from opnav.errors import ConfigError
 
 __all__ = ["METRICS", "CONSTANT_METRICS", "APPROACH_METHODS", "SIM_KEYS", "Study", "plan", "simulation_shapes",
@@ -338,23 +337,8 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
     return out
 
 
-@functools.lru_cache(maxsize=1)
-def _spec_defaults() -> dict:
-    """Per-study defaults from the schema (validators fill ``properties`` defaults only,
-    not those of a map's ``additionalProperties``); read once per process, shared: callers
-    merge it into a new dict and never change it."""
-    from pathlib import Path
-
-    import yaml
-
-    schema = Path(__file__).resolve().parent / "schemas" / "studies.schema.yaml"
-    props = yaml.load(schema.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    props = props["additionalProperties"]["properties"]
-    return {k: v["default"] for k, v in props.items() if "default" in v}
-
-
 def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_STUDY_VALUES) -> Study:
-    spec = {**_spec_defaults(), **spec}
+    spec = {**study_spec_defaults(), **spec}
     paper = spec["paper"]
     where = f"study '{name}'"
     problems: list[str] = []
