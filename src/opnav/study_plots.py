@@ -89,11 +89,13 @@ def axis_label(metric: str, paper: str, stat: str) -> str:
 
 def plotted_statistic(study: Mapping, metric: str) -> str:
     """What a panel draws: paper A's estimate errors as their RMS about the truth (a stalled
-    estimate that never moved has a tiny spread but a large error), else
-    :func:`opnav.studies.shown_statistic`."""
+    estimate that never moved has a tiny spread but a large error) and its other metrics as
+    their mean, else :func:`opnav.studies.shown_statistic`."""
     stat = shown_statistic(study, metric)
-    if study["paper"] == "approach" and metric.startswith("err_") and stat == "sd":
-        return "rms"
+    if study["paper"] == "approach" and stat == "sd":
+        # errors about the truth as their RMS; any other quantity (a km error norm, data
+        # needed) as its mean with interval: the spread of an error norm is not its size
+        return "rms" if metric.startswith("err_") else "mean"
     return stat
 
 
