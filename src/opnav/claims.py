@@ -248,7 +248,7 @@ def conclusion(df: pd.DataFrame) -> str:
     d = _with_short(df)
     out = []
     rep = d[d["verdict"] == REPRODUCED]
-    out.append(("As written, the papers give " + join([f"{r.claim_short} ({r.claim_id})" for r in rep.itertuples()])
+    out.append(("Reproduced from the papers as written: " + join([f"{r.claim_short} ({r.claim_id})" for r in rep.itertuples()])
                 + ".") if len(rep) else "No claim reproduced from the papers as written.")
     for verdict, head, item, tail in _CONCLUSION:
         sel = d[d["verdict"] == verdict]
@@ -268,7 +268,7 @@ def limitations(df: pd.DataFrame) -> str:
          "verdict is conditional on the readings listed in docs/modelling-choices.md; a different reading "
          "could change a verdict, and the published runs' own noise realisations cannot be recovered."]
     if len(choice):
-        s.append(f"{len(choice)} of {len(d)} claims hinge on such a reading or cannot be tested by our runs ("
+        s.append(f"Of the {len(d)} claims, {len(choice)} hinge on such a reading or cannot be tested by our runs ("
                  + join([r.claim_id for r in choice.itertuples()]) + ").")
     s.append(f"Easy: {join([r.claim_id for r in easy.itertuples()])} reproduced from the text alone; hard: "
              f"{join([r.claim_id for r in hard.itertuples()])}, where the stated model does not give the "

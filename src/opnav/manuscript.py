@@ -132,7 +132,8 @@ def rst_to_latex(text: str) -> str:
         elif p.startswith("*") and p.endswith("*") and len(p) > 2:
             out.append(r"\emph{" + latex_escape(p[1:-1]) + "}")
         else:
-            out.append(latex_escape(p))
+            lead, tail = " " if p[:1].isspace() else "", " " if p[-1:].isspace() else ""
+            out.append(lead + prose_tex(p) + tail if p.strip() else p)
     return "".join(out)
 
 
