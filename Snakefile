@@ -12,19 +12,16 @@ min_version("9.0")
 
 
 # Every config file (this default and each --configfile, which Snakemake has read
-# already) through opnav's own loader too: a key given twice, an alias bomb, an empty
-# file or a top level that is not a mapping is refused naming the file and line.
+# already) through opnav's own loader too: a key given twice or an alias bomb (which
+# Snakemake's loader accepts) is refused naming the file and line. (A file Snakemake
+# cannot parse at all it refuses itself, before this file is read.) config_exit is the
+# one way every config problem leaves the workflow.
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(workflow.basedir) / "src"))
 from opnav.config import ConfigError, read_config_file  # noqa: E402
-
-
-def config_exit(exc):
-    """The one way a config problem leaves the workflow: its lines, no traceback, exit 1."""
-    sys.exit(f"ConfigError (no job was run):\n{exc}")
-
+from opnav.snakeio import config_exit  # noqa: E402
 
 _config_files = [Path(workflow.basedir, "config", "config.yaml")]
 _config_files += list(getattr(getattr(workflow, "config_settings", None), "configfiles", None) or [])

@@ -187,6 +187,13 @@ def mock_snakemake(rule: str, *, configfiles=(), root: str | Path | None = None,
     return smk
 
 
+def config_exit(exc) -> None:
+    """Leave the workflow (Snakefile, rule files) on config problems: their lines after
+    ``ConfigError (no job was run):``, no traceback, exit status 1 (``opnav study``
+    forwards these lines: :func:`opnav.cli.snakemake_error`)."""
+    sys.exit(f"ConfigError (no job was run):\n{exc}")
+
+
 class CorruptIntermediate(ValueError):
     """An intermediate file is truncated or unreadable; the message names it and
     the command that rebuilds it."""
