@@ -301,6 +301,8 @@ def identifiability_text(setup: Setup | dict, x1: pd.DataFrame) -> str:
             "roll": "turning the camera about its boresight turns the misalignment's offset in inertial space "
                     "while a position error stays fixed, so the data separate the two",
             "reference-start": "knowing the true start state removes the position ambiguity",
+            "stars": "star images (beyond the paper) measure the camera attitude directly, with no parallax, so "
+                     "theta is no longer confused with a position error, and stars off the boresight see tz",
         }.get(v, "")
         q0 = r.get("crlb_q0_x_total_arcsec", math.nan)
         q0_txt = (f"; {_fmt(q0)} arcsec with Q = 0, the truth having no process noise" if not pd.isna(q0) else "")
