@@ -48,7 +48,8 @@ def test_unchanged_config_lists_nothing(edits):
 
 
 @pytest.mark.parametrize("edit, only", [
-    ("accuracy_target", {"approach_tables", "approach_x1_figure"}),
+    # approach_crlb: the roll rate that reaches the target within the published data (issue 28)
+    ("accuracy_target", {"approach_tables", "approach_x1_figure", "approach_crlb"}),
     ("convergence_tol", {"approach_convergence", "approach_tables", "approach_x1_figure"}),
 ])
 def test_editing_one_key_reruns_only_its_users(edits, edit, only):

@@ -96,14 +96,14 @@ rule approach_crlb:
 
 
 rule approach_stars:
-    """The stars variant (beyond the paper): per stars.study_per_image, the bound of (tx, ty, tz),
-    the data to reach the claimed accuracy, and the EM-EKF and augmented-EKF estimates."""
+    """The stars variant (beyond the paper): per stars.study_per_image, the bound of (tx, ty, tz)
+    against the data, and the EM-EKF and augmented-EKF estimates."""
     input:
         A_SRC + src("approach/alternatives.py", "approach/batch_ml.py"),
     output:
         f"{A_WORK}/stars.pkl",
     params:
-        approach=cfg("approach", *A_EM, "growing", "alternatives", "accuracy_target_arcsec"),
+        approach=cfg("approach", *A_EM, "growing", "alternatives"),
     log:
         f"{APPROACH}/logs/stars.log",
     benchmark:

@@ -35,7 +35,7 @@ with script_context(snakemake) as log:
     atomic_write_text(snakemake.output.verdict, report.identifiability_text(setup, x1))
     summ = report.summary(setup, t1, x1, curves.get("roll_rate"))
     if snakemake.input.stars:  # the stars variant (beyond the paper)
-        summ["stars"] = report.stars_summary(load_pickle(snakemake.input.stars))
+        summ["stars"] = report.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
     summ["profile"] = snakemake.params.profile
     summ["text"] = report.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
     write_json(snakemake.output.summary, summ)

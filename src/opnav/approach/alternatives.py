@@ -211,8 +211,8 @@ def time_em(setup: Setup | dict, variant: str, case: cases.Case, seed_indices, g
 def stars_study(setup: Setup | dict, log=None) -> list[dict]:
     """The ``stars`` variant (beyond the paper) with ``stars.study_per_image`` stars per image,
     headline case, ``n_seeds`` seeds: per star count, the bound of (tx, ty, tz) after all the data
-    (with Q and Q = 0) and the data to reach ``accuracy_target_arcsec`` (samples after N0; the
-    first sample whose bound of tx and ty is at or below it), beside the estimates of the
+    (with Q and Q = 0) and its curve against the data (samples after N0; the report reads the
+    data to reach the claimed accuracy from it), beside the estimates of the
     EM-EKF (growing windows with SQUAREM, and the paper's sliding plain EM) and of the
     augmented EKF on the same measurements (arcsec)."""
     from dataclasses import replace
@@ -222,7 +222,6 @@ def stars_study(setup: Setup | dict, log=None) -> list[dict]:
     setup = Setup.of(setup)
     case = cases.headline_case(setup)
     seeds = range(setup.n_seeds)
-    target = setup.accuracy_target_arcsec
     out = []
     for m in setup.stars.study_per_image:
         s_m = setup.replace(stars=replace(setup.stars, per_image=int(m)))
@@ -230,11 +229,10 @@ def stars_study(setup: Setup | dict, log=None) -> list[dict]:
         Rvar = geo.measurement_variance(case.sigma3_px)
         c, c0 = bound_curves(s_m, geo, [(Rvar, case.truth_arcsec, False), (Rvar, case.truth_arcsec, True)], "stars")
         d = min(s_m.segments.data_samples, len(c) - 1)
-        below = np.nonzero(c[:, :2].max(1) <= target)[0]
         row = {"per_image": int(m), "every_K": s_m.stars.every_K, "images": int(np.sum(geo.stars.idx <= geo.t.size - 1)),
                "truth_arcsec": np.asarray(case.truth_arcsec, float), "total_samples": int(d),
                "crlb_all_arcsec": c[d], "crlb_all_q0_arcsec": c0[d],
-               "samples_to_target": float(below[0]) if below.size else float("nan"), "estimators": {}}
+               "crlb_curve_arcsec": c, "estimators": {}}
         for name, st, method in (("em_growing_squarem", s_m.scheme("growing"), "squarem"),
                                  ("em_plain", s_m, "plain")):
             r = cases.run_case(st, "stars", case, seeds, geo=geo, method=method)

@@ -390,12 +390,15 @@ def roll_rate_text(rr: dict) -> str:
             + f" (about rate^{rr['slope_all']:.2g}); {reach}.")
 
 
-def stars_summary(study: list[dict]) -> dict:
+def stars_summary(study: list[dict], target_arcsec: float) -> dict:
     """The stars study (:func:`opnav.approach.alternatives.stars_study`) for the summary, per
     stars per image (key ``m<k>``): bound of tx, ty, tz after all the data (Q and Q = 0), samples
-    to the target, and per estimator the seed mean and sd of (tx, ty, tz) and its label (EM)."""
+    after N0 until the bound of tx and ty is at most ``target_arcsec``, and per estimator the
+    seed mean and sd of (tx, ty, tz) and its label (EM)."""
     out = {}
     for row in study:
+        curve = np.asarray(row["crlb_curve_arcsec"])
+        need = _first_below(curve[:, :2].max(1), target_arcsec)
         est = {}
         for name, e in row["estimators"].items():
             th = np.asarray(e["theta_final_arcsec"], float)
@@ -409,7 +412,7 @@ def stars_summary(study: list[dict]) -> dict:
             "total_samples": row["total_samples"],
             "crlb_arcsec": [float(x) for x in row["crlb_all_arcsec"]],
             "crlb_q0_arcsec": [float(x) for x in row["crlb_all_q0_arcsec"]],
-            "samples_to_target": _num(row, "samples_to_target"), "estimators": est}
+            "samples_to_target": None if math.isnan(need) else need, "estimators": est}
     return out
 
 
