@@ -891,8 +891,8 @@ def rows_paper_a(table1: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
             if axis and f"truth_{axis}_arcsec" in table1.columns and f"crlb_{axis}_arcsec" in table1.columns:
                 row["truth"] = float(r[f"truth_{axis}_arcsec"])
                 row["crlb"] = float(r[f"crlb_{axis}_arcsec"])  # the bound of the data the estimate used
-            row["reason_note"] = (f"; {nav_note(r)}" if base.startswith("nav_err_after") and nav_note(r)
-                                  else _reading_note(r))
+            row["reason_note"] = ((f"; {nav_note(r)}" if base.startswith("nav_err_after") and nav_note(r) else "")
+                                  if base.startswith("nav_err") else _reading_note(r))
             rows.append(row)
     rows += _rows_paper_a_headline(summary, pub.get("headline", {}))
     head = pub.get("headline", {})
