@@ -160,9 +160,10 @@ def test_quick_profile_through_slurm_equals_the_local_build(slurm_cluster, quick
     for p in logs:
         inside.update(_job_outputs(p.read_text(errors="replace"), ("rule", "localrule")))
     assert inside == remote, sorted(set(inside.items()) ^ set(remote.items()))
-    # ... and they are the rules the profile sends to the cluster (the measured ones)
+    # ... among them every rule the profile has measured resources for (a rule added
+    # since the last measurement goes out with the default resources)
     profile = yaml.safe_load((wd / "profiles" / "slurm" / "config.yaml").read_text())
-    assert set(remote.values()) == set(profile["set-resources"]), sorted(set(remote.values()))
+    assert set(profile["set-resources"]) <= set(remote.values()), sorted(set(remote.values()))
     print(f"through SLURM: {len(remote)} output files of {len(set(remote.values()))} rules, "
           f"{len(ids)} sbatch calls")
 
