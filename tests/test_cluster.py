@@ -22,6 +22,7 @@ import pytest
 import yaml
 
 from conftest import REPO, _snakemake_cmd, copy_workflow
+from opnav.snakeio import CSV_STAMP, load_csv
 
 pytestmark = [pytest.mark.cluster, pytest.mark.slow]
 
@@ -112,8 +113,15 @@ def _job_outputs(log: str, kinds: tuple[str, ...]) -> dict[str, str]:
     return outs
 
 
+def _read(path: Path) -> pd.DataFrame:
+    """A table; an intermediate stamped with its row count and checksum is checked."""
+    with open(path) as f:
+        stamped = f.readline().startswith(CSV_STAMP)
+    return load_csv(path) if stamped else pd.read_csv(path)
+
+
 def _tables(root: Path) -> dict[str, pd.DataFrame]:
-    return {p.relative_to(root).as_posix(): pd.read_csv(p) for p in sorted(root.rglob("*.csv"))
+    return {p.relative_to(root).as_posix(): _read(p) for p in sorted(root.rglob("*.csv"))
             if "benchmarks" not in p.parts}
 
 
@@ -127,7 +135,7 @@ def _untimed(df: pd.DataFrame) -> pd.DataFrame:
 def _differing(local: pd.DataFrame, slurm: pd.DataFrame) -> list[str]:
     """The columns whose untimed cells differ (or a shape mismatch)."""
     if list(local.columns) != list(slurm.columns) or local.shape != slurm.shape:
-        return [f"shape {local.shape} vs {slurm.shape}"]
+        return [f"columns/shape {list(local.columns)} {local.shape} vs {list(slurm.columns)} {slurm.shape}"]
     a, b = _untimed(local), _untimed(slurm)
     if a.shape != b.shape:
         return [f"timing rows {a.shape} vs {b.shape}"]
