@@ -36,7 +36,7 @@ with script_context(snakemake) as log:
                          f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
                          f"error below {conv:g} m. " + timing.method_text(tm)))
     t = next(iter(data.values()))["t"]
-    figures.save(plots.fig_nav_error_envelopes(t, data, legend_outside=True), snakemake.output.f)
+    figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f)
     out = headline(df, ref)
     out["n_boot"] = n_boot
     with open(snakemake.output.summary, "w") as fh:

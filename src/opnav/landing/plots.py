@@ -139,15 +139,14 @@ def _phase_ends(t, data: dict[str, dict]) -> dict:
     return {}
 
 
-def fig_nav_error_envelopes(t, data: dict[str, dict], legend_outside: bool = False):
+def fig_nav_error_envelopes(t, data: dict[str, dict]):
     """B-F6 / B-X1: error envelopes over the runs, per axis, of the position (m),
     velocity (m/s) and attitude (roll/pitch/yaw, deg) errors, one line per method
     (log scale): 3 x the RMS about zero over the runs, ``3 sqrt(mean_runs e^2)``,
     which keeps any bias (3 x the standard deviation about the mean would drop
     it). The phases are marked: the median time of the last landmark update
     (after it, site bearings only) and of the last vision update (after it, the
-    IMU-only coast). ``legend_outside``: the legend below the panels (many
-    methods)."""
+    IMU-only coast). The legend sits below the panels, clear of the curves."""
     import matplotlib.pyplot as plt
 
     rows = (("err_r", "position", "m", ("x", "y", "z")),
@@ -155,7 +154,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict], legend_outside: bool = Fal
             ("err_rpy_deg", "attitude", "deg", ("roll", "pitch", "yaw")))
     ends = _phase_ends(np.asarray(t, float), data)
     with figures.style():
-        fig, axs = plt.subplots(3, 3, figsize=(figures.PAGE_WIDTH_IN, 6.6 if legend_outside else 6.2),
+        fig, axs = plt.subplots(3, 3, figsize=(figures.PAGE_WIDTH_IN, 6.6),
                                 sharex=True, constrained_layout=True)
         for i, (key, name, unit, axes) in enumerate(rows):
             for j in range(3):
@@ -176,10 +175,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict], legend_outside: bool = Fal
                 if i == 2:
                     ax.set_xlabel("time (s)")
         h, lab = axs[0, 0].get_legend_handles_labels()
-        if legend_outside:
-            fig.legend(h, lab, loc="outside lower center", ncol=min(5, len(lab)), fontsize="x-small")
-        else:
-            axs[0, 0].legend(h, lab, loc="lower left", fontsize="x-small")
+        fig.legend(h, lab, loc="outside lower center", ncol=min(5, len(lab)), fontsize="x-small")
         fig.suptitle("3 x RMS over the runs about zero (bias included); grey: IMU-only coast",
                      fontsize="small")
         return fig
