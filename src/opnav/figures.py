@@ -100,11 +100,13 @@ def save(fig: "matplotlib.figure.Figure", paths: Iterable[str | Path] | str | Pa
     paths = [Path(p) for p in paths]
     out = []
     try:
-        if fig.get_layout_engine() is not None and len(paths) > 1:
+        if fig.get_layout_engine() is not None:
             # One layout for every format: savefig runs the layout engine in a dry draw
             # before each format's own draw (constrained layout: about half of a save's
             # time, measured). Solve it once, then remove the engine (positions stay), so
-            # each format is drawn once. The layout is in figure coordinates.
+            # each format is drawn once. The layout is in figure coordinates. Done for a
+            # single format too, so the tight bounding box (SAVE_KW) sees the same layout
+            # whatever formats are saved together.
             fig.draw_without_rendering()
             with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
                 fig.set_layout_engine(None)
