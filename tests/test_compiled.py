@@ -1,0 +1,67 @@
+"""opnav.compiled's on-disk cache: a second process loads what the first compiled, and a
+kernel that calls another module's kernel is recompiled when that module changes (numba
+alone keys a cached function by its own file, and would load the old callee's code)."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+from conftest import REPO
+
+from opnav import compiled
+
+CALLEE = "from opnav.compiled import kernel\n\n\n@kernel\ndef f(x):\n    return x + {}\n"
+CALLER = textwrap.dedent("""\
+    from opnav.compiled import kernel, warms
+    from ka import f
+
+
+    @kernel
+    def g(x):
+        return f(x) * 2.0
+
+
+    @warms
+    def _warm():
+        g(1.0)
+""")
+RUN = textwrap.dedent("""\
+    import json, opnav.compiled as c
+    c.KERNEL_MODULES = ("ka", "kb")
+    seconds = c.warm()
+    import kb
+    print(json.dumps({"g": kb.g(1.0), "modules": sorted(seconds), **c.cache_stats()}))
+""")
+
+
+def _run(tmp_path):
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO / "src"), str(tmp_path)]))
+    env.pop("NUMBA_CACHE_DIR", None)
+    out = subprocess.run([sys.executable, "-c", RUN], cwd=tmp_path, env=env, capture_output=True,
+                         text=True, check=True)
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def test_cache_loaded_by_the_next_process_and_invalidated_by_a_callee_change(tmp_path):
+    (tmp_path / "ka.py").write_text(CALLEE.format("1.0"))
+    (tmp_path / "kb.py").write_text(CALLER)
+    first = _run(tmp_path)
+    # g and, as its callee, f
+    assert first == {"g": 4.0, "modules": ["kb"], "loaded": 0, "compiled": 2}
+    assert _run(tmp_path) == {"g": 4.0, "modules": ["kb"], "loaded": 1, "compiled": 0}
+    assert list((tmp_path / "__pycache__").glob("kb.g-*.nbi")), "cache written beside the source"
+    # the callee's module changes, the caller's file does not: g must see the new f
+    (tmp_path / "ka.py").write_text(CALLEE.format("10.0"))
+    assert _run(tmp_path) == {"g": 22.0, "modules": ["kb"], "loaded": 0, "compiled": 2}
+    assert _run(tmp_path) == {"g": 22.0, "modules": ["kb"], "loaded": 1, "compiled": 0}
+
+
+def test_kernel_sources_are_the_registered_modules_files():
+    files = compiled.kernel_sources()
+    assert files[0] == REPO / "src" / "opnav" / "compiled.py"
+    assert len(files) == 1 + len(compiled.KERNEL_MODULES)
+    for name, path in zip(compiled.KERNEL_MODULES, files[1:]):
+        assert path.is_file(), name
+        assert path.relative_to(REPO / "src").with_suffix("").parts == tuple(name.split("."))
