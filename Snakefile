@@ -36,6 +36,7 @@ configfile: "config/config.yaml"
 
 
 include: "workflow/rules/common.smk"
+include: "workflow/rules/kernels.smk"
 include: "workflow/rules/approach.smk"
 include: "workflow/rules/approach_extra.smk"
 include: "workflow/rules/approach_peers.smk"

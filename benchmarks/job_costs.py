@@ -5,7 +5,10 @@ Every successful job ends its log with ``job resources: cpu_s=... max_rss_mb=...
 imports included). This script finds those lines under a results folder and prints,
 per group of logs (the part's folder and the log name's first word: ``landing/mc``,
 ``studies/runs``, ...), the job count, total and largest CPU seconds and the largest
-peak memory, sorted by total CPU. Usage::
+peak memory, sorted by total CPU; then the compiled kernels (``kernels_loaded=``,
+``kernels_compiled=`` on the same line, :mod:`opnav.compiled`): how many jobs loaded
+them from numba's cache, and every job but ``compile_kernels`` that compiled some
+itself (a warm-up missing a signature the pipeline calls). Usage::
 
     python benchmarks/job_costs.py results/quick
     python benchmarks/job_costs.py results --top 20
@@ -19,6 +22,20 @@ import sys
 from pathlib import Path
 
 _LINE = re.compile(r"job resources: cpu_s=([0-9.]+) user_s=([0-9.]+) sys_s=([0-9.]+) max_rss_mb=([0-9.]+)")
+_KERNELS = re.compile(r"kernels_loaded=(\d+) kernels_compiled=(\d+)")
+
+
+def kernel_counts(root: Path) -> list[tuple[str, int, int]]:
+    """(log path relative to ``root``, kernel signatures loaded, compiled) of every job
+    log whose resource line counts kernels."""
+    out = []
+    for log in sorted(root.rglob("logs/*.log")):
+        m = None
+        for m in _KERNELS.finditer(log.read_text(errors="replace")):
+            pass
+        if m:
+            out.append((str(log.relative_to(root)), int(m.group(1)), int(m.group(2))))
+    return out
 
 
 def costs(root: Path) -> list[tuple[str, float, float]]:
@@ -66,6 +83,13 @@ def main(argv=None) -> int:
     print(f"{'total':40s} {len(rows):5d} {total:9.1f}")
     for path, cpu, rss in sorted(rows, key=lambda r: -r[1])[:a.top]:
         print(f"  {cpu:8.2f} s {rss:6.0f} MB  {path}")
+    kernels = kernel_counts(a.results)
+    if kernels:
+        compiling = [(p, c) for p, _, c in kernels if c and Path(p).stem != "compile_kernels"]
+        print(f"kernels: {len(kernels)} jobs used them, {sum(n for _, n, _ in kernels)} signatures loaded from "
+              f"the cache; {len(compiling)} jobs besides compile_kernels compiled some themselves")
+        for path, n in compiling:
+            print(f"  {n:4d} compiled  {path}")
     return 0
 
 

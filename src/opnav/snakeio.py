@@ -74,7 +74,9 @@ def resource_line() -> str:
     process so far, its finished child processes included (LaTeX, say):
     ``resource.getrusage``; the peak memory is ``VmHWM`` of ``/proc/self/status``
     (``ru_maxrss`` keeps the forking parent's peak across ``exec`` on Linux), else
-    ``ru_maxrss`` (KiB on Linux)."""
+    ``ru_maxrss`` (KiB on Linux). A job that imported ``opnav.compiled`` also gets the
+    kernel signatures it loaded from numba's cache and compiled itself
+    (:func:`opnav.compiled.cache_stats`; after rule ``compile_kernels``, none compiled)."""
     me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     user, sys_ = me.ru_utime + kids.ru_utime, me.ru_stime + kids.ru_stime
     rss_kib = float(me.ru_maxrss)
@@ -82,8 +84,13 @@ def resource_line() -> str:
         for line in Path("/proc/self/status").read_text().splitlines():
             if line.startswith("VmHWM:"):
                 rss_kib = float(line.split()[1])
-    return (f"{RESOURCE_PREFIX} cpu_s={user + sys_:.3f} user_s={user:.3f} "
-            f"sys_s={sys_:.3f} max_rss_mb={rss_kib / 1024:.1f}")
+    out = (f"{RESOURCE_PREFIX} cpu_s={user + sys_:.3f} user_s={user:.3f} "
+           f"sys_s={sys_:.3f} max_rss_mb={rss_kib / 1024:.1f}")
+    compiled = sys.modules.get("opnav.compiled")  # a job that used kernels (not imported here)
+    if compiled is not None:
+        stats = compiled.cache_stats()
+        out += f" kernels_loaded={stats['loaded']} kernels_compiled={stats['compiled']}"
+    return out
 
 
 def stand_in(input=None, output=None, params=None, log=None, wildcards=None,

@@ -45,6 +45,7 @@ rule approach_mc:
     process start-up (about 0.7 CPU-s a job) and the geometry."""
     input:
         A_SRC,
+        kernels=kernels(),
     output:
         [f"{A_WORK}/mc/{{variant}}__{{group}}__{s}.pkl" for s in A_SCHEMES],
     params:
@@ -64,6 +65,7 @@ rule approach_convergence:
     variant in one job (they share the process start-up, about 0.8 CPU-s a job)."""
     input:
         A_SRC,
+        kernels=kernels(),
     output:
         expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
     params:
@@ -83,6 +85,7 @@ rule approach_crlb:
     input:
         A_SRC,
         src("published.py", "data/published.yaml"),
+        kernels=kernels(),
     output:
         f"{A_WORK}/crlb.pkl",
     params:
@@ -100,6 +103,7 @@ rule approach_stars:
     against the data, and the EM-EKF and augmented-EKF estimates."""
     input:
         A_SRC + src("approach/alternatives.py", "approach/batch_ml.py"),
+        kernels=kernels(),
     output:
         f"{A_WORK}/stars.pkl",
     params:

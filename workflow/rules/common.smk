@@ -1,4 +1,5 @@
 # Shared helpers: config validation, output paths, and the final outputs (final_outputs).
+from opnav.compiled import kernel_sources  # noqa: E402
 from opnav.config import ConfigError, validate_config  # noqa: E402
 from opnav.snakeio import compact_params_change_reasons  # noqa: E402
 
@@ -36,6 +37,17 @@ def stop_rate_limit_timers():
 def res(*parts):
     """Path under the results directory."""
     return str(Path(RESULTS, *parts))
+
+
+# the kernel modules' sources and rule compile_kernels' output (kernels.smk)
+KERNEL_SRC = [str(p) for p in kernel_sources()]
+KERNELS_JSON = res("kernels", "kernels.json")
+
+
+def kernels():
+    """Input of a rule whose jobs call compiled kernels: rule compile_kernels' output,
+    ancient (it orders the job after the cache is filled; recompiling does not rerun it)."""
+    return ancient(KERNELS_JSON)
 
 
 def src(*modules):

@@ -37,6 +37,7 @@ rule study_runs:
     (paper A: variant and estimator) that a study of that value compares."""
     input:
         lambda wc: STUDY_SRC[wc.spaper],
+        kernels=kernels(),
     output:
         f"{STUDIES_DIR}/runs/{{spaper}}/{{sdigest}}/{{schunk}}.csv",
     wildcard_constraints:
