@@ -1,7 +1,7 @@
 """Provenance: which software and which commit made the results.
 
 :func:`collect` records the Python version, the versions of the required stack
-(numpy, scipy, casadi, pandas, matplotlib, snakemake) and the git commit of the
+(numpy, scipy, numba, casadi, pandas, matplotlib, snakemake) and the git commit of the
 checkout (with a flag when tracked files had uncommitted edits). The rule
 ``provenance`` writes it to ``results/provenance.{json,csv,md}`` (the CSV is
 in the HTML report) and to ``results/paper/provenance.tex`` (macros and a
@@ -17,7 +17,7 @@ from importlib import metadata
 from pathlib import Path
 
 #: The stack whose versions every output records, in this order.
-PACKAGES = ("numpy", "scipy", "casadi", "pandas", "matplotlib", "snakemake")
+PACKAGES = ("numpy", "scipy", "numba", "casadi", "pandas", "matplotlib", "snakemake")
 
 
 def _git(root: Path, *args: str) -> str | None:
