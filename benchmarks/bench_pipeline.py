@@ -16,6 +16,16 @@ default config):
    and CPU seconds the job measured itself. The CPU beyond the benchmarked
    jobs' own is what the other jobs and snakemake's per-job overhead cost.
 
+With ``--compare REV`` it builds each profile twice in one invocation, from empty
+results and with the same profile and cores: first the workflow of commit ``REV``
+(``git archive`` of its workflow parts into a scratch folder), then the working tree's
+(uncommitted edits included); each scratch copy imports its own ``src`` (its own
+``PYTHONPATH``) and starts with an empty numba cache (``NUMBA_CACHE_DIR`` unset, no
+``__pycache__`` copied: compilation is paid inside the build, as in a fresh clone).
+It prints new/old ratios of wall time and CPU seconds with the issue's targets
+(issue 31: CPU-s new/old at most 0.5 quick, 0.35 full), and the kernel compile job's
+log (compile and load seconds per kernel module) and how many other jobs compiled.
+
 With ``--pytest`` it also times ``pytest -q`` of the checkout (wall and CPU).
 Targets (issue 14): quick <= 45 s, full <= 5 min wall, pytest <= 90 s on two
 cores. Ratios are the thing to compare on a loaded machine: run what you
@@ -35,6 +45,7 @@ Use::
     python benchmarks/bench_pipeline.py                       # quick profile
     python benchmarks/bench_pipeline.py --profile quick full  # both, one after the other
     python benchmarks/bench_pipeline.py --pytest --profile    # pytest only
+    python benchmarks/bench_pipeline.py --compare 960b5d0 --profile quick   # old vs new
 """
 
 from __future__ import annotations
@@ -57,12 +68,16 @@ sys.path.insert(0, str(REPO / "src"))
 from opnav.snakeio import copy_workflow  # noqa: E402
 
 TARGET_S = {"quick": 45.0, "full": 300.0, "pytest": 90.0}
+#: issue 31: CPU seconds new/old of a profile from empty, at most
+TARGET_CPU_RATIO = {"quick": 0.5, "full": 0.35}
 PROFILE_ARGS = {"quick": ["--configfile", "config/quick.yaml"], "full": []}
 
 
 def _env(wd: Path) -> dict:
-    return dict(os.environ, PYTHONPATH=os.pathsep.join(
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         p for p in (str(wd / "src"), os.environ.get("PYTHONPATH", "")) if p))
+    env.pop("NUMBA_CACHE_DIR", None)  # kernels cached beside the copy's own sources: from empty
+    return env
 
 
 def _children_cpu() -> float:
@@ -183,10 +198,37 @@ def benchmark_seconds(results: Path) -> dict[str, tuple[int, float, float]]:
     return {k: tuple(v) for k, v in out.items()}
 
 
-def run_profile(name: str, cores: int, keep: Path | None) -> dict:
+def export_revision(rev: str, dst: Path) -> str:
+    """The workflow parts (``opnav.snakeio.WORKFLOW_PARTS``) of commit ``rev`` of this
+    checkout, extracted into ``dst`` (``git archive``); returns the full commit id."""
+    from opnav.snakeio import WORKFLOW_PARTS
+
+    def git(*args, **kw):
+        return subprocess.run(["git", *args], cwd=REPO, check=True, capture_output=True, **kw).stdout
+
+    try:
+        commit = git("rev-parse", "--verify", f"{rev}^{{commit}}", text=True).strip()
+    except subprocess.CalledProcessError:
+        raise SystemExit(f"bench_pipeline: --compare {rev}: not a commit of {REPO}") from None
+    parts = [p for p in WORKFLOW_PARTS if git("ls-tree", "--name-only", commit, p, text=True).strip()]
+    dst.mkdir(parents=True, exist_ok=True)
+    archive = git("archive", "--format=tar", commit, *parts)
+    subprocess.run(["tar", "-x", "-C", str(dst)], input=archive, check=True)
+    return commit
+
+
+def run_profile(name: str, cores: int, keep: Path | None, rev: str | None = None) -> dict:
+    """Build profile ``name`` from empty in a scratch copy: of the working tree, or of
+    commit ``rev`` (:func:`export_revision`)."""
     tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix=f"bench_pipeline_{name}_"))
-    (tmp / name).mkdir(parents=True, exist_ok=True)
-    wd = copy_workflow(REPO, tmp / name)
+    label = f"{name}-{rev}" if rev else name
+    (tmp / label).mkdir(parents=True, exist_ok=True)
+    if rev:
+        commit = export_revision(rev, tmp / label)
+        wd = tmp / label
+    else:
+        commit = "working tree"
+        wd = copy_workflow(REPO, tmp / label, kernel_cache=False)  # compiled inside the build
     env = _env(wd)
     base = [sys.executable, "-m", "snakemake", *PROFILE_ARGS[name]]
     dry = timed([*base, "-n", "--cores", "1"], wd, env)
@@ -198,12 +240,48 @@ def run_profile(name: str, cores: int, keep: Path | None) -> dict:
     logs = sorted((wd / ".snakemake" / "log").glob("*.snakemake.log"))
     per_rule = log_job_seconds(logs[-1].read_text()) if logs else {}
     return {"name": name, "wd": wd, "jobs": jobs, "dry": dry, "run": run, "per_rule": per_rule,
-            "bench": benchmark_seconds(wd / "results")}
+            "bench": benchmark_seconds(wd / "results"), "commit": commit}
+
+
+def kernel_report(wd: Path) -> list[str]:
+    """The compile_kernels job's log lines (compile and load seconds per kernel module)
+    and the count of other jobs that compiled kernels themselves (job_costs)."""
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    from job_costs import kernel_counts
+
+    lines = []
+    for log in sorted(wd.glob("results/**/kernels/logs/compile_kernels.log")):
+        lines += [line for line in log.read_text(errors="replace").splitlines()
+                  if " INFO " in line or " WARNING " in line]
+    counts = [c for c in kernel_counts(wd / "results") if Path(c[0]).stem != "compile_kernels"]
+    if counts:
+        compiling = [c for c in counts if c[2]]
+        lines.append(f"{len(counts)} jobs used kernels: {sum(c[1] for c in counts)} signatures loaded, "
+                     f"{sum(c[2] for c in counts)} compiled by {len(compiling)} jobs"
+                     + "".join(f"\n  {c[2]} compiled in {c[0]}" for c in compiling))
+    return lines
+
+
+def report_compare(old: dict, new: dict, ref_ms: float) -> None:
+    """New/old ratios of wall and CPU seconds of one profile, with the target."""
+    name, o, n = new["name"], old["run"], new["run"]
+    cpu, wall = n["cpu_s"] / o["cpu_s"], n["wall_s"] / o["wall_s"]
+    target = TARGET_CPU_RATIO.get(name)
+    print(f"\n== compare, {name} profile: old {old['commit'][:10]}, new {new['commit']}")
+    print(f"old: {o['wall_s']:.1f} s wall, {o['cpu_s']:.0f} CPU-s, {old['jobs'].get('total', 0)} jobs; "
+          f"{units(o['wall_s'], ref_ms)}")
+    print(f"new: {n['wall_s']:.1f} s wall, {n['cpu_s']:.0f} CPU-s, {new['jobs'].get('total', 0)} jobs; "
+          f"{units(n['wall_s'], ref_ms)}")
+    for line in kernel_report(new["wd"]):
+        print(f"new kernels: {line}")
+    verdict = "" if target is None else f" (target <= {target}: {'met' if cpu <= target else 'NOT met'})"
+    print(f"{name} profile new/old: CPU-s {cpu:.3f}{verdict}, wall {wall:.3f}")
 
 
 def report_profile(r: dict, cores: int, ref_ms: float) -> None:
     run, jobs = r["run"], r["jobs"]
-    print(f"\n== {r['name']} profile (snakemake --cores {cores}{' ' + ' '.join(PROFILE_ARGS[r['name']]) if PROFILE_ARGS[r['name']] else ''}), scratch copy {r['wd']}")
+    print(f"\n== {r['name']} profile of {r['commit']} (snakemake --cores {cores}"
+          f"{' ' + ' '.join(PROFILE_ARGS[r['name']]) if PROFILE_ARGS[r['name']] else ''}), scratch copy {r['wd']}")
     print(f"dry run: {jobs.get('total', 0)} jobs, parse + DAG {r['dry']['wall_s']:.1f} s wall, {r['dry']['cpu_s']:.1f} CPU-s")
     print(f"{'rule':28s} {'jobs':>5s} {'job-s (log)':>12s}")
     rows = sorted(((k, v) for k, v in jobs.items() if k != "total"),
@@ -245,14 +323,26 @@ def main(argv=None) -> int:
     ap.add_argument("--cores", type=int, default=2)
     ap.add_argument("--pytest", action="store_true", help="also time the test suite")
     ap.add_argument("--keep", help="make the scratch copies under this folder (kept)")
+    ap.add_argument("--compare", metavar="REV",
+                    help="also build commit REV (first) and print new/old ratios (module docstring)")
     args = ap.parse_args(argv)
     if args.cores < 1:
         ap.error("--cores must be >= 1")
     print(f"{os.cpu_count()} CPUs; load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
     ref_ms = report_reference("before")["ref_ms"]
+    keep = Path(args.keep) if args.keep else None
+    if args.compare:  # a bad revision stops before any build
+        export_revision(args.compare, Path(tempfile.mkdtemp(prefix="bench_pipeline_rev_")))
     for name in args.profile:
-        report_profile(run_profile(name, args.cores, Path(args.keep) if args.keep else None), args.cores,
-                       ref_ms)
+        old = None
+        if args.compare:
+            old = run_profile(name, args.cores, keep, rev=args.compare)
+            report_profile(old, args.cores, ref_ms)
+            report_reference(f"after the old {name} build")
+        new = run_profile(name, args.cores, keep)
+        report_profile(new, args.cores, ref_ms)
+        if old:
+            report_compare(old, new, ref_ms)
     if args.pytest:
         run_pytest(ref_ms)
     after = report_reference("after")["ref_ms"]

@@ -311,15 +311,20 @@ class _Named(list):
 WORKFLOW_PARTS = ("Snakefile", "config", "workflow", "src", "paper", "profiles")
 
 
-def copy_workflow(repo: Path, dst: Path) -> Path:
+def copy_workflow(repo: Path, dst: Path, kernel_cache: bool = True) -> Path:
     """Copy the workflow of checkout ``repo`` into ``dst`` (for tests and benchmarks
-    that run snakemake in a scratch directory)."""
+    that run snakemake in a scratch directory). ``kernel_cache``: numba's cache files
+    (``__pycache__/*.nbi``, ``*.nbc``) come along, so the copy loads the kernels the
+    checkout compiled (entries are keyed by source content, :mod:`opnav.compiled`);
+    without, the copy compiles them itself, as a fresh clone does. Bytecode is never
+    copied."""
     import shutil
 
+    skip = ("*.pyc", "*.pdf") if kernel_cache else ("__pycache__", "*.pdf")
     for name in WORKFLOW_PARTS:
         p = Path(repo) / name
         if p.is_dir():
-            shutil.copytree(p, Path(dst) / name, ignore=shutil.ignore_patterns("__pycache__", "*.pdf"))
+            shutil.copytree(p, Path(dst) / name, ignore=shutil.ignore_patterns(*skip))
         elif p.exists():
             shutil.copy2(p, Path(dst) / name)
     return Path(dst)
