@@ -14,10 +14,11 @@ A_EM = A_SCENARIO + ("n_seeds", "em", "nav_error")
 A_GROUPS = ["size", "polarity", "initial", "pixel", "install"]
 A_VARIANTS = config["approach"]["variants"]
 A_METHODS = config["approach"]["methods"]
-A_SRC = src("approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
-            "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
-            "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py",
-            "approach/stars.py")
+A_SRC = with_kernels("approach", src(
+    "approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
+    "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
+    "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py",
+    "approach/stars.py"))
 
 
 A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"

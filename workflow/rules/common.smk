@@ -44,6 +44,15 @@ KERNEL_SRC = [str(p) for p in kernel_sources()]
 KERNELS_JSON = res("kernels", "kernels.json")
 
 
+def with_kernels(paper, files):
+    """``files`` and the kernel modules' sources the jobs of ``paper`` ("approach" or
+    "landing") run: those of its package and the shared ones (compiled.py, opnav.rotations,
+    ...), each once. A module registered in KERNEL_MODULES is then an input of its rules
+    without being named here (editing it reruns them)."""
+    other = {"approach", "landing"} - {paper}
+    return list(dict.fromkeys([*files, *(p for p in KERNEL_SRC if Path(p).parent.name not in other)]))
+
+
 def kernels():
     """Input of a rule whose jobs call compiled kernels: rule compile_kernels' output,
     ancient (it orders the job after the cache is filled; recompiling does not rerun it)."""

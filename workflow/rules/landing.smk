@@ -61,11 +61,11 @@ B_SIMS = {s: canonical({**{k: c[k] for k in _B_SIM_KEYS},
 # would lose the site)
 B_SIM = canonical({**{k: config["landing"][k] for k in _B_SIM_KEYS},
                    "mc": {k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")}})
-B_SRC = src("landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
-            "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
-            "landing/planner.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
-            "landing/depth_map.py",
-            "landing/metrics.py", "landing/casadi_model.py", "rotations.py")
+B_SRC = with_kernels("landing", src(
+    "landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
+    "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
+    "landing/planner.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
+    "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "rotations.py"))
 B_SCN_RE = "|".join(B_SCENARIOS)
 
 
@@ -191,9 +191,10 @@ rule landing_summary:
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         single=f"{LANDING}/single/summary_{{bscn}}.json",
         tuning=f"{LANDING}/tuning.json",
-        code=src("landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
-                 "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
-                 "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml"),
+        code=with_kernels("landing", src(
+            "landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
+            "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
+            "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml")),
         kernels=kernels(),
     output:
         t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),
