@@ -252,7 +252,7 @@ def kernel_report(wd: Path) -> list[str]:
     lines = []
     for log in sorted(wd.glob("results/**/kernels/logs/compile_kernels.log")):
         lines += [line for line in log.read_text(errors="replace").splitlines()
-                  if " INFO " in line or " WARNING " in line]
+                  if (" INFO " in line or " WARNING " in line) and "job resources" not in line]
     counts = [c for c in kernel_counts(wd / "results") if Path(c[0]).stem != "compile_kernels"]
     if counts:
         compiling = [c for c in counts if c[2]]
