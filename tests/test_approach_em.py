@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 from scipy.optimize import minimize
 
 from opnav.approach import cases, crlb, ekf, em, pipeline, smoother
@@ -213,23 +214,43 @@ def test_each_seed_stops_its_ml_iteration_at_its_own_step_criterion():
         np.testing.assert_allclose(sc.arcsec(t1[0, :2]), sc.arcsec(th[i, :2]), atol=1e-3)
 
 
-def test_los_moments_are_the_einsums_bits():
-    """E[u u^T] summed elementwise in the einsum's order gives its numbers bit for bit
-    (the E-step's numbers must not move with the faster form)."""
-    cfg = pipeline.Setup.of(approach_cfg(N0=20, N=30, M=1, L=1))
-    case = cases.headline_case(cfg)
-    for variant in ("literal", "roll"):
-        geo = sc.build_geometry(cfg, variant)
-        Rvar, z, dx0 = cases.simulate_case(cfg, geo, case, range(3), "sampled")
-        win = geo.window(Rvar).slice(20, 50)
-        f = ekf.run_filter(z[:, 20:51], np.full((3, 3), 2e-5), dx0, geo.P0, win, predicted=False)
-        s = smoother.bryson_frazier(f, win, ekf.POS)
-        m, Mom = em.los_moments(s, win)
-        C = win.C[1:]
-        ref = (np.einsum("kij,skjl,kml->skim", C, s.Ps[:, 1:, :3, :3], C)
-               + np.einsum("ski,skj->skij", m, m))
-        assert Mom.shape == ref.shape and Mom.strides == ref.strides
-        assert Mom.tobytes() == ref.tobytes()
+EPS = np.zeros((3, 3, 3))
+EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
+EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
+
+
+def _estep_reference(z, xs, Ps, win):
+    """The E-step sums written as the einsums of the definition (eq. 23/26, module docstring
+    of em): m = u_ref - C x_r, E[u u^T] = C P_rr C^T + m m^T, N = sum E[U^T W U], b = sum E[U^T W e]."""
+    C = win.C[1:]
+    m = win.u_ref[1:] - np.einsum("kij,skj->ski", C, xs[:, 1:, :3])
+    Mom = np.einsum("kij,skjl,kml->skim", C, Ps[:, 1:, :3, :3], C) + np.einsum("ski,skj->skij", m, m)
+    w = win.weights(z.shape[0])
+    N = np.einsum("ijk,sti,inl,stjn->skl", EPS, w, EPS, Mom)
+    b = (np.einsum("ijk,stj,sti,sti->sk", EPS, m, w, z[:, 1:])
+         - np.einsum("ijk,sti,stji->sk", EPS, w, Mom))
+    return N, b
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), S=st.integers(1, 4), n=st.integers(1, 12), per_seed=st.booleans(),
+       full=st.booleans())
+def test_estep_kernel_equals_the_einsums_of_the_definition(seed, S, n, per_seed, full):
+    """The compiled E-step sums equal the definition's einsums over random smoothed moments
+    (SPD covariances, rotations C, per-sample and per-seed variances; the smoother's position
+    block or its full 6-state moments)."""
+    win, rng = small_window(n=n, seed=seed % 1000)
+    if per_seed:
+        win = ekf.Window(win.Phi, win.C, win.u_ref, 0.5 + rng.random((n + 1, S, 3)), win.Q)
+    c = 6 if full else 3
+    xs = rng.standard_normal((S, n + 1, c)) * 3.0
+    A = rng.standard_normal((S, n + 1, c, c))
+    Ps = A @ np.swapaxes(A, -1, -2) + 0.1 * np.eye(c)
+    z = rng.standard_normal((S, n + 1, 3)) + win.u_ref
+    st_ = em.estep(z, smoother.SmootherResult(xs, Ps, None, None), win)
+    N, b = _estep_reference(z, xs, Ps, win)
+    np.testing.assert_allclose(st_.N, N, rtol=1e-12, atol=1e-12 * np.abs(N).max())
+    np.testing.assert_allclose(st_.b, b, rtol=1e-12, atol=1e-12 * np.abs(b).max())
 
 
 def test_em_schemes_sharing_a_jobs_simulation_equal_separate_runs():

@@ -91,3 +91,122 @@ def test_batched_time_update_gives_each_members_bits(shape):
     _, Pb = kalman.predict(None, P, F, Q)
     for i in np.ndindex(shape):
         assert np.array_equal(Pb[i], kalman.predict(None, P[i], F, Q)[1])
+
+
+# ----------------------------------------------------------------- compiled steps vs references
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+
+def _dense_update(m, P, H, rvar, nu):
+    """x | z of the joint Gaussian: m + G nu, P - G H P, det S with G = P H^T S^-1 (numpy)."""
+    Sm = H @ P @ H.T + np.diag(rvar)
+    G = P @ H.T @ np.linalg.inv(Sm)
+    return m + G @ nu, P - G @ H @ P, np.linalg.det(Sm), G
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), d=st.integers(3, 9), lead=st.sampled_from([(), (1,), (4,), (2, 3)]),
+       joseph=st.booleans(), scale=st.sampled_from([1e-6, 1.0, 1e4]))
+def test_condition_on_equals_dense_conditioning_over_random_inputs(seed, d, lead, joseph, scale):
+    """The compiled update (any contiguous column block, either form, batched or not)
+    equals conditioning the joint Gaussian in numpy, with H zero outside its columns."""
+    rng = np.random.default_rng(seed)
+    c = int(rng.integers(1, d - 1)) if d > 3 else 3
+    c = max(c, 1)
+    c0 = int(rng.integers(0, d - c + 1))
+    m = rng.standard_normal(lead + (d,))
+    P = _spd(rng, d, lead) * scale
+    Hc = rng.standard_normal(lead + (3, c))
+    rvar = (0.5 + rng.random(lead + (3,))) * scale
+    nu = rng.standard_normal(lead + (3,))
+    u = kalman.condition_on(m, P, Hc, rvar, nu, cols=slice(c0, c0 + c), joseph=joseph)
+    assert u.P.shape == lead + (d, d) and u.K.shape == lead + (d, 3)
+    for i in np.ndindex(lead):
+        H = np.zeros((3, d))
+        H[:, c0:c0 + c] = Hc[i]
+        mr, Pr, det, G = _dense_update(m[i], P[i], H, rvar[i], nu[i])
+        tol = 1e-9 * np.abs(P[i]).max()
+        np.testing.assert_allclose(u.m[i], mr, rtol=1e-9, atol=1e-9 * np.abs(mr).max())
+        np.testing.assert_allclose(u.P[i], Pr, rtol=1e-7, atol=tol)
+        assert np.array_equal(u.P[i], u.P[i].T)  # symmetrised
+        np.testing.assert_allclose(u.K[i], G, rtol=1e-9, atol=1e-9 * np.abs(G).max())
+        np.testing.assert_allclose(u.det[i], det, rtol=1e-9)
+        np.testing.assert_allclose(u.Sinv[i] @ (H @ P[i] @ H.T + np.diag(rvar[i])), np.eye(3), atol=1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), d=st.integers(1, 9), lead=st.sampled_from([(), (1,), (5,), (2, 3)]),
+       per_member_F=st.booleans(), with_mean=st.booleans())
+def test_predict_equals_numpy_over_random_inputs(seed, d, lead, per_member_F, with_mean):
+    rng = np.random.default_rng(seed)
+    F = rng.standard_normal((lead if per_member_F else ()) + (d, d))
+    P, Q = _spd(rng, d, lead), _spd(rng, d)
+    m = rng.standard_normal(lead + (d,)) if with_mean else None
+    mo, Po = kalman.predict(m, P, F, Q)
+    np.testing.assert_allclose(Po, F @ P @ np.swapaxes(F, -1, -2) + Q, rtol=1e-12, atol=1e-12 * np.abs(Po).max())
+    if with_mean:
+        np.testing.assert_allclose(mo, np.einsum("...ij,...j->...i", F, m), rtol=1e-12, atol=1e-12 * np.abs(mo).max())
+    else:
+        assert mo is None
+
+
+def _numpy_ekf(z, theta, x0, P0, win, s):
+    """The EM-EKF of seed ``s`` written with numpy.linalg (an independent reference)."""
+    from opnav.approach.camera import misalignment_small
+
+    A = misalignment_small(theta[s][None])[0]
+    R = win.Rvar[:, s] if win.Rvar.ndim == 3 else win.Rvar
+    x, P, ll = x0[s].copy(), P0.copy(), 0.0
+    xs, Ps = [x], [P]
+    for k in range(1, win.n + 1):
+        x, P = win.Phi[k] @ x, win.Phi[k] @ P @ win.Phi[k].T + win.Q
+        H = np.zeros((3, 6))
+        H[:, :3] = -A @ win.C[k]
+        Sm = H @ P @ H.T + np.diag(R[k])
+        nu = z[s, k] - A @ (win.u_ref[k] - win.C[k] @ x[:3])
+        x, P, det, _ = _dense_update(x, P, H, R[k], nu)
+        ll += -0.5 * (np.log(det) + nu @ np.linalg.solve(Sm, nu) + 3 * np.log(2 * np.pi))
+        xs.append(x)
+        Ps.append(P)
+    return np.array(xs), np.array(Ps), ll
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), S=st.integers(1, 4), n=st.integers(1, 10), per_seed=st.booleans(),
+       predicted=st.booleans())
+def test_filter_window_equals_a_numpy_ekf_over_random_windows(seed, S, n, per_seed, predicted):
+    """The compiled window pass of the EM-EKF (run_filter) equals a plain numpy EKF seed by
+    seed: filtered moments, log-likelihood and the last sample's K H."""
+    from opnav.approach import ekf
+
+    win, rng = small_window(n=n, seed=seed % 997)
+    if per_seed:
+        win = ekf.Window(win.Phi, win.C, win.u_ref, 0.5 + rng.random((n + 1, S, 3)), win.Q)
+    z = rng.standard_normal((S, n + 1, 3)) * 3 + win.u_ref
+    theta = rng.normal(size=(S, 3)) * 0.05
+    x0 = rng.normal(size=(S, 6))
+    P0 = _spd(rng, 6)
+    f = ekf.run_filter(z, theta, x0, P0, win, predicted=predicted)
+    assert (f.xp is not None) == predicted
+    for s in range(S):
+        xs, Ps, ll = _numpy_ekf(z, theta, x0, P0, win, s)
+        np.testing.assert_allclose(f.xf[s], xs, rtol=1e-9, atol=1e-9 * np.abs(xs).max())
+        np.testing.assert_allclose(f.Pf[s], Ps, rtol=1e-8, atol=1e-9 * np.abs(Ps).max())
+        np.testing.assert_allclose(f.loglik[s], ll, rtol=1e-10)
+        KH = np.zeros((6, 6))
+        KH[:, :3] = f.K[s, -1] @ f.Hr[s, -1]
+        np.testing.assert_allclose(f.KH_last[s], KH, rtol=1e-12, atol=1e-14 * np.abs(KH).max())
+        assert not KH[:, 3:].any() and KH[:, :3].any()
+        if predicted:
+            np.testing.assert_allclose(f.Pp[s, 1:], win.Phi[1:] @ Ps[:-1] @ np.swapaxes(win.Phi[1:], -1, -2) + win.Q,
+                                       rtol=1e-9, atol=1e-9 * np.abs(Ps).max())
+
+
+def test_a_broken_filter_stops_with_one_clear_error():
+    """A non-positive innovation covariance (negative variances) raises instead of going on."""
+    from opnav.approach import ekf
+
+    win, rng = small_window(n=3, seed=1)
+    win = ekf.Window(win.Phi, win.C, win.u_ref, -1e6 * np.ones_like(win.Rvar), win.Q)
+    with pytest.raises(FloatingPointError, match="not positive definite"):
+        ekf.run_filter(np.zeros((1, 4, 3)), np.zeros((1, 3)), np.zeros((1, 6)), np.eye(6), win)

@@ -168,3 +168,26 @@ def test_filter_measurement_jacobian_is_minus_A_C_at_every_sample():
             H = ekf.measurement_jacobian(theta[s:s + 1], win.C[k])[0]
             np.testing.assert_allclose(f.Hr[s, k], H[:, :3], rtol=1e-15, atol=0)
             assert not H[:, 3:].any()
+
+
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), S=st.integers(1, 3), n=st.integers(1, 12),
+       cols=st.sampled_from([slice(None), slice(0, 3), slice(3, 6), slice(1, 4)]))
+def test_compiled_bryson_frazier_equals_rts_over_random_windows(seed, S, n, cols):
+    """The compiled Bryson-Frazier moments (any contiguous block of states) equal the numpy
+    RTS smoother's (eq. 7-9) on random linear models."""
+    win, rng = small_window(n=n, seed=seed % 991)
+    z = rng.standard_normal((S, n + 1, 3)) * 3 + win.u_ref
+    theta = rng.normal(size=(S, 3)) * 0.05
+    A = rng.standard_normal((6, 6))
+    f = ekf.run_filter(z, theta, rng.normal(size=(S, 6)), A @ A.T + np.eye(6), win)
+    r = smoother.rts(f, win)
+    b = smoother.bryson_frazier(f, win, cols)
+    np.testing.assert_allclose(b.xs, r.xs[..., cols], rtol=1e-8, atol=1e-9 * np.abs(r.xs).max())
+    np.testing.assert_allclose(b.Ps, r.Ps[..., cols, cols], rtol=1e-7, atol=1e-9 * np.abs(r.Ps).max())
+    assert np.array_equal(b.Ps, np.swapaxes(b.Ps, -1, -2))
+    with pytest.raises(ValueError, match="contiguous"):
+        smoother.bryson_frazier(f, win, slice(0, 6, 2))

@@ -108,63 +108,48 @@ def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
 
 def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
                win: Window, predicted: bool = True) -> FilterResult:
-    """EKF over a window for every seed at once (eq. 6): :func:`kalman.predict` and
-    :func:`kalman.condition_on` with the position block of ``H``.
+    """EKF over a window for every seed at once (eq. 6): the compiled pass
+    :func:`kalman.filter_window` (the one predict and update of :mod:`kalman`, with the
+    position block of ``H``).
 
     z (S, n+1, 3) (index 0 ignored), theta (S, 3) rad, x0 (S, 6), P0 (S, 6, 6) or (6, 6).
     ``predicted=False``: ``xp, Pp`` are not kept (None; the RTS smoother needs them, the
     Bryson-Frazier smoother and the E-step do not); every other output is the same.
     """
     S, n = z.shape[0], win.n
-    A = misalignment_small(theta)
-    # (S, n+1, 3, 3) position block of H, -A_m C: the sum over j in order (bit for bit the
-    # einsum "sij,kjl->skil", several times faster)
-    Hrs = -(A[:, None, :, 0, None] * win.C[None, :, None, 0, :] + A[:, None, :, 1, None] * win.C[None, :, None, 1, :]
-            + A[:, None, :, 2, None] * win.C[None, :, None, 2, :])
-    d = z - np.einsum("sij,kj->ski", A, win.u_ref)  # z_k - A_m u_ref,k of every sample
+    A = misalignment_small(np.asarray(theta, float))
+    Rvar = win.Rvar if win.Rvar.ndim == 3 else win.Rvar[:, None, :]
     xf = np.empty((S, n + 1, 6))
     Pf = np.empty((S, n + 1, 6, 6))
-    xp = np.zeros((S, n + 1, 6)) if predicted else None
-    Pp = np.zeros((S, n + 1, 6, 6)) if predicted else None
-    x = np.array(x0, float)
-    P = np.broadcast_to(P0, (S, 6, 6)).copy()
-    xf[:, 0], Pf[:, 0] = x, P
+    xp = np.zeros((S, n + 1, 6)) if predicted else np.empty((0, 0, 6))
+    Pp = np.zeros((S, n + 1, 6, 6)) if predicted else np.empty((0, 0, 6, 6))
     Ks = np.zeros((S, n + 1, 6, 3))
     Sinvs = np.zeros((S, n + 1, 3, 3))
     nus = np.zeros((S, n + 1, 3))
-    dets = np.ones((S, n + 1))
-    for k in range(1, n + 1):
-        x, P = kalman.predict(x, P, win.Phi[k], win.Q)
-        if predicted:
-            xp[:, k], Pp[:, k] = x, P
-        Hr = Hrs[:, k]
-        nu = d[:, k] - (Hr @ x[:, :3, None])[..., 0]
-        x, P, K, Sinv, det = kalman.condition_on(x, P, Hr, win.Rvar[k], nu, cols=POS)
-        xf[:, k], Pf[:, k] = x, P
-        Ks[:, k], Sinvs[:, k], nus[:, k], dets[:, k] = K, Sinv, nu, det
-    if np.any(dets <= 0):
+    Hrs = np.empty((S, n + 1, 3, 3))
+    ll = np.empty(S)
+    KH = np.empty((S, 6, 6))
+    c = kalman.carray
+    dmin = kalman.filter_window(c(z), c(A), c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6))),
+                                c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))),
+                                c(win.Q), predicted, xf, Pf, xp, Pp, Ks, Sinvs, nus, Hrs, ll, KH)
+    if not dmin > 0:
         raise FloatingPointError("innovation covariance not positive definite")
-    ll = kalman.innovation_loglik(nus[:, 1:], Sinvs[:, 1:], dets[:, 1:]).sum(1)
-    KH = np.zeros((S, 6, 6))
-    KH[:, :, :3] = Ks[:, n] @ Hrs[:, n]
-    return FilterResult(xf, Pf, xp, Pp, ll, KH, Ks, Sinvs, nus, Hrs)
+    return FilterResult(xf, Pf, xp if predicted else None, Pp if predicted else None, ll, KH, Ks, Sinvs, nus, Hrs)
 
 
 def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window, at=None):
     """Prior mean and covariance propagated through the window without data.
 
     ``at``: increasing sample indices; then the moments at each of them, as lists
-    (one pass: the moments at ``at[i]`` are those of the window ``slice(0, at[i])``).
+    (one pass, :func:`kalman.propagate`: the moments at ``at[i]`` are those of the window
+    ``slice(0, at[i])``).
     """
-    x, P = np.array(x0, float), np.array(P0, float)
     stops = [win.n] if at is None else [int(a) for a in at]
     if any(b < a for a, b in zip(stops, stops[1:])) or (stops and not 0 <= stops[0] <= stops[-1] <= win.n):
         raise ValueError(f"predict_only: sample indices must increase within 0..{win.n}, got {stops}")
-    xs, Ps, done = [], [], 0
-    for stop in stops:
-        for k in range(done + 1, stop + 1):
-            x, P = kalman.predict(x, P, win.Phi[k], win.Q)
-        done = stop
-        xs.append(x)
-        Ps.append(P)
-    return (x, P) if at is None else (xs, Ps)
+    last = stops[-1] if stops else 0
+    xs, Ps = kalman.propagate(np.asarray(x0, float), np.asarray(P0, float), win.Phi[:last + 1], win.Q)
+    if at is None:
+        return xs[-1], Ps[-1]
+    return [xs[a] for a in stops], [Ps[a] for a in stops]

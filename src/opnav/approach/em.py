@@ -34,13 +34,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from opnav.compiled import kernel, warms
+
 from .ekf import POS, FilterResult, Window, run_filter
+from .kalman import carray
 from .smoother import SmootherResult, bryson_frazier
-
-EPS = np.zeros((3, 3, 3))
-EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
-EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
-
 
 @dataclass
 class EStats:
@@ -51,38 +49,54 @@ class EStats:
     J_stars: np.ndarray | None = None  # (3, 3) the star images' part of N (``stars`` variant)
 
 
-def los_moments(s: SmootherResult, win: Window) -> tuple[np.ndarray, np.ndarray]:
-    """Mean (S,n,3) and second moment E[u u^T] (S,n,3,3) of u_k, samples 1..n.
+@kernel
+def _estep_window(z, xs, Ps, C, u_ref, Rvar, N, b):
+    """Sums of the E-step over samples 1..n for every seed (see :func:`estep`).
 
-    ``E[u u^T] = C P_rr C^T + m m^T`` with ``(C P C^T)_im = sum_j sum_l (C_ij P_jl) C_ml``,
-    summed in that order (j outer, l inner) from zero: the bits of
-    ``numpy.einsum("kij,skjl,kml->skim", C, P, C)`` (a test checks it), as whole-array
-    products over (seed, sample), about four times faster than the einsum."""
-    C = win.C[1:]
-    m = win.u_ref[1:] - np.einsum("kij,skj->ski", C, s.xs[:, 1:, :3])
-    Ct = np.ascontiguousarray(C.transpose(1, 2, 0))  # (i, j, k)
-    Pt = np.ascontiguousarray(s.Ps[:, 1:, :3, :3].transpose(2, 3, 0, 1))  # (j, l, s, k)
-    mt = np.ascontiguousarray(m.transpose(2, 0, 1))  # (i, s, k)
-    Mom = np.empty(m.shape + (3,))
-    for i in range(3):
-        a = [[Ct[i, j] * Pt[j, l] for l in range(3)] for j in range(3)]
-        for k in range(3):
-            acc = 0.0
-            for j in range(3):
+    z (S, n+1, 3); xs (S, n+1, >=3) and Ps (S, n+1, >=3, >=3) smoothed moments (position
+    first); C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3). Per sample, with the mean
+    ``m = u_ref - C x_r`` and second moment ``M = C P_rr C^T + m m^T`` of ``u``, ``w = 1/R``
+    and ``U = [u x]`` (``U_ik = -eps_ijk u_j``):
+    ``N_kl += sum_i w_i eps_ijk eps_inl M_jn``, ``b_k += sum_i w_i eps_ijk (m_j z_i - M_ji)``."""
+    S, n1 = z.shape[0], z.shape[1]
+    m = np.empty(3)
+    M = np.empty((3, 3))
+    CP = np.empty((3, 3))
+    for s in range(S):
+        N[s, :, :] = 0.0
+        b[s, :] = 0.0
+        for t in range(1, n1):
+            for i in range(3):
+                m[i] = u_ref[t, i] - (C[t, i, 0] * xs[s, t, 0] + C[t, i, 1] * xs[s, t, 1] + C[t, i, 2] * xs[s, t, 2])
+            for i in range(3):
                 for l in range(3):
-                    acc = acc + a[j][l] * Ct[k, l]
-            Mom[..., i, k] = acc + mt[i] * mt[k]
-    return m, Mom
+                    CP[i, l] = C[t, i, 0] * Ps[s, t, 0, l] + C[t, i, 1] * Ps[s, t, 1, l] + C[t, i, 2] * Ps[s, t, 2, l]
+            for i in range(3):
+                for j in range(3):
+                    M[i, j] = (CP[i, 0] * C[t, j, 0] + CP[i, 1] * C[t, j, 1] + CP[i, 2] * C[t, j, 2]) + m[i] * m[j]
+            for i in range(3):
+                w = 1.0 / Rvar[t, s, i]
+                # eps_ijk is +1 at (j, k) = (i+1, i+2) and -1 at (i+2, i+1) (mod 3)
+                j1 = (i + 1) % 3
+                k1 = (i + 2) % 3
+                N[s, k1, k1] += w * M[j1, j1]
+                N[s, k1, j1] -= w * M[j1, k1]
+                N[s, j1, k1] -= w * M[k1, j1]
+                N[s, j1, j1] += w * M[k1, k1]
+                b[s, k1] += w * (m[j1] * z[s, t, i] - M[j1, i])
+                b[s, j1] -= w * (m[k1] * z[s, t, i] - M[k1, i])
 
 
 def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:
-    """E-step statistics of eq. 23/26 for the closed-form M-step (see module docstring)."""
-    m, Mom = los_moments(s, win)
-    w = win.weights(z.shape[0])  # (S,n,3)
-    zz = z[:, 1:]
-    N = np.einsum("ijk,sti,inl,stjn->skl", EPS, w, EPS, Mom, optimize=True)
-    b = (np.einsum("ijk,stj,sti,sti->sk", EPS, m, w, zz, optimize=True)
-         - np.einsum("ijk,sti,stji->sk", EPS, w, Mom, optimize=True))
+    """E-step statistics of eq. 23/26 for the closed-form M-step (see module docstring):
+    with the mean ``m_k`` and second moment ``E[u u^T] = C P_rr C^T + m m^T`` of ``u_k`` under
+    the smoothed Gaussian, ``N = sum_k E[U^T W U]``, ``b = sum_k E[U^T W e]`` (compiled,
+    :func:`_estep_window`; a test checks it against the einsums of the definition)."""
+    S = z.shape[0]
+    Rvar = win.Rvar if win.Rvar.ndim == 3 else win.Rvar[:, None, :]
+    N, b = np.empty((S, 3, 3)), np.empty((S, 3))
+    c = carray
+    _estep_window(c(z), c(s.xs), c(s.Ps), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (win.n + 1, S, 3))), N, b)
     if win.stars is not None and win.star_y is not None:  # star images: a direct measurement of theta
         from .stars import normal_equations
 
@@ -312,3 +326,12 @@ def squarem_cycle(theta0: np.ndarray, F) -> np.ndarray:
     th3, ll_acc = F(th_acc)
     ok = (ll_acc >= ll0)[:, None]
     return np.where(ok, th3, th2)
+
+
+@warms
+def _warm() -> None:
+    """The E-step kernel once with the pipeline's argument types."""
+    n1 = 2
+    win = Window(np.broadcast_to(np.eye(6), (n1, 6, 6)).copy(), np.broadcast_to(np.eye(3), (n1, 3, 3)).copy(),
+                 np.ones((n1, 3)), np.ones((n1, 3)), np.eye(6))
+    estep(np.zeros((1, n1, 3)), SmootherResult(np.zeros((1, n1, 3)), np.zeros((1, n1, 3, 3)), None, None), win)

@@ -40,13 +40,7 @@ def _start_covariances(geo: sc.Geometry, win: Window, variant: str) -> np.ndarra
     if sc.START_OF[variant] == "truth":
         z = np.zeros((1, n + 1, 3))
         return run_filter(z, np.zeros((1, 3)), np.zeros((1, 6)), geo.P0, win, predicted=False).Pf[0]
-    out = np.empty((n + 1, 6, 6))
-    P = geo.P0.copy()
-    out[0] = P
-    for k in range(1, n + 1):
-        _, P = kalman.predict(None, P, win.Phi[k], win.Q)
-        out[k] = P
-    return out
+    return kalman.propagate(None, geo.P0, win.Phi, win.Q)[1]
 
 
 def bound_curve(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,

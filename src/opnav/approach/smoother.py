@@ -24,7 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from opnav.compiled import kernel, warms
+
 from .ekf import FilterResult, Window
+from .kalman import carray
 
 
 @dataclass
@@ -81,6 +84,96 @@ def lag_one_recursive(f: FilterResult, s: SmootherResult, win: Window) -> np.nda
     return out
 
 
+@kernel
+def _bryson_frazier_window(xf, Pf, K, Hr, Sinv, nu, Phi, c0, xs, Ps):
+    """The modified Bryson-Frazier pass of :func:`bryson_frazier` for every seed, one seed
+    at a time backwards in time, keeping only the adjoint ``Lh, lh`` of the current sample:
+    fills ``xs (S, n+1, c)`` and ``Ps (S, n+1, c, c)`` with the smoothed moments of the
+    state components ``c0..c0+c``. ``H`` touches the position columns 0..2 only."""
+    S, n1 = xf.shape[0], xf.shape[1]
+    c = xs.shape[2]
+    L = np.zeros((6, 6))
+    lv = np.zeros(6)
+    Ct = np.empty((6, 6))
+    T = np.empty((6, 6))
+    Lt = np.empty((6, 6))
+    lt = np.empty(6)
+    HS = np.empty((3, 3))
+    for s in range(S):
+        L[:, :] = 0.0
+        lv[:] = 0.0
+        for k in range(n1 - 1, -1, -1):
+            # moments at k from the adjoint (Lh_k, lh_k): X - P lh, P - P Lh P
+            for i in range(c):
+                acc = 0.0
+                for j in range(6):
+                    acc += Pf[s, k, c0 + i, j] * lv[j]
+                xs[s, k, i] = xf[s, k, c0 + i] - acc
+                for j in range(6):
+                    acc = 0.0
+                    for l in range(6):
+                        acc += Pf[s, k, c0 + i, l] * L[l, j]
+                    T[i, j] = acc  # (P Lh) rows of the components
+            for i in range(c):
+                for m in range(c):
+                    acc = 0.0
+                    for j in range(6):
+                        acc += T[i, j] * Pf[s, k, j, c0 + m]
+                    Ps[s, k, i, m] = Pf[s, k, c0 + i, c0 + m] - acc
+            for i in range(c):
+                for m in range(i + 1, c):
+                    v = 0.5 * (Ps[s, k, i, m] + Ps[s, k, m, i])
+                    Ps[s, k, i, m] = v
+                    Ps[s, k, m, i] = v
+            if k == 0:
+                break
+            # Ct = I - K H of sample k (H on the position columns)
+            for i in range(6):
+                for j in range(6):
+                    Ct[i, j] = 1.0 if i == j else 0.0
+                for j in range(3):
+                    Ct[i, j] -= K[s, k, i, 0] * Hr[s, k, 0, j] + K[s, k, i, 1] * Hr[s, k, 1, j] + K[s, k, i, 2] * Hr[s, k, 2, j]
+            for i in range(6):  # T = Lh Ct
+                for j in range(6):
+                    acc = 0.0
+                    for l in range(6):
+                        acc += L[i, l] * Ct[l, j]
+                    T[i, j] = acc
+            for i in range(6):  # Lt = Ct^T Lh Ct, lt = Ct^T lh
+                for j in range(6):
+                    acc = 0.0
+                    for l in range(6):
+                        acc += Ct[l, i] * T[l, j]
+                    Lt[i, j] = acc
+                acc = 0.0
+                for l in range(6):
+                    acc += Ct[l, i] * lv[l]
+                lt[i] = acc
+            for i in range(3):  # H^T S^-1 (3 x 3)
+                for a in range(3):
+                    HS[i, a] = Hr[s, k, 0, i] * Sinv[s, k, 0, a] + Hr[s, k, 1, i] * Sinv[s, k, 1, a] + Hr[s, k, 2, i] * Sinv[s, k, 2, a]
+            for i in range(3):  # + H^T S^-1 H, - H^T S^-1 nu
+                for j in range(3):
+                    Lt[i, j] += HS[i, 0] * Hr[s, k, 0, j] + HS[i, 1] * Hr[s, k, 1, j] + HS[i, 2] * Hr[s, k, 2, j]
+                lt[i] -= HS[i, 0] * nu[s, k, 0] + HS[i, 1] * nu[s, k, 1] + HS[i, 2] * nu[s, k, 2]
+            for i in range(6):  # Lh_{k-1} = Phi^T Lt Phi, lh_{k-1} = Phi^T lt
+                for j in range(6):
+                    acc = 0.0
+                    for l in range(6):
+                        acc += Lt[i, l] * Phi[k, l, j]
+                    T[i, j] = acc
+            for i in range(6):
+                for j in range(6):
+                    acc = 0.0
+                    for l in range(6):
+                        acc += Phi[k, l, i] * T[l, j]
+                    L[i, j] = acc
+                acc = 0.0
+                for l in range(6):
+                    acc += Phi[k, l, i] * lt[l]
+                lv[i] = acc
+
+
 def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> SmootherResult:
     """The same smoothed moments by the modified Bryson-Frazier recursion (fast path).
 
@@ -90,34 +183,29 @@ def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> S
     ``Ct = I - K H``; ``X_{k|N} = X_k - P_k lh_k``, ``P_{k|N} = P_k - P_k Lh_k P_k``.
     Algebraically identical to :func:`rts` (a test checks it); used inside the
     EM iterations. The lag-one covariance is not formed (``Plag`` zeros); use
-    :func:`rts` where it is needed. ``cols``: only these state components of the
-    smoothed moments (``xs (S, n+1, c)``, ``Ps (S, n+1, c, c)``; the E-step needs the
-    position only); each entry is the one of the full moments, bit for bit.
+    :func:`rts` where it is needed. ``cols``: only these state components (a contiguous
+    slice) of the smoothed moments (``xs (S, n+1, c)``, ``Ps (S, n+1, c, c)``; the E-step
+    needs the position only); each entry is the one of the full moments, bit for bit.
+    Compiled (:func:`_bryson_frazier_window`); against the stacked numpy recursion it
+    replaces (f02dab2), per EM map: see the module docstring.
     """
+    c0, c1, step = cols.indices(6)
+    if step != 1 or c1 <= c0:
+        raise ValueError(f"bryson_frazier: cols must be a contiguous slice of the 6 states, got {cols}")
     S, n1 = f.xf.shape[:2]
-    n = n1 - 1
-    Lh = np.zeros((S, n + 1, 6, 6))
-    lh = np.zeros((S, n + 1, 6))
-    L = np.zeros((S, 6, 6))
-    lv = np.zeros((S, 6))
-    HtSi = np.swapaxes(f.Hr, -1, -2) @ f.Sinv  # (S,n+1,3,3)
-    HSH = HtSi @ f.Hr
-    HSnu = (HtSi @ f.nu[..., None])[..., 0]
-    KH = f.K @ f.Hr  # (S,n+1,6,3): the position columns of K H
-    I6 = np.broadcast_to(np.eye(6), (S, 6, 6))
-    for k in range(n, 0, -1):
-        Ct = I6.copy()  # Ct = I - K H of sample k
-        Ct[..., :3] -= KH[:, k]
-        CtT = np.swapaxes(Ct, -1, -2)
-        Lt = CtT @ L @ Ct
-        Lt[:, :3, :3] += HSH[:, k]
-        lt = (CtT @ lv[..., None])[..., 0]
-        lt[:, :3] -= HSnu[:, k]
-        Phi = win.Phi[k]
-        L = np.matmul(Phi.T @ Lt, Phi, out=Lh[:, k - 1])  # Phi^T Lt Phi, stored in place
-        lv = np.matmul(lt, Phi, out=lh[:, k - 1])
-    Pr = f.Pf[..., cols, :]
-    xs = f.xf[..., cols] - np.einsum("skij,skj->ski", Pr, lh)
-    Ps = f.Pf[..., cols, cols] - Pr @ Lh @ f.Pf[..., :, cols]
-    Ps = 0.5 * (Ps + np.swapaxes(Ps, -1, -2))
+    xs = np.empty((S, n1, c1 - c0))
+    Ps = np.empty((S, n1, c1 - c0, c1 - c0))
+    c = carray
+    _bryson_frazier_window(c(f.xf), c(f.Pf), c(f.K), c(f.Hr), c(f.Sinv), c(f.nu), c(win.Phi), c0, xs, Ps)
     return SmootherResult(xs, Ps, np.zeros(Ps.shape), np.zeros(Ps.shape))
+
+
+@warms
+def _warm() -> None:
+    from .ekf import FilterResult as FR
+
+    S, n1 = 1, 3
+    P = np.broadcast_to(np.eye(6), (S, n1, 6, 6)).copy()
+    f = FR(np.zeros((S, n1, 6)), P, None, None, np.zeros(S), np.zeros((S, 6, 6)), np.zeros((S, n1, 6, 3)),
+           np.broadcast_to(np.eye(3), (S, n1, 3, 3)).copy(), np.zeros((S, n1, 3)), np.zeros((S, n1, 3, 3)))
+    bryson_frazier(f, Window(P[0], np.zeros((n1, 3, 3)), np.zeros((n1, 3)), np.ones((n1, 3)), np.eye(6)), slice(0, 3))
