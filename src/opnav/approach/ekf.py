@@ -31,8 +31,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from opnav.compiled import kernel, warms
+
 from . import kalman
 from .camera import misalignment_small
+from .kalman import _condition1, _loglik1, _predict_cov1, _predict_mean1
 
 POS = slice(0, 3)  # position columns of the state: the only ones H touches
 
@@ -106,10 +109,64 @@ def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
     return H
 
 
+@kernel
+def filter_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, keep_pred, xf, Pf, xp, Pp, K, Sinv, nu, Hr, ll, KH):
+    """The EM-EKF (eq. 6, :func:`opnav.approach.ekf.run_filter`) over one window for every
+    seed: ``_predict_mean1``, ``_predict_cov1`` then ``_condition1`` with ``H = [-A_m C_k, 0]`` and the innovation
+    ``nu_k = z_k - A_m u_ref,k - H_r x_k|k-1`` (the model is linear in the state).
+
+    z (S, n+1, 3); A (S, 3, 3) = A_m(theta) per seed; x0 (S, 6); P0 (S, 6, 6); Phi (n+1, 6, 6);
+    C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3); Q (6, 6). Fills xf, Pf, (xp, Pp when
+    ``keep_pred``), K (S, n+1, 6, 3), Sinv (S, n+1, 3, 3), nu (S, n+1, 3), Hr (S, n+1, 3, 3),
+    the log-likelihood ll (S,) and KH (S, 6, 6) of the last sample. Returns the smallest
+    det S (not positive: the filter broke)."""
+    S, n1 = z.shape[0], z.shape[1]
+    FP = np.empty((6, 6))
+    PHt = np.empty((6, 3))
+    Sm = np.empty((3, 3))
+    T = np.empty((6, 6))
+    dmin = np.inf
+    for s in range(S):
+        for k in range(n1):  # H_r = -A_m C_k
+            for i in range(3):
+                for j in range(3):
+                    Hr[s, k, i, j] = -(A[s, i, 0] * C[k, 0, j] + A[s, i, 1] * C[k, 1, j] + A[s, i, 2] * C[k, 2, j])
+        for i in range(6):
+            xf[s, 0, i] = x0[s, i]
+            for j in range(6):
+                Pf[s, 0, i, j] = P0[s, i, j]
+        acc_ll = 0.0
+        for k in range(1, n1):
+            x, P = xf[s, k], Pf[s, k]  # predicted, then updated in place
+            _predict_mean1(xf[s, k - 1], Phi[k], x)
+            _predict_cov1(Pf[s, k - 1], Phi[k], Q, P, FP)
+            if keep_pred:
+                for i in range(6):
+                    xp[s, k, i] = x[i]
+                    for j in range(6):
+                        Pp[s, k, i, j] = P[i, j]
+            for i in range(3):
+                acc = z[s, k, i] - (A[s, i, 0] * u_ref[k, 0] + A[s, i, 1] * u_ref[k, 1] + A[s, i, 2] * u_ref[k, 2])
+                acc -= Hr[s, k, i, 0] * x[0] + Hr[s, k, i, 1] * x[1] + Hr[s, k, i, 2] * x[2]
+                nu[s, k, i] = acc
+            det = _condition1(True, x, P, Hr[s, k], 0, Rvar[k, s], nu[s, k], False, K[s, k], Sinv[s, k], PHt, Sm, T, T)
+            dmin = min(dmin, det)
+            if det > 0.0:
+                acc_ll += _loglik1(nu[s, k], Sinv[s, k], det)
+        ll[s] = acc_ll
+        n = n1 - 1
+        for i in range(6):
+            for j in range(6):
+                KH[s, i, j] = 0.0
+            for j in range(3):
+                KH[s, i, j] = K[s, n, i, 0] * Hr[s, n, 0, j] + K[s, n, i, 1] * Hr[s, n, 1, j] + K[s, n, i, 2] * Hr[s, n, 2, j]
+    return dmin
+
+
 def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
                win: Window, predicted: bool = True) -> FilterResult:
     """EKF over a window for every seed at once (eq. 6): the compiled pass
-    :func:`kalman.filter_window` (the one predict and update of :mod:`kalman`, with the
+    :func:`filter_window` (the one predict and update of :mod:`kalman`, with the
     position block of ``H``).
 
     z (S, n+1, 3) (index 0 ignored), theta (S, 3) rad, x0 (S, 6), P0 (S, 6, 6) or (6, 6).
@@ -130,7 +187,7 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     ll = np.empty(S)
     KH = np.empty((S, 6, 6))
     c = kalman.carray
-    dmin = kalman.filter_window(c(z), c(A), c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6))),
+    dmin = filter_window(c(z), c(A), c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6))),
                                 c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))),
                                 c(win.Q), predicted, xf, Pf, xp, Pp, Ks, Sinvs, nus, Hrs, ll, KH)
     if not dmin > 0:
@@ -153,3 +210,13 @@ def predict_only(x0: np.ndarray, P0: np.ndarray, win: Window, at=None):
     if at is None:
         return xs[-1], Ps[-1]
     return [xs[a] for a in stops], [Ps[a] for a in stops]
+
+
+@warms
+def _warm() -> None:
+    """The window pass once with the pipeline's argument types."""
+    S, n1 = 1, 2
+    win = Window(np.broadcast_to(np.eye(6), (n1, 6, 6)).copy(), np.broadcast_to(np.eye(3), (n1, 3, 3)).copy(),
+                 np.zeros((n1, 3)), np.ones((n1, 3)), np.eye(6))
+    run_filter(np.zeros((S, n1, 3)), np.zeros((S, 3)), np.zeros((S, 6)), np.eye(6), win)
+    run_filter(np.zeros((S, n1, 3)), np.zeros((S, 3)), np.zeros((S, 6)), np.eye(6), win, predicted=False)

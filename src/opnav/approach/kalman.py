@@ -4,9 +4,10 @@ Description
     Every filter of paper A is built from these two steps, as dynamax builds
     its filters from one ``_predict`` and one ``_condition_on``:
 
-    * the EM-EKF (:func:`opnav.approach.ekf.run_filter`, paper eq. 6, whose window pass
-      :func:`filter_window` is compiled here beside the steps it calls) and the prior
-      propagated without data (:func:`opnav.approach.ekf.predict_only`);
+    * the EM-EKF (:func:`opnav.approach.ekf.run_filter`, paper eq. 6, whose compiled
+      window pass :func:`opnav.approach.ekf.filter_window` calls the kernels of the steps
+      below) and the prior propagated without data (:func:`propagate`,
+      :func:`opnav.approach.ekf.predict_only`);
     * the augmented EKF of ``[dX; theta]`` (:func:`opnav.approach.augmented.run_augmented`);
     * the Cramér-Rao bound recursion (:func:`opnav.approach.crlb.crlb_curve`),
       the covariance of the same augmented filter on the linear-Gaussian model.
@@ -30,12 +31,13 @@ Description
 Implementation
     Each step is written once, for one batch member, as plain loops compiled with
     :func:`opnav.compiled.kernel` (``_predict_mean1``, ``_predict_cov1``, ``_condition1``, ``_loglik1``); the
-    batched Python API loops them over the members, and :func:`filter_window` runs the
-    EM-EKF's whole window for every seed in one call. (The EM-EKF's pass lives in this
-    file, not in ``ekf.py``, because numba's on-disk cache does not notice a change in a
-    kernel of another file that a cached kernel calls.) Measured against the stacked
-    numpy steps they replace (one process, this machine, ``benchmarks/bench_approach.py
-    --kernels``): see that script's output and the commit messages.
+    batched Python API (:func:`predict`, :func:`condition_on`, :func:`propagate`,
+    :func:`innovation_loglik`) loops them over the members, and
+    :func:`opnav.approach.ekf.filter_window` runs the EM-EKF's whole window for every seed
+    in one call. Against the stacked numpy steps they replace (f02dab2), a time update
+    costs about the same per call at the batch sizes used (a few us of Python around
+    either); the gain is in the window passes, where the loop over samples is compiled
+    too (``benchmarks/bench_approach.py --kernels``).
 
 Shapes
     Leading axes ``...`` (seeds, windows, or none) broadcast: ``m (..., d)``,
@@ -339,61 +341,6 @@ def innovation_loglik(nu: np.ndarray, Sinv: np.ndarray, det: np.ndarray) -> np.n
     return out.reshape(lead)
 
 
-# ----------------------------------------------------------------- the EM-EKF's window pass
-@kernel
-def filter_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, keep_pred, xf, Pf, xp, Pp, K, Sinv, nu, Hr, ll, KH):
-    """The EM-EKF (eq. 6, :func:`opnav.approach.ekf.run_filter`) over one window for every
-    seed: ``_predict_mean1``, ``_predict_cov1`` then ``_condition1`` with ``H = [-A_m C_k, 0]`` and the innovation
-    ``nu_k = z_k - A_m u_ref,k - H_r x_k|k-1`` (the model is linear in the state).
-
-    z (S, n+1, 3); A (S, 3, 3) = A_m(theta) per seed; x0 (S, 6); P0 (S, 6, 6); Phi (n+1, 6, 6);
-    C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3); Q (6, 6). Fills xf, Pf, (xp, Pp when
-    ``keep_pred``), K (S, n+1, 6, 3), Sinv (S, n+1, 3, 3), nu (S, n+1, 3), Hr (S, n+1, 3, 3),
-    the log-likelihood ll (S,) and KH (S, 6, 6) of the last sample. Returns the smallest
-    det S (not positive: the filter broke)."""
-    S, n1 = z.shape[0], z.shape[1]
-    FP = np.empty((6, 6))
-    PHt = np.empty((6, 3))
-    Sm = np.empty((3, 3))
-    T = np.empty((6, 6))
-    dmin = np.inf
-    for s in range(S):
-        for k in range(n1):  # H_r = -A_m C_k
-            for i in range(3):
-                for j in range(3):
-                    Hr[s, k, i, j] = -(A[s, i, 0] * C[k, 0, j] + A[s, i, 1] * C[k, 1, j] + A[s, i, 2] * C[k, 2, j])
-        for i in range(6):
-            xf[s, 0, i] = x0[s, i]
-            for j in range(6):
-                Pf[s, 0, i, j] = P0[s, i, j]
-        acc_ll = 0.0
-        for k in range(1, n1):
-            x, P = xf[s, k], Pf[s, k]  # predicted, then updated in place
-            _predict_mean1(xf[s, k - 1], Phi[k], x)
-            _predict_cov1(Pf[s, k - 1], Phi[k], Q, P, FP)
-            if keep_pred:
-                for i in range(6):
-                    xp[s, k, i] = x[i]
-                    for j in range(6):
-                        Pp[s, k, i, j] = P[i, j]
-            for i in range(3):
-                acc = z[s, k, i] - (A[s, i, 0] * u_ref[k, 0] + A[s, i, 1] * u_ref[k, 1] + A[s, i, 2] * u_ref[k, 2])
-                acc -= Hr[s, k, i, 0] * x[0] + Hr[s, k, i, 1] * x[1] + Hr[s, k, i, 2] * x[2]
-                nu[s, k, i] = acc
-            det = _condition1(True, x, P, Hr[s, k], 0, Rvar[k, s], nu[s, k], False, K[s, k], Sinv[s, k], PHt, Sm, T, T)
-            dmin = min(dmin, det)
-            if det > 0.0:
-                acc_ll += _loglik1(nu[s, k], Sinv[s, k], det)
-        ll[s] = acc_ll
-        n = n1 - 1
-        for i in range(6):
-            for j in range(6):
-                KH[s, i, j] = 0.0
-            for j in range(3):
-                KH[s, i, j] = K[s, n, i, 0] * Hr[s, n, 0, j] + K[s, n, i, 1] * Hr[s, n, 1, j] + K[s, n, i, 2] * Hr[s, n, 2, j]
-    return dmin
-
-
 @warms
 def _warm() -> None:
     """Each kernel once with the pipeline's argument types (float64 arrays, int64, bool)."""
@@ -404,9 +351,3 @@ def _warm() -> None:
     u = condition_on(m, P1, np.eye(3)[None], np.ones((1, 3)), np.zeros((1, 3)), cols=slice(0, 3))
     condition_on(None, P1, np.ones((1, 3, 6)), np.ones((1, 3)), None, joseph=True)
     innovation_loglik(np.zeros((1, 3)), u.Sinv, u.det)
-    S, n1 = 1, 2
-    filter_window(np.zeros((S, n1, 3)), np.eye(3)[None], np.zeros((S, 6)), P, np.broadcast_to(F, (n1, 6, 6)).copy(),
-                  np.broadcast_to(np.eye(3), (n1, 3, 3)).copy(), np.zeros((n1, 3)), np.ones((n1, S, 3)), Q, False,
-                  np.empty((S, n1, 6)), np.empty((S, n1, 6, 6)), np.empty((0, 0, 6)), np.empty((0, 0, 6, 6)),
-                  np.zeros((S, n1, 6, 3)), np.zeros((S, n1, 3, 3)), np.zeros((S, n1, 3)), np.empty((S, n1, 3, 3)),
-                  np.empty(S), np.empty((S, 6, 6)))
