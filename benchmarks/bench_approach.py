@@ -21,6 +21,10 @@ fields aside), which must be 0 or round-off.
 ``--against RESULTS``: the same jobs with this checkout only, against the work pickles
 of a finished run of that profile; "before" is the ``cpu_time`` of its benchmark files.
 
+``--kernels``: the CPU time of the compiled window passes of the EM-EKF (filter,
+position smoother, E-step, one EM map) per window length and seed count; with
+``--before REV`` beside REV's (numpy) versions and their ratios.
+
 Without either: the CPU time of one EM iteration (EKF + smoother + E/M step)
 on a 250-sample segment per seed count, and with ``--workflow`` the wall time of
 ``snakemake --cores 2`` for every part-A output from an empty results directory
@@ -77,6 +81,66 @@ with open(out, "wb") as fh:
     pickle.dump(res, fh)
 print(json.dumps({"cpu_s": cpu}))
 """
+
+
+# the compiled window passes against the numpy they replaced: argv = samples seeds (comma lists)
+_KERNELS = r"""
+import json, sys, time
+import numpy as np
+from opnav.approach import em, ekf, smoother, scenario as sc
+from opnav.config import load_config
+cfg = load_config()["approach"]
+rows = []
+for n in map(int, sys.argv[1].split(",")):
+    geo = sc.build_geometry(cfg, "roll", n=n)
+    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    win = geo.window(Rvar)
+    for S in map(int, sys.argv[2].split(",")):
+        z, _ = sc.simulate(geo, Rvar, sc.rad(cfg["truth_bias_arcsec"]), sc.seed_streams(1, 1, range(S)))
+        theta, x0 = np.full((S, 3), 1e-5), np.zeros((S, 6))
+        em.em_map(theta, z, x0, geo.P0, win, 1e-6)  # warm-up (loads the kernels)
+        f = ekf.run_filter(z, theta, x0, geo.P0, win, predicted=False)
+        s = smoother.bryson_frazier(f, win, ekf.POS)
+        reps = max(3, int(4000 / (n * S)))
+        def best(fn):
+            t = []
+            for _ in range(reps):
+                t0 = time.process_time(); fn(); t.append(time.process_time() - t0)
+            return min(t)
+        rows.append({"samples": n, "seeds": S,
+                     "filter": best(lambda: ekf.run_filter(z, theta, x0, geo.P0, win, predicted=False)),
+                     "smoother": best(lambda: smoother.bryson_frazier(f, win, ekf.POS)),
+                     "estep": best(lambda: em.estep(z, s, win)),
+                     "em_map": best(lambda: em.em_map(theta, z, x0, geo.P0, win, 1e-6))})
+print(json.dumps(rows))
+"""
+
+
+def kernel_timing(src: Path, samples: str, seeds: str) -> list[dict]:
+    """Best-of CPU seconds of the EKF window pass, the position Bryson-Frazier smoother, the
+    E-step and one whole EM map, per window length and seed count, with the package ``src``."""
+    p = subprocess.run([sys.executable, "-c", _KERNELS, samples, seeds], cwd=REPO, check=True,
+                       capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(src)))
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def compare_kernels(rev: str | None, samples: str, seeds: str) -> None:
+    """:func:`kernel_timing` of this checkout, and of ``rev`` beside it with the ratios."""
+    parts = ("filter", "smoother", "estep", "em_map")
+    with tempfile.TemporaryDirectory() as d:
+        before = kernel_timing(_export_src(rev, Path(d)), samples, seeds) if rev else None
+    after = kernel_timing(REPO / "src", samples, seeds)
+    print("CPU ms (best of repeats), roll geometry" + (f"; before = {rev}, after = this checkout" if rev else ""))
+    print(f"{'samples':>7s} {'seeds':>5s} " + " ".join(f"{p:>22s}" for p in parts))
+    for i, a in enumerate(after):
+        cells = []
+        for p in parts:
+            if before:
+                b = before[i][p]
+                cells.append(f"{b * 1e3:8.2f} ->{a[p] * 1e3:8.2f} {a[p] / b:4.2f}")
+            else:
+                cells.append(f"{a[p] * 1e3:22.2f}")
+        print(f"{a['samples']:7d} {a['seeds']:5d} " + " ".join(cells), flush=True)
 
 
 def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int = 5) -> list[dict]:
@@ -289,7 +353,15 @@ def main() -> None:
                     help="Monte-Carlo jobs variant:group (every EM scheme: one job now, one per scheme "
                          "before) or variant:group:scheme, or 'all'")
     ap.add_argument("--x2", nargs="*", default=[], help="A-X2 variants (one job each)")
+    ap.add_argument("--kernels", action="store_true",
+                    help="time the compiled window passes (filter, smoother, E-step, EM map); with --before "
+                         "REV beside REV's numpy versions")
+    ap.add_argument("--samples", default="50,250,2000", help="--kernels: window lengths")
+    ap.add_argument("--seeds", default="3,20,80", help="--kernels: seed counts")
     args = ap.parse_args()
+    if args.kernels:
+        compare_kernels(args.before, args.samples, args.seeds)
+        return
     if args.against:
         compare_with_run(args.against, mc_specs(args.quick) if args.mc == ["all"] else args.mc, args.x2, args.quick,
                          schemes_of(args.quick))
