@@ -250,10 +250,10 @@ def kernel_report(wd: Path) -> list[str]:
     from job_costs import kernel_counts
 
     lines = []
-    for log in sorted(wd.glob("results/**/kernels/logs/compile_kernels.log")):
+    for log in sorted(wd.glob("results/**/kernels/logs/compile_*.log")):
         lines += [line for line in log.read_text(errors="replace").splitlines()
                   if (" INFO " in line or " WARNING " in line) and "job resources" not in line]
-    counts = [c for c in kernel_counts(wd / "results") if Path(c[0]).stem != "compile_kernels"]
+    counts = [c for c in kernel_counts(wd / "results") if Path(c[0]).parent.parent.name != "kernels"]
     if counts:
         compiling = [c for c in counts if c[2]]
         lines.append(f"{len(counts)} jobs used kernels: {sum(c[1] for c in counts)} signatures loaded, "

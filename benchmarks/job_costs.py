@@ -85,7 +85,7 @@ def main(argv=None) -> int:
         print(f"  {cpu:8.2f} s {rss:6.0f} MB  {path}")
     kernels = kernel_counts(a.results)
     if kernels:
-        compiling = [(p, c) for p, _, c in kernels if c and Path(p).stem != "compile_kernels"]
+        compiling = [(p, c) for p, _, c in kernels if c and not Path(p).parent.parent.name == "kernels"]
         print(f"kernels: {len(kernels)} jobs used them, {sum(n for _, n, _ in kernels)} signatures loaded from "
               f"the cache; {len(compiling)} jobs besides compile_kernels compiled some themselves")
         for path, n in compiling:

@@ -46,7 +46,7 @@ rule approach_mc:
     process start-up (about 0.7 CPU-s a job) and the geometry."""
     input:
         A_SRC,
-        kernels=kernels(),
+        kernels=kernels("approach"),
     output:
         [f"{A_WORK}/mc/{{variant}}__{{group}}__{s}.pkl" for s in A_SCHEMES],
     params:
@@ -66,7 +66,7 @@ rule approach_convergence:
     variant in one job (they share the process start-up, about 0.8 CPU-s a job)."""
     input:
         A_SRC,
-        kernels=kernels(),
+        kernels=kernels("approach"),
     output:
         expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
     params:
@@ -86,7 +86,7 @@ rule approach_crlb:
     input:
         A_SRC,
         src("published.py", "data/published.yaml"),
-        kernels=kernels(),
+        kernels=kernels("approach"),
     output:
         f"{A_WORK}/crlb.pkl",
     params:
@@ -104,7 +104,7 @@ rule approach_stars:
     against the data, and the EM-EKF and augmented-EKF estimates."""
     input:
         A_SRC + src("approach/alternatives.py", "approach/batch_ml.py"),
-        kernels=kernels(),
+        kernels=kernels("approach"),
     output:
         f"{A_WORK}/stars.pkl",
     params:

@@ -18,7 +18,7 @@ rule approach_x2_group:
     of them) and variant, same seeds as the EM-EKF Monte Carlo; the headline group also times the EM-EKF."""
     input:
         A_X2_SRC,
-        kernels=kernels(),
+        kernels=kernels("approach"),
     output:
         f"{A_WORK}/x2/{{variant}}__{{group}}.pkl",
     params:

@@ -17,7 +17,7 @@ if HAVE_BSK:
         variant in one job (they share the start-up and Basilisk's import, about 2 CPU-s)."""
         input:
             A_SRC + src("approach/peers.py"),
-            kernels=kernels(),
+            kernels=kernels("approach"),
         output:
             expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
         params:

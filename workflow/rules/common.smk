@@ -1,5 +1,5 @@
 # Shared helpers: config validation, output paths, and the final outputs (final_outputs).
-from opnav.compiled import kernel_sources  # noqa: E402
+from opnav.compiled import KERNEL_MODULES, kernel_sources  # noqa: E402
 from opnav.config import ConfigError, validate_config  # noqa: E402
 from opnav.snakeio import compact_params_change_reasons  # noqa: E402
 
@@ -39,24 +39,34 @@ def res(*parts):
     return str(Path(RESULTS, *parts))
 
 
-# the kernel modules' sources and rule compile_kernels' output (kernels.smk)
-KERNEL_SRC = [str(p) for p in kernel_sources()]
-KERNELS_JSON = res("kernels", "kernels.json")
+# Compiled kernels (kernels.smk): the registered modules (opnav.compiled.KERNEL_MODULES,
+# read without importing numba) that each paper's jobs run.
+KERNEL_PAPERS = ("approach", "landing")
+
+
+def kernel_modules(paper):
+    """The registered kernel modules the jobs of ``paper`` (KERNEL_PAPERS) run: those of
+    its package and the shared ones (opnav.rotations, ...)."""
+    other = set(KERNEL_PAPERS) - {paper}
+    return [m for m in KERNEL_MODULES if not set(m.split(".")[1:2]) & other]
+
+
+def kernel_src(paper):
+    """opnav/compiled.py and the source files of kernel_modules(paper)."""
+    return [str(p) for p in kernel_sources(tuple(kernel_modules(paper)))]
 
 
 def with_kernels(paper, files):
-    """``files`` and the kernel modules' sources the jobs of ``paper`` ("approach" or
-    "landing") run: those of its package and the shared ones (compiled.py, opnav.rotations,
-    ...), each once. A module registered in KERNEL_MODULES is then an input of its rules
-    without being named here (editing it reruns them)."""
-    other = {"approach", "landing"} - {paper}
-    return list(dict.fromkeys([*files, *(p for p in KERNEL_SRC if Path(p).parent.name not in other)]))
+    """``files`` and kernel_src(paper), each once: a module registered in KERNEL_MODULES
+    is an input of its paper's rules (editing it reruns them) without being named there."""
+    return list(dict.fromkeys([*files, *kernel_src(paper)]))
 
 
-def kernels():
-    """Input of a rule whose jobs call compiled kernels: rule compile_kernels' output,
-    ancient (it orders the job after the cache is filled; recompiling does not rerun it)."""
-    return ancient(KERNELS_JSON)
+def kernels(paper):
+    """Input of a rule whose jobs call ``paper``'s compiled kernels: rule compile_kernels'
+    output for that paper, ancient (it orders the job after the cache is filled;
+    recompiling does not rerun the job: its own src inputs decide that)."""
+    return ancient(res("kernels", f"{paper}.json"))
 
 
 def src(*modules):

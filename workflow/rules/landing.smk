@@ -82,7 +82,7 @@ rule landing_mc_chunk:
     """One Monte-Carlo job: runs of one planning method in one camera scenario (scatter)."""
     input:
         B_SRC,
-        kernels=kernels(),
+        kernels=kernels("landing"),
     output:
         f"{LANDING}/mc/{{bscn}}/chunks/{{bmethod}}/{{bchunk}}.npz",
     wildcard_constraints:
@@ -143,7 +143,7 @@ rule landing_single:
     input:
         B_SRC,
         src("landing/plots.py", "figures.py", "opnav.mplstyle"),
-        kernels=kernels(),
+        kernels=kernels("landing"),
     output:
         summary=f"{LANDING}/single/summary_{{bscn}}.json",
         f5=report_figure(f"{LANDING}/B-F5_depth_error_map_{{bscn}}", "B-F5", "Paper B", "{bscn}"),
@@ -166,7 +166,7 @@ rule landing_tuning:
     input:
         B_SRC,
         src("landing/tuning.py"),
-        kernels=kernels(),
+        kernels=kernels("landing"),
     output:
         f"{LANDING}/tuning.json",
     params:
@@ -195,7 +195,7 @@ rule landing_summary:
             "landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
             "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
             "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml")),
-        kernels=kernels(),
+        kernels=kernels("landing"),
     output:
         t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),
         summary=f"{LANDING}/summaries/B-summary_{{bscn}}.json",

@@ -16,7 +16,7 @@ rule landing_x1_summary:
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         code=with_kernels("landing", src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py",
                                          "landing/plots.py", "tables.py", "figures.py", "opnav.mplstyle")),
-        kernels=kernels(),
+        kernels=kernels("landing"),
     output:
         f=report_figure(f"{LANDING}/B-X1_envelopes_{{bscn}}", "B-X1", "Paper B", "beyond"),
         t=report_table(f"{LANDING}/B-X1_ranking_{{bscn}}", "B-X1", "Paper B"),

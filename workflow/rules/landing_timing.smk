@@ -10,7 +10,7 @@ rule landing_timing:
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
         code=B_SRC + src("landing/timing.py"),
-        kernels=kernels(),
+        kernels=kernels("landing"),
     output:
         f"{LANDING}/timing/{{bscn}}.npz",
     wildcard_constraints:

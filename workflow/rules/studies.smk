@@ -37,7 +37,7 @@ rule study_runs:
     (paper A: variant and estimator) that a study of that value compares."""
     input:
         lambda wc: STUDY_SRC[wc.spaper],
-        kernels=kernels(),
+        kernels=lambda wc: kernels(wc.spaper),
     output:
         f"{STUDIES_DIR}/runs/{{spaper}}/{{sdigest}}/{{schunk}}.csv",
     wildcard_constraints:

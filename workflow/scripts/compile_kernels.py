@@ -1,4 +1,4 @@
-"""Fills numba's on-disk cache with every kernel (rule compile_kernels, opnav.compiled)."""
+"""Fills numba's on-disk cache with a paper's kernels (rule compile_kernels, opnav.compiled)."""
 
 import sys
 
@@ -9,12 +9,13 @@ from opnav.snakeio import mock_snakemake, script_context
 from opnav.tables import write_json
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
-    snakemake = mock_snakemake("compile_kernels", argv=sys.argv[1:])
+    snakemake = mock_snakemake("compile_kernels", argv=sys.argv[1:], kpaper="landing")
 
 with script_context(snakemake) as log:
-    here = compiled.warm()
+    modules = tuple(snakemake.params.modules)
+    here = compiled.warm(modules)
     stats = compiled.cache_stats()
-    fresh = compiled.warm_fresh()
+    fresh = compiled.warm_fresh(modules)
     for module in sorted(here):
         log.info("%s: %.3f s here, %.3f s in a fresh process", module, here[module], fresh["seconds"][module])
     log.info("kernels: %d signatures compiled and %d loaded here (%.2f s); a fresh process then compiled %d "
@@ -24,5 +25,5 @@ with script_context(snakemake) as log:
         log.warning("%d kernel signatures compiled again in a fresh process: not cached (every job "
                     "calling them compiles them)", fresh["compiled"])
     # no timings: the same kernel set gives the same file
-    write_json(snakemake.output[0], {"kernel_modules": list(compiled.KERNEL_MODULES),
+    write_json(snakemake.output[0], {"kernel_modules": list(modules),
                                      "kernel_set_digest": compiled.kernel_set_digest(), "numba": numba.__version__})
