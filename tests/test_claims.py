@@ -81,6 +81,19 @@ def test_pixel_claim_needs_more_data_for_worse_pixels():
     assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C5"]["verdict"] == C.NOT_REPRODUCED
 
 
+def test_pixel_claim_counts_data_only_where_the_data_can_tell_the_bias():
+    """The as-written counts grow with the pixel noise, but the bound of the data used is
+    above the claimed 2 arcsec: EM converges to an ML the data cannot tell from zero, so
+    its sample counts are not 'data needed'. Only the identifiable roll rows can carry it."""
+    t = table(literal={"bound": 20.6})
+    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C5"]
+    assert r["verdict"] == C.WITH_ADDITION and r["best_variant"] == "roll"
+    assert "not identifiable" in r["ours_as_written"] and "20.6" in r["bound"]
+    t = table(literal={"bound": 20.6}, roll={"bound": 8.2})
+    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C5"]
+    assert r["verdict"] == C.NOT_REPRODUCIBLE and "20.6" in r["named"]
+
+
 def _scenario(equivalent=True, pick=50.0, controls=(), faster="faster", yaw=False, red=29.0, red_alt=70.0):
     return {"eval_path": "matrix_scalar", "yaw_converges": yaw, "yaw_reason": "yaw 3-sigma flat",
             "equivalence": {"methods": {"depth": {"equivalent": equivalent, "same_pick_pct": pick,
@@ -111,6 +124,7 @@ def test_paper_b_verdicts_flip_with_the_numbers():
     r = by_id(rows_b(summary_b(interior={"controls": ["random"]}, **{"site-tilt": {"controls": ["random"]}}),
                      PUB["paper_b"]))
     assert r["B-C1"]["verdict"] == C.NOT_REPRODUCED
+    assert "random" in r["B-C1"]["cause"].split("site-tilt")[0], "the cause names the passing control"
     # the two cameras disagree: the claim depends on the camera
     r = by_id(rows_b(summary_b(**{"site-tilt": {"equivalent": False}}), PUB["paper_b"]))
     assert r["B-C1"]["verdict"] == C.DEPENDS and "camera" in r["B-C1"]["named"]

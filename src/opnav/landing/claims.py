@@ -69,7 +69,10 @@ def _claim_same_accuracy(head: str, scen: dict) -> dict:
                        + (f", controls also equivalent: {join(ctrl)}" if ctrl else ""))
     verdict, named = _across(per, head, "the camera, which the paper does not give")
     eqh = (scen[head].get("equivalence") or {}).get("methods", {}).get("depth", {})
+    ctrl_h = list(scen[head].get("controls_equivalent") or (scen[head].get("equivalence") or {}).get("controls_equivalent") or [])
     cause = (f"In the {head} scenario {_clause(eqh.get('text', texts[head]))}"
+             + (f"; but the same rule also finds the control{'s' if len(ctrl_h) > 1 else ''} {join(ctrl_h)} "
+                "equivalent, so it cannot credit the depth-error metric" if ctrl_h else "")
              + "".join(f"; in {k}: {texts[k]}" for k in scen if k != head))
     others = [k for k in scen if k != head]
     return C.row("B", "B-C1", "Accuracy almost the same as SVD, GDOP and condition number (Fig. 6)", "almost the same (3-sigma envelopes)", verdict, cause, "B-T3, B-F6, B-X1",
