@@ -230,7 +230,7 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                 med = float(np.median(v))
                 ax.annotate(f"{med:.0f}", (p_, med), xytext=(0, 3), textcoords="offset points",
                             ha="center", va="bottom", fontsize="xx-small")
-        ax.set_ylabel("planning-call time (us)")
+        ax.set_ylabel("planning-call time (µs)")
         ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"
                       f"whiskers: 5-95 %; plain: {main_name}"
                       + (f"; hatched: {alt_name}" if alt_name else ""), fontsize="x-small")
