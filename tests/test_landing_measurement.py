@@ -112,3 +112,33 @@ def test_tangent_jacobian_is_the_projected_candidate_rows(seed, scale):
         d = (p[k] - r[k]).tolist()
         rho = float(np.sqrt(np.sum((p[k] - r[k]) ** 2)))
         assert np.array_equal(tangent_jacobian_scalar(R[k].tolist(), *d, rho, scale), G[k])
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 10_000), st.floats(1.0, 2e4))
+def test_kernels_are_eq_12_and_18_as_printed(seed, dist):
+    """The compiled blocks against the paper's printed forms: b = R rho / |rho|
+    (eq. 12), H_C = R (|rho|^2 I - rho rho^T) / |rho|^3 (eq. 18); the kernel's
+    inverse range; the tangent rows (one landmark) equal the batched form."""
+    from opnav.landing.measurement import blocks, line_of_sight, tangent_rows
+
+    rng = np.random.default_rng(seed)
+    r = rng.normal(size=3) * 1000
+    rho = rng.normal(size=3)
+    rho *= dist / np.linalg.norm(rho)
+    p = r + rho
+    rho = p - r                                        # exactly what the kernel sees
+    R = Rotation.random(random_state=rng).as_matrix()
+    u = np.empty(3)
+    inv = line_of_sight(r, p, u)
+    n = np.linalg.norm(rho)
+    np.testing.assert_allclose(inv, 1 / n, rtol=1e-14)
+    b, HC = np.empty(3), np.empty((3, 3))
+    blocks(R, u, inv, b, HC)
+    np.testing.assert_allclose(b, R @ rho / n, atol=1e-14)
+    want = R @ (n**2 * np.eye(3) - np.outer(rho, rho)) / n**3
+    np.testing.assert_allclose(HC, want, rtol=0, atol=1e-13 * np.abs(want).max())
+    G = np.empty((2, 12))
+    tangent_rows(R, p - r, 3.0, G)
+    np.testing.assert_array_equal(G, tangent_jacobian(r, R, p, 3.0))
+    assert line_of_sight(r, r, u) == 0.0 and np.isnan(line_of_sight(r, p + np.nan, u))

@@ -54,12 +54,16 @@ basis orthogonal to ``b`` (``t1, t2`` orthogonal to ``u`` in {L}); then
 ``T^T H_C = [t1; t2]^T / |rho|`` and ``T^T [b x] = [-t2_B; t1_B]^T``
 (``t_B = R_LtoB t``).
 
-ONE home: every numpy evaluation of eq. 12 and 14-18 in the package is a
-function of this module, batched over arbitrary leading dimensions (runs x
-candidates x ...; inputs broadcast). The symbolic CasADi derivation
-(:mod:`opnav.landing.casadi_model`) is its cross-check only
+ONE home: eq. 12 and 15-18 are written once, as compiled kernels over one
+landmark (``opnav.compiled.kernel``): :func:`line_of_sight` (u, 1/|rho|),
+:func:`blocks` (b and H_C) and :func:`tangent_rows` (the tangent-plane rows).
+The filter's kernels (``opnav.landing.ekf``) and the planner's call them
+directly; the Python functions below run them over arbitrary leading dimensions
+(runs x candidates x ...; inputs broadcast). The symbolic CasADi derivation
+(:mod:`opnav.landing.casadi_model`) is the reference
 (tests/test_landing_metrics.py compares them; tests/test_landing_measurement.py
-checks central differences). A single vector and a batch give the same bits.
+checks central differences and the printed forms of eq. 12 and 18). A single
+vector and a batch give the same bits.
 
 Units: positions m, angles rad; the bearing is dimensionless; H_C and the
 position / landmark columns 1/m, the attitude columns dimensionless (1/rad).
@@ -71,9 +75,10 @@ import math
 
 import numpy as np
 
+from opnav.compiled import kernel, warms
 from opnav.rotations import skew
 
-__all__ = ["bearing", "bearing_jacobian", "jacobian_blocks", "selection_jacobian",
+__all__ = ["line_of_sight", "blocks", "tangent_rows", "bearing", "bearing_jacobian", "jacobian_blocks", "selection_jacobian",
            "tangent_basis", "tangent_jacobian", "tangent_jacobian_scalar", "BehindCameraError",
            "N_STATE", "N_MEAS", "SL_R", "SL_V", "SL_THETA", "SL_P"]
 
@@ -91,25 +96,105 @@ class BehindCameraError(ValueError):
     """The landmark coincides with the lander (zero range): no bearing exists."""
 
 
-def _line_of_sight(r_L, p_L) -> tuple[np.ndarray, np.ndarray]:
-    """``(u, 1/|rho|)``: unit line of sight (..., 3) and inverse range (...) (1/m)
-    from ``r_L`` to ``p_L`` (broadcast)."""
-    d = np.asarray(p_L, dtype=float) - np.asarray(r_L, dtype=float)
-    # d0^2 + d1^2 + d2^2 left to right: the bits of np.sum over the 3-axis (numpy sums
-    # fewer than 8 terms in order), without the reduction's overhead (3-5x, measured)
-    rho = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2])
-    if not np.all(np.isfinite(rho)):
-        raise ValueError(f"non-finite lander/landmark position: r_L={r_L}, p_L={p_L}")
-    if np.any(rho == 0.0):
-        raise BehindCameraError("landmark coincides with the lander: bearing undefined")
+# ---------------------------------------------------------------- kernels (the one home)
+
+@kernel
+def line_of_sight(r_L, p_L, u) -> float:
+    """Unit line of sight ``u`` (3,) <- ``(p_L - r_L) / |p_L - r_L|`` from ``r_L``
+    to ``p_L`` (3,) m; returns the inverse range ``1/|rho|`` (1/m): 0.0 at zero
+    range, NaN if a coordinate is not finite (``u`` then unset)."""
+    d0 = p_L[0] - r_L[0]
+    d1 = p_L[1] - r_L[1]
+    d2 = p_L[2] - r_L[2]
+    rho = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    if not math.isfinite(rho):
+        return math.nan
+    if rho == 0.0:
+        return 0.0
     inv = 1.0 / rho
-    return d * inv[..., None], inv
+    u[0] = d0 * inv
+    u[1] = d1 * inv
+    u[2] = d2 * inv
+    return inv
 
 
-def _rotate(R_LtoB, u) -> np.ndarray:
-    """``R_LtoB @ u`` over leading dimensions (matmul: the same bits for one
-    vector and for a batch)."""
-    return (np.asarray(R_LtoB, dtype=float) @ u[..., None])[..., 0]
+@kernel
+def blocks(R_LtoB, u, inv_rho, b, HC) -> None:
+    """The bearing ``b = R_LtoB u`` (eq. 12) and ``H_C = (R_LtoB - b u^T) / |rho|``
+    (eq. 18, 1/m) into ``b`` (3,) and ``HC`` (3, 3), from the unit line of sight
+    ``u`` (3,) in {L} and the inverse range (1/m). With them eq. 15-17 are
+    ``-H_C``, ``[b x]`` and ``H_C``."""
+    for i in range(3):
+        b[i] = R_LtoB[i, 0] * u[0] + R_LtoB[i, 1] * u[1] + R_LtoB[i, 2] * u[2]
+    for i in range(3):
+        for j in range(3):
+            HC[i, j] = (R_LtoB[i, j] - b[i] * u[j]) * inv_rho
+
+
+@kernel
+def _bearing_batch(r, R, p, b, HC) -> int:
+    """:func:`line_of_sight` and :func:`blocks` over ``n`` rows (r (n, 3), R (n, 3,
+    3), p (n, 3) -> b (n, 3), HC (n, 3, 3)); returns 0, 1 (zero range) or 2
+    (not finite) at the first bad row."""
+    u = np.empty(3)
+    for k in range(r.shape[0]):
+        inv = line_of_sight(r[k], p[k], u)
+        if not inv == inv:
+            return 2
+        if inv == 0.0:
+            return 1
+        blocks(R[k], u, inv, b[k], HC[k])
+    return 0
+
+
+@kernel
+def _blocks_batch(R, u, inv, b, HC) -> None:
+    for k in range(u.shape[0]):
+        blocks(R[k], u[k], inv[k], b[k], HC[k])
+
+
+@warms
+def _warm() -> None:
+    r = np.zeros((1, 3))
+    p = np.ones((1, 3))
+    _bearing_batch(r, np.eye(3)[None].copy(), p, np.empty((1, 3)), np.empty((1, 3, 3)))
+    G = np.empty((1, 2, N_STATE))
+    _tangent_batch(np.eye(3)[None].copy(), p, np.ones(1), G)
+    tangent_rows(np.eye(3), p[0], 1.0, G[0])
+    _basis_batch(p, np.empty((1, 3)), np.empty((1, 3)))
+    _blocks_batch(np.eye(3)[None].copy(), p, np.ones(1), np.empty((1, 3)), np.empty((1, 3, 3)))
+    blocks(np.eye(3), p[0], 1.0, np.empty(3), np.empty((3, 3)))
+
+
+def _flat(a: np.ndarray, shape: tuple, tail: tuple) -> np.ndarray:
+    """``a`` broadcast to ``shape + tail`` as contiguous rows (n, *tail) (no copy
+    when it already is)."""
+    if a.shape != shape + tail or not a.flags.c_contiguous:
+        a = np.ascontiguousarray(np.broadcast_to(a, shape + tail))
+    return a.reshape((-1,) + tail)
+
+
+def _rows(r_L, R_LtoB, p_L):
+    """Broadcast ``(r_L, R_LtoB, p_L)`` over their leading dimensions and flatten
+    them to rows: ``(shape, r (n, 3), R (n, 3, 3), p (n, 3))``."""
+    r = np.asarray(r_L, dtype=float)
+    R = np.asarray(R_LtoB, dtype=float)
+    p = np.asarray(p_L, dtype=float)
+    shape = np.broadcast_shapes(r.shape[:-1], R.shape[:-2], p.shape[:-1])
+    return shape, _flat(r, shape, (3,)), _flat(R, shape, (3, 3)), _flat(p, shape, (3,))
+
+
+def _evaluate(r_L, R_LtoB, p_L) -> tuple[np.ndarray, np.ndarray]:
+    """``(b, H_C)`` (..., 3), (..., 3, 3) of eq. 12 and 18 by the kernels, broadcast."""
+    shape, r, R, p = _rows(r_L, R_LtoB, p_L)
+    b = np.empty(r.shape)
+    HC = np.empty(R.shape)
+    status = _bearing_batch(r, R, p, b, HC)
+    if status == 2:
+        raise ValueError(f"non-finite lander/landmark position: r_L={r_L}, p_L={p_L}")
+    if status == 1:
+        raise BehindCameraError("landmark coincides with the lander: bearing undefined")
+    return b.reshape(shape + (3,)), HC.reshape(shape + (3, 3))
 
 
 def bearing(r_L, R_LtoB, p_L) -> np.ndarray:
@@ -121,24 +206,28 @@ def bearing(r_L, R_LtoB, p_L) -> np.ndarray:
     inside the camera's field of view is not checked here (see
     ``opnav.landing.camera``).
     """
-    u, _ = _line_of_sight(r_L, p_L)
-    return _rotate(R_LtoB, u)
+    return _evaluate(r_L, R_LtoB, p_L)[0]
 
 
 def jacobian_blocks(R_LtoB, u, inv_rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(b, H_C, [b x])`` from the unit line of sight ``u`` (..., 3) in {L} and
     the inverse range ``inv_rho`` (...) (1/m): the bearing (eq. 12), ``H_C =
     (R_LtoB - b u^T) / |rho|`` (eq. 18, 1/m) and the attitude block ``[b x]``
-    (eq. 16), batched. The core of every function below (callers that already
-    hold ``u`` and the range, e.g. the metrics' per-candidate path, call it
-    directly)."""
+    (eq. 16), by the kernel :func:`blocks`, broadcast over leading dimensions."""
     R = np.asarray(R_LtoB, dtype=float)
-    if u.ndim == 1 and R.ndim == 2:  # one landmark (the metrics' per-candidate path): the
-        b = R @ u                     # same operations without the broadcasting overhead
-        return b, (R - b[:, None] * u[None, :]) * inv_rho, skew(b)
-    b = _rotate(R, u)
-    HC = (R - b[..., :, None] * u[..., None, :]) * np.asarray(inv_rho)[..., None, None]
-    return b, HC, skew(b)
+    u = np.asarray(u, dtype=float)
+    if u.ndim == 1 and R.ndim == 2:           # one landmark: the kernel itself
+        b, HC = np.empty(3), np.empty((3, 3))
+        blocks(np.ascontiguousarray(R), np.ascontiguousarray(u), float(inv_rho), b, HC)
+        return b, HC, skew(b)
+    inv = np.asarray(inv_rho, dtype=float)
+    shape = np.broadcast_shapes(R.shape[:-2], u.shape[:-1], inv.shape)
+    uf = _flat(u, shape, (3,))
+    b = np.empty(uf.shape)
+    HC = np.empty((b.shape[0], 3, 3))
+    _blocks_batch(_flat(R, shape, (3, 3)), uf, _flat(inv, shape, ()), b, HC)
+    b = b.reshape(shape + (3,))
+    return b, HC.reshape(shape + (3, 3)), skew(b)
 
 
 def bearing_jacobian(r_L, R_LtoB, p_L) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -149,9 +238,8 @@ def bearing_jacobian(r_L, R_LtoB, p_L) -> tuple[np.ndarray, np.ndarray, np.ndarr
     side, see the module docstring; dimensionless) and the landmark position
     ``p_L`` (1/m).
     """
-    u, inv = _line_of_sight(r_L, p_L)
-    _, HC, Sb = jacobian_blocks(R_LtoB, u, inv)
-    return -HC, Sb, HC                                                # eq. 15, 16, 17
+    b, HC = _evaluate(r_L, R_LtoB, p_L)
+    return -HC, skew(b), HC                                           # eq. 15, 16, 17
 
 
 def selection_jacobian(r_L, R_LtoB, p_known_L, p_cand_L) -> np.ndarray:
@@ -172,83 +260,99 @@ def selection_jacobian(r_L, R_LtoB, p_known_L, p_cand_L) -> np.ndarray:
     return H
 
 
-def tangent_basis(u) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormal ``(t1, t2)`` (..., 3) orthogonal to the unit vectors ``u``
-    (..., 3): ``t1 = u x a / |u x a|`` with ``a`` the {L} axis e_x if
-    ``|u_z| > 0.9`` else e_z, ``t2 = u x t1`` (written out component by
-    component: :func:`tangent_jacobian_scalar` repeats this arithmetic in floats)."""
-    u = np.asarray(u, dtype=float)
-    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
-    use_x = np.abs(u2) > 0.9
-    zero = np.zeros_like(u0)
-    a0 = np.where(use_x, zero, u1)      # u x e_x = (0, u2, -u1); u x e_z = (u1, -u0, 0)
-    a1 = np.where(use_x, u2, -u0)
-    a2 = np.where(use_x, -u1, zero)
-    na = 1.0 / np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-    a0, a1, a2 = a0 * na, a1 * na, a2 * na
-    t1 = np.stack([a0, a1, a2], axis=-1)
-    t2 = np.stack([u1 * a2 - u2 * a1, u2 * a0 - u0 * a2, u0 * a1 - u1 * a0], axis=-1)
-    return t1, t2
-
-
-def _rotate_sum(R, t) -> np.ndarray:
-    """``R @ t`` as ``sum_j R_ij t_j`` in index order (the bits of the float
-    arithmetic of :func:`tangent_jacobian_scalar`), written out: the same bits
-    as ``np.sum(R * t[..., None, :], axis=-1)`` and 4-5x faster (measured)."""
-    return (R[..., :, 0] * t[..., 0, None] + R[..., :, 1] * t[..., 1, None]
-            + R[..., :, 2] * t[..., 2, None])
-
-
-def tangent_jacobian(r_L, R_LtoB, p_L, scale=1.0) -> np.ndarray:
-    """``scale * T^T [H_r, 0, H_theta, H_p]`` (..., 2, 12): the candidate rows of
-    :func:`selection_jacobian` projected on the tangent plane of its bearing
-    (module docstring; ``T = R_LtoB [t1, t2]`` from :func:`tangent_basis`),
-    batched over leading dimensions. ``scale`` (e.g. 1/sigma, rad^-1,
-    broadcast) whitens the rows: the candidate's information is ``G^T G`` for
-    ``G = tangent_jacobian(..., 1/sigma)`` when its bearing noise is ``sigma^2 I``."""
-    u, inv = _line_of_sight(r_L, p_L)
-    t1, t2 = tangent_basis(u)
-    R = np.asarray(R_LtoB, dtype=float)
-    t1B, t2B = _rotate_sum(R, t1), _rotate_sum(R, t2)
-    sc = np.asarray(scale, dtype=float)
-    q = (sc * inv)[..., None]
-    sw = sc[..., None]
-    G = np.zeros(np.broadcast_shapes(q.shape[:-1], t1B.shape[:-1]) + (2, N_STATE))
-    G[..., 0, SL_R] = -q * t1             # T^T H_r = -T_L^T / |rho|   (eq. 15, 18)
-    G[..., 0, SL_THETA] = -sw * t2B       # T^T [b x] = [-t2_B; t1_B]  (eq. 16)
-    G[..., 0, SL_P] = q * t1              # T^T H_p = T_L^T / |rho|    (eq. 17, 18)
-    G[..., 1, SL_R] = -q * t2
-    G[..., 1, SL_THETA] = sw * t1B
-    G[..., 1, SL_P] = q * t2
-    return G
-
-
-def tangent_jacobian_scalar(R_rows, d0: float, d1: float, d2: float, rho: float, scale: float
-                            ) -> np.ndarray:
-    """:func:`tangent_jacobian` (2, 12) of ONE candidate at offset ``d = p_L -
-    r_L`` (m) with ``rho = |d|``, ``R_rows = R_LtoB.tolist()``, in float
-    arithmetic: the same operations in the same order, so the same bits
-    (tested, tests/test_landing_measurement.py). It exists for speed: the
-    information metrics' golden-section path calls it once per candidate, and
-    the array form costs ~10x more on a single vector (numpy call overhead;
-    ``benchmarks/bench_metrics.py``, logdet ``seq_scalar``)."""
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R_rows
-    inv = 1.0 / rho
-    u0, u1, u2 = d0 * inv, d1 * inv, d2 * inv
+@kernel
+def _basis(u0, u1, u2):
+    """Orthonormal ``(t1, t2)`` orthogonal to the unit vector ``u`` (as two
+    3-tuples): ``t1 = u x a / |u x a|`` with ``a`` the {L} axis e_x if
+    ``|u_z| > 0.9`` else e_z, ``t2 = u x t1``."""
     if abs(u2) > 0.9:  # t1 = u x e_x
         a0, a1, a2 = 0.0, u2, -u1
     else:  # t1 = u x e_z
         a0, a1, a2 = u1, -u0, 0.0
     na = 1.0 / math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
     a0, a1, a2 = a0 * na, a1 * na, a2 * na
-    b0, b1, b2 = u1 * a2 - u2 * a1, u2 * a0 - u0 * a2, u0 * a1 - u1 * a0  # t2 = u x t1
-    sw = scale
+    return (a0, a1, a2), (u1 * a2 - u2 * a1, u2 * a0 - u0 * a2, u0 * a1 - u1 * a0)
+
+
+@kernel
+def tangent_rows(R_LtoB, d, scale, G) -> None:
+    """``G`` (2, 12) <- ``scale * T^T [H_r, 0, H_theta, H_p]`` of ONE landmark at
+    offset ``d = p_L - r_L`` (3,) m from the lander (module docstring: the
+    candidate rows of eq. 15-18 on the tangent plane of the bearing, ``T =
+    R_LtoB [t1, t2]``); ``scale`` (e.g. 1/sigma, rad^-1) whitens the rows. The
+    one home of the tangent-plane form: :func:`tangent_jacobian` runs it over a
+    batch, the planner's kernels call it per candidate."""
+    rho = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    inv = 1.0 / rho
+    u0, u1, u2 = d[0] * inv, d[1] * inv, d[2] * inv
+    (a0, a1, a2), (b0, b1, b2) = _basis(u0, u1, u2)
     q = scale * inv
-    return np.array([
-        [-q * a0, -q * a1, -q * a2, 0.0, 0.0, 0.0,
-         -sw * (r00 * b0 + r01 * b1 + r02 * b2), -sw * (r10 * b0 + r11 * b1 + r12 * b2),
-         -sw * (r20 * b0 + r21 * b1 + r22 * b2), q * a0, q * a1, q * a2],
-        [-q * b0, -q * b1, -q * b2, 0.0, 0.0, 0.0,
-         sw * (r00 * a0 + r01 * a1 + r02 * a2), sw * (r10 * a0 + r11 * a1 + r12 * a2),
-         sw * (r20 * a0 + r21 * a1 + r22 * a2), q * b0, q * b1, q * b2],
-    ])
+    R = R_LtoB
+    G[0, 0], G[0, 1], G[0, 2] = -q * a0, -q * a1, -q * a2          # T^T H_r = -T_L^T / |rho|
+    G[1, 0], G[1, 1], G[1, 2] = -q * b0, -q * b1, -q * b2
+    for c in range(3, 6):
+        G[0, c] = 0.0
+        G[1, c] = 0.0
+    for i in range(3):                                               # T^T [b x] = [-t2_B; t1_B]
+        G[0, 6 + i] = -scale * (R[i, 0] * b0 + R[i, 1] * b1 + R[i, 2] * b2)
+        G[1, 6 + i] = scale * (R[i, 0] * a0 + R[i, 1] * a1 + R[i, 2] * a2)
+    G[0, 9], G[0, 10], G[0, 11] = q * a0, q * a1, q * a2            # T^T H_p = T_L^T / |rho|
+    G[1, 9], G[1, 10], G[1, 11] = q * b0, q * b1, q * b2
+
+
+@kernel
+def _tangent_batch(R, d, scale, G) -> None:
+    for k in range(d.shape[0]):
+        tangent_rows(R[k], d[k], scale[k], G[k])
+
+
+@kernel
+def _basis_batch(u, t1, t2) -> None:
+    for k in range(u.shape[0]):
+        (t1[k, 0], t1[k, 1], t1[k, 2]), (t2[k, 0], t2[k, 1], t2[k, 2]) = _basis(u[k, 0], u[k, 1], u[k, 2])
+
+
+def tangent_basis(u) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal ``(t1, t2)`` (..., 3) orthogonal to the unit vectors ``u``
+    (..., 3) (the kernel :func:`tangent_rows`' basis: ``t1 = u x a / |u x a|``
+    with ``a`` the {L} axis e_x if ``|u_z| > 0.9`` else e_z, ``t2 = u x t1``)."""
+    u = np.asarray(u, dtype=float)
+    flat = np.ascontiguousarray(u).reshape(-1, 3)
+    t1, t2 = np.empty(flat.shape), np.empty(flat.shape)
+    _basis_batch(flat, t1, t2)
+    return t1.reshape(u.shape), t2.reshape(u.shape)
+
+
+def tangent_jacobian(r_L, R_LtoB, p_L, scale=1.0) -> np.ndarray:
+    """``scale * T^T [H_r, 0, H_theta, H_p]`` (..., 2, 12): the candidate rows of
+    :func:`selection_jacobian` projected on the tangent plane of its bearing
+    (module docstring; ``T = R_LtoB [t1, t2]`` from :func:`tangent_basis`),
+    batched over leading dimensions by the kernel :func:`tangent_rows`. ``scale``
+    (e.g. 1/sigma, rad^-1, broadcast) whitens the rows: the candidate's
+    information is ``G^T G`` for ``G = tangent_jacobian(..., 1/sigma)`` when its
+    bearing noise is ``sigma^2 I``. Raises like :func:`bearing` at zero range."""
+    r = np.asarray(r_L, dtype=float)
+    p = np.asarray(p_L, dtype=float)
+    R = np.asarray(R_LtoB, dtype=float)
+    sc = np.asarray(scale, dtype=float)
+    shape = np.broadcast_shapes(r.shape[:-1], p.shape[:-1], R.shape[:-2], sc.shape)
+    d = _flat(p - r, shape, (3,))
+    rho2 = np.einsum("ni,ni->n", d, d)
+    if not np.all(np.isfinite(rho2)):
+        raise ValueError(f"non-finite lander/landmark position: r_L={r_L}, p_L={p_L}")
+    if np.any(rho2 == 0.0):
+        raise BehindCameraError("landmark coincides with the lander: bearing undefined")
+    G = np.empty((d.shape[0], 2, N_STATE))
+    _tangent_batch(_flat(R, shape, (3, 3)), d, _flat(sc, shape, ()), G)
+    return G.reshape(shape + (2, N_STATE))
+
+
+def tangent_jacobian_scalar(R_rows, d0: float, d1: float, d2: float, rho: float, scale: float
+                            ) -> np.ndarray:
+    """:func:`tangent_jacobian` (2, 12) of ONE candidate at offset ``d = p_L -
+    r_L`` (m), ``R_rows = R_LtoB.tolist()`` (``rho`` unused: the kernel
+    :func:`tangent_rows` computes it). Kept for the metrics' per-candidate
+    path until it calls :func:`tangent_rows` from its own kernels."""
+    G = np.empty((2, N_STATE))
+    tangent_rows(np.array(R_rows), np.array([d0, d1, d2]), float(scale), G)
+    return G
