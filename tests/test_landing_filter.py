@@ -174,39 +174,21 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
     assert alone["pairs"] == {}
 
 
-def _descent_spying_on_H(landing, monkeypatch, iterations, oc=True):
-    """One seeded descent recording, for every measurement linearisation, the
-    projection direction and the Jacobian that the update used."""
-    from opnav.landing import ekf
-
+def _descent(landing, iterations, oc=True):
+    """One seeded descent with the filter's update iterations and OC switch."""
     cfg = copy.deepcopy(landing)
     cfg["filter"].update(iterations=iterations, observability_constrained=oc)
-    seen = []
-    orig = ekf._linearise
-
-    def spy(st, meas, N):
-        H, res = orig(st, meas, N)
-        seen.append((H, N))
-        return H, res
-
-    monkeypatch.setattr(ekf, "_linearise", spy)
-    run = run_descent(build_scenario(cfg), "depth", 3)
-    return run, seen
+    return run_descent(build_scenario(cfg), "depth", 3)
 
 
 @pytest.mark.parametrize("iterations", [2, 4])
-def test_iterated_oc_update_keeps_the_nullspace(landing, monkeypatch, iterations):
-    """OC-EKF with an iterated update: every relinearised Jacobian annihilates
-    the unobservable direction of the prior (H N at round-off) and the yaw
-    1-sigma keeps its prior value (without the projection it collapses)."""
-    run, seen = _descent_spying_on_H(landing, monkeypatch, iterations)
-    assert len(seen) > 100
-    worst = 0.0
-    for H, N in seen:
-        assert N is not None, "iterated OC update linearised without the nullspace"
-        n = N / np.linalg.norm(N, axis=-1, keepdims=True)          # (runs, 12): a batch of one
-        worst = max(worst, float(np.abs(np.einsum("...ij,...j->...i", H, n)).max()))
-    assert worst <= 1e-9, worst
+def test_iterated_oc_update_keeps_the_nullspace(landing, iterations):
+    """OC-EKF with an iterated update: the yaw 1-sigma keeps its prior value
+    (without the projection of every relinearised Jacobian on the complement
+    of the prior's unobservable direction it collapses; that H N = 0 in every
+    iteration is tests/test_landing_ekf_kernels.py)."""
+    run = _descent(landing, iterations)
+    assert run["updated"].sum() > 50
     # yaw is unobservable with one known landmark: its sigma keeps (most of) its
     # prior; it shrinks a little only through the position prior, which bounds how
     # far the whole geometry can turn about the site (measured 0.93; 0.68 with the
@@ -214,10 +196,10 @@ def test_iterated_oc_update_keeps_the_nullspace(landing, monkeypatch, iterations
     assert run["sig_yaw_deg"][-1] > 0.9 * run["sig_yaw_deg"][0]
 
 
-def test_plain_ekf_gains_spurious_yaw_information(landing, monkeypatch):
+def test_plain_ekf_gains_spurious_yaw_information(landing):
     """The contrast that makes the test above meaningful: without the
     constraint the same descent's yaw sigma shrinks well below its prior."""
-    run, _ = _descent_spying_on_H(landing, monkeypatch, 3, oc=False)
+    run = _descent(landing, 3, oc=False)
     assert run["sig_yaw_deg"][-1] < 0.8 * run["sig_yaw_deg"][0]
 
 

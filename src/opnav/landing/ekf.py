@@ -34,11 +34,23 @@ Batches: every function takes arrays with any leading (batch) dimensions,
 flies the runs of a chunk as one batch (``opnav.landing.descent``); a single
 run is the batch of shape ().
 
+Compiled: each step is written once as plain loops over one run's 3-vectors
+and 12 x 12 matrices (``opnav.compiled.kernel``: ``_transition`` eq. 6-10,
+``_oc``, ``_propagate``, ``_linearise``/``_update`` eq. 11-18, ``_init``,
+``_inject``, ``_nullspace``), and a ``*_batch`` kernel loops over the runs; the
+Python functions below flatten the leading dimensions and call them. The
+bearing and its Jacobian blocks are the kernels of ``opnav.landing.measurement``,
+Exp is ``opnav.rotations.exp_so3_into``. The pre-kernel numpy EKF
+(tests/descent_reference.py) is the reference the tests compare against.
+Measured per run and filter step (3 update iterations, site + landmark; one
+loaded 2-core machine): update 1090 -> 145 us in a batch of 4 runs, 55 -> 16 us
+in a batch of 300; propagation 160 -> 90 and 5.6 -> 3.7 us.
+
 Update: the stacked unit bearings of the known landmark and the unknown one
-(eq. 11-18: ``measurement.bearing`` and ``measurement.bearing_jacobian``, their
-one home), isotropic noise ``sigma_b`` rad per component, Joseph form. The
-cross-product matrices and the attitude correction ``Exp`` are
-``opnav.rotations.skew`` / ``exp_so3``.
+(eq. 11-18: ``measurement.line_of_sight`` and ``measurement.blocks``, their
+one home), isotropic noise ``sigma_b`` rad per component, gain by a Cholesky
+solve, Joseph form. The attitude correction ``Exp`` is
+``opnav.rotations.exp_so3_into``.
 
 Landmark initialisation (Fig. 3 strategy): from its first bearing ``b`` and a
 depth guess ``d`` (the estimated line of sight cut with the ground plane),
@@ -54,22 +66,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.landing.measurement import bearing, bearing_jacobian
-from opnav.rotations import exp_so3, skew
+from opnav.compiled import kernel, warms
+from opnav.landing.measurement import blocks, line_of_sight
+from opnav.rotations import exp_so3_into
 
 __all__ = ["NavState", "transition_matrix", "oc_transition", "process_noise", "propagate",
-           "update", "init_landmark", "inject", "nullspace", "init_jacobian", "Bearing"]
+           "update", "linearise", "init_landmark", "inject", "nullspace", "init_jacobian", "Bearing"]
 
 N_X = 12
-
-
-def _T(A: np.ndarray) -> np.ndarray:
-    return np.swapaxes(A, -1, -2)
-
-
-def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Matrix (..., n, m) times vector (..., m)."""
-    return (A @ x[..., None])[..., 0]
 
 
 @dataclass
@@ -95,20 +99,471 @@ class NavState:
             other.r, other.v, other.R, other.p, other.P)
 
 
-def transition_matrix(r_i, v_i, C_i, r_j, v_j, C_j, Dt: float, g) -> np.ndarray:
-    """Phi (..., 12, 12) of eq. 6-10 from the nominal states at ``i`` and ``j``."""
-    g = np.asarray(g, float)
-    r_i = np.asarray(r_i, float)
-    Phi = np.broadcast_to(np.eye(N_X), r_i.shape[:-1] + (N_X, N_X)).copy()
-    Phi[..., 0:3, 3:6] = Dt * np.eye(3)
-    Phi[..., 0:3, 6:9] = skew(r_i - r_j + v_i * Dt + 0.5 * g * Dt**2) @ _T(C_i)
-    Phi[..., 3:6, 6:9] = skew(v_i - v_j + g * Dt) @ _T(C_i)
-    Phi[..., 6:9, 6:9] = C_j @ _T(C_i)
-    return Phi
+# ---------------------------------------------------------------- kernels: one run each
+# (plain loops over 3-vectors and 12 x 12 matrices; the *_batch kernels loop over runs)
+
+@kernel
+def _skew_CT(a0, a1, a2, C, Phi, row) -> None:
+    """``Phi[row:row+3, 6:9] = [a x] C^T`` (eq. 8-9)."""
+    for j in range(3):
+        Phi[row, 6 + j] = -a2 * C[j, 1] + a1 * C[j, 2]
+        Phi[row + 1, 6 + j] = a2 * C[j, 0] - a0 * C[j, 2]
+        Phi[row + 2, 6 + j] = -a1 * C[j, 0] + a0 * C[j, 1]
+
+
+@kernel
+def _transition(r_i, v_i, C_i, r_j, v_j, C_j, Dt, g, Phi) -> None:
+    """Phi (12, 12) of eq. 6-10 (module docstring) into ``Phi``."""
+    for a in range(N_X):
+        for b in range(N_X):
+            Phi[a, b] = 1.0 if a == b else 0.0
+    for a in range(3):
+        Phi[a, 3 + a] = Dt
+    h = 0.5 * Dt * Dt
+    _skew_CT(r_i[0] - r_j[0] + v_i[0] * Dt + g[0] * h, r_i[1] - r_j[1] + v_i[1] * Dt + g[1] * h,
+             r_i[2] - r_j[2] + v_i[2] * Dt + g[2] * h, C_i, Phi, 0)                   # eq. 8
+    _skew_CT(v_i[0] - v_j[0] + g[0] * Dt, v_i[1] - v_j[1] + g[1] * Dt,
+             v_i[2] - v_j[2] + g[2] * Dt, C_i, Phi, 3)                                # eq. 9
+    for a in range(3):                                                               # eq. 10
+        for b in range(3):
+            Phi[6 + a, 6 + b] = C_j[a, 0] * C_i[b, 0] + C_j[a, 1] * C_i[b, 1] + C_j[a, 2] * C_i[b, 2]
+
+
+@kernel
+def _nullspace(r, v, R, p, N) -> None:
+    """``N`` (12,) <- ``[e_z x r, e_z x v, R e_z, e_z x p]`` (:func:`nullspace`)."""
+    N[0], N[1], N[2] = -r[1], r[0], 0.0
+    N[3], N[4], N[5] = -v[1], v[0], 0.0
+    N[6], N[7], N[8] = R[0, 2], R[1, 2], R[2, 2]
+    N[9], N[10], N[11] = -p[1], p[0], 0.0
+
+
+@kernel
+def _oc(Phi, N_i, N_j, C_i_prior, C_j, Dt) -> None:
+    """:func:`oc_transition` in place on one ``Phi`` (12, 12)."""
+    for a in range(3):
+        for b in range(3):
+            Phi[6 + a, 6 + b] = (C_j[a, 0] * C_i_prior[b, 0] + C_j[a, 1] * C_i_prior[b, 1]
+                                 + C_j[a, 2] * C_i_prior[b, 2])
+    uu = N_i[6] * N_i[6] + N_i[7] * N_i[7] + N_i[8] * N_i[8]
+    for blk in range(2):                      # position rows (w1), velocity rows (w2)
+        row = 3 * blk
+        for a in range(3):
+            Au = Phi[row + a, 6] * N_i[6] + Phi[row + a, 7] * N_i[7] + Phi[row + a, 8] * N_i[8]
+            w = N_j[row + a] - N_i[row + a] - (Dt * N_i[3 + a] if blk == 0 else 0.0)
+            f = (Au - w) / uu
+            for b in range(3):
+                Phi[row + a, 6 + b] -= f * N_i[6 + b]
+    for a in range(3):                        # the landmark's part of N (w3)
+        w3 = N_j[9 + a] - N_i[9 + a]
+        for b in range(3):
+            Phi[9 + a, 6 + b] = w3 * N_i[6 + b] / uu
+
+
+@kernel
+def _propagate(r, v, C_i, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
+               r_j, v_j, C_j, P_j, Phi, N_j, T) -> None:
+    """One run's :func:`propagate` (``Phi``, ``N_j`` (12,), ``T`` (12, 12) scratch)."""
+    h = 0.5 * Dt * Dt
+    for a in range(3):        # R_BtoL = C_i^T
+        r_j[a] = (r[a] + v[a] * Dt + (C_i[0, a] * dp[0] + C_i[1, a] * dp[1] + C_i[2, a] * dp[2])
+                  + g[a] * h)
+        v_j[a] = v[a] + (C_i[0, a] * dv[0] + C_i[1, a] * dv[1] + C_i[2, a] * dv[2]) + g[a] * Dt
+    for a in range(3):        # C_j = (C_i^T dR)^T = dR^T C_i
+        for b in range(3):
+            C_j[a, b] = dR[0, a] * C_i[0, b] + dR[1, a] * C_i[1, b] + dR[2, a] * C_i[2, b]
+    _transition(r, v, C_i, r_j, v_j, C_j, Dt, g, Phi)
+    if oc:
+        _nullspace(r_j, v_j, C_j, p, N_j)
+        _oc(Phi, N_i, N_j, C_i_prior, C_j, Dt)
+    for a in range(N_X):      # T = Phi P
+        for b in range(N_X):
+            s = 0.0
+            for c in range(N_X):
+                s += Phi[a, c] * P[c, b]
+            T[a, b] = s
+    for a in range(N_X):      # P_j = T Phi^T + Q
+        for b in range(N_X):
+            s = 0.0
+            for c in range(N_X):
+                s += T[a, c] * Phi[b, c]
+            P_j[a, b] = s + Q[a, b]
+    _symmetrize(P_j)
+
+
+@kernel
+def _symmetrize(P) -> None:
+    n = P.shape[0]
+    for a in range(n):
+        for b in range(a + 1, n):
+            m = 0.5 * (P[a, b] + P[b, a])
+            P[a, b] = m
+            P[b, a] = m
+
+
+@kernel
+def _inject(r, v, R, p, dx, r_o, v_o, R_o, p_o, E) -> None:
+    """``(r_o, v_o, R_o, p_o)`` <- the state corrected by ``dx`` (12,) (:func:`inject`;
+    ``E`` (3, 3) scratch)."""
+    for a in range(3):
+        r_o[a] = r[a] + dx[a]
+        v_o[a] = v[a] + dx[3 + a]
+        p_o[a] = p[a] + dx[9 + a]
+    exp_so3_into(-dx[6:9], E)
+    for a in range(3):
+        for b in range(3):
+            R_o[a, b] = E[a, 0] * R[0, b] + E[a, 1] * R[1, b] + E[a, 2] * R[2, b]
+
+
+@kernel
+def _linearise(r, R, p, bs, pk, known, N, use_N, H, res, u, bb, HC) -> bool:
+    """Stacked Jacobian ``H`` (3m, 12) and residual ``res`` (3m,) of the ``m``
+    bearings ``bs`` (m, 3) at ``(r, R, p)`` (eq. 12, 15-18 by the measurement
+    kernels): landmark ``pk[i]`` if ``known[i]``, else the state's ``p``. ``H``
+    projected on the complement of ``N`` (12,) if ``use_N``. False at zero range
+    or a non-finite position (``H``, ``res`` then meaningless)."""
+    m = bs.shape[0]
+    for i in range(m):
+        inv = line_of_sight(r, pk[i] if known[i] else p, u)
+        if not inv > 0.0:
+            return False
+        blocks(R, u, inv, bb, HC)
+        for a in range(3):
+            k = 3 * i + a
+            res[k] = bs[i, a] - bb[a]                                       # eq. 12
+            for c in range(N_X):
+                H[k, c] = 0.0
+            for c in range(3):
+                H[k, c] = -HC[a, c]                                         # eq. 15
+                if not known[i]:
+                    H[k, 9 + c] = HC[a, c]                                  # eq. 17
+        # eq. 16: [b x]
+        H[3 * i, 7], H[3 * i, 8] = -bb[2], bb[1]
+        H[3 * i + 1, 6], H[3 * i + 1, 8] = bb[2], -bb[0]
+        H[3 * i + 2, 6], H[3 * i + 2, 7] = -bb[1], bb[0]
+    if use_N:
+        nn = 0.0
+        for c in range(N_X):
+            nn += N[c] * N[c]
+        for k in range(3 * m):
+            hn = 0.0
+            for c in range(N_X):
+                hn += H[k, c] * N[c]
+            f = hn / nn
+            for c in range(N_X):
+                H[k, c] -= f * N[c]
+    return True
+
+
+@kernel
+def _cholesky(S, n) -> None:
+    """Lower Cholesky factor of ``S[:n, :n]`` in place (lower triangle)."""
+    for j in range(n):
+        d = S[j, j]
+        for k in range(j):
+            d -= S[j, k] * S[j, k]
+        d = np.sqrt(d)
+        S[j, j] = d
+        for i in range(j + 1, n):
+            s = S[i, j]
+            for k in range(j):
+                s -= S[i, k] * S[j, k]
+            S[i, j] = s / d
+
+
+@kernel
+def _cho_solve(L, n, x) -> None:
+    """``x[:n] <- (L L^T)^-1 x[:n]``."""
+    for i in range(n):
+        s = x[i]
+        for k in range(i):
+            s -= L[i, k] * x[k]
+        x[i] = s / L[i, i]
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * x[k]
+        x[i] = s / L[i, i]
+
+
+@kernel
+def _update(r, v, R, p, P, bs, pk, known, sigma_b, N, use_N, iterations,
+            r_o, v_o, R_o, p_o, P_o, H, K, res, S, col, delta, PHt, A, T, u, bb, HC, E) -> float:
+    """One run's iterated bearing update (:func:`update`), scratch arrays passed
+    in; returns the NIS at the prior (NaN if a bearing is undefined: the state
+    is then returned unchanged)."""
+    m3 = 3 * bs.shape[0]
+    for a in range(3):
+        r_o[a], v_o[a], p_o[a] = r[a], v[a], p[a]
+        for b in range(3):
+            R_o[a, b] = R[a, b]
+    for c in range(N_X):
+        delta[c] = 0.0
+    nis = 0.0
+    s2 = sigma_b * sigma_b
+    for it in range(max(1, iterations)):
+        if not _linearise(r_o, R_o, p_o, bs, pk, known, N, use_N, H, res, u, bb, HC):
+            for a in range(3):
+                r_o[a], v_o[a], p_o[a] = r[a], v[a], p[a]
+                for b in range(3):
+                    R_o[a, b] = R[a, b]
+            for a in range(N_X):
+                for b in range(N_X):
+                    P_o[a, b] = P[a, b]
+            return np.nan
+        for a in range(N_X):                      # PHt = P H^T
+            for k in range(m3):
+                s = 0.0
+                for c in range(N_X):
+                    s += P[a, c] * H[k, c]
+                PHt[a, k] = s
+        for k in range(m3):                       # S = H P H^T + sigma_b^2 I
+            for l in range(k + 1):
+                s = 0.0
+                for c in range(N_X):
+                    s += H[k, c] * PHt[c, l]
+                S[k, l] = s + (s2 if k == l else 0.0)
+        _cholesky(S, m3)
+        for a in range(N_X):                      # K = P H^T S^-1 (row a: S^-1 (P H^T)[a])
+            for k in range(m3):
+                col[k] = PHt[a, k]
+            _cho_solve(S, m3, col)
+            for k in range(m3):
+                K[a, k] = col[k]
+        if it == 0:                               # NIS = res^T S^-1 res
+            for k in range(m3):
+                col[k] = res[k]
+            _cho_solve(S, m3, col)
+            for k in range(m3):
+                nis += res[k] * col[k]
+        for k in range(m3):                       # y = res + H delta
+            s = res[k]
+            for c in range(N_X):
+                s += H[k, c] * delta[c]
+            col[k] = s
+        change = 0.0
+        for a in range(N_X):                      # delta_new = K y
+            s = 0.0
+            for k in range(m3):
+                s += K[a, k] * col[k]
+            change = max(change, abs(s - delta[a]))
+            delta[a] = s
+        _inject(r, v, R, p, delta, r_o, v_o, R_o, p_o, E)
+        if change < 1e-9:
+            break
+    for a in range(N_X):                          # A = I - K H
+        for b in range(N_X):
+            s = 1.0 if a == b else 0.0
+            for k in range(m3):
+                s -= K[a, k] * H[k, b]
+            A[a, b] = s
+    for a in range(N_X):                          # T = A P
+        for b in range(N_X):
+            s = 0.0
+            for c in range(N_X):
+                s += A[a, c] * P[c, b]
+            T[a, b] = s
+    for a in range(N_X):                          # P_o = T A^T + sigma_b^2 K K^T (Joseph)
+        for b in range(N_X):
+            s = 0.0
+            for c in range(N_X):
+                s += T[a, c] * A[b, c]
+            q = 0.0
+            for k in range(m3):
+                q += K[a, k] * K[b, k]
+            P_o[a, b] = s + s2 * q
+    _symmetrize(P_o)
+    return nis
+
+
+@kernel
+def _init(r, R, P, b, depth_sigma_frac, sigma_b, p_o, P_o, J, JP) -> bool:
+    """One run's :func:`init_landmark` into ``p_o`` (3,), ``P_o`` (12, 12) (left
+    as they are when the ray misses the ground); ``J`` (3, 9) the Jacobian of
+    :func:`init_jacobian`, ``JP`` (3, 9) scratch. Returns ``ok``."""
+    u0 = R[0, 0] * b[0] + R[1, 0] * b[1] + R[2, 0] * b[2]       # u = R^T b
+    u1 = R[0, 1] * b[0] + R[1, 1] * b[1] + R[2, 1] * b[2]
+    u2 = R[0, 2] * b[0] + R[1, 2] * b[1] + R[2, 2] * b[2]
+    if not (u2 < 0.0 and r[2] > 0.0):
+        return False
+    d = -r[2] / u2
+    u = (u0, u1, u2)
+    for a in range(3):                        # proj = I - u e_z^T / u_z
+        for c in range(3):
+            J[a, c] = (1.0 if a == c else 0.0) - (u[a] / u2 if c == 2 else 0.0)
+            J[a, 3 + c] = 0.0
+    # attitude block: proj (-d R^T [b x]); R^T [b x] column c = R^T (b x e_c)
+    for c in range(3):
+        e0 = (0.0, -b[2], b[1])[c]            # b x e_c = column c of [b x]
+        e1 = (b[2], 0.0, -b[0])[c]
+        e2 = (-b[1], b[0], 0.0)[c]
+        w0 = -d * (R[0, 0] * e0 + R[1, 0] * e1 + R[2, 0] * e2)
+        w1 = -d * (R[0, 1] * e0 + R[1, 1] * e1 + R[2, 1] * e2)
+        w2 = -d * (R[0, 2] * e0 + R[1, 2] * e1 + R[2, 2] * e2)
+        for a in range(3):
+            J[a, 6 + c] = J[a, 0] * w0 + J[a, 1] * w1 + J[a, 2] * w2
+    for a in range(3):
+        p_o[a] = r[a] + d * u[a]
+    for a in range(3):                        # JP = J P_xx
+        for c in range(9):
+            s = 0.0
+            for k in range(9):
+                s += J[a, k] * P[k, c]
+            JP[a, c] = s
+    for a in range(N_X):
+        for c in range(N_X):
+            P_o[a, c] = P[a, c]
+    fd2 = (depth_sigma_frac * d) ** 2
+    bd2 = (d * sigma_b) ** 2
+    for a in range(3):
+        for c in range(9):
+            P_o[9 + a, c] = JP[a, c]
+            P_o[c, 9 + a] = JP[a, c]
+        for c in range(3):
+            s = 0.0
+            for k in range(9):
+                s += JP[a, k] * J[c, k]
+            uu = u[a] * u[c]
+            P_o[9 + a, 9 + c] = s + fd2 * uu + bd2 * ((1.0 if a == c else 0.0) - uu)
+    _symmetrize(P_o)
+    return True
+
+
+# ---------------------------------------------------------------- kernels: batches of runs
+
+@kernel
+def _transition_batch(r_i, v_i, C_i, r_j, v_j, C_j, Dt, g, Phi) -> None:
+    for k in range(r_i.shape[0]):
+        _transition(r_i[k], v_i[k], C_i[k], r_j[k], v_j[k], C_j[k], Dt[k], g, Phi[k])
+
+
+@kernel
+def _oc_batch(Phi, N_i, N_j, C_i_prior, C_j, Dt) -> None:
+    for k in range(Phi.shape[0]):
+        _oc(Phi[k], N_i[k], N_j[k], C_i_prior[k], C_j[k], Dt)
+
+
+@kernel
+def _nullspace_batch(r, v, R, p, N) -> None:
+    for k in range(r.shape[0]):
+        _nullspace(r[k], v[k], R[k], p[k], N[k])
+
+
+@kernel
+def _propagate_batch(r, v, R, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
+                     r_j, v_j, R_j, P_j) -> None:
+    Phi = np.empty((N_X, N_X))
+    T = np.empty((N_X, N_X))
+    N_j = np.empty(N_X)
+    for k in range(r.shape[0]):
+        _propagate(r[k], v[k], R[k], p[k], P[k], dR[k], dv[k], dp[k], Dt, g, Q, oc, N_i[k],
+                   C_i_prior[k], r_j[k], v_j[k], R_j[k], P_j[k], Phi, N_j, T)
+
+
+@kernel
+def _update_batch(r, v, R, p, P, bs, pk, known, sigma_b, N, use_N, iterations,
+                  r_o, v_o, R_o, p_o, P_o, nis) -> None:
+    m3 = 3 * bs.shape[1]
+    H = np.empty((m3, N_X))
+    K = np.empty((N_X, m3))
+    res = np.empty(m3)
+    S = np.empty((m3, m3))
+    col = np.empty(m3)
+    delta = np.empty(N_X)
+    PHt = np.empty((N_X, m3))
+    A = np.empty((N_X, N_X))
+    T = np.empty((N_X, N_X))
+    u = np.empty(3)
+    bb = np.empty(3)
+    HC = np.empty((3, 3))
+    E = np.empty((3, 3))
+    for k in range(r.shape[0]):
+        nis[k] = _update(r[k], v[k], R[k], p[k], P[k], bs[k], pk[k], known, sigma_b, N[k], use_N,
+                         iterations, r_o[k], v_o[k], R_o[k], p_o[k], P_o[k], H, K, res, S, col,
+                         delta, PHt, A, T, u, bb, HC, E)
+
+
+@kernel
+def _linearise_batch(r, R, p, bs, pk, known, N, use_N, H, res) -> bool:
+    u = np.empty(3)
+    bb = np.empty(3)
+    HC = np.empty((3, 3))
+    for k in range(r.shape[0]):
+        if not _linearise(r[k], R[k], p[k], bs[k], pk[k], known, N[k], use_N, H[k], res[k],
+                          u, bb, HC):
+            return False
+    return True
+
+
+@kernel
+def _init_batch(r, R, P, b, depth_sigma_frac, sigma_b, p_o, P_o, J, ok) -> None:
+    JP = np.empty((3, 9))
+    for k in range(r.shape[0]):
+        ok[k] = _init(r[k], R[k], P[k], b[k], depth_sigma_frac, sigma_b, p_o[k], P_o[k], J[k], JP)
+
+
+@kernel
+def _inject_batch(r, v, R, p, dx, r_o, v_o, R_o, p_o) -> None:
+    E = np.empty((3, 3))
+    for k in range(r.shape[0]):
+        _inject(r[k], v[k], R[k], p[k], dx[k], r_o[k], v_o[k], R_o[k], p_o[k], E)
+
+
+@warms
+def _warm() -> None:
+    st = NavState(np.array([[10.0, 20.0, 3000.0]]), np.ones((1, 3)), np.eye(3)[None].copy(),
+                  np.array([[50.0, 0.0, 0.0]]), np.eye(N_X)[None].copy())
+    g = np.array([0.0, 0.0, -3.711])
+    N = nullspace(st.r, st.v, st.R, st.p)
+    st2 = propagate(st, np.eye(3)[None], np.zeros((1, 3)), np.zeros((1, 3)), 1.0, g,
+                    np.eye(N_X), (N, st.R))
+    oc_transition(transition_matrix(st.r, st.v, st.R, st2.r, st2.v, st2.R, 1.0, g), N, N, st.R,
+                  st2.R, 1.0)
+    b = np.array([[0.0, 0.0, -1.0]])
+    new, _ = init_landmark(st2, b, 0.1, 1e-3)
+    meas = [Bearing(b, np.zeros(3)), Bearing(b)]
+    update(new, meas, 1e-3, N, 3)
+    linearise(new, meas, N)
+    inject(new, np.zeros((1, N_X)))
+
+
+# ---------------------------------------------------------------- the Python API (batches)
+
+def _rows(a, tail: tuple, lead: tuple) -> np.ndarray:
+    """``a`` broadcast to ``lead + tail`` as contiguous float rows (n, *tail) (no
+    copy when it already is)."""
+    a = np.asarray(a, float)
+    if a.shape != lead + tail or not a.flags.c_contiguous:
+        a = np.ascontiguousarray(np.broadcast_to(a, lead + tail))
+    return a.reshape((-1,) + tail)
+
+
+def _flat(st: NavState) -> tuple:
+    lead = st.r.shape[:-1]
+    return lead, (_rows(st.r, (3,), lead), _rows(st.v, (3,), lead), _rows(st.R, (3, 3), lead),
+                  _rows(st.p, (3,), lead), _rows(st.P, (N_X, N_X), lead))
+
+
+def _state(lead: tuple, r, v, R, p, P) -> NavState:
+    return NavState(r.reshape(lead + (3,)), v.reshape(lead + (3,)), R.reshape(lead + (3, 3)),
+                    p.reshape(lead + (3,)), P.reshape(lead + (N_X, N_X)))
+
+
+def transition_matrix(r_i, v_i, C_i, r_j, v_j, C_j, Dt, g) -> np.ndarray:
+    """Phi (..., 12, 12) of eq. 6-10 from the nominal states at ``i`` and ``j``
+    (``Dt`` s, a scalar or one per run; all broadcast over leading dimensions)."""
+    lead = np.broadcast_shapes(*(np.shape(x)[:-1] for x in (r_i, v_i, r_j, v_j)),
+                               *(np.shape(x)[:-2] for x in (C_i, C_j)), np.shape(Dt))
+    Phi = np.empty((int(np.prod(lead)), N_X, N_X))
+    _transition_batch(_rows(r_i, (3,), lead), _rows(v_i, (3,), lead), _rows(C_i, (3, 3), lead),
+                      _rows(r_j, (3,), lead), _rows(v_j, (3,), lead), _rows(C_j, (3, 3), lead),
+                      _rows(Dt, (), lead), np.asarray(g, float), Phi)
+    return Phi.reshape(lead + (N_X, N_X))
 
 
 def process_noise(sigma_a: float, sigma_w: float, dt: float, n_sub: int) -> np.ndarray:
-    """Q (12, 12) of one filter interval of ``n_sub`` IMU samples of step ``dt``."""
+    """Q (12, 12) of one filter interval of ``n_sub`` IMU samples of step ``dt``
+    (computed once per scenario: numpy; the propagation kernel adds it)."""
     k = np.arange(n_sub)
     c = (n_sub - k - 0.5) * dt
     q = sigma_a**2 * dt**2
@@ -121,10 +576,6 @@ def process_noise(sigma_a: float, sigma_w: float, dt: float, n_sub: int) -> np.n
     return Q
 
 
-def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., :, None] * b[..., None, :]
-
-
 def oc_transition(Phi: np.ndarray, N_i: np.ndarray, N_j: np.ndarray, C_i_prior: np.ndarray,
                   C_j: np.ndarray, Dt: float) -> np.ndarray:
     """Observability-constrained Phi (Hesch et al. 2013): the smallest change of
@@ -134,25 +585,18 @@ def oc_transition(Phi: np.ndarray, N_i: np.ndarray, N_j: np.ndarray, C_i_prior: 
     at the *posterior* instead, and the filter gains spurious yaw information
     (paper B ref. [16]); the landmark rows get the rank-one term that carries
     its part of ``N`` from its prior to its posterior estimate."""
-    Phi = Phi.copy()
-    Phi[..., 6:9, 6:9] = C_j @ _T(C_i_prior)
-    u = N_i[..., 6:9]
-    uu = np.einsum("...i,...i->...", u, u)[..., None, None]
-    w1 = N_j[..., 0:3] - N_i[..., 0:3] - Dt * N_i[..., 3:6]
-    w2 = N_j[..., 3:6] - N_i[..., 3:6]
-    A = Phi[..., 0:3, 6:9]
-    Phi[..., 0:3, 6:9] = A - _outer(_mv(A, u) - w1, u) / uu
-    B = Phi[..., 3:6, 6:9]
-    Phi[..., 3:6, 6:9] = B - _outer(_mv(B, u) - w2, u) / uu
-    # the landmark's estimate moved in the update: carry its part of N too
-    w3 = N_j[..., 9:12] - N_i[..., 9:12]
-    Phi[..., 9:12, 6:9] = _outer(w3, u) / uu
-    return Phi
+    Phi = np.asarray(Phi, float)
+    lead = Phi.shape[:-2]
+    out = _rows(Phi, (N_X, N_X), lead).copy()
+    _oc_batch(out, _rows(N_i, (N_X,), lead), _rows(N_j, (N_X,), lead),
+              _rows(C_i_prior, (3, 3), lead), _rows(C_j, (3, 3), lead), float(Dt))
+    return out.reshape(Phi.shape)
 
 
 def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
               oc: tuple | None = None) -> NavState:
-    """Closed-form propagation of one interval (imu.apply_increment) and of P.
+    """Closed-form propagation of one interval (imu.apply_increment) and of P
+    (``P_j = Phi P Phi^T + Q``, eq. 6-10), one kernel call for the batch.
 
     ``oc = (N_i, C_i_prior)`` switches on the observability constraint: ``N_i``
     the unobservable direction at the prior estimate of step i (attitude
@@ -160,37 +604,38 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
     to ``N_j`` at the new prior. The update Jacobian, evaluated at that prior,
     annihilates ``N_j`` exactly, so the linearised system keeps yaw unobservable.
     """
-    g = np.asarray(g, float)
-    C_i = st.R
-    R_BtoL = _T(C_i)
-    r_j = st.r + st.v * Dt + _mv(R_BtoL, dp) + 0.5 * g * Dt**2
-    v_j = st.v + _mv(R_BtoL, dv) + g * Dt
-    C_j = _T(R_BtoL @ dR)
-    Phi = transition_matrix(st.r, st.v, C_i, r_j, v_j, C_j, Dt, g)
-    if oc is not None:
-        N_i, C_i_prior = oc
-        Phi = oc_transition(Phi, N_i, nullspace(r_j, v_j, C_j, st.p), C_i_prior, C_j, Dt)
-    P = Phi @ st.P @ _T(Phi) + Q
-    return NavState(r_j, v_j, C_j, st.p.copy(), 0.5 * (P + _T(P)))
+    lead, (r, v, R, p, P) = _flat(st)
+    n = r.shape[0]
+    N_i, C_p = (np.zeros((n, N_X)), R) if oc is None else (_rows(oc[0], (N_X,), lead),
+                                                           _rows(oc[1], (3, 3), lead))
+    r_j, v_j, R_j, P_j = np.empty_like(r), np.empty_like(v), np.empty_like(R), np.empty_like(P)
+    _propagate_batch(r, v, R, p, P, _rows(dR, (3, 3), lead), _rows(dv, (3,), lead),
+                     _rows(dp, (3,), lead), float(Dt), np.asarray(g, float),
+                     np.ascontiguousarray(Q, dtype=float), oc is not None, N_i, C_p, r_j, v_j, R_j, P_j)
+    return _state(lead, r_j, v_j, R_j, p.copy(), P_j)
 
 
 def inject(st: NavState, dx: np.ndarray) -> None:
-    """Apply an error-state correction (..., 12) in place (attitude on the body side)."""
-    st.r = st.r + dx[..., 0:3]
-    st.v = st.v + dx[..., 3:6]
-    st.R = exp_so3(-dx[..., 6:9]) @ st.R
-    st.p = st.p + dx[..., 9:12]
+    """Apply an error-state correction (..., 12) in place (attitude on the body
+    side: ``R <- Exp(-dtheta) R``)."""
+    lead, (r, v, R, p, _) = _flat(st)
+    out = [np.empty_like(a) for a in (r, v, R, p)]
+    _inject_batch(r, v, R, p, _rows(dx, (N_X,), lead), *out)
+    st.r, st.v, st.R, st.p = (a.reshape(lead + a.shape[1:]) for a in out)
 
 
 def nullspace(r, v, R, p) -> np.ndarray:
     """Unobservable direction (..., 12) of the error state with one known landmark at
     the {L} origin: a rotation of everything about the vertical through the site
     (yaw): ``[e_z x r, e_z x v, R e_z, e_z x p]`` (our body-side dtheta)."""
-    # e_z x a = [-a_y, a_x, 0]
-    r, v, R, p = (np.asarray(x, float) for x in (r, v, R, p))
-    z = np.zeros(r.shape[:-1])
-    return np.stack([-r[..., 1], r[..., 0], z, -v[..., 1], v[..., 0], z, R[..., 0, 2], R[..., 1, 2],
-                     R[..., 2, 2], -p[..., 1], p[..., 0], z], axis=-1)
+    r = np.asarray(r, float)
+    lead = r.shape[:-1]
+    if not (np.shape(v)[:-1] == np.shape(R)[:-2] == np.shape(p)[:-1] == lead):
+        lead = np.broadcast_shapes(lead, np.shape(v)[:-1], np.shape(R)[:-2], np.shape(p)[:-1])
+    N = np.empty((int(np.prod(lead)), N_X))
+    _nullspace_batch(_rows(r, (3,), lead), _rows(v, (3,), lead), _rows(R, (3, 3), lead),
+                     _rows(p, (3,), lead), N)
+    return N.reshape(lead + (N_X,))
 
 
 @dataclass(frozen=True)
@@ -202,31 +647,46 @@ class Bearing:
     p_known: np.ndarray | None = None
 
 
-def _linearise(st: NavState, meas: list[Bearing], N):
-    """Stacked Jacobian H (..., 3m, 12) and residual (..., 3m) of the bearings
-    at ``st``; H projected on the complement of ``N`` (..., 12) if given."""
-    lead = st.r.shape[:-1]
+def _measurements(lead: tuple, meas: list[Bearing]):
+    """``(bs (n, m, 3), pk (n, m, 3), known (m,))`` of the bearings ``meas``."""
     m = len(meas)
-    H = np.zeros(lead + (3 * m, N_X))
-    res = np.empty(lead + (3 * m,))
+    n = int(np.prod(lead))
+    bs = np.empty((n, m, 3))
+    pk = np.zeros((n, m, 3))
+    known = np.zeros(m, np.bool_)
     for i, ms in enumerate(meas):
-        p = st.p if ms.p_known is None else np.broadcast_to(ms.p_known, st.r.shape)
-        Hr, Ht, Hp = bearing_jacobian(st.r, st.R, p)                 # eq. 15-18
-        res[..., 3 * i:3 * i + 3] = ms.b - bearing(st.r, st.R, p)      # eq. 12
-        H[..., 3 * i:3 * i + 3, 0:3] = Hr
-        H[..., 3 * i:3 * i + 3, 6:9] = Ht
-        if ms.p_known is None:
-            H[..., 3 * i:3 * i + 3, 9:12] = Hp
-    if N is not None:
-        n = N / np.linalg.norm(N, axis=-1, keepdims=True)
-        H = H - _outer(_mv(H, n), n)
-    return H, res
+        bs[:, i] = _rows(ms.b, (3,), lead)
+        if ms.p_known is not None:
+            pk[:, i] = _rows(ms.p_known, (3,), lead)
+            known[i] = True
+    return bs, pk, known
+
+
+def _direction(N, lead: tuple) -> tuple[np.ndarray, bool]:
+    if N is None:
+        return np.zeros((int(np.prod(lead)), N_X)), False
+    return _rows(N, (N_X,), lead), True
+
+
+def linearise(st: NavState, meas: list[Bearing], N=None) -> tuple[np.ndarray, np.ndarray]:
+    """Stacked Jacobian H (..., 3m, 12) and residual (..., 3m) of the bearings
+    ``meas`` at ``st`` (eq. 12, 15-18); H projected on the complement of ``N``
+    (..., 12) if given (the kernel :func:`update` iterates with)."""
+    lead, (r, v, R, p, P) = _flat(st)
+    bs, pk, known = _measurements(lead, meas)
+    Nf, use = _direction(N, lead)
+    H = np.empty((r.shape[0], 3 * len(meas), N_X))
+    res = np.empty((r.shape[0], 3 * len(meas)))
+    if not _linearise_batch(r, R, p, bs, pk, known, Nf, use, H, res):
+        raise ValueError("bearing undefined: a landmark at the lander or a non-finite state")
+    return H.reshape(lead + H.shape[1:]), res.reshape(lead + res.shape[1:])
 
 
 def update(st: NavState, meas: list[Bearing], sigma_b: float,
            N: np.ndarray | None = None, iterations: int = 1) -> tuple[NavState, np.ndarray]:
     """Bearing update (eq. 11-18) of every run of the batch with the same kinds
-    of bearings ``meas`` (each :class:`Bearing` holds one per run).
+    of bearings ``meas`` (each :class:`Bearing` holds one per run), one kernel
+    call: gain from a Cholesky solve of ``S = H P H^T + sigma_b^2 I``, Joseph form.
 
     Returns the updated state and the NIS (at the prior, per run).
 
@@ -234,64 +694,44 @@ def update(st: NavState, meas: list[Bearing], sigma_b: float,
     (iterated EKF, Gauss-Newton on the MAP cost): with initial errors of 1 km
     and 2 deg the second-order terms of a bearing exceed its 0.5-pixel noise,
     so a single linearisation is overconfident. A run stops iterating once its
-    correction changes by less than 1e-9 (the others go on: masks). ``N``
+    correction changes by less than 1e-9 (per run, in the kernel). ``N``
     (..., 12), if given, is the unobservable direction; the Jacobian is then
     projected so that ``H N = 0`` (observability-constrained EKF, Hesch et al.
     2013, paper B ref. [16]).
     """
-    m = len(meas)
     lead = st.r.shape[:-1]
-    if m == 0:
+    if len(meas) == 0:
         return st, np.full(lead, np.nan)
-    Rn = sigma_b**2 * np.eye(3 * m)
-    it = st
-    delta = np.zeros(lead + (N_X,))
-    K = H = nis = None
-    going = np.ones(lead, bool)
-    for k in range(max(1, int(iterations))):
-        H_k, res = _linearise(it, meas, N)
-        PHt = st.P @ _T(H_k)
-        S = H_k @ PHt + Rn
-        if k == 0:         # one solve for the gain and the NIS
-            X = np.linalg.solve(S, np.concatenate([_T(PHt), res[..., None]], axis=-1))
-            K_k = _T(X[..., :N_X])
-            nis = np.einsum("...i,...i->...", res, X[..., N_X])
-            K, H = K_k, H_k
-        else:
-            K_k = _T(np.linalg.solve(S, _T(PHt)))
-        delta_new = _mv(K_k, res + _mv(H_k, delta))
-        g = going[..., None]
-        K = np.where(g[..., None], K_k, K)
-        H = np.where(g[..., None], H_k, H)
-        nxt = NavState(st.r, st.v, st.R, st.p, st.P)
-        inject(nxt, delta_new)
-        it = NavState(*(np.where(going.reshape(lead + (1,) * (a.ndim - len(lead))), a, b)
-                        for a, b in ((nxt.r, it.r), (nxt.v, it.v), (nxt.R, it.R), (nxt.p, it.p))),
-                      st.P)
-        conv = np.max(np.abs(delta_new - delta), axis=-1) < 1e-9
-        delta = np.where(g, delta_new, delta)
-        going = going & ~conv
-        if not going.any():
-            break
-    A = np.eye(N_X) - K @ H
-    P = A @ st.P @ _T(A) + K @ Rn @ _T(K)
-    return NavState(it.r, it.v, it.R, it.p, 0.5 * (P + _T(P))), nis
+    lead, (r, v, R, p, P) = _flat(st)
+    bs, pk, known = _measurements(lead, meas)
+    Nf, use = _direction(N, lead)
+    out = [np.empty_like(a) for a in (r, v, R, p, P)]
+    nis = np.empty(r.shape[0])
+    _update_batch(r, v, R, p, P, bs, pk, known, float(sigma_b), Nf, use, int(iterations), *out, nis)
+    if np.isnan(nis).any():
+        raise ValueError("bearing undefined: a landmark at the lander or a non-finite state")
+    return _state(lead, *out), nis.reshape(lead)
 
 
 def init_jacobian(st: NavState, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(p, J, d, ok)``: the new landmark ``p`` (..., 3) seen along ``b`` cut with
     the ground, the Jacobian ``J`` (..., 3, 9) of ``p`` w.r.t. ``[dr, dv,
-    dtheta]``, the depth guess ``d`` (..., m) and ``ok`` (...,): False where the
+    dtheta]``, the depth guess ``d`` (...) and ``ok`` (...,): False where the
     ray misses the ground or the lander is not above it (p, J, d meaningless there)."""
-    u = _mv(_T(st.R), b)
-    ok = (u[..., 2] < 0) & (st.r[..., 2] > 0)
-    uz = np.where(ok, u[..., 2], -1.0)
-    d = -st.r[..., 2] / uz
-    proj = np.eye(3) - _outer(u, np.array([0.0, 0.0, 1.0])) / uz[..., None, None]
-    J = np.zeros(b.shape[:-1] + (3, 9))
-    J[..., 0:3] = proj
-    J[..., 6:9] = proj @ (-d[..., None, None] * _T(st.R) @ skew(b))
-    return st.r + d[..., None] * u, J, d, ok
+    new, ok, J = _init_landmark(st, b, 0.0, 0.0)
+    u_z = np.einsum("...j,...j->...", np.asarray(st.R, float)[..., :, 2], b)     # (R^T b)_z
+    d = -st.r[..., 2] / np.where(ok, u_z, -1.0)
+    return new.p, J, d, ok
+
+
+def _init_landmark(st: NavState, b, depth_sigma_frac: float, sigma_b: float):
+    lead, (r, v, R, p, P) = _flat(st)
+    p_o, P_o = p.copy(), P.copy()
+    J = np.zeros((r.shape[0], 3, 9))
+    ok = np.empty(r.shape[0], np.bool_)
+    _init_batch(r, R, P, _rows(b, (3,), lead), float(depth_sigma_frac), float(sigma_b), p_o, P_o, J, ok)
+    return (_state(lead, r.copy(), v.copy(), R.copy(), p_o, P_o), ok.reshape(lead),
+            J.reshape(lead + (3, 9)))
 
 
 def init_landmark(st: NavState, b: np.ndarray, depth_sigma_frac: float, sigma_b: float
@@ -302,20 +742,5 @@ def init_landmark(st: NavState, b: np.ndarray, depth_sigma_frac: float, sigma_b:
     does not meet the ground or the estimated lander is not above it, the
     run's state is returned unchanged and ``ok`` is False.
     """
-    p, J, d, ok = init_jacobian(st, b)
-    u = _mv(_T(st.R), b)
-    Pxx = st.P[..., :9, :9]
-    Ppx = J @ Pxx
-    uu = _outer(u, u)
-    # ... plus a large independent depth variance (the depth guess) and the
-    # bearing noise across the line of sight
-    dd = d[..., None, None]
-    Ppp = J @ Pxx @ _T(J) + (depth_sigma_frac * dd) ** 2 * uu + (dd * sigma_b) ** 2 * (np.eye(3) - uu)
-    P = st.P.copy()
-    P[..., 9:12, :9] = Ppx
-    P[..., :9, 9:12] = _T(Ppx)
-    P[..., 9:12, 9:12] = Ppp
-    P = 0.5 * (P + _T(P))
-    okv = ok[..., None]
-    return NavState(st.r.copy(), st.v.copy(), st.R.copy(), np.where(okv, p, st.p),
-                    np.where(okv[..., None], P, st.P)), ok
+    new, ok, _ = _init_landmark(st, b, depth_sigma_frac, sigma_b)
+    return new, ok
