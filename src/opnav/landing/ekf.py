@@ -533,8 +533,8 @@ def _rows(a, tail: tuple, lead: tuple) -> np.ndarray:
     """``a`` broadcast to ``lead + tail`` as contiguous float rows (n, *tail) (no
     copy when it already is)."""
     a = np.asarray(a, float)
-    if a.shape != lead + tail or not a.flags.c_contiguous:
-        a = np.ascontiguousarray(np.broadcast_to(a, lead + tail))
+    if a.shape != lead + tail or not (a.flags.c_contiguous and a.flags.writeable):
+        a = np.array(np.broadcast_to(a, lead + tail), order="C")   # writable: one kernel signature
     return a.reshape((-1,) + tail)
 
 
@@ -557,7 +557,7 @@ def transition_matrix(r_i, v_i, C_i, r_j, v_j, C_j, Dt, g) -> np.ndarray:
     Phi = np.empty((int(np.prod(lead)), N_X, N_X))
     _transition_batch(_rows(r_i, (3,), lead), _rows(v_i, (3,), lead), _rows(C_i, (3, 3), lead),
                       _rows(r_j, (3,), lead), _rows(v_j, (3,), lead), _rows(C_j, (3, 3), lead),
-                      _rows(Dt, (), lead), np.asarray(g, float), Phi)
+                      _rows(Dt, (), lead), _rows(g, (3,), ())[0], Phi)
     return Phi.reshape(lead + (N_X, N_X))
 
 
@@ -610,8 +610,8 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
                                                            _rows(oc[1], (3, 3), lead))
     r_j, v_j, R_j, P_j = np.empty_like(r), np.empty_like(v), np.empty_like(R), np.empty_like(P)
     _propagate_batch(r, v, R, p, P, _rows(dR, (3, 3), lead), _rows(dv, (3,), lead),
-                     _rows(dp, (3,), lead), float(Dt), np.asarray(g, float),
-                     np.ascontiguousarray(Q, dtype=float), oc is not None, N_i, C_p, r_j, v_j, R_j, P_j)
+                     _rows(dp, (3,), lead), float(Dt), _rows(g, (3,), ())[0],
+                     _rows(Q, (N_X, N_X), ())[0], oc is not None, N_i, C_p, r_j, v_j, R_j, P_j)
     return _state(lead, r_j, v_j, R_j, p.copy(), P_j)
 
 

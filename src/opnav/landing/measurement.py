@@ -167,10 +167,10 @@ def _warm() -> None:
 
 
 def _flat(a: np.ndarray, shape: tuple, tail: tuple) -> np.ndarray:
-    """``a`` broadcast to ``shape + tail`` as contiguous rows (n, *tail) (no copy
-    when it already is)."""
-    if a.shape != shape + tail or not a.flags.c_contiguous:
-        a = np.ascontiguousarray(np.broadcast_to(a, shape + tail))
+    """``a`` broadcast to ``shape + tail`` as contiguous writable rows (n, *tail) (no
+    copy when it already is)."""
+    if a.shape != shape + tail or not (a.flags.c_contiguous and a.flags.writeable):
+        a = np.array(np.broadcast_to(a, shape + tail), order="C")   # writable: one kernel signature
     return a.reshape((-1,) + tail)
 
 
@@ -218,7 +218,7 @@ def jacobian_blocks(R_LtoB, u, inv_rho) -> tuple[np.ndarray, np.ndarray, np.ndar
     u = np.asarray(u, dtype=float)
     if u.ndim == 1 and R.ndim == 2:           # one landmark: the kernel itself
         b, HC = np.empty(3), np.empty((3, 3))
-        blocks(np.ascontiguousarray(R), np.ascontiguousarray(u), float(inv_rho), b, HC)
+        blocks(_flat(R, (), (3, 3))[0], _flat(u, (), (3,))[0], float(inv_rho), b, HC)
         return b, HC, skew(b)
     inv = np.asarray(inv_rho, dtype=float)
     shape = np.broadcast_shapes(R.shape[:-2], u.shape[:-1], inv.shape)
