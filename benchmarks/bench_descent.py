@@ -3,7 +3,9 @@
 as batches of the default size (landing.mc.batch_size; 0 = the whole chunk,
 here all runs at once), per camera scenario and planning method, in one
 process; also the pre-refactor per-run descent (tests/descent_reference.py)
-on the same runs, and a check that the batched numbers equal the per-run ones.
+on the same runs, and a check that the batched numbers equal the per-run ones;
+and the batched descent's CPU per run less its planning calls (the filter and
+the descent's own bookkeeping: ``filter ms/run``).
 
     PYTHONPATH=src python benchmarks/bench_descent.py [--runs 50] [--methods depth,svd]
         [--scenarios interior,site-tilt] [--batch N] [--no-reference]
@@ -33,17 +35,31 @@ sys.path.insert(0, str(REPO / "src"))
 sys.path.insert(0, str(REPO / "tests"))
 
 from opnav.config import load_config  # noqa: E402
+from opnav.landing import descent  # noqa: E402
 from opnav.landing.descent import run_descents  # noqa: E402
 from opnav.landing.scenario import build_scenario, camera_scenarios  # noqa: E402
 
 
+PLAN_CPU = [0.0]      # CPU s spent in the planner (descent.plan_batch) since the last reset
+
+
+def _timed_plan_batch(*args, **kw):
+    t0 = time.process_time()
+    try:
+        return _plan_batch(*args, **kw)
+    finally:
+        PLAN_CPU[0] += time.process_time() - t0
+
+
 def fly(scn, method, runs, batch):
+    """Fly ``runs`` in batches of ``batch``: (runs, CPU s, of which planning CPU s)."""
     size = len(runs) if batch <= 0 else batch
+    PLAN_CPU[0] = 0.0
     t0 = time.process_time()
     out = []
     for a in range(0, len(runs), size):
         out.extend(run_descents(scn, method, runs[a:a + size]))
-    return out, time.process_time() - t0
+    return out, time.process_time() - t0, PLAN_CPU[0]
 
 
 def max_rel_diff(a, b) -> float:
@@ -69,6 +85,9 @@ def main(argv=None) -> int:
                     help="batched size (default landing.mc.batch_size; 0 = all runs)")
     ap.add_argument("--no-reference", action="store_true", help="skip the pre-refactor per-run code")
     args = ap.parse_args(argv)
+    global _plan_batch
+    _plan_batch = descent.plan_batch
+    descent.plan_batch = _timed_plan_batch
     cfg = load_config()["landing"]
     batch = int(cfg["mc"]["batch_size"]) if args.batch is None else args.batch
     runs = list(range(args.runs))
@@ -79,15 +98,17 @@ def main(argv=None) -> int:
     print(f"{len(runs)} runs per cell; batched size {batch or len(runs)} "
           f"({'landing.mc.batch_size' if args.batch is None else '--batch'} = {batch}); CPU s = process_time")
     print(f"{'scenario':10s} {'method':7s} {'per-run ref':>12s} {'batch 1':>10s} {'batched':>10s} "
-          f"{'x vs 1':>7s} {'x vs ref':>8s} {'max rel diff':>12s}   (descents per CPU-second)")
-    tot = {"1": 0.0, "b": 0.0, "ref": 0.0}
+          f"{'x vs 1':>7s} {'x vs ref':>8s} {'max rel diff':>12s} {'filter ms/run':>13s}   (descents per "
+          f"CPU-second; filter: the batched descent's CPU per run less its planning calls)")
+    tot = {"1": 0.0, "b": 0.0, "ref": 0.0, "filter": 0.0}
     n_cells = 0
     for name in args.scenarios.split(","):
         scn = build_scenario(scns[name])
         for m in args.methods.split(","):
             run_descents(scn, m, [0, 1])                          # warm caches / imports
-            one, t1 = fly(scn, m, runs, 1)
-            bat, tb = fly(scn, m, runs, batch)
+            one, t1, _ = fly(scn, m, runs, 1)
+            bat, tb, tp = fly(scn, m, runs, batch)
+            tot["filter"] += tb - tp
             diff = max_rel_diff(bat, one)
             tr = np.nan
             if ref is not None:
@@ -101,12 +122,13 @@ def main(argv=None) -> int:
             n_cells += 1
             n = len(runs)
             print(f"{name:10s} {m:7s} {n / tr if tr == tr else math.nan:12.1f} {n / t1:10.1f} {n / tb:10.1f} {t1 / tb:7.1f} "
-                  f"{tr / tb:8.1f} {diff:12.2e}", flush=True)
+                  f"{tr / tb:8.1f} {diff:12.2e} {(tb - tp) / n * 1e3:13.2f}", flush=True)
     n = len(runs) * n_cells
     vs_ref = (f"per-run reference {n / tot['ref']:.1f}, " if ref is not None else "")
     print(f"all cells: {vs_ref}batch 1 {n / tot['1']:.1f}, batched {n / tot['b']:.1f} descents per "
           f"CPU-second" + (f"; batched vs per-run reference {tot['ref'] / tot['b']:.1f}x"
                            if ref is not None else ""))
+    print(f"descent excluding planning, batched: {tot['filter'] / n * 1e3:.2f} ms CPU per run")
     print(f"batch speedup: {tot['1'] / tot['b']:.1f}")
     return 0
 
