@@ -280,8 +280,8 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
         it_theta.extend(tr.theta)
         it_ll.extend(tr.loglik)
         it_data.extend([used] * len(tr.theta))
-        f = tr.last_filter
-        lat, rng, lat3, rng3 = lateral_range_errors(f.xf[:, -1], f.Pf[:, -1], dx_true[b], geo.C[b])
+        x_end, P_end = tr.last_state
+        lat, rng, lat3, rng3 = lateral_range_errors(x_end, P_end, dx_true[b], geo.C[b])
         seg_lat.append(lat)
         seg_rng.append(rng)
         seg_lat3.append(lat3)

@@ -109,17 +109,34 @@ def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
     return H
 
 
+@kernel(inline="always")
+def ekf_step(xprev, Pprev, Phi, Q, A, C, u_ref, z, rvar, x, P, K, Sinv, nu, Hr, FP, PHt, Sm, T):
+    """One sample of the EM-EKF (eq. 6): ``H_r = -A_m C_k`` into ``Hr``, the time update of
+    ``(xprev, Pprev)`` into ``(x, P)`` (``_predict_mean1``, ``_predict_cov1``), the innovation
+    ``nu = z - A_m u_ref - H_r x`` (the model is linear in the state) and the update in place
+    (``_condition1``, K, Sinv). Scratch: FP (6, 6), PHt (6, 3), Sm (3, 3), T (6, 6).
+    Returns det S."""
+    for i in range(3):
+        for j in range(3):
+            Hr[i, j] = -(A[i, 0] * C[0, j] + A[i, 1] * C[1, j] + A[i, 2] * C[2, j])
+    _predict_mean1(xprev, Phi, x)
+    _predict_cov1(Pprev, Phi, Q, P, FP)
+    for i in range(3):
+        nu[i] = (z[i] - (A[i, 0] * u_ref[0] + A[i, 1] * u_ref[1] + A[i, 2] * u_ref[2])
+                 - (Hr[i, 0] * x[0] + Hr[i, 1] * x[1] + Hr[i, 2] * x[2]))
+    return _condition1(True, x, P, Hr, 0, rvar, nu, False, K, Sinv, PHt, Sm, T, T)
+
+
 @kernel
 def filter_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, keep_pred, xf, Pf, xp, Pp, K, Sinv, nu, Hr, ll, KH):
-    """The EM-EKF (eq. 6, :func:`opnav.approach.ekf.run_filter`) over one window for every
-    seed: ``_predict_mean1``, ``_predict_cov1`` then ``_condition1`` with ``H = [-A_m C_k, 0]`` and the innovation
-    ``nu_k = z_k - A_m u_ref,k - H_r x_k|k-1`` (the model is linear in the state).
+    """The EM-EKF (eq. 6, :func:`run_filter`) over one window for every seed, :func:`ekf_step`
+    by step.
 
     z (S, n+1, 3); A (S, 3, 3) = A_m(theta) per seed; x0 (S, 6); P0 (S, 6, 6); Phi (n+1, 6, 6);
     C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3); Q (6, 6). Fills xf, Pf, (xp, Pp when
-    ``keep_pred``), K (S, n+1, 6, 3), Sinv (S, n+1, 3, 3), nu (S, n+1, 3), Hr (S, n+1, 3, 3),
-    the log-likelihood ll (S,) and KH (S, 6, 6) of the last sample. Returns the smallest
-    det S (not positive: the filter broke)."""
+    ``keep_pred``), K (S, n+1, 6, 3), Sinv (S, n+1, 3, 3), nu (S, n+1, 3), Hr (S, n+1, 3, 3)
+    (sample 0: ``-A_m C_0``), the log-likelihood ll (S,) and KH (S, 6, 6) of the last sample.
+    Returns the smallest det S (not positive: the filter broke)."""
     S, n1 = z.shape[0], z.shape[1]
     FP = np.empty((6, 6))
     PHt = np.empty((6, 3))
@@ -127,29 +144,20 @@ def filter_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, keep_pred, xf, Pf, xp, P
     T = np.empty((6, 6))
     dmin = np.inf
     for s in range(S):
-        for k in range(n1):  # H_r = -A_m C_k
-            for i in range(3):
-                for j in range(3):
-                    Hr[s, k, i, j] = -(A[s, i, 0] * C[k, 0, j] + A[s, i, 1] * C[k, 1, j] + A[s, i, 2] * C[k, 2, j])
+        for i in range(3):
+            for j in range(3):
+                Hr[s, 0, i, j] = -(A[s, i, 0] * C[0, 0, j] + A[s, i, 1] * C[0, 1, j] + A[s, i, 2] * C[0, 2, j])
         for i in range(6):
             xf[s, 0, i] = x0[s, i]
             for j in range(6):
                 Pf[s, 0, i, j] = P0[s, i, j]
         acc_ll = 0.0
         for k in range(1, n1):
-            x, P = xf[s, k], Pf[s, k]  # predicted, then updated in place
-            _predict_mean1(xf[s, k - 1], Phi[k], x)
-            _predict_cov1(Pf[s, k - 1], Phi[k], Q, P, FP)
-            if keep_pred:
-                for i in range(6):
-                    xp[s, k, i] = x[i]
-                    for j in range(6):
-                        Pp[s, k, i, j] = P[i, j]
-            for i in range(3):
-                acc = z[s, k, i] - (A[s, i, 0] * u_ref[k, 0] + A[s, i, 1] * u_ref[k, 1] + A[s, i, 2] * u_ref[k, 2])
-                acc -= Hr[s, k, i, 0] * x[0] + Hr[s, k, i, 1] * x[1] + Hr[s, k, i, 2] * x[2]
-                nu[s, k, i] = acc
-            det = _condition1(True, x, P, Hr[s, k], 0, Rvar[k, s], nu[s, k], False, K[s, k], Sinv[s, k], PHt, Sm, T, T)
+            det = ekf_step(xf[s, k - 1], Pf[s, k - 1], Phi[k], Q, A[s], C[k], u_ref[k], z[s, k], Rvar[k, s],
+                           xf[s, k], Pf[s, k], K[s, k], Sinv[s, k], nu[s, k], Hr[s, k], FP, PHt, Sm, T)
+            if keep_pred:  # the predicted moments again (the step updated them in place)
+                _predict_mean1(xf[s, k - 1], Phi[k], xp[s, k])
+                _predict_cov1(Pf[s, k - 1], Phi[k], Q, Pp[s, k], FP)
             dmin = min(dmin, det)
             if det > 0.0:
                 acc_ll += _loglik1(nu[s, k], Sinv[s, k], det)

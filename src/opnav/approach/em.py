@@ -36,9 +36,10 @@ import numpy as np
 
 from opnav.compiled import kernel, warms
 
-from .ekf import POS, FilterResult, Window, run_filter
-from .kalman import carray
-from .smoother import SmootherResult, bryson_frazier
+from .camera import misalignment_small
+from .ekf import Window, ekf_step
+from .kalman import _loglik1, carray
+from .smoother import SmootherResult, bf_back, bf_moments
 
 @dataclass
 class EStats:
@@ -49,42 +50,109 @@ class EStats:
     J_stars: np.ndarray | None = None  # (3, 3) the star images' part of N (``stars`` variant)
 
 
+@kernel(inline="always")
+def estep_add(z, xs, Ps, C, u_ref, rvar, N, b, m, M, CP):
+    """Add one sample's E-step terms to ``N`` (3, 3) and ``b`` (3,) (see :func:`estep`).
+
+    z (3,); xs (>=3,), Ps (>=3, >=3) smoothed moments (position first); C (3, 3); u_ref (3,);
+    rvar (3,). With the mean ``m = u_ref - C x_r`` and second moment ``M = C P_rr C^T + m m^T``
+    of ``u``, ``w = 1/R`` and ``U = [u x]`` (``U_ik = -eps_ijk u_j``):
+    ``N_kl += sum_i w_i eps_ijk eps_inl M_jn``, ``b_k += sum_i w_i eps_ijk (m_j z_i - M_ji)``.
+    Scratch: m (3,), M, CP (3, 3)."""
+    for i in range(3):
+        m[i] = u_ref[i] - (C[i, 0] * xs[0] + C[i, 1] * xs[1] + C[i, 2] * xs[2])
+    for i in range(3):
+        for l in range(3):
+            CP[i, l] = C[i, 0] * Ps[0, l] + C[i, 1] * Ps[1, l] + C[i, 2] * Ps[2, l]
+    for i in range(3):
+        for j in range(3):
+            M[i, j] = (CP[i, 0] * C[j, 0] + CP[i, 1] * C[j, 1] + CP[i, 2] * C[j, 2]) + m[i] * m[j]
+    for i in range(3):
+        w = 1.0 / rvar[i]
+        # eps_ijk is +1 at (j, k) = (i+1, i+2) and -1 at (i+2, i+1) (mod 3)
+        j1 = (i + 1) % 3
+        k1 = (i + 2) % 3
+        N[k1, k1] += w * M[j1, j1]
+        N[k1, j1] -= w * M[j1, k1]
+        N[j1, k1] -= w * M[k1, j1]
+        N[j1, j1] += w * M[k1, k1]
+        b[k1] += w * (m[j1] * z[i] - M[j1, i])
+        b[j1] -= w * (m[k1] * z[i] - M[k1, i])
+
+
 @kernel
 def _estep_window(z, xs, Ps, C, u_ref, Rvar, N, b):
-    """Sums of the E-step over samples 1..n for every seed (see :func:`estep`).
-
-    z (S, n+1, 3); xs (S, n+1, >=3) and Ps (S, n+1, >=3, >=3) smoothed moments (position
-    first); C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3). Per sample, with the mean
-    ``m = u_ref - C x_r`` and second moment ``M = C P_rr C^T + m m^T`` of ``u``, ``w = 1/R``
-    and ``U = [u x]`` (``U_ik = -eps_ijk u_j``):
-    ``N_kl += sum_i w_i eps_ijk eps_inl M_jn``, ``b_k += sum_i w_i eps_ijk (m_j z_i - M_ji)``."""
-    S, n1 = z.shape[0], z.shape[1]
+    """:func:`estep_add` over samples 1..n for every seed: z (S, n+1, 3); xs (S, n+1, >=3),
+    Ps (S, n+1, >=3, >=3); C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3); N (S, 3, 3), b (S, 3)."""
     m = np.empty(3)
     M = np.empty((3, 3))
     CP = np.empty((3, 3))
-    for s in range(S):
+    for s in range(z.shape[0]):
         N[s, :, :] = 0.0
         b[s, :] = 0.0
-        for t in range(1, n1):
-            for i in range(3):
-                m[i] = u_ref[t, i] - (C[t, i, 0] * xs[s, t, 0] + C[t, i, 1] * xs[s, t, 1] + C[t, i, 2] * xs[s, t, 2])
-            for i in range(3):
-                for l in range(3):
-                    CP[i, l] = C[t, i, 0] * Ps[s, t, 0, l] + C[t, i, 1] * Ps[s, t, 1, l] + C[t, i, 2] * Ps[s, t, 2, l]
-            for i in range(3):
-                for j in range(3):
-                    M[i, j] = (CP[i, 0] * C[t, j, 0] + CP[i, 1] * C[t, j, 1] + CP[i, 2] * C[t, j, 2]) + m[i] * m[j]
-            for i in range(3):
-                w = 1.0 / Rvar[t, s, i]
-                # eps_ijk is +1 at (j, k) = (i+1, i+2) and -1 at (i+2, i+1) (mod 3)
-                j1 = (i + 1) % 3
-                k1 = (i + 2) % 3
-                N[s, k1, k1] += w * M[j1, j1]
-                N[s, k1, j1] -= w * M[j1, k1]
-                N[s, j1, k1] -= w * M[k1, j1]
-                N[s, j1, j1] += w * M[k1, k1]
-                b[s, k1] += w * (m[j1] * z[s, t, i] - M[j1, i])
-                b[s, j1] -= w * (m[k1] * z[s, t, i] - M[k1, i])
+        for t in range(1, z.shape[1]):
+            estep_add(z[s, t], xs[s, t], Ps[s, t], C[t], u_ref[t], Rvar[t, s], N[s], b[s], m, M, CP)
+
+
+@kernel
+def _em_map_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, N, b, ll, x_last, P_last):
+    """The E-step statistics of one EM map for every seed, seed by seed in one pass: the EKF
+    forward (:func:`opnav.approach.ekf.ekf_step`), the position Bryson-Frazier smoother
+    backward (:func:`opnav.approach.smoother.bf_moments`, ``bf_back``) and :func:`estep_add`
+    at each sample as its smoothed moments come out (summed n..1), with per-seed buffers
+    of one window (no (seeds x samples) arrays). Arguments as
+    :func:`opnav.approach.ekf.filter_window`; fills N (S, 3, 3), b (S, 3), the log-likelihood
+    ll (S,) and the filtered state at the last sample x_last (S, 6), P_last (S, 6, 6).
+    Returns the smallest det S."""
+    S, n1 = z.shape[0], z.shape[1]
+    xf = np.empty((n1, 6))
+    Pf = np.empty((n1, 6, 6))
+    K = np.empty((n1, 6, 3))
+    Sinv = np.empty((n1, 3, 3))
+    nu = np.empty((n1, 3))
+    Hr = np.empty((n1, 3, 3))
+    FP = np.empty((6, 6))
+    PHt = np.empty((6, 3))
+    Sm = np.empty((3, 3))
+    T = np.empty((6, 6))
+    L = np.empty((6, 6))
+    lv = np.empty(6)
+    KH = np.empty((6, 3))
+    Lt = np.empty((6, 6))
+    lt = np.empty(6)
+    HS = np.empty((3, 3))
+    xs = np.empty(3)
+    Ps = np.empty((3, 3))
+    m = np.empty(3)
+    M = np.empty((3, 3))
+    CP = np.empty((3, 3))
+    dmin = np.inf
+    for s in range(S):
+        for i in range(6):
+            xf[0, i] = x0[s, i]
+            for j in range(6):
+                Pf[0, i, j] = P0[s, i, j]
+        acc_ll = 0.0
+        for k in range(1, n1):
+            det = ekf_step(xf[k - 1], Pf[k - 1], Phi[k], Q, A[s], C[k], u_ref[k], z[s, k], Rvar[k, s],
+                           xf[k], Pf[k], K[k], Sinv[k], nu[k], Hr[k], FP, PHt, Sm, T)
+            dmin = min(dmin, det)
+            if det > 0.0:
+                acc_ll += _loglik1(nu[k], Sinv[k], det)
+        ll[s] = acc_ll
+        for i in range(6):
+            x_last[s, i] = xf[n1 - 1, i]
+            for j in range(6):
+                P_last[s, i, j] = Pf[n1 - 1, i, j]
+        L[:, :] = 0.0
+        lv[:] = 0.0
+        N[s, :, :] = 0.0
+        b[s, :] = 0.0
+        for k in range(n1 - 1, 0, -1):
+            bf_moments(xf[k], Pf[k], L, lv, 0, xs, Ps, T)
+            estep_add(z[s, k], xs, Ps, C[k], u_ref[k], Rvar[k, s], N[s], b[s], m, M, CP)
+            bf_back(K[k], Hr[k], Sinv[k], nu[k], Phi[k], L, lv, KH, T, Lt, lt, HS)
+    return dmin
 
 
 def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:
@@ -97,7 +165,13 @@ def estep(z: np.ndarray, s: SmootherResult, win: Window) -> EStats:
     N, b = np.empty((S, 3, 3)), np.empty((S, 3))
     c = carray
     _estep_window(c(z), c(s.xs), c(s.Ps), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (win.n + 1, S, 3))), N, b)
-    if win.stars is not None and win.star_y is not None:  # star images: a direct measurement of theta
+    return _with_stars(N, b, win)
+
+
+def _with_stars(N: np.ndarray, b: np.ndarray, win: Window) -> EStats:
+    """The E-step statistics with the star images' normal equations added (``stars``
+    variant: a direct measurement of theta), if the window has any."""
+    if win.stars is not None and win.star_y is not None:
         from .stars import normal_equations
 
         J, h = normal_equations(win.stars, win.star_y)
@@ -172,21 +246,32 @@ class EMTrace:
     theta: list = field(default_factory=list)  # (S,3) after each map evaluation
     loglik: list = field(default_factory=list)  # (S,) observed-data LL at the evaluated theta
     unobservable: np.ndarray | None = None  # (S,3) bool, of the last M-step
-    last_filter: FilterResult | None = None
-    last_smoother: SmootherResult | None = None
+    last_state: tuple | None = None  # (x (S,6), P (S,6,6)) filtered at the window's end, last map
 
 
 def em_map(theta, z, x0, P0, win, tz_tol):
-    """One EM map theta -> theta' (filter, smoother, E-step, M-step) and LL(theta)."""
-    f = run_filter(z, theta, x0, P0, win, predicted=False)
-    s = bryson_frazier(f, win, POS)  # identical to rts() (tested), no 6x6 inverses; position only
-    new, unobs = mstep(estep(z, s, win), theta, tz_tol)
-    ll = f.loglik
+    """One EM map theta -> theta' (filter, smoother, E-step, M-step) and LL(theta): the
+    fused compiled pass :func:`_em_map_window` (the same filter, position smoother and E-step
+    as :func:`opnav.approach.ekf.run_filter`, :func:`opnav.approach.smoother.bryson_frazier`
+    and :func:`estep`, seed by seed), then :func:`mstep`. Returns theta', LL(theta), the
+    unobservable mask and the filtered state at the window's end ``(x (S, 6), P (S, 6, 6))``."""
+    S, n = z.shape[0], win.n
+    A = misalignment_small(np.asarray(theta, float))
+    Rvar = win.Rvar if win.Rvar.ndim == 3 else win.Rvar[:, None, :]
+    N, b, ll = np.empty((S, 3, 3)), np.empty((S, 3)), np.empty(S)
+    x_last, P_last = np.empty((S, 6)), np.empty((S, 6, 6))
+    c = carray
+    dmin = _em_map_window(c(z), c(A), c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6))),
+                          c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))), c(win.Q),
+                          N, b, ll, x_last, P_last)
+    if not dmin > 0:
+        raise FloatingPointError("innovation covariance not positive definite")
+    new, unobs = mstep(_with_stars(N, b, win), theta, tz_tol)
     if win.stars is not None and win.star_y is not None:
         from .stars import loglik
 
         ll = ll + loglik(win.stars, win.star_y, theta)
-    return new, ll, unobs, f, s
+    return new, ll, unobs, (x_last, P_last)
 
 
 def em_window(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray, win: Window,
@@ -201,11 +286,11 @@ def em_window(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     theta = np.array(theta0, float)
 
     def F(th):
-        new, ll, unobs, f, s = em_map(th, z, x0, P0, win, tz_tol)
+        new, ll, unobs, end = em_map(th, z, x0, P0, win, tz_tol)
         tr.theta.append(new)
         tr.loglik.append(ll)
         tr.unobservable = unobs
-        tr.last_filter, tr.last_smoother = f, s
+        tr.last_state = end
         return new, ll
 
     if method == "plain":
@@ -330,8 +415,9 @@ def squarem_cycle(theta0: np.ndarray, F) -> np.ndarray:
 
 @warms
 def _warm() -> None:
-    """The E-step kernel once with the pipeline's argument types."""
+    """The E-step kernels once with the pipeline's argument types."""
     n1 = 2
     win = Window(np.broadcast_to(np.eye(6), (n1, 6, 6)).copy(), np.broadcast_to(np.eye(3), (n1, 3, 3)).copy(),
                  np.ones((n1, 3)), np.ones((n1, 3)), np.eye(6))
     estep(np.zeros((1, n1, 3)), SmootherResult(np.zeros((1, n1, 3)), np.zeros((1, n1, 3, 3)), None, None), win)
+    em_map(np.zeros((1, 3)), np.zeros((1, n1, 3)), np.zeros((1, 6)), np.eye(6), win, 1e-6)

@@ -89,7 +89,8 @@ def _predict_mean1(x, F, xo):
 
 @kernel
 def _predict_cov1(P, F, Q, Po, FP):
-    """Time update of one member's covariance: ``Po = F P F^T + Q``; ``FP`` (d, d) scratch."""
+    """Time update of one member's covariance: ``Po = F P F^T + Q``, P and Q symmetric (the
+    upper triangle is computed and mirrored); ``FP`` (d, d) scratch."""
     d = P.shape[0]
     for i in range(d):
         for j in range(d):
@@ -97,18 +98,20 @@ def _predict_cov1(P, F, Q, Po, FP):
             for l in range(d):
                 acc += F[i, l] * P[l, j]
             FP[i, j] = acc
-    for i in range(d):
-        for j in range(d):
+    for i in range(d):  # symmetric: the upper triangle, mirrored
+        for j in range(i, d):
             acc = 0.0
             for l in range(d):
                 acc += FP[i, l] * F[j, l]
             Po[i, j] = acc + Q[i, j]
+            Po[j, i] = Po[i, j]
 
 
 @kernel
 def _condition1(has_m, x, P, H, c0, rvar, nu, joseph, K, Sinv, PHt, S, T1, T2):
-    """Measurement update of one member, in place on ``x`` (d,) and ``P`` (d, d); ``H`` (3, c)
-    on the state columns ``c0..c0+c``. Writes the gain ``K`` (d, 3) and ``Sinv`` (3, 3);
+    """Measurement update of one member, in place on ``x`` (d,) and ``P`` (d, d) (symmetric:
+    the upper triangle of the result is computed and mirrored); ``H`` (3, c) on the state
+    columns ``c0..c0+c``. Writes the gain ``K`` (d, 3) and ``Sinv`` (3, 3);
     returns det S. Scratch: ``PHt`` (d, 3), ``S`` (3, 3), ``T1``, ``T2`` (d, d) (Joseph form only)."""
     d = P.shape[0]
     c = H.shape[1]
@@ -147,22 +150,20 @@ def _condition1(has_m, x, P, H, c0, rvar, nu, joseph, K, Sinv, PHt, S, T1, T2):
                 for l in range(d):
                     acc += T1[i, l] * P[l, j]
                 T2[i, j] = acc
-        for i in range(d):  # P = T2 (I - K H)^T + K R K^T
-            for j in range(d):
+        for i in range(d):  # P = T2 (I - K H)^T + K R K^T (symmetric: upper triangle, mirrored)
+            for j in range(i, d):
                 acc = 0.0
                 for l in range(d):
                     acc += T2[i, l] * T1[j, l]
-                P[i, j] = acc + (K[i, 0] * rvar[0] * K[j, 0] + K[i, 1] * rvar[1] * K[j, 1]
-                                 + K[i, 2] * rvar[2] * K[j, 2])
+                acc += K[i, 0] * rvar[0] * K[j, 0] + K[i, 1] * rvar[1] * K[j, 1] + K[i, 2] * rvar[2] * K[j, 2]
+                P[i, j] = acc
+                P[j, i] = acc
     else:
-        for i in range(d):  # P = P - K (P H^T)^T
-            for j in range(d):
-                P[i, j] -= K[i, 0] * PHt[j, 0] + K[i, 1] * PHt[j, 1] + K[i, 2] * PHt[j, 2]
-    for i in range(d):
-        for j in range(i + 1, d):
-            v = 0.5 * (P[i, j] + P[j, i])
-            P[i, j] = v
-            P[j, i] = v
+        for i in range(d):  # P = P - K (P H^T)^T (symmetric: upper triangle, mirrored)
+            for j in range(i, d):
+                v = P[i, j] - (K[i, 0] * PHt[j, 0] + K[i, 1] * PHt[j, 1] + K[i, 2] * PHt[j, 2])
+                P[i, j] = v
+                P[j, i] = v
     return det
 
 

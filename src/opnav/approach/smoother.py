@@ -84,17 +84,103 @@ def lag_one_recursive(f: FilterResult, s: SmootherResult, win: Window) -> np.nda
     return out
 
 
+@kernel(inline="always")
+def bf_moments(x, P, L, lv, c0, xs, Ps, T):
+    """Smoothed moments of the components ``c0..c0+c`` at one sample from its filtered ``x, P``
+    and the adjoint ``(Lh, lh)`` there: ``xs = x - P lh``, ``Ps = P - P Lh P`` (symmetrised);
+    ``T`` (>= c, 6) scratch."""
+    c = xs.shape[0]
+    for i in range(c):
+        acc = 0.0
+        for j in range(6):
+            acc += P[c0 + i, j] * lv[j]
+        xs[i] = x[c0 + i] - acc
+        for j in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += P[c0 + i, l] * L[l, j]
+            T[i, j] = acc  # (P Lh) rows of the components
+    for i in range(c):
+        for m in range(c):
+            acc = 0.0
+            for j in range(6):
+                acc += T[i, j] * P[j, c0 + m]
+            Ps[i, m] = P[c0 + i, c0 + m] - acc
+    for i in range(c):
+        for m in range(i + 1, c):
+            v = 0.5 * (Ps[i, m] + Ps[m, i])
+            Ps[i, m] = v
+            Ps[m, i] = v
+
+
+@kernel(inline="always")
+def bf_back(K, Hr, Sinv, nu, Phi, L, lv, KH, T, Lt, lt, HS):
+    """The adjoint from sample k to k-1, in place on ``L`` (Lh) and ``lv`` (lh), with the gain
+    ``K`` (6, 3), ``Hr`` (3, 3, position columns), ``Sinv``, ``nu`` of sample k and
+    ``Phi = Phi_k``: ``Lt = H^T S^-1 H + Ct^T Lh Ct``, ``lt = -H^T S^-1 nu + Ct^T lh``,
+    ``Lh <- Phi^T Lt Phi``, ``lh <- Phi^T lt`` with ``Ct = I - K H``. Scratch: KH (6, 3),
+    T, Lt (6, 6), lt (6,), HS (3, 3)."""
+    # Ct differs from I only in its first 3 columns, by -K H_r (6 x 3)
+    for i in range(6):
+        for j in range(3):
+            KH[i, j] = K[i, 0] * Hr[0, j] + K[i, 1] * Hr[1, j] + K[i, 2] * Hr[2, j]
+    for i in range(6):  # T = Lh Ct
+        for j in range(3):
+            acc = L[i, j]
+            for l in range(6):
+                acc -= L[i, l] * KH[l, j]
+            T[i, j] = acc
+        for j in range(3, 6):
+            T[i, j] = L[i, j]
+    for i in range(6):  # Lt = Ct^T T (symmetric: upper triangle, mirrored), lt = Ct^T lh
+        for j in range(i, 6):
+            acc = T[i, j]
+            if i < 3:
+                for l in range(6):
+                    acc -= KH[l, i] * T[l, j]
+            Lt[i, j] = acc
+            Lt[j, i] = acc
+        acc = lv[i]
+        if i < 3:
+            for l in range(6):
+                acc -= KH[l, i] * lv[l]
+        lt[i] = acc
+    for i in range(3):  # H^T S^-1 (3 x 3)
+        for a in range(3):
+            HS[i, a] = Hr[0, i] * Sinv[0, a] + Hr[1, i] * Sinv[1, a] + Hr[2, i] * Sinv[2, a]
+    for i in range(3):  # + H^T S^-1 H, - H^T S^-1 nu
+        for j in range(3):
+            Lt[i, j] += HS[i, 0] * Hr[0, j] + HS[i, 1] * Hr[1, j] + HS[i, 2] * Hr[2, j]
+        lt[i] -= HS[i, 0] * nu[0] + HS[i, 1] * nu[1] + HS[i, 2] * nu[2]
+    for i in range(6):  # Lh_{k-1} = Phi^T Lt Phi (symmetric), lh_{k-1} = Phi^T lt
+        for j in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += Lt[i, l] * Phi[l, j]
+            T[i, j] = acc
+    for i in range(6):
+        for j in range(i, 6):
+            acc = 0.0
+            for l in range(6):
+                acc += Phi[l, i] * T[l, j]
+            L[i, j] = acc
+            L[j, i] = acc
+        acc = 0.0
+        for l in range(6):
+            acc += Phi[l, i] * lt[l]
+        lv[i] = acc
+
+
 @kernel
 def _bryson_frazier_window(xf, Pf, K, Hr, Sinv, nu, Phi, c0, xs, Ps):
     """The modified Bryson-Frazier pass of :func:`bryson_frazier` for every seed, one seed
-    at a time backwards in time, keeping only the adjoint ``Lh, lh`` of the current sample:
-    fills ``xs (S, n+1, c)`` and ``Ps (S, n+1, c, c)`` with the smoothed moments of the
-    state components ``c0..c0+c``. ``H`` touches the position columns 0..2 only."""
+    at a time backwards in time (:func:`bf_moments`, :func:`bf_back`), keeping only the
+    adjoint of the current sample: fills ``xs (S, n+1, c)`` and ``Ps (S, n+1, c, c)`` with the
+    smoothed moments of the state components ``c0..c0+c``."""
     S, n1 = xf.shape[0], xf.shape[1]
-    c = xs.shape[2]
     L = np.zeros((6, 6))
     lv = np.zeros(6)
-    Ct = np.empty((6, 6))
+    KH = np.empty((6, 3))
     T = np.empty((6, 6))
     Lt = np.empty((6, 6))
     lt = np.empty(6)
@@ -103,75 +189,9 @@ def _bryson_frazier_window(xf, Pf, K, Hr, Sinv, nu, Phi, c0, xs, Ps):
         L[:, :] = 0.0
         lv[:] = 0.0
         for k in range(n1 - 1, -1, -1):
-            # moments at k from the adjoint (Lh_k, lh_k): X - P lh, P - P Lh P
-            for i in range(c):
-                acc = 0.0
-                for j in range(6):
-                    acc += Pf[s, k, c0 + i, j] * lv[j]
-                xs[s, k, i] = xf[s, k, c0 + i] - acc
-                for j in range(6):
-                    acc = 0.0
-                    for l in range(6):
-                        acc += Pf[s, k, c0 + i, l] * L[l, j]
-                    T[i, j] = acc  # (P Lh) rows of the components
-            for i in range(c):
-                for m in range(c):
-                    acc = 0.0
-                    for j in range(6):
-                        acc += T[i, j] * Pf[s, k, j, c0 + m]
-                    Ps[s, k, i, m] = Pf[s, k, c0 + i, c0 + m] - acc
-            for i in range(c):
-                for m in range(i + 1, c):
-                    v = 0.5 * (Ps[s, k, i, m] + Ps[s, k, m, i])
-                    Ps[s, k, i, m] = v
-                    Ps[s, k, m, i] = v
-            if k == 0:
-                break
-            # Ct = I - K H of sample k (H on the position columns)
-            for i in range(6):
-                for j in range(6):
-                    Ct[i, j] = 1.0 if i == j else 0.0
-                for j in range(3):
-                    Ct[i, j] -= K[s, k, i, 0] * Hr[s, k, 0, j] + K[s, k, i, 1] * Hr[s, k, 1, j] + K[s, k, i, 2] * Hr[s, k, 2, j]
-            for i in range(6):  # T = Lh Ct
-                for j in range(6):
-                    acc = 0.0
-                    for l in range(6):
-                        acc += L[i, l] * Ct[l, j]
-                    T[i, j] = acc
-            for i in range(6):  # Lt = Ct^T Lh Ct, lt = Ct^T lh
-                for j in range(6):
-                    acc = 0.0
-                    for l in range(6):
-                        acc += Ct[l, i] * T[l, j]
-                    Lt[i, j] = acc
-                acc = 0.0
-                for l in range(6):
-                    acc += Ct[l, i] * lv[l]
-                lt[i] = acc
-            for i in range(3):  # H^T S^-1 (3 x 3)
-                for a in range(3):
-                    HS[i, a] = Hr[s, k, 0, i] * Sinv[s, k, 0, a] + Hr[s, k, 1, i] * Sinv[s, k, 1, a] + Hr[s, k, 2, i] * Sinv[s, k, 2, a]
-            for i in range(3):  # + H^T S^-1 H, - H^T S^-1 nu
-                for j in range(3):
-                    Lt[i, j] += HS[i, 0] * Hr[s, k, 0, j] + HS[i, 1] * Hr[s, k, 1, j] + HS[i, 2] * Hr[s, k, 2, j]
-                lt[i] -= HS[i, 0] * nu[s, k, 0] + HS[i, 1] * nu[s, k, 1] + HS[i, 2] * nu[s, k, 2]
-            for i in range(6):  # Lh_{k-1} = Phi^T Lt Phi, lh_{k-1} = Phi^T lt
-                for j in range(6):
-                    acc = 0.0
-                    for l in range(6):
-                        acc += Lt[i, l] * Phi[k, l, j]
-                    T[i, j] = acc
-            for i in range(6):
-                for j in range(6):
-                    acc = 0.0
-                    for l in range(6):
-                        acc += Phi[k, l, i] * T[l, j]
-                    L[i, j] = acc
-                acc = 0.0
-                for l in range(6):
-                    acc += Phi[k, l, i] * lt[l]
-                lv[i] = acc
+            bf_moments(xf[s, k], Pf[s, k], L, lv, c0, xs[s, k], Ps[s, k], T)
+            if k > 0:
+                bf_back(K[s, k], Hr[s, k], Sinv[s, k], nu[s, k], Phi[k], L, lv, KH, T, Lt, lt, HS)
 
 
 def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> SmootherResult:
