@@ -13,9 +13,9 @@ nearest detected landmark); only the objective differs. This script
    ``--reps`` rounds; it prints per method the median time per call (us), the
    median objective evaluations per call, the time per evaluation beyond the
    depth method's, and the ratio to the SVD baseline measured in the same
-   process; the baselines are timed with the configured evaluation path
-   (``landing.planner.eval_path``, default ``matrix_scalar``: H of eq. 14-18 +
-   one LAPACK SVD per candidate) and, for reference, with the closed-form path;
+   process; on the configured path (``landing.planner.eval_path``, default
+   ``compiled``) and on the other (``paper``: the paper's definition, CasADi H +
+   LAPACK SVD, interpreted);
 2. with ``--mc``, runs the landing Monte Carlo of the config (every method)
    through Snakemake with ``--cores 2`` in a scratch results directory and
    prints its wall time.
@@ -142,10 +142,10 @@ def main(argv=None) -> int:
     table(t, e)
     print("-- CPU time of the thread (thread_time_ns) --")
     table(c, e)
-    if path != "closed_form":
-        print("\n== baselines via eval_path = closed_form (metrics module's closed form; beyond the paper) ==")
-        t, c, e = time_methods(scn, states, methods, args.reps, "closed_form")
-        table(t, e)
+    other = PL.alternative_path(scn.planner).eval_path
+    print(f"\n== eval_path = {other} (the other path) ==")
+    t, c, e = time_methods(scn, states, methods, args.reps, other)
+    table(t, e)
     if args.mc:
         wall = run_mc(args.config)
         n = landing["mc"]["n_runs"]

@@ -95,7 +95,7 @@ def test_pixel_claim_counts_data_only_where_the_data_can_tell_the_bias():
 
 
 def _scenario(equivalent=True, pick=50.0, controls=(), faster="faster", yaw=False, red=29.0, red_alt=70.0):
-    return {"eval_path": "matrix_scalar", "yaw_converges": yaw, "yaw_reason": "yaw 3-sigma flat",
+    return {"eval_path": "compiled", "yaw_converges": yaw, "yaw_reason": "yaw 3-sigma flat",
             "equivalence": {"methods": {"depth": {"equivalent": equivalent, "same_pick_pct": pick,
                                                   "text": "depth is equivalent to svd within 2 m"}},
                             "metrics": {}},

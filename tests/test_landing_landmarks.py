@@ -12,7 +12,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.spatial import cKDTree
 
 from opnav.landing.landmarks import GridIndex, LandmarkField, make_field, nearest_brute_force
-from opnav.landing.planner import _pick_nearest, _pick_nearest_batch
+from opnav.landing import kernels as K
 
 
 def _lattice_field(n_side: int, step: float, seed: int) -> np.ndarray:
@@ -71,27 +71,23 @@ def test_grid_nearest_many_rejections_falls_back_exactly():
     assert f.grid.nearest(0.0, 0.0, members) == nearest_brute_force(f.xyz[:, :2], 0.0, 0.0, members)
 
 
-def test_pick_nearest_and_batch_agree_with_brute_force_on_ties():
-    """The per-call pick (bucket index) and the batched pick (one KD-tree query,
-    re-ranked) equal the brute force on a lattice field with exact ties, for
-    many points and excluded landmarks, including detected lists that hold
-    none of a point's knn nearest."""
+def test_compiled_nearest_pick_agrees_with_brute_force_on_ties():
+    """The planner's pick (kernels.nearest: bucket grid, ring search) equals the
+    brute force on a lattice field with exact ties, for many points and excluded
+    landmarks, detected lists from most to few landmarks, points far outside."""
     xy = _lattice_field(15, 10.0, 7)
-    field = LandmarkField(np.column_stack([xy, np.zeros(len(xy))]), cKDTree(xy))
+    xyz = np.column_stack([xy, np.zeros(len(xy))])
+    grid, cells = K.field_grid(xyz)
     rng = np.random.default_rng(3)
     for frac in (1.0, 0.5, 0.05):
         det = np.flatnonzero(rng.random(len(xy)) < frac)
         pts = np.concatenate([xy[rng.integers(len(xy), size=20)] + 5.0 * rng.integers(-1, 2, (20, 2)),
-                              rng.uniform(-30, 180, (20, 2))])
-        pts3 = np.column_stack([pts, np.zeros(len(pts))])
+                              rng.uniform(-300, 480, (20, 2))])
         ex = np.where(rng.random(len(pts)) < 0.5, rng.choice(det, len(pts)), -1)
-        for knn in (1, 2, 4):        # ties across the knn boundary widen exactly
-            got = _pick_nearest_batch(field, pts3, det, knn=knn, exclude=ex)
-            for j, (x, y) in enumerate(pts.tolist()):
-                e = {int(ex[j])} if ex[j] >= 0 else set()
-                want = nearest_brute_force(xy, x, y, det, e)
-                assert _pick_nearest(field, pts3[j], det, e) == want
-                assert got[j] == want, (knn, j, x, y)
+        for j, (x, y) in enumerate(pts.tolist()):
+            e = {int(ex[j])} if ex[j] >= 0 else set()
+            want = nearest_brute_force(xy, x, y, det, e)
+            assert K.nearest(x, y, xyz, det, int(ex[j]), grid, cells) == want, (frac, j, x, y)
 
 
 def test_grid_index_bad_input():

@@ -19,8 +19,10 @@ from opnav.landing.metrics import (
     _scores_from_H,
     chol_logdet,
     make_metric,
-    structural_singular_values,
 )
+from opnav.landing import kernels as K
+
+
 
 R0 = np.array([3300.0, 5870.0, 6570.0])  # paper Table 1 initial position, m
 V0 = np.array([-56.0, -66.0, -90.0])
@@ -208,11 +210,25 @@ def test_closed_form_singular_values_equal_svd_of_casadi_H(r, R, seed):
     d = cand - r
     rho = np.linalg.norm(d, axis=1)
     w = d / rho[:, None]
-    sc = np.sort(
-        structural_singular_values(1 / np.linalg.norm(r), 1 / rho, w @ u, np.sum(np.cross(u, w) ** 2, 1)), axis=1
-    )[:, ::-1]
-    # LAPACK's s4 carries ~eps * s1 / s4 relative error; the closed form is exact
-    np.testing.assert_allclose(sc, s, rtol=1e-9)
+    c, s2 = w @ u, np.sum(np.cross(u, w) ** 2, 1)
+    x = 1 / np.linalg.norm(r)
+    want = {K.SVD: s[:, 3], K.COND: s[:, 3] / s[:, 0], K.GDOP: 1 / np.sum(s ** -2.0, axis=1)}
+    for kind, ref in want.items():
+        got = [K.h_metric(kind, x, 1 / rh, cc, ss) for rh, cc, ss in zip(rho, c, s2)]
+        # LAPACK's s4 carries ~eps * s1 / s4 relative error; the closed form is exact
+        np.testing.assert_allclose(got, ref, rtol=1e-9)
+
+
+def test_known_answer_closed_form_far_field():
+    """Landmarks far away (x, y -> 0): s^2 -> {2, 1 + |c|, 1 - |c|, 0} with s4^2 ~
+    ((x - c y)^2 + (2 - c^2) y^2) / 2 for the smallest: svd -> 0 like 1/range."""
+    c, s2 = 0.3, 1 - 0.09
+    assert K.h_metric(K.SVD, 0.0, 0.0, c, s2) == 0.0
+    for y in (1e-3, 1e-5):
+        x = 2 * y
+        s4 = K.h_metric(K.SVD, x, y, c, s2)
+        assert s4 == pytest.approx(np.sqrt(((x - c * y) ** 2 + (2 - c * c) * y * y + s2 * 0) / 2), rel=1e-2)
+        assert K.h_metric(K.COND, x, y, c, s2) == pytest.approx(s4 / np.sqrt(2.0), rel=1e-2)
 
 
 # --------------------------------------------------------------------------
@@ -223,19 +239,16 @@ def test_closed_form_singular_values_equal_svd_of_casadi_H(r, R, seed):
 @pytest.mark.parametrize("name", METRIC_NAMES)
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(r=lander, R=quat, seed=seeds, aniso=st.booleans())
-def test_batched_scalar_and_map_equal_reference(name, r, R, seed, aniso):
-    """aniso=False: isotropic bearing noise (tangent-plane 2 x 2 update path);
-    aniso=True: correlated R_meas (generic 12 x 12 path)."""
+def test_fast_path_equals_the_papers_definition(name, r, R, seed, aniso):
+    """Fast path (compiled closed form for svd/gdop/cond) vs the paper's definition
+    (CasADi H, LAPACK). aniso=False: isotropic bearing noise (tangent-plane 2 x 2
+    update); aniso=True: correlated R_meas (the definition's 12 x 12 information)."""
     rng = np.random.default_rng(seed)
     ctx = _ctx(r=r, R=R, rng=rng, R_meas=_aniso_R(rng) if aniso else None)
     cand = _ground(rng, 7)
     m = make_metric(name)
     ref = m.reference(ctx, cand)
     fast = m(ctx, cand)
-    mapped = m.casadi_map(ctx, cand)
-    nph = m.numpy_H(ctx, cand)
-    scal = np.array([m.scalar(ctx, p) for p in cand])
-    mats = np.array([m.numpy_H(ctx, p[None])[0] for p in cand])  # -> matrix_scalar
     assert np.all(np.isfinite(ref))
     if name == "mineig":
         # eigvalsh on the mixed-unit information (entries 1e-7..1e7) has absolute
@@ -249,9 +262,8 @@ def test_batched_scalar_and_map_equal_reference(name, r, R, seed, aniso):
         atol, rtol = 2e-6, 1e-9
     else:
         atol, rtol = 0.0, 1e-9
-    for got in (fast, mapped, nph, scal, mats):
-        np.testing.assert_allclose(got, ref, rtol=rtol, atol=atol)
-    assert m.n_evals == 6 * 7 and m.n_calls == 4 + 2 * 7
+    np.testing.assert_allclose(fast, ref, rtol=rtol, atol=atol)
+    assert m.n_evals == 2 * 7 and m.n_calls == 2
 
 
 @pytest.mark.parametrize("name", METRIC_NAMES)
@@ -291,13 +303,6 @@ def test_known_answer_singular_values():
     assert 1 / np.trace(np.linalg.pinv(H[0].T @ H[0], rcond=1e-10, hermitian=True)) == pytest.approx(
         _scores_from_H("gdop", H, ctx)[0], rel=1e-10
     )
-
-
-def test_known_answer_closed_form_far_field():
-    """Infinitely far landmarks (x = y = 0): s^2 = {2, 1 + |c|, 1 - |c|, 0}."""
-    c = 0.3
-    s = structural_singular_values(0.0, 0.0, c, 1 - c * c)
-    np.testing.assert_allclose(np.sort(s), np.sqrt(np.sort([2.0, 0.0, 1 + c, 1 - c])), atol=1e-15)
 
 
 @settings(max_examples=30, deadline=None)
@@ -348,19 +353,13 @@ def test_degenerate_candidates_score_minus_inf(name):
     r = ctx.r_L
     cand = np.array([r, r + np.array([0, 0, 100.0]), [0.0, 0.0, 0.0], [100.0, -200.0, 0.0]])
     m = make_metric(name)
-    for vals in (
-        m(ctx, cand),
-        m.reference(ctx, cand),
-        np.array([m.scalar(ctx, p) for p in cand]),
-        np.array([m.matrix_scalar(ctx, p) for p in cand]),
-    ):
+    for vals in (m(ctx, cand), m.reference(ctx, cand)):
         assert vals[0] == -np.inf and vals[1] == -np.inf  # at the lander / behind the camera
         assert np.all(np.isfinite(vals[2:]))
         assert not np.any(np.isnan(vals))
     # known landmark behind the camera: no valid two-landmark measurement
     up = _ctx(R=Rotation.from_euler("x", 180, degrees=True).as_matrix(), boresight=np.array([0.0, 0.0, -1.0]))
-    assert np.all(m(up, cand) == -np.inf)
-    assert m.scalar(up, cand[2]) == -np.inf
+    assert np.all(m(up, cand) == -np.inf) and np.all(m.reference(up, cand) == -np.inf)
 
 
 def test_context_validation_names_the_field():
@@ -384,7 +383,7 @@ def test_evaluation_counter():
     ctx = _ctx()
     m = make_metric("svd")
     m(ctx, _ground(np.random.default_rng(0), 13))
-    m.scalar(ctx, np.array([10.0, 20.0, 0.0]))
+    m.reference(ctx, _ground(np.random.default_rng(0), 1))
     m(ctx, np.array([1.0, 2.0, 0.0]))  # a single (3,) candidate is a batch of one
     assert (m.n_evals, m.n_calls) == (15, 3)
     m.reset()
@@ -404,17 +403,14 @@ def test_information_metrics_against_50_digit_reference():
     H = me.selection_jacobian(r, R, np.zeros(3), cand)
     ld, mi = make_metric("logdet"), make_metric("mineig")
     fast = (ld(ctx, cand), mi(ctx, cand))
-    scal = ([ld.scalar(ctx, p) for p in cand], [mi.scalar(ctx, p) for p in cand])
     for i in range(3):
         Lam = mp.matrix(ctx.P.tolist()) ** -1 + mp.matrix(H[i].T.tolist()) * mp.matrix(
             np.linalg.inv(ctx.R_meas).tolist()
         ) * mp.matrix(H[i].tolist())
         true_ld = float(mp.log(mp.det(Lam)))
         true_me = float(min(mp.eigsy(Lam)[0]))
-        for got in (fast[0][i], scal[0][i]):
-            assert got == pytest.approx(true_ld, abs=1e-8)
-        for got in (fast[1][i], scal[1][i]):
-            assert got == pytest.approx(true_me, rel=1e-8)
+        assert fast[0][i] == pytest.approx(true_ld, abs=1e-8)
+        assert fast[1][i] == pytest.approx(true_me, rel=1e-8)
 
 
 def test_benchmark_script_runs_and_every_path_agrees():
@@ -427,11 +423,10 @@ def test_benchmark_script_runs_and_every_path_agrees():
     mod = iu.module_from_spec(spec)
     spec.loader.exec_module(mod)
     df = mod.run(n=2, reps=1)
-    assert set(df.metric) == set(METRIC_NAMES) and set(df.impl) == set(mod.IMPLEMENTATIONS)
+    assert set(df.metric) == set(METRIC_NAMES) and set(df.impl) == {"fast", "reference"}
     assert (df.us_per_call > 0).all()
     tol = np.where(df.metric == "mineig", 1e-5, 1e-8)
     assert (df.max_rel_diff_vs_ref < tol).all(), df[df.max_rel_diff_vs_ref >= tol]
-    assert len(mod.run_jacobian(n=2, reps=1)) == 4
 
 
 def test_context_copies_inputs():
@@ -473,7 +468,7 @@ def _descent_ctx_and_candidates(k=20, n=300, seed=3):
 
 
 def test_whitened_metrics_agree_across_paths_and_with_a_dense_reference():
-    """svd_w / gdop_w / cond_w: batch, scalar, matrix and CasADi paths agree, and
+    """svd_w / gdop_w / cond_w: the fast path and the paper's definition agree, and
     equal the singular values of R^-1/2 H P^1/2 with P^1/2 a symmetric root."""
     from scipy.linalg import sqrtm
 
@@ -486,8 +481,7 @@ def test_whitened_metrics_agree_across_paths_and_with_a_dense_reference():
     for name in ("svd_w", "gdop_w", "cond_w"):
         m = make_metric(name)
         batch = m(ctx, cand)
-        np.testing.assert_allclose([m.scalar(ctx, p) for p in cand], batch, rtol=1e-9)
-        np.testing.assert_allclose(m.reference(ctx, cand[:5]), batch[:5], rtol=1e-9)
+        np.testing.assert_allclose(m.reference(ctx, cand[:5]), batch[:5], rtol=1e-8)
         s_ref = []
         for p in cand[:5]:
             H = cm.jacobian_function()(ctx.r_L, ctx.v_L, ctx.p_known_L, p, ctx.R_LtoB).full()
@@ -511,132 +505,3 @@ def test_paper_baselines_rank_identically_and_whitened_ones_do_not():
     assert spearmanr(sc["svd"], sc["svd_w"])[0] < 0.99
 
 
-@pytest.mark.parametrize("name", METRIC_NAMES)
-def test_batch_over_runs_equals_each_context_alone(name):
-    """Metric.batch on R planning contexts (runs) x n candidates, ragged lists
-    padded with a mask, gives each run's own numbers (the batched descent's
-    call); one run with correlated R_meas mixes the tangent and generic paths,
-    one has a boresight that puts some candidates behind the camera."""
-    from opnav.landing.metrics import stack_contexts
-
-    rng = np.random.default_rng(17)
-    bs = np.array([0.0, 0.0, -1.0])
-    ctxs = [_ctx(r=R0 + rng.normal(0, 300, 3), R=Rotation.random(random_state=k).as_matrix(), rng=rng,
-                 R_meas=_aniso_R(rng) if k == 1 else None, boresight=bs) for k in range(3)]
-    cand = np.stack([_ground(rng, 6) for _ in ctxs])
-    mask = np.ones((3, 6), bool)
-    mask[2, 4:] = False
-    cand[2, 5] = np.nan                                   # padding may hold anything
-    m = make_metric(name)
-    got = m.batch(stack_contexts(ctxs), cand, mask)
-    assert got.shape == (3, 6) and m.n_evals == 16
-    for k, ctx in enumerate(ctxs):
-        n = int(mask[k].sum())
-        want = m(ctx, cand[k, :n])
-        np.testing.assert_allclose(got[k, :n], want, rtol=1e-12, atol=0)
-        assert np.all(got[k, n:] == -np.inf)
-    with pytest.raises(ValueError):
-        m.batch(ctxs, cand[:2])
-    # the matrix path: the bits of the planner's per-candidate matrix_scalar
-    mat = m.batch(ctxs, cand, mask, path="matrix")
-    for k, ctx in enumerate(ctxs):
-        n = int(mask[k].sum())
-        assert np.array_equal(mat[k, :n], [m.matrix_scalar(ctx, p) for p in cand[k, :n]])
-        assert np.all(mat[k, n:] == -np.inf)
-
-
-def _jitter_bound(ctx, c):
-    """Per candidate, 12 eps tr(A_s^-1) (nats): the most the explicit logdet's Cholesky
-    jitter (``metrics.chol_logdet``, 12 eps I on the equilibrated information A_s)
-    raises it."""
-    _, _, Pinv, W = ctx._info()
-    H = me.selection_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, c)
-    Lam = Pinv + np.swapaxes(H, -1, -2) @ W @ H
-    Lam = 0.5 * (Lam + np.swapaxes(Lam, -1, -2))
-    sc = 1.0 / np.sqrt(np.diagonal(Lam, axis1=-2, axis2=-1))
-    lam = np.linalg.eigvalsh(Lam * sc[:, :, None] * sc[:, None, :])
-    return 12 * np.finfo(float).eps * np.sum(1.0 / np.maximum(lam, 1e-300), axis=-1)
-
-
-@pytest.mark.parametrize("name", ["svd_w", "cond_w"])
-@pytest.mark.parametrize("seed", range(4))
-def test_whitened_screen_scores_only_the_contenders_exactly(name, seed):
-    """svd_w / cond_w screening: the crude 2 x 2 bounds decide most candidates (a
-    minority gets the exact 4 x 4 eigenvalues, lo = hi), they bracket the explicit
-    score, and every candidate within the planner's short-list margin of the best
-    is among the exact ones, with the values the 4 x 4 eigenvalues give them all."""
-    from opnav.landing import metrics as mt
-
-    rng = np.random.default_rng(seed)
-    ctx = _ctx(r=R0 * (1 + seed), R=Rotation.random(random_state=seed).as_matrix(), rng=rng)
-    c = _ground(rng, 200)
-    m = make_metric(name)
-    ex = m.numpy_H(ctx, c)
-    lo, hi = m.screen(ctx, c)
-    fin = np.isfinite(ex)
-    assert fin.sum() > 100
-    exact = lo == hi
-    assert 0 < exact.sum() < 0.5 * fin.sum()
-    tol = 1e-8 * np.abs(ex[fin])
-    assert np.all(lo[fin] <= ex[fin] + tol) and np.all(ex[fin] <= hi[fin] + tol)
-    near = fin & (ex >= ex[fin].max() * (1 - 1e-5))
-    assert np.all(exact[near])
-    # the exact ones: the values of the 4 x 4 eigenvalues of every candidate
-    wt = mt._whitened_tangent_setup(ctx)
-    sc, P, GkP, K = wt
-    p = c[fin]
-    G = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, p, sc)
-    n = len(p)
-    G2 = G.reshape(2 * n, 12)
-    Bt = (G2 @ GkP.T).reshape(n, 2, 2)
-    D = (G2 @ P).reshape(n, 2, 12) @ np.swapaxes(G, 1, 2)
-    D = 0.5 * (D + np.swapaxes(D, 1, 2))
-    M = np.empty((n, 4, 4))
-    M[:, 0:2, 0:2], M[:, 2:4, 0:2], M[:, 0:2, 2:4], M[:, 2:4, 2:4] = K, Bt, np.swapaxes(Bt, 1, 2), D
-    want = mt._whitened_from_sv(name, np.sqrt(np.maximum(np.linalg.eigvalsh(M)[:, ::-1], 0.0)))
-    assert np.array_equal(lo[fin][exact[fin]], want[exact[fin]])
-    # so the planner's short list (minimised scores) is the one exact values give
-    from opnav.landing.planner import _shortlist
-
-    assert np.array_equal(_shortlist(-hi[fin], -lo[fin]), _shortlist(-want, -want))
-
-
-@pytest.mark.parametrize("name", METRIC_NAMES)
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(r=lander, R=quat, seed=seeds, aniso=st.booleans(), dormant=st.booleans())
-def test_screening_bounds_hold_the_explicit_score(name, r, R, seed, aniso, dormant):
-    """Metric.screen (the batched edge rule's screening) brackets the explicit
-    matrix path's score of every candidate (up to rounding), with the same
-    invalid candidates; with ``rtol`` the best candidate's bracket is that
-    narrow and holds the explicit best. Both kinds of noise (the tangent
-    forms need R_meas = sigma^2 I, else the fast path), correlated priors,
-    and a dormant landmark block (1e8 m^2 I: the eigenvalues at the top of
-    Sigma_k coincide, the loosest case for mineig's bounds)."""
-    rng = np.random.default_rng(seed)
-    P = _prior(rng)
-    if dormant:
-        P[9:, :] = 0.0
-        P[:, 9:] = 0.0
-        P[9:, 9:] = 1e8 * np.eye(3)
-    ctx = _ctx(r=r, R=R, P=P, rng=rng, R_meas=_aniso_R(rng) if aniso else None)
-    c = _ground(rng, 200)
-    m = make_metric(name)
-    ex = m.numpy_H(ctx, c)
-    lo, hi = m.screen(ctx, c)
-    fin = np.isfinite(ex)
-    np.testing.assert_array_equal(np.isfinite(lo) | np.isfinite(hi), fin)
-    if not fin.any():
-        return
-    e, l, h = ex[fin], lo[fin], hi[fin]
-    # logdet (nats): the explicit path's Cholesky jitter (12 eps I on the equilibrated
-    # 12 x 12 information A_s) raises it by up to 12 eps tr(A_s^-1) (log det is
-    # concave): ~5e-7 nats on ill-conditioned priors, a few 1e-6 right above the known
-    # landmark with a dormant landmark block (hypothesis found r = (0, 0, 30) m); the
-    # factorisation's own rounding, ~|A_s| eps tr(A_s^-1) <= 12 eps tr(A_s^-1), as much again
-    tol = 1e-8 * np.abs(e) + (2e-6 + 2.0 * _jitter_bound(ctx, c[fin]) if name == "logdet" else 0.0)
-    assert np.all(l <= e + tol) and np.all(e <= h + tol), name
-    lo2, hi2 = m.screen(ctx, c, rtol=1e-7)
-    assert np.all(lo2[fin] <= e + tol) and np.all(e <= hi2[fin] + tol), name
-    b = int(np.argmax(lo2))                           # the best by its guaranteed score
-    assert hi2[b] - lo2[b] <= 1e-7 * abs(hi2[b]) * 1.01
-    assert ex[b] >= ex[fin].max() * (1 - 1e-6) if ex[b] > 0 else ex[b] >= ex[fin].max() - 1e-6 * abs(ex[b])

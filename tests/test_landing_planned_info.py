@@ -90,8 +90,7 @@ def test_oc_keeps_yaw_unobservable():
 
 def test_planner_objective_uses_the_filter_noise_model_and_strategy():
     from opnav.config import load_config
-    from opnav.landing.depth_error import plane_geometry
-    from opnav.landing.planner import OBJECTIVES, PlanState
+    from opnav.landing.planner import PlanState, candidate_scores, plan_one
     from opnav.landing.scenario import build_scenario, camera_scenarios
 
     scn = build_scenario(camera_scenarios(load_config()["landing"])["interior"])
@@ -99,8 +98,10 @@ def test_planner_objective_uses_the_filter_noise_model_and_strategy():
     assert (cfg.noise_scale, cfg.obs_per_landmark) == (scn.noise_scale, scn.obs_per_landmark) != (1.0, 1)
     r, v, a, R, P, cand = _state(3)
     st = PlanState(r, v, a, R, P)
-    f = OBJECTIVES["logdet_nav"](st, plane_geometry(r, v), cfg, scn.camera, scn.camera.sigma_b)
+    field = scn.field.__class__(np.ascontiguousarray(cand), scn.field.tree)
+    _, q = plan_one("logdet_nav", st, scn.camera, field, cfg, -1, np.arange(len(cand)))
+    got = candidate_scores("logdet_nav", st, scn.camera, field, cfg, q, np.arange(len(cand)))
     want = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, scn.camera.sigma_b * scn.noise_scale,
                               scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt, scn.g, scn.oc,
                               scn.camera.boresight_B)
-    np.testing.assert_allclose(-f.batch(cand), want, rtol=1e-12)
+    np.testing.assert_allclose(-got, want, rtol=1e-12)

@@ -10,8 +10,29 @@ from opnav.config import load_config
 from opnav.landing.camera import camera_from_config
 from opnav.landing.depth_error import plane_geometry
 from opnav.landing.descent import build_scenario
-from opnav.landing.planner import (OBJECTIVES, PlanState, available_methods, plan,
-                                   visible_intervals)
+from opnav.landing import kernels as K
+from opnav.landing.planner import (OBJECTIVE_METHODS, PlanState, available_methods, golden_section, plan,
+                                   plan_one, visible_intervals)
+
+
+def _nearest(field, x, y, det, exclude=-1):
+    grid, cells = K.field_grid(field.xyz)
+    return K.nearest(float(x), float(y), np.ascontiguousarray(field.xyz), np.asarray(det, np.int64),
+                     exclude, grid, cells)
+
+
+def _grid_intervals(geom, R, cam, margin, n=72001):
+    """Reference: the betas of an n-point grid over [-pi, pi] whose line of sight
+    is in the field of view and meets the ground, the longest run, split at 0."""
+    b = np.linspace(-math.pi, math.pi, n)
+    u = np.cos(b)[:, None] * geom.v_hat + np.sin(b)[:, None] * geom.w_hat
+    ok = cam.in_view(u @ R.T, margin) & (u[:, 2] < 0)
+    if not ok.any():
+        return []
+    idx = np.flatnonzero(ok)
+    run = max(np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1), key=len)
+    lo, hi = b[run[0]], b[run[-1]]
+    return [iv for iv in ((lo, min(hi, -1e-9)), (max(lo, 1e-9), hi)) if iv[1] > iv[0]]
 
 
 @pytest.fixture(scope="module")
@@ -30,8 +51,8 @@ def test_exact_visible_interval_matches_a_fine_grid():
         R = Rotation.random(random_state=rng).as_matrix()
         geom = plane_geometry(r, v)
         for margin in (0.0, 40.0):
-            ex = visible_intervals(geom, R, cam, 0, margin)
-            gr = visible_intervals(geom, R, cam, 72001, margin)
+            ex = visible_intervals(geom, R, cam, margin)
+            gr = _grid_intervals(geom, R, cam, margin)
             assert len(ex) == len(gr)
             for (a, b), (c, d) in zip(ex, gr):
                 step = 2 * math.pi / 72000
@@ -43,7 +64,7 @@ def test_exact_visible_interval_matches_a_fine_grid():
 def test_dispatch_is_table_driven_and_unknown_methods_fail(scn):
     for m in ("depth", "svd", "gdop", "cond"):
         assert m in available_methods()
-    assert set(OBJECTIVES) >= {"depth", "svd", "gdop", "cond"}
+    assert set(OBJECTIVE_METHODS) >= {"depth", "svd", "gdop", "cond"}
     tr = scn.truth
     st = PlanState(tr.r[5], tr.v[5], tr.a[5], tr.R_LtoB[5], np.eye(12))
     vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[5]) @ tr.R_LtoB[5].T, margin)
@@ -78,27 +99,67 @@ def test_degenerate_geometry_falls_back_with_a_note(scn):
     assert "does not descend" in res.note and math.isnan(res.beta)
 
 
-def test_only_degenerate_geometry_falls_back_other_errors_propagate(scn):
-    """The fallback is keyed on the exception type (DegenerateGeometry), not on
-    its text; every metric is a planning method (no method dropped silently)."""
+def test_bad_path_is_refused_and_zero_velocity_falls_back(scn):
+    """An unknown evaluation path stops at the configuration with one line naming
+    the key; a zero velocity falls back with a note; every metric is a planning
+    method (no method dropped silently)."""
     import dataclasses
 
-    from opnav.landing.depth_error import DegenerateGeometry
     from opnav.landing.metrics import METRIC_NAMES
 
-    assert set(METRIC_NAMES) <= set(OBJECTIVES)
+    assert set(METRIC_NAMES) <= set(OBJECTIVE_METHODS)
+    with pytest.raises(ValueError, match="eval_path"):
+        dataclasses.replace(scn.planner, eval_path="nope")
     tr = scn.truth
     k = 20
-    P = np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3)
     vis = lambda p, margin=40.0: scn.camera.in_view((np.asarray(p) - tr.r[k]) @ tr.R_LtoB[k].T, margin)
-    bad = dataclasses.replace(scn.planner, eval_path="nope")
-    with pytest.raises(ValueError, match="eval_path") as exc:
-        plan("svd", PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], P), scn.camera, scn.field, vis, bad)
-    assert not isinstance(exc.value, DegenerateGeometry)
-    st0 = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], P)
-    st0 = dataclasses.replace(st0, v=np.zeros(3), a=np.zeros(3))   # zero velocity: fallback, a note
-    res = plan("depth", st0, scn.camera, scn.field, vis, scn.planner)
-    assert "zero velocity" in res.note and res.index >= 0
+    st0 = PlanState(tr.r[k], np.zeros(3), np.zeros(3), tr.R_LtoB[k], np.eye(12))
+    for path in ("compiled", "paper"):
+        res = plan("depth", st0, scn.camera, scn.field, vis, dataclasses.replace(scn.planner, eval_path=path))
+        assert "zero velocity" in res.note and res.index >= 0
+
+
+def _recorded_calls(scn, method, runs=(0, 1)):
+    """Planning inputs of a short seeded descent: (state, detected, exclude) per call."""
+    from opnav.landing.descent import run_descent
+
+    out = []
+    for run in runs:
+        d = run_descent(scn, method, run)
+        for i in range(len(d["plan_index"])):
+            k = int(d["plan_step"][i])
+            r_t, R_t = scn.truth.r[k], scn.truth.R_LtoB[k]
+            det = np.flatnonzero(scn.camera.in_view((scn.field.xyz - r_t) @ R_t.T, scn.planner.margin_px))
+            out.append((PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i],
+                                  d["plan_P"][i]), det, int(d["plan_exclude"][i])))
+    return out
+
+
+@pytest.mark.parametrize("method", ["depth", "svd"])
+def test_compiled_call_picks_the_papers_definition_pick_away_from_ties(scn, method):
+    """On a descent's recorded planning calls the compiled call and the paper's
+    definition (law-of-sines depth error / CasADi H + LAPACK SVD, interpreted)
+    agree: picks exactly wherever the deciding scores are not within 1e-6 of a
+    tie, optima to round-off (beta within 1e-7 rad), the same edge flags and
+    evaluation counts."""
+    import dataclasses
+
+    paper = dataclasses.replace(scn.planner, eval_path="paper")
+    calls = _recorded_calls(scn, method)[::3]
+    xy = scn.field.xyz[:, :2]
+    n = 0
+    for st, det, ex in calls:
+        a, q = plan_one(method, st, scn.camera, scn.field, scn.planner, ex, det)
+        b, _ = plan_one(method, st, scn.camera, scn.field, paper, ex, det)
+        assert a.edge == b.edge and a.n_evals == b.n_evals
+        assert abs(a.beta - b.beta) < 1e-7
+        if not a.edge:
+            d = np.sort(np.hypot(*(xy[det[det != ex]] - a.ground[:2]).T))
+            if d.size > 1 and d[1] - d[0] < 1e-6 * d[0] + 1e-3:
+                continue
+        assert a.index == b.index
+        n += 1
+    assert n >= 0.9 * len(calls) and n > 10
 
 
 def test_landing_site_in_view_for_the_whole_descent(scn):
@@ -137,14 +198,15 @@ def test_pick_nearest_widens_until_a_detected_landmark():
     """The optimum may fall outside the true image: the pick is then the
     nearest *detected* landmark, never 'no landmark' while one is detected."""
     from opnav.landing.landmarks import make_field
-    from opnav.landing.planner import _pick_nearest
 
     field = make_field(1000.0, 500, seed=3)
-    point = np.array([0.0, 0.0, 0.0])
-    far = np.argsort(np.hypot(*field.xyz[:, :2].T))[200]          # the 201st nearest
-    assert _pick_nearest(field, point, np.array([far]), exclude=set()) == far
-    assert _pick_nearest(field, point, np.array([far]), exclude={int(far)}) == -1
-    assert _pick_nearest(field, point, np.zeros(0, np.int64), set()) == -1
+    order = np.argsort(np.hypot(*field.xyz[:, :2].T))
+    far = order[200]                                               # the 201st nearest
+    assert _nearest(field, 0.0, 0.0, np.array([far])) == far
+    assert _nearest(field, 0.0, 0.0, np.array([far]), int(far)) == -1
+    assert _nearest(field, 0.0, 0.0, np.zeros(0, np.int64)) == -1
+    det = np.sort(order[150:])                                     # more than a short list: the grid
+    assert _nearest(field, 0.0, 0.0, det) == order[150]
 
 
 def _image_grid_field(scn, k, n=3, inset_px=60.0):
@@ -186,7 +248,7 @@ def _reference_objective(method, st, scn, pts):
     return -make_metric(method).reference(ctx, pts)
 
 
-@pytest.mark.parametrize("method", [m for m in OBJECTIVES if m != "mineig"])
+@pytest.mark.parametrize("method", [m for m in OBJECTIVE_METHODS if m != "mineig"])
 def test_edge_optimum_picks_the_best_detected_landmark_at_a_corner(scn, method):
     """Site-tilt camera at t = 1 s: every metric's in-plane optimum lies beyond
     an end of the visible interval. The landmarks sit under a 3 x 3 pixel grid;
@@ -209,8 +271,7 @@ def test_edge_optimum_picks_the_best_detected_landmark_at_a_corner(scn, method):
     if method in ("depth", "svd", "gdop", "cond"):
         half = scn.camera.half_px
         assert np.all(np.abs(uv[res.index]) > 0.8 * half), "best landmark not at a corner"
-        from opnav.landing.planner import _pick_nearest
-        assert _pick_nearest(field, res.ground, np.flatnonzero(vis(field.xyz)), set()) != res.index
+        assert _nearest(field, *res.ground[:2], np.flatnonzero(vis(field.xyz))) != res.index
 
 
 def test_pick_ratio_records_how_far_the_pick_is_from_the_best(scn):
@@ -230,43 +291,21 @@ def test_pick_ratio_records_how_far_the_pick_is_from_the_best(scn):
         assert res.pick_ratio == pytest.approx(want, rel=1e-7)
 
 
-def test_depth_batch_matches_the_paper_formula_at_landmarks(scn):
-    """The planner's vectorised depth error at landmarks equals eq. 23-25 via
-    the triangle angles (depth_error_at_landmarks), and its in-plane scalar
-    objective at the landmarks that lie in the plane."""
-    from opnav.landing.depth_error import depth_error_at_landmarks, error_radius
-    from opnav.landing.planner import depth_objective
-
-    tr = scn.truth
-    for k in (1, 50, 150):
-        P = np.diag([1e4] * 3 + [4.0] * 3 + [1e-4] * 3 + [1e6] * 3)
-        st = PlanState(tr.r[k], tr.v[k], tr.a[k], tr.R_LtoB[k], P)
-        geom = plane_geometry(st.r, st.v)
-        f = depth_objective(st, geom, scn.planner)
-        pts = scn.field.xyz[::7]
-        r_e = error_radius(P[3:6, 3:6], scn.planner.t_s, scn.planner.n_sigma_v)
-        want = depth_error_at_landmarks(st.r, st.v, st.a, pts, scn.planner.t_s, r_e)
-        np.testing.assert_allclose(f.batch(pts), want, rtol=1e-8)
-        from opnav.landing.depth_error import ground_point
-        betas = np.linspace(-1.0, 0.5, 13)
-        betas = betas[betas != 0]
-        g = ground_point(betas, geom)
-        ok = np.all(np.isfinite(g), axis=1)
-        np.testing.assert_allclose(f.batch(g[ok]), [f(b) for b in betas[ok]], rtol=1e-8)
-
-
 def _unconstrained_inside(state, camera, cfg):
     """Is the in-plane depth-error optimum over the whole ground arc strictly
-    inside the visible interval (estimated state, planning margin)?"""
-    from opnav.landing.planner import depth_objective, golden_section
+    inside the visible interval (estimated state, planning margin)? (The paper's
+    law-of-sines formula, searched by the interpreted golden section.)"""
+    from opnav.landing.depth_error import baseline, error_radius, signed_depth_error
 
     geom = plane_geometry(state.r, state.v)
-    f = depth_objective(state, geom, cfg)
+    b = baseline(state.v, state.a, cfg.t_s)
+    r_e = error_radius(state.P[3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
+    f = lambda x: float(signed_depth_error(x, geom, b, r_e))
     opts = [golden_section(f, lo, hi, cfg.tol_rad)[:2]
             for lo, hi in ((-(math.pi - geom.gamma) + 1e-6, -1e-9), (1e-9, geom.gamma - 1e-6))]
-    b = min(opts, key=lambda o: o[1])[0]
-    ivs = visible_intervals(geom, state.R_LtoB, camera, cfg.n_grid, cfg.margin_px)
-    return any(lo + cfg.tol_rad < b < hi - cfg.tol_rad for lo, hi in ivs)
+    x = min(opts, key=lambda o: o[1])[0]
+    ivs = visible_intervals(geom, state.R_LtoB, camera, cfg.margin_px)
+    return any(lo + cfg.tol_rad < x < hi - cfg.tol_rad for lo, hi in ivs)
 
 
 @pytest.mark.parametrize("scenario, inside", [("interior", True), ("site-tilt", False)])

@@ -35,7 +35,8 @@ from typing import Callable
 #: Modules holding kernels, imported by :func:`warm` (each registers its warm-up on import).
 KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
                                     "opnav.approach.em",
-                                    "opnav.rotations", "opnav.landing.measurement", "opnav.landing.ekf")
+                                    "opnav.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
+                                    "opnav.landing.kernels")
 
 _WARMUPS: dict[str, Callable[[], None]] = {}
 _KERNELS: list = []  # every dispatcher made by kernel(), for cache_stats

@@ -120,8 +120,11 @@ def _claim_yaw(head: str, scen: dict) -> dict:
                  verdict, cause, "B-F6", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
 
 
-#: the SVD baseline's evaluation paths (B-summary ``eval_path``), as the text names them
-PATH_NAMES = {"matrix_scalar": "explicit-matrix SVD", "closed_form": "closed-form singular values"}
+#: the planner's paths (B-summary ``eval_path``, ``opnav.landing.planner.PATHS``), as the text
+#: names them; the claim is judged on the configured path (compiled: what a lander would run)
+PATH_NAMES = {"compiled": "compiled implementation",
+              "paper": "the paper's definition (CasADi H, LAPACK SVD; interpreted)"}
+OTHER_PATH = {"compiled": "paper", "paper": "compiled"}
 
 
 def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any]) -> dict:
@@ -130,7 +133,7 @@ def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any]) -> dict:
     for name, s in scen.items():
         d = (s.get("methods") or {}).get("depth") or {}
         path = PATH_NAMES.get(s.get("eval_path", ""), s.get("eval_path", "the configured path"))
-        alt = PATH_NAMES["closed_form"] if s.get("eval_path") == "matrix_scalar" else "the alternative path"
+        alt = PATH_NAMES.get(OTHER_PATH.get(s.get("eval_path", ""), ""), "the alternative path")
         for key, lab in (("time_reduction_vs_svd_pct", path), ("time_reduction_vs_svd_alt_pct", alt)):
             if d.get(key) is None:
                 continue
@@ -152,7 +155,7 @@ def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any]) -> dict:
         verdict, named = C.NOT_REPRODUCED, ""
     best = min((k for k in outs if k != lit), key=lambda k: (abs(outs[k][0] - p), k), default=None)
     cause = (f"On the same replayed planning calls depth's median call takes {txt[lit]} than SVD's "
-             f"({lit[0]} camera, {lit[1]} as the paper computes it) against the published {p:g} %, "
+             f"({lit[0]} camera, {lit[1]}) against the published {p:g} %, "
              "and " + join([f"{txt[k]} ({k[1]}, {k[0]} camera)" for k in outs if k != lit])
              + "; the size of the saving depends on how the SVD baseline is implemented")
     return C.row("B", "B-C4", f"Median planning time {p:g} % below SVD (Fig. 7)",

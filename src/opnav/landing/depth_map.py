@@ -49,7 +49,7 @@ def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
     b = baseline(v, a, scn.Dt)
     betas = np.linspace(-(math.pi - geom.gamma) + 1e-3, geom.gamma - 1e-3, n_curve)
     curve = signed_depth_error(betas, geom, b, r_e)
-    ivs = visible_intervals(geom, R, cam, scn.planner.n_grid, 0.0)
+    ivs = visible_intervals(geom, R, cam, 0.0)
     best_b, best_f = math.nan, math.inf
     for lo, hi in ivs:
         x, fx, _ = golden_section(lambda bb: float(signed_depth_error(bb, geom, b, r_e)), lo, hi,
@@ -92,4 +92,4 @@ def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
             "unconstrained_ground_xy": ground_point(unc_b, geom)[0, :2],
             "lander_xy": r[:2].copy(), "footprint_xy": footprint,
             "optimum_inside_image": bool(any(lo < unc_b < hi for lo, hi in
-                                             visible_intervals(geom, R, cam, 0, 0.0)))}
+                                             visible_intervals(geom, R, cam, 0.0)))}

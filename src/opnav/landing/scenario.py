@@ -91,8 +91,7 @@ def _scenario_from_json(text: str) -> Scenario:
     sw = math.radians(float(c["imu"]["sigma_w_degps"]))
     pl = c["planner"]
     pcfg = PlannerConfig(t_s=Dt, n_sigma_v=float(pl["n_sigma_v"]), tol_rad=float(pl["tol_rad"]),
-                         n_grid=int(pl["n_grid"]), margin_px=float(pl["margin_px"]),
-                         knn=int(pl["knn"]), eval_path=str(pl["eval_path"]),
+                         margin_px=float(pl["margin_px"]), eval_path=str(pl["eval_path"]),
                          noise_scale=float(c["filter"]["meas_noise_scale"]),
                          depth_sigma_frac=float(c["filter"]["depth_sigma_frac"]),
                          obs_per_landmark=int(c["filter"]["obs_per_landmark"]),

@@ -14,8 +14,9 @@ Replay (:func:`replay`): the recorded calls of the Monte Carlo of every
 method are pooled (in method order, then run, then call); a deterministic
 subset of at most ``max_calls`` of them, evenly spaced by pool index
 (:func:`select_calls`), is replayed through every method's planning call
-(``planner.plan``), the paper's H baselines (``metrics.H_METRICS``) on both
-evaluation paths (the configured one and ``planner.alternative_path``), one
+(``planner.plan``) on both paths (the configured one, ``compiled``: the kernels
+a lander's computer would run, and ``planner.alternative_path``, ``paper``: the
+paper's definition interpreted, CasADi H and LAPACK SVD), one
 call at a time in one process. For the ``q``-th replayed call the variants
 (method, path) run in the configured order rotated by ``q`` (never ordered by
 a clock), so slow drifts of the machine (frequency, other processes) fall on
@@ -48,7 +49,8 @@ import numpy as np
 from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 
 __all__ = ["select_calls", "variants", "replay", "save", "load", "times_ns", "median_us",
-           "time_reduction", "method_text", "summary_frame", "median_evals", "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us", "STAGES"]
+           "time_reduction", "method_text", "summary_frame", "median_evals", "from_times", "method_summary",
+           "call_overhead", "replay_own", "per_run_median_us"]
 
 
 # ----------------------------------------------------------------- replay
@@ -67,16 +69,16 @@ def select_calls(n_pool: int, max_calls: int) -> np.ndarray:
 
 def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
     """The timed (method, path, PlannerConfig): every method on ``cfg``'s path
-    (``"main"``), the paper's H baselines also on the alternative path
-    (``"alt"``) unless ``alt`` is false."""
-    from opnav.landing.metrics import H_METRICS
-    from opnav.landing.planner import alternative_path
+    (``"main"``), and, unless ``alt`` is false, every method with a search on the
+    other path (``"alt"``, ``planner.alternative_path``: compiled <-> the paper's
+    definition; not ``logdet_nav``, whose one implementation is the interpreted one)."""
+    from opnav.landing.planner import PICKERS, alternative_path
 
     alt_cfg = alternative_path(cfg)
     out = []
     for m in methods:
         out.append((m, "main", cfg))
-        if alt and m in H_METRICS:
+        if alt and m not in PICKERS and m != "logdet_nav":
             out.append((m, "alt", alt_cfg))
     return out
 
@@ -344,148 +346,72 @@ def summary_frame(tm: dict):
     return pd.DataFrame(rows)
 
 
-#: stages of a planning call (``planner._plan``) timed alone by :func:`call_overhead`
-STAGES = ("plane", "visible interval", "objective build", "search loop beyond evals",
-          "ground point", "edge candidate list", "nearest-landmark pick")
-
-
-def _hot_ns(fn, reps: int, repeats: int = 3) -> float:
-    """Thread CPU ns of one ``fn()`` called ``reps`` times in a row, the minimum of ``repeats``."""
-    best = math.inf
-    for _ in range(repeats):
-        c0 = time.thread_time_ns()
-        for _ in range(reps):
-            fn()
-        best = min(best, (time.thread_time_ns() - c0) / reps)
-    return best
-
-
-def _stage_ns(pl, method, state, cam, field_, cfg, det, exclude, geom, ivs, f, betas, res, cand,
-              reps: int) -> dict:
-    """One call's stages (:data:`STAGES`), the whole call and its evaluations,
-    each timed alone and hot (:func:`_hot_ns`), ns; the search loop is the
-    golden-section searches less their evaluations."""
-    from opnav.landing.depth_error import ground_point_scalar, plane_geometry
-
-    def search():
-        for a, b in ivs:
-            pl.golden_section(f, a, b, cfg.tol_rad)
-
-    def evals():
-        for b in betas:
-            f(b)
-
-    edge = res.edge and cand.size
-    ev = _hot_ns(evals, reps)
-    point = res.ground
-    return {
-        "call": _hot_ns(lambda: pl.plan(method, state, cam, field_, None, cfg, exclude=exclude,
-                                        detected=det, diagnose=False), reps),
-        "evaluations": ev + (_hot_ns(lambda: f.batch(field_.xyz[cand]), reps) if edge else 0.0),
-        "plane": _hot_ns(lambda: plane_geometry(state.r, state.v), reps),
-        "visible interval": _hot_ns(lambda: pl.visible_intervals(geom, state.R_LtoB, cam, cfg.n_grid,
-                                                                 cfg.margin_px), reps),
-        "objective build": _hot_ns(lambda: pl.OBJECTIVES[method](
-            state=state, geom=geom, cfg=cfg, camera=cam, sigma_b=cam.sigma_b), reps),
-        "search loop beyond evals": _hot_ns(search, reps) - ev,
-        "ground point": _hot_ns(lambda: np.array(ground_point_scalar(geom)(res.beta)), reps),
-        "edge candidate list": _hot_ns(lambda: pl._candidates(det, exclude), reps) if res.edge else 0.0,
-        "nearest-landmark pick": (0.0 if edge and np.isfinite(f.batch(field_.xyz[cand])).any() else
-                                  _hot_ns(lambda: pl._pick_nearest(field_, point, det, exclude), reps)),
-    }
-
-
 def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0,
-                  repeats: int = 3, stage_reps: int = 0) -> dict:
-    """The planning call's overhead beyond its objective evaluations, by replay.
+                  repeats: int = 3, reps: int = 50) -> dict:
+    """The compiled planning call's overhead beyond its objective evaluations, by replay.
 
-    For each selected recorded call of ``recorded[method]`` (evenly spaced,
-    :func:`select_calls`): the whole ``planner.plan`` call (as :func:`replay`
-    times it) and, in the same process, its objective evaluations alone: the
-    objective the call builds (``planner.OBJECTIVES[method]``) evaluated at the
-    betas the call's golden-section searches evaluate (recorded by a first,
-    untimed pass), in a plain loop, plus, for a call whose search ended on the
-    edge of the visible interval, the objective's batch scoring of the detected
-    landmarks (edge rule: metric evaluations too). Each is the minimum over
-    ``repeats`` (thread CPU clock, ns). Returns per call ``call_ns``,
-    ``evals_ns``, ``n_evals`` (scalar evaluations plus landmarks scored),
-    ``edge`` and ``overhead_ratio = (call - evals) / evals``.
+    For each selected recorded call of ``recorded[method]`` (:func:`select_calls`)
+    on the compiled path: the whole ``planner.plan`` call (``call_ns``: ``reps``
+    calls in a row, thread CPU clock, the minimum of ``repeats`` averages) and its
+    objective evaluations alone (``evals_ns``: ``kernels.evaluations`` at the betas
+    the call's searches evaluate, recorded by an interpreted pass of the same
+    search, plus the detected landmarks an edge call scores; timed inside the
+    kernel, ``reps`` times, so no call overhead is counted as evaluations). Returns
+    per call ``call_ns``, ``evals_ns``, ``n_evals``, ``edge``, ``cold_ns`` (the
+    call once, as the replay times it) and ``overhead_ratio = (call - evals) / evals``."""
+    import dataclasses
 
-    ``stage_reps > 0``: also ``stages``, per call the thread CPU ns of each of
-    :data:`STAGES`, of the whole call and of its evaluations, each timed alone
-    and hot (``stage_reps`` calls in a row, minimum of 3): where the overhead
-    goes (the hot call less its hot evaluations and stages is the call's own
-    rest; a replayed call runs once, on colder caches).
-    """
+    from opnav.landing import kernels as K
     from opnav.landing import planner as pl
-    from opnav.landing.depth_error import plane_geometry
 
     d = recorded[method]
     sel = select_calls(len(d["plan_step"]), max_calls)
-    cam, field_, tr, cfg = scn.camera, scn.field, scn.truth, scn.planner
+    cam, field_, tr = scn.camera, scn.field, scn.truth
+    cfg = dataclasses.replace(scn.planner, eval_path="compiled")
     thread = time.thread_time_ns
-    call_ns, evals_ns, n_ev, edges = [], [], [], []
-    stages: dict = {k: [] for k in STAGES + ("call", "evaluations")}
-    build = pl.OBJECTIVES[method]
+    rows = []
     gc_was = gc.isenabled()
     gc.disable()
     try:
         for i in sel:
             k = int(d["plan_step"][i])
-            r_t, R_t = tr.r[k], tr.R_LtoB[k]
-
-            def visible(pts, r_t=r_t, R_t=R_t):
-                return cam.in_view((np.asarray(pts) - r_t) @ R_t.T, cfg.margin_px)
-
-            state = pl.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i],
-                                 d["plan_P"][i])
+            det = np.flatnonzero(cam.in_view((field_.xyz - tr.r[k]) @ tr.R_LtoB[k].T, cfg.margin_px))
+            st = pl.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
             ex = int(d["plan_exclude"][i])
             exclude = {ex} if ex >= 0 else set()
-            det = np.flatnonzero(visible(field_.xyz))
-            geom = plane_geometry(state.r, state.v)
-            ivs = pl.visible_intervals(geom, state.R_LtoB, cam, cfg.n_grid, cfg.margin_px)
-            if not ivs:
+            c0 = thread()
+            res = pl.plan(method, st, cam, field_, None, cfg, exclude=exclude, detected=det, diagnose=False)
+            cold = thread() - c0
+            _, q = pl.plan_one(method, st, cam, field_, cfg, ex, det)
+            if not np.isfinite(res.beta):
                 continue
-            f = build(state=state, geom=geom, cfg=cfg, camera=cam, sigma_b=cam.sigma_b)
             betas = []
 
-            def spy(b, f=f, betas=betas):
+            def spy(b, q, betas=betas):
                 betas.append(b)
-                return f(b)
+                return K.objective(b, q)
 
-            for a, b in ivs:
-                pl.golden_section(spy, a, b, cfg.tol_rad)
-            cand = det[~np.isin(det, list(exclude))] if exclude else det
-            pts = field_.xyz[cand]
-            best_call = best_eval = None
+            search = K.interpreted(K.golden_section, objective=spy)
+            for lo, hi in pl.visible_intervals(pl.plane_geometry(st.r, st.v), st.R_LtoB, cam, cfg.margin_px):
+                search(q, lo, hi, cfg.tol_rad)
+            cand = det[det != ex] if res.edge else np.zeros(0, np.int64)
+            xyz = np.ascontiguousarray(field_.xyz)
+            bs = np.array(betas)
+            call = ev = math.inf
             for _ in range(max(int(repeats), 1)):
                 c0 = thread()
-                res = pl.plan(method, state, cam, field_, visible, cfg, exclude=exclude, rng=None,
-                              detected=det, diagnose=False)
+                for _ in range(reps):
+                    pl.plan(method, st, cam, field_, None, cfg, exclude=exclude, detected=det, diagnose=False)
                 c1 = thread()
-                for b in betas:
-                    f(b)
-                if res.edge and cand.size:
-                    f.batch(pts)
+                K.evaluations(q, bs, xyz, cand, reps)
                 c2 = thread()
-                best_call = c1 - c0 if best_call is None else min(best_call, c1 - c0)
-                best_eval = c2 - c1 if best_eval is None else min(best_eval, c2 - c1)
-            call_ns.append(best_call)
-            evals_ns.append(best_eval)
-            n_ev.append(len(betas) + (int(cand.size) if res.edge else 0))
-            edges.append(bool(res.edge))
-            if stage_reps > 0:
-                for key, val in _stage_ns(pl, method, state, cam, field_, cfg, det, exclude, geom,
-                                          ivs, f, betas, res, cand, int(stage_reps)).items():
-                    stages[key].append(val)
+                call, ev = min(call, (c1 - c0) / reps), min(ev, (c2 - c1) / reps)
+            rows.append((call, ev, len(betas) + cand.size, res.edge, cold))
     finally:
         if gc_was:
             gc.enable()
-    call_ns, evals_ns = np.asarray(call_ns, np.int64), np.asarray(evals_ns, np.int64)
+    call_ns, evals_ns, n_ev, edge, cold = (np.array(x) for x in zip(*rows)) if rows else [np.zeros(0)] * 5
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = (call_ns - evals_ns) / evals_ns
-    out = {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": np.asarray(n_ev, np.int64),
-           "edge": np.asarray(edges, bool), "overhead_ratio": ratio}
-    if stage_reps > 0:
-        out["stages"] = {k: np.asarray(v, float) for k, v in stages.items()}
-    return out
+    return {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": n_ev.astype(np.int64),
+            "edge": edge.astype(bool), "cold_ns": cold, "overhead_ratio": ratio}
