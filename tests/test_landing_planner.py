@@ -345,3 +345,16 @@ def test_unknown_headline_scenario_is_refused():
     cfg = {**cfg, "headline_scenario": "nope"}
     with pytest.raises(ValueError, match="landing.headline_scenario"):
         camera_scenarios(cfg)
+
+
+def test_tie_rule_lowest_index_within_the_stated_tolerance():
+    """kernels.best_index: scores within TIE_RTOL (1e-9) relative of the best are
+    tied and the first (lowest landmark index) wins; beyond it the strict best;
+    none finite: -1."""
+    assert K.TIE_RTOL == 1e-9
+    assert K.best_index(np.array([3.0, 1.0 + 5e-10, 1.0, 2.0])) == 1
+    assert K.best_index(np.array([3.0, 1.0 + 5e-9, 1.0, 2.0])) == 2
+    assert K.best_index(np.array([-5.0 * (1 - 5e-10), -5.0, 0.0])) == 0
+    assert K.best_index(np.array([-5.0 * (1 - 5e-9), -5.0, 0.0])) == 1
+    assert K.best_index(np.array([np.inf, np.inf])) == -1
+    assert K.best_index(np.zeros(0)) == -1

@@ -207,10 +207,6 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
     return f, lambda q, xyz, cand: score(xyz[cand]), K.OK
 
 
-def _compiled(method: str, cfg: PlannerConfig) -> bool:
-    return method in K.KINDS and cfg.eval_path == "compiled"
-
-
 # ----------------------------------------------------------------- planning
 
 _CACHE: dict = {}
@@ -241,19 +237,20 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     call's per-run constants (``kernels.NQ``). ``detected``: sorted int64 field
     indices of the landmarks the image holds; ``exclude``: the current landmark
     (-1: none)."""
-    if method in PICKERS:
+    kind = K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+    if kind < 0 and method in PICKERS:
         cand = _candidates(detected, exclude)
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
                           math.nan, 0, 0), None
-    if method not in OBJECTIVE_METHODS:
+    if kind < 0 and method not in OBJECTIVE_METHODS:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
     xyz, c, cells = _setup(field_, cfg, camera)
-    work = np.zeros(K.NQ + 9)
+    work = np.empty(K.NQ + 9)
     q, out = work[:K.NQ], work[K.NQ:]
-    if _compiled(method, cfg):
-        K.plan_run(K.KINDS[method], state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected,
-                   exclude, cells, work)
+    if kind >= 0:
+        K.plan_run(kind, state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected, exclude,
+                   cells, work)
     else:
         st = K.plane(state.r, state.v, q)
         if st == K.OK:
@@ -264,7 +261,7 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
             core(q, camera.R_BtoC @ state.R_LtoB, c[K.C_KFOV], c[K.C_TOL], xyz, detected, exclude,
                  c[K.C_GRID:K.C_GRID + 5], cells, out)
         else:
-            out[8] = st
+            out[3], out[8] = 0, st
     o = out.tolist()
     if o[8] != K.OK:      # documented fallback: the detected landmark nearest the boresight
         bs = state.R_LtoB.T @ camera.boresight_B
@@ -279,7 +276,7 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
     """The objective (minimised) of landmarks ``cand`` (field indices) at the call
     with per-run constants ``q`` (:func:`plan_one`): the edge rule's scores."""
     xyz = _setup(field_, cfg, camera)[0]
-    if _compiled(method, cfg):
+    if method in K.KINDS and cfg.eval_path == "compiled":
         return K.score_points(q, xyz, cand)
     return _python_objective(method, state, cfg, camera, q)[1](q, xyz, cand)
 
