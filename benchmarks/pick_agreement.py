@@ -53,7 +53,7 @@ def compare(a) -> None:
     z = np.load(a.calls)
     keys = sorted({tuple(k.split("|")[:2]) for k in z.files})
     scns = camera_scenarios(load_config()["landing"])
-    tot_far = tot_agree = 0
+    tot_far = tot_agree = tot_all = tot_all_agree = 0
     for name, m in keys:
         scn = build_scenario(scns[name])
         cam, field_, tr = scn.camera, scn.field, scn.truth
@@ -63,7 +63,7 @@ def compare(a) -> None:
             return z[f"{name}|{m}|{k}"]
 
         n = len(g("plan_index"))
-        far = agree = ties = edge_diff = 0
+        far = agree = ties = edge_diff = all_agree = 0
         for i in range(n):
             k = int(g("plan_step")[i])
             r_t, R_t = tr.r[k], tr.R_LtoB[k]
@@ -87,13 +87,18 @@ def compare(a) -> None:
             else:
                 tie = False
             ties += bool(tie)
+            all_agree += res.index == old
             if not tie:
                 far += 1
                 agree += res.index == old
         tot_far += far
         tot_agree += agree
+        tot_all += n
+        tot_all_agree += all_agree
         print(f"{name:10s} {m:7s} calls {n:5d}  near a tie {ties:4d}  edge flag differs {edge_diff:3d}  "
               f"agree away from ties {agree}/{far} ({100.0 * agree / max(far, 1):.2f} %)", flush=True)
+    print(f"all calls, ties included: {tot_all_agree} of {tot_all} picks agree "
+          f"({100.0 * tot_all_agree / max(tot_all, 1):.2f} %)")
     print(f"pick agreement away from ties: {100.0 * tot_agree / max(tot_far, 1):.2f} % "
           f"({tot_agree} of {tot_far} calls)")
 

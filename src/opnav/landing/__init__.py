@@ -28,18 +28,17 @@ eq.        function                                                    units
            ``measurement.jacobian_blocks`` (H_C, [b x]);
            tangent-plane form ``measurement.tangent_jacobian``
            (cross-check: ``casadi_model.jacobian_function``, CasADi)
-19-20      ``depth_error.baseline`` (estimated baseline |b|)               m
-21-22      ``depth_error.error_radius`` (r = eps_v t_s)                    m
-23-25      ``depth_error.depth_error`` / ``signed_depth_error``            m
-           (law of sines ``depth_error.depth``);
-           planner hot paths ``depth_error.depth_error_scalar``,
-           ``depth_error.depth_error_at_points``;
+19-20      ``kernels.baseline`` (estimated baseline |b|)                   m
+21-22      ``kernels.error_radius`` (r = eps_v t_s)                        m
+23-25      ``kernels.depth_error`` (compiled, the planner's);              m
+           the paper's formula ``depth_error.depth_error`` /
+           ``signed_depth_error`` (law of sines ``depth_error.depth``),
            arbitrary landmarks ``depth_error.depth_error_at_landmarks``
-26         ``planner.plan`` (golden-section ``planner.golden_section``     rad (beta), m (ground point)
-           over the visible interval), plane ``depth_error.plane_geometry``,
-           ground point ``depth_error.ground_point`` /
-           ``depth_error.ground_point_scalar``
-sec. 2.2   ``metrics.make_metric`` (svd, gdop, cond from the 6 x 12 H;     1/m (svd), 1/m^2 (gdop), 1 (cond)
-           B-X1 logdet, mineig, whitened variants), ``planner.OBJECTIVES``
+26         ``kernels.ground_point`` (law of sines ``kernels.plane_depth``); rad (beta), m (ground point)
+           the call ``kernels.plan_core`` (``planner.plan_batch``): plane,
+           visible interval, ``kernels.golden_section``, nearest pick
+sec. 2.2   ``metrics.make_metric`` (svd, gdop, cond from the 6 x 12 H,     1/m (svd), 1/m^2 (gdop), 1 (cond)
+           closed form ``kernels.h_metric``; B-X1 logdet, mineig,
+           whitened variants), ``planner.OBJECTIVE_METHODS``
 =========  ==========================================================  ===============================
 """

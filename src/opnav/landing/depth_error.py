@@ -56,7 +56,7 @@ import numpy as np
 from opnav.landing import kernels as K
 
 __all__ = ["DegenerateGeometry", "depth", "depth_error", "PlaneGeometry", "plane_geometry",
-           "signed_alpha", "signed_depth_error", "ground_point", "baseline", "error_radius",
+           "signed_depth_error", "ground_point", "baseline", "error_radius",
            "angles_to_landmarks", "depth_error_at_landmarks"]
 
 
@@ -142,16 +142,11 @@ def plane_geometry(r_L, v_L) -> PlaneGeometry:
     return PlaneGeometry(q[0:3].copy(), q[3:6].copy(), q[6:9].copy(), float(q[9]), float(q[10]))
 
 
-def signed_alpha(beta_signed, gamma: float) -> np.ndarray:
-    """alpha for a signed beta (see the module docstring)."""
-    return np.where(np.asarray(beta_signed) > 0, np.pi - gamma, gamma)
-
-
 def signed_depth_error(beta_signed, geom: PlaneGeometry, b: float, r_e: float) -> np.ndarray:
     """Depth error (m) for signed beta (rad) in the velocity's vertical plane (the
     paper's definition, :func:`depth_error`)."""
-    bs = np.asarray(beta_signed, float)
-    return depth_error(np.abs(bs), signed_alpha(bs, geom.gamma), geom.cd, b, r_e)
+    bs = np.asarray(beta_signed, float)          # alpha = pi - gamma beyond D (beta > 0), else gamma
+    return depth_error(np.abs(bs), np.where(bs > 0, np.pi - geom.gamma, geom.gamma), geom.cd, b, r_e)
 
 
 def ground_point(beta_signed, geom: PlaneGeometry) -> np.ndarray:

@@ -23,26 +23,20 @@ the vertical plane holding the estimated velocity) differs:
    landmark index wins); ``edge`` says so and the landmarks scored count as
    evaluations.
 
-Degenerate geometry (zero velocity, not descending, zero baseline) or no
-visible interval: the detected landmark nearest to the boresight's ground
-point, ``note`` says why.
+Degenerate geometry or no visible interval: the detected landmark nearest to
+the boresight's ground point, ``note`` says why.
 
-Objectives: ``depth`` (eq. 23-25) and the paper's H baselines ``svd``, ``gdop``,
-``cond`` are compiled (``kernels.objective``); the B-X1 metrics (``logdet``,
-``mineig``, the whitened ones: ``metrics`` fast path at the ground point) and
-``logdet_nav`` (``planned_info``) are Python objectives run through the same
-call's source (``kernels.interpreted``). Methods without a search are
-:data:`PICKERS`.
+Objectives: ``depth`` (eq. 23-25) and the H baselines ``svd``, ``gdop``, ``cond``
+are compiled (``kernels.objective``); the B-X1 metrics (``metrics`` fast path at
+the ground point) and ``logdet_nav`` (``planned_info``) are Python objectives run
+through the same call's source (``kernels.interpreted``); :data:`PICKERS` search nothing.
 
-Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer
-would run: the compiled call above) and ``paper`` (the paper's definition, run
-by the interpreter through the same call: the depth error by the vectorised
-law-of-sines formula of ``depth_error``, the H baselines by H built with CasADi
-and LAPACK's SVD / pseudo-inverse, ``metrics.Metric.reference``). The Monte
-Carlo plans on ``compiled``; timing (``opnav.landing.timing``) replays both.
-
-One planner: :func:`plan_batch` plans the runs of a batched descent one by one
-with :func:`plan_one`; :func:`plan` is one call of it with its wall time.
+Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer would
+run) and ``paper`` (the paper's definition through the same call, interpreted:
+the law-of-sines depth error of ``depth_error``; H from CasADi and LAPACK's SVD /
+pseudo-inverse, ``metrics.Metric.reference``); timing replays both. One planner:
+:func:`plan_batch` plans run by run with :func:`plan_one`; :func:`plan` is one
+timed call of it.
 """
 
 from __future__ import annotations
@@ -58,8 +52,8 @@ import numpy as np
 from opnav.landing import kernels as K
 from opnav.landing import metrics
 from opnav.landing.camera import Camera
-from opnav.landing.depth_error import (REASONS, PlaneGeometry, depth_error_at_landmarks, plane_geometry,
-                                       signed_depth_error)
+from opnav.landing.depth_error import (REASONS, PlaneGeometry, baseline, depth_error_at_landmarks,
+                                       error_radius, plane_geometry, signed_depth_error)
 from opnav.landing.landmarks import LandmarkField
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig", "plan",
@@ -113,8 +107,7 @@ class PlanResult:
     n_evals: int               # objective evaluations (edge rule: + landmarks scored)
     time_ns: int               # wall time of the planning call (plan: perf_counter_ns; else 0)
     note: str = ""
-    cpu_ns: int = 0            # not measured by the call: the replay (timing.replay) reads
-                               # the thread CPU clock around it
+    cpu_ns: int = 0            # not measured by the call (timing.replay reads the CPU clock)
     edge: bool = False         # optimum on an end of the visible interval (edge rule)
     pick_ratio: float = math.nan  # picked landmark's metric / best detected one's (>= 1)
 
@@ -173,13 +166,11 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
     """``(f(beta, q), scores(q, xyz, cand), status)`` of a method the interpreter
     runs: the paper's definitions (``cfg.eval_path == "paper"``) and the B-X1
     objectives; both minimised, ``+inf`` where the line of sight misses the ground."""
-    if method == "depth":               # the paper's definition (eq. 19, 22-25, law of sines)
-        h = 0.5 * cfg.t_s ** 2
-        b = float(np.linalg.norm(state.v * cfg.t_s + state.a * h))
+    if method == "depth":               # the paper's eq. 23-25 (law of sines, numpy)
+        b = baseline(state.v, state.a, cfg.t_s)
         if not b > 0:
             return None, None, K.ZERO_BASELINE
-        Pvv = state.P[3:6, 3:6]
-        r_e = cfg.n_sigma_v * math.sqrt(max(np.linalg.eigvalsh(0.5 * (Pvv + Pvv.T))[-1], 0.0)) * cfg.t_s
+        r_e = error_radius(state.P[3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
         geom = PlaneGeometry(q[0:3], q[3:6], q[6:9], q[9], q[10])
         f = lambda beta, q: float(signed_depth_error(beta, geom, b, r_e))
         scores = lambda q, xyz, cand: depth_error_at_landmarks(state.r, state.v, state.a, xyz[cand],

@@ -238,7 +238,8 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             ours = tmg.time_reduction(timing, "depth", "svd", n_boot=0)[0]
             title = f"depth vs SVD: {ours:.1f} % less ({main_name})"
             if tmg.times_ns(timing, "svd", "alt").size:
-                ours_alt = tmg.time_reduction(timing, "depth", "svd", path_b="alt", n_boot=0)[0]
+                da = "alt" if tmg.times_ns(timing, "depth", "alt").size else "main"   # both on that path
+                ours_alt = tmg.time_reduction(timing, "depth", "svd", path_a=da, path_b="alt", n_boot=0)[0]
                 title += f", {ours_alt:.1f} % ({alt_name})"
             ax.set_title(f"{title}\npublished {published_reduction_vs_svd:.2f} %", fontsize="x-small")
         return fig
