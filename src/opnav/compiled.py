@@ -34,7 +34,7 @@ from typing import Callable
 
 #: Modules holding kernels, imported by :func:`warm` (each registers its warm-up on import).
 KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
-                                    "opnav.approach.em",
+                                    "opnav.approach.em", "opnav.approach.augmented",
                                     "opnav.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
                                     "opnav.landing.kernels")
 
