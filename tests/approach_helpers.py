@@ -23,3 +23,17 @@ def approach_cfg(**segments):
     cfg = load_config()["approach"]
     cfg["segments"].update(segments)
     return cfg
+
+
+def random_filter_problem(seed, S, n, per_seed=False):
+    """A random EM-EKF problem on :func:`small_window` for hypothesis tests: the window (with
+    per-seed variances (n+1, S, 3) if ``per_seed``), its generator, measurements z (S, n+1, 3),
+    small misalignments theta (S, 3), start means x0 (S, 6) and an SPD start covariance P0."""
+    win, rng = small_window(n=n, seed=seed % 997)
+    if per_seed:
+        win = Window(win.Phi, win.C, win.u_ref, 0.5 + rng.random((n + 1, S, 3)), win.Q)
+    z = rng.standard_normal((S, n + 1, 3)) * 3 + win.u_ref
+    theta = rng.normal(size=(S, 3)) * 0.05
+    x0 = rng.normal(size=(S, 6))
+    A = rng.standard_normal((6, 6))
+    return win, rng, z, theta, x0, A @ A.T + np.eye(6)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from approach_helpers import small_window
+from approach_helpers import random_filter_problem, small_window
 from opnav.approach import alternatives, crlb
 from opnav.approach import scenario as sc
 from opnav.approach.augmented import run_augmented
@@ -293,15 +293,7 @@ def _augmented_reference(z, x0, P0, theta0, sig, win, q_theta=0.0, u_lin=None):
 def test_compiled_augmented_filter_equals_the_step_by_step_reference(seed, S, n, linear, per_seed):
     """The compiled augmented EKF (its EKF and linear forms, shared or per-seed variances)
     equals the same filter written step by step with the batched kalman API."""
-    from opnav.approach.ekf import Window
-
-    win, rng = small_window(n=n, seed=seed % 977)
-    if per_seed:
-        win = Window(win.Phi, win.C, win.u_ref, 0.5 + rng.random((n + 1, S, 3)), win.Q)
-    z = rng.standard_normal((S, n + 1, 3)) + win.u_ref
-    x0 = rng.normal(size=(S, 6))
-    A = rng.standard_normal((6, 6))
-    P0 = A @ A.T + np.eye(6)
+    win, rng, z, _, x0, P0 = random_filter_problem(seed, S, n, per_seed)
     th0 = rng.normal(size=3) * 1e-4
     u_lin = win.u_ref + rng.standard_normal(win.u_ref.shape) if linear else None
     res = run_augmented(z, x0, P0, th0, 1e-3, win, q_theta=1e-12, u_lin=u_lin)

@@ -9,7 +9,7 @@ from opnav.approach import cases, crlb, ekf, em, pipeline, smoother
 from opnav.approach import scenario as sc
 from opnav.approach.dynamics import ARCSEC
 
-from approach_helpers import approach_cfg, small_window
+from approach_helpers import approach_cfg, random_filter_problem, small_window
 
 
 def _approach_window(variant="prior", n=200, bias=(10.0, 20.0, 10.0), seeds=range(3), N0=50):
@@ -258,14 +258,7 @@ def test_fused_em_map_equals_filter_smoother_and_estep(seed, S, n, per_seed):
     """One EM map's fused compiled pass gives the statistics of the separate steps (the EKF,
     the position Bryson-Frazier smoother, the E-step and the M-step), the log-likelihood and
     the filtered state at the window's end, to round-off."""
-    win, rng = small_window(n=n, seed=seed % 983)
-    if per_seed:
-        win = ekf.Window(win.Phi, win.C, win.u_ref, 0.5 + rng.random((n + 1, S, 3)), win.Q)
-    z = rng.standard_normal((S, n + 1, 3)) * 3 + win.u_ref
-    theta = rng.normal(size=(S, 3)) * 0.05
-    x0 = rng.normal(size=(S, 6))
-    A = rng.standard_normal((6, 6))
-    P0 = A @ A.T + np.eye(6)
+    win, _, z, theta, x0, P0 = random_filter_problem(seed, S, n, per_seed)
     new, ll, unobs, (x_end, P_end) = em.em_map(theta, z, x0, P0, win, 1e-6)
     f = ekf.run_filter(z, theta, x0, P0, win, predicted=False)
     st_ = em.estep(z, smoother.bryson_frazier(f, win, ekf.POS), win)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from approach_helpers import approach_cfg, small_window
+from approach_helpers import approach_cfg, random_filter_problem, small_window
 from opnav.approach import crlb, kalman, pipeline
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
@@ -179,13 +179,7 @@ def test_filter_window_equals_a_numpy_ekf_over_random_windows(seed, S, n, per_se
     seed: filtered moments, log-likelihood and the last sample's K H."""
     from opnav.approach import ekf
 
-    win, rng = small_window(n=n, seed=seed % 997)
-    if per_seed:
-        win = ekf.Window(win.Phi, win.C, win.u_ref, 0.5 + rng.random((n + 1, S, 3)), win.Q)
-    z = rng.standard_normal((S, n + 1, 3)) * 3 + win.u_ref
-    theta = rng.normal(size=(S, 3)) * 0.05
-    x0 = rng.normal(size=(S, 6))
-    P0 = _spd(rng, 6)
+    win, _, z, theta, x0, P0 = random_filter_problem(seed, S, n, per_seed)
     f = ekf.run_filter(z, theta, x0, P0, win, predicted=predicted)
     assert (f.xp is not None) == predicted
     for s in range(S):

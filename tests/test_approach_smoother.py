@@ -6,7 +6,7 @@ import pytest
 from opnav.approach import crlb, ekf, smoother
 from opnav.approach.camera import misalignment_small
 
-from approach_helpers import small_window
+from approach_helpers import random_filter_problem, small_window
 
 
 def _dense_posterior(z, theta, x0, P0, win):
@@ -179,11 +179,8 @@ from hypothesis import given, settings, strategies as st  # noqa: E402
 def test_compiled_bryson_frazier_equals_rts_over_random_windows(seed, S, n, cols):
     """The compiled Bryson-Frazier moments (any contiguous block of states) equal the numpy
     RTS smoother's (eq. 7-9) on random linear models."""
-    win, rng = small_window(n=n, seed=seed % 991)
-    z = rng.standard_normal((S, n + 1, 3)) * 3 + win.u_ref
-    theta = rng.normal(size=(S, 3)) * 0.05
-    A = rng.standard_normal((6, 6))
-    f = ekf.run_filter(z, theta, rng.normal(size=(S, 6)), A @ A.T + np.eye(6), win)
+    win, _, z, theta, x0, P0 = random_filter_problem(seed, S, n)
+    f = ekf.run_filter(z, theta, x0, P0, win)
     r = smoother.rts(f, win)
     b = smoother.bryson_frazier(f, win, cols)
     np.testing.assert_allclose(b.xs, r.xs[..., cols], rtol=1e-8, atol=1e-9 * np.abs(r.xs).max())

@@ -168,6 +168,9 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
     with ``H_k = [-A_m(theta0) C_k, 0, [u_lin,k x]]`` (theta0 of the first
     seed); its covariance is then the Bayesian Cramér-Rao bound of that
     linear-Gaussian model, independent of the data.
+
+    Compiled between star images (:func:`_augmented_samples`); 60 seeds over 2000 samples
+    took 0.57-0.80 CPU-s with the former step-by-step loop (f02dab2) and 0.21 s compiled.
     """
     z = np.asarray(z, float)
     S, n = z.shape[0], win.n
