@@ -36,7 +36,8 @@ from typing import Callable
 KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
                                     "opnav.approach.em", "opnav.approach.augmented",
                                     "opnav.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
-                                    "opnav.landing.kernels")
+                                    "opnav.landing.kernels",
+                                    "opnav.landing.descent")
 
 _WARMUPS: dict[str, Callable[[], None]] = {}
 _KERNELS: list = []  # every dispatcher made by kernel(), for cache_stats

@@ -17,8 +17,8 @@ leading shape. They are written out (not through
 ``scipy.spatial.transform.Rotation``) because the filters call them in their
 inner loops on single vectors, where scipy's object construction costs more
 than the arithmetic, and because the batched paths want arbitrary leading
-dimensions; Exp is a compiled kernel (:func:`exp_so3_into`, which the landing
-filter's kernels call); tests pin them against scipy (``tests/test_rotations.py``).
+dimensions; Exp and Log are compiled kernels (:func:`exp_so3_into`,
+:func:`log_so3_into`, which the landing filter's kernels call); tests pin them against scipy (``tests/test_rotations.py``).
 
 Where they are used
 -------------------
@@ -51,7 +51,7 @@ import numpy as np
 
 from opnav.compiled import kernel, warms
 
-__all__ = ["skew", "cross", "exp_so3", "exp_so3_into", "log_so3"]
+__all__ = ["skew", "cross", "exp_so3", "exp_so3_into", "log_so3", "log_so3_into"]
 
 _EYE3 = np.eye(3)
 
@@ -118,6 +118,7 @@ def _exp_batch(phi, out) -> None:
 @warms
 def _warm() -> None:
     _exp_batch(np.zeros((1, 3)), np.empty((1, 3, 3)))
+    _log_batch(np.eye(3)[None].copy(), np.empty((1, 3)))
 
 
 def exp_so3(phi) -> np.ndarray:
@@ -125,22 +126,39 @@ def exp_so3(phi) -> np.ndarray:
     (rad), by the kernel :func:`exp_so3_into` over the leading dimensions (a single
     vector and a batch give the same bits)."""
     phi = np.asarray(phi, dtype=float)
-    flat = np.ascontiguousarray(phi).reshape(-1, 3)
+    flat = np.array(phi, order="C").reshape(-1, 3)        # a writable copy: one kernel signature
     out = np.empty((flat.shape[0], 3, 3))
     _exp_batch(flat, out)
     return out.reshape(phi.shape[:-1] + (3, 3))
 
 
+@kernel
+def log_so3_into(R, out) -> None:
+    """``out`` (3,) <- the rotation vector (rad) of one rotation matrix ``R`` (3, 3):
+    angle ``atan2(|w|, (tr R - 1)/2)`` with ``w`` the axial vector of ``(R - R^T)/2``
+    (accurate for small angles; angles near pi, where ``w`` vanishes, are not
+    supported). The one home of Log: :func:`log_so3` runs it over a batch."""
+    w0 = 0.5 * (R[2, 1] - R[1, 2])
+    w1 = 0.5 * (R[0, 2] - R[2, 0])
+    w2 = 0.5 * (R[1, 0] - R[0, 1])
+    s = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    c = 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)
+    f = 1.0 if s < 1e-12 else math.atan2(s, c) / s
+    out[0], out[1], out[2] = w0 * f, w1 * f, w2 * f
+
+
+@kernel
+def _log_batch(R, out) -> None:
+    for k in range(R.shape[0]):
+        log_so3_into(R[k], out[k])
+
+
 def log_so3(R) -> np.ndarray:
     """Rotation vectors ``(..., 3)`` (rad) of rotation matrices ``R`` ``(..., 3, 3)``:
-    ``exp_so3(log_so3(R)) == R``. Angle from ``atan2(|w|, (tr R - 1)/2)`` with
-    ``w`` the axial vector of ``(R - R^T)/2`` (accurate for small angles; angles
-    near pi, where ``w`` vanishes, are not supported)."""
+    ``exp_so3(log_so3(R)) == R``, by the kernel :func:`log_so3_into` over the
+    leading dimensions."""
     R = np.asarray(R, dtype=float)
-    w = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
-                        R[..., 1, 0] - R[..., 0, 1]], axis=-1)
-    s = np.sqrt(np.sum(w * w, axis=-1))
-    c = 0.5 * (R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2] - 1.0)
-    small = s < 1e-12
-    f = np.where(small, 1.0, np.arctan2(s, c) / np.where(small, 1.0, s))
-    return w * f[..., None]
+    flat = np.array(R, order="C").reshape(-1, 3, 3)
+    out = np.empty((flat.shape[0], 3))
+    _log_batch(flat, out)
+    return out.reshape(R.shape[:-2] + (3,))

@@ -77,6 +77,8 @@ included, plans in lockstep (``planner.plan_batch``, the picks of the per-call
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from opnav.landing import ekf, imu
@@ -85,10 +87,12 @@ from opnav.landing.planner import PlanState, plan_batch
 from opnav.landing.records import append_call, new_calls, record_plan_inputs, stack_calls
 from opnav.landing.scenario import Scenario, build_scenario
 from opnav.landing.trajectory import euler_rpy_deg
-from opnav.rotations import exp_so3, log_so3
+from opnav.compiled import kernel, warms
+from opnav.landing.ekf import _cho_solve, _cholesky
+from opnav.rotations import exp_so3, log_so3_into
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
-           "yaw_sigma_rad", "tracking_step", "vision_cutoff_altitude"]
+           "tracking_step", "vision_cutoff_altitude"]
 
 def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
     """Error state (truth - estimate) [dr, dv, dtheta] (9,), uniform per axis."""
@@ -97,23 +101,60 @@ def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
                            rng.uniform(-bt, bt, 3)])
 
 
-def _att_error(R_true: np.ndarray, R_est: np.ndarray) -> np.ndarray:
-    """dtheta (..., 3) rad with R_true = Exp(-dtheta) R_est (log map; angles < pi/2)."""
-    return -log_so3(R_true @ np.swapaxes(R_est, -1, -2))
-
-
 def _wrap_deg(x):
     return (np.asarray(x) + 180.0) % 360.0 - 180.0
 
 
-def yaw_sigma_rad(R_LtoB: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """1-sigma (rad) of the filter's heading error: the attitude error about the
-    {L} vertical, i.e. along ``R_LtoB e_z`` in our body-side ``dtheta`` (the
-    attitude part of the unobservable direction, :func:`ekf.nullspace`).
-    Broadcasts over leading dimensions."""
-    u = R_LtoB[..., :, 2]
-    q = np.einsum("...i,...ij,...j->...", u, P[..., 6:9, 6:9], u)
-    return np.sqrt(np.maximum(q, 0.0))
+@kernel
+def _record(r_t, v_t, R_t, r, v, R, P, k, err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v) -> None:
+    """Column ``k`` of the per-run tracks from the truth (``r_t``, ``v_t``, ``R_t``
+    at step k) and the estimates of every run (``r`` (B, 3), ``R`` (B, 3, 3), ``P``
+    (B, 12, 12)): errors truth - estimate of position, velocity (m, m/s) and
+    attitude (``dtheta`` rad, ``R_true = Exp(-dtheta) R_est``), the filter's
+    1-sigma of the 9 navigation states, the 1-sigma (rad) of the heading error
+    (the attitude error about the {L} vertical, i.e. along ``R_LtoB e_z`` in our
+    body-side ``dtheta``: the attitude part of the unobservable direction,
+    ``ekf.nullspace``), and the position and velocity NEES."""
+    M = np.empty((3, 3))
+    L = np.empty((3, 3))
+    x = np.empty(3)
+    for b in range(r.shape[0]):
+        for i in range(3):
+            err_r[b, k, i] = r_t[i] - r[b, i]
+            err_v[b, k, i] = v_t[i] - v[b, i]
+            for j in range(3):
+                M[i, j] = R_t[i, 0] * R[b, j, 0] + R_t[i, 1] * R[b, j, 1] + R_t[i, 2] * R[b, j, 2]
+        log_so3_into(M, x)
+        for i in range(3):
+            err_th[b, k, i] = -x[i]
+        for i in range(9):
+            sig[b, k, i] = math.sqrt(max(P[b, i, i], 0.0))
+        q = 0.0
+        for i in range(3):
+            for j in range(3):
+                q += R[b, i, 2] * P[b, 6 + i, 6 + j] * R[b, j, 2]
+        sig_yaw[b, k] = math.sqrt(max(q, 0.0))
+        for blk in range(2):
+            e = err_r[b, k] if blk == 0 else err_v[b, k]
+            for i in range(3):
+                x[i] = e[i]
+                for j in range(3):
+                    L[i, j] = P[b, 3 * blk + i, 3 * blk + j]
+            _cholesky(L, 3)
+            _cho_solve(L, 3, x)
+            s = e[0] * x[0] + e[1] * x[1] + e[2] * x[2]
+            if blk == 0:
+                nees_r[b, k] = s
+            else:
+                nees_v[b, k] = s
+
+
+@warms
+def _warm() -> None:
+    tracks = [np.zeros((1, 2, 3)), np.zeros((1, 2, 3)), np.zeros((1, 2, 3)), np.zeros((1, 2, 9)),
+              np.zeros((1, 2)), np.zeros((1, 2)), np.zeros((1, 2))]
+    _record(np.zeros(3), np.zeros(3), np.eye(3), np.zeros((1, 3)), np.zeros((1, 3)),
+            np.eye(3)[None].copy(), np.eye(12)[None].copy(), 1, *tracks)
 
 
 def vision_cutoff_altitude(r_est: np.ndarray, margin_m: float) -> np.ndarray:
@@ -225,14 +266,9 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     n_used = np.zeros(B, np.int64)
 
     def record(k):
-        er = tr.r[k] - st.r
-        ev = tr.v[k] - st.v
-        err_r[:, k], err_v[:, k] = er, ev
-        err_th[:, k] = _att_error(tr.R_LtoB[k], st.R)
-        sig[:, k] = np.sqrt(np.clip(np.diagonal(st.P, axis1=1, axis2=2)[:, :9], 0, None))
-        sig_yaw[:, k] = yaw_sigma_rad(st.R, st.P)
-        nees_r[:, k] = np.einsum("bi,bi->b", er, np.linalg.solve(st.P[:, 0:3, 0:3], er[..., None])[..., 0])
-        nees_v[:, k] = np.einsum("bi,bi->b", ev, np.linalg.solve(st.P[:, 3:6, 3:6], ev[..., None])[..., 0])
+        c = (lambda a: np.array(a, float, order="C"))      # writable: the warmed signature
+        _record(c(tr.r[k]), c(tr.v[k]), c(tr.R_LtoB[k]), c(st.r), c(st.v), c(st.R), c(st.P), k,
+                err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v)
 
     record(0)
     # the planner's metric contexts skip validation: validate the descent's
