@@ -177,3 +177,29 @@ def test_init_landmark_is_the_reference_and_its_jacobian_the_derivative(seed):
         ekf.inject(minus, -e)
         fd = (ekf.init_jacobian(plus, b)[0] - ekf.init_jacobian(minus, b)[0]) / (2 * h[c])
         np.testing.assert_allclose(J[:2, :, c], fd[:2], rtol=1e-5, atol=1e-8 * np.abs(J).max())
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**31), st.integers(1, 12))
+def test_preintegration_kernel_is_the_sample_scheme(seed, n_sub):
+    """imu.preintegrate (kernel) against the sample-by-sample scheme of the imu
+    module docstring written with scipy rotations: R_mid = R Exp(w dt/2),
+    v += R_mid f dt, r += v dt + R_mid f dt^2/2, R = R Exp(w dt)."""
+    from opnav.landing import imu
+
+    rng = np.random.default_rng(seed)
+    m, dt = 3, 0.1
+    f = rng.normal(size=(m * n_sub, 3)) * 5
+    w = rng.normal(size=(m * n_sub, 3)) * 0.2
+    pre = imu.preintegrate(f, w, dt, n_sub)
+    for j in range(m):
+        R, v, r = np.eye(3), np.zeros(3), np.zeros(3)
+        for k in range(j * n_sub, (j + 1) * n_sub):
+            R_mid = R @ Rotation.from_rotvec(w[k] * dt / 2).as_matrix()
+            a = R_mid @ f[k]
+            r = r + v * dt + 0.5 * a * dt * dt
+            v = v + a * dt
+            R = R @ Rotation.from_rotvec(w[k] * dt).as_matrix()
+        np.testing.assert_allclose(pre.dR[j], R, atol=1e-13)
+        np.testing.assert_allclose(pre.dv[j], v, rtol=1e-12, atol=1e-13)
+        np.testing.assert_allclose(pre.dp[j], r, rtol=1e-12, atol=1e-13)

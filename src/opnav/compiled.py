@@ -37,7 +37,7 @@ KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf"
                                     "opnav.approach.em", "opnav.approach.augmented",
                                     "opnav.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
                                     "opnav.landing.kernels",
-                                    "opnav.landing.descent")
+                                    "opnav.landing.descent", "opnav.landing.imu")
 
 _WARMUPS: dict[str, Callable[[], None]] = {}
 _KERNELS: list = []  # every dispatcher made by kernel(), for cache_stats

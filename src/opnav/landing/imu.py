@@ -27,7 +27,7 @@ Pre-integration (:func:`preintegrate`) groups the samples of each filter
 interval ``Delta t = n_sub dt`` and returns the rotation, velocity and position
 increments in the body frame at the start of the interval; the filter's
 closed-form propagation (``opnav.landing.ekf.propagate``) applies them. It is
-vectorised over intervals: one Python loop over the ``n_sub`` samples.
+a compiled kernel (``opnav.compiled``), a loop over intervals and samples.
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.rotations import exp_so3, log_so3
+from opnav.compiled import kernel, warms
+from opnav.rotations import exp_so3, exp_so3_into, log_so3
 
 __all__ = ["synthesize", "add_noise", "Preintegrated", "preintegrate", "dead_reckon"]
 
@@ -75,24 +76,53 @@ class Preintegrated:
     n_sub: int         # IMU samples per interval
 
 
+@kernel
+def _preintegrate(F, W, dt, dR, dv, dp) -> None:
+    """Per interval ``j`` of ``F``, ``W`` (m, n_sub, 3): the increments into ``dR``
+    (m, 3, 3), ``dv``, ``dp`` (m, 3), sample by sample (module docstring)."""
+    half = np.empty((3, 3))
+    mid = np.empty((3, 3))
+    phi = np.empty(3)
+    for j in range(F.shape[0]):
+        R = dR[j]
+        for a in range(3):
+            dv[j, a] = 0.0
+            dp[j, a] = 0.0
+            for b in range(3):
+                R[a, b] = 1.0 if a == b else 0.0
+        for k in range(F.shape[1]):
+            for a in range(3):
+                phi[a] = W[j, k, a] * dt / 2
+            exp_so3_into(phi, half)
+            for a in range(3):                 # R_mid = dR half
+                for b in range(3):
+                    mid[a, b] = R[a, 0] * half[0, b] + R[a, 1] * half[1, b] + R[a, 2] * half[2, b]
+            for a in range(3):
+                inc = (mid[a, 0] * F[j, k, 0] + mid[a, 1] * F[j, k, 1] + mid[a, 2] * F[j, k, 2]) * dt
+                dp[j, a] += dv[j, a] * dt + 0.5 * inc * dt
+                dv[j, a] += inc
+            for a in range(3):                 # dR = R_mid half
+                for b in range(3):
+                    R[a, b] = mid[a, 0] * half[0, b] + mid[a, 1] * half[1, b] + mid[a, 2] * half[2, b]
+
+
+@warms
+def _warm() -> None:
+    preintegrate(np.zeros((2, 3)), np.zeros((2, 3)), 0.1, 2)
+
+
 def preintegrate(f: np.ndarray, w: np.ndarray, dt: float, n_sub: int) -> Preintegrated:
-    """Group IMU samples (n_int * n_sub, 3) into ``n_int`` intervals of ``n_sub``."""
+    """Group IMU samples (n_int * n_sub, 3) into ``n_int`` intervals of ``n_sub``
+    (the kernel ``_preintegrate``, one loop over the samples of each interval)."""
     n = f.shape[0]
     if n % n_sub:
         raise ValueError(f"{n} IMU samples do not split into intervals of {n_sub}")
     m = n // n_sub
-    F = f.reshape(m, n_sub, 3)
-    W = w.reshape(m, n_sub, 3)
-    dR = np.broadcast_to(np.eye(3), (m, 3, 3)).copy()
-    dv = np.zeros((m, 3))
-    dp = np.zeros((m, 3))
-    for k in range(n_sub):
-        half = exp_so3(W[:, k] * dt / 2)
-        R_mid = dR @ half
-        inc = np.einsum("mij,mj->mi", R_mid, F[:, k]) * dt
-        dp += dv * dt + 0.5 * inc * dt
-        dv += inc
-        dR = R_mid @ half
+    dR = np.empty((m, 3, 3))
+    dv = np.empty((m, 3))
+    dp = np.empty((m, 3))
+    _preintegrate(np.array(f, float, order="C").reshape(m, n_sub, 3),
+                  np.array(w, float, order="C").reshape(m, n_sub, 3), float(dt), dR, dv, dp)
     return Preintegrated(dR=dR, dv=dv, dp=dp, dt=dt, n_sub=n_sub)
 
 
