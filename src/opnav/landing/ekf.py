@@ -176,12 +176,7 @@ def _propagate(r, v, C_i, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
     if oc:
         _nullspace(r_j, v_j, C_j, p, N_j)
         _oc(Phi, N_i, N_j, C_i_prior, C_j, Dt)
-    for a in range(N_X):      # T = Phi P
-        for b in range(N_X):
-            s = 0.0
-            for c in range(N_X):
-                s += Phi[a, c] * P[c, b]
-            T[a, b] = s
+    _matmul(Phi, P, T)
     for a in range(N_X):      # P_j = T Phi^T + Q
         for b in range(N_X):
             s = 0.0
@@ -189,6 +184,17 @@ def _propagate(r, v, C_i, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
                 s += T[a, c] * Phi[b, c]
             P_j[a, b] = s + Q[a, b]
     _symmetrize(P_j)
+
+
+@kernel
+def _matmul(A, B, C) -> None:
+    """``C = A B`` (plain loops, sums in index order)."""
+    for a in range(A.shape[0]):
+        for b in range(B.shape[1]):
+            s = 0.0
+            for c in range(A.shape[1]):
+                s += A[a, c] * B[c, b]
+            C[a, b] = s
 
 
 @kernel
@@ -357,12 +363,7 @@ def _update(r, v, R, p, P, bs, pk, known, sigma_b, N, use_N, iterations,
             for k in range(m3):
                 s -= K[a, k] * H[k, b]
             A[a, b] = s
-    for a in range(N_X):                          # T = A P
-        for b in range(N_X):
-            s = 0.0
-            for c in range(N_X):
-                s += A[a, c] * P[c, b]
-            T[a, b] = s
+    _matmul(A, P, T)
     for a in range(N_X):                          # P_o = T A^T + sigma_b^2 K K^T (Joseph)
         for b in range(N_X):
             s = 0.0
