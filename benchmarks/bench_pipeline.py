@@ -53,6 +53,7 @@ from __future__ import annotations
 import argparse
 import collections
 import datetime as dt
+import json
 import os
 import re
 import resource
@@ -244,8 +245,9 @@ def run_profile(name: str, cores: int, keep: Path | None, rev: str | None = None
 
 
 def kernel_report(wd: Path) -> list[str]:
-    """The compile_kernels job's log lines (compile and load seconds per kernel module)
-    and the count of other jobs that compiled kernels themselves (job_costs)."""
+    """The compile_kernels jobs' log lines (compile seconds per kernel module), the
+    load seconds of every kernel in a fresh process from the filled cache, and the
+    count of other jobs that loaded or compiled kernels themselves (job_costs)."""
     sys.path.insert(0, str(REPO / "benchmarks"))
     from job_costs import kernel_counts
 
@@ -253,6 +255,16 @@ def kernel_report(wd: Path) -> list[str]:
     for log in sorted(wd.glob("results/**/kernels/logs/compile_*.log")):
         lines += [line for line in log.read_text(errors="replace").splitlines()
                   if (" INFO " in line or " WARNING " in line) and "job resources" not in line]
+    if (wd / "src" / "opnav" / "compiled.py").is_file():  # every kernel again in a fresh process
+        code = "import json, opnav.compiled as c; s = c.warm(); print(json.dumps({'seconds': s, **c.cache_stats()}))"
+        c0 = _children_cpu()
+        proc = subprocess.run([sys.executable, "-c", code], cwd=wd, env=_env(wd), capture_output=True, text=True)
+        if proc.returncode == 0:
+            fresh = json.loads(proc.stdout.splitlines()[-1])
+            lines.append(f"a fresh process loads every kernel from the filled cache: {fresh['loaded']} signatures "
+                         f"loaded, {fresh['compiled']} compiled, {sum(fresh['seconds'].values()):.2f} s wall "
+                         f"({_children_cpu() - c0:.2f} CPU-s with numba's import and the interpreter); "
+                         + ", ".join(f"{m} {t:.3f} s" for m, t in sorted(fresh["seconds"].items())))
     counts = [c for c in kernel_counts(wd / "results") if Path(c[0]).parent.parent.name != "kernels"]
     if counts:
         compiling = [c for c in counts if c[2]]

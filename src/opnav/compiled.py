@@ -135,20 +135,3 @@ def cache_stats() -> dict[str, int]:
     return {"loaded": sum(sum(d.stats.cache_hits.values()) for d in _KERNELS),
             "compiled": sum(sum(d.stats.cache_misses.values()) for d in _KERNELS)}
 
-
-def warm_fresh(modules: tuple[str, ...] | None = None) -> dict:
-    """:func:`warm` of ``modules`` in a new interpreter importing this same package (the
-    cache as the next job finds it): ``{"seconds": {module: s}, "loaded": n, "compiled": n}``."""
-    import json
-    import os
-    import subprocess
-    import sys
-
-    package_parent = str(Path(__file__).resolve().parents[1])
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        p for p in (package_parent, os.environ.get("PYTHONPATH", "")) if p))
-    code = ("import json, sys, opnav.compiled as c; m = json.loads(sys.argv[1]); "
-            "s = c.warm(None if m is None else tuple(m)); print(json.dumps({'seconds': s, **c.cache_stats()}))")
-    out = subprocess.run([sys.executable, "-c", code, json.dumps(None if modules is None else list(modules))],
-                         env=env, capture_output=True, text=True, check=True)
-    return json.loads(out.stdout.splitlines()[-1])

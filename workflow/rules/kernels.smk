@@ -10,8 +10,8 @@
 
 rule compile_kernels:
     """Compiles a paper's registered kernels once (opnav.compiled.warm) into numba's
-    on-disk cache; the log gives each module's compile (or load) seconds and its load
-    seconds from a fresh interpreter; the output (no timings) names the kernel set."""
+    on-disk cache; the log gives each module's compile (or, cache filled, load) seconds;
+    the output (no timings) names the kernel set."""
     input:
         lambda wc: kernel_src(wc.kpaper),
     output:
