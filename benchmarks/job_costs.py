@@ -25,29 +25,27 @@ _LINE = re.compile(r"job resources: cpu_s=([0-9.]+) user_s=([0-9.]+) sys_s=([0-9
 _KERNELS = re.compile(r"kernels_loaded=(\d+) kernels_compiled=(\d+)")
 
 
-def kernel_counts(root: Path) -> list[tuple[str, int, int]]:
-    """(log path relative to ``root``, kernel signatures loaded, compiled) of every job
-    log whose resource line counts kernels."""
+def _last_matches(root: Path, pattern: re.Pattern) -> list[tuple[str, re.Match]]:
+    """(log path relative to ``root``, the last match of ``pattern``) of every job log that has one."""
     out = []
     for log in sorted(root.rglob("logs/*.log")):
         m = None
-        for m in _KERNELS.finditer(log.read_text(errors="replace")):
+        for m in pattern.finditer(log.read_text(errors="replace")):
             pass
         if m:
-            out.append((str(log.relative_to(root)), int(m.group(1)), int(m.group(2))))
+            out.append((str(log.relative_to(root)), m))
     return out
+
+
+def kernel_counts(root: Path) -> list[tuple[str, int, int]]:
+    """(log path relative to ``root``, kernel signatures loaded, compiled) of every job
+    log whose resource line counts kernels."""
+    return [(p, int(m.group(1)), int(m.group(2))) for p, m in _last_matches(root, _KERNELS)]
 
 
 def costs(root: Path) -> list[tuple[str, float, float]]:
     """(log path relative to ``root``, CPU seconds, max RSS MB) of every job log that has the line."""
-    out = []
-    for log in sorted(root.rglob("logs/*.log")):
-        m = None
-        for m in _LINE.finditer(log.read_text(errors="replace")):
-            pass
-        if m:
-            out.append((str(log.relative_to(root)), float(m.group(1)), float(m.group(4))))
-    return out
+    return [(p, float(m.group(1)), float(m.group(4))) for p, m in _last_matches(root, _LINE)]
 
 
 def family(path: str) -> str:
