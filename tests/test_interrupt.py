@@ -33,12 +33,14 @@ def _job_in_flight(pgid: int, script: str) -> bool:
 
 def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     from opnav.config import load_config
-    from opnav.landing.montecarlo import load, run_chunk
+    from opnav.landing.montecarlo import gather, load, run_chunk
 
     wd = tmp_path / "wf"
     wd.mkdir()
     copy_workflow(wd)
-    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 3, runs_per_job: 1}}\n")
+    # four runs per job: with the compiled descent a run takes a fraction of a second, so a
+    # job of one run could end between seeing it in flight and the signal (CI, 08:13 UTC)
+    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 12, runs_per_job: 4}}\n")
     target = "results/quick/landing/mc/site-tilt/depth.npz"  # the quick profile's results_dir
     args = [target, "--cores", "1", "--configfile", "config/quick.yaml", "small.yaml"]
     chunks = wd / "results" / "quick" / "landing" / "mc" / "site-tilt" / "chunks" / "depth"
@@ -69,9 +71,9 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
 
     cfg = camera_scenarios(load_config(REPO / "config" / "config.yaml",
                                        overlays=[REPO / "config" / "quick.yaml", wd / "small.yaml"])["landing"])["site-tilt"]
-    # one run per job, so each job flies a batch of one: the clean run does the
-    # same (batch size changes numbers only at round-off, tests/test_landing_batch.py)
-    clean = run_chunk(cfg, "depth", [0, 1, 2], batch_size=1)
+    # each job flies its chunk of four runs as one batch: the clean run does the same
+    # (batch size changes numbers only at round-off, tests/test_landing_batch.py)
+    clean = gather([run_chunk(cfg, "depth", list(range(a, a + 4)), batch_size=4) for a in (0, 4, 8)])
     got = load(wd / target)
     assert set(got) - {"method", "reuse_key"} == set(clean)
     differ = {k for k in clean if not np.array_equal(np.asarray(got[k]), np.asarray(clean[k]),
