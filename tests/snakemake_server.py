@@ -23,6 +23,7 @@ on stdout ``{"id", "pid"}`` when the child is forked and ``{"id", "rc"}`` when i
 import json
 import os
 import select
+import signal
 import sys
 
 # sys.path of this process without what PYTHONPATH and the script's folder put there:
@@ -71,6 +72,10 @@ def _child(req: dict) -> None:
     try:
         if req.get("session"):
             os.setsid()
+            # a test signals this session as a terminal's Ctrl-C would: SIGINT raises
+            # KeyboardInterrupt here and in the jobs, even where the test run inherited it
+            # ignored (a shell's background job, nohup: ignored signals survive exec)
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         for name in req.get("hide", ()):
             sys.modules[name] = None
         os.chdir(req["cwd"])
