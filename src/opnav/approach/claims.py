@@ -114,9 +114,14 @@ def accuracy_outcome(r, target: float, name: str) -> Outcome:
     return _outcome(name, conv and err <= target, text, score=err)
 
 
+def _bound(r) -> float:
+    """The bound of the data used, the larger axis (arcsec)."""
+    return max(float(r["crlb_x_arcsec"]), float(r["crlb_y_arcsec"]))
+
+
 def _bound_text(r) -> str:
     """'CRLB 20.6 arcsec (data used), 20.6 with Q = 0' (the larger axis)."""
-    b = max(float(r["crlb_x_arcsec"]), float(r["crlb_y_arcsec"]))
+    b = _bound(r)
     q0 = r.get("crlb_q0_x_arcsec") if hasattr(r, "get") else None
     q0s = "" if q0 is None or pd.isna(q0) else f", {fmt(float(q0))} with Q = 0"
     return f"CRLB {fmt(b)} arcsec (data used){q0s}"
@@ -127,7 +132,7 @@ def _claim_headline_accuracy(t1, head_pub, target, summary) -> dict:
     pe = (abs(head_pub["est_x_arcsec"] - truth[0]), abs(head_pub["est_y_arcsec"] - truth[1]))
     outs = {v: accuracy_outcome(_head(t1, v), target, v) for v in _variants(t1) if _head(t1, v) is not None}
     lit = _head(t1, AS_WRITTEN)
-    lit_bound = max(float(lit["crlb_x_arcsec"]), float(lit["crlb_y_arcsec"]))
+    lit_bound = _bound(lit)
     bound = _bound_text(lit)
     blocks = (f"CRLB {fmt(lit_bound)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lit_bound > target else "")
@@ -237,7 +242,7 @@ def _claim_little_data(t1, head_pub, target) -> dict:
                 + f", RMS error {fmt(err)} arcsec")
         outs[v] = _outcome(v, ok, text, score=st * 1e6 + (1e5 if math.isnan(d) else d))
     lit = _head(t1, AS_WRITTEN)
-    lb = max(float(lit["crlb_x_arcsec"]), float(lit["crlb_y_arcsec"]))
+    lb = _bound(lit)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
     verdict, lo, best, named = C.decide(outs, AS_WRITTEN, addition, blocks)
@@ -266,7 +271,7 @@ def _claim_pixels(t1, target: float) -> dict:
         # data to converge means data to an estimate the data can tell: where the bound of the
         # data used exceeds the target, EM converges to an ML the data cannot tell from zero,
         # and its sample count says how fast EM contracts, not how much data the bias needs
-        bounds = [max(float(r["crlb_x_arcsec"]), float(r["crlb_y_arcsec"])) for _, r in g.iterrows()]
+        bounds = [_bound(r) for _, r in g.iterrows()]
         blind = [b > target for b in bounds]
         inc = not any(st) and not any(blind) and all(b > a for a, b in zip(d, d[1:]))
         px = ", ".join(f"{p:g}" for p in g["pixel_sigma3_px"].astype(float))
@@ -282,7 +287,7 @@ def _claim_pixels(t1, target: float) -> dict:
                      C.NOT_TESTED, "No pixel cases were run in this profile.", "A-T1",
                      named="no pixel cases in this profile")
     lit = pix[pix["variant"] == AS_WRITTEN]
-    lb = max([max(float(r["crlb_x_arcsec"]), float(r["crlb_y_arcsec"])) for _, r in lit.iterrows()], default=math.nan)
+    lb = max([_bound(r) for _, r in lit.iterrows()], default=math.nan)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
     verdict, lo, best, named = C.decide(outs, AS_WRITTEN, addition, blocks)
