@@ -13,7 +13,8 @@ _inv_sym3; approach.ekf.filter_window/ekf_step and smoother._bryson_frazier_wind
 (bf_moments, bf_back) against the dense posterior; the measurement Jacobians of
 approach.ekf.ekf_step and approach.augmented._jacobian1 by finite differences;
 landing.ekf._transition (finite differences), _inject, _nullspace, _cholesky,
-_cho_solve, _linearise (CasADi); landing.measurement.tangent_rows (CasADi);
+_cho_solve, _linearise (CasADi); landing.measurement.tangent_rows (CasADi) and
+_blocks_batch (the printed eq. 12, 16, 18);
 landing.descent._record; and the warm-up of every kernel module.
 """
 
@@ -177,8 +178,9 @@ def test_approach_measurement_jacobians_match_central_differences(seed, S, n):
     ``H = [-A_m C, 0, [u x] arcsec]`` (``augmented._jacobian1``, by
     ``augmented_jacobian``) equal central differences of the model.
     Mutations tried: ``+`` for ``-`` in ``ekf_step``'s ``Hr`` -> fails; the same in
-    ``_jacobian1``'s position block -> fails (the augmented filter's reference test uses
-    ``augmented_jacobian`` itself, so it cannot see this one)."""
+    ``_jacobian1``'s position block -> fails (the hypothesis test of the compiled augmented
+    filter builds its reference's H with ``augmented_jacobian`` too and passes under this
+    mutation; only fixed-case tests, the GLS mean and the batch ML, saw it before)."""
     from opnav.approach import ekf
     from opnav.approach.augmented import augmented_jacobian
     from opnav.approach.camera import misalignment_small
@@ -207,6 +209,34 @@ def test_approach_measurement_jacobians_match_central_differences(seed, S, n):
 
 
 # ================================================================= paper B (landing)
+
+@settings(max_examples=30, deadline=None)
+@given(SEEDS, st.sampled_from([(), (1,), (4,), (2, 3)]), st.floats(1.0, 2e4))
+def test_jacobian_blocks_batch_is_eq_12_16_18_as_printed(seed, lead, dist):
+    """measurement.jacobian_blocks (kernel ``blocks``; over a batch ``_blocks_batch``, which
+    no other test reaches) against the printed forms: ``b = R u`` (eq. 12),
+    ``H_C = R (|rho|^2 I - rho rho^T) / |rho|^3`` (eq. 18) and ``[b x]`` (eq. 16).
+    Mutation tried: the loop of ``_blocks_batch`` passing ``inv[0]`` for ``inv[k]`` -> fails."""
+    from opnav.landing.measurement import jacobian_blocks
+
+    rng = np.random.default_rng(seed)
+    m = int(np.prod(lead))
+    R = Rotation.random(m, random_state=rng).as_matrix()
+    rho = rng.normal(size=(m, 3))
+    rho *= (dist * rng.uniform(0.5, 2.0, m) / np.linalg.norm(rho, axis=1))[:, None]
+    n = np.linalg.norm(rho, axis=1)
+    u = rho / n[:, None]
+    b, HC, bx = jacobian_blocks(R.reshape(lead + (3, 3)), u.reshape(lead + (3,)), (1.0 / n).reshape(lead))
+    assert b.shape == lead + (3,) and HC.shape == bx.shape == lead + (3, 3)
+    b, HC, bx = b.reshape(m, 3), HC.reshape(m, 3, 3), bx.reshape(m, 3, 3)
+    for k in range(m):
+        _close(b[k], R[k] @ u[k], 1e-14)
+        want = R[k] @ (n[k] ** 2 * np.eye(3) - np.outer(rho[k], rho[k])) / n[k] ** 3
+        _close(HC[k], want, 1e-12)
+        w = rng.normal(size=3)
+        _close(bx[k] @ w, np.cross(R[k] @ u[k], w), 1e-14)
+
+
 
 G_MARS = np.array([0.0, 0.0, -3.711])
 
