@@ -29,6 +29,7 @@ from scipy.spatial.transform import Rotation
 from scipy.stats import multivariate_normal
 
 from approach_helpers import random_filter_problem
+from landing_helpers import random_nav_states
 from conftest import REPO
 
 SEEDS = st.integers(0, 2**32 - 1)
@@ -241,19 +242,6 @@ def test_jacobian_blocks_batch_is_eq_12_16_18_as_printed(seed, lead, dist):
 G_MARS = np.array([0.0, 0.0, -3.711])
 
 
-def _landing_state(rng, n):
-    """``n`` plausible descent estimates (m, m/s, R_LtoB, landmark on the ground, SPD P)."""
-    from opnav.landing import ekf
-
-    r = np.c_[rng.uniform(-4000, 4000, (n, 2)), rng.uniform(300, 6000, n)]
-    v = rng.uniform(-60, 60, (n, 3))
-    R = Rotation.random(n, random_state=rng).as_matrix()
-    p = np.c_[r[:, :2] + rng.uniform(-2000, 2000, (n, 2)), np.zeros(n)]
-    A = rng.normal(size=(n, 12, 12)) * np.array([30, 30, 30, 1, 1, 1, 0.01, 0.01, 0.01, 50, 50, 50])
-    P = A @ np.swapaxes(A, 1, 2) / 12 + np.eye(12) * 1e-6
-    return ekf.NavState(r, v, R, p, P)
-
-
 def _perturbed(st_, dx):
     """The state corrected by the error state ``dx`` (12,) with scipy's rotations (our
     convention: additive r, v, p; ``R_true = Exp(-dtheta) R``), one run."""
@@ -286,7 +274,7 @@ def test_landing_transition_matrix_is_the_derivative_of_the_propagation(seed, Dt
     from opnav.landing import ekf
 
     rng = np.random.default_rng(seed)
-    s = _one(_landing_state(rng, 1), 0)
+    s = _one(random_nav_states(rng, 1), 0)
     dR = Rotation.from_rotvec(rng.normal(scale=0.05, size=3)).as_matrix()
     dv, dp = rng.normal(size=3) * 5 * Dt, rng.normal(size=3) * 3 * Dt * Dt
     Q = np.zeros((12, 12))
@@ -310,7 +298,7 @@ def test_landing_inject_is_scipys_rotation_on_the_body_side(seed, angle):
     from opnav.landing import ekf
 
     rng = np.random.default_rng(seed)
-    s = _landing_state(rng, 3)
+    s = random_nav_states(rng, 3)
     dx = rng.normal(size=(3, 12)) * 10
     dx[:, 6:9] = rng.normal(size=(3, 3))
     dx[:, 6:9] *= angle / np.linalg.norm(dx[:, 6:9], axis=1, keepdims=True)
@@ -335,7 +323,7 @@ def test_landing_nullspace_is_the_derivative_of_a_yaw_rotation_of_the_world(seed
     from opnav.landing.measurement import bearing
 
     rng = np.random.default_rng(seed)
-    s = _landing_state(rng, 2)
+    s = random_nav_states(rng, 2)
     N = ekf.nullspace(s.r, s.v, s.R, s.p)
     a = 1e-6
     for k in range(2):
@@ -389,7 +377,7 @@ def test_landing_filter_jacobian_and_tangent_rows_equal_the_casadi_model(seed, s
     from opnav.landing.measurement import tangent_rows
 
     rng = np.random.default_rng(seed)
-    s = _landing_state(rng, 1)
+    s = random_nav_states(rng, 1)
     b = rng.normal(size=(2, 3))
     b /= np.linalg.norm(b, axis=1, keepdims=True)
     H, res = ekf.linearise(s, [ekf.Bearing(b[0][None], np.zeros(3)), ekf.Bearing(b[1][None])])
@@ -414,7 +402,7 @@ def test_descent_record_equals_numpy_and_scipy(seed, B, att):
     from opnav.landing.descent import _record
 
     rng = np.random.default_rng(seed)
-    s = _landing_state(rng, B)
+    s = random_nav_states(rng, B)
     r_t = s.r[0] + rng.normal(size=3) * 30
     v_t = s.v[0] + rng.normal(size=3)
     R_t = Rotation.from_rotvec(rng.normal(size=3) * att).as_matrix() @ s.R[0]

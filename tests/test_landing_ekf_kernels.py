@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 
+from landing_helpers import random_nav_states
 from opnav.landing import ekf
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -22,16 +23,9 @@ SIG_B = 2.5e-3
 
 
 def _runs(seed: int, n: int):
-    """``n`` plausible descent states (one per run) and what the filter sees."""
+    """``n`` plausible descent states (one per run) and the generator that drew them."""
     rng = np.random.default_rng(seed)
-    r = np.c_[rng.uniform(-4000, 4000, (n, 2)), rng.uniform(300, 6000, n)]
-    v = rng.uniform(-60, 60, (n, 3))
-    R = Rotation.random(n, random_state=rng).as_matrix()
-    p = np.c_[r[:, :2] + rng.uniform(-2000, 2000, (n, 2)), np.zeros(n)]
-    A = rng.normal(size=(n, 12, 12)) * np.array([30, 30, 30, 1, 1, 1, 0.01, 0.01, 0.01, 50, 50, 50])
-    P = A @ np.swapaxes(A, 1, 2) / 12 + np.eye(12) * 1e-6
-    st_ = ekf.NavState(r, v, R, p, P)
-    return rng, st_
+    return rng, random_nav_states(rng, n)
 
 
 def _one(st_: ekf.NavState, k: int) -> REF.NavState:
