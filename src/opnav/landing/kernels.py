@@ -11,15 +11,16 @@ baselines (:func:`h_metric`), the candidate validity rule (:func:`candidate_ok`)
 the visible interval (:func:`visible_interval`), the golden-section search
 (:func:`golden_section`), the nearest detected landmark (:func:`nearest`), the
 tie rule (:func:`best_index`) and the call itself (:func:`plan_core`, compiled
-by :func:`plan_run` for depth, svd, gdop, cond; run by the interpreter with a
-Python objective through :func:`interpreted` for the other methods and for the
-paper's definitions, ``opnav.landing.planner``).
+by :func:`plan_run` for every :data:`KINDS`; run by the interpreter with a
+Python objective through :func:`interpreted` for ``logdet_nav`` and the paper's
+definitions, ``opnav.landing.planner``); the B-X1 metrics (:func:`info_metric`)
+take per-call constants (:func:`info_constants`).
 
-Per-run constants ``q`` (float64 (24,)): 0-2 C (m), 3-5 v_hat, 6-8 w_hat, 9 |CD|
+Per-run constants ``q`` (float64 (NQ,)): 0-2 C (m), 3-5 v_hat, 6-8 w_hat, 9 |CD|
 (m), 10 gamma (rad), 11 objective kind (:data:`KINDS`), 12 b (m), 13 r_e (m),
 14-16 unit line of sight to the known landmark u, 17 x = 1/rho_known (1/m),
 18-20 boresight in {L}, 21 known landmark usable (1/0), 22 min_range (m),
-23 boresight check on (1/0).
+23 boresight check on (1/0); the B-X1 kinds' slots from :data:`Q_R` on.
 
 Objectives are minimised: the depth error (m), or minus a metric (larger is
 better for every metric). ``+inf`` where the line of sight misses the ground,
@@ -33,11 +34,14 @@ import types
 import numpy as np
 
 from opnav.compiled import kernel, warms
+from opnav.landing import measurement as me
 
-#: objective kinds compiled here (``q[11]``)
-KINDS = {"depth": 0, "svd": 1, "gdop": 2, "cond": 3}
-DEPTH, SVD, GDOP, COND = 0, 1, 2, 3
-NQ = 24
+#: objective kinds compiled here (``q[11]``); the whitened ones are their base + 5
+KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8)
+DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W = 0, 1, 2, 3, 4, 5, 6
+#: q slots of the B-X1 kinds (:func:`info_constants`): R_LtoB (3 x 3, row-major), 1/sigma
+#: (rad^-1); logdet, mineig: log det Lambda_k, Sigma_k (12 x 12); whitened: L, G_k L (2 x 12)
+Q_R, Q_SCALE, Q_LD, Q_SIG, Q_L, Q_A, NQ = 24, 33, 34, 35, 35, 179, 203
 #: the tie rule's relative tolerance: candidates whose score lies within
 #: TIE_RTOL * |best| of the best score are tied, and the lowest landmark index
 #: wins. Paths agree to round-off (~1e-12 relative: closed form vs LAPACK's
@@ -148,8 +152,8 @@ def depth_error(d, cb, sb, b, r_e) -> float:
 
 @kernel
 def h_metric(kind, x, y, c, s2) -> float:
-    """The paper's H baselines in closed form (larger is better): svd = s4, cond =
-    s4/s1, gdop = 1 / sum s_i^-2 of the four structural singular values of H, from
+    """The paper's H baselines in closed form (larger is better, :func:`sv_metric`
+    of the four structural singular values of H), from
     x = 1/rho_known, y = 1/rho_cand (1/m), c = u . w, s2 = |u x w|^2 (squared
     singular values m +- sqrt(e^2 + k_j^2) and D_j / (m + ...), written without
     cancellation; ``opnav.landing.metrics`` derives them)."""
@@ -164,14 +168,75 @@ def h_metric(kind, x, y, c, s2) -> float:
     D2 = base + (1.0 + s2) * xy * xy
     lp1 = m + math.sqrt(e2 + k1 * k1)
     lp2 = m + math.sqrt(e2 + k2 * k2)
-    lm1, lm2 = D1 / lp1, D2 / lp2
-    if kind == SVD:
-        return math.sqrt(min(lm1, lm2))
-    if kind == COND:
-        return math.sqrt(min(lm1, lm2) / max(lp1, lp2))
-    if D1 <= 0.0 or D2 <= 0.0:
+    return sv_metric(kind, max(lp1, lp2), min(lp1, lp2), max(D1 / lp1, D2 / lp2), min(D1 / lp1, D2 / lp2))
+
+
+@kernel
+def sv_metric(base, l1, l2, l3, l4) -> float:
+    """svd = s4, cond = s4 / s1, gdop = 1 / sum s_i^-2 (``base`` SVD, COND, GDOP) from the
+    squares l_i = s_i^2 of the four structural singular values (l1 the largest, l4
+    the smallest); 0 if l4 <= 0."""
+    if not l4 > 0.0:
         return 0.0
-    return 1.0 / ((lp1 + lm1) / D1 + (lp2 + lm2) / D2)
+    if base == SVD:
+        return math.sqrt(l4)
+    if base == COND:
+        return math.sqrt(l4 / l1)
+    return 1.0 / (1.0 / l1 + 1.0 / l2 + 1.0 / l3 + 1.0 / l4)
+
+
+@kernel
+def info_constants(R_LtoB, P, sigma, q) -> None:
+    """Fill the B-X1 slots of q (kind q[11], after :func:`metric_constants`) once per call
+    for the prior P (12 x 12), bearing noise sigma^2 I_6 (rad^2) and the known landmark's
+    rows G_k (:func:`info_metric`, no landmark columns): logdet, mineig: Lambda_k = P^-1 +
+    G_k^T G_k, Sigma_k = Lambda_k^-1, log det Lambda_k (Jacobi-equilibrated); whitened: L = chol(P), G_k L."""
+    q[Q_R:Q_R + 9], q[Q_SCALE] = R_LtoB.ravel(), 1.0 / sigma
+    if q[21] == 0.0:                                 # known landmark unusable: all invalid
+        return
+    G = np.empty((2, 12))
+    me.tangent_rows(R_LtoB, q[14:17] / q[17], q[Q_SCALE], G)
+    G[:, 9:] = 0.0
+    if int(q[11]) >= SVD_W:
+        L = np.linalg.cholesky(P)
+        q[Q_L:Q_L + 144], q[Q_A:Q_A + 24] = L.ravel(), (G @ L).ravel()
+        return
+    Pinv = np.linalg.inv(P)
+    s = 1.0 / np.sqrt(np.diag(Pinv) + (G * G).sum(axis=0))
+    S = np.outer(s, s)
+    Ls = (0.5 * (Pinv + Pinv.T) + G.T @ G) * S
+    Sig = np.linalg.inv(Ls) * S
+    q[Q_SIG:Q_SIG + 144] = (0.5 * (Sig + Sig.T)).ravel()
+    q[Q_LD] = 2.0 * (np.log(np.diag(np.linalg.cholesky(Ls + 12 * 2.0 ** -52 * np.eye(12)))).sum()
+                     - np.log(s).sum())
+
+
+@kernel
+def info_metric(kind, d0, d1, d2, q) -> float:
+    """The B-X1 metric (larger is better) of a valid candidate at offset d (m) from
+    its bearing's tangent-plane rows G = T^T H / sigma (2 x 12, ``measurement.tangent_rows``)
+    and :func:`info_constants`: logdet = log det Lambda_k + log det(I_2 + G Sigma_k G^T)
+    (= log a + log e), mineig = 1 / lambda_max of the Woodbury posterior Sigma_k - (G
+    Sigma_k)^T (I_2 + G Sigma_k G^T)^-1 G Sigma_k (-inf if not positive); whitened:
+    :func:`sv_metric` of [G_k; G] L (4 x 12; the singular values of H_w = R^-1/2 H P^1/2
+    for R = sigma^2 I_6, as b^T H = 0) by the eigenvalues of its 4 x 4 Gram matrix."""
+    G = np.empty((2, 12))
+    me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
+    if kind >= SVD_W:
+        W = np.empty((4, 12))
+        W[:2], W[2:] = q[Q_A:Q_A + 24].reshape((2, 12)), G @ q[Q_L:Q_L + 144].reshape((12, 12))
+        lam = np.linalg.eigvalsh(W @ W.T)
+        return sv_metric(kind - 5, lam[3], lam[2], lam[1], lam[0])
+    Sig = q[Q_SIG:Q_SIG + 144].reshape((12, 12))
+    GS = G @ Sig
+    Q = GS @ G.T
+    a, b = 1.0 + Q[0, 0], 0.5 * (Q[0, 1] + Q[1, 0])
+    e = 1.0 + Q[1, 1] - b * b / a                  # Schur complement, >= 1
+    if kind == LOGDET:
+        return q[Q_LD] + math.log(a) + math.log(e)
+    Sp = Sig - GS.T @ (np.array([[1.0 + Q[1, 1], -b], [-b, a]]) / (a * e)) @ GS
+    lmax = np.linalg.eigvalsh(0.5 * (Sp + Sp.T))[-1]
+    return 1.0 / lmax if lmax > 0 else -math.inf
 
 
 @kernel
@@ -218,8 +283,8 @@ def valid_points(q, pts):
 @kernel
 def score_point(p0, p1, p2, q) -> float:
     """The objective (minimised) of kind q[11] at the ground point p (m): the depth
-    error (eq. 23-25 at the landmark's range) or minus an H baseline (+inf where
-    the candidate is invalid)."""
+    error (eq. 23-25 at the landmark's range) or minus an H baseline or B-X1
+    metric (+inf where the candidate is invalid)."""
     d0, d1, d2 = p0 - q[0], p1 - q[1], p2 - q[2]
     rho = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     kind = int(q[11])
@@ -231,6 +296,8 @@ def score_point(p0, p1, p2, q) -> float:
                            math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / rho, q[12], q[13])
     if not candidate_ok(d0, d1, d2, rho, q):
         return math.inf
+    if kind >= LOGDET:
+        return -info_metric(kind, d0, d1, d2, q)
     y = 1.0 / rho
     w0, w1, w2 = d0 * y, d1 * y, d2 * y
     u0, u1, u2 = q[14], q[15], q[16]
@@ -502,7 +569,8 @@ def plan_core(q, M, kfov, tol, xyz, det, exclude, grid, cells, out) -> None:
 
 
 #: layout of :func:`plan_run`'s constant vector ``c`` (per field, config and camera)
-C_TS, C_NSIGMA, C_TOL, C_KFOV, C_MINRANGE, C_RBC, C_BS, C_PKNOWN, C_GRID, NC = 0, 1, 2, 3, 4, 5, 14, 17, 20, 25
+C_TS, C_NSIGMA, C_TOL, C_KFOV, C_MINRANGE, C_RBC, C_BS, C_PKNOWN, C_GRID = 0, 1, 2, 3, 4, 5, 14, 17, 20
+C_SIGMA, NC = 25, 26
 
 
 @kernel
@@ -510,7 +578,8 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
     """:func:`plan_core` of a compiled objective ``kind`` (:data:`KINDS`) for one
     run: ``c`` (:data:`NC`) = [t_s (s), n_sigma_v, tol (rad), tan half-FOV less
     margin, min_range (m), R_BtoC (9, row-major), boresight_B (3), known landmark
-    (3, m), grid (5, :func:`field_grid`)]; ``work`` (NQ + 9) receives q and out
+    (3, m), grid (5, :func:`field_grid`), sigma_b (rad: the B-X1 kinds' bearing
+    noise sigma_b^2 I_6)]; ``P`` the prior (12 x 12); ``work`` (NQ + 9) receives q and out
     (status at work[NQ + 8]; 0 ok)."""
     q, out = work[:NQ], work[NQ:]
     st = plane(r, v, q)
@@ -521,6 +590,8 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
             st = ZERO_BASELINE
     elif st == OK:
         metric_constants(r, R_LtoB, c[C_BS:C_BS + 3], 1.0, c[C_PKNOWN:C_PKNOWN + 3], c[C_MINRANGE], q)
+        if kind >= LOGDET:
+            info_constants(R_LtoB, P, c[C_SIGMA], q)
     if st != OK:
         out[3], out[8] = 0, st
         return
@@ -542,7 +613,8 @@ def _warm() -> None:
     P = np.eye(12)
     R = np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]])
     c = np.zeros(NC)
-    c[:5], c[C_RBC:C_RBC + 9:4], c[C_BS + 2], c[C_GRID:] = (1.0, 3.0, 1e-3, 0.5, 1e-6), 1.0, -1.0, grid
+    c[:5], c[C_RBC:C_RBC + 9:4], c[C_BS + 2], c[C_GRID:C_SIGMA], c[C_SIGMA] = (
+        (1.0, 3.0, 1e-3, 0.5, 1e-6), 1.0, -1.0, grid, 1e-3)
     work = np.zeros(NQ + 9)
     for kind in KINDS.values():
         plan_run(kind, np.array([10.0, 0, 1000.0]), np.array([-5.0, 0, -20.0]), np.zeros(3), R, P, c,
@@ -551,4 +623,6 @@ def _warm() -> None:
         score_points(q, xyz, det)
         evaluations(q, np.array([-0.1, 0.1]), xyz, det, 1)
     valid_points(q, xyz)
+    info_constants(R, P, 1.0, q)
+    sv_metric(SVD, 1.0, 1.0, 1.0, 1.0)
     nearest(0.0, 0.0, xyz, det, np.int64(3), grid, cells)

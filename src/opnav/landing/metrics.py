@@ -37,17 +37,17 @@ ranges and ``svd``, ``gdop``, ``cond`` rank candidates alike in the descent.
 
 Information metrics need ``ctx.P`` (12 x 12 prior covariance of [r (m), v (m/s),
 dtheta (rad), p (m)]) and ``ctx.R_meas`` (6 x 6, rad^2): log det of Lambda = P^-1
-+ H^T R^-1 H by Cholesky of the Jacobi-equilibrated matrix (:func:`chol_logdet`),
-lambda_min as 1 / lambda_max of the posterior covariance. Caution: one epoch of
-two bearings informs neither velocity nor the new landmark's depth, so with a
-large isotropic landmark prior lambda_min is that prior's for every candidate
-(spread ~2e-15): ``mineig`` then ties everywhere (the planner's tie rule picks
-the lowest index). Fast path (``R_meas`` block diagonal with candidate block
-sigma^2 I_3, the descent case): Lambda_k, Sigma_k = Lambda_k^-1 after the known
-landmark once per context; the candidate adds G^T G, G = sigma^-1 T^T H_c (2 x 12,
-``measurement.tangent_jacobian``): log det Lambda = log det Lambda_k + log det(I_2
-+ G Sigma_k G^T), Sigma_post by Woodbury. Whitened fast path: eigenvalues of the
-6 x 6 Gram matrix H_w H_w^T.
++ H^T R^-1 H (:func:`chol_logdet` in the definition), lambda_min as 1 / lambda_max
+of the posterior covariance. Caution: one epoch of two bearings informs neither
+velocity nor the new landmark's depth, so with a large isotropic landmark prior
+lambda_min is that prior's for every candidate (spread ~2e-15): ``mineig`` then
+ties everywhere (the planner's tie rule picks the lowest index). Fast path for
+``R_meas`` = sigma^2 I_6 (the descent's), compiled (``kernels.info_constants``,
+``kernels.info_metric``): a bearing's information is that of its tangent-plane
+rows G = sigma^-1 T^T H (2 x 12, ``measurement.tangent_rows``): log det Lambda =
+log det Lambda_k + log det(I_2 + G Sigma_k G^T) after the known landmark,
+Sigma_post by Woodbury; whitened: [G_k; G] L (L = chol(P)), the eigenvalues of
+its 4 x 4 Gram matrix. Any other ``R_meas``: the definition (``metric.reference``).
 
 Validity (``kernels.candidate_ok``): a candidate within ``ctx.min_range_m`` of the
 lander or behind the camera (b . boresight_B <= 0; None disables), or with the
@@ -66,11 +66,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from opnav.landing import kernels as K
-from opnav.landing import measurement as me
 
 METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig", "svd_w", "gdop_w", "cond_w")
 H_METRICS = ("svd", "gdop", "cond")
-INFO_METRICS = ("logdet", "mineig")
 #: whitened baselines (B-X1): the paper's H metric of H_w = R^-1/2 H P^1/2
 WHITENED = {"svd_w": "svd", "gdop_w": "gdop", "cond_w": "cond"}
 #: structural rank of the 6 x 12 two-bearing Jacobian (2 per unit bearing)
@@ -80,7 +78,7 @@ PINV_RCOND = 1e-10
 
 
 def _checked(name: str, a, shape: tuple, symmetric: bool = False) -> np.ndarray:
-    a = np.array(a, dtype=float)  # a private copy: the per-context cache must not go stale
+    a = np.array(a, dtype=float, order="C")  # a private copy: the per-context cache must not go stale
     if a.shape != shape:
         raise ValueError(f"MetricContext.{name} must have shape {shape}, got {a.shape}")
     if not np.isfinite(a).all():
@@ -128,18 +126,6 @@ class MetricContext:
             raise ValueError("MetricContext.min_range_m must be finite and >= 0")
         s(self, "_cache", {})
 
-    @classmethod
-    def trusted(cls, r_L, v_L, R_LtoB, p_known_L, P=None, R_meas=None, boresight_B=None,
-                min_range_m: float = 1e-6) -> "MetricContext":
-        """A context from inputs validated once by the caller (per descent): no
-        copies, no checks. Arrays float64 of the documented shapes, unit boresight."""
-        self = object.__new__(cls)
-        for k, v in (("r_L", r_L), ("v_L", v_L), ("R_LtoB", R_LtoB), ("p_known_L", p_known_L),
-                     ("P", P), ("R_meas", R_meas), ("boresight_B", boresight_B),
-                     ("min_range_m", float(min_range_m)), ("_cache", {})):
-            object.__setattr__(self, k, v)
-        return self
-
     def cached(self, key: str, fn):
         """``fn(self)``, computed once per context."""
         c = self._cache
@@ -147,16 +133,24 @@ class MetricContext:
             c[key] = fn(self)
         return c[key]
 
-    def q(self) -> np.ndarray:
-        """The kernels' per-run constants (``kernels.NQ``) of the validity rule and
-        the H baselines (``kernels.metric_constants``)."""
+    def q(self, kind: int = 0) -> np.ndarray:
+        """The kernels' per-run constants (``kernels.NQ``) of objective ``kind`` (``kernels.KINDS``):
+        ``kernels.metric_constants``, and ``kernels.info_constants`` for the B-X1 kinds."""
         def build(ctx):
             q = np.zeros(K.NQ)
             bs = ctx.boresight_B
             K.metric_constants(ctx.r_L, ctx.R_LtoB, np.zeros(3) if bs is None else np.asarray(bs, float),
                                0.0 if bs is None else 1.0, ctx.p_known_L, ctx.min_range_m, q)
+            q[11] = kind
+            if kind >= K.LOGDET:   # ctx.info() checks P and R_meas
+                K.info_constants(ctx.R_LtoB, ctx.info()[0], math.sqrt(ctx.R_meas[0, 0]), q)
             return q
-        return self.cached("q", build)
+        return self.cached(("q", kind), build)
+
+    def isotropic(self) -> bool:
+        """R_meas = sigma^2 I_6 (the compiled B-X1 metrics; module docstring)."""
+        Rm = self.info()[1]
+        return bool(Rm[0, 0] > 0 and np.array_equal(Rm, Rm[0, 0] * np.eye(6)))
 
     def info(self):
         """(P, R_meas, P^-1, R_meas^-1) for the information and whitened metrics."""
@@ -210,14 +204,13 @@ def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
     """The paper's definition on explicit H (n, 6, 12): LAPACK SVD / pseudo-inverse
     of H (or of the whitened H_w), the 12 x 12 information."""
     if name in WHITENED:
-        Ci, L = _whitening(ctx)
-        s = np.linalg.svd(Ci @ H @ L, compute_uv=False)[:, :STRUCTURAL_RANK]
-        return _from_singular_values(WHITENED[name], s)
+        Ci, L = np.linalg.inv(np.linalg.cholesky(ctx.info()[1])), np.linalg.cholesky(ctx.P)
+        return _sv_metric(WHITENED[name], np.linalg.svd(Ci @ H @ L, compute_uv=False))
     if name == "gdop":
         Hp = np.linalg.pinv(H, rcond=PINV_RCOND)  # (H^T H)^+ = H^+ H^+T
         return 1.0 / np.einsum("nij,nij->n", Hp, Hp)
     if name in H_METRICS:
-        return _from_singular_values(name, np.linalg.svd(H, compute_uv=False)[:, :STRUCTURAL_RANK])
+        return _sv_metric(name, np.linalg.svd(H, compute_uv=False))
     P, Rm, Pinv, W = ctx.info()
     Lam = Pinv + np.swapaxes(H, -1, -2) @ W @ H
     Lam = 0.5 * (Lam + np.swapaxes(Lam, 1, 2))
@@ -226,64 +219,9 @@ def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
     return np.linalg.eigvalsh(Lam)[:, 0]
 
 
-def _from_singular_values(base: str, s: np.ndarray) -> np.ndarray:
-    """svd / cond / gdop from the four structural singular values (..., 4), descending."""
-    if base == "svd":
-        return s[..., -1]
-    if base == "cond":
-        return s[..., -1] / s[..., 0]
-    return 1.0 / np.sum(1.0 / (s * s), axis=-1)
-
-
-def _whitening(ctx: MetricContext):
-    """(C^-1 (6, 6), L (12, 12)) with R_meas = C C^T and P = L L^T (cached)."""
-    def build(c):
-        _, Rm, _, _ = c.info()
-        return np.linalg.inv(np.linalg.cholesky(Rm)), np.linalg.cholesky(c.P)
-    return ctx.cached("whiten", build)
-
-
-def _tangent_setup(ctx: MetricContext):
-    """(w = 1/sigma^2, Sigma_k, log det Lambda_k) of the tangent-plane update after
-    the known landmark, or None unless R_meas is block diagonal with an isotropic
-    candidate block sigma^2 I_3 (module docstring)."""
-    def build(c):
-        P, Rm, Pinv, W = c.info()
-        if np.any(Rm[0:3, 3:6]) or not Rm[3, 3] > 0 or not np.array_equal(Rm[3:6, 3:6], Rm[3, 3] * np.eye(3)):
-            return None
-        Hk = me.selection_jacobian(c.r_L, c.R_LtoB, c.p_known_L, c.p_known_L)[0:3]
-        Lk = Pinv + Hk.T @ W[0:3, 0:3] @ Hk
-        Lk = 0.5 * (Lk + Lk.T)
-        sc = 1.0 / np.sqrt(np.diagonal(Lk))
-        Sig = np.linalg.inv(Lk * np.outer(sc, sc)) * np.outer(sc, sc)
-        return 1.0 / Rm[3, 3], 0.5 * (Sig + Sig.T), float(chol_logdet(Lk[None])[0])
-    return ctx.cached("tangent", build)
-
-
-def _fast(name: str, ctx: MetricContext, p: np.ndarray) -> np.ndarray:
-    """The fast path of ``name`` for valid candidates p (k, 3)."""
-    if name in WHITENED:
-        Ci, L = _whitening(ctx)
-        Hw = Ci @ me.selection_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, p) @ L
-        lam = np.linalg.eigvalsh(Hw @ np.swapaxes(Hw, -1, -2))[..., ::-1][..., :STRUCTURAL_RANK]
-        return _from_singular_values(WHITENED[name], np.sqrt(np.maximum(lam, 0.0)))
-    tg = _tangent_setup(ctx)
-    if tg is None:
-        return _scores_from_H(name, me.selection_jacobian(ctx.r_L, ctx.R_LtoB, ctx.p_known_L, p), ctx)
-    w, Sig, ld = tg
-    G = me.tangent_jacobian(ctx.r_L, ctx.R_LtoB, p, math.sqrt(w))     # (k, 2, 12)
-    GS = G @ Sig
-    Q = GS @ np.swapaxes(G, -1, -2)
-    a = 1.0 + Q[:, 0, 0]
-    b = 0.5 * (Q[:, 0, 1] + Q[:, 1, 0])
-    e = 1.0 + Q[:, 1, 1] - b * b / a                                   # Schur complement, >= 1
-    if name == "logdet":
-        return ld + np.log(a) + np.log(e)
-    Minv = np.stack([np.stack([1.0 + Q[:, 1, 1], -b], -1), np.stack([-b, a], -1)], -2) / (a * e)[:, None, None]
-    Sp = Sig - np.swapaxes(GS, -1, -2) @ Minv @ GS
-    lmax = np.linalg.eigvalsh(0.5 * (Sp + np.swapaxes(Sp, -1, -2)))[:, -1]
-    with np.errstate(divide="ignore"):
-        return np.where(lmax > 0, 1.0 / lmax, -np.inf)
+def _sv_metric(base: str, s: np.ndarray) -> np.ndarray:
+    """``kernels.sv_metric`` of the structural singular values of each row of s (n, >= 4), descending."""
+    return np.array([K.sv_metric(K.KINDS[base], *(x * x for x in row[:STRUCTURAL_RANK])) for row in s])
 
 
 class Metric:
@@ -319,11 +257,10 @@ class Metric:
         return out
 
     def __call__(self, ctx: MetricContext, cand_L) -> np.ndarray:
-        if self.name in H_METRICS:                   # compiled closed form
-            q = ctx.q().copy()
-            q[11] = K.KINDS[self.name]
-            return self._scored(ctx, cand_L, lambda c: -K.score_points(q, c, np.arange(len(c))))
-        return self._scored(ctx, cand_L, lambda c: _fast(self.name, ctx, c))
+        if self.name not in H_METRICS and not ctx.isotropic():  # no compiled form: the definition
+            return self.reference(ctx, cand_L)
+        q = ctx.q(K.KINDS[self.name])
+        return self._scored(ctx, cand_L, lambda c: -K.score_points(q, c, np.arange(len(c))))
 
     def reference(self, ctx: MetricContext, cand_L) -> np.ndarray:
         """The paper's definition: H of every candidate from the CasADi derivation

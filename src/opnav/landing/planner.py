@@ -26,10 +26,10 @@ the vertical plane holding the estimated velocity) differs:
 Degenerate geometry or no visible interval: the detected landmark nearest to
 the boresight's ground point, ``note`` says why.
 
-Objectives: ``depth`` (eq. 23-25) and the H baselines ``svd``, ``gdop``, ``cond``
-are compiled (``kernels.objective``); the B-X1 metrics (``metrics`` fast path at
-the ground point) and ``logdet_nav`` (``planned_info``) are Python objectives run
-through the same call's source (``kernels.interpreted``); :data:`PICKERS` search nothing.
+Objectives: ``depth`` (eq. 23-25), the H baselines and the B-X1 metrics
+(``kernels.KINDS``) are compiled (``kernels.objective``); ``logdet_nav``
+(``planned_info``) is a Python objective run through the same call's source
+(``kernels.interpreted``); :data:`PICKERS` search nothing.
 
 Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer would
 run) and ``paper`` (the paper's definition through the same call, interpreted:
@@ -156,16 +156,16 @@ def _ratio(method: str) -> Callable[[float, float], float]:
 
 def _metric_context(state: PlanState, cfg: PlannerConfig, camera: Camera) -> metrics.MetricContext:
     """The metrics' context of a planning state (bearing noise sigma_b^2 I, rad^2)."""
-    return metrics.MetricContext.trusted(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
-                                         p_known_L=np.asarray(cfg.p_known, float), P=state.P,
-                                         R_meas=camera.sigma_b ** 2 * np.eye(6),
-                                         boresight_B=camera.boresight_B, min_range_m=MIN_RANGE_M)
+    return metrics.MetricContext(r_L=state.r, v_L=state.v, R_LtoB=state.R_LtoB,
+                                 p_known_L=np.asarray(cfg.p_known, float), P=0.5 * (state.P + state.P.T),
+                                 R_meas=camera.sigma_b ** 2 * np.eye(6), boresight_B=camera.boresight_B,
+                                 min_range_m=MIN_RANGE_M)
 
 
 def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera: Camera, q: np.ndarray):
     """``(f(beta, q), scores(q, xyz, cand), status)`` of a method the interpreter
-    runs: the paper's definitions (``cfg.eval_path == "paper"``) and the B-X1
-    objectives; both minimised, ``+inf`` where the line of sight misses the ground."""
+    runs: the paper's definitions (``cfg.eval_path == "paper"``) and ``logdet_nav``;
+    both minimised, ``+inf`` where the line of sight misses the ground."""
     if method == "depth":               # the paper's eq. 23-25 (law of sines, numpy)
         b = baseline(state.v, state.a, cfg.t_s)
         if not b > 0:
@@ -187,9 +187,7 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
                                                 p_known, pts, **kw)
     else:
         ctx = _metric_context(state, cfg, camera)
-        m = metrics.make_metric(method)
-        call = m.reference if cfg.eval_path == "paper" else m
-        score = lambda pts: -call(ctx, pts)
+        score = lambda pts: -metrics.make_metric(method).reference(ctx, pts)
 
     def f(beta, q):
         hit, x, y, z = K.ground_point(beta, q)
@@ -212,13 +210,9 @@ def _setup(field_: LandmarkField, cfg: PlannerConfig, camera: Camera):
         xyz = np.ascontiguousarray(field_.xyz, float)
         grid, cells = K.field_grid(xyz)
         c = np.concatenate([[cfg.t_s, cfg.n_sigma_v, cfg.tol_rad, _kfov(camera, cfg.margin_px), MIN_RANGE_M],
-                            camera.R_BtoC.ravel(), camera.boresight_B, cfg.p_known, grid])
+                            camera.R_BtoC.ravel(), camera.boresight_B, cfg.p_known, grid, [camera.sigma_b]])
         _CACHE[key] = (field_, cfg, camera, xyz, c, cells)
     return _CACHE[key][3:]
-
-
-def _candidates(detected: np.ndarray, exclude: int) -> np.ndarray:
-    return detected[detected != exclude]
 
 
 def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
@@ -230,7 +224,7 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     (-1: none)."""
     kind = K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
     if kind < 0 and method in PICKERS:
-        cand = _candidates(detected, exclude)
+        cand = detected[detected != exclude]
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
                           math.nan, 0, 0), None
@@ -274,7 +268,7 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
 
 def _diagnose(res: PlanResult, q, state, camera, field_, cfg, detected, exclude) -> None:
     """``res.pick_ratio``: the picked landmark's score over the best detected one's."""
-    cand = _candidates(detected, exclude)
+    cand = detected[detected != exclude]
     if res.index < 0 or not cand.size or not math.isfinite(res.beta):
         return
     vals = candidate_scores(res.method, state, camera, field_, cfg, q, cand)
