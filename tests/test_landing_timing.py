@@ -154,3 +154,146 @@ def test_b_f7_boxes_are_the_replayed_times():
     notes = sorted(t.get_text() for t in ax.texts)
     assert notes == ["123", "4567"]
     assert "97.3 % less" in ax.get_title()        # 100 (1 - 123 / 4567)
+
+
+# ----------------------------------------------------- the paper path's subset
+
+@given(st.integers(0, 400), st.integers(0, 500), st.integers(0, 600))
+def test_paper_subset_is_select_calls_over_the_replayed_calls(n_pool, m, mp):
+    """The paper path's calls are ``select_calls`` over the replay positions:
+    evenly spaced (gaps differ by at most one), deterministic, 0 or >= the
+    replayed calls = all of them, never more than the replayed calls."""
+    nc = len(timing.select_calls(n_pool, m))
+    sub = timing.select_calls(nc, mp, "landing.timing.max_calls_paper")
+    want = nc if mp == 0 or mp >= nc else mp
+    assert len(sub) == want and np.all(np.diff(sub) > 0)
+    assert want == 0 or (sub[0] == 0 and sub[-1] < nc)
+    if want > 1:
+        gaps = np.diff(np.append(sub, nc))
+        assert gaps.max() - gaps.min() <= 1
+    np.testing.assert_array_equal(sub, timing.select_calls(nc, mp))
+
+
+def test_bad_max_calls_paper_names_the_key():
+    from opnav.config import validate_config
+    from opnav.errors import ConfigError
+
+    with pytest.raises(ValueError, match="landing.timing.max_calls_paper must be >= 0"):
+        timing.select_calls(10, -1, "landing.timing.max_calls_paper")
+    cfg = load_config()
+    assert cfg["landing"]["timing"]["max_calls_paper"] >= 0
+    bad = copy.deepcopy(cfg)
+    bad["landing"]["timing"]["max_calls_paper"] = -2
+    with pytest.raises(ConfigError, match=r"^invalid config key 'landing.timing.max_calls_paper'"):
+        validate_config(bad)
+    bad["landing"]["timing"]["max_calls_paper"] = 2.5
+    with pytest.raises(ConfigError, match="landing.timing.max_calls_paper"):
+        validate_config(bad)
+
+
+def test_replay_times_the_paper_path_on_its_subset_only(recorded):
+    """max_calls_paper = 4 of 12 replayed calls: the compiled variants run on
+    every call, the paper-path ones on the 4 evenly spaced calls only (the
+    others marked -1 / pick -2, not run); the rotation rule puts every variant
+    first in turn within each kind of call; picks equal the full replay's."""
+    scn, rec = recorded
+    a = timing.replay(scn, rec, list(METHODS), max_calls=12, max_calls_paper=4)
+    full = timing.replay(scn, rec, list(METHODS), max_calls=12, max_calls_paper=0)
+    sub = timing.select_calls(12, 4)
+    paper = timing.paper_limited([(m, p, type("C", (), {"eval_path": e}))
+                                  for m, p, e in zip(a["variant_method"], a["variant_path"],
+                                                     a["variant_eval_path"])])
+    assert paper.sum() == 2 and set(a["variant_eval_path"][paper]) == {"paper"}
+    tmd = a["timed"]
+    assert tmd[:, ~paper].all()
+    np.testing.assert_array_equal(np.flatnonzero(tmd[:, paper].all(axis=1)), sub)
+    assert not tmd[np.setdiff1d(np.arange(12), sub)][:, paper].any()
+    off = ~tmd
+    assert (a["wall_ns"][off] == -1).all() and (a["cpu_ns"][off] == -1).all()
+    assert (a["pick"][off] == -2).all() and (a["slot"][off] == -1).all() and (a["n_evals"][off] == -1).all()
+    assert (a["wall_ns"][tmd] > 0).all()
+    np.testing.assert_array_equal(a["pick"][tmd], full["pick"][tmd])
+    assert full["timed"].all() and a["mismatch"].sum() == 0
+    # rotation: every subset call runs all variants, the others the compiled ones;
+    # within each kind the first slot goes to each variant in turn
+    nv = tmd.shape[1]
+    first_sub = [int(np.flatnonzero(a["slot"][q] == 0)[0]) for q in sub]
+    assert first_sub == [0, 1, 2, 3]           # i-th subset call: configured order rotated by i
+    rest = [q for q in range(12) if q not in set(sub)]
+    firsts = [int(np.flatnonzero(a["slot"][q] == 0)[0]) for q in rest]
+    assert set(firsts) == set(np.flatnonzero(~paper)) and nv - 2 == len(set(firsts))
+    s = timing.method_summary(a)
+    assert s["timed_calls"] == 12 and s["timed_calls_paper"] == 4 and s["max_calls_paper"] == 4
+    assert "on 4 of them" in timing.method_text(a)
+    assert timing.method_summary(full)["timed_calls_paper"] == 12
+
+
+def _subset_timing(n=40, every=4):
+    """Fake replay: depth and svd on main (all n calls) and on alt (every
+    ``every``-th call); the untimed alt entries hold -1 (as the replay writes)."""
+    runs = np.repeat(np.arange(8), n // 8)
+    main_d, main_s = np.full(n, 100.0), np.full(n, 400.0)
+    alt_d = np.where(np.arange(n) % 2 == 0, 1000.0, 3000.0)      # subset calls (even) cost 1000
+    alt_s = np.full(n, 5000.0)
+    alt_s[np.arange(n) % every != 0] = 50.0                        # not on the subset
+    tm = timing.from_times({"depth": main_d * 1e3, "svd": main_s * 1e3, "depth@": alt_d * 1e3,
+                            "svd@": alt_s * 1e3},
+                           {"depth": main_d * 1e3, "svd": main_s * 1e3, "depth@": alt_d * 1e3,
+                            "svd@": alt_s * 1e3}, runs, n_evals=7)
+    tm["variant_method"] = np.array(["depth", "svd", "depth", "svd"])
+    tm["variant_path"] = np.array(["main", "main", "alt", "alt"])
+    tm["variant_eval_path"] = np.array(["compiled", "compiled", "paper", "paper"])
+    tm["methods"] = np.array(["depth", "svd"])
+    tm["mismatch"], tm["checked"] = np.zeros(2, np.int64), np.zeros(2, np.int64)
+    sub = np.arange(n) % every == 0
+    tm["timed"][~sub, 2:] = False
+    for k in ("wall_ns", "cpu_ns", "n_evals", "slot"):
+        tm[k][~sub, 2:] = -1
+    tm["n_evals"][sub, 2:] = 31
+    tm["max_calls_paper"] = np.int64(n // every)
+    return tm, sub
+
+
+def test_consumers_ignore_untimed_entries(recorded):
+    """Medians, evaluations, quantiles, per-run medians, B-T3, B-F7 and the
+    method summary read only the timed entries: the -1 entries (three quarters
+    of the paper path's calls) would drag every paper-path median to -1 us."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from opnav.landing.plots import fig_planning_time
+
+    tm, sub = _subset_timing()
+    assert timing.median_us(tm, "svd", "alt") == pytest.approx(5000.0)
+    assert timing.median_us(tm, "depth", "alt", clock="cpu") == pytest.approx(1000.0)
+    assert timing.times_ns(tm, "svd", "alt").size == sub.sum()
+    assert timing.median_evals(tm, "svd", "alt") == 31 and timing.median_evals(tm, "svd") == 7
+    assert timing.timed_calls(tm, "svd", "alt") == 10 and timing.timed_calls(tm, "svd") == 40
+    f = timing.summary_frame(tm).set_index(["method", "path"])
+    assert f.loc[("svd", "alt"), "calls"] == 10 and f.loc[("svd", "alt"), "wall_p05_us"] == pytest.approx(5000)
+    assert f.loc[("depth", "alt"), "median_evals"] == 31
+    assert set(timing.per_run_median_us(tm, "svd", path="alt").values()) == {5000.0}
+    assert timing.method_summary(tm)["timed_calls_paper"] == 10
+    _, rec = recorded
+    t = summary_table({m: copy.copy(rec[m]) for m in ("depth", "svd")}, tm).set_index("method")
+    assert t.loc["svd", "median_plan_time_alt_us"] == pytest.approx(5000.0)
+    assert t.loc["depth", "timed_calls_alt"] == 10 and t.loc["depth", "timed_calls"] == 40
+    assert t.loc["depth", "time_reduction_vs_svd_alt_pct"] == pytest.approx(80.0)
+    fig = fig_planning_time(tm, ["depth", "svd"], 29.03)
+    assert sorted(x.get_text() for x in fig.axes[0].texts) == ["100", "1000", "400", "5000"]
+    assert "80.0 %" in fig.axes[0].get_title() and "10 of the calls" in fig.axes[0].get_xlabel()
+
+
+def test_reductions_across_paths_use_the_common_subset():
+    """depth compiled (every call) vs svd paper (the subset): the medians come
+    from the calls timed on both; the main-path depth times outside the subset
+    (here 1 us) would move the result if they were used."""
+    tm, sub = _subset_timing()
+    tm["wall_ns"][~sub, 0] = 1000                                  # 1 us off the subset
+    red, sd = timing.time_reduction(tm, "depth", "svd", path_a="main", path_b="alt", n_boot=50)
+    assert red == pytest.approx(100 * (1 - 100 / 5000)) and sd == pytest.approx(0.0, abs=1e-9)
+    assert timing.time_reduction(tm, "depth", "svd", path_a="alt", path_b="alt", n_boot=0)[0] \
+        == pytest.approx(80.0)
+    assert timing.median_us(tm, "depth") == pytest.approx(1.0)      # its own median: every call
+    tm["timed"][:, 3] = False
+    assert np.isnan(timing.time_reduction(tm, "depth", "svd", path_b="alt")[0])

@@ -19,6 +19,7 @@ rule landing_timing:
         landing=lambda wc: B_SIMS[wc.bscn],
         methods=X1_METHODS,
         max_calls=config["landing"]["timing"]["max_calls"],
+        max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
     priority: 10        # a long job on the critical path (speed only)
     log:
         f"{LANDING}/logs/timing_{{bscn}}.log",

@@ -14,7 +14,8 @@ with script_context(snakemake) as log:
     methods = list(snakemake.params.methods)
     recorded = {m: load(p) for m, p in zip(methods, snakemake.input.mc)}
     tm = timing.replay(build_scenario(snakemake.params.landing), recorded, methods,
-                       int(snakemake.params.max_calls))
+                       int(snakemake.params.max_calls),
+                       max_calls_paper=int(snakemake.params.max_calls_paper))
     timing.save(snakemake.output[0], tm)
     log.info("%s", timing.method_text(tm))
     log.info("%s", timing.summary_frame(tm).to_string())

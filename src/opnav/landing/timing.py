@@ -17,13 +17,28 @@ subset of at most ``max_calls`` of them, evenly spaced by pool index
 (``planner.plan``) on both paths (the configured one, ``compiled``: the kernels
 a lander's computer would run, and ``planner.alternative_path``, ``paper``: the
 paper's definition interpreted, CasADi H and LAPACK SVD), one
-call at a time in one process. For the ``q``-th replayed call the variants
-(method, path) run in the configured order rotated by ``q`` (never ordered by
-a clock), so slow drifts of the machine (frequency, other processes) fall on
-every method alike; every method is timed on the same states, so the
-comparison is paired per call. Each call is timed by ``time.perf_counter_ns``
-(wall) and ``time.thread_time_ns`` (CPU time of the calling thread, which
-other processes do not inflate), around ``planner.plan`` with the image's
+call at a time in one process. The variants on the paper's definition that are
+not the configured path (``alt`` when ``eval_path`` is ``compiled``; an edge call
+of an H baseline scores every detected landmark through CasADi, 0.4 s per call
+in site-tilt) are timed on a subset of the replayed calls only: at most
+``max_calls_paper`` of them, evenly spaced over the replayed calls by the same
+rule (``select_calls(n_replayed, max_calls_paper)`` over replay positions, so the
+subset spans the descent; 0 or at least the replayed calls: all of them). The
+calls outside it are not run on those variants and marked untimed (``timed``
+false; ``wall_ns`` = ``cpu_ns`` = ``n_evals`` = ``slot`` = -1, ``pick`` = -2);
+every consumer below reads timed entries only, and a comparison of two variants
+(:func:`time_reduction`) uses the calls timed on both. So a median on the
+configured path rests on every replayed call, one on the paper's definition
+on the subset (``method_summary``: ``timed_calls``, ``timed_calls_paper``).
+Order rule: on the ``i``-th call of the subset every variant runs, in the
+configured order rotated left by ``i``; on the ``j``-th call outside it the
+variants timed there run in their configured order rotated left by ``j``
+(never ordered by a clock), so slow drifts of the machine (frequency, other
+processes) fall on every method alike and every variant comes first in turn;
+every method is timed on the same states, so the comparison is paired per
+call. Each call is timed by ``time.perf_counter_ns`` (wall) and
+``time.thread_time_ns`` (CPU time of the calling thread, which other
+processes do not inflate), around ``planner.plan`` with the image's
 detected landmarks given (the feature detector's list, computed from the
 truth pose before the clock starts, as in the descent) and without the
 pick-ratio diagnostic. The garbage collector is held during the timed calls
@@ -48,20 +63,20 @@ import numpy as np
 
 from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 
-__all__ = ["select_calls", "variants", "replay", "save", "load", "times_ns", "median_us",
-           "time_reduction", "method_text", "summary_frame", "median_evals", "from_times", "method_summary",
-           "call_overhead", "replay_own", "per_run_median_us"]
+__all__ = ["select_calls", "variants", "paper_limited", "replay", "timed", "save", "load", "times_ns",
+           "median_us", "time_reduction", "timed_calls", "method_text", "summary_frame", "median_evals",
+           "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us"]
 
 
 # ----------------------------------------------------------------- replay
 
-def select_calls(n_pool: int, max_calls: int) -> np.ndarray:
+def select_calls(n_pool: int, max_calls: int, key: str = "landing.timing.max_calls") -> np.ndarray:
     """Pool indices replayed: all if ``max_calls`` is 0 or at least ``n_pool``,
     else ``max_calls`` indices evenly spaced over the pool (``floor(i n / m)``,
-    distinct, increasing; deterministic)."""
+    distinct, increasing; deterministic). ``key`` names the limit in the error."""
     n, m = int(n_pool), int(max_calls)
     if m < 0:
-        raise ValueError(f"landing.timing.max_calls must be >= 0, got {m}")
+        raise ValueError(f"{key} must be >= 0, got {m}")
     if m == 0 or m >= n:
         return np.arange(n, dtype=np.int64)
     return (np.arange(m, dtype=np.int64) * n) // m
@@ -81,6 +96,14 @@ def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
         if alt and m not in PICKERS and m != "logdet_nav":
             out.append((m, "alt", alt_cfg))
     return out
+
+
+def paper_limited(var) -> np.ndarray:
+    """Per variant of :func:`variants`, whether ``landing.timing.max_calls_paper``
+    limits it: the paper's definition on the other path (``alt`` with
+    ``eval_path == "paper"``); the configured path is always timed on every
+    replayed call (it carries the pick check)."""
+    return np.array([p == "alt" and getattr(c, "eval_path", "") == "paper" for _, p, c in var], bool)
 
 
 def _pool(recorded: dict) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -103,7 +126,8 @@ def _pool(recorded: dict) -> tuple[np.ndarray, np.ndarray, list[str]]:
             np.concatenate(pos) if pos else np.zeros(0, np.int64), names)
 
 
-def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: bool = True) -> dict:
+def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: bool = True,
+           max_calls_paper: int = 0) -> dict:
     """Replay recorded planning calls through every method (module docstring).
 
     ``scn``: the descent's scenario (``descent.build_scenario``); ``recorded``:
@@ -111,11 +135,14 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     the calls; ``methods``: the methods timed. Returns arrays: per replayed call
     ``source`` (position in ``sources``), ``run``, ``call`` (position in its
     source's calls), ``step``; per call and variant ``wall_ns``, ``cpu_ns``,
-    ``pick``, ``n_evals``, ``slot`` (position in that call's order); per
-    variant ``variant_method``, ``variant_path``, ``variant_eval_path``; per
-    method of ``methods`` ``mismatch`` (recorded pick != replayed pick, own
-    calls) and ``checked`` (own calls replayed); ``n_pool``, ``max_calls``.
-    ``alt = False`` times the configured evaluation path only.
+    ``pick``, ``n_evals``, ``slot`` (position in that call's order), ``timed``
+    (false: not run, the entries -1, pick -2); per variant ``variant_method``,
+    ``variant_path``, ``variant_eval_path``; per method of ``methods``
+    ``mismatch`` (recorded pick != replayed pick, own calls) and ``checked``
+    (own calls replayed); ``n_pool``, ``max_calls``, ``max_calls_paper``.
+    ``alt = False`` times the configured evaluation path only;
+    ``max_calls_paper`` limits the paper's-definition variants on the other path
+    to that many of the replayed calls, evenly spaced (0: all; module docstring).
     """
     from opnav.landing.planner import PlanState, plan
 
@@ -126,14 +153,19 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     sel = select_calls(len(src), max_calls)
     var = variants(methods, scn.planner, alt)
     nv, nc = len(var), len(sel)
+    limited = paper_limited(var)
+    timed_ = np.ones((nc, nv), bool)
+    timed_[:, limited] = False
+    sub = select_calls(nc, max_calls_paper, "landing.timing.max_calls_paper")
+    timed_[np.ix_(sub, np.flatnonzero(limited))] = True
     cam, field_, xyz = scn.camera, scn.field, scn.field.xyz
     tr = scn.truth
     margin = scn.planner.margin_px
-    wall = np.zeros((nc, nv), np.int64)
-    cpu = np.zeros((nc, nv), np.int64)
+    wall = np.full((nc, nv), -1, np.int64)
+    cpu = np.full((nc, nv), -1, np.int64)
     pick = np.full((nc, nv), -2, np.int64)
-    evals = np.zeros((nc, nv), np.int64)
-    slot = np.zeros((nc, nv), np.int64)
+    evals = np.full((nc, nv), -1, np.int64)
+    slot = np.full((nc, nv), -1, np.int64)
     own = {m: (names.index(m) if m in names else -1) for m in methods}
     mismatch = np.zeros(len(methods), np.int64)
     checked = np.zeros(len(methods), np.int64)
@@ -163,12 +195,18 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     gc_was = gc.isenabled()
     gc.collect()
     gc.disable()
+    # rotation counter per kind of call (all variants / those of the configured path)
+    kind = timed_.all(axis=1)
+    turn = np.zeros(nc, np.int64)
+    for kd in (True, False):
+        turn[kind == kd] = np.arange(int(np.sum(kind == kd)))
     try:
         for q in range(nc):
             d, i, k, state, visible, exclude, det, words = inputs(q)
             run[q] = int(d["plan_run"][i]) if "plan_run" in d else -1
             step[q] = k
-            for s_, v in enumerate(np.roll(np.arange(nv), -(q % nv))):
+            order = np.flatnonzero(timed_[q])
+            for s_, v in enumerate(np.roll(order, -(int(turn[q]) % len(order)))):
                 m, _, cfg = var[v]
                 rng = rng_from_words(words)
                 t0 = perf()
@@ -194,11 +232,13 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     return {"sources": np.array(names), "methods": np.array(methods),
             "source": src[sel], "call": pos[sel], "run": run, "step": step,
             "wall_ns": wall, "cpu_ns": cpu, "pick": pick, "n_evals": evals, "slot": slot,
+            "timed": timed_,
             "variant_method": np.array([v[0] for v in var]),
             "variant_path": np.array([v[1] for v in var]),
             "variant_eval_path": np.array([v[2].eval_path for v in var]),
             "mismatch": mismatch, "checked": checked,
-            "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls)}
+            "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls),
+            "max_calls_paper": np.int64(max_calls_paper)}
 
 
 def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
@@ -211,10 +251,12 @@ def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
     return replay(scn, {method: d}, [method], max_calls, alt=False)
 
 
-def per_run_median_us(tm: dict, method: str, clock: str = "wall") -> dict[int, float]:
-    """Median replayed planning time (us) per run (the run of the recorded call)."""
-    t = times_ns(tm, method, "main", clock)
-    run = np.asarray(tm["run"])
+def per_run_median_us(tm: dict, method: str, clock: str = "wall", path: str = "main") -> dict[int, float]:
+    """Median replayed planning time (us) per run (the run of the recorded call),
+    over the calls timed on ``path``."""
+    t = times_ns(tm, method, path, clock)
+    j = _variant(tm, method, path)
+    run = np.asarray(tm["run"])[timed(tm)[:, j]] if j is not None else np.zeros(0, np.int64)
     return {int(r): float(np.median(t[run == r]) / 1e3) for r in np.unique(run)}
 
 
@@ -230,10 +272,11 @@ def from_times(wall_ns: dict, cpu_ns: dict, run, n_evals: int = 0) -> dict:
             "wall_ns": np.column_stack([np.asarray(wall_ns[m]) for m in methods]).astype(np.int64),
             "cpu_ns": np.column_stack([np.asarray(cpu_ns[m]) for m in methods]).astype(np.int64),
             "pick": np.full((n, k), -2, np.int64), "n_evals": np.full((n, k), int(n_evals), np.int64),
-            "slot": np.zeros((n, k), np.int64), "variant_method": np.array(methods),
+            "slot": np.zeros((n, k), np.int64), "timed": np.ones((n, k), bool),
+            "variant_method": np.array(methods),
             "variant_path": np.array(["main"] * k), "variant_eval_path": np.array(["main"] * k),
             "mismatch": np.zeros(k, np.int64), "checked": np.zeros(k, np.int64),
-            "n_pool": np.int64(n), "max_calls": np.int64(0)}
+            "n_pool": np.int64(n), "max_calls": np.int64(0), "max_calls_paper": np.int64(0)}
 
 
 # ----------------------------------------------------------------- consumers
@@ -246,24 +289,41 @@ def _variant(tm: dict, method: str, path: str) -> int | None:
     return None
 
 
+def timed(tm: dict) -> np.ndarray:
+    """``(calls, variants)``: whether the replay ran that variant on that call
+    (false for the paper path's calls outside its subset; a replay saved before
+    the flag: every entry with a time >= 0)."""
+    if "timed" in tm:
+        return np.asarray(tm["timed"], bool)
+    return np.asarray(tm["wall_ns"]) >= 0
+
+
 def times_ns(tm: dict, method: str, path: str = "main", clock: str = "wall") -> np.ndarray:
-    """Per replayed call, the planning time (ns) of ``method`` on ``path``
-    (``"main"`` / ``"alt"``) by ``clock`` (``"wall"``: perf_counter, ``"cpu"``:
-    thread CPU); empty if that variant was not timed."""
+    """The planning times (ns) of ``method`` on ``path`` (``"main"`` /
+    ``"alt"``) by ``clock`` (``"wall"``: perf_counter, ``"cpu"``: thread CPU),
+    one per replayed call timed on that variant (:func:`timed`), in replay
+    order; empty if that variant was not timed."""
     if clock not in ("wall", "cpu"):
         raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
     j = _variant(tm, method, path)
     if j is None:
         return np.zeros(0, np.int64)
-    return np.asarray(tm[f"{clock}_ns"])[:, j]
+    return np.asarray(tm[f"{clock}_ns"])[timed(tm)[:, j], j]
+
+
+def timed_calls(tm: dict, method: str, path: str = "main") -> int:
+    """Replayed calls timed on ``method``'s ``path`` variant (0 if none)."""
+    j = _variant(tm, method, path)
+    return 0 if j is None else int(np.sum(timed(tm)[:, j]))
 
 
 def median_evals(tm: dict, method: str, path: str = "main") -> float:
-    """Median objective evaluations per replayed call (nan if none)."""
+    """Median objective evaluations per timed replayed call (nan if none)."""
     j = _variant(tm, method, path)
-    if j is None or not len(tm["source"]):
+    if j is None:
         return math.nan
-    return float(np.median(np.asarray(tm["n_evals"])[:, j]))
+    ev = np.asarray(tm["n_evals"])[timed(tm)[:, j], j]
+    return float(np.median(ev)) if ev.size else math.nan
 
 
 def median_us(tm: dict, method: str, path: str = "main", clock: str = "wall") -> float:
@@ -275,16 +335,24 @@ def median_us(tm: dict, method: str, path: str = "main", clock: str = "wall") ->
 def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str = "main",
                    path_b: str = "main", n_boot: int = 200, seed: int = 0) -> tuple[float, float]:
     """``100 (1 - median_a / median_b)`` (%) of the planning times of methods
-    ``a`` (on ``path_a``) and ``b`` (``path_b``) on the same replayed calls,
-    and its bootstrap standard deviation: clusters (source Monte Carlo, run)
+    ``a`` (on ``path_a``) and ``b`` (``path_b``) on the same replayed calls (those
+    timed on both variants: the paper path's subset when either is on it), and
+    its bootstrap standard deviation: clusters (source Monte Carlo, run)
     resampled with replacement, both methods from the same resample (paired).
-    ``nan`` if a variant is missing; the spread is ``nan`` below two clusters
-    or two resamples."""
-    ta, tb = times_ns(tm, a, path_a, clock), times_ns(tm, b, path_b, clock)
-    if not ta.size or not tb.size:
+    ``nan`` if a variant is missing or no call was timed on both; the spread is
+    ``nan`` below two clusters or two resamples."""
+    if clock not in ("wall", "cpu"):
+        raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
+    ja, jb = _variant(tm, a, path_a), _variant(tm, b, path_b)
+    if ja is None or jb is None:
         return math.nan, math.nan
+    both = timed(tm)[:, ja] & timed(tm)[:, jb]
+    if not both.any():
+        return math.nan, math.nan
+    t = np.asarray(tm[f"{clock}_ns"])[both]
+    ta, tb = t[:, ja], t[:, jb]
     red = 100.0 * (1.0 - float(np.median(ta)) / float(np.median(tb)))
-    key = np.asarray(tm["source"]) * (1 << 32) + np.asarray(tm["run"])
+    key = (np.asarray(tm["source"]) * (1 << 32) + np.asarray(tm["run"]))[both]
     clusters, inv = np.unique(key, return_inverse=True)
     if len(clusters) < 2 or n_boot < 2:
         return red, math.nan
@@ -299,13 +367,22 @@ def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str
 
 def method_summary(tm: dict) -> dict:
     """The replay's method in numbers (summary JSON, manuscript macros): calls
-    replayed and recorded, ``max_calls``, methods timed, own calls checked and
-    pick mismatches."""
+    replayed and recorded, ``max_calls``, the calls the paper's definition was
+    timed on (``timed_calls_paper``, 0 if not timed) and ``max_calls_paper``,
+    methods timed, own calls checked and pick mismatches."""
     return {"method": "replay", "timed_calls": int(len(tm["source"])), "recorded_calls": int(tm["n_pool"]),
             "max_calls": int(tm["max_calls"]), "all_calls": bool(len(tm["source"]) == int(tm["n_pool"])),
+            "timed_calls_paper": _paper_calls(tm), "max_calls_paper": int(tm.get("max_calls_paper", 0)),
             "n_methods": int(len(tm["methods"])), "checked_calls": int(np.sum(tm["checked"])),
             "pick_mismatches": int(np.sum(tm["mismatch"])),
             "sources_text": ", ".join(str(x) for x in tm["sources"])}
+
+
+def _paper_calls(tm: dict) -> int:
+    """Replayed calls on which the paper's definition was timed (on whichever
+    path it is; 0 if it was not timed)."""
+    paper = np.asarray(tm["variant_eval_path"]).astype(str) == "paper"
+    return int(np.sum(timed(tm)[:, paper].any(axis=1))) if paper.any() else 0
 
 
 def method_text(tm: dict) -> str:
@@ -316,29 +393,36 @@ def method_text(tm: dict) -> str:
               f"{n} of the {pool} recorded planning calls (every {pool / n:.1f}th by index, "
               f"landing.timing.max_calls = {int(tm['max_calls'])})")
     mis = int(np.sum(tm["mismatch"]))
+    npaper = _paper_calls(tm)
+    paper = ("" if npaper in (0, n) else
+             f"; the paper's definition (interpreted, CasADi H) on {npaper} of them, evenly spaced "
+             f"(landing.timing.max_calls_paper = {int(tm.get('max_calls_paper', 0))}), its medians "
+             "and its comparisons on those calls")
     return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
             "every method's planning call, one call at a time, interleaved across methods in one "
-            "process (order rotated per call), the same states for every method; wall clock "
+            f"process (order rotated per call), the same states for every method{paper}; wall clock "
             "perf_counter_ns, CPU clock thread_time_ns; replayed picks equal to the recorded ones "
             f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls.")
 
 
 def summary_frame(tm: dict):
-    """One row per timed variant: method, path, evaluation path, replayed calls,
-    median and 5-95 % quantiles of the wall and CPU times (us), median
-    evaluations; the method's own-call check (checked, mismatch) on its main row."""
+    """One row per timed variant: method, path, evaluation path, calls timed on
+    it (:func:`timed`), median and 5-95 % quantiles of the wall and CPU times
+    (us) and median evaluations over those calls; the method's own-call check
+    (checked, mismatch) on its main row."""
     import pandas as pd
 
     methods = [str(m) for m in tm["methods"]]
+    ok = timed(tm)
     rows = []
     for j, (m, p, e) in enumerate(zip(tm["variant_method"], tm["variant_path"], tm["variant_eval_path"])):
-        w, c = np.asarray(tm["wall_ns"])[:, j] / 1e3, np.asarray(tm["cpu_ns"])[:, j] / 1e3
+        w, c = np.asarray(tm["wall_ns"])[ok[:, j], j] / 1e3, np.asarray(tm["cpu_ns"])[ok[:, j], j] / 1e3
         row = {"method": str(m), "path": str(p), "eval_path": str(e), "calls": int(len(w))}
         for name, x in (("wall", w), ("cpu", c)):
             q = np.quantile(x, [0.05, 0.5, 0.95]) if len(x) else [math.nan] * 3
             row.update({f"{name}_median_us": float(q[1]), f"{name}_p05_us": float(q[0]),
                         f"{name}_p95_us": float(q[2])})
-        row["median_evals"] = float(np.median(np.asarray(tm["n_evals"])[:, j])) if len(w) else math.nan
+        row["median_evals"] = median_evals(tm, str(m), str(p))
         if str(p) == "main":
             i = methods.index(str(m))
             row["checked"], row["mismatch"] = int(tm["checked"][i]), int(tm["mismatch"][i])
