@@ -103,7 +103,7 @@ def paper_limited(var) -> np.ndarray:
     limits it: the paper's definition on the other path (``alt`` with
     ``eval_path == "paper"``); the configured path is always timed on every
     replayed call (it carries the pick check)."""
-    return np.array([p == "alt" and getattr(c, "eval_path", "") == "paper" for _, p, c in var], bool)
+    return np.array([p == "alt" and c.eval_path == "paper" for _, p, c in var], bool)
 
 
 def _pool(recorded: dict) -> tuple[np.ndarray, np.ndarray, list[str]]:
