@@ -13,8 +13,7 @@ the visible interval (:func:`visible_interval`), the golden-section search
 tie rule (:func:`best_index`) and the call itself (:func:`plan_core`, compiled
 by :func:`plan_run` for every :data:`KINDS`; run by the interpreter with a
 Python objective through :func:`interpreted` for ``logdet_nav`` and the paper's
-definitions, ``opnav.landing.planner``); the B-X1 metrics (:func:`info_metric`)
-take per-call constants (:func:`info_constants`).
+definitions, ``opnav.landing.planner``; B-X1 metrics: :func:`info_metric`).
 
 Per-run constants ``q`` (float64 (NQ,)): 0-2 C (m), 3-5 v_hat, 6-8 w_hat, 9 |CD|
 (m), 10 gamma (rad), 11 objective kind (:data:`KINDS`), 12 b (m), 13 r_e (m),
@@ -178,64 +177,83 @@ def sv_metric(base, l1, l2, l3, l4) -> float:
     the smallest); 0 if l4 <= 0."""
     if not l4 > 0.0:
         return 0.0
-    if base == SVD:
-        return math.sqrt(l4)
-    if base == COND:
-        return math.sqrt(l4 / l1)
-    return 1.0 / (1.0 / l1 + 1.0 / l2 + 1.0 / l3 + 1.0 / l4)
+    return (math.sqrt(l4) if base == SVD else math.sqrt(l4 / l1) if base == COND
+            else 1.0 / (1.0 / l1 + 1.0 / l2 + 1.0 / l3 + 1.0 / l4))
 
 
 @kernel
 def info_constants(R_LtoB, P, sigma, q) -> None:
-    """Fill the B-X1 slots of q (kind q[11], after :func:`metric_constants`) once per call
-    for the prior P (12 x 12), bearing noise sigma^2 I_6 (rad^2) and the known landmark's
-    rows G_k (:func:`info_metric`, no landmark columns): logdet, mineig: Lambda_k = P^-1 +
-    G_k^T G_k, Sigma_k = Lambda_k^-1, log det Lambda_k (Jacobi-equilibrated); whitened: L = chol(P), G_k L."""
-    q[Q_R:Q_R + 9], q[Q_SCALE] = R_LtoB.ravel(), 1.0 / sigma
+    """Fill the B-X1 slots of q (kind q[11], after :func:`metric_constants`) once per call for
+    prior P (12 x 12), noise sigma^2 I_6 (rad^2), the known landmark's rows G_k (:func:`info_metric`):
+    Sigma_k = (P^-1 + G_k^T G_k)^-1 and its log det (equilibrated), or L = chol(P) and G_k L."""
+    for i in range(9):
+        q[Q_R + i] = R_LtoB[i // 3, i % 3]
+    q[Q_SCALE] = 1.0 / sigma
     if q[21] == 0.0:                                 # known landmark unusable: all invalid
         return
     G = np.empty((2, 12))
-    me.tangent_rows(R_LtoB, q[14:17] / q[17], q[Q_SCALE], G)
-    G[:, 9:] = 0.0
+    me.tangent_rows(R_LtoB, np.array([q[14] / q[17], q[15] / q[17], q[16] / q[17]]), q[Q_SCALE], G)
+    for j in range(9, 12):
+        G[0, j] = G[1, j] = 0.0
     if int(q[11]) >= SVD_W:
         L = np.linalg.cholesky(P)
-        q[Q_L:Q_L + 144], q[Q_A:Q_A + 24] = L.ravel(), (G @ L).ravel()
+        for j in range(12):
+            q[Q_A + j] = q[Q_A + 12 + j] = 0.0
+            for i in range(12):
+                q[Q_L + 12 * i + j] = L[i, j]
+                q[Q_A + j] += G[0, i] * L[i, j]
+                q[Q_A + 12 + j] += G[1, i] * L[i, j]
         return
-    Pinv = np.linalg.inv(P)
-    s = 1.0 / np.sqrt(np.diag(Pinv) + (G * G).sum(axis=0))
-    S = np.outer(s, s)
-    Ls = (0.5 * (Pinv + Pinv.T) + G.T @ G) * S
-    Sig = np.linalg.inv(Ls) * S
-    q[Q_SIG:Q_SIG + 144] = (0.5 * (Sig + Sig.T)).ravel()
-    q[Q_LD] = 2.0 * (np.log(np.diag(np.linalg.cholesky(Ls + 12 * 2.0 ** -52 * np.eye(12)))).sum()
-                     - np.log(s).sum())
+    Pi, Ls, s = np.linalg.inv(P), np.empty((12, 12)), np.empty(12)
+    for i in range(12):
+        s[i] = 1.0 / math.sqrt(Pi[i, i] + G[0, i] ** 2 + G[1, i] ** 2)
+    for i in range(12):
+        for j in range(12):
+            Ls[i, j] = (0.5 * (Pi[i, j] + Pi[j, i]) + G[0, i] * G[0, j] + G[1, i] * G[1, j]) * s[i] * s[j]
+    Sig = np.linalg.inv(Ls)
+    for i in range(12):
+        Ls[i, i] += 12 * 2.0 ** -52
+    C, q[Q_LD] = np.linalg.cholesky(Ls), 0.0
+    for i in range(12):
+        q[Q_LD] += 2.0 * (math.log(C[i, i]) - math.log(s[i]))
+        for j in range(12):
+            q[Q_SIG + 12 * i + j] = 0.5 * (Sig[i, j] + Sig[j, i]) * s[i] * s[j]
 
 
 @kernel
 def info_metric(kind, d0, d1, d2, q) -> float:
-    """The B-X1 metric (larger is better) of a valid candidate at offset d (m) from
-    its bearing's tangent-plane rows G = T^T H / sigma (2 x 12, ``measurement.tangent_rows``)
-    and :func:`info_constants`: logdet = log det Lambda_k + log det(I_2 + G Sigma_k G^T)
-    (= log a + log e), mineig = 1 / lambda_max of the Woodbury posterior Sigma_k - (G
-    Sigma_k)^T (I_2 + G Sigma_k G^T)^-1 G Sigma_k (-inf if not positive); whitened:
-    :func:`sv_metric` of [G_k; G] L (4 x 12; the singular values of H_w = R^-1/2 H P^1/2
-    for R = sigma^2 I_6, as b^T H = 0) by the eigenvalues of its 4 x 4 Gram matrix."""
+    """The B-X1 metric (larger is better) of a valid candidate at offset d (m), its tangent-plane
+    rows G = T^T H / sigma (2 x 12, ``measurement.tangent_rows``), :func:`info_constants`: logdet
+    = log det Lambda_k + log det(I_2 + G Sigma_k G^T), mineig = 1 / lambda_max of the Woodbury
+    posterior (-inf if not positive); whitened: :func:`sv_metric` of [G_k; G] L (4 x 12: the
+    singular values of R^-1/2 H P^1/2 for R = sigma^2 I_6, as b^T H = 0) by its Gram's eigenvalues."""
     G = np.empty((2, 12))
     me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
+    M, GM, Q = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((4, 12)), np.zeros((4, 4))  # Sigma_k or L
+    for k in range(12):
+        for j in range(12):
+            GM[2, j] += G[0, k] * M[k, j]
+            GM[3, j] += G[1, k] * M[k, j]
+    for j in range(24):                            # rows 0-1: G_k L (whitened) or G
+        GM[j // 12, j % 12] = q[Q_A + j] if kind >= SVD_W else G[j // 12, j % 12]
+    for i in range(4):                    # whitened: Gram of [G_k L; G L]; else Q[2:, :2] = G Sigma_k G^T
+        for j in range(4):
+            for k in range(12):
+                Q[i, j] += GM[i, k] * GM[j, k]
     if kind >= SVD_W:
-        W = np.empty((4, 12))
-        W[:2], W[2:] = q[Q_A:Q_A + 24].reshape((2, 12)), G @ q[Q_L:Q_L + 144].reshape((12, 12))
-        lam = np.linalg.eigvalsh(W @ W.T)
+        lam = np.linalg.eigvalsh(Q)
         return sv_metric(kind - 5, lam[3], lam[2], lam[1], lam[0])
-    Sig = q[Q_SIG:Q_SIG + 144].reshape((12, 12))
-    GS = G @ Sig
-    Q = GS @ G.T
-    a, b = 1.0 + Q[0, 0], 0.5 * (Q[0, 1] + Q[1, 0])
-    e = 1.0 + Q[1, 1] - b * b / a                  # Schur complement, >= 1
+    a, b = 1.0 + Q[2, 0], 0.5 * (Q[2, 1] + Q[3, 0])
+    e = 1.0 + Q[3, 1] - b * b / a                  # Schur complement, >= 1
     if kind == LOGDET:
         return q[Q_LD] + math.log(a) + math.log(e)
-    Sp = Sig - GS.T @ (np.array([[1.0 + Q[1, 1], -b], [-b, a]]) / (a * e)) @ GS
-    lmax = np.linalg.eigvalsh(0.5 * (Sp + Sp.T))[-1]
+    m0, m1, m2 = (1.0 + Q[3, 1]) / (a * e), -b / (a * e), 1.0 / e
+    Sp = np.empty((12, 12))                        # Woodbury, with (G Sigma_k) = GM[2:]
+    for i in range(12):
+        for j in range(12):
+            Sp[i, j] = (M[i, j] - GM[2, i] * (m0 * GM[2, j] + m1 * GM[3, j])
+                        - GM[3, i] * (m1 * GM[2, j] + m2 * GM[3, j]))
+    lmax = np.linalg.eigvalsh(Sp)[-1]
     return 1.0 / lmax if lmax > 0 else -math.inf
 
 
@@ -424,12 +442,6 @@ def best_index(scores) -> int:
 
 
 @kernel
-def _member(det, i) -> bool:
-    k = np.searchsorted(det, i)
-    return k < det.size and det[k] == i
-
-
-@kernel
 def _nearest_of(x, y, xyz, det, exclude) -> int:
     best, bd = -1, math.inf
     for i in det:
@@ -468,7 +480,8 @@ def nearest(x, y, xyz, det, exclude, grid, cells) -> int:
                     dx, dy = xyz[i, 0] - x, xyz[i, 1] - y
                     d2 = dx * dx + dy * dy
                     if d2 < bd or (d2 == bd and i < best):
-                        if i != exclude and _member(det, i):
+                        k = np.searchsorted(det, i)              # detected?
+                        if i != exclude and k < det.size and det[k] == i:
                             best, bd = i, d2
                         else:
                             rejected += 1
@@ -494,7 +507,7 @@ def nearest(x, y, xyz, det, exclude, grid, cells) -> int:
 def interpreted(fn, **names):
     """The kernel ``fn``'s Python source run by the interpreter, with the module
     names ``names`` (kernels it calls) replaced: the same steps with a Python
-    objective (the planner's B-X1 metrics and the paper's definitions)."""
+    objective (the planner's ``logdet_nav`` and the paper's definitions)."""
     py = fn.py_func
     return types.FunctionType(py.__code__, {**py.__globals__, **names}, py.__name__, py.__defaults__,
                               py.__closure__)
@@ -522,17 +535,9 @@ def field_grid(xyz: np.ndarray, per_cell: float = 1.0) -> tuple[np.ndarray, np.n
 def edge_pick(q, xyz, det, exclude):
     """The edge rule: (pick, landmarks scored): every detected landmark less
     ``exclude`` scored (:func:`score_points`), the tie rule picks (-1: none finite)."""
-    m = 0
-    for i in det:
-        m += i != exclude
-    cand = np.empty(m, np.int64)
-    m = 0
-    for i in det:
-        if i != exclude:
-            cand[m] = i
-            m += 1
-    j = best_index(score_points(q, xyz, cand)) if m else -1
-    return (cand[j] if j >= 0 else -1), m
+    cand = det[det != exclude]
+    j = best_index(score_points(q, xyz, cand)) if cand.size else -1
+    return (cand[j] if j >= 0 else -1), cand.size
 
 
 @kernel

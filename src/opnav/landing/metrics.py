@@ -35,13 +35,12 @@ equal to the SVD of the CasADi-derived H. H mixes units (1/m position columns, 1
 attitude columns): s4 ~ 1/range, s1 ~ sqrt(2), so ``svd`` mostly rewards short
 ranges and ``svd``, ``gdop``, ``cond`` rank candidates alike in the descent.
 
-Information metrics need ``ctx.P`` (12 x 12 prior covariance of [r (m), v (m/s),
-dtheta (rad), p (m)]) and ``ctx.R_meas`` (6 x 6, rad^2): log det of Lambda = P^-1
-+ H^T R^-1 H (:func:`chol_logdet` in the definition), lambda_min as 1 / lambda_max
-of the posterior covariance. Caution: one epoch of two bearings informs neither
-velocity nor the new landmark's depth, so with a large isotropic landmark prior
-lambda_min is that prior's for every candidate (spread ~2e-15): ``mineig`` then
-ties everywhere (the planner's tie rule picks the lowest index). Fast path for
+Information metrics need ``ctx.P`` (12 x 12 prior of [r (m), v (m/s), dtheta (rad),
+p (m)]) and ``ctx.R_meas`` (6 x 6, rad^2): log det of Lambda = P^-1 + H^T R^-1 H
+(:func:`chol_logdet`), lambda_min as 1 / lambda_max of the posterior covariance.
+Caution: one epoch of two bearings informs neither velocity nor the new landmark's
+depth, so with a large isotropic landmark prior lambda_min is that prior's for every
+candidate (spread ~2e-15): ``mineig`` ties everywhere (the tie rule: lowest index). Fast path for
 ``R_meas`` = sigma^2 I_6 (the descent's), compiled (``kernels.info_constants``,
 ``kernels.info_metric``): a bearing's information is that of its tangent-plane
 rows G = sigma^-1 T^T H (2 x 12, ``measurement.tangent_rows``): log det Lambda =
@@ -146,11 +145,6 @@ class MetricContext:
                 K.info_constants(ctx.R_LtoB, ctx.info()[0], math.sqrt(ctx.R_meas[0, 0]), q)
             return q
         return self.cached(("q", kind), build)
-
-    def isotropic(self) -> bool:
-        """R_meas = sigma^2 I_6 (the compiled B-X1 metrics; module docstring)."""
-        Rm = self.info()[1]
-        return bool(Rm[0, 0] > 0 and np.array_equal(Rm, Rm[0, 0] * np.eye(6)))
 
     def info(self):
         """(P, R_meas, P^-1, R_meas^-1) for the information and whitened metrics."""
@@ -257,7 +251,8 @@ class Metric:
         return out
 
     def __call__(self, ctx: MetricContext, cand_L) -> np.ndarray:
-        if self.name not in H_METRICS and not ctx.isotropic():  # no compiled form: the definition
+        Rm = None if self.name in H_METRICS else ctx.info()[1]
+        if Rm is not None and not np.array_equal(Rm, Rm[0, 0] * np.eye(6)):  # no compiled form
             return self.reference(ctx, cand_L)
         q = ctx.q(K.KINDS[self.name])
         return self._scored(ctx, cand_L, lambda c: -K.score_points(q, c, np.arange(len(c))))
