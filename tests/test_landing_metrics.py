@@ -294,6 +294,29 @@ def test_compiled_bx1_kernels_equal_the_papers_definition(name, r, R, seed, n):
         assert K.best_index(-comp) == int(np.argmax(ref))
 
 
+
+@settings(max_examples=30, deadline=None)
+@given(r=lander, R=quat, seed=seeds, lm_sd=st.sampled_from([2000.0, 2.0, 0.1]))
+def test_compiled_mineig_equals_the_information_through_its_equilibrated_inverse(r, R, seed, lm_sd):
+    """mineig off its plateau (landmark prior sd ``lm_sd`` m: small, the largest posterior
+    variance is one the bearings inform): the compiled Woodbury score equals 1 / lambda_max
+    of the inverse of the definition's 12 x 12 information P^-1 + H^T R^-1 H (CasADi H,
+    Jacobi-equilibrated before LAPACK's inverse, so accurate relative to lambda_max), to
+    1e-7 relative (the definition's eigvalsh on Lambda is only good to ~eps ||Lambda||).
+    Mutation tried: the sign of the Woodbury cross term -> fails."""
+    rng = np.random.default_rng(seed)
+    P = _prior(rng)
+    f = np.r_[np.ones(9), np.full(3, lm_sd / 2000.0)]
+    ctx = _ctx(r=r, R=R, P=P * np.outer(f, f))
+    cand = _ground(rng, 6)
+    H = cm.jacobian_casadi_batch(ctx.r_L, ctx.v_L, ctx.p_known_L, cand, ctx.R_LtoB)
+    Lam = np.linalg.inv(ctx.P) + np.swapaxes(H, 1, 2) @ H / SIG_BEARING**2
+    d = 1.0 / np.sqrt(np.diagonal(Lam, axis1=1, axis2=2))
+    D = d[:, :, None] * d[:, None, :]
+    ref = 1.0 / np.linalg.eigvalsh(np.linalg.inv(Lam * D) * D)[:, -1]
+    np.testing.assert_allclose(make_metric("mineig")(ctx, cand), ref, rtol=1e-7)
+
+
 @pytest.mark.parametrize("name", METRIC_NAMES)
 def test_scores_invariant_to_candidate_permutation(name):
     rng = np.random.default_rng(11)
