@@ -40,6 +40,12 @@ candidate ``p_c`` (m, {L}) from the current estimate (r, v, R_LtoB, P):
 
 Candidates behind the camera or whose line of sight
 misses the ground score ``-inf``.
+
+Not compiled (issue 31): the planner runs ``logdet_nav`` through the interpreted
+call (``kernels.interpreted``), numpy batched over candidates. Measured with the
+full config (2 descents, 151 planning calls, shared 2-core machine): about 97 ms
+of CPU per planning call, ~19 us per candidate scored (edge calls score every
+detected landmark), against 2.3 ms per call for the compiled ``logdet``.
 """
 
 from __future__ import annotations
