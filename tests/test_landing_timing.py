@@ -70,7 +70,7 @@ def test_the_pick_check_can_fail(recorded):
 def test_replay_deterministic_and_order_independent(recorded):
     """Same inputs, same picks, whatever the method order or the subset; the
     methods are timed on both paths (compiled, the paper's definition) with the same picks; the rotation puts
-    every variant first in turn."""
+    every variant first in turn within its path's pass."""
     scn, rec = recorded
     a = timing.replay(scn, rec, list(METHODS), max_calls=12)
     b = timing.replay(scn, rec, list(METHODS)[::-1], max_calls=12)
@@ -93,8 +93,10 @@ def test_replay_deterministic_and_order_independent(recorded):
     src_svd = list(METHODS).index("svd")
     np.testing.assert_array_equal(a["pick"][svd_calls, timing._variant(a, "svd", "main")],
                                   full["pick"][[row[(src_svd, int(c))] for c in a["call"][svd_calls]], 0])
-    nv = a["wall_ns"].shape[1]
-    assert set(a["slot"][:, 0][:nv]) == set(range(nv))
+    # one pass per path: a variant's slot is its place among its own path's variants
+    for path in ("main", "alt"):
+        g = np.flatnonzero(a["variant_path"] == path)
+        assert set(a["slot"][:g.size, g[0]]) == set(range(g.size)), path
 
 
 def _fake_timing(wall_us: dict, cpu_us: dict, runs):
@@ -194,8 +196,9 @@ def test_bad_max_calls_paper_names_the_key():
 def test_replay_times_the_paper_path_on_its_subset_only(recorded):
     """max_calls_paper = 4 of 12 replayed calls: the compiled variants run on
     every call, the paper-path ones on the 4 evenly spaced calls only (the
-    others marked -1 / pick -2, not run); the rotation rule puts every variant
-    first in turn within each kind of call; picks equal the full replay's."""
+    others marked -1 / pick -2, not run), each path in its own pass; the
+    rotation rule puts every variant first in turn within its pass; picks equal
+    the full replay's."""
     scn, rec = recorded
     a = timing.replay(scn, rec, list(METHODS), max_calls=12, max_calls_paper=4)
     full = timing.replay(scn, rec, list(METHODS), max_calls=12, max_calls_paper=0)
@@ -213,14 +216,15 @@ def test_replay_times_the_paper_path_on_its_subset_only(recorded):
     assert (a["wall_ns"][tmd] > 0).all()
     np.testing.assert_array_equal(a["pick"][tmd], full["pick"][tmd])
     assert full["timed"].all() and a["mismatch"].sum() == 0
-    # rotation: every subset call runs all variants, the others the compiled ones;
-    # within each kind the first slot goes to each variant in turn
-    nv = tmd.shape[1]
-    first_sub = [int(np.flatnonzero(a["slot"][q] == 0)[0]) for q in sub]
-    assert first_sub == [0, 1, 2, 3]           # i-th subset call: configured order rotated by i
-    rest = [q for q in range(12) if q not in set(sub)]
-    firsts = [int(np.flatnonzero(a["slot"][q] == 0)[0]) for q in rest]
-    assert set(firsts) == set(np.flatnonzero(~paper)) and nv - 2 == len(set(firsts))
+    # passes: the configured path on every call, then the paper's definition on its
+    # subset; within each pass the first slot goes to each of its variants in turn
+    # (the t-th call of a pass: its variants rotated left by t)
+    main = np.flatnonzero(~paper)
+    firsts = [int(np.flatnonzero(a["slot"][q, main] == 0)[0]) for q in range(12)]
+    assert firsts == [t % main.size for t in range(12)]
+    first_paper = [int(np.flatnonzero(a["slot"][q, paper] == 0)[0]) for q in sub]
+    assert first_paper == [t % 2 for t in range(4)]
+    assert (a["slot"][:, main] < main.size).all() and (a["slot"][np.ix_(sub, np.flatnonzero(paper))] < 2).all()
     s = timing.method_summary(a)
     assert s["timed_calls"] == 12 and s["timed_calls_paper"] == 4 and s["max_calls_paper"] == 4
     assert "on 4 of them" in timing.method_text(a)

@@ -30,12 +30,19 @@ every consumer below reads timed entries only, and a comparison of two variants
 (:func:`time_reduction`) uses the calls timed on both. So a median on the
 configured path rests on every replayed call, one on the paper's definition
 on the subset (``method_summary``: ``timed_calls``, ``timed_calls_paper``).
-Order rule: on the ``i``-th call of the subset every variant runs, in the
-configured order rotated left by ``i``; on the ``j``-th call outside it the
-variants timed there run in their configured order rotated left by ``j``
-(never ordered by a clock), so slow drifts of the machine (frequency, other
-processes) fall on every method alike and every variant comes first in turn;
-every method is timed on the same states, so the comparison is paired per
+Passes and order rule: each path is timed in its own pass over the calls, first
+the configured path on every replayed call, then the other path on its subset;
+on the ``t``-th call of a pass that pass's variants run in their configured
+order rotated left by ``t`` (never ordered by a clock), so slow drifts of the
+machine (frequency, other processes) fall on every method alike and every
+variant comes first in turn. Separate passes because a compiled call timed right
+after a paper-path call (milliseconds of CasADi and LAPACK work) starts with
+caches that work has evicted: interleaved, the compiled calls measured about 4x
+slower (interior, 60 calls: 47 against 12 us a call) and the depth-vs-SVD
+reduction on the compiled path moved from -45 % to +15 % between two builds of
+the same config, beyond its own spread; in separate passes it read -5.7 % and
+-2.3 % in two replays. Every method is timed on the same states, so the
+comparison is paired per
 call. Each call is timed by ``time.perf_counter_ns`` (wall) and
 ``time.thread_time_ns`` (CPU time of the calling thread, which other
 processes do not inflate), around ``planner.plan`` with the image's
@@ -195,30 +202,32 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     gc_was = gc.isenabled()
     gc.collect()
     gc.disable()
-    # rotation counter per kind of call (all variants / those of the configured path)
-    kind = timed_.all(axis=1)
-    turn = np.zeros(nc, np.int64)
-    for kd in (True, False):
-        turn[kind == kd] = np.arange(int(np.sum(kind == kd)))
+    # one pass per path (module docstring): the configured path on every replayed
+    # call, then the other path on its calls; the t-th call of a pass runs that
+    # pass's variants in their configured order rotated left by t
+    vpath = np.array([v[1] for v in var])
     try:
-        for q in range(nc):
-            d, i, k, state, visible, exclude, det, words = inputs(q)
-            run[q] = int(d["plan_run"][i]) if "plan_run" in d else -1
-            step[q] = k
-            order = np.flatnonzero(timed_[q])
-            for s_, v in enumerate(np.roll(order, -(int(turn[q]) % len(order)))):
-                m, _, cfg = var[v]
-                rng = rng_from_words(words)
-                t0 = perf()
-                c0 = thread()
-                res = plan(m, state, cam, field_, visible, cfg, exclude=exclude, rng=rng,
-                           detected=det, diagnose=False)
-                c1 = thread()
-                t1 = perf()
-                wall[q, v], cpu[q, v] = t1 - t0, c1 - c0
-                pick[q, v], evals[q, v], slot[q, v] = res.index, res.n_evals, s_
-            if q % 64 == 63:
-                gc.collect()
+        for path in ("main", "alt"):
+            group = np.flatnonzero(vpath == path)
+            calls = [q for q in range(nc) if group.size and timed_[q, group].any()]
+            for t, q in enumerate(calls):
+                d, i, k, state, visible, exclude, det, words = inputs(q)
+                run[q] = int(d["plan_run"][i]) if "plan_run" in d else -1
+                step[q] = k
+                order = group[timed_[q, group]]
+                for s_, v in enumerate(np.roll(order, -(t % len(order)))):
+                    m, _, cfg = var[v]
+                    rng = rng_from_words(words)
+                    t0 = perf()
+                    c0 = thread()
+                    res = plan(m, state, cam, field_, visible, cfg, exclude=exclude, rng=rng,
+                               detected=det, diagnose=False)
+                    c1 = thread()
+                    t1 = perf()
+                    wall[q, v], cpu[q, v] = t1 - t0, c1 - c0
+                    pick[q, v], evals[q, v], slot[q, v] = res.index, res.n_evals, s_
+                if t % 64 == 63:
+                    gc.collect()
     finally:
         if gc_was:
             gc.enable()
