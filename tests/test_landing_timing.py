@@ -93,10 +93,13 @@ def test_replay_deterministic_and_order_independent(recorded):
     src_svd = list(METHODS).index("svd")
     np.testing.assert_array_equal(a["pick"][svd_calls, timing._variant(a, "svd", "main")],
                                   full["pick"][[row[(src_svd, int(c))] for c in a["call"][svd_calls]], 0])
-    # one pass per path: a variant's slot is its place among its own path's variants
-    for path in ("main", "alt"):
-        g = np.flatnonzero(a["variant_path"] == path)
-        assert set(a["slot"][:g.size, g[0]]) == set(range(g.size)), path
+    # one pass per (path, compiled or interpreted): a variant's slot is its place among
+    # its own pass's variants, and each of them comes first in turn
+    keys = timing.pass_keys(timing.variants(list(METHODS), scn.planner))
+    assert keys == [(0, 0), (1, 1), (0, 0), (1, 1), (0, 1), (0, 1)]   # depth, svd: main + alt; pickers
+    for key in set(keys):
+        g = np.flatnonzero([k == key for k in keys])
+        assert set(a["slot"][:g.size, g[0]]) == set(range(g.size)), key
 
 
 def _fake_timing(wall_us: dict, cpu_us: dict, runs):
@@ -216,15 +219,16 @@ def test_replay_times_the_paper_path_on_its_subset_only(recorded):
     assert (a["wall_ns"][tmd] > 0).all()
     np.testing.assert_array_equal(a["pick"][tmd], full["pick"][tmd])
     assert full["timed"].all() and a["mismatch"].sum() == 0
-    # passes: the configured path on every call, then the paper's definition on its
-    # subset; within each pass the first slot goes to each of its variants in turn
-    # (the t-th call of a pass: its variants rotated left by t)
-    main = np.flatnonzero(~paper)
-    firsts = [int(np.flatnonzero(a["slot"][q, main] == 0)[0]) for q in range(12)]
-    assert firsts == [t % main.size for t in range(12)]
-    first_paper = [int(np.flatnonzero(a["slot"][q, paper] == 0)[0]) for q in sub]
-    assert first_paper == [t % 2 for t in range(4)]
-    assert (a["slot"][:, main] < main.size).all() and (a["slot"][np.ix_(sub, np.flatnonzero(paper))] < 2).all()
+    # passes (timing.pass_keys): compiled searches of the configured path, its
+    # interpreted pickers, then the paper's definition on its subset; the t-th call
+    # of a pass runs that pass's variants rotated left by t
+    keys = timing.pass_keys(timing.variants(list(METHODS), scn.planner))
+    for key in sorted(set(keys)):
+        g = np.flatnonzero([k == key for k in keys])
+        calls = sub if key[0] == 1 else np.arange(12)
+        firsts = [int(g[np.flatnonzero(a["slot"][q, g] == 0)[0]]) for q in calls]
+        assert firsts == [int(g[t % g.size]) for t in range(len(calls))], key
+        assert (a["slot"][np.ix_(calls, g)] < g.size).all()
     s = timing.method_summary(a)
     assert s["timed_calls"] == 12 and s["timed_calls_paper"] == 4 and s["max_calls_paper"] == 4
     assert "on 4 of them" in timing.method_text(a)
@@ -300,3 +304,32 @@ def test_reductions_across_paths_use_the_common_subset():
     assert timing.median_us(tm, "depth") == pytest.approx(1.0)      # its own median: every call
     tm["timed"][:, 3] = False
     assert np.isnan(timing.time_reduction(tm, "depth", "svd", path_b="alt")[0])
+
+
+def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monkeypatch):
+    """Every compiled search is run once untimed right before its timed call (so its
+    time is its own work, not the caches its predecessor evicted); interpreted
+    variants (the paper's definition, the pickers) run once per timed call. Counted
+    by wrapping planner.plan: per variant, one warm-up call, then 2 (compiled) or 1
+    (interpreted) per timed call."""
+    from opnav.landing import planner
+
+    scn, rec = recorded
+    seen = []
+    real = planner.plan
+
+    def counting(m, state, camera, field_, visible, cfg, **kw):
+        seen.append((m, cfg.eval_path))
+        return real(m, state, camera, field_, visible, cfg, **kw)
+
+    monkeypatch.setattr(planner, "plan", counting)
+    a = timing.replay(scn, rec, list(METHODS), max_calls=6, max_calls_paper=3)
+    var = timing.variants(list(METHODS), scn.planner)
+    keys = timing.pass_keys(var)
+    for v, ((m, _, cfg), key) in enumerate(zip(var, keys)):
+        n_timed = int(a["timed"][:, v].sum())
+        per_call = 2 if key[1] == 0 else 1
+        assert seen.count((m, cfg.eval_path)) == 1 + per_call * n_timed, (m, cfg.eval_path)
+    # the compiled calls of a pass come before any interpreted one (passes in key order)
+    first_interp = next(i for i, (m, p) in enumerate(seen[len(var):]) if not (m in ("depth", "svd") and p == "compiled"))
+    assert all(not (m in ("depth", "svd") and p == "compiled") for m, p in seen[len(var) + first_interp:])

@@ -30,19 +30,24 @@ every consumer below reads timed entries only, and a comparison of two variants
 (:func:`time_reduction`) uses the calls timed on both. So a median on the
 configured path rests on every replayed call, one on the paper's definition
 on the subset (``method_summary``: ``timed_calls``, ``timed_calls_paper``).
-Passes and order rule: each path is timed in its own pass over the calls, first
-the configured path on every replayed call, then the other path on its subset;
-on the ``t``-th call of a pass that pass's variants run in their configured
-order rotated left by ``t`` (never ordered by a clock), so slow drifts of the
-machine (frequency, other processes) fall on every method alike and every
-variant comes first in turn. Separate passes because a compiled call timed right
-after a paper-path call (milliseconds of CasADi and LAPACK work) starts with
-caches that work has evicted: interleaved, the compiled calls measured about 4x
-slower (interior, 60 calls: 47 against 12 us a call) and the depth-vs-SVD
-reduction on the compiled path moved from -45 % to +15 % between two builds of
-the same config, beyond its own spread; in separate passes it read -5.7 % and
--2.3 % in two replays. Every method is timed on the same states, so the
-comparison is paired per
+Passes and order rule (:func:`pass_keys`): the variants are timed in separate
+passes over the calls, first the configured path on every replayed call, then
+the other path on its subset, and within a path the compiled searches before the
+interpreted code (the paper's definition, ``logdet_nav``, the pickers); on the
+``t``-th call of a pass that pass's variants run in their configured order
+rotated left by ``t`` (never ordered by a clock), so slow drifts of the machine
+(frequency, other processes) fall on every method alike and every variant comes
+first in turn. A compiled call is timed warm, right after an untimed call of the same variant on
+the same inputs, so that it measures its own work and not the caches the call
+before it evicted; the interpreted calls (milliseconds of numpy, CasADi and
+LAPACK, which that work dominates) are timed once. Measured (interior, 30 calls
+of the quick profile, thread CPU, timed once): in a rotation each variant has the
+same predecessor on every call, and depth placed after svd_w (4-5 ms of compiled
+edge-call work) took 46-52 us a call against SVD's 14-21 us (-141 % and -215 %),
+while without svd_w the four searches took 15-17 us each (-12 % +- 21);
+interleaved with the paper path the compiled calls measured about 4x slower (47
+against 12 us) and the compiled depth-vs-SVD reduction read -45 % and +15 % in
+two builds of the same config. Every method is timed on the same states, so the comparison is paired per
 call. Each call is timed by ``time.perf_counter_ns`` (wall) and
 ``time.thread_time_ns`` (CPU time of the calling thread, which other
 processes do not inflate), around ``planner.plan`` with the image's
@@ -70,7 +75,7 @@ import numpy as np
 
 from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 
-__all__ = ["select_calls", "variants", "paper_limited", "replay", "timed", "save", "load", "times_ns",
+__all__ = ["select_calls", "variants", "pass_keys", "paper_limited", "replay", "timed", "save", "load", "times_ns",
            "median_us", "time_reduction", "timed_calls", "method_text", "summary_frame", "median_evals",
            "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us"]
 
@@ -103,6 +108,17 @@ def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
         if alt and m not in PICKERS and m != "logdet_nav":
             out.append((m, "alt", alt_cfg))
     return out
+
+
+def pass_keys(var) -> list[tuple[int, int]]:
+    """Per variant of :func:`variants`, the pass that times it (module docstring):
+    ``(0, .)`` the configured path, ``(1, .)`` the other one; ``(., 0)`` a compiled
+    search (a method of ``kernels.KINDS`` on the compiled path), ``(., 1)`` interpreted
+    code (the paper's definition, ``logdet_nav``, the pickers). Passes run in
+    ascending key order."""
+    from opnav.landing.kernels import KINDS
+
+    return [(int(p != "main"), int(not (m in KINDS and c.eval_path == "compiled"))) for m, p, c in var]
 
 
 def paper_limited(var) -> np.ndarray:
@@ -202,13 +218,13 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     gc_was = gc.isenabled()
     gc.collect()
     gc.disable()
-    # one pass per path (module docstring): the configured path on every replayed
-    # call, then the other path on its calls; the t-th call of a pass runs that
-    # pass's variants in their configured order rotated left by t
-    vpath = np.array([v[1] for v in var])
+    # one pass per pass key (module docstring: path, then compiled before interpreted);
+    # the t-th call of a pass runs that pass's variants in their configured order
+    # rotated left by t
+    keys = pass_keys(var)
     try:
-        for path in ("main", "alt"):
-            group = np.flatnonzero(vpath == path)
+        for key in sorted(set(keys)):
+            group = np.flatnonzero(np.array([k == key for k in keys]))
             calls = [q for q in range(nc) if group.size and timed_[q, group].any()]
             for t, q in enumerate(calls):
                 d, i, k, state, visible, exclude, det, words = inputs(q)
@@ -217,6 +233,9 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
                 order = group[timed_[q, group]]
                 for s_, v in enumerate(np.roll(order, -(t % len(order)))):
                     m, _, cfg = var[v]
+                    if key[1] == 0:                 # compiled: timed warm (module docstring)
+                        plan(m, state, cam, field_, visible, cfg, exclude=exclude,
+                             rng=rng_from_words(words), detected=det, diagnose=False)
                     rng = rng_from_words(words)
                     t0 = perf()
                     c0 = thread()
