@@ -129,3 +129,23 @@ def test_readme_study_example_runs_only_its_jobs(quick_results, edits):
     assert len(table) == n_values * len(spec["methods"]) * len(spec["metrics"])
     assert set(table["metric"]) == set(spec["metrics"]) and (table["n_runs"] == 2).all()
     assert (out / f"B-S_{name}.png").stat().st_size > 10_000
+
+
+def test_editing_a_kernel_module_reruns_its_users_in_the_same_run(quick_results):
+    """An edit of a compiled-kernel module lists compile_kernels AND the jobs that call
+    those kernels (their src inputs hold the module) in one invocation. With the kernel
+    cache's marker as an ancient() input, Snakemake 9.27 listed compile_kernels alone and
+    kept the stale Monte Carlo (this test fails on that design). The file's content and
+    times are restored after the dry run (the scratch run is shared)."""
+    import os
+
+    path = quick_results / "src" / "opnav" / "landing" / "kernels.py"
+    text, st = path.read_bytes(), path.stat()
+    try:
+        path.write_bytes(text + b"\n# an edit\n")
+        rules = {r for r, _ in dry_run_jobs_many(quick_results, [("--configfile", "config/quick.yaml")])[0]}
+    finally:
+        path.write_bytes(text)
+        os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert {"compile_kernels", "landing_mc_chunk", "landing_timing"} <= rules, sorted(rules)
+    assert not {r for r in rules if r.startswith("approach_")}, sorted(rules)

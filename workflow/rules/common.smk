@@ -64,9 +64,13 @@ def with_kernels(paper, files):
 
 def kernels(paper):
     """Input of a rule whose jobs call ``paper``'s compiled kernels: rule compile_kernels'
-    output for that paper, ancient (it orders the job after the cache is filled;
-    recompiling does not rerun the job: its own src inputs decide that)."""
-    return ancient(res("kernels", f"{paper}.json"))
+    output for that paper (it orders the job after the cache is filled). A plain input,
+    not ancient(): the job's src inputs hold the same kernel modules (with_kernels), so a
+    recompile reruns only jobs an edit reruns anyway; as ancient(), a job whose own src
+    changed was not scheduled in the run that recompiled (Snakemake 9.27: an edit of
+    landing/montecarlo.py plus a pending compile_kernels ran compile_kernels alone, and
+    the stale Monte Carlo was kept until the next invocation)."""
+    return res("kernels", f"{paper}.json")
 
 
 def src(*modules):

@@ -4,8 +4,8 @@
 # Its inputs are the kernel modules' sources (opnav.compiled.kernel_sources, read at
 # parse time without importing numba): editing one reruns the job, which recompiles
 # (cache entries are keyed by the whole kernel set). The jobs that call kernels take its
-# output as `kernels=kernels(paper)`, an ancient() input: it orders them after this
-# job, and their own src() inputs decide whether they rerun.
+# output as `kernels=kernels(paper)`: it orders them after this job; their own src()
+# inputs hold the same kernel modules, so a recompile reruns no job an edit would not.
 
 
 rule compile_kernels:
