@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from conftest import REPO, dry_run_jobs_many, run_snakemake
+from conftest import REPO, dry_run_jobs, dry_run_jobs_many, run_snakemake
 
 # rules that only gather finished outputs into the manuscript; any new output reruns them
 AGGREGATORS = {"paper_claims", "paper_floats", "paper_macros", "paper_pdf", "paper_scorecard", "all"}
@@ -143,7 +143,7 @@ def test_editing_a_kernel_module_reruns_its_users_in_the_same_run(quick_results)
     text, st = path.read_bytes(), path.stat()
     try:
         path.write_bytes(text + b"\n# an edit\n")
-        rules = {r for r, _ in dry_run_jobs_many(quick_results, [("--configfile", "config/quick.yaml")])[0]}
+        rules = {r for r, _ in dry_run_jobs(quick_results, "--configfile", "config/quick.yaml")}
     finally:
         path.write_bytes(text)
         os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))

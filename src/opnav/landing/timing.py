@@ -222,12 +222,15 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
     # the t-th call of a pass runs that pass's variants in their configured order
     # rotated left by t
     keys = pass_keys(var)
+    seen: dict = {}
     try:
         for key in sorted(set(keys)):
             group = np.flatnonzero(np.array([k == key for k in keys]))
-            calls = [q for q in range(nc) if group.size and timed_[q, group].any()]
+            calls = [q for q in range(nc) if timed_[q, group].any()]
             for t, q in enumerate(calls):
-                d, i, k, state, visible, exclude, det, words = inputs(q)
+                if q not in seen:           # built once per call, whatever the passes
+                    seen[q] = inputs(q)
+                d, i, k, state, visible, exclude, det, words = seen[q]
                 run[q] = int(d["plan_run"][i]) if "plan_run" in d else -1
                 step[q] = k
                 order = group[timed_[q, group]]
