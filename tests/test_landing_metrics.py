@@ -317,6 +317,47 @@ def test_compiled_mineig_equals_the_information_through_its_equilibrated_inverse
     np.testing.assert_allclose(make_metric("mineig")(ctx, cand), ref, rtol=1e-7)
 
 
+@settings(max_examples=40, deadline=None)
+@given(r=lander, R=quat, seed=seeds, lm_sd=st.sampled_from([2000.0, 2.0, 0.1]), n=st.integers(1, 80),
+       dup=st.integers(0, 3), behind=st.booleans())
+def test_mineig_brackets_hold_and_the_bounded_edge_pick_is_the_tie_rule(r, R, seed, lm_sd, n, dup, behind):
+    """The edge rule's mineig (``kernels.edge_pick``: ``score_bounds`` brackets from the rank-2
+    downdate in Sigma_k's eigenbasis, narrowed by the inertia count, LAPACK only where they
+    cannot decide) picks what scoring every candidate does (``best_index(score_points)``),
+    ties included (``dup`` exact copies of one candidate; the landmark prior sd ``lm_sd``
+    m: 2000 puts mineig on its plateau), and every bracket holds the compiled score, at
+    each narrowing. Mutations tried: the coupling term c2 dropped from the upper bound, and
+    the inertia test's ``>= 1`` as ``>= 2`` -> fail."""
+    rng = np.random.default_rng(seed)
+    f = np.r_[np.ones(9), np.full(3, lm_sd / 2000.0)]
+    ctx = _ctx(r=r, R=R, P=_prior(rng) * np.outer(f, f), boresight=np.array([0.0, 0.0, -1.0]) if behind else None)
+    cand = _ground(rng, n)
+    cand = np.concatenate([cand, np.repeat(cand[rng.integers(n)][None], dup, axis=0)])[rng.permutation(n + dup)]
+    idx = np.arange(len(cand), dtype=np.int64)
+    q = ctx.q(K.MINEIG)
+    exact = K.score_points(q, cand, idx)
+    lo, hi = K.score_bounds(q, cand, idx)
+    fin = np.isfinite(exact)
+    assert np.array_equal(np.isfinite(hi), fin)
+    assert np.all((lo[fin] <= exact[fin]) & (exact[fin] <= hi[fin]))
+    for rtol in K.NARROWING:
+        for i in np.flatnonzero(fin):
+            a, b = K.narrow(q, cand, idx[i], lo[i], hi[i], rtol)
+            assert a <= exact[i] <= b and b - a <= max(rtol * abs(b), hi[i] - lo[i])
+    assert K.edge_pick(q, cand, idx, np.int64(-1)) == (K.best_index(exact), len(cand))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.one_of(st.floats(-10.0, 10.0), st.just(np.inf), st.just(-2.0), st.just(-2.0 * (1 - 5e-10))),
+                max_size=12))
+def test_tie_pick_on_exact_scores_is_best_index(scores):
+    """``kernels.tie_pick`` with exact scores (lo = hi: every kind but mineig, and the paper's
+    definitions) is the tie rule ``best_index``: ties within TIE_RTOL to the first, +inf out."""
+    s = np.array(scores, float)
+    assert K.tie_pick(np.zeros(K.NQ), np.zeros((len(s), 3)), np.arange(len(s), dtype=np.int64), s.copy(),
+                      s.copy()) == K.best_index(s)
+
+
 @pytest.mark.parametrize("name", METRIC_NAMES)
 def test_scores_invariant_to_candidate_permutation(name):
     rng = np.random.default_rng(11)

@@ -10,7 +10,8 @@ eq. 21-22 (:func:`error_radius`), eq. 23-25 (:func:`depth_error`), eq. 26
 baselines (:func:`h_metric`), the candidate validity rule (:func:`candidate_ok`),
 the visible interval (:func:`visible_interval`), the golden-section search
 (:func:`golden_section`), the nearest detected landmark (:func:`nearest`), the
-tie rule (:func:`best_index`) and the call itself (:func:`plan_core`, compiled
+tie rule (:func:`best_index`; on bounds, :func:`tie_pick`, whose mineig brackets
+come from :func:`mineig_bracket`) and the call itself (:func:`plan_core`, compiled
 by :func:`plan_run` for every :data:`KINDS`; run by the interpreter with a
 Python objective through :func:`interpreted` for ``logdet_nav`` and the paper's
 definitions, ``opnav.landing.planner``; B-X1 metrics: :func:`info_metric`).
@@ -39,14 +40,18 @@ from opnav.landing import measurement as me
 KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8)
 DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W = 0, 1, 2, 3, 4, 5, 6
 #: q slots of the B-X1 kinds (:func:`info_constants`): R_LtoB (3 x 3, row-major), 1/sigma
-#: (rad^-1); logdet, mineig: log det Lambda_k, Sigma_k (12 x 12); whitened: L, G_k L (2 x 12)
-Q_R, Q_SCALE, Q_LD, Q_SIG, Q_L, Q_A, NQ = 24, 33, 34, 35, 35, 179, 203
+#: (rad^-1); logdet, mineig: log det Lambda_k, Sigma_k (12 x 12); whitened: L, G_k L (2 x 12);
+#: mineig: Sigma_k's eigenvalues s (12, descending) and eigenvectors V (12 x 12, columns)
+Q_R, Q_SCALE, Q_LD, Q_SIG, Q_L, Q_A, Q_S, Q_V, NQ = 24, 33, 34, 35, 35, 179, 203, 215, 359
 #: the tie rule's relative tolerance: candidates whose score lies within
 #: TIE_RTOL * |best| of the best score are tied, and the lowest landmark index
 #: wins. Paths agree to round-off (~1e-12 relative: closed form vs LAPACK's
 #: smallest structural singular value), far inside it; mineig's plateau
 #: (spread ~2e-15, ``opnav.landing.metrics``) is one tie
 TIE_RTOL = 1e-9
+#: :func:`score_bounds`: mineig's brackets are narrowed to this relative width, then those
+#: that may hold the best to each of :data:`NARROWING` in turn (:func:`tie_pick`)
+MINEIG_RTOL, NARROWING = 1e-2, (1e-4, 1e-7)
 #: status codes of :func:`plane` / :func:`plan_core` (``depth_error.REASONS`` says them)
 OK, ZERO_VELOCITY, NOT_ABOVE, NOT_DESCENDING, ZERO_BASELINE, NO_INTERVAL = 0, 1, 2, 3, 4, 5
 INVPHI = (math.sqrt(5.0) - 1.0) / 2.0
@@ -218,6 +223,12 @@ def info_constants(R_LtoB, P, sigma, q) -> None:
         q[Q_LD] += 2.0 * (math.log(C[i, i]) - math.log(s[i]))
         for j in range(12):
             q[Q_SIG + 12 * i + j] = 0.5 * (Sig[i, j] + Sig[j, i]) * s[i] * s[j]
+    if int(q[11]) == MINEIG:                         # mineig_bracket's eigenbasis
+        w, V = np.linalg.eigh(q[Q_SIG:Q_SIG + 144].reshape((12, 12)))
+        for i in range(12):
+            q[Q_S + i] = w[11 - i]
+            for j in range(12):
+                q[Q_V + 12 * i + j] = V[i, 11 - j]
 
 
 @kernel
@@ -225,8 +236,11 @@ def info_metric(kind, d0, d1, d2, q) -> float:
     """The B-X1 metric (larger is better) of a valid candidate at offset d (m), its tangent-plane
     rows G = T^T H / sigma (2 x 12, ``measurement.tangent_rows``), :func:`info_constants`: logdet
     = log det Lambda_k + log det(I_2 + G Sigma_k G^T), mineig = 1 / lambda_max of the Woodbury
-    posterior (-inf if not positive); whitened: :func:`sv_metric` of [G_k; G] L (4 x 12: the
+    posterior (:func:`mineig_bracket` to round-off; -inf if not positive); whitened: :func:`sv_metric` of [G_k; G] L (4 x 12: the
     singular values of R^-1/2 H P^1/2 for R = sigma^2 I_6, as b^T H = 0) by its Gram's eigenvalues."""
+    if kind == MINEIG:
+        lo, hi = mineig_bracket(d0, d1, d2, q, 0.0, math.inf, 2.0 ** -52)
+        return 2.0 / (lo + hi) if hi > 0 else -math.inf
     G = np.empty((2, 12))
     me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
     M, GM, Q = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((4, 12)), np.zeros((4, 4))  # Sigma_k or L
@@ -245,16 +259,114 @@ def info_metric(kind, d0, d1, d2, q) -> float:
         return sv_metric(kind - 5, lam[3], lam[2], lam[1], lam[0])
     a, b = 1.0 + Q[2, 0], 0.5 * (Q[2, 1] + Q[3, 0])
     e = 1.0 + Q[3, 1] - b * b / a                  # Schur complement, >= 1
-    if kind == LOGDET:
-        return q[Q_LD] + math.log(a) + math.log(e)
-    m0, m1, m2 = (1.0 + Q[3, 1]) / (a * e), -b / (a * e), 1.0 / e
-    Sp = np.empty((12, 12))                        # Woodbury, with (G Sigma_k) = GM[2:]
+    return q[Q_LD] + math.log(a) + math.log(e)
+
+
+@kernel
+def _above(s, W, mu) -> bool:
+    """lambda_max(diag(s) - W^T W) > mu (:func:`mineig_bracket`'s inertia count)."""
+    for i in range(12):
+        if s[i] == mu:                             # mu on a pole: its neighbour above
+            mu = np.nextafter(mu, math.inf)
+    n_above, e00, e01, e11 = 0, 1.0, 0.0, 1.0      # I_2 - W D^-1 W^T
+    for i in range(12):
+        r = 1.0 / (s[i] - mu)
+        n_above += s[i] > mu
+        e00 -= W[0, i] * W[0, i] * r
+        e01 -= W[0, i] * W[1, i] * r
+        e11 -= W[1, i] * W[1, i] * r
+    det = e00 * e11 - e01 * e01
+    return n_above + (1 if det < 0 else 2 if e00 + e11 > 0 else 0) - 2 >= 1
+
+
+@kernel
+def mineig_bracket(d0, d1, d2, q, lo0, hi0, rtol):
+    """(lo, hi) in [lo0, hi0] with lo <= lambda_max(Sigma_post) <= hi for the candidate at offset d (m), mineig =
+    1 / lambda_max, without a 12 x 12 eigenproblem (bounds for :func:`tie_pick`). In the eigenbasis V
+    of Sigma_k (s descending, :func:`info_constants`), Sigma_post = diag(s) - W^T W, W = L^T Z diag(s)
+    (2 x 12), Z = G V, L L^T = (I + Z diag(s) Z^T)^-1 (Woodbury). With the top k <= 3 eigenvalues
+    (k the least with s_k <= s_0 / 2): block A = diag(s_t) - W_t^T W_t, coupling C = W_t^T W_r, rest
+    <= s_k I; lo = lambda_max(A) (Rayleigh-Ritz), hi = the larger eigenvalue of [[lo, |C|_F], [|C|_F,
+    s_k]] (for unit x = (a, b): x^T Sigma_post x <= lo a^2 + 2 |C| a b + s_k b^2), at most s_0.
+    Then bisection until hi - lo <= rtol hi: Sigma_post - mu I has #(s_i > mu) + #pos(I_2 - W
+    D^-1 W^T) - 2 positive eigenvalues, D = diag(s - mu) (Haynsworth inertia additivity on [[D, W^T],
+    [W, I_2]]), so lambda_max > mu iff that count is >= 1 (a root in round-off: measured 2.5 us
+    against 4.8 us for LAPACK on the 12 x 12 Sigma_post). Widened by 1e-12 relative + 64 eps s_0,
+    the round-off of the count near the root (brackets of other narrowings hold the score)."""
+    G = np.empty((2, 12))
+    me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
+    s, V = q[Q_S:Q_S + 12], q[Q_V:Q_V + 144].reshape((12, 12))
+    Z = np.zeros((2, 12))
     for i in range(12):
         for j in range(12):
-            Sp[i, j] = (M[i, j] - GM[2, i] * (m0 * GM[2, j] + m1 * GM[3, j])
-                        - GM[3, i] * (m1 * GM[2, j] + m2 * GM[3, j]))
-    lmax = np.linalg.eigvalsh(Sp)[-1]
-    return 1.0 / lmax if lmax > 0 else -math.inf
+            Z[0, j] += G[0, i] * V[i, j]
+            Z[1, j] += G[1, i] * V[i, j]
+    a, b, c = 1.0, 0.0, 1.0                        # M = I + Z diag(s) Z^T
+    for j in range(12):
+        a += s[j] * Z[0, j] * Z[0, j]
+        b += s[j] * Z[0, j] * Z[1, j]
+        c += s[j] * Z[1, j] * Z[1, j]
+    l00 = math.sqrt(c / (a * c - b * b))           # L = chol(M^-1)
+    l10 = -b / (a * c - b * b) / l00
+    l11 = math.sqrt(max(a / (a * c - b * b) - l10 * l10, 0.0))
+    W = np.empty((2, 12))
+    for j in range(12):
+        W[0, j] = (l00 * Z[0, j] + l10 * Z[1, j]) * s[j]
+        W[1, j] = l11 * Z[1, j] * s[j]
+    k = 1
+    while k < 3 and s[k] > 0.5 * s[0]:
+        k += 1
+    A, c2 = np.zeros((3, 3)), 0.0
+    for i in range(k):
+        A[i, i] = s[i]
+        for j in range(k):
+            A[i, j] -= W[0, i] * W[0, j] + W[1, i] * W[1, j]
+        for j in range(k, 12):
+            c2 += (W[0, i] * W[0, j] + W[1, i] * W[1, j]) ** 2
+    lo = max_eig_sym3(A)
+    for i in range(k, 12):                         # e_i's Rayleigh quotients: an untouched s_i stays
+        lo = max(lo, s[i] - W[0, i] * W[0, i] - W[1, i] * W[1, i])
+    hi = min(0.5 * (lo + s[k]) + math.sqrt(0.25 * (lo - s[k]) ** 2 + c2), s[0], hi0)
+    lo = min(max(lo, lo0), hi)
+    mu = lo * (1.0 + 0.25 * TIE_RTOL)              # on a plateau (lambda_max = lo): one test
+    if mu < hi and not _above(s, W, mu):
+        hi = mu
+    for _ in range(64):
+        if not hi - lo > rtol * hi:
+            break
+        mu = 0.5 * (lo + hi)
+        if _above(s, W, mu):
+            lo = mu
+        else:
+            hi = mu
+    pad = 64 * 2.0 ** -52 * s[0]
+    return lo * (1 - 1e-12) - pad, hi * (1 + 1e-12) + pad
+
+
+@kernel
+def score_bounds(q, xyz, cand):
+    """(lo, hi) of :func:`score_point` of landmarks ``xyz[cand]`` (lo <= score <= hi): mineig's
+    :func:`narrow` to :data:`MINEIG_RTOL`, every other kind's its score (lo = hi)."""
+    lo, hi = np.empty(cand.size), np.empty(cand.size)
+    for j in range(cand.size):
+        lo[j], hi[j] = narrow(q, xyz, cand[j], -math.inf, math.inf, MINEIG_RTOL)
+    return lo, hi
+
+
+@kernel
+def narrow(q, xyz, i, lo, hi, rtol):
+    """Bounds lo <= score <= hi of landmark ``xyz[i]`` (:func:`score_point`) narrowed, within
+    the given ones, to hi - lo <= rtol |hi| or a plateau (mineig, :func:`mineig_bracket`:
+    score = -1 / lambda_max); every other kind, or rtol = 0: its score (lo = hi)."""
+    p0, p1, p2 = xyz[i, 0], xyz[i, 1], xyz[i, 2]
+    d0, d1, d2 = p0 - q[0], p1 - q[1], p2 - q[2]
+    if (rtol == 0.0 or int(q[11]) != MINEIG
+            or not candidate_ok(d0, d1, d2, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), q)):
+        f = score_point(p0, p1, p2, q)
+        return f, f
+    a, b = mineig_bracket(d0, d1, d2, q, -1.0 / lo if lo < 0 else 0.0, -1.0 / hi if hi < 0 else math.inf,
+                          rtol)
+    return -1.0 / a if a > 0 else -math.inf, -1.0 / b if b > 0 else math.inf
 
 
 @kernel
@@ -434,9 +546,58 @@ def best_index(scores) -> int:
             best = s
     if not math.isfinite(best):
         return -1
-    lim = best + TIE_RTOL * abs(best)
+    lim = _tie_limit(best)
     for j in range(scores.size):
         if scores[j] <= lim:
+            return j
+    return -1
+
+
+@kernel
+def _tie_limit(best) -> float:
+    """The tie rule's bound: scores <= best + TIE_RTOL |best| are tied with ``best``."""
+    return best + TIE_RTOL * abs(best) if math.isfinite(best) else best
+
+
+@kernel
+def tie_pick(q, xyz, cand, lo, hi) -> int:
+    """:func:`best_index` of the scores of ``xyz[cand]`` known by bounds lo <= score <= hi
+    (:func:`score_bounds`), each refined to its score (:func:`score_point`) only where the
+    bounds cannot decide: with best in [min lo, min hi], a candidate whose lo exceeds
+    the tie bound of min hi is out, one whose hi is within that of min lo is tied; the
+    first undecided one fixes best (every candidate with lo <= min hi refined) and is
+    refined itself. Equal to ``best_index(score_points(...))`` (same tie rule) where
+    the bounds hold; with lo = hi it is that, without refinement."""
+    n = cand.size
+    if n == 0:
+        return -1
+    blo, bhi = lo.min(), hi.min()
+    if blo == math.inf:
+        return -1
+    for rtol in NARROWING:                          # narrow the bounds that may hold the best
+        for k in range(n):
+            if lo[k] <= _tie_limit(bhi) and hi[k] - lo[k] > rtol * abs(hi[k]):
+                lo[k], hi[k] = narrow(q, xyz, cand[k], lo[k], hi[k], rtol)
+        blo, bhi = lo.min(), hi.min()
+    exact = blo == bhi
+    for j in range(n):
+        if lo[j] > _tie_limit(bhi):
+            continue
+        if hi[j] <= _tie_limit(blo):
+            return j
+        if not exact:                               # fix best: refine every possible minimum
+            for k in range(n):
+                if lo[k] <= bhi and lo[k] < hi[k]:
+                    lo[k], hi[k] = narrow(q, xyz, cand[k], lo[k], hi[k], 0.0)
+            blo = bhi = hi.min()
+            exact = True
+            if blo == math.inf:
+                return -1
+            if lo[j] > _tie_limit(bhi):
+                continue
+        if lo[j] < hi[j]:
+            lo[j], hi[j] = narrow(q, xyz, cand[j], lo[j], hi[j], 0.0)
+        if hi[j] <= _tie_limit(bhi):
             return j
     return -1
 
@@ -536,7 +697,8 @@ def edge_pick(q, xyz, det, exclude):
     """The edge rule: (pick, landmarks scored): every detected landmark less
     ``exclude`` scored (:func:`score_points`), the tie rule picks (-1: none finite)."""
     cand = det[det != exclude]
-    j = best_index(score_points(q, xyz, cand)) if cand.size else -1
+    lo, hi = score_bounds(q, xyz, cand)
+    j = tie_pick(q, xyz, cand, lo, hi)
     return (cand[j] if j >= 0 else -1), cand.size
 
 
@@ -626,6 +788,7 @@ def _warm() -> None:
                  xyz, det, np.int64(-1), cells, work)
         q = work[:NQ]
         score_points(q, xyz, det)
+        edge_pick(q, xyz, det, np.int64(-1))
         evaluations(q, np.array([-0.1, 0.1]), xyz, det, 1)
     valid_points(q, xyz)
     info_constants(R, P, 1.0, q)

@@ -45,7 +45,9 @@ candidate (spread ~2e-15): ``mineig`` ties everywhere (the tie rule: lowest inde
 ``kernels.info_metric``): a bearing's information is that of its tangent-plane
 rows G = sigma^-1 T^T H (2 x 12, ``measurement.tangent_rows``): log det Lambda =
 log det Lambda_k + log det(I_2 + G Sigma_k G^T) after the known landmark,
-Sigma_post by Woodbury; whitened: [G_k; G] L (L = chol(P)), the eigenvalues of
+Sigma_post by Woodbury, its lambda_max by bisection on an inertia count in Sigma_k's
+eigenbasis (``kernels.mineig_bracket``: the edge rule scores thousands of candidates from
+brackets and narrows only those that may be the best, ``kernels.tie_pick``); whitened: [G_k; G] L (L = chol(P)), the eigenvalues of
 its 4 x 4 Gram matrix. Any other ``R_meas``: the definition (``metric.reference``).
 
 Validity (``kernels.candidate_ok``): a candidate within ``ctx.min_range_m`` of the

@@ -196,6 +196,14 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
     return f, lambda q, xyz, cand: score(xyz[cand]), K.OK
 
 
+def _exact_bounds(scores):
+    """``kernels.score_bounds`` of an interpreted objective: its scores, known exactly (lo = hi)."""
+    def bounds(q, xyz, cand):
+        s = np.asarray(scores(q, xyz, cand), float)
+        return s, s.copy()
+    return bounds
+
+
 # ----------------------------------------------------------------- planning
 
 _CACHE: dict = {}
@@ -242,7 +250,7 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
             f, scores, st = _python_objective(method, state, cfg, camera, q)
         if st == K.OK:
             core = K.interpreted(K.plan_core, golden_section=K.interpreted(K.golden_section, objective=f),
-                                 edge_pick=K.interpreted(K.edge_pick, score_points=scores))
+                                 edge_pick=K.interpreted(K.edge_pick, score_bounds=_exact_bounds(scores)))
             core(q, camera.R_BtoC @ state.R_LtoB, c[K.C_KFOV], c[K.C_TOL], xyz, detected, exclude,
                  c[K.C_GRID:K.C_GRID + 5], cells, out)
         else:
