@@ -333,3 +333,13 @@ def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monke
     # the compiled calls of a pass come before any interpreted one (passes in key order)
     first_interp = next(i for i, (m, p) in enumerate(seen[len(var):]) if not (m in ("depth", "svd") and p == "compiled"))
     assert all(not (m in ("depth", "svd") and p == "compiled") for m, p in seen[len(var) + first_interp:])
+
+
+def test_less_time_text_says_more_for_a_negative_reduction():
+    """B-F7's title and the manuscript's sentence: a negative reduction is more time."""
+    from opnav.landing.timing import less_time_text
+
+    assert less_time_text(34.2) == "34.2 % less"
+    assert less_time_text(-137.4) == "137.4 % more"
+    assert less_time_text(0.0) == "0.0 % less"
+    assert less_time_text(float("nan")) == "n/a"

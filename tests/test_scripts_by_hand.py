@@ -44,3 +44,17 @@ def test_a_missing_wildcard_is_named(tmp_path):
 
     with pytest.raises(SystemExit, match="needs the wildcard.*variant"):
         mock_snakemake("approach_mc", root=REPO)
+
+
+def test_the_landing_chunk_job_gets_the_configured_batch_size(tmp_path):
+    """landing.mc.batch_size reaches the Monte-Carlo job (it was read from the
+    simulation config, which does not carry it, so any value flew the whole chunk
+    as one batch); it is a param of its own, outside the runs' reuse key."""
+    from opnav.snakeio import mock_snakemake
+
+    overlay = tmp_path / "batch.yaml"
+    overlay.write_text(yaml.safe_dump({"landing": {"mc": {"batch_size": 3}}}))
+    sm = mock_snakemake("landing_mc_chunk", root=REPO, argv=["--configfile", str(overlay)],
+                        bscn="site-tilt", bmethod="depth", bchunk="r0000-0001")
+    assert sm.params.batch_size == 3
+    assert "batch_size" not in sm.params.landing.get("mc", {})

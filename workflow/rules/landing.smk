@@ -95,6 +95,8 @@ rule landing_mc_chunk:
         # the pick-ratio diagnostic scores every detected landmark once more per planning
         # call (half an information metric's descent); only B-T3 (landing.mc.methods) shows it
         pick_ratio=lambda wc: wc.bmethod in B_METHODS,
+        # runs flown per batch (speed and memory only: the numbers do not depend on it)
+        batch_size=config["landing"]["mc"]["batch_size"],
     # the longest jobs, and the timing replay waits for them: started first, so
     # that no core idles at the end of a run (speed only)
     priority: 10

@@ -22,7 +22,7 @@ with script_context(snakemake) as log:
     key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio,
                          "code": code})
     data, flown = run_chunk_reusing(snakemake.output[0], key, snakemake.params.landing, method, runs,
-                                    pick_ratio=pick_ratio)
+                                    pick_ratio=pick_ratio, batch_size=int(snakemake.params.batch_size))
     save(snakemake.output[0], data, method)
     log.info("%s: runs %s..%s (%d flown, %d taken from earlier chunks), %d planning calls", method,
              runs[0], runs[-1], len(flown), len(runs) - len(flown), len(data["plan_index"]))

@@ -107,12 +107,12 @@ def earlier_chunks(path, run_indices) -> list[tuple[Path, list[int]]]:
 
 
 def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_indices,
-                      pick_ratio: bool = True) -> tuple[dict, list[int]]:
+                      pick_ratio: bool = True, batch_size: int | None = None) -> tuple[dict, list[int]]:
     """:func:`run_chunk` for the chunk file ``path``, taking the runs already
     flown in :func:`earlier_chunks` whose stored ``reuse_key`` (a digest of
     everything the runs depend on, given by the caller) equals ``reuse_key``:
     (the chunk, as :func:`run_chunk` would return it, with ``reuse_key``; the run
-    indices actually flown). Gathering in run order makes it the same chunk
+    indices actually flown; ``batch_size`` as :func:`run_chunk`'s, not in the key). Gathering in run order makes it the same chunk
     whatever was reused (:func:`gather`)."""
     idx = [int(i) for i in run_indices]
     parts = []
@@ -123,7 +123,7 @@ def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_
     have = {int(i) for part in parts for i in part["run_index"]}
     todo = [i for i in idx if i not in have]
     if todo:
-        parts.append(run_chunk(landing_cfg, method, todo, pick_ratio=pick_ratio))
+        parts.append(run_chunk(landing_cfg, method, todo, batch_size=batch_size, pick_ratio=pick_ratio))
     data = parts[0] if len(parts) == 1 else gather(parts)
     return {**data, "reuse_key": np.array(reuse_key)}, todo
 

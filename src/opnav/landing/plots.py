@@ -240,13 +240,10 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                       fontsize="x-small")
         if published_reduction_vs_svd is not None and {"depth", "svd"} <= set(methods):
             ours = tmg.time_reduction(timing, "depth", "svd", n_boot=0)[0]
-            def less(v):   # a negative reduction is more time
-                return f"{v:.1f} % less" if v >= 0 else f"{-v:.1f} % more"
-
-            title = f"depth vs SVD: {less(ours)} time ({main_name})"
+            title = f"depth vs SVD: {tmg.less_time_text(ours)} time ({main_name})"
             if tmg.times_ns(timing, "svd", "alt").size:
                 da = "alt" if tmg.times_ns(timing, "depth", "alt").size else "main"   # both on that path
                 ours_alt = tmg.time_reduction(timing, "depth", "svd", path_a=da, path_b="alt", n_boot=0)[0]
-                title += f", {less(ours_alt)} ({alt_name})"
+                title += f", {tmg.less_time_text(ours_alt)} ({alt_name})"
             ax.set_title(f"{title}\npublished {published_reduction_vs_svd:.2f} % less", fontsize="x-small")
         return fig

@@ -396,6 +396,14 @@ def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str
     return red, float(np.std(vals, ddof=1))
 
 
+def less_time_text(reduction_pct: float) -> str:
+    """A :func:`time_reduction` in words: ``"34.2 % less"``, a negative one ``"137.4 % more"``
+    (not "-137.4 % less"); ``"n/a"`` if it is nan."""
+    if not math.isfinite(reduction_pct):
+        return "n/a"
+    return f"{reduction_pct:.1f} % less" if reduction_pct >= 0 else f"{-reduction_pct:.1f} % more"
+
+
 def method_summary(tm: dict) -> dict:
     """The replay's method in numbers (summary JSON, manuscript macros): calls
     replayed and recorded, ``max_calls``, the calls the paper's definition was
