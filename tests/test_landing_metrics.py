@@ -347,6 +347,23 @@ def test_mineig_brackets_hold_and_the_bounded_edge_pick_is_the_tie_rule(r, R, se
     assert K.edge_pick(q, cand, idx, np.int64(-1)) == (K.best_index(exact), len(cand))
 
 
+@settings(max_examples=60, deadline=None)
+@given(seed=seeds, scale=st.sampled_from([1e-6, 1.0, 1e6]), rank=st.integers(1, 4))
+def test_inv_trace4_is_the_trace_of_numpys_inverse(seed, scale, rank):
+    """gdop_w's trace(Q^-1) (``kernels.inv_trace4``, Cholesky) is numpy's for positive definite
+    Gram matrices of any scale, +inf for singular ones (rank < 4: gdop_w 0, as sv_metric
+    of a zero eigenvalue). Mutation tried: the forward substitution's ``k in range(c, i)`` as
+    ``range(c + 1, i)`` -> fails."""
+    rng = np.random.default_rng(seed)
+    B = rng.standard_normal((4, rank)) * scale
+    Q = B @ B.T + (0.0 if rank < 4 else 0.1 * scale**2 * np.eye(4))
+    got = K.inv_trace4(Q)
+    if rank < 4:
+        assert got == np.inf or got > 1e12 / scale**2
+    else:
+        np.testing.assert_allclose(got, np.trace(np.linalg.inv(Q)), rtol=1e-10)
+
+
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.one_of(st.floats(-10.0, 10.0), st.just(np.inf), st.just(-2.0), st.just(-2.0 * (1 - 5e-10))),
                 max_size=12))
