@@ -227,11 +227,13 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             ev = tmg.median_evals(timing, m)
             labels.append(f"{_label(m)}\n{ev:.0f} evals")
         ax.set_xticks(range(1, len(methods) + 1), labels, fontsize="small")
-        for p_, v in zip(pos, vals):
+        for p_, v in zip(pos, vals):       # the median, above the upper whisker (clear of the box)
             if len(v):
                 med = float(np.median(v))
-                ax.annotate(f"{med:.0f}", (p_, med), xytext=(0, 3), textcoords="offset points",
-                            ha="center", va="bottom", fontsize="xx-small")
+                ax.annotate(f"{med:.1f}" if med < 100 else f"{med:.0f}", (p_, float(np.percentile(v, 95))),
+                            xytext=(0, 2), textcoords="offset points", ha="center", va="bottom",
+                            fontsize="xx-small")
+        ax.set_ylim(top=ax.get_ylim()[1] * 2.0)   # room for the labels of the tallest boxes
         ax.set_ylabel("planning-call time (µs)")
         n_alt = max((tmg.timed_calls(timing, m, "alt") for m in methods), default=0)
         ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"
