@@ -93,3 +93,17 @@ def test_a_field_without_enough_stars_stops_with_the_key():
     cfg["stars"].update(mag_limit=2.0)
     with pytest.raises(ValueError, match="approach.stars"):
         sc.build_geometry(cfg, "stars")
+
+
+def test_an_arc_with_no_star_image_gives_an_empty_field():
+    """An arc that ends before its first star image (sample N0 + every_K) gives a field of no
+    image with the shapes of one (it failed in a reshape), and normal equations of zero
+    information; the config check refuses such an arc for the stars variant
+    (test_bad_input: approach.stars.every_K)."""
+    from opnav.approach import stars
+
+    C = np.repeat(np.eye(3)[None], 11, axis=0)
+    f = stars.star_field(C, 10, 5, 3, 6.0, 0.0, 0.1, 1e-5, stars.catalogue(0, 1000))
+    assert f.p0.shape == (0, 6) and f.G.shape == (0, 6, 3) and f.v.shape == (0, 3, 3)
+    J, h = stars.normal_equations(f, np.zeros((2, 0, 6)))
+    assert np.array_equal(J, np.zeros((3, 3))) and h.shape == (2, 3)

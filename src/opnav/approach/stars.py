@@ -125,8 +125,8 @@ def star_field(C: np.ndarray, N0: int, every_K: int, per_image: int, mag_limit: 
         pick = inside[np.argsort(mag[inside], kind="stable")[:per_image]]
         vs.append(v[pick])
     v = np.stack(vs) if vs else np.zeros((0, per_image, 3))
-    p0 = focal_plane(v).reshape(len(idx), -1)
-    G = sensitivity(v).reshape(len(idx), -1, 3)
+    p0 = focal_plane(v).reshape(len(idx), 2 * per_image)      # no image: (0, 2m), not a reshape error
+    G = sensitivity(v).reshape(len(idx), 2 * per_image, 3)
     w = np.full(p0.shape, 1.0 / sigma_rad**2)
     return StarField(idx, v, p0, G, w)
 
