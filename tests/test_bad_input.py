@@ -71,7 +71,6 @@ BAD_CONFIGS = [
     ("approach: {camera: {ifov_arcsec: 0.1}}", "approach.camera"),
     ("approach: {geometry: {range_km: 20000}}", "approach.camera"),
     ("approach: {truth_bias_arcsec: [6000, 0, 0]}", "approach.truth_bias_arcsec"),
-    ("approach: {stars: {every_K: 1000000}}", "approach.stars.every_K"),
     ("approach: {segments: {N: 100000, L: 10000}}", "approach.segments"),
     ("approach: {n_seeds: 1000, segments: {N0: 10000}}", "approach.n_seeds"),
     ("approach: {roll: {steps_deg: [0, 90], step_interval_s: 100.3}}", "approach.roll.step_interval_s"),

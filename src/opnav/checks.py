@@ -448,10 +448,6 @@ def approach_problems(a: dict) -> list[str]:
         out.append(f"{k}geometry': the arc reaches Mars' surface within its {T:g} s "
                    "(dt_s x samples); raise geometry.aim_offset_km or range_km, or shorten the arc")
         return out
-    st = a.get("stars")
-    if "stars" in a["variants"] and st and s["N0"] + st["every_K"] > n:
-        out.append(f"{k}stars.every_K': the first star image (sample N0 + every_K = "
-                   f"{s['N0'] + st['every_K']}) lies beyond the arc's last sample {n}; lower every_K")
     cam = a["camera"]
     disc = scenario.mars_disc_px(rmin, cam["ifov_arcsec"])
     if disc > cam["pixels"]:

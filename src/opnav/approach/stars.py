@@ -106,12 +106,16 @@ def star_field(C: np.ndarray, N0: int, every_K: int, per_image: int, mag_limit: 
                half_fov_rad: float, sigma_rad: float, cat: tuple[np.ndarray, np.ndarray]) -> StarField:
     """The star images of an arc whose Mars-tracking attitude is ``C`` (n+1, 3, 3): one every
     ``every_K`` samples after ``N0``, each with the ``per_image`` brightest catalogue stars
-    brighter than ``mag_limit`` in the slewed camera's field (``ValueError`` if a field has fewer)."""
+    brighter than ``mag_limit`` in the slewed camera's field (``ValueError`` if a field has fewer, or
+    if the arc holds no image)."""
     dirs, mag = cat
     bright = mag <= mag_limit
     dirs, mag = dirs[bright], mag[bright]
     n = C.shape[0] - 1
     idx = np.arange(N0 + every_K, n + 1, every_K)
+    if idx.size == 0:
+        raise ValueError(f"approach.stars.every_K: the first star image (sample N0 + every_K = {N0 + every_K}) "
+                         f"lies beyond the arc's last sample {n}; lower every_K or lengthen the arc")
     R = rot_x(np.deg2rad(slew_deg))
     vs = []
     for k in idx:
@@ -125,8 +129,8 @@ def star_field(C: np.ndarray, N0: int, every_K: int, per_image: int, mag_limit: 
         pick = inside[np.argsort(mag[inside], kind="stable")[:per_image]]
         vs.append(v[pick])
     v = np.stack(vs) if vs else np.zeros((0, per_image, 3))
-    p0 = focal_plane(v).reshape(len(idx), 2 * per_image)      # no image: (0, 2m), not a reshape error
-    G = sensitivity(v).reshape(len(idx), 2 * per_image, 3)
+    p0 = focal_plane(v).reshape(len(idx), -1)
+    G = sensitivity(v).reshape(len(idx), -1, 3)
     w = np.full(p0.shape, 1.0 / sigma_rad**2)
     return StarField(idx, v, p0, G, w)
 
