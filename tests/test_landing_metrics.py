@@ -347,6 +347,36 @@ def test_mineig_brackets_hold_and_the_bounded_edge_pick_is_the_tie_rule(r, R, se
     assert K.edge_pick(q, cand, idx, np.int64(-1)) == (K.best_index(exact), len(cand))
 
 
+@settings(max_examples=40, deadline=None)
+@given(r=lander, R=quat, seed=seeds, kind=st.sampled_from(["svd_w", "cond_w"]), n=st.integers(1, 80),
+       dup=st.integers(0, 3), jitter=st.sampled_from([0.0, 1e-6, 1e-5, 1e-4]), behind=st.booleans(),
+       order=st.sampled_from(["random", "worst first"]))
+def test_whitened_screen_bounds_hold_and_its_edge_pick_is_the_tie_rule(r, R, seed, kind, n, dup, jitter, behind,
+                                                                      order):
+    """svd_w and cond_w's edge rule (``kernels.whitened_bounds``: exact scores only for the
+    candidates that may reach the best so far, by a bound or a Cholesky test of Q - mu I) picks
+    what scoring every candidate does (``best_index(score_points)``), with exact and near ties
+    (``dup`` copies of the best candidate moved by ``jitter`` m: 1e-5 m is ~1e-9 relative), invalid candidates (``behind``) and
+    the candidates in the worst order (ascending metric: every one a new best); its bounds hold
+    every score. Mutations tried: L as trace Q (an upper bound of l1, not a lower one), and the
+    upper bound halved -> fail (a mutation that only screens less, or screens a candidate
+    with a valid bound, is still the tie rule: ``tie_pick`` refines what its bounds leave open)."""
+    rng = np.random.default_rng(seed)
+    ctx = _ctx(r=r, R=R, P=_prior(rng), boresight=np.array([0.0, 0.0, -1.0]) if behind else None)
+    q = ctx.q(K.KINDS[kind])
+    cand = _ground(rng, n)
+    best = cand[np.argmin(K.score_points(q, cand, np.arange(n, dtype=np.int64)))]
+    copies = best + jitter * rng.standard_normal((dup, 3))
+    cand = np.concatenate([cand, copies])[rng.permutation(n + dup)]
+    idx = np.arange(len(cand), dtype=np.int64)
+    exact = K.score_points(q, cand, idx)
+    if order == "worst first":
+        cand, exact = cand[np.argsort(-exact, kind="stable")], exact[np.argsort(-exact, kind="stable")]
+    lo, hi = K.score_bounds(q, cand, idx)
+    assert np.all((lo <= exact) & (exact <= hi))
+    assert K.edge_pick(q, cand, idx, np.int64(-1)) == (K.best_index(exact), len(cand))
+
+
 @settings(max_examples=60, deadline=None)
 @given(seed=seeds, scale=st.sampled_from([1e-6, 1.0, 1e6]), rank=st.integers(1, 4))
 def test_inv_trace4_is_the_trace_of_numpys_inverse(seed, scale, rank):

@@ -11,7 +11,7 @@ baselines (:func:`h_metric`), the candidate validity rule (:func:`candidate_ok`)
 the visible interval (:func:`visible_interval`), the golden-section search
 (:func:`golden_section`), the nearest detected landmark (:func:`nearest`), the
 tie rule (:func:`best_index`; on bounds, :func:`tie_pick`, whose mineig brackets
-come from :func:`mineig_bracket`) and the call itself (:func:`plan_core`, compiled
+come from :func:`mineig_bracket`, svd_w and cond_w's from :func:`whitened_bounds`) and the call itself (:func:`plan_core`, compiled
 by :func:`plan_run` for every :data:`KINDS`; run by the interpreter with a
 Python objective through :func:`interpreted` for ``logdet_nav`` and the paper's
 definitions, ``opnav.landing.planner``; B-X1 metrics: :func:`info_metric`).
@@ -38,7 +38,7 @@ from opnav.landing import measurement as me
 
 #: objective kinds compiled here (``q[11]``); the whitened ones are their base + 5
 KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8)
-DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W = 0, 1, 2, 3, 4, 5, 6, 7
+DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W, COND_W = 0, 1, 2, 3, 4, 5, 6, 7, 8
 #: q slots of the B-X1 kinds (:func:`info_constants`): R_LtoB (3 x 3, row-major), 1/sigma
 #: (rad^-1); logdet, mineig: log det Lambda_k, Sigma_k (12 x 12); whitened: L, G_k L (2 x 12);
 #: mineig: Sigma_k's eigenvalues s (12, descending) and eigenvectors V (12 x 12, columns)
@@ -241,28 +241,117 @@ def info_metric(kind, d0, d1, d2, q) -> float:
     if kind == MINEIG:
         lo, hi = mineig_bracket(d0, d1, d2, q, 0.0, math.inf, 2.0 ** -52)
         return 2.0 / (lo + hi) if hi > 0 else -math.inf
+    Q = np.zeros((4, 4))
+    gram(kind, d0, d1, d2, q, Q)
+    if kind >= SVD_W:
+        return whitened_metric(kind, Q)
+    a, b = 1.0 + Q[2, 0], 0.5 * (Q[2, 1] + Q[3, 0])
+    e = 1.0 + Q[3, 1] - b * b / a                  # Schur complement, >= 1
+    return q[Q_LD] + math.log(a) + math.log(e)
+
+
+@kernel
+def gram(kind, d0, d1, d2, q, Q) -> None:
+    """Q (4 x 4, zeroed) <- the Gram of [G_k L; G L] (whitened kinds: L = chol(P)) or, in Q[2:, :2],
+    G Sigma_k G^T (logdet) for the candidate's rows G (:func:`info_metric`)."""
     G = np.empty((2, 12))
     me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
-    M, GM, Q = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((4, 12)), np.zeros((4, 4))  # Sigma_k or L
+    M, GM = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((4, 12))  # Sigma_k or L
     for k in range(12):
         for j in range(12):
             GM[2, j] += G[0, k] * M[k, j]
             GM[3, j] += G[1, k] * M[k, j]
     for j in range(24):                            # rows 0-1: G_k L (whitened) or G
         GM[j // 12, j % 12] = q[Q_A + j] if kind >= SVD_W else G[j // 12, j % 12]
-    for i in range(4):                    # whitened: Gram of [G_k L; G L]; else Q[2:, :2] = G Sigma_k G^T
+    for i in range(4):
         for j in range(4):
             for k in range(12):
                 Q[i, j] += GM[i, k] * GM[j, k]
-    if kind == GDOP_W:                             # 1 / sum 1 / lambda_i without the eigenvalues
+
+
+@kernel
+def whitened_metric(kind, Q) -> float:
+    """svd_w, gdop_w, cond_w (:func:`sv_metric`) of the whitened Gram Q (:func:`gram`): gdop_w =
+    1 / trace(Q^-1) without the eigenvalues (:func:`inv_trace4`), else by LAPACK eigvalsh."""
+    if kind == GDOP_W:
         it = inv_trace4(Q)
         return 1.0 / it if it < math.inf else 0.0
-    if kind >= SVD_W:
-        lam = np.linalg.eigvalsh(Q)
-        return sv_metric(kind - 5, lam[3], lam[2], lam[1], lam[0])
-    a, b = 1.0 + Q[2, 0], 0.5 * (Q[2, 1] + Q[3, 0])
-    e = 1.0 + Q[3, 1] - b * b / a                  # Schur complement, >= 1
-    return q[Q_LD] + math.log(a) + math.log(e)
+    lam = np.linalg.eigvalsh(Q)
+    return sv_metric(kind - 5, lam[3], lam[2], lam[1], lam[0])
+
+
+@kernel
+def chol4(Q, mu, C) -> bool:
+    """C (4 x 4) <- the Cholesky factor of Q - mu I (Q symmetric, lower triangle read); False if
+    that is not positive definite (exact arithmetic: lambda_min(Q) <= mu; in floating point
+    within a backward error of ~20 eps max Q_ii)."""
+    for j in range(4):
+        p = Q[j, j] - mu
+        for k in range(j):
+            p -= C[j, k] * C[j, k]
+        if not p > 0.0:
+            return False
+        C[j, j] = math.sqrt(p)
+        for i in range(j + 1, 4):
+            v = Q[i, j]
+            for k in range(j):
+                v -= C[i, k] * C[j, k]
+            C[i, j] = v / C[j, j]
+    return True
+
+
+@kernel
+def whitened_bounds(q, xyz, cand):
+    """:func:`score_bounds` of svd_w and cond_w (score = -metric, metric = sqrt(l4) or sqrt(l4 / l1),
+    l the eigenvalues of the Gram Q, :func:`gram`) with few eigenproblems: the candidate whose
+    metric may be largest (by the upper bound sqrt(min_i Q_ii) or sqrt(min_i Q_ii / L), L =
+    |Q^2 e|/|Q e| <= l1 for e the column of Q of largest norm) is scored first; every other
+    one is scored exactly only if it may reach t = (1 - TIE_RTOL) m of the best metric m so far:
+    not if l4 < t^2 (svd_w) or l4 < t^2 L (cond_w), shown by its bound or by a Cholesky failure
+    of Q - mu I (:func:`chol4`; mu less 64 eps trace Q, the Cholesky's and eigvalsh's
+    round-off). Such a candidate lies beyond the tie bound of the best (lo = -t (1 - 1e-12),
+    hi = 0), so :func:`tie_pick` leaves it out. Needed by measurement: the score by eigvalsh
+    costs 1.3 us, the Gram and its Cholesky test about 0.4 us, and an edge call of 2,000-10,000
+    candidates scores about ln(n) of them exactly."""
+    n, kind = cand.size, int(q[11])
+    lo, hi = np.full(n, math.inf), np.full(n, math.inf)
+    Qs, ub, lmax, C = np.zeros((n, 4, 4)), np.full(n, -1.0), np.ones(n), np.empty((4, 4))
+    for j in range(n):
+        d0, d1, d2 = xyz[cand[j], 0] - q[0], xyz[cand[j], 1] - q[1], xyz[cand[j], 2] - q[2]
+        if not candidate_ok(d0, d1, d2, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), q):
+            continue                                 # invalid: +inf
+        Q = Qs[j]
+        gram(kind, d0, d1, d2, q, Q)
+        tr, mind, e, en = 0.0, math.inf, 0, -1.0
+        for i in range(4):
+            tr += Q[i, i]
+            mind = min(mind, Q[i, i])
+            ni = Q[0, i] ** 2 + Q[1, i] ** 2 + Q[2, i] ** 2 + Q[3, i] ** 2
+            if ni > en:
+                e, en = i, ni
+        if kind == COND_W and en > 0.0:  # L = |Q y| / |y|, y = Q e
+            y2 = 0.0
+            for i in range(4):
+                z = Q[i, 0] * Q[0, e] + Q[i, 1] * Q[1, e] + Q[i, 2] * Q[2, e] + Q[i, 3] * Q[3, e]
+                y2 += z * z
+            lmax[j] = math.sqrt(y2 / en) * (1 - 1e-12) - 4 * 2.0 ** -52 * tr
+        ub[j] = math.sqrt(max(mind + 4 * 2.0 ** -52 * tr, 0.0) / (lmax[j] if kind == COND_W else 1.0))
+    s = np.argmax(ub)
+    if ub[s] < 0.0:
+        return lo, hi
+    best = -whitened_metric(kind, Qs[s])
+    lo[s] = hi[s] = best
+    for j in range(n):
+        if j == s or ub[j] < 0.0:
+            continue
+        t = -_tie_limit(best) * (1 - 1e-12)          # the metric a candidate must reach
+        if t > 0.0 and (ub[j] < t or not chol4(
+                Qs[j], t * t * (lmax[j] if kind == COND_W else 1.0) - 64 * 2.0 ** -52 * np.trace(Qs[j]), C)):
+            lo[j], hi[j] = -t, 0.0
+            continue
+        lo[j] = hi[j] = -whitened_metric(kind, Qs[j])
+        best = min(best, lo[j])
+    return lo, hi
 
 
 @kernel
@@ -350,6 +439,8 @@ def mineig_bracket(d0, d1, d2, q, lo0, hi0, rtol):
 def score_bounds(q, xyz, cand):
     """(lo, hi) of :func:`score_point` of landmarks ``xyz[cand]`` (lo <= score <= hi): mineig's
     :func:`narrow` to :data:`MINEIG_RTOL`, every other kind's its score (lo = hi)."""
+    if int(q[11]) == SVD_W or int(q[11]) == COND_W:
+        return whitened_bounds(q, xyz, cand)
     lo, hi = np.empty(cand.size), np.empty(cand.size)
     for j in range(cand.size):
         lo[j], hi[j] = narrow(q, xyz, cand[j], -math.inf, math.inf, MINEIG_RTOL)
@@ -379,18 +470,8 @@ def inv_trace4(Q) -> float:
     gdop of Q's eigenvalues): measured 0.5 us a score against 1.3 us through numba's LAPACK
     eigvalsh (its workspace query and copies were 3/4 of a whitened score)."""
     C, x, t = np.zeros((4, 4)), np.empty(4), 0.0
-    for j in range(4):
-        p = Q[j, j]
-        for k in range(j):
-            p -= C[j, k] * C[j, k]
-        if not p > 0.0:
-            return math.inf
-        C[j, j] = math.sqrt(p)
-        for i in range(j + 1, 4):
-            v = Q[i, j]
-            for k in range(j):
-                v -= C[i, k] * C[j, k]
-            C[i, j] = v / C[j, j]
+    if not chol4(Q, 0.0, C):
+        return math.inf
     for c in range(4):                             # column c of C^-1, forward substitution
         for i in range(c, 4):
             v = 1.0 if i == c else 0.0

@@ -48,7 +48,9 @@ log det Lambda_k + log det(I_2 + G Sigma_k G^T) after the known landmark,
 Sigma_post by Woodbury, its lambda_max by bisection on an inertia count in Sigma_k's
 eigenbasis (``kernels.mineig_bracket``: the edge rule scores thousands of candidates from
 brackets and narrows only those that may be the best, ``kernels.tie_pick``); whitened: [G_k; G] L (L = chol(P)), the eigenvalues of
-its 4 x 4 Gram matrix. Any other ``R_meas``: the definition (``metric.reference``).
+its 4 x 4 Gram matrix (gdop_w: its inverse's trace; the edge rule's svd_w and cond_w score
+exactly only the candidates a bound and a Cholesky test cannot rule out,
+``kernels.whitened_bounds``). Any other ``R_meas``: the definition (``metric.reference``).
 
 Validity (``kernels.candidate_ok``): a candidate within ``ctx.min_range_m`` of the
 lander or behind the camera (b . boresight_B <= 0; None disables), or with the
