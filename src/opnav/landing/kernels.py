@@ -252,21 +252,37 @@ def info_metric(kind, d0, d1, d2, q) -> float:
 
 @kernel
 def gram(kind, d0, d1, d2, q, Q) -> None:
-    """Q (4 x 4, zeroed) <- the Gram of [G_k L; G L] (whitened kinds: L = chol(P)) or, in Q[2:, :2],
-    G Sigma_k G^T (logdet) for the candidate's rows G (:func:`info_metric`)."""
+    """Q (4 x 4) <- the Gram of [G_k L; G L] (whitened kinds: L = chol(P), lower triangular) or, in
+    Q[2:, :2], G Sigma_k G^T (logdet) for the candidate's rows G (:func:`info_metric`). G's
+    columns 3-5 (velocity) are zero (``measurement.tangent_rows``): skipped, as L's upper
+    triangle (measured per score: logdet 0.34 -> 0.23 us, gdop_w 0.55 -> 0.40 us)."""
     G = np.empty((2, 12))
     me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
-    M, GM = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((4, 12))  # Sigma_k or L
-    for k in range(12):
-        for j in range(12):
-            GM[2, j] += G[0, k] * M[k, j]
-            GM[3, j] += G[1, k] * M[k, j]
-    for j in range(24):                            # rows 0-1: G_k L (whitened) or G
-        GM[j // 12, j % 12] = q[Q_A + j] if kind >= SVD_W else G[j // 12, j % 12]
-    for i in range(4):
-        for j in range(4):
+    M, GM, A = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((2, 12)), q[Q_A:Q_A + 24].reshape((2, 12))
+    w = kind >= SVD_W
+    for k in range(12):                            # GM = G M (M: Sigma_k, or L)
+        if 3 <= k < 6:
+            continue
+        for j in range(k + 1 if w else 12):
+            GM[0, j] += G[0, k] * M[k, j]
+            GM[1, j] += G[1, k] * M[k, j]
+    for a in range(2):
+        for b in range(2):
+            Q[2 + a, b] = Q[b, 2 + a] = 0.0
+            for k in range(12):                    # G L (G_k L)^T, or G Sigma_k G^T
+                Q[2 + a, b] += GM[a, k] * (A[b, k] if w else G[b, k])
+    if not w:
+        return
+    for a in range(2):
+        for b in range(a + 1):
+            Q[a, b] = Q[b, a] = Q[2 + a, 2 + b] = Q[2 + b, 2 + a] = 0.0
             for k in range(12):
-                Q[i, j] += GM[i, k] * GM[j, k]
+                Q[a, b] += A[a, k] * A[b, k]
+                Q[2 + a, 2 + b] += GM[a, k] * GM[b, k]
+            Q[b, a], Q[2 + b, 2 + a] = Q[a, b], Q[2 + a, 2 + b]
+    for a in range(2):
+        for b in range(2):
+            Q[b, 2 + a] = Q[2 + a, b]
 
 
 @kernel
