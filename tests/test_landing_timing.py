@@ -307,32 +307,45 @@ def test_reductions_across_paths_use_the_common_subset():
 
 
 def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monkeypatch):
-    """Every compiled search is run once untimed right before its timed call (so its
-    time is its own work, not the caches its predecessor evicted); interpreted
-    variants (the paper's definition, the pickers) run once per timed call. Counted
-    by wrapping planner.plan: per variant, one warm-up call, then 2 (compiled) or 1
-    (interpreted) per timed call."""
+    """Every compiled search is timed as the kernel's call itself (planner.compiled_call,
+    without the Python wrapper), run right after an untimed planner.plan of the same
+    variant on the same inputs (its pick; and its time is its own work, not the caches
+    its predecessor evicted); interpreted variants (the paper's definition, the pickers)
+    run planner.plan once per timed call. Counted by wrapping both: per variant, one
+    warm-up plan, then per timed call plan + compiled_call (compiled) or plan (interpreted)."""
     from opnav.landing import planner
 
     scn, rec = recorded
     seen = []
-    real = planner.plan
+    real, real_call = planner.plan, planner.compiled_call
 
     def counting(m, state, camera, field_, visible, cfg, **kw):
-        seen.append((m, cfg.eval_path))
+        seen.append((m, cfg.eval_path, "plan"))
         return real(m, state, camera, field_, visible, cfg, **kw)
 
+    def counting_call(m, state, camera, field_, cfg, exclude, detected):
+        seen.append((m, cfg.eval_path, "kernel"))
+        call = real_call(m, state, camera, field_, cfg, exclude, detected)
+        assert call is not None
+        return call
+
     monkeypatch.setattr(planner, "plan", counting)
+    monkeypatch.setattr(planner, "compiled_call", counting_call)
     a = timing.replay(scn, rec, list(METHODS), max_calls=6, max_calls_paper=3)
     var = timing.variants(list(METHODS), scn.planner)
     keys = timing.pass_keys(var)
     for v, ((m, _, cfg), key) in enumerate(zip(var, keys)):
         n_timed = int(a["timed"][:, v].sum())
-        per_call = 2 if key[1] == 0 else 1
-        assert seen.count((m, cfg.eval_path)) == 1 + per_call * n_timed, (m, cfg.eval_path)
+        compiled = key[1] == 0
+        assert seen.count((m, cfg.eval_path, "plan")) == 1 + n_timed, (m, cfg.eval_path)
+        assert seen.count((m, cfg.eval_path, "kernel")) == (n_timed if compiled else 0), (m, cfg.eval_path)
+    for i, (m, p, what) in enumerate(seen):      # each kernel call right after its own plan
+        if what == "kernel":
+            assert seen[i - 1] == (m, p, "plan")
     # the compiled calls of a pass come before any interpreted one (passes in key order)
-    first_interp = next(i for i, (m, p) in enumerate(seen[len(var):]) if not (m in ("depth", "svd") and p == "compiled"))
-    assert all(not (m in ("depth", "svd") and p == "compiled") for m, p in seen[len(var) + first_interp:])
+    body = seen[len(var):]
+    first_interp = next(i for i, (m, p, _) in enumerate(body) if not (m in ("depth", "svd") and p == "compiled"))
+    assert all(not (m in ("depth", "svd") and p == "compiled") for m, p, _ in body[first_interp:])
 
 
 def test_less_time_text_says_more_for_a_negative_reduction():
@@ -343,3 +356,30 @@ def test_less_time_text_says_more_for_a_negative_reduction():
     assert less_time_text(-137.4) == "137.4 % more"
     assert less_time_text(0.0) == "0.0 % less"
     assert less_time_text(float("nan")) == "n/a"
+
+
+def test_the_timed_compiled_call_is_the_planning_call(recorded):
+    """What the replay times for a compiled method (planner.compiled_call) computes the pick,
+    optimum and evaluations planner.plan returns, on every recorded call of depth and svd
+    (the kernel's out vector after the timed call); None for interpreted variants."""
+    from opnav.landing import kernels as K
+    from opnav.landing import planner
+
+    scn, rec = recorded
+    cam, field_, tr = scn.camera, scn.field, scn.truth
+    for m in ("depth", "svd"):
+        d = rec[m]
+        for i in range(len(d["plan_step"])):
+            k = int(d["plan_step"][i])
+            det = np.flatnonzero(cam.in_view((field_.xyz - tr.r[k]) @ tr.R_LtoB[k].T, scn.planner.margin_px))
+            st = planner.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
+            ex = int(d["plan_exclude"][i])
+            res = planner.plan(m, st, cam, field_, None, scn.planner, exclude={ex} - {-1}, detected=det,
+                               diagnose=False)
+            call = planner.compiled_call(m, st, cam, field_, scn.planner, ex, det)
+            call()
+            out = call.args[-1][K.NQ:]
+            if out[8] == K.OK:
+                assert (int(out[0]), int(out[3])) == (res.index, res.n_evals)
+                assert out[1] == res.beta
+        assert planner.compiled_call(m, st, cam, field_, planner.alternative_path(scn.planner), ex, det) is None

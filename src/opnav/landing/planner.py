@@ -42,6 +42,7 @@ timed call of it.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from dataclasses import dataclass
@@ -57,8 +58,8 @@ from opnav.landing.depth_error import (REASONS, PlaneGeometry, baseline, depth_e
 from opnav.landing.landmarks import LandmarkField
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig", "plan",
-           "plan_one", "plan_batch", "candidate_scores", "PICKERS", "PATHS", "available_methods",
-           "alternative_path"]
+           "plan_one", "plan_batch", "compiled_call", "candidate_scores", "PICKERS", "PATHS",
+           "available_methods", "alternative_path"]
 
 PATHS = ("compiled", "paper")
 #: candidates closer than this to the lander are invalid (m; ``kernels.candidate_ok``)
@@ -239,12 +240,14 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     if kind < 0 and method not in OBJECTIVE_METHODS:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
     xyz, c, cells = _setup(field_, cfg, camera)
-    work = np.empty(K.NQ + 9)
-    q, out = work[:K.NQ], work[K.NQ:]
     if kind >= 0:
-        K.plan_run(kind, state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected, exclude,
-                   cells, work)
+        args = _kernel_args(kind, state, camera, field_, cfg, exclude, detected)
+        K.plan_run(*args)
+        work = args[-1]
     else:
+        work = np.empty(K.NQ + 9)
+    q, out = work[:K.NQ], work[K.NQ:]
+    if kind < 0:
         st = K.plane(state.r, state.v, q)
         if st == K.OK:
             f, scores, st = _python_objective(method, state, cfg, camera, q)
@@ -262,6 +265,29 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
         k = K.nearest(point[0], point[1], xyz, detected, exclude, c[K.C_GRID:K.C_GRID + 5], cells)
         return PlanResult(method, int(k), math.nan, point, math.nan, int(o[3]), 0, REASONS[int(o[8])]), q
     return PlanResult(method, int(o[0]), o[1], out[5:8], o[2], int(o[3]), 0, "", 0, o[4] > 0), q
+
+
+def _kernel_args(kind: int, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
+                 exclude: int, detected: np.ndarray) -> tuple:
+    """``kernels.plan_run``'s arguments for one call (its ``work`` last: q, then out)."""
+    xyz, c, cells = _setup(field_, cfg, camera)
+    return (kind, state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected, exclude, cells,
+            np.empty(K.NQ + 9))
+
+
+def compiled_call(method: str, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
+                  exclude: int, detected: np.ndarray) -> Callable[[], None] | None:
+    """The compiled planning call as a lander's computer runs it, for timing: a function of no
+    argument that runs ``kernels.plan_run`` on these inputs (the whole call: plane, visible
+    interval, searches, edge rule, nearest landmark; numba's argument dispatch included), without
+    the Python wrapper of :func:`plan_one` around it (the per-field constants, the
+    ``PlanResult`` the Monte Carlo keeps, the degenerate-geometry fallback). None if ``method``
+    has no compiled kind on ``cfg``'s path. ``detected``: sorted int64 field indices."""
+    kind = K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+    if kind < 0:
+        return None
+    return functools.partial(K.plan_run, *_kernel_args(kind, state, camera, field_, cfg, int(exclude),
+                                                       np.asarray(detected, np.int64)))
 
 
 def candidate_scores(method: str, state: PlanState, camera: Camera, field_: LandmarkField,
