@@ -1,17 +1,15 @@
-"""The per-call planner's nearest-landmark lookup (landmarks.GridIndex, a
-uniform grid of buckets in plain floats) against a brute-force search over
-every candidate, and the batched planner's KD-tree query against both: the
-same landmark for any query point, subset of detected landmarks and excluded
-landmark, exact distance ties included (broken by the smaller index)."""
+"""The planner's nearest-landmark pick (kernels.nearest: a uniform grid of
+buckets, kernels.field_grid) against a brute-force search over every candidate:
+the same landmark for any query point, subset of detected landmarks and
+excluded landmark, exact distance ties included (broken by the smaller index)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
-from scipy.spatial import cKDTree
 
-from opnav.landing.landmarks import GridIndex, LandmarkField, make_field, nearest_brute_force
+from opnav.landing.landmarks import make_field, nearest_brute_force
 from opnav.landing import kernels as K
 
 
@@ -43,11 +41,13 @@ def test_grid_nearest_equals_brute_force(seed, per_cell, frac, lattice):
     rng = np.random.default_rng(seed)
     xy = (_lattice_field(12, 25.0, seed) if lattice else
           rng.uniform(-1000.0, 1000.0, size=(int(rng.integers(1, 400)), 2)))
-    g = GridIndex(xy, per_cell)
+    xyz = np.column_stack([xy, np.zeros(len(xy))])
+    grid, cells = K.field_grid(xyz, per_cell)
+    x0, y0, h, nx, ny = grid
     n = len(xy)
-    members = np.flatnonzero(rng.random(n) < frac) if frac < 1.0 else None
-    edges_x = g.x0 + g.h * rng.integers(-1, g.nx + 2, size=6)
-    edges_y = g.y0 + g.h * rng.integers(-1, g.ny + 2, size=6)
+    members = np.flatnonzero(rng.random(n) < frac) if frac < 1.0 else np.arange(n)
+    edges_x = x0 + h * rng.integers(-1, int(nx) + 2, size=6)
+    edges_y = y0 + h * rng.integers(-1, int(ny) + 2, size=6)
     q = np.concatenate([
         xy[rng.integers(n, size=6)],                                      # on landmarks
         np.stack([edges_x, edges_y], 1),                                  # bucket corners
@@ -57,9 +57,9 @@ def test_grid_nearest_equals_brute_force(seed, per_cell, frac, lattice):
         rng.uniform(-1.0, 1.0, size=(3, 2)) * 1e5,                         # far outside
     ])
     for x, y in q.tolist():
-        for exclude in (set(), {int(rng.integers(n))}):
-            want = nearest_brute_force(xy, x, y, members, exclude)
-            assert g.nearest(x, y, members, exclude) == want, (x, y, exclude)
+        for ex in (-1, int(rng.integers(n))):
+            want = nearest_brute_force(xy, x, y, members, {ex} - {-1})
+            assert K.nearest(x, y, xyz, members, np.int64(ex), grid, cells) == want, (x, y, ex)
 
 
 def test_grid_nearest_many_rejections_falls_back_exactly():
@@ -67,8 +67,10 @@ def test_grid_nearest_many_rejections_falls_back_exactly():
     the way than the ring search tries) still gets the nearest detected one."""
     f = make_field(1000.0, 2000, seed=4)
     far = np.argsort(np.hypot(*f.xyz[:, :2].T))[-3:]                  # three in a far corner
-    members = np.sort(far)
-    assert f.grid.nearest(0.0, 0.0, members) == nearest_brute_force(f.xyz[:, :2], 0.0, 0.0, members)
+    members = np.sort(far).astype(np.int64)
+    grid, cells = K.field_grid(f.xyz)
+    assert K.nearest(0.0, 0.0, f.xyz, members, np.int64(-1), grid, cells) == nearest_brute_force(
+        f.xyz[:, :2], 0.0, 0.0, members)
 
 
 def test_compiled_nearest_pick_agrees_with_brute_force_on_ties():
@@ -88,10 +90,3 @@ def test_compiled_nearest_pick_agrees_with_brute_force_on_ties():
             e = {int(ex[j])} if ex[j] >= 0 else set()
             want = nearest_brute_force(xy, x, y, det, e)
             assert K.nearest(x, y, xyz, det, int(ex[j]), grid, cells) == want, (frac, j, x, y)
-
-
-def test_grid_index_bad_input():
-    with pytest.raises(ValueError, match="GridIndex"):
-        GridIndex(np.zeros((0, 2)))
-    with pytest.raises(ValueError, match="GridIndex"):
-        GridIndex(np.array([[0.0, np.nan]]))

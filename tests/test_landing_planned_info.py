@@ -98,7 +98,7 @@ def test_planner_objective_uses_the_filter_noise_model_and_strategy():
     assert (cfg.noise_scale, cfg.obs_per_landmark) == (scn.noise_scale, scn.obs_per_landmark) != (1.0, 1)
     r, v, a, R, P, cand = _state(3)
     st = PlanState(r, v, a, R, P)
-    field = scn.field.__class__(np.ascontiguousarray(cand), scn.field.tree)
+    field = scn.field.__class__(np.ascontiguousarray(cand))
     _, q = plan_one("logdet_nav", st, scn.camera, field, cfg, -1, np.arange(len(cand)))
     got = candidate_scores("logdet_nav", st, scn.camera, field, cfg, q, np.arange(len(cand)))
     want = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, scn.camera.sigma_b * scn.noise_scale,

@@ -215,8 +215,6 @@ def test_pick_nearest_widens_until_a_detected_landmark():
 def _image_grid_field(scn, k, n=3, inset_px=60.0):
     """Landmarks on the ground under an n x n grid of pixels spanning the image
     (truth pose at step k), and their pixel coordinates."""
-    from scipy.spatial import cKDTree
-
     from opnav.landing.landmarks import LandmarkField
 
     cam, r, R = scn.camera, scn.truth.r[k], scn.truth.R_LtoB[k]
@@ -225,7 +223,7 @@ def _image_grid_field(scn, k, n=3, inset_px=60.0):
     c = np.stack([uu.ravel(), vv.ravel(), np.full(uu.size, cam.focal_px)], 1)
     d_L = (c @ cam.R_BtoC) @ R                  # camera -> body -> {L}
     pts = r + (-r[2] / d_L[:, 2])[:, None] * d_L
-    return LandmarkField(pts, cKDTree(pts[:, :2])), c[:, :2]
+    return LandmarkField(pts), c[:, :2]
 
 
 def _reference_objective(method, st, scn, pts):
