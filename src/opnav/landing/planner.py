@@ -239,9 +239,9 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
                           math.nan, 0, 0), None
     if kind < 0 and method not in OBJECTIVE_METHODS:
         raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
-    xyz, c, cells = _setup(field_, cfg, camera)
+    xyz, c, cells = setup = _setup(field_, cfg, camera)
     if kind >= 0:
-        args = _kernel_args(kind, state, camera, field_, cfg, exclude, detected)
+        args = _kernel_args(kind, state, setup, exclude, detected)
         K.plan_run(*args)
         work = args[-1]
     else:
@@ -267,10 +267,10 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     return PlanResult(method, int(o[0]), o[1], out[5:8], o[2], int(o[3]), 0, "", 0, o[4] > 0), q
 
 
-def _kernel_args(kind: int, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
-                 exclude: int, detected: np.ndarray) -> tuple:
-    """``kernels.plan_run``'s arguments for one call (its ``work`` last: q, then out)."""
-    xyz, c, cells = _setup(field_, cfg, camera)
+def _kernel_args(kind: int, state: PlanState, setup: tuple, exclude: int, detected: np.ndarray) -> tuple:
+    """``kernels.plan_run``'s arguments for one call (``setup``: :func:`_setup`'s; ``work`` last: q,
+    then out)."""
+    xyz, c, cells = setup
     return (kind, state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected, exclude, cells,
             np.empty(K.NQ + 9))
 
@@ -286,7 +286,7 @@ def compiled_call(method: str, state: PlanState, camera: Camera, field_: Landmar
     kind = K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
     if kind < 0:
         return None
-    return functools.partial(K.plan_run, *_kernel_args(kind, state, camera, field_, cfg, int(exclude),
+    return functools.partial(K.plan_run, *_kernel_args(kind, state, _setup(field_, cfg, camera), int(exclude),
                                                        np.asarray(detected, np.int64)))
 
 
