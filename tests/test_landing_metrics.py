@@ -377,6 +377,18 @@ def test_whitened_screen_bounds_hold_and_its_edge_pick_is_the_tie_rule(r, R, see
     assert K.edge_pick(q, cand, idx, np.int64(-1)) == (K.best_index(exact), len(cand))
 
 
+@pytest.mark.parametrize("kind", list(K.KINDS))
+def test_edge_pick_with_no_candidate_picks_none(kind):
+    """An edge call whose image holds no landmark, or only the current one, picks none (-1,
+    0 scored) for every compiled kind (the landmark-free end of the descent). It crashed
+    for svd_w and cond_w (numba's argmax of an empty array in whitened_bounds)."""
+    rng = np.random.default_rng(5)
+    q = _ctx(P=_prior(rng)).q(K.KINDS[kind])
+    xyz = _ground(rng, 3)
+    assert K.edge_pick(q, xyz, np.zeros(0, np.int64), np.int64(-1)) == (-1, 0)
+    assert K.edge_pick(q, xyz, np.array([1], np.int64), np.int64(1)) == (-1, 0)
+
+
 @settings(max_examples=60, deadline=None)
 @given(seed=seeds, scale=st.sampled_from([1e-6, 1.0, 1e6]), rank=st.integers(1, 4))
 def test_inv_trace4_is_the_trace_of_numpys_inverse(seed, scale, rank):
