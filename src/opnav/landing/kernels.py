@@ -333,7 +333,8 @@ def whitened_bounds(q, xyz, cand):
     lo, hi = np.full(n, math.inf), np.full(n, math.inf)
     if n == 0:
         return lo, hi
-    Qs, ub, lmax, C = np.zeros((n, 4, 4)), np.full(n, -1.0), np.ones(n), np.empty((4, 4))
+    Qs, ub, C = np.zeros((n, 4, 4)), np.full(n, -1.0), np.empty((4, 4))
+    lmax = np.ones(n)                                # L (cond_w); 1 for svd_w: one rule for both
     for j in range(n):
         d0, d1, d2 = xyz[cand[j], 0] - q[0], xyz[cand[j], 1] - q[1], xyz[cand[j], 2] - q[2]
         if not candidate_ok(d0, d1, d2, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), q):
@@ -353,7 +354,7 @@ def whitened_bounds(q, xyz, cand):
                 z = Q[i, 0] * Q[0, e] + Q[i, 1] * Q[1, e] + Q[i, 2] * Q[2, e] + Q[i, 3] * Q[3, e]
                 y2 += z * z
             lmax[j] = math.sqrt(y2 / en) * (1 - 1e-12) - 4 * 2.0 ** -52 * tr
-        ub[j] = math.sqrt(max(mind + 4 * 2.0 ** -52 * tr, 0.0) / (lmax[j] if kind == COND_W else 1.0))
+        ub[j] = math.sqrt(max(mind + 4 * 2.0 ** -52 * tr, 0.0) / lmax[j])
     s = np.argmax(ub)
     if ub[s] < 0.0:
         return lo, hi
@@ -364,7 +365,7 @@ def whitened_bounds(q, xyz, cand):
             continue
         t = -_tie_limit(best) * (1 - 1e-12)          # the metric a candidate must reach
         if t > 0.0 and (ub[j] < t or not chol4(
-                Qs[j], t * t * (lmax[j] if kind == COND_W else 1.0) - 64 * 2.0 ** -52 * np.trace(Qs[j]), C)):
+                Qs[j], t * t * lmax[j] - 64 * 2.0 ** -52 * np.trace(Qs[j]), C)):
             lo[j], hi[j] = -t, 0.0
             continue
         lo[j] = hi[j] = -whitened_metric(kind, Qs[j])

@@ -58,7 +58,7 @@ from opnav.landing.depth_error import (REASONS, PlaneGeometry, baseline, depth_e
 from opnav.landing.landmarks import LandmarkField
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig", "plan",
-           "plan_one", "plan_batch", "compiled_call", "candidate_scores", "PICKERS", "PATHS",
+           "plan_one", "plan_batch", "compiled_kind", "compiled_call", "candidate_scores", "PICKERS", "PATHS",
            "available_methods", "alternative_path"]
 
 PATHS = ("compiled", "paper")
@@ -231,7 +231,7 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     call's per-run constants (``kernels.NQ``). ``detected``: sorted int64 field
     indices of the landmarks the image holds; ``exclude``: the current landmark
     (-1: none)."""
-    kind = K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+    kind = compiled_kind(method, cfg)
     if kind < 0 and method in PICKERS:
         cand = detected[detected != exclude]
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
@@ -267,6 +267,11 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     return PlanResult(method, int(o[0]), o[1], out[5:8], o[2], int(o[3]), 0, "", 0, o[4] > 0), q
 
 
+def compiled_kind(method: str, cfg: PlannerConfig) -> int:
+    """The compiled objective kind of ``method`` on ``cfg``'s path (``kernels.KINDS``); -1: none."""
+    return K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+
+
 def _kernel_args(kind: int, state: PlanState, setup: tuple, exclude: int, detected: np.ndarray) -> tuple:
     """``kernels.plan_run``'s arguments for one call (``setup``: :func:`_setup`'s; ``work`` last: q,
     then out)."""
@@ -283,7 +288,7 @@ def compiled_call(method: str, state: PlanState, camera: Camera, field_: Landmar
     the Python wrapper of :func:`plan_one` around it (the per-field constants, the
     ``PlanResult`` the Monte Carlo keeps, the degenerate-geometry fallback). None if ``method``
     has no compiled kind on ``cfg``'s path. ``detected``: sorted int64 field indices."""
-    kind = K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+    kind = compiled_kind(method, cfg)
     if kind < 0:
         return None
     return functools.partial(K.plan_run, *_kernel_args(kind, state, _setup(field_, cfg, camera), int(exclude),
@@ -295,7 +300,7 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
     """The objective (minimised) of landmarks ``cand`` (field indices) at the call
     with per-run constants ``q`` (:func:`plan_one`): the edge rule's scores."""
     xyz = _setup(field_, cfg, camera)[0]
-    if method in K.KINDS and cfg.eval_path == "compiled":
+    if compiled_kind(method, cfg) >= 0:
         return K.score_points(q, xyz, cand)
     return _python_objective(method, state, cfg, camera, q)[1](q, xyz, cand)
 

@@ -122,9 +122,9 @@ def pass_keys(var) -> list[tuple[int, int]]:
     search (a method of ``kernels.KINDS`` on the compiled path), ``(., 1)`` interpreted
     code (the paper's definition, ``logdet_nav``, the pickers). Passes run in
     ascending key order."""
-    from opnav.landing.kernels import KINDS
+    from opnav.landing.planner import compiled_kind
 
-    return [(int(p != "main"), int(not (m in KINDS and c.eval_path == "compiled"))) for m, p, c in var]
+    return [(int(p != "main"), int(compiled_kind(m, c) < 0)) for m, p, c in var]
 
 
 def paper_limited(var) -> np.ndarray:
