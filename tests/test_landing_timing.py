@@ -289,6 +289,10 @@ def test_consumers_ignore_untimed_entries(recorded):
     fig = fig_planning_time(tm, ["depth", "svd"], 29.03)
     assert sorted(x.get_text() for x in fig.axes[0].texts) == ["100", "1000", "400", "5000"]
     assert "80.0 %" in fig.axes[0].get_title() and "10 of the calls" in fig.axes[0].get_xlabel()
+    leg = fig.axes[0].get_legend()                 # which box is which path: filled, hollow hatched
+    assert [t.get_text() for t in leg.get_texts()] == ["compiled", "paper"]
+    boxes = [p for p in fig.axes[0].patches if p.get_hatch()]
+    assert len(boxes) == 2 and all(p.get_facecolor()[:3] == (1.0, 1.0, 1.0) for p in boxes)
 
 
 def test_reductions_across_paths_use_the_common_subset():

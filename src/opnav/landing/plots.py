@@ -190,6 +190,7 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
     alternative metric evaluation path too get a second, hatched box (on the
     calls timed there: the paper's definition on a subset, ``max_calls_paper``;
     its reduction in the title on the calls timed on both)."""
+    import matplotlib
     import matplotlib.pyplot as plt
 
     from opnav.landing import timing as tmg
@@ -217,9 +218,9 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
         # machine noise (a shared machine's 10-130 ms interruptions), not planning work
         bp = ax.boxplot(vals, positions=pos, whis=(5, 95), showfliers=False, patch_artist=True,
                         widths=0.32)
-        for patch, c, h in zip(bp["boxes"], cols, hatch):
-            patch.set_facecolor(c)
-            patch.set_alpha(0.5)
+        for patch, c, h in zip(bp["boxes"], cols, hatch):   # the other path: hollow, hatched
+            patch.set_facecolor(matplotlib.colors.to_rgba(c, 0.5) if not h else "white")
+            patch.set_edgecolor(c if h else "k")
             patch.set_hatch(h)
         ax.set_yscale("log")
         labels = []
@@ -234,10 +235,15 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                             xytext=(0, 2), textcoords="offset points", ha="center", va="bottom",
                             fontsize="xx-small")
         ax.set_ylim(top=ax.get_ylim()[1] * 2.0)   # room for the labels of the tallest boxes
+        if any(hatch):                            # which box is which path, where no box is
+            from matplotlib.patches import Patch
+            ax.legend(handles=[Patch(facecolor=(0.5, 0.5, 0.5, 0.5), edgecolor="k", label=main_name),
+                               Patch(facecolor="white", edgecolor="0.3", hatch="///", label=alt_name)],
+                      fontsize="x-small", loc="upper left", framealpha=0.9)
         ax.set_ylabel("planning-call time (µs)")
         n_alt = max((tmg.timed_calls(timing, m, "alt") for m in methods), default=0)
         ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"
-                      f"whiskers: 5-95 %; plain: {main_name}"
+                      f"whiskers: 5-95 %; filled: {main_name}"
                       + (f"; hatched: {alt_name} ({n_alt} of the calls)" if alt_name and n_alt else ""),
                       fontsize="x-small")
         if published_reduction_vs_svd is not None and {"depth", "svd"} <= set(methods):
