@@ -3,8 +3,13 @@ candidate's own initialisation, the filter's noise model, obs_per_landmark
 observations, marginalised on the navigation states; against a direct
 information-form computation and with invariants that a mis-specification breaks."""
 
+import dataclasses
+import functools
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from opnav.landing import ekf
 from opnav.landing.measurement import selection_jacobian
@@ -105,3 +110,49 @@ def test_planner_objective_uses_the_filter_noise_model_and_strategy():
                               scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt, scn.g, scn.oc,
                               scn.camera.boresight_B)
     np.testing.assert_allclose(-got, want, rtol=1e-12)
+
+
+@functools.lru_cache(maxsize=None)
+def _scenario(name):
+    from opnav.config import load_config
+    from opnav.landing.scenario import build_scenario, camera_scenarios
+
+    return build_scenario(camera_scenarios(load_config()["landing"])[name])
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from(["interior", "site-tilt"]), st.sampled_from([1, 2, 3, 5]),
+       st.booleans(), st.sampled_from([0.02, 0.1, 0.5]), st.sampled_from([0.5, 1.0, 2.0]),
+       st.sampled_from([1.0, 5.0]))
+def test_compiled_logdet_nav_is_planned_info_and_plans_as_it(seed, camera, n_obs, oc, frac, dt, scale):
+    """The compiled objective (``kernels.planned_nav`` through ``plan_one``, the Monte
+    Carlo's path) equals ``planned_info`` in numpy (the reference, the paper path's
+    objective) to round-off for any strategy, noise scale and OC flag, +inf exactly
+    where the candidate cannot be initialised or is behind the camera; off a plateau the
+    two paths' planning calls (search, edge rule, pick) agree."""
+    from opnav.landing.planner import PlanState, alternative_path, candidate_scores, plan_one
+
+    scn = _scenario(camera)
+    cfg = dataclasses.replace(scn.planner, obs_per_landmark=n_obs, oc=oc, depth_sigma_frac=frac, t_s=dt,
+                              noise_scale=scale)
+    r, v, a, _, P, _ = _state(seed)
+    rng = np.random.default_rng(seed)
+    R = exp_so3(rng.normal(0, 0.05, 3))                         # boresight (body -z, tilted) downwards
+    cand = np.column_stack([r[0] + rng.uniform(-1500, 1500, 40), r[1] + rng.uniform(-1500, 1500, 40),
+                            np.zeros(40)])
+    cand = np.vstack([cand, r + [0.0, 0.0, 50.0]])              # above the lander: behind the camera
+    st_ = PlanState(r, v, a, R, P)
+    field = scn.field.__class__(np.ascontiguousarray(cand))
+    det = np.arange(len(cand))
+    res, q = plan_one("logdet_nav", st_, scn.camera, field, cfg, -1, det)
+    got = candidate_scores("logdet_nav", st_, scn.camera, field, cfg, q, det)
+    want = -planned_nav_logdet(r, v, a, R, P, np.asarray(cfg.p_known), cand, scn.camera.sigma_b * scale, frac,
+                               n_obs, dt, cfg.g, oc, scn.camera.boresight_B)
+    fin = np.isfinite(want)
+    assert not fin[-1] and np.array_equal(np.isfinite(got), fin) and np.array_equal(got[~fin], want[~fin])
+    np.testing.assert_allclose(got[fin], want[fin], rtol=1e-9, atol=1e-9)
+    if np.ptp(want[fin]) <= 1e-6 * np.abs(want[fin]).max():
+        return    # a plateau (n_obs = 1: one bearing adds nothing to its own initialisation): round-off decides
+    ref, _ = plan_one("logdet_nav", st_, scn.camera, field, alternative_path(cfg), -1, det)
+    assert (res.index, res.edge, res.n_evals, res.note) == (ref.index, ref.edge, ref.n_evals, ref.note)
+    assert res.beta == pytest.approx(ref.beta, abs=1e-9, nan_ok=True)

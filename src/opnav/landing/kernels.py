@@ -14,8 +14,8 @@ tie rule (:func:`best_index`; on bounds, :func:`tie_pick`, whose mineig brackets
 come from :func:`mineig_bracket`, svd_w and cond_w's from :func:`whitened_bounds`)
 and the call itself (:func:`plan_core`, compiled by :func:`plan_run` for every
 :data:`KINDS`; run by the interpreter with a Python objective through
-:func:`interpreted` for ``logdet_nav`` and the paper's definitions,
-``opnav.landing.planner``; B-X1 metrics: :func:`info_metric`).
+:func:`interpreted` for the paper's definitions, ``opnav.landing.planner``;
+B-X1 metrics: :func:`info_metric`, ``logdet_nav``: :func:`planned_nav`).
 
 Per-run constants ``q`` (float64 (NQ,)): 0-2 C (m), 3-5 v_hat, 6-8 w_hat, 9 |CD|
 (m), 10 gamma (rad), 11 objective kind (:data:`KINDS`), 12 b (m), 13 r_e (m),
@@ -35,15 +35,19 @@ import types
 import numpy as np
 
 from opnav.compiled import kernel, warms
+from opnav.landing import ekf
 from opnav.landing import measurement as me
 
 #: objective kinds compiled here (``q[11]``); the whitened ones are their base + 5
-KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8)
-DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W, COND_W = 0, 1, 2, 3, 4, 5, 6, 7, 8
+KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8, logdet_nav=9)
+DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W, COND_W, LOGDET_NAV = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 #: q slots of the B-X1 kinds (:func:`info_constants`): R_LtoB (3 x 3, row-major), 1/sigma
 #: (rad^-1); logdet, mineig: log det Lambda_k, Sigma_k (12 x 12); whitened: L, G_k L (2 x 12);
 #: mineig: Sigma_k's eigenvalues s (12, descending) and eigenvectors V (12 x 12, columns)
 Q_R, Q_SCALE, Q_LD, Q_SIG, Q_L, Q_A, Q_S, Q_V, NQ = 24, 33, 34, 35, 35, 179, 203, 215, 359
+#: logdet_nav's slots (:func:`nav_constants`; its prior P at Q_SIG): velocity (m/s), acceleration
+#: (m/s^2), gravity (m/s^2), known landmark (m), sigma_f (rad), depth_sigma_frac, n_obs, dt (s), oc
+Q_NV, Q_NA, Q_NG, Q_NK, Q_NSF, Q_NDF, Q_NOBS, Q_NDT, Q_NOC = 179, 182, 185, 188, 191, 192, 193, 194, 195
 #: the tie rule's relative tolerance: candidates whose score lies within
 #: TIE_RTOL * |best| of the best score are tied, and the lowest landmark index
 #: wins. Paths agree to round-off (~1e-12 relative: closed form vs LAPACK's
@@ -297,26 +301,6 @@ def whitened_metric(kind, Q) -> float:
 
 
 @kernel
-def chol4(Q, mu, C) -> bool:
-    """C (4 x 4) <- the Cholesky factor of Q - mu I (Q symmetric, lower triangle read); False if
-    that is not positive definite (exact arithmetic: lambda_min(Q) <= mu; in floating point
-    within a backward error of ~20 eps max Q_ii)."""
-    for j in range(4):
-        p = Q[j, j] - mu
-        for k in range(j):
-            p -= C[j, k] * C[j, k]
-        if not p > 0.0:
-            return False
-        C[j, j] = math.sqrt(p)
-        for i in range(j + 1, 4):
-            v = Q[i, j]
-            for k in range(j):
-                v -= C[i, k] * C[j, k]
-            C[i, j] = v / C[j, j]
-    return True
-
-
-@kernel
 def whitened_bounds(q, xyz, cand):
     """:func:`score_bounds` of svd_w and cond_w (score = -metric, metric = sqrt(l4) or sqrt(l4 / l1),
     l the eigenvalues of the Gram Q, :func:`gram`) with few eigenproblems: the candidate whose
@@ -324,7 +308,7 @@ def whitened_bounds(q, xyz, cand):
     |Q^2 e|/|Q e| <= l1 for e the column of Q of largest norm) is scored first; every other
     one is scored exactly only if it may reach t = (1 - TIE_RTOL) m of the best metric m so far:
     not if l4 < t^2 (svd_w) or l4 < t^2 L (cond_w), shown by its bound or by a Cholesky failure
-    of Q - mu I (:func:`chol4`; mu less 64 eps trace Q, the Cholesky's and eigvalsh's
+    of Q - mu I (:func:`cholesky_shifted`; mu less 64 eps trace Q, the Cholesky's and eigvalsh's
     round-off). Such a candidate lies beyond the tie bound of the best (lo = -t (1 - 1e-12),
     hi = 0), so :func:`tie_pick` leaves it out. Needed by measurement (5,000 candidates): an
     edge call costs 0.32 us a candidate against 1.4 us for scoring each by eigvalsh; a 10-run
@@ -364,8 +348,8 @@ def whitened_bounds(q, xyz, cand):
         if j == s or ub[j] < 0.0:
             continue
         t = -_tie_limit(best) * (1 - 1e-12)          # the metric a candidate must reach
-        if t > 0.0 and (ub[j] < t or not chol4(
-                Qs[j], t * t * lmax[j] - 64 * 2.0 ** -52 * np.trace(Qs[j]), C)):
+        if t > 0.0 and (ub[j] < t or not cholesky_shifted(
+                Qs[j], 4, t * t * lmax[j] - 64 * 2.0 ** -52 * np.trace(Qs[j]), C)):
             lo[j], hi[j] = -t, 0.0
             continue
         lo[j] = hi[j] = -whitened_metric(kind, Qs[j])
@@ -489,7 +473,7 @@ def inv_trace4(Q) -> float:
     gdop of Q's eigenvalues): measured 0.5 us a score against 1.3 us through numba's LAPACK
     eigvalsh (its workspace query and copies were 3/4 of a whitened score)."""
     C, x, t = np.zeros((4, 4)), np.empty(4), 0.0
-    if not chol4(Q, 0.0, C):
+    if not cholesky_shifted(Q, 4, 0.0, C):
         return math.inf
     for c in range(4):                             # column c of C^-1, forward substitution
         for i in range(c, 4):
@@ -499,6 +483,162 @@ def inv_trace4(Q) -> float:
             x[i] = v / C[i, i]
             t += x[i] * x[i]
     return t
+
+
+@kernel
+def nav_constants(v, a, R_LtoB, P, c, q) -> None:
+    """Fill logdet_nav's slots of q (after :func:`metric_constants`) once per call: the planning
+    state's velocity v (m/s), acceleration a (m/s^2), attitude R_LtoB, prior P (12 x 12), and the
+    filter's model from :func:`plan_run`'s ``c``: sigma_f = noise scale x sigma_b (rad), the new
+    landmark's depth 1-sigma / depth, n_obs observations dt = t_s (s) apart, oc, gravity (m/s^2)."""
+    for i in range(9):
+        q[Q_R + i] = R_LtoB[i // 3, i % 3]
+    for i in range(12):
+        for j in range(12):
+            q[Q_SIG + 12 * i + j] = P[i, j]
+    for i in range(3):
+        q[Q_NV + i], q[Q_NA + i], q[Q_NG + i], q[Q_NK + i] = v[i], a[i], c[C_NAV + 4 + i], c[C_PKNOWN + i]
+    q[Q_NSF], q[Q_NDF], q[Q_NOBS] = c[C_NAV] * c[C_SIGMA], c[C_NAV + 1], c[C_NAV + 2]
+    q[Q_NDT], q[Q_NOC] = c[C_TS], c[C_NAV + 3]
+
+
+@kernel
+def cholesky_shifted(Q, n, mu, C) -> bool:
+    """C[:n, :n] <- the lower Cholesky factor of Q[:n, :n] - mu I (lower triangle of Q read); False
+    if that is not positive definite (exact arithmetic: lambda_min <= mu; in floating point within a
+    backward error of ~n eps max Q_ii)."""
+    for j in range(n):
+        p = Q[j, j] - mu
+        for k in range(j):
+            p -= C[j, k] * C[j, k]
+        if not p > 0.0:
+            return False
+        C[j, j] = math.sqrt(p)
+        for i in range(j + 1, n):
+            v = Q[i, j]
+            for k in range(j):
+                v -= C[i, k] * C[j, k]
+            C[i, j] = v / C[j, j]
+    return True
+
+
+@kernel
+def logdet_spd(A, n, C) -> float:
+    """log det A[:n, :n] (symmetric) as ``metrics.chol_logdet`` defines it: 2 sum log diag of the
+    Cholesky factor of the Jacobi-equilibrated D^-1/2 A D^-1/2 + j I, plus sum log D; j from n eps,
+    x 1e3 while the Cholesky fails, up to 1e-8; -inf if it still fails or a diagonal entry is not
+    positive (C: (n, n) scratch, receives the factor)."""
+    ld = 0.0
+    for i in range(n):
+        for j in range(n):
+            if not math.isfinite(A[i, j]):
+                return -math.inf
+        if not A[i, i] > 0.0:
+            return -math.inf
+        ld += math.log(A[i, i])
+    S = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            S[i, j] = A[i, j] / math.sqrt(A[i, i] * A[j, j])
+    jit = n * 2.0 ** -52
+    while jit <= 1e-8:
+        if cholesky_shifted(S, n, -jit, C):
+            for i in range(n):
+                ld += 2.0 * math.log(C[i, i])
+            return ld
+        jit *= 1e3
+    return -math.inf
+
+
+@kernel
+def planned_nav(d0, d1, d2, rho, q) -> float:
+    """logdet_nav's objective (minimised): log det (nats) of the navigation block (9 x 9) of the
+    planned posterior of the candidate at offset d = p - r (m), |d| = rho, as ``planned_info``
+    specifies it, step by step: its initialisation from its noise-free bearing (``ekf._init``: the
+    12 x 12 P0 with its own block), the site's and its tangent-plane rows whitened by 1/sigma_f
+    (``measurement.tangent_rows``) at the n_obs predicted poses r + v t + a t^2 / 2 (attitude
+    held; the first image the site's only), mapped to the planning instant by Phi
+    (``ekf._transition``, eq. 6-10), projected off the unit yaw direction (``ekf._nullspace``) if
+    oc; Sigma = P0 - (A P0)^T S^-1 A P0 with S = I + A P0 A^T = L L^T (Woodbury, as X^T X for X =
+    L^-1 A P0); its log det by :func:`logdet_spd`. +inf where the candidate cannot be
+    initialised (its line of sight misses the ground)."""
+    R, P, r = q[Q_R:Q_R + 9].reshape((3, 3)), q[Q_SIG:Q_SIG + 144].reshape((12, 12)), q[0:3]
+    b = np.empty(3)
+    for i in range(3):
+        b[i] = (R[i, 0] * d0 + R[i, 1] * d1 + R[i, 2] * d2) / rho
+    p0, P0, J, JP = np.empty(3), np.empty((12, 12)), np.empty((3, 9)), np.empty((3, 9))
+    if not ekf._init(r, R, P, b, q[Q_NDF], q[Q_NSF], p0, P0, J, JP):
+        return math.inf
+    n_obs = int(q[Q_NOBS])
+    m = 4 * n_obs - 2
+    A, G, Phi = np.empty((m, 12)), np.empty((2, 12)), np.empty((12, 12))
+    v, g = q[Q_NV:Q_NV + 3], q[Q_NG:Q_NG + 3]
+    rk, vk, dk = np.empty(3), np.empty(3), np.empty(3)
+    row = 0
+    for k in range(n_obs):
+        t = k * q[Q_NDT]
+        for i in range(3):
+            rk[i] = r[i] + v[i] * t + 0.5 * q[Q_NA + i] * t * t
+            vk[i] = v[i] + q[Q_NA + i] * t
+        if k:
+            ekf._transition(r, v, R, rk, vk, R, t, g, Phi)
+        for s in range(2 if k else 1):               # the site (its landmark columns zero), then p0
+            for i in range(3):
+                dk[i] = (q[Q_NK + i] if s == 0 else p0[i]) - rk[i]
+            me.tangent_rows(R, dk, 1.0 / q[Q_NSF], G)
+            if s == 0:
+                G[0, 9:] = 0.0
+                G[1, 9:] = 0.0
+            for a in range(2):
+                for c in range(12):
+                    if k == 0:
+                        A[row + a, c] = G[a, c]
+                    else:
+                        x = 0.0
+                        for j in range(12):
+                            x += G[a, j] * Phi[j, c]
+                        A[row + a, c] = x
+            row += 2
+    if q[Q_NOC] != 0.0:                               # A (I - N N^T), N the unit yaw direction
+        N = np.empty(12)
+        ekf._nullspace(r, v, R, p0, N)
+        N /= math.sqrt(np.sum(N * N))
+        for a in range(m):
+            x = 0.0
+            for c in range(12):
+                x += A[a, c] * N[c]
+            for c in range(12):
+                A[a, c] -= x * N[c]
+    X, S = np.zeros((m, 12)), np.empty((m, m))
+    for a in range(m):                                # X <- A P0
+        for c in range(12):
+            x = 0.0
+            for j in range(12):
+                x += A[a, j] * P0[j, c]
+            X[a, c] = x
+    for a in range(m):                                # S = I + A P0 A^T (lower triangle)
+        for b_ in range(a + 1):
+            x = 1.0 if a == b_ else 0.0
+            for j in range(12):
+                x += X[a, j] * A[b_, j]
+            S[a, b_] = x
+    L = np.empty((m, m))
+    if not cholesky_shifted(S, m, 0.0, L):
+        return -math.inf
+    for c in range(9):                                # X <- L^-1 A P0 (the navigation columns)
+        for a in range(m):
+            x = X[a, c]
+            for j in range(a):
+                x -= L[a, j] * X[j, c]
+            X[a, c] = x / L[a, a]
+    Sig = np.empty((9, 9))
+    for i in range(9):
+        for j in range(9):
+            x = P0[i, j]
+            for a in range(m):
+                x -= X[a, i] * X[a, j]
+            Sig[i, j] = x
+    return logdet_spd(Sig, 9, np.empty((9, 9)))
 
 
 @kernel
@@ -556,6 +696,8 @@ def score_point(p0, p1, p2, q) -> float:
         c0, c1, c2 = d1 * q[5] - d2 * q[4], d2 * q[3] - d0 * q[5], d0 * q[4] - d1 * q[3]  # d x v_hat
         return depth_error(rho, (d0 * q[3] + d1 * q[4] + d2 * q[5]) / rho,
                            math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / rho, q[12], q[13])
+    if kind == LOGDET_NAV:
+        return planned_nav(d0, d1, d2, rho, q) if in_view(d0, d1, d2, rho, q) else math.inf
     if not candidate_ok(d0, d1, d2, rho, q):
         return math.inf
     if kind >= LOGDET:
@@ -800,7 +942,7 @@ def nearest(x, y, xyz, det, exclude, grid, cells) -> int:
 def interpreted(fn, **names):
     """The kernel ``fn``'s Python source run by the interpreter, with the module
     names ``names`` (kernels it calls) replaced: the same steps with a Python
-    objective (the planner's ``logdet_nav`` and the paper's definitions)."""
+    objective (the planner's paper path: the paper's definitions, ``planned_info``)."""
     py = fn.py_func
     return types.FunctionType(py.__code__, {**py.__globals__, **names}, py.__name__, py.__defaults__,
                               py.__closure__)
@@ -869,7 +1011,7 @@ def plan_core(q, M, kfov, tol, xyz, det, exclude, grid, cells, out) -> None:
 
 #: layout of :func:`plan_run`'s constant vector ``c`` (per field, config and camera)
 C_TS, C_NSIGMA, C_TOL, C_KFOV, C_MINRANGE, C_RBC, C_BS, C_PKNOWN, C_GRID = 0, 1, 2, 3, 4, 5, 14, 17, 20
-C_SIGMA, NC = 25, 26
+C_SIGMA, C_NAV, NC = 25, 26, 33
 
 
 @kernel
@@ -878,8 +1020,9 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
     run: ``c`` (:data:`NC`) = [t_s (s), n_sigma_v, tol (rad), tan half-FOV less
     margin, min_range (m), R_BtoC (9, row-major), boresight_B (3), known landmark
     (3, m), grid (5, :func:`field_grid`), sigma_b (rad: the B-X1 kinds' bearing
-    noise sigma_b^2 I_6)]; ``P`` the prior (12 x 12); ``work`` (NQ + 9) receives q and out
-    (status at work[NQ + 8]; 0 ok)."""
+    noise sigma_b^2 I_6), logdet_nav's filter model (:func:`nav_constants`: noise
+    scale, depth_sigma_frac, obs_per_landmark, oc (1/0), gravity (3, m/s^2))]; ``P``
+    the prior (12 x 12); ``work`` (NQ + 9) receives q and out (status at work[NQ + 8]; 0 ok)."""
     q, out = work[:NQ], work[NQ:]
     st = plane(r, v, q)
     q[11] = kind
@@ -889,7 +1032,9 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
             st = ZERO_BASELINE
     elif st == OK:
         metric_constants(r, R_LtoB, c[C_BS:C_BS + 3], 1.0, c[C_PKNOWN:C_PKNOWN + 3], c[C_MINRANGE], q)
-        if kind >= LOGDET:
+        if kind == LOGDET_NAV:
+            nav_constants(v, a, R_LtoB, P, c, q)
+        elif kind >= LOGDET:
             info_constants(R_LtoB, P, c[C_SIGMA], q)
     if st != OK:
         out[3], out[8] = 0, st
@@ -912,8 +1057,8 @@ def _warm() -> None:
     P = np.eye(12)
     R = np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]])
     c = np.zeros(NC)
-    c[:5], c[C_RBC:C_RBC + 9:4], c[C_BS + 2], c[C_GRID:C_SIGMA], c[C_SIGMA] = (
-        (1.0, 3.0, 1e-3, 0.5, 1e-6), 1.0, -1.0, grid, 1e-3)
+    c[:5], c[C_RBC:C_RBC + 9:4], c[C_BS + 2], c[C_GRID:C_SIGMA], c[C_SIGMA], c[C_NAV:NC] = (
+        (1.0, 3.0, 1e-3, 0.5, 1e-6), 1.0, -1.0, grid, 1e-3, (5.0, 0.1, 3.0, 1.0, 0.0, 0.0, -3.711))
     work = np.zeros(NQ + 9)
     for kind in KINDS.values():
         plan_run(kind, np.array([10.0, 0, 1000.0]), np.array([-5.0, 0, -20.0]), np.zeros(3), R, P, c,

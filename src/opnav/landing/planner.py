@@ -26,15 +26,16 @@ the vertical plane holding the estimated velocity) differs:
 Degenerate geometry or no visible interval: the detected landmark nearest to
 the boresight's ground point, ``note`` says why.
 
-Objectives: ``depth`` (eq. 23-25), the H baselines and the B-X1 metrics
-(``kernels.KINDS``) are compiled (``kernels.objective``); ``logdet_nav``
-(``planned_info``) is a Python objective run through the same call's source
-(``kernels.interpreted``); :data:`PICKERS` search nothing.
+Objectives: ``depth`` (eq. 23-25), the H baselines, the B-X1 metrics and
+``logdet_nav`` (``kernels.KINDS``) are compiled (``kernels.objective``);
+:data:`PICKERS` search nothing.
 
 Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer would
-run) and ``paper`` (the paper's definition through the same call, interpreted:
-the law-of-sines depth error of ``depth_error``; H from CasADi and LAPACK's SVD /
-pseudo-inverse, ``metrics.Metric.reference``); timing replays both. One planner:
+run) and ``paper`` (the paper's definition through the same call's source run by
+the interpreter, ``kernels.interpreted``: the law-of-sines depth error of
+``depth_error``; H from CasADi and LAPACK's SVD / pseudo-inverse,
+``metrics.Metric.reference``; ``logdet_nav``: ``planned_info`` in numpy);
+timing replays both. One planner:
 :func:`plan_batch` plans run by run with :func:`plan_one`; :func:`plan` is one
 timed call of it.
 """
@@ -165,8 +166,8 @@ def _metric_context(state: PlanState, cfg: PlannerConfig, camera: Camera) -> met
 
 def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera: Camera, q: np.ndarray):
     """``(f(beta, q), scores(q, xyz, cand), status)`` of a method the interpreter
-    runs: the paper's definitions (``cfg.eval_path == "paper"``) and ``logdet_nav``;
-    both minimised, ``+inf`` where the line of sight misses the ground."""
+    runs on the paper path (``cfg.eval_path == "paper"``): the paper's definitions and
+    ``planned_info`` for ``logdet_nav``; minimised, ``+inf`` where the line of sight misses the ground."""
     if method == "depth":               # the paper's eq. 23-25 (law of sines, numpy)
         b = baseline(state.v, state.a, cfg.t_s)
         if not b > 0:
@@ -219,7 +220,8 @@ def _setup(field_: LandmarkField, cfg: PlannerConfig, camera: Camera):
         xyz = np.ascontiguousarray(field_.xyz, float)
         grid, cells = K.field_grid(xyz)
         c = np.concatenate([[cfg.t_s, cfg.n_sigma_v, cfg.tol_rad, _kfov(camera, cfg.margin_px), MIN_RANGE_M],
-                            camera.R_BtoC.ravel(), camera.boresight_B, cfg.p_known, grid, [camera.sigma_b]])
+                            camera.R_BtoC.ravel(), camera.boresight_B, cfg.p_known, grid, [camera.sigma_b],
+                            [cfg.noise_scale, cfg.depth_sigma_frac, cfg.obs_per_landmark, float(cfg.oc)], cfg.g])
         _CACHE[key] = (field_, cfg, camera, xyz, c, cells)
     return _CACHE[key][3:]
 
@@ -388,8 +390,7 @@ def _pick_closest(field_, cand, state, camera, rng) -> int:
 PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center,
                                 "closest": _pick_closest}
 #: methods with a search: the compiled kinds, the metrics, the planned information
-OBJECTIVE_METHODS = tuple(K.KINDS) + tuple(m for m in metrics.METRIC_NAMES if m not in K.KINDS) + (
-    "logdet_nav",)
+OBJECTIVE_METHODS = tuple(K.KINDS) + tuple(m for m in metrics.METRIC_NAMES if m not in K.KINDS)
 
 
 def available_methods() -> tuple[str, ...]:

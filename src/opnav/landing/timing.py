@@ -33,7 +33,7 @@ on the subset (``method_summary``: ``timed_calls``, ``timed_calls_paper``).
 Passes and order rule (:func:`pass_keys`): the variants are timed in separate
 passes over the calls, first the configured path on every replayed call, then
 the other path on its subset, and within a path the compiled searches before the
-interpreted code (the paper's definition, ``logdet_nav``, the pickers); on the
+interpreted code (the paper's definition, the pickers); on the
 ``t``-th call of a pass that pass's variants run in their configured order
 rotated left by ``t`` (never ordered by a clock), so slow drifts of the machine
 (frequency, other processes) fall on every method alike and every variant comes
@@ -104,14 +104,14 @@ def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
     """The timed (method, path, PlannerConfig): every method on ``cfg``'s path
     (``"main"``), and, unless ``alt`` is false, every method with a search on the
     other path (``"alt"``, ``planner.alternative_path``: compiled <-> the paper's
-    definition; not ``logdet_nav``, whose one implementation is the interpreted one)."""
+    definition; for ``logdet_nav``, ``planned_info`` in numpy)."""
     from opnav.landing.planner import PICKERS, alternative_path
 
     alt_cfg = alternative_path(cfg)
     out = []
     for m in methods:
         out.append((m, "main", cfg))
-        if alt and m not in PICKERS and m != "logdet_nav":
+        if alt and m not in PICKERS:
             out.append((m, "alt", alt_cfg))
     return out
 
@@ -120,7 +120,7 @@ def pass_keys(var) -> list[tuple[int, int]]:
     """Per variant of :func:`variants`, the pass that times it (module docstring):
     ``(0, .)`` the configured path, ``(1, .)`` the other one; ``(., 0)`` a compiled
     search (a method of ``kernels.KINDS`` on the compiled path), ``(., 1)`` interpreted
-    code (the paper's definition, ``logdet_nav``, the pickers). Passes run in
+    code (the paper's definition, the pickers). Passes run in
     ascending key order."""
     from opnav.landing.planner import compiled_kind
 
