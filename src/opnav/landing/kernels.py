@@ -195,7 +195,7 @@ def sv_metric(base, l1, l2, l3, l4) -> float:
 def info_constants(R_LtoB, P, sigma, q) -> None:
     """Fill the B-X1 slots of q (kind q[11], after :func:`metric_constants`) once per call for
     prior P (12 x 12), noise sigma^2 I_6 (rad^2), the known landmark's rows G_k (:func:`info_metric`):
-    Sigma_k = (P^-1 + G_k^T G_k)^-1 and its log det (equilibrated), or L = chol(P) and G_k L."""
+    Sigma_k = (P^-1 + G_k^T G_k)^-1 and log det Lambda_k (:func:`logdet_spd`), or L = chol(P) and G_k L."""
     for i in range(9):
         q[Q_R + i] = R_LtoB[i // 3, i % 3]
     q[Q_SCALE] = 1.0 / sigma
@@ -214,18 +214,17 @@ def info_constants(R_LtoB, P, sigma, q) -> None:
                 q[Q_A + j] += G[0, i] * L[i, j]
                 q[Q_A + 12 + j] += G[1, i] * L[i, j]
         return
-    Pi, Ls, s = np.linalg.inv(P), np.empty((12, 12)), np.empty(12)
-    for i in range(12):
-        s[i] = 1.0 / math.sqrt(Pi[i, i] + G[0, i] ** 2 + G[1, i] ** 2)
+    Pi, Lam, s = np.linalg.inv(P), np.empty((12, 12)), np.empty(12)
     for i in range(12):
         for j in range(12):
-            Ls[i, j] = (0.5 * (Pi[i, j] + Pi[j, i]) + G[0, i] * G[0, j] + G[1, i] * G[1, j]) * s[i] * s[j]
-    Sig = np.linalg.inv(Ls)
+            Lam[i, j] = 0.5 * (Pi[i, j] + Pi[j, i]) + G[0, i] * G[0, j] + G[1, i] * G[1, j]
+        s[i] = 1.0 / math.sqrt(Lam[i, i])
+    q[Q_LD] = logdet_spd(Lam, 12, np.empty((12, 12)))
+    for i in range(12):                              # Sigma_k from the equilibrated information
+        for j in range(12):
+            Lam[i, j] *= s[i] * s[j]
+    Sig = np.linalg.inv(Lam)
     for i in range(12):
-        Ls[i, i] += 12 * 2.0 ** -52
-    C, q[Q_LD] = np.linalg.cholesky(Ls), 0.0
-    for i in range(12):
-        q[Q_LD] += 2.0 * (math.log(C[i, i]) - math.log(s[i]))
         for j in range(12):
             q[Q_SIG + 12 * i + j] = 0.5 * (Sig[i, j] + Sig[j, i]) * s[i] * s[j]
     if int(q[11]) == MINEIG:                         # mineig_bracket's eigenbasis
