@@ -316,7 +316,7 @@ def whitened_bounds(q, xyz, cand):
     lo, hi = np.full(n, math.inf), np.full(n, math.inf)
     if n == 0:
         return lo, hi
-    Qs, ub, C = np.zeros((n, 4, 4)), np.full(n, -1.0), np.empty((4, 4))
+    Qs, ub, C, trs = np.zeros((n, 4, 4)), np.full(n, -1.0), np.empty((4, 4)), np.zeros(n)
     lmax = np.ones(n)                                # L (cond_w); 1 for svd_w: one rule for both
     for j in range(n):
         d0, d1, d2 = xyz[cand[j], 0] - q[0], xyz[cand[j], 1] - q[1], xyz[cand[j], 2] - q[2]
@@ -337,7 +337,7 @@ def whitened_bounds(q, xyz, cand):
                 z = Q[i, 0] * Q[0, e] + Q[i, 1] * Q[1, e] + Q[i, 2] * Q[2, e] + Q[i, 3] * Q[3, e]
                 y2 += z * z
             lmax[j] = math.sqrt(y2 / en) * (1 - 1e-12) - 4 * 2.0 ** -52 * tr
-        ub[j] = math.sqrt(max(mind + 4 * 2.0 ** -52 * tr, 0.0) / lmax[j])
+        ub[j], trs[j] = math.sqrt(max(mind + 4 * 2.0 ** -52 * tr, 0.0) / lmax[j]), tr
     s = np.argmax(ub)
     if ub[s] < 0.0:
         return lo, hi
@@ -348,7 +348,7 @@ def whitened_bounds(q, xyz, cand):
             continue
         t = -_tie_limit(best) * (1 - 1e-12)          # the metric a candidate must reach
         if t > 0.0 and (ub[j] < t or not cholesky_shifted(
-                Qs[j], 4, t * t * lmax[j] - 64 * 2.0 ** -52 * np.trace(Qs[j]), C)):
+                Qs[j], 4, t * t * lmax[j] - 64 * 2.0 ** -52 * trs[j], C)):
             lo[j], hi[j] = -t, 0.0
             continue
         lo[j] = hi[j] = -whitened_metric(kind, Qs[j])
@@ -608,7 +608,7 @@ def planned_nav(d0, d1, d2, rho, q) -> float:
                 x += A[a, c] * N[c]
             for c in range(12):
                 A[a, c] -= x * N[c]
-    X, S = np.zeros((m, 12)), np.empty((m, m))
+    X, S = np.empty((m, 12)), np.empty((m, m))
     for a in range(m):                                # X <- A P0
         for c in range(12):
             x = 0.0
