@@ -20,8 +20,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(workflow.basedir) / "src"))
-from opnav.config import ConfigError, read_config_file  # noqa: E402
-from opnav.snakeio import config_exit  # noqa: E402
+from opnav.core.config import ConfigError, read_config_file  # noqa: E402
+from opnav.core.snakeio import config_exit  # noqa: E402
 
 _config_files = [Path(workflow.basedir, "config", "config.yaml")]
 _config_files += list(getattr(getattr(workflow, "config_settings", None), "configfiles", None) or [])

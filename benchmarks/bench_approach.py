@@ -54,7 +54,7 @@ REPO = Path(__file__).resolve().parents[1]
 _JOB = r"""
 import json, os, pickle, sys, time
 kind, spec, quick, out = sys.argv[1:5]
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.approach.setup import Setup
 cfg = load_config(overlays=["config/quick.yaml"] if quick == "1" else [])["approach"]
 setup = Setup.from_config(cfg)
@@ -88,7 +88,7 @@ _KERNELS = r"""
 import json, sys, time
 import numpy as np
 from opnav.approach import em, ekf, smoother, scenario as sc
-from opnav.config import load_config
+from opnav.core.config import load_config
 cfg = load_config()["approach"]
 rows = []
 for n in map(int, sys.argv[1].split(",")):
@@ -145,7 +145,7 @@ def compare_kernels(rev: str | None, samples: str, seeds: str) -> None:
 
 def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int = 5) -> list[dict]:
     from opnav.approach import em, scenario as sc
-    from opnav.config import load_config
+    from opnav.core.config import load_config
 
     cfg = load_config(REPO / "config" / "config.yaml")["approach"]
     geo = sc.build_geometry(cfg, "roll", n=n_samples)
@@ -169,7 +169,7 @@ def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int =
 
 
 def workflow_timing(configfile: str | None = None) -> float:
-    from opnav.snakeio import copy_workflow
+    from opnav.core.snakeio import copy_workflow
 
     with tempfile.TemporaryDirectory() as d:
         dst = copy_workflow(REPO, Path(d))
@@ -242,7 +242,7 @@ def max_rel_diff(a, b, path: str = "") -> tuple[float, str]:
 
 
 def schemes_of(quick: bool) -> list[str]:
-    from opnav.config import load_config
+    from opnav.core.config import load_config
 
     cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if quick else [])["approach"]
     return list(cfg["methods"]) + [f"growing-{m}" for m in cfg["growing"]["methods"]]
@@ -252,7 +252,7 @@ def mc_specs(quick: bool) -> list[str]:
     """Every Monte-Carlo job of the profile, ``variant:group`` (all EM schemes)."""
     from opnav.approach.pipeline import groups_for
     from opnav.approach.setup import Setup
-    from opnav.config import load_config
+    from opnav.core.config import load_config
 
     cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if quick else [])["approach"]
     setup = Setup.from_config(cfg)
@@ -369,7 +369,7 @@ def main() -> None:
     if args.before:
         from opnav.approach import cases
         from opnav.approach.setup import Setup
-        from opnav.config import load_config
+        from opnav.core.config import load_config
 
         mc = mc_specs(args.quick) if args.mc == ["all"] else args.mc
         cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if args.quick else [])["approach"]

@@ -27,7 +27,7 @@ def main(argv=None) -> int:
     from opnav.approach import alternatives as alt
     from opnav.approach import cases
     from opnav.approach import scenario as sc
-    from opnav.config import load_config
+    from opnav.core.config import load_config
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="use config/quick.yaml")

@@ -34,7 +34,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
 sys.path.insert(0, str(REPO / "tests"))
 
-from opnav.config import load_config  # noqa: E402
+from opnav.core.config import load_config  # noqa: E402
 from opnav.landing import descent  # noqa: E402
 from opnav.landing.descent import run_descents  # noqa: E402
 from opnav.landing.scenario import build_scenario, camera_scenarios  # noqa: E402

@@ -44,7 +44,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
 
-from opnav.config import load_config  # noqa: E402
+from opnav.core.config import load_config  # noqa: E402
 from opnav.landing import descent as D  # noqa: E402
 from opnav.landing import planner as PL  # noqa: E402
 

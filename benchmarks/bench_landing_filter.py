@@ -16,7 +16,7 @@ import time
 import numpy as np
 from scipy.stats import chi2
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing.montecarlo import per_run_stats, run_chunk
 
 CONFIGS = [(8.0, 1), (1.0, 1), (2.0, 3), (4.0, 3), (5.0, 3), (6.0, 3), (8.0, 3)]

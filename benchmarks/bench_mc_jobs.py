@@ -3,7 +3,7 @@
 Description
 -----------
 For each (camera scenario, method) asked, the parameters of the real chunk job
-(``opnav.snakeio.mock_snakemake("landing_mc_chunk", ...)``: the scenario's landing
+(``opnav.core.snakeio.mock_snakemake("landing_mc_chunk", ...)``: the scenario's landing
 config, whether the pick-ratio diagnostic runs), one untimed run (imports, kernel
 loads, caches), then ``--runs`` runs timed by process CPU time
 (``time.process_time``). Prints CPU seconds and planning calls per job. The per-job
@@ -24,7 +24,7 @@ import time
 def job_cpu(scenario: str, method: str, runs: int, configfiles: list[str]) -> tuple[float, int]:
     """(CPU seconds, planning calls) of runs 1..runs of one chunk job, after an untimed run 0."""
     from opnav.landing.montecarlo import run_chunk
-    from opnav.snakeio import mock_snakemake
+    from opnav.core.snakeio import mock_snakemake
 
     argv = ["--configfile", *configfiles] if configfiles else []
     sm = mock_snakemake("landing_mc_chunk", argv=argv, bscn=scenario, bmethod=method, bchunk="r0000-0000")

@@ -2,7 +2,7 @@
 
 Description
 -----------
-In a scratch copy of the workflow (``opnav.snakeio.copy_workflow``), for each
+In a scratch copy of the workflow (``opnav.core.snakeio.copy_workflow``), for each
 profile asked (``quick``: ``--configfile config/quick.yaml``; ``full``: the
 default config):
 
@@ -66,7 +66,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
 
-from opnav.snakeio import copy_workflow  # noqa: E402
+from opnav.core.snakeio import copy_workflow  # noqa: E402
 
 TARGET_S = {"quick": 45.0, "full": 300.0, "pytest": 90.0}
 #: issue 31: CPU seconds new/old of a profile from empty, at most
@@ -200,9 +200,9 @@ def benchmark_seconds(results: Path) -> dict[str, tuple[int, float, float]]:
 
 
 def export_revision(rev: str, dst: Path) -> str:
-    """The workflow parts (``opnav.snakeio.WORKFLOW_PARTS``) of commit ``rev`` of this
+    """The workflow parts (``opnav.core.snakeio.WORKFLOW_PARTS``) of commit ``rev`` of this
     checkout, extracted into ``dst`` (``git archive``); returns the full commit id."""
-    from opnav.snakeio import WORKFLOW_PARTS
+    from opnav.core.snakeio import WORKFLOW_PARTS
 
     def git(*args, **kw):
         return subprocess.run(["git", *args], cwd=REPO, check=True, capture_output=True, **kw).stdout
@@ -256,7 +256,7 @@ def kernel_report(wd: Path) -> list[str]:
         lines += [line for line in log.read_text(errors="replace").splitlines()
                   if (" INFO " in line or " WARNING " in line) and "job resources" not in line]
     if (wd / "src" / "opnav" / "compiled.py").is_file():  # every kernel again in a fresh process
-        code = "import json, opnav.compiled as c; s = c.warm(); print(json.dumps({'seconds': s, **c.cache_stats()}))"
+        code = "import json, opnav.core.compiled as c; s = c.warm(); print(json.dumps({'seconds': s, **c.cache_stats()}))"
         c0 = _children_cpu()
         proc = subprocess.run([sys.executable, "-c", code], cwd=wd, env=_env(wd), capture_output=True, text=True)
         if proc.returncode == 0:

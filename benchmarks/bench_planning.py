@@ -29,7 +29,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing import timing
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk

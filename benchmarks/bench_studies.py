@@ -2,7 +2,7 @@
 
 Description
 -----------
-In a scratch copy of the workflow (``opnav.snakeio.copy_workflow``), with the
+In a scratch copy of the workflow (``opnav.core.snakeio.copy_workflow``), with the
 config of ``--config`` (default: the quick profile, whose other studies are small):
 
 1. runs a 3-value landing study (``landing.imu.sigma_a_mps2``; methods depth and
@@ -36,7 +36,7 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
-from opnav.snakeio import copy_workflow  # noqa: E402
+from opnav.core.snakeio import copy_workflow  # noqa: E402
 
 VALUES = [2.5e-4, 5.0e-4, 1.0e-3]
 

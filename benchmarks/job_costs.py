@@ -1,12 +1,12 @@
 """Where a Snakemake run's CPU time goes: per rule, from the jobs' logs.
 
 Every successful job ends its log with ``job resources: cpu_s=... max_rss_mb=...``
-(:func:`opnav.snakeio.resource_line`: the whole process, interpreter start-up and
+(:func:`opnav.core.snakeio.resource_line`: the whole process, interpreter start-up and
 imports included). This script finds those lines under a results folder and prints,
 per group of logs (the part's folder and the log name's first word: ``landing/mc``,
 ``studies/runs``, ...), the job count, total and largest CPU seconds and the largest
 peak memory, sorted by total CPU; then the compiled kernels (``kernels_loaded=``,
-``kernels_compiled=`` on the same line, :mod:`opnav.compiled`): how many jobs loaded
+``kernels_compiled=`` on the same line, :mod:`opnav.core.compiled`): how many jobs loaded
 them from numba's cache, and every job but ``compile_kernels`` that compiled some
 itself (a warm-up missing a signature the pipeline calls). Usage::
 

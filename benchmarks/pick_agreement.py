@@ -27,7 +27,7 @@ METHODS = "depth,svd,gdop,cond,logdet,mineig,svd_w"
 
 
 def record(a) -> None:
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.montecarlo import run_chunk
     from opnav.landing.scenario import camera_scenarios
 
@@ -44,7 +44,7 @@ def record(a) -> None:
 
 
 def compare(a) -> None:
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing import kernels as K
     from opnav.landing import planner as pl
     from opnav.landing.descent import build_scenario

@@ -4,7 +4,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from opnav.approach.ekf import Window
-from opnav.config import load_config
+from opnav.core.config import load_config
 
 
 def small_window(n=6, seed=0, rvar=1.0, q=0.1):

@@ -19,7 +19,7 @@ from pathlib import Path  # noqa: E402
 
 import pytest  # noqa: E402
 
-from opnav.snakeio import copy_workflow as _copy_workflow  # noqa: E402
+from opnav.core.snakeio import copy_workflow as _copy_workflow  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -200,6 +200,12 @@ def _uses_quick_build(item) -> bool:
     return QUICK_FIXTURE in getattr(item, "fixturenames", ())
 
 
+def pytest_itemcollected(item):
+    """A test that waits for the shared quick build is slow, marked or not."""
+    if _uses_quick_build(item) and item.get_closest_marker("slow") is None:
+        item.add_marker(pytest.mark.slow)
+
+
 def pytest_collection_modifyitems(config, items):
     """Tests that read the shared quick build run after all others (order kept otherwise)."""
     items.sort(key=_uses_quick_build)
@@ -276,3 +282,53 @@ from hypothesis import settings as _hyp_settings  # noqa: E402
 _hyp_settings.register_profile("repro", derandomize=True)
 _hyp_settings.register_profile("explore", derandomize=False, max_examples=200)
 _hyp_settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repro"))
+
+
+# ------------------------------------------------------------ the fast default run
+# `pytest` (README's command) runs the tests not marked slow or cluster (pyproject's
+# addopts); `pytest -m slow` runs the slow ones, `pytest -m cluster` the SLURM test. An
+# unmarked test must stay fast: one whose call takes more than UNMARKED_LIMIT_CPU_S of
+# CPU (this process plus the child processes it waited for), or UNMARKED_LIMIT_WALL_S of
+# wall time, fails with a line saying to mark it. CPU, not wall time, is the rule, so a
+# loaded machine does not fail a fast test; a call that compiled numba kernels (an empty
+# cache) is exempt, since a warm cache is the rule's premise.
+UNMARKED_LIMIT_CPU_S = float(os.environ.get("OPNAV_UNMARKED_LIMIT_CPU_S", "5"))
+UNMARKED_LIMIT_WALL_S = float(os.environ.get("OPNAV_UNMARKED_LIMIT_WALL_S", "30"))
+
+
+def _cpu_now() -> float:
+    import resource
+    import time
+
+    ch = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + ch.ru_utime + ch.ru_stime
+
+
+def _kernels_compiled() -> int:
+    compiled = sys.modules.get("opnav.core.compiled")
+    return compiled.cache_stats()["compiled"] if compiled is not None else 0
+
+
+def unmarked_too_slow(cpu_s: float, wall_s: float, compiled: bool) -> str | None:
+    """Why an unmarked test's call is too slow for the default run, or None."""
+    if compiled:
+        return None
+    if cpu_s > UNMARKED_LIMIT_CPU_S:
+        return f"took {cpu_s:.1f} CPU-s (> {UNMARKED_LIMIT_CPU_S:g})"
+    if wall_s > UNMARKED_LIMIT_WALL_S:
+        return f"took {wall_s:.1f} s wall (> {UNMARKED_LIMIT_WALL_S:g})"
+    return None
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item):
+    import time
+
+    if item.get_closest_marker("slow") or item.get_closest_marker("cluster"):
+        return (yield)
+    cpu0, wall0, comp0 = _cpu_now(), time.perf_counter(), _kernels_compiled()
+    result = yield
+    why = unmarked_too_slow(_cpu_now() - cpu0, time.perf_counter() - wall0, _kernels_compiled() > comp0)
+    if why:
+        pytest.fail(f"unmarked test {why}: mark it @pytest.mark.slow or make it faster", pytrace=False)
+    return result

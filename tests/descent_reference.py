@@ -15,7 +15,7 @@ import numpy as np
 
 from opnav.landing import imu
 from opnav.landing.measurement import bearing_jacobian
-from opnav.rotations import exp_so3, skew
+from opnav.core.rotations import exp_so3, skew
 from opnav.landing.metrics import H_METRICS
 from opnav.landing.planner import PlanState, plan
 from opnav.landing.trajectory import euler_rpy_deg

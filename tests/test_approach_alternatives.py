@@ -10,7 +10,7 @@ from opnav.approach import scenario as sc
 from opnav.approach.augmented import run_augmented
 from opnav.approach.batch_ml import BatchML
 from opnav.approach.em import em_window
-from opnav.config import load_config
+from opnav.core.config import load_config
 
 N_SAMPLES = 600
 TRUTH = np.array([10.0, 20.0, 10.0])
@@ -44,6 +44,7 @@ def test_roll_bound_is_below_3_arcsec_and_tz_stays_at_its_prior(roll_case):
     assert bound[2] > 1000.0  # tz: unobservable, stays at the diffuse prior
 
 
+@pytest.mark.slow
 def test_augmented_batch_ml_and_em_within_4_bound_sigma_and_ml_equals_em(roll_case):
     """All three estimators are within a few CRLB sigma of the truth; batch ML and converged EM
     maximise the same observed-data likelihood, so they agree far more closely."""
@@ -244,7 +245,7 @@ def _augmented_reference(z, x0, P0, theta0, sig, win, q_theta=0.0, u_lin=None):
     from opnav.approach.augmented import augmented_jacobian, augmented_noise
     from opnav.approach.dynamics import ARCSEC
     from opnav.approach.stars import theta_information_update
-    from opnav.rotations import skew
+    from opnav.core.rotations import skew
 
     S, n = z.shape[0], win.n
     y = np.zeros((S, 9))

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from opnav import published
+from opnav.core import published
 from opnav.approach import cases, pipeline, report
 from opnav.approach import scenario as sc
 

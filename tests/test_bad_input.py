@@ -1,7 +1,7 @@
 """Bad input is refused before any job runs, with one line naming the key.
 
 Each case is an overlay on config/config.yaml + config/quick.yaml, checked with
-:func:`opnav.config.validate_config`, which is what the Snakefile runs before it
+:func:`opnav.core.config.validate_config`, which is what the Snakefile runs before it
 builds the DAG (one `snakemake -n` case below proves that path) and what the
 CLI runs before it computes anything.
 """
@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from conftest import REPO, run_snakemake
-from opnav.config import ConfigError, _merge, validate_config
+from opnav.core.config import ConfigError, _merge, validate_config
 
 
 def _raw_quick() -> dict:
@@ -269,7 +269,7 @@ def test_tracked_folders_come_from_git(tmp_path):
     placeholders only (results/README.md) or of untracked files is not."""
     import subprocess
 
-    from opnav.checks import results_dir_problems, tracked_dirs
+    from opnav.core.checks import results_dir_problems, tracked_dirs
 
     subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
     for f in ("notes/a.txt", "results/README.md", "scratch/x.txt"):
@@ -282,7 +282,7 @@ def test_tracked_folders_come_from_git(tmp_path):
 
 
 def test_yaml_anchors_and_merge_keys_still_work(tmp_path):
-    from opnav.config import read_config_file
+    from opnav.core.config import read_config_file
 
     f = tmp_path / "ok.yaml"
     f.write_text("x: &c {fov_deg: 45.0}\nlanding: {camera: {<<: *c, tilt_deg: 40.0}}\n")
@@ -337,7 +337,7 @@ def test_bad_config_file_refused_naming_file_and_line(content, expected, tmp_pat
 
 
 def test_a_directory_is_not_a_config_file(tmp_path):
-    from opnav.config import read_config_file
+    from opnav.core.config import read_config_file
 
     with pytest.raises(ConfigError, match="not a regular file"):
         read_config_file(tmp_path)
@@ -497,7 +497,7 @@ def test_json_output_is_strict():
 
     import numpy as np
 
-    from opnav.tables import json_ready
+    from opnav.core.tables import json_ready
 
     obj = {"a": float("nan"), "b": [float("inf"), 1.5], "c": np.float64("nan"), "d": np.array([1.0, np.nan]),
            "e": "nan", "f": 3}

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing.montecarlo import (chunk_label, chunks, earlier_chunks, load, run_chunk,
                                       run_chunk_reusing, save)
 from opnav.landing.scenario import camera_scenarios
@@ -47,6 +47,7 @@ def test_earlier_chunks_picks_disjoint_subsets(tmp_path):
     assert earlier_chunks(tmp_path / "r0000-0002.npz", range(3)) == []
 
 
+@pytest.mark.slow
 def test_raising_n_runs_flies_only_the_new_runs(tmp_path, landing):
     """4 -> 6 -> 7 runs with 6 runs per job: the partial chunk r0000-0003 becomes
     r0000-0005 by flying runs 4 and 5 only, then r0006-0006 flies run 6; every chunk

@@ -1,4 +1,4 @@
-"""The claims table (opnav.claims, opnav.approach.claims, opnav.landing.claims) on hand-made
+"""The claims table (opnav.report.claims, opnav.report.approach_claims, opnav.report.landing_claims) on hand-made
 inputs: verdicts that flip when the numbers do, diagnostics that never reproduce, and a
 generated abstract that changes with a verdict."""
 
@@ -7,10 +7,10 @@ import copy
 import pandas as pd
 import pytest
 
-from opnav import claims as C
-from opnav import published
-from opnav.approach.claims import claim_rows as rows_a
-from opnav.landing.claims import claim_rows as rows_b
+from opnav.report import claims as C
+from opnav.core import published
+from opnav.report.approach_claims import claim_rows as rows_a
+from opnav.report.landing_claims import claim_rows as rows_b
 
 PUB = published.load()
 CASES = [("T1-01", "size", 0.1), ("T1-10", "pixel", 0.1), ("T1-11", "pixel", 0.5), ("T1-12", "pixel", 1.0)]

@@ -1,8 +1,9 @@
 """The quick profile through a real single-node SLURM (``.ci/slurm-cluster``) and the
 executor plugin (``--workflow-profile profiles/slurm``), compared with the local build.
 
-Runs where the cluster can be started: Linux, as root, with slurm-wlm installed or
-apt-get to install it (CI). Elsewhere it is skipped with one line saying why. Deselect
+Runs where the cluster can be started: Linux, as root, with slurm-wlm installed, or
+apt-get to install it and ``OPNAV_ALLOW_APT=1`` (CI sets it; the test never installs
+system packages without it). Elsewhere it is skipped with one line saying why. Deselect
 with ``-m "not cluster"``. The cluster is started by the test and stopped at its end
 (if it was not already running), by the daemons' pid files; one cluster test at a time
 per machine (a lock file), so two sessions never share or stop each other's daemons.
@@ -22,9 +23,9 @@ import pytest
 import yaml
 
 from conftest import REPO, _snakemake_cmd, copy_workflow
-from opnav.snakeio import CSV_STAMP, load_csv
+from opnav.core.snakeio import CSV_STAMP, load_csv
 
-pytestmark = [pytest.mark.cluster, pytest.mark.slow]
+pytestmark = pytest.mark.cluster  # run with `pytest -m cluster`
 
 SCRIPT = REPO / ".ci" / "slurm-cluster"
 # What a cluster without accounting (no slurmdbd) needs: job status from squeue (the
@@ -47,9 +48,16 @@ def _why_not() -> str | None:
         return "SLURM cluster test: Linux only"
     if os.geteuid() != 0:
         return "SLURM cluster test: needs root to start munged/slurmctld/slurmd (.ci/slurm-cluster)"
-    if not any(os.access(os.path.join(d, b), os.X_OK) for d in os.environ.get("PATH", "").split(os.pathsep)
-               for b in ("apt-get", "slurmctld")):
+    def found(b):
+        return any(os.access(os.path.join(d, b), os.X_OK) for d in os.environ.get("PATH", "").split(os.pathsep))
+
+    if found("slurmctld"):
+        return None
+    if not found("apt-get"):
         return "SLURM cluster test: neither slurm-wlm nor apt-get to install it"
+    if os.environ.get("OPNAV_ALLOW_APT") != "1":
+        return ("SLURM cluster test: slurm-wlm is not installed; set OPNAV_ALLOW_APT=1 to let the test "
+                "install slurm-wlm and munge with apt-get (it changes the system)")
     return None
 
 

@@ -1,4 +1,4 @@
-"""opnav.compiled's on-disk cache: a second process loads what the first compiled, and a
+"""opnav.core.compiled's on-disk cache: a second process loads what the first compiled, and a
 kernel that calls another module's kernel is recompiled when that module changes (numba
 alone keys a cached function by its own file, and would load the old callee's code)."""
 
@@ -10,11 +10,11 @@ import textwrap
 
 from conftest import REPO
 
-from opnav import compiled
+from opnav.core import compiled
 
-CALLEE = "from opnav.compiled import kernel\n\n\n@kernel\ndef f(x):\n    return x + {}\n"
+CALLEE = "from opnav.core.compiled import kernel\n\n\n@kernel\ndef f(x):\n    return x + {}\n"
 CALLER = textwrap.dedent("""\
-    from opnav.compiled import kernel, warms
+    from opnav.core.compiled import kernel, warms
     from ka import f
 
 
@@ -28,7 +28,7 @@ CALLER = textwrap.dedent("""\
         g(1.0)
 """)
 RUN = textwrap.dedent("""\
-    import json, opnav.compiled as c
+    import json, opnav.core.compiled as c
     c.KERNEL_MODULES = ("ka", "kb")
     seconds = c.warm()
     import kb
@@ -60,7 +60,7 @@ def test_cache_loaded_by_the_next_process_and_invalidated_by_a_callee_change(tmp
 
 def test_kernel_sources_are_the_registered_modules_files():
     files = compiled.kernel_sources()
-    assert files[0] == REPO / "src" / "opnav" / "compiled.py"
+    assert files[0] == REPO / "src" / "opnav" / "core" / "compiled.py"
     assert len(files) == 1 + len(compiled.KERNEL_MODULES)
     for name, path in zip(compiled.KERNEL_MODULES, files[1:]):
         assert path.is_file(), name

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import REPO
-from opnav.config import ConfigError, load_config
+from opnav.core.config import ConfigError, load_config
 
 
 def test_defaults_fill_missing_keys(tmp_path):
@@ -32,7 +32,7 @@ def test_bad_value_names_key(tmp_path):
 def test_schema_defaults_are_the_full_profile():
     """The schema's defaults (what an installed ``opnav`` uses outside a
     checkout) equal config/config.yaml key for key, nested sections included."""
-    from opnav.config import SCHEMA_PATH, validate_config
+    from opnav.core.config import SCHEMA_PATH, validate_config
 
     defaults = validate_config({}, SCHEMA_PATH)
     full = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
@@ -40,7 +40,7 @@ def test_schema_defaults_are_the_full_profile():
 
 
 def test_outside_a_checkout_the_schema_defaults_apply(tmp_path, monkeypatch):
-    import opnav.config as oc
+    import opnav.core.config as oc
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(oc, "repo_root", lambda start=None: (_ for _ in ()).throw(ConfigError("no checkout")))
@@ -63,7 +63,7 @@ def test_closest_approach_closed_form_matches_numerical_integration(range_km, ai
     import numpy as np
 
     from opnav.approach import dynamics
-    from opnav.checks import _hyperbola_min_range_km, _integrated_min_range_km
+    from opnav.core.checks import _hyperbola_min_range_km, _integrated_min_range_km
 
     d = np.array([0.3 + dx, -0.9, 0.1 + dz])
     d /= np.linalg.norm(d)
@@ -84,7 +84,7 @@ def test_the_approach_check_uses_the_closest_approach_of_the_configured_arc():
     """The configured arc's closest range is the closed form's, and an arc aimed
     at Mars is refused naming geometry."""
     from opnav.approach import dynamics, scenario
-    from opnav.checks import _approach_min_range_km, _integrated_min_range_km, approach_problems
+    from opnav.core.checks import _approach_min_range_km, _integrated_min_range_km, approach_problems
 
     a = load_config(REPO / "config" / "config.yaml")["approach"]
     T = 5.0e5

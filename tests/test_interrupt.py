@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from conftest import REPO, copy_workflow, run_snakemake, start_snakemake
 
@@ -31,8 +32,9 @@ def _job_in_flight(pgid: int, script: str) -> bool:
     return False
 
 
+@pytest.mark.slow
 def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.montecarlo import gather, load, run_chunk
 
     wd = tmp_path / "wf"

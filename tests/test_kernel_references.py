@@ -1,4 +1,4 @@
-"""Compiled kernels (opnav.compiled.kernel) against independent references, over
+"""Compiled kernels (opnav.core.compiled.kernel) against independent references, over
 hypothesis-drawn inputs: the gaps left by the per-module tests (issue 31's audit).
 
 Each test compares a kernel, or the public function that runs it, with a reference
@@ -186,7 +186,7 @@ def test_approach_measurement_jacobians_match_central_differences(seed, S, n):
     from opnav.approach.augmented import augmented_jacobian
     from opnav.approach.camera import misalignment_small
     from opnav.approach.dynamics import ARCSEC
-    from opnav.rotations import skew
+    from opnav.core.rotations import skew
 
     win, rng, z, theta, x0, P0 = random_filter_problem(seed, S, n)
     f = ekf.run_filter(z, theta, x0, P0, win, predicted=False)
@@ -427,7 +427,7 @@ def test_descent_record_equals_numpy_and_scipy(seed, B, att):
 # ================================================================= warm-ups
 
 WARM_AGAIN = """
-import json, opnav.compiled as c
+import json, opnav.core.compiled as c
 seconds = c.warm()
 print(json.dumps({"modules": sorted(seconds), **c.cache_stats()}))
 """
@@ -440,7 +440,7 @@ def test_every_kernel_module_registers_a_warm_up_and_a_warmed_cache_compiles_not
     load; that the warm-ups cover the signatures the jobs call is test_workflow's
     ``test_kernels_compiled_once_then_only_loaded``). Mutation tried: a module's
     ``@warms`` removed -> fails (modules)."""
-    from opnav import compiled
+    from opnav.core import compiled
 
     compiled.warm()                                  # fills the on-disk cache (a no-op if full)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(

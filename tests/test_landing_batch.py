@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing import planner as PL
 from opnav.landing.descent import run_descent, run_descents, tracking_step
 from opnav.landing.scenario import build_scenario, camera_scenarios
@@ -43,6 +43,7 @@ def assert_same_run(a: dict, b: dict, rtol: float = 1e-7, atol: float = 1e-9):
 
 @pytest.mark.parametrize("scenario, methods", [("interior", ("depth", "svd", "logdet", "random")),
                                                 ("site-tilt", ("depth", "cond"))])
+@pytest.mark.slow
 def test_batched_descent_equals_the_per_run_reference(scenarios, scenario, methods):
     """Two runs flown as one batch give the numbers of the pre-refactor per-run
     descent (picks identical, states to round-off), in both camera scenarios
@@ -101,6 +102,7 @@ def _planning_calls(scn, runs):
     return seen
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scenario", ["interior", "site-tilt"])
 def test_batched_planner_picks_equal_the_per_call_planner(scenarios, scenario):
     """Every method of planner.available_methods(): on the planning states of a

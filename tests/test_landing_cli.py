@@ -23,7 +23,7 @@ def test_cli_flies_one_descent(capsys, method):
 
 
 def test_cli_scenario_flag_flies_that_camera(capsys):
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.descent import build_scenario, run_descent
     from opnav.landing.montecarlo import summarize_run
     from opnav.landing.scenario import camera_scenarios

@@ -74,7 +74,7 @@ def test_controls_are_not_equivalent_and_a_real_pair_is():
 
 def test_claim_not_reproduced_when_a_control_passes():
     from opnav.landing.report import same_accuracy_verdict
-    from opnav.verdicts import NOT_REPRODUCED, REPRODUCED
+    from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED
 
     st = _runs()
     for frac, ok in ((0.25, REPRODUCED), (1.0, NOT_REPRODUCED)):
@@ -171,7 +171,7 @@ def test_vision_cut_off_uses_the_estimate_never_the_truth():
     last metres the truth is still above the limit while the estimate-based
     quantity is not, so a cut-off on the true altitude would update there and
     fail this test."""
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.descent import run_descents, vision_cutoff_altitude
     from opnav.landing.scenario import build_scenario, camera_scenarios
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
 from opnav.landing.montecarlo import chunks, gather, run_chunk

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 from opnav.landing.measurement import (BehindCameraError, bearing, bearing_jacobian,
                                        selection_jacobian, tangent_basis, tangent_jacobian,
                                        tangent_jacobian_scalar)
-from opnav.rotations import exp_so3, skew
+from opnav.core.rotations import exp_so3, skew
 
 
 def _case(seed):

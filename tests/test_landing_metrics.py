@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from opnav.landing import casadi_model as cm
 from opnav.landing import measurement as me
-from opnav.rotations import skew
+from opnav.core.rotations import skew
 from opnav.landing.metrics import (
     H_METRICS,
     METRIC_NAMES,
@@ -603,7 +603,7 @@ def test_paper_baselines_rank_identically_in_descent_geometry():
 
 
 def _descent_ctx_and_candidates(k=20, n=300, seed=3):
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.descent import build_scenario
     from opnav.landing.metrics import MetricContext
 

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from opnav.landing import ekf
 from opnav.landing.measurement import selection_jacobian
 from opnav.landing.planned_info import planned_nav_logdet, planned_posterior
-from opnav.rotations import exp_so3
+from opnav.core.rotations import exp_so3
 
 
 G = np.array([0.0, 0.0, -3.711])
@@ -94,7 +94,7 @@ def test_oc_keeps_yaw_unobservable():
 
 
 def test_planner_objective_uses_the_filter_noise_model_and_strategy():
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.planner import PlanState, candidate_scores, plan_one
     from opnav.landing.scenario import build_scenario, camera_scenarios
 
@@ -114,7 +114,7 @@ def test_planner_objective_uses_the_filter_noise_model_and_strategy():
 
 @functools.lru_cache(maxsize=None)
 def _scenario(name):
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.scenario import build_scenario, camera_scenarios
 
     return build_scenario(camera_scenarios(load_config()["landing"])[name])

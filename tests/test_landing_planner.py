@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing.camera import camera_from_config
 from opnav.landing.depth_error import plane_geometry
 from opnav.landing.descent import build_scenario

@@ -190,7 +190,7 @@ def test_headline_feeds_manuscript_macros():
     """B-X1-summary.json flattens into distinct LaTeX macros (no collisions)."""
     import json
 
-    from opnav.manuscript import macros_from_summary
+    from opnav.report.manuscript import macros_from_summary
 
     runs = np.arange(5)
     data = {"depth": _fake_mc(np.arange(1.0, 6.0), runs, 100.0, 0),

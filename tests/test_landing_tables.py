@@ -1,6 +1,6 @@
 import numpy as np
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing.scenario import error_bounds_table, initial_state_table
 from conftest import REPO
 

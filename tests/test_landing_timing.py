@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing import records, timing
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
@@ -45,6 +45,7 @@ def test_select_calls_evenly_spaced_distinct(n, m):
     assert np.all(np.diff(idx) > 0) and (want == 0 or (idx[0] == 0 and idx[-1] < n))
 
 
+@pytest.mark.slow
 def test_replay_reproduces_every_recorded_pick(recorded):
     """Every own call replayed (max_calls = 0): the replayed pick is the recorded one."""
     scn, rec = recorded
@@ -67,6 +68,7 @@ def test_the_pick_check_can_fail(recorded):
         assert tm["mismatch"][0] > 0, key
 
 
+@pytest.mark.slow
 def test_replay_deterministic_and_order_independent(recorded):
     """Same inputs, same picks, whatever the method order or the subset; the
     methods are timed on both paths (compiled, the paper's definition) with the same picks; the rotation puts
@@ -180,8 +182,8 @@ def test_paper_subset_is_select_calls_over_the_replayed_calls(n_pool, m, mp):
 
 
 def test_bad_max_calls_paper_names_the_key():
-    from opnav.config import validate_config
-    from opnav.errors import ConfigError
+    from opnav.core.config import validate_config
+    from opnav.core.errors import ConfigError
 
     with pytest.raises(ValueError, match="landing.timing.max_calls_paper must be >= 0"):
         timing.select_calls(10, -1, "landing.timing.max_calls_paper")

@@ -26,7 +26,7 @@ def test_choice_prefers_consistent_then_not_overconfident_smallest_scale():
 
 def test_tuning_runs_use_their_own_stream():
     from conftest import REPO
-    from opnav.config import load_config
+    from opnav.core.config import load_config
     from opnav.landing.scenario import camera_scenarios
 
     cfg = load_config(overlays=[str(REPO / "config" / "quick.yaml")])["landing"]

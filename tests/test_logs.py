@@ -1,6 +1,6 @@
 """Quiet logs: a params-change reason names the changed keys, not whole sections."""
 
-from opnav.snakeio import compact_params_change_reasons, params_change_text
+from opnav.core.snakeio import compact_params_change_reasons, params_change_text
 
 
 def test_only_changed_leaves_are_named():

@@ -4,7 +4,7 @@ from pathlib import Path
 
 from hypothesis import given, strategies as st
 
-from opnav.manuscript import (float_block, format_number, macro_name, macros_from_summary,
+from opnav.report.manuscript import (float_block, format_number, macro_name, macros_from_summary,
                               render_macros, rst_to_latex)
 
 
@@ -74,8 +74,8 @@ def test_no_nan_text_reaches_the_manuscript():
     import numpy as np
     import pandas as pd
 
-    from opnav.manuscript import COMPACT_VIEWS, macros_from_summary, render_macros
-    from opnav.tables import to_latex, to_markdown
+    from opnav.report.manuscript import COMPACT_VIEWS, macros_from_summary, render_macros
+    from opnav.core.tables import to_latex, to_markdown
 
     nanword = re.compile(r"(?<![A-Za-z])(nan|inf|<NA>)(?![A-Za-z])", re.IGNORECASE)
     summary = {"a": float("nan"), "b": np.float32("nan"), "c": "nan", "d": [None, np.nan],
@@ -95,7 +95,7 @@ def test_no_nan_text_reaches_the_manuscript():
 
 
 def test_prose_typography():
-    from opnav.manuscript import prose_tex
+    from opnav.report.manuscript import prose_tex
 
     t = prose_tex("tx = 1.2 +- 0.3 arcsec, theta from 1e+06 km, rho*theta, 29 % less, 5 us, rate^-0.99, a_b")
     assert r"$t_x$" in t and r"$\pm$" in t and r"1.2" in t and r"0.3\arcsec{}" in t
@@ -107,7 +107,7 @@ def test_prose_typography():
 def test_table1_grouped_has_one_column_group_per_variant_and_marks_unconverged():
     import pandas as pd
 
-    from opnav.manuscript import table1_grouped_latex
+    from opnav.report.manuscript import table1_grouped_latex
 
     rows = []
     for v, lab in (("literal", "converged"), ("roll", "stalled")):
@@ -123,7 +123,7 @@ def test_table1_grouped_has_one_column_group_per_variant_and_marks_unconverged()
 
 
 def test_pdf_selection_drops_variants_not_studies():
-    from opnav.manuscript import in_pdf
+    from opnav.report.manuscript import in_pdf
 
     drop = ["prior", "reference-start"]
     assert in_pdf("results/approach/A-F4_bias_estimate_literal.pdf", drop)

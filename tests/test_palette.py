@@ -1,4 +1,4 @@
-"""One palette (opnav.figures.PALETTE): every method and scenario variant of both papers
+"""One palette (opnav.core.figures.PALETTE): every method and scenario variant of both papers
 has one colour, and every figure that draws it uses that colour (A-X1 and the A-X3
 ablation figure used to colour the roll variant differently)."""
 
@@ -7,10 +7,11 @@ import pandas as pd
 import pytest
 from matplotlib.colors import to_rgba
 
-from opnav import figures, study_plots
+from opnav.core import figures
+from opnav.report import study_plots
 from opnav.approach import plots as aplots
 from opnav.approach.report import METHOD_LABELS
-from opnav.config import load_config
+from opnav.core.config import load_config
 from opnav.landing import plots as lplots
 from opnav.landing.planner import available_methods
 from opnav.studies import APPROACH_METHODS
@@ -116,7 +117,7 @@ def test_saved_png_is_200_dpi_and_tight_even_outside_the_style(tmp_path):
     import matplotlib.pyplot as plt
     from PIL import Image
 
-    from opnav import figures
+    from opnav.core import figures
 
     with figures.style():
         fig, ax = plt.subplots()

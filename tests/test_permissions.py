@@ -5,8 +5,8 @@ import stat
 
 import pytest
 
-from opnav import figures
-from opnav.tables import atomic_target, atomic_write_text
+from opnav.core import figures
+from opnav.core.tables import atomic_target, atomic_write_text
 
 
 @pytest.fixture(params=[0o022, 0o002, 0o077])

@@ -3,7 +3,7 @@
 import subprocess
 from importlib import metadata
 
-from opnav import provenance
+from opnav.core import provenance
 
 
 def _git(cwd, *args):

@@ -9,8 +9,8 @@ import pytest
 import yaml
 
 from conftest import REPO, dry_run_jobs, dry_run_jobs_many, run_snakemake
-from opnav import figures
-from opnav.config import load_config
+from opnav.core import figures
+from opnav.core.config import load_config
 
 QUICK = ("--configfile", "config/quick.yaml")
 QUICK_TARGET = "results/quick/landing/B-T1_initial_state.csv"

@@ -1,11 +1,11 @@
-"""opnav.rotations: hat map, SO(3) exp / log against scipy, batching over
+"""opnav.core.rotations: hat map, SO(3) exp / log against scipy, batching over
 leading dimensions (same bits as one vector at a time), small-angle branch."""
 
 import numpy as np
 from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 
-from opnav.rotations import cross, exp_so3, log_so3, skew
+from opnav.core.rotations import cross, exp_so3, log_so3, skew
 
 
 def _vectors(seed, shape, scale):

@@ -4,7 +4,7 @@ import math
 
 from hypothesis import given, strategies as st
 
-from opnav.scorecard import (NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED, judge, score_rows,
+from opnav.report.scorecard import (NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED, judge, score_rows,
                              tolerance)
 
 

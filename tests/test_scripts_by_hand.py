@@ -1,4 +1,4 @@
-"""Every workflow script runs by hand as the real job (opnav.snakeio.mock_snakemake builds
+"""Every workflow script runs by hand as the real job (opnav.core.snakeio.mock_snakemake builds
 the rule's inputs, outputs, params and log from the Snakefile and the overlays given)."""
 
 import subprocess
@@ -40,7 +40,7 @@ def test_a_script_run_by_hand_gets_the_rule_params_of_its_overlays(tmp_path):
 
 
 def test_a_missing_wildcard_is_named(tmp_path):
-    from opnav.snakeio import mock_snakemake
+    from opnav.core.snakeio import mock_snakemake
 
     with pytest.raises(SystemExit, match="needs the wildcard.*variant"):
         mock_snakemake("approach_mc", root=REPO)
@@ -50,7 +50,7 @@ def test_the_landing_chunk_job_gets_the_configured_batch_size(tmp_path):
     """landing.mc.batch_size reaches the Monte-Carlo job (it was read from the
     simulation config, which does not carry it, so any value flew the whole chunk
     as one batch); it is a param of its own, outside the runs' reuse key."""
-    from opnav.snakeio import mock_snakemake
+    from opnav.core.snakeio import mock_snakemake
 
     overlay = tmp_path / "batch.yaml"
     overlay.write_text(yaml.safe_dump({"landing": {"mc": {"batch_size": 3}}}))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from opnav.landing import montecarlo
-from opnav.snakeio import CorruptIntermediate, load_pickle, save_pickle, script_context, stand_in
+from opnav.core.snakeio import CorruptIntermediate, load_pickle, save_pickle, script_context, stand_in
 
 
 def test_failing_job_writes_traceback_to_its_log(tmp_path):
@@ -83,7 +83,7 @@ def test_intermediate_csv_refuses_a_cut_or_edited_file(tmp_path):
     import numpy as np
     import pandas as pd
 
-    from opnav.snakeio import CorruptIntermediate, load_csv, save_csv
+    from opnav.core.snakeio import CorruptIntermediate, load_csv, save_csv
 
     df = pd.DataFrame({"method": ["depth", "svd"] * 3, "run": np.arange(6),
                        "final_pos_err_m": np.linspace(0.1, 9.9, 6) / 3.0})
@@ -101,7 +101,7 @@ def test_intermediate_csv_refuses_a_cut_or_edited_file(tmp_path):
 
 
 def test_intermediate_json_refuses_a_truncated_file(tmp_path):
-    from opnav.snakeio import CorruptIntermediate, load_json
+    from opnav.core.snakeio import CorruptIntermediate, load_json
 
     f = tmp_path / "s.json"
     f.write_text('{"a": [1, 2, 3], "b": {"c": 1.5}}')

@@ -8,6 +8,7 @@ import os
 import subprocess
 import sys
 
+import pytest
 import yaml
 
 from opnav.cli import study_command
@@ -27,6 +28,7 @@ def _opnav(wd, *args):
     return subprocess.run([sys.executable, "-m", "opnav", *args], cwd=wd, capture_output=True, text=True, env=env)
 
 
+@pytest.mark.slow
 def test_opnav_study_runs_only_that_study(workdir):
     name, spec = _overlay(workdir)
     cmd = study_command(name, ["a.yaml", "b.yaml"])

@@ -7,7 +7,7 @@ import pytest
 import yaml
 
 from conftest import REPO, run_snakemake
-from opnav.config import ConfigError, load_config, validate_config
+from opnav.core.config import ConfigError, load_config, validate_config
 
 
 def _write_bad(workdir: Path, mutations, name: str) -> Path:
@@ -126,7 +126,7 @@ def test_kernels_compiled_once_then_only_loaded(quick_results):
     import json
     import re
 
-    from opnav import compiled
+    from opnav.core import compiled
 
     out = quick_results / "results" / "quick"
     made = [json.loads((out / "kernels" / f"{p}.json").read_text())["kernel_modules"]

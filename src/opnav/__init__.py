@@ -10,9 +10,9 @@ landing
     landmark selection by depth estimation error against observability
     baselines.
 
-Shared modules: :mod:`opnav.config` (configuration loading and validation),
-:mod:`opnav.tables` (CSV/LaTeX/Markdown writers), :mod:`opnav.figures` (the
-shared matplotlib style and deterministic saving), :mod:`opnav.published`
+Shared modules: :mod:`opnav.core.config` (configuration loading and validation),
+:mod:`opnav.core.tables` (CSV/LaTeX/Markdown writers), :mod:`opnav.core.figures` (the
+shared matplotlib style and deterministic saving), :mod:`opnav.core.published`
 (the papers' published values, always labelled as such).
 """
 

@@ -26,7 +26,7 @@ import sys
 from typing import Any
 
 from opnav import __version__
-from opnav.config import ConfigError, validate_config
+from opnav.core.config import ConfigError, validate_config
 
 #: Exit code of every user error (argparse's own code for a bad flag).
 EXIT_USER = 2
@@ -76,9 +76,9 @@ def with_flags(config: dict, flags: dict[str, tuple[str, Any]], *, workflow: boo
 
     ``flags`` maps a dotted config key to ``(flag, value)``; ``None`` values are
     skipped. The whole config is validated again (schema limits and the physics
-    checks of :mod:`opnav.checks`), and every error line about a flag's key (or
+    checks of :mod:`opnav.core.checks`), and every error line about a flag's key (or
     a parent or child of it) is prefixed with the flag. Raises
-    :class:`~opnav.config.ConfigError`.
+    :class:`~opnav.core.config.ConfigError`.
     """
     given = {k: fv for k, fv in flags.items() if fv[1] is not None}
     for key, (_, value) in given.items():
@@ -102,7 +102,7 @@ def with_flags(config: dict, flags: dict[str, tuple[str, Any]], *, workflow: boo
 
 def print_json(obj: Any, **kw) -> None:
     """Print ``obj`` as strict JSON (NaN and infinities written as ``null``)."""
-    from opnav.tables import json_ready
+    from opnav.core.tables import json_ready
 
     print(json.dumps(json_ready(obj), allow_nan=False, **kw))
 
@@ -163,7 +163,7 @@ def parse_set(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not sep or not _SET_KEY_RE.fullmatch(key):
         raise ConfigError(f"--set {text!r}: expected KEY.PATH=VALUE, e.g. --set landing.camera.fov_deg=75")
-    from opnav.config import _StrictLoader
+    from opnav.core.config import _StrictLoader
 
     try:
         value = yaml.load(raw, Loader=_StrictLoader)    # a key twice in a {...} value is refused too
@@ -179,7 +179,7 @@ def load_cli_config(args, *, workflow: bool = False) -> dict:
     keys, validated by the same schema and physics checks as the pipeline's config (with
     ``workflow``, also the workflow's: studies, growing windows, job bounds). A ``--set``
     key must exist; its errors name the flag."""
-    from opnav.config import load_config
+    from opnav.core.config import load_config
 
     overlays = [*([args.config] if getattr(args, "config", None) else []), *getattr(args, "overlays", [])]
     config = load_config(overlays=overlays, workflow=workflow and not getattr(args, "sets", []))
@@ -233,7 +233,7 @@ def run_study(args) -> int:
 
     import yaml
 
-    from opnav.config import repo_root
+    from opnav.core.config import repo_root
 
     if args.cores < 1:
         raise ConfigError("--cores: must be at least 1")

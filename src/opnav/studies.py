@@ -44,8 +44,8 @@ from typing import Any, Callable, Iterable, Mapping
 import numpy as np
 import pandas as pd
 
-from opnav.checks import MAX_APPROACH_SEED_SAMPLES, MAX_STUDY_VALUES, study_size_problem, study_spec_defaults
-from opnav.errors import ConfigError
+from opnav.core.checks import MAX_APPROACH_SEED_SAMPLES, MAX_STUDY_VALUES, study_size_problem, study_spec_defaults
+from opnav.core.errors import ConfigError
 
 __all__ = ["METRICS", "CONSTANT_METRICS", "APPROACH_METHODS", "SIM_KEYS", "Study", "plan", "simulation_shapes",
            "config_digest",
@@ -302,7 +302,7 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
     ``shapes[paper]`` is the simulation's view of ``config[paper]`` (default
     :func:`simulation_shapes`); ``validate(cfg)`` raises :class:`ConfigError` (or
     ``ValueError``) for a bad merged config, or ``validate_paper(cfg, paper)`` (the
-    workflow's: :func:`opnav.config.validate_study_value`, which checks that paper's
+    workflow's: :func:`opnav.core.config.validate_study_value`, which checks that paper's
     section alone); ``landing_methods`` are the planner's method names (default: its
     registry). Raises one :class:`ConfigError` with one line per problem of every
     study, each naming ``studies.<name>...``. Without shapes, validate and methods the
@@ -430,7 +430,7 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
 
 def _check_approach_job_size(where: str, approach: Mapping, seeds_per_job: int) -> None:
     """A paper-A study job runs its seeds batched over the whole arc: the same memory
-    limit as the Monte Carlo's (:data:`opnav.checks.MAX_APPROACH_SEED_SAMPLES`)."""
+    limit as the Monte Carlo's (:data:`opnav.core.checks.MAX_APPROACH_SEED_SAMPLES`)."""
     from opnav.approach.scenario import n_samples
 
     n = n_samples(approach)

@@ -26,7 +26,7 @@ A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
 _a_seg, _a_grow = config["approach"]["segments"], config["approach"]["growing"]
 if _a_grow["methods"] and (_a_seg["L"] * _a_seg["N"]) % _a_grow["N"]:
     config_exit(f"invalid config key 'approach.growing.N': {_a_grow['N']} does not divide approach.segments.L x N "
-                f"= {_a_seg['L'] * _a_seg['N']}")  # checked before (opnav.checks.growing_problems)
+                f"= {_a_seg['L'] * _a_seg['N']}")  # checked before (opnav.core.checks.growing_problems)
 # Table 1 again with growing windows (approach.growing), as its own rows: scheme "growing-<method>"
 A_MC_GROWING = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__growing-{m}.pkl"
                 for v in A_VARIANTS for g in a_groups(v) for m in config["approach"]["growing"]["methods"]}
@@ -85,7 +85,7 @@ rule approach_crlb:
     against the roll rate with the rate that reaches the claimed accuracy in the published data."""
     input:
         A_SRC,
-        src("published.py", "data/published.yaml"),
+        src("core/published.py", "data/published.yaml"),
         kernels=kernels("approach"),
     output:
         f"{A_WORK}/crlb.pkl",
@@ -124,7 +124,7 @@ rule approach_tables:
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
         stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
-        code=src("approach/report.py", "approach/setup.py", "tables.py", "published.py", "data/published.yaml"),
+        code=src("approach/report.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
         x1=report_table(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),
@@ -151,7 +151,7 @@ rule approach_figures:
     job's Python, matplotlib and pickles (about 0.65 CPU-s a job, measured)."""
     input:
         **{f"mc_{v}": a_headline_mc_of(v) for v in A_VARIANTS},
-        code=src("approach/plots.py", "figures.py", "opnav.mplstyle", "data/published.yaml"),
+        code=src("approach/plots.py", "core/figures.py", "opnav.mplstyle", "data/published.yaml"),
     output:
         **{f"{key}_{v}": report_figure(f"{APPROACH}/{fid}_{name}_{v}", fid, "Paper A", v)
            for v in A_VARIANTS for key, (fid, name) in A_FIGURES.items()},
@@ -171,7 +171,7 @@ rule approach_x1_figure:
         crlb=f"{A_WORK}/crlb.pkl",
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         x1=f"{APPROACH}/A-X1_crlb.csv",
-        code=src("approach/plots.py", "figures.py", "opnav.mplstyle"),
+        code=src("approach/plots.py", "core/figures.py", "opnav.mplstyle"),
     output:
         fig=report_figure(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),
     params:

@@ -4,7 +4,7 @@
 # defined and one line says so; everything else still runs.
 import importlib.util
 
-A_P1_VARIANTS = config["approach"]["peers"]["variants"]  # inside table1_variants (opnav.checks)
+A_P1_VARIANTS = config["approach"]["peers"]["variants"]  # inside table1_variants (opnav.core.checks)
 # found without importing it (parse time); a None in sys.modules marks it absent, as for import
 HAVE_BSK = sys.modules.get("Basilisk", True) is not None and importlib.util.find_spec("Basilisk") is not None
 
@@ -38,7 +38,7 @@ if HAVE_BSK:
             peer=expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
             mc=[A_MC[(v, a_groups(v)[0], m)] for v in A_P1_VARIANTS for m in A_METHODS],
             x2=[A_X2[v] for v in A_P1_VARIANTS],
-            code=src("approach/peers.py", "approach/report.py", "tables.py"),
+            code=src("approach/peers.py", "approach/report.py", "core/tables.py"),
         output:
             table=report_table(f"{APPROACH}/A-P1_peer_ukf", "A-P1", "Paper A"),
             long=f"{A_WORK}/peers/A-P1_seeds.csv",
@@ -54,7 +54,7 @@ if HAVE_BSK:
         input:
             peer=expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
             table=f"{APPROACH}/A-P1_peer_ukf.csv",
-            code=src("approach/peer_plots.py", "figures.py", "opnav.mplstyle"),
+            code=src("approach/peer_plots.py", "core/figures.py", "opnav.mplstyle"),
         output:
             fig=report_figure(f"{APPROACH}/A-P1_peer_ukf", "A-P1", "Paper A"),
         log:

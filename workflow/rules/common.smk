@@ -1,14 +1,14 @@
 # Shared helpers: config validation, output paths, and the final outputs (final_outputs).
-from opnav.compiled import KERNEL_MODULES, kernel_sources  # noqa: E402
-from opnav.config import ConfigError, validate_config  # noqa: E402
-from opnav.snakeio import compact_params_change_reasons  # noqa: E402
+from opnav.core.compiled import KERNEL_MODULES, kernel_sources  # noqa: E402
+from opnav.core.config import ConfigError, validate_config  # noqa: E402
+from opnav.core.snakeio import compact_params_change_reasons  # noqa: E402
 
 # "Params have changed" reasons name the changed keys, not whole config sections.
 compact_params_change_reasons()
 
 # Every config problem before any job, in one pass, one line each naming the key (and
 # the study or scenario): the schema (defaults filled in place, finite numbers, strict
-# integers), the cross-key physics checks of opnav.checks (camera scenarios, growing
+# integers), the cross-key physics checks of opnav.core.checks (camera scenarios, growing
 # windows, headline scenario, results_dir), every parameter study's values, and the
 # job-graph bounds (limits), before the DAG is built: the same function the `opnav`
 # CLI uses. config_exit (Snakefile) is the one way out for them.
@@ -39,20 +39,20 @@ def res(*parts):
     return str(Path(RESULTS, *parts))
 
 
-# Compiled kernels (kernels.smk): the registered modules (opnav.compiled.KERNEL_MODULES,
+# Compiled kernels (kernels.smk): the registered modules (opnav.core.compiled.KERNEL_MODULES,
 # read without importing numba) that each paper's jobs run.
 KERNEL_PAPERS = ("approach", "landing")
 
 
 def kernel_modules(paper):
     """The registered kernel modules the jobs of ``paper`` (KERNEL_PAPERS) run: those of
-    its package and the shared ones (opnav.rotations, ...)."""
+    its package and the shared ones (opnav.core.rotations, ...)."""
     other = set(KERNEL_PAPERS) - {paper}
     return [m for m in KERNEL_MODULES if not set(m.split(".")[1:2]) & other]
 
 
 def kernel_src(paper):
-    """opnav/compiled.py and the source files of kernel_modules(paper)."""
+    """opnav/core/compiled.py and the source files of kernel_modules(paper)."""
     return [str(p) for p in kernel_sources(tuple(kernel_modules(paper)))]
 
 

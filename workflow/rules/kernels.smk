@@ -1,7 +1,7 @@
-# Compiled kernels (opnav.compiled): numba's on-disk cache is filled by one job per
+# Compiled kernels (opnav.core.compiled): numba's on-disk cache is filled by one job per
 # paper (KERNEL_PAPERS: its kernel modules and the shared ones; the two run side by side)
 # before any job that calls them, so the other jobs only load it (none compiles).
-# Its inputs are the kernel modules' sources (opnav.compiled.kernel_sources, read at
+# Its inputs are the kernel modules' sources (opnav.core.compiled.kernel_sources, read at
 # parse time without importing numba): editing one reruns the job, which recompiles
 # (cache entries are keyed by the whole kernel set). The jobs that call kernels take its
 # output as `kernels=kernels(paper)`: it orders them after this job; their own src()
@@ -9,7 +9,7 @@
 
 
 rule compile_kernels:
-    """Compiles a paper's registered kernels once (opnav.compiled.warm) into numba's
+    """Compiles a paper's registered kernels once (opnav.core.compiled.warm) into numba's
     on-disk cache; the log gives each module's compile (or, cache filled, load) seconds;
     the output (no timings) names the kernel set."""
     input:

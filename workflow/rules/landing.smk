@@ -6,7 +6,7 @@ LANDING = res("landing")
 rule landing_tables:
     """B-T1 and B-T2, rendered from the config."""
     input:
-        src("landing/scenario.py", "landing/trajectory.py", "tables.py", "published.py",
+        src("landing/scenario.py", "landing/trajectory.py", "core/tables.py", "core/published.py",
             "data/published.yaml"),
     output:
         t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
@@ -38,7 +38,7 @@ try:
     B_SCENARIO_CFG = camera_scenarios(config["landing"])
     B_HEADLINE = headline_scenario(config["landing"])
 except ValueError as exc:
-    config_exit(exc)  # checked before (opnav.checks): the one way out, should it happen
+    config_exit(exc)  # checked before (opnav.core.checks): the one way out, should it happen
 # Camera scenarios (landing.scenarios): each flies its own Monte Carlo under
 # results/landing/mc/{bscn}/ and gets its own B-F5, B-F6, B-F7, B-T3, B-X1 (file
 # stems end in _{bscn}, as paper A's variants); B-summary.json gathers them all,
@@ -65,7 +65,7 @@ B_SRC = with_kernels("landing", src(
     "landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
     "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
     "landing/planner.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
-    "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "rotations.py"))
+    "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "core/rotations.py"))
 B_SCN_RE = "|".join(B_SCENARIOS)
 
 
@@ -127,7 +127,7 @@ rule landing_mc_gather:
 rule landing_true_states:
     """B-F4: the truth trajectory (the same in every camera scenario)."""
     input:
-        src("landing/trajectory.py", "landing/plots.py", "figures.py", "opnav.mplstyle"),
+        src("landing/trajectory.py", "landing/plots.py", "core/figures.py", "opnav.mplstyle"),
     output:
         f4=report_figure(f"{LANDING}/B-F4_true_states", "B-F4", "Paper B"),
     params:
@@ -144,7 +144,7 @@ rule landing_single:
     """The single descent of one scenario and B-F5 (depth-error maps)."""
     input:
         B_SRC,
-        src("landing/plots.py", "figures.py", "opnav.mplstyle"),
+        src("landing/plots.py", "core/figures.py", "opnav.mplstyle"),
         kernels=kernels("landing"),
     output:
         summary=f"{LANDING}/single/summary_{{bscn}}.json",
@@ -196,7 +196,7 @@ rule landing_summary:
         code=with_kernels("landing", src(
             "landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
             "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
-            "tables.py", "figures.py", "opnav.mplstyle", "published.py", "data/published.yaml")),
+            "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),
         kernels=kernels("landing"),
     output:
         t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),

@@ -3,7 +3,8 @@
 import os
 import shutil
 
-from opnav import manuscript, provenance
+from opnav.report import manuscript
+from opnav.core import provenance
 
 PAPER = res("paper")
 PAPER_DIR = Path(workflow.basedir) / "paper"
@@ -34,14 +35,14 @@ SCORE_INPUTS = {
 
 
 rule paper_claims:
-    """The claims table (one row per published claim, opnav.claims) and the generated
+    """The claims table (one row per published claim, opnav.report.claims) and the generated
     abstract, conclusion and limitations (claims.json)."""
     input:
         **{f"summary_{k}": p for k, p in SUMMARIES.items() if k in ("A", "B")},
         **{k: p for k, p in SCORE_INPUTS.items() if k == "a_table1"},
         published=src("data/published.yaml"),
-        code=src("claims.py", "approach/claims.py", "landing/claims.py", "verdicts.py", "manuscript.py",
-                 "published.py"),
+        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "core/verdicts.py", "report/manuscript.py",
+                 "core/published.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
         md=f"{PAPER}/claims.md",
@@ -61,7 +62,7 @@ PDF_FLOATS = {part: [p for p in _floats(part) if manuscript.in_pdf(p, PDF_DROP)]
 
 
 rule paper_floats:
-    """Figure and table floats for the manuscript (headline variants only, opnav.manuscript.in_pdf),
+    """Figure and table floats for the manuscript (headline variants only, opnav.report.manuscript.in_pdf),
     captions from workflow/report/; paper A's Table 1 as one grouped table."""
     input:
         approach=PDF_FLOATS["approach"],
@@ -70,7 +71,7 @@ rule paper_floats:
         tables_csv=[c for c in (t[:-4] + ".csv" for t in PDF_FLOATS["approach"] + PDF_FLOATS["landing"]) if c in _targets],
         captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
         study_captions=[t for ts in STUDY_TARGETS.values() for t in ts if t.endswith(".rst")],
-        code=src("manuscript.py", "approach/report.py", "landing/report.py", "tables.py"),
+        code=src("report/manuscript.py", "approach/report.py", "landing/report.py", "core/tables.py"),
     output:
         approach=f"{PAPER}/floats_approach.tex",
         landing=f"{PAPER}/floats_landing.tex",
@@ -87,12 +88,12 @@ rule paper_floats:
 
 
 rule paper_scorecard:
-    """Every published number beside ours, with a verdict (opnav.scorecard)."""
+    """Every published number beside ours, with a verdict (opnav.report.scorecard)."""
     input:
         **SCORE_INPUTS,
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         published=src("data/published.yaml"),
-        code=src("scorecard.py", "verdicts.py", "approach/report.py", "landing/report.py", "published.py"),
+        code=src("report/scorecard.py", "core/verdicts.py", "approach/report.py", "landing/report.py", "core/published.py"),
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
         longtable=f"{PAPER}/scorecard_longtable.tex",
@@ -113,7 +114,7 @@ rule paper_macros:
         scorecard=rules.paper_scorecard.output.json,
         claims=rules.paper_claims.output.json,
         published=src("data/published.yaml"),
-        code=src("manuscript.py", "published.py"),
+        code=src("report/manuscript.py", "core/published.py"),
     output:
         f"{PAPER}/macros.tex",
     params:
@@ -129,10 +130,10 @@ rule paper_macros:
 
 
 rule provenance:
-    """Python, package versions and git commit of this run (opnav.provenance);
+    """Python, package versions and git commit of this run (opnav.core.provenance);
     collected when the workflow is parsed, so a new commit or upgrade reruns it."""
     input:
-        code=src("provenance.py"),
+        code=src("core/provenance.py"),
     output:
         csv=report(res("provenance.csv"), caption=_caption("provenance"), category="Provenance",
                    subcategory="environment"),

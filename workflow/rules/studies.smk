@@ -7,7 +7,7 @@
 # simulations are flown once, and editing one study's values queues only the new
 # values' jobs. Outputs: results/studies/<name>/.
 from opnav import studies as _studies
-from opnav.config import validate_study_value
+from opnav.core.config import validate_study_value
 
 STUDIES_DIR = res("studies")
 STUDY_SHAPES = {
@@ -72,7 +72,7 @@ for _name, _s in STUDIES.items():
             f"study_{_name}_outputs"
         input:
             runs=[f for f, _ in _files],
-            code=src("studies.py", "landing/study.py", "tables.py", "study_plots.py", "figures.py",
+            code=src("studies.py", "landing/study.py", "core/tables.py", "report/study_plots.py", "core/figures.py",
                      "opnav.mplstyle"),
         output:
             table=[report(f"{_stem}.csv", caption=_caption("study"), category="Studies",

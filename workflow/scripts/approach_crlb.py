@@ -4,12 +4,12 @@ the roll variant's bound against the roll rate (pipeline.roll_rate_study)."""
 import sys
 from pathlib import Path
 
-from opnav import published
+from opnav.core import published
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
 from opnav.approach.pipeline import bound_curve, roll_rate_study
 from opnav.approach.setup import Setup
-from opnav.snakeio import mock_snakemake, save_pickle, script_context
+from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_crlb", argv=sys.argv[1:])

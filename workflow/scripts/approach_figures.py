@@ -3,9 +3,9 @@
 
 import sys
 
-from opnav import figures, published
+from opnav.core import figures, published
 from opnav.approach import plots
-from opnav.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_figures", argv=sys.argv[1:])

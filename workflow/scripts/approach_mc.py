@@ -5,7 +5,7 @@ from pathlib import Path
 
 from opnav.approach.pipeline import run_group
 from opnav.approach.setup import Setup
-from opnav.snakeio import mock_snakemake, save_pickle, script_context
+from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_mc", argv=sys.argv[1:], variant="literal", group="size")

@@ -4,9 +4,9 @@ import sys
 
 import pandas as pd
 
-from opnav import figures
+from opnav.core import figures
 from opnav.approach import peer_plots
-from opnav.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_peer_figure", argv=sys.argv[1:])

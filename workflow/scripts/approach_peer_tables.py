@@ -3,8 +3,8 @@
 import sys
 
 from opnav.approach import peers
-from opnav.snakeio import load_pickle, mock_snakemake, script_context
-from opnav.tables import write_json, write_table
+from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.tables import write_json, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_peer_tables", argv=sys.argv[1:])

@@ -5,7 +5,7 @@ from pathlib import Path
 
 from opnav.approach.peers import run_variant
 from opnav.approach.setup import Setup
-from opnav.snakeio import mock_snakemake, save_pickle, script_context
+from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_peer_ukf", argv=sys.argv[1:])

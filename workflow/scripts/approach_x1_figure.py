@@ -4,10 +4,10 @@ import sys
 
 import pandas as pd
 
-from opnav import figures
+from opnav.core import figures
 from opnav.approach import plots
 from opnav.approach.setup import Setup
-from opnav.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x1_figure", argv=sys.argv[1:])

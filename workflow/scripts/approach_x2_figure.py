@@ -4,10 +4,10 @@ import sys
 
 import pandas as pd
 
-from opnav import figures
+from opnav.core import figures
 from opnav.approach import plots
 from opnav.approach.report import METHOD_LABELS
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x2_figure", argv=sys.argv[1:])

@@ -7,7 +7,7 @@ from opnav.approach import alternatives as alt
 from opnav.approach import scenario as sc
 from opnav.approach.pipeline import cases_in
 from opnav.approach.setup import Setup
-from opnav.snakeio import mock_snakemake, save_pickle, script_context
+from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x2_group", argv=sys.argv[1:], variant="roll", group="size")

@@ -4,8 +4,8 @@ import sys
 
 from opnav.approach import report
 from opnav.approach.setup import Setup
-from opnav.snakeio import load_pickle, mock_snakemake, script_context
-from opnav.tables import write_json, write_table
+from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.tables import write_json, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x2_tables", argv=sys.argv[1:])

@@ -1,12 +1,12 @@
-"""Fills numba's on-disk cache with a paper's kernels (rule compile_kernels, opnav.compiled)."""
+"""Fills numba's on-disk cache with a paper's kernels (rule compile_kernels, opnav.core.compiled)."""
 
 import sys
 
 import numba
 
-from opnav import compiled
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_json
+from opnav.core import compiled
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_json
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("compile_kernels", argv=sys.argv[1:], kpaper="landing")

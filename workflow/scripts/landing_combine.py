@@ -6,8 +6,8 @@ import json
 import sys
 
 from opnav.landing.report import combine_scenarios
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_json
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_json
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_summary_all", argv=sys.argv[1:])

@@ -5,7 +5,7 @@ import sys
 from pathlib import Path
 
 from opnav.landing.montecarlo import run_chunk_reusing, save
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 from opnav.studies import config_digest
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)

@@ -3,7 +3,7 @@
 import sys
 
 from opnav.landing.montecarlo import gather, load, save
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_mc_gather", argv=sys.argv[1:], bscn="site-tilt", bmethod="depth")

@@ -4,12 +4,12 @@ B-F5 (depth-error maps: detected landmarks, whole field, in-plane curve)."""
 import json
 import sys
 
-from opnav import figures
+from opnav.core import figures
 from opnav.landing import plots
 from opnav.landing.depth_map import depth_map
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_single", argv=sys.argv[1:], bscn="site-tilt")

@@ -8,12 +8,12 @@ import sys
 
 import pandas as pd
 
-from opnav import figures, published
+from opnav.core import figures, published
 from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
 from opnav.landing.report import accuracy_tests, scenario_summary, summary_table
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_json, write_table
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_json, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_summary", argv=sys.argv[1:], bscn="site-tilt")

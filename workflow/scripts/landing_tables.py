@@ -3,8 +3,8 @@
 import sys
 
 from opnav.landing.scenario import error_bounds_table, initial_state_table
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_table
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_tables", argv=sys.argv[1:])

@@ -5,7 +5,7 @@ import sys
 from opnav.landing import timing
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import load
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_timing", argv=sys.argv[1:], bscn="site-tilt")

@@ -4,10 +4,10 @@ import sys
 
 import numpy as np
 
-from opnav import figures
+from opnav.core import figures
 from opnav.landing import plots
 from opnav.landing.trajectory import euler_rpy_deg, truth_states
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_true_states", argv=sys.argv[1:])

@@ -5,8 +5,8 @@ against the configured landing.filter."""
 import sys
 
 from opnav.landing.tuning import tuning_report
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_json
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_json
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_tuning", argv=sys.argv[1:])

@@ -5,12 +5,12 @@ the reference (depth), and B-X1-summary.json for the manuscript macros."""
 import json
 import sys
 
-from opnav import figures
+from opnav.core import figures
 from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
 from opnav.landing.ranking import headline, ranking_table
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import write_table
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_x1_summary", argv=sys.argv[1:], bscn="site-tilt")

@@ -1,5 +1,5 @@
 """results/paper/claims.csv: one row per published claim of each paper, with its verdict
-(opnav.claims); claims.json holds the counts and the generated abstract, conclusion and
+(opnav.report.claims); claims.json holds the counts and the generated abstract, conclusion and
 limitations for the manuscript's macros."""
 
 import json
@@ -7,12 +7,13 @@ import sys
 
 import pandas as pd
 
-from opnav import claims, published
-from opnav.approach.claims import HEADLINE_IDS as A_HEAD, claim_rows as rows_a
-from opnav.landing.claims import HEADLINE_IDS as B_HEAD, claim_rows as rows_b
-from opnav.manuscript import claims_detail_latex, claims_glance_latex
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import atomic_write_text, write_table
+from opnav.report import claims
+from opnav.core import published
+from opnav.report.approach_claims import HEADLINE_IDS as A_HEAD, claim_rows as rows_a
+from opnav.report.landing_claims import HEADLINE_IDS as B_HEAD, claim_rows as rows_b
+from opnav.report.manuscript import claims_detail_latex, claims_glance_latex
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_claims", argv=sys.argv[1:])

@@ -1,6 +1,6 @@
 """Figure/table floats for the manuscript, one file per paper.
 
-Tables too wide for a page (ids in opnav.manuscript.COMPACT_VIEWS) are shown
+Tables too wide for a page (ids in opnav.report.manuscript.COMPACT_VIEWS) are shown
 through a compact view computed from their CSV, written under compact/.
 """
 
@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from opnav.manuscript import COMPACT_VIEWS, float_block, output_id, table1_grouped_latex
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import atomic_write_text, write_table
+from opnav.report.manuscript import COMPACT_VIEWS, float_block, output_id, table1_grouped_latex
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_floats", argv=sys.argv[1:])

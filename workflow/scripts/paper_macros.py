@@ -3,10 +3,10 @@
 import json
 import sys
 
-from opnav import published
-from opnav.manuscript import format_sci, macros_from_summary, prose_tex, render_macros
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import atomic_write_text
+from opnav.core import published
+from opnav.report.manuscript import format_sci, macros_from_summary, prose_tex, render_macros
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import atomic_write_text
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_macros", argv=sys.argv[1:])

@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from opnav.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_pdf", argv=sys.argv[1:])

@@ -5,11 +5,12 @@ import sys
 
 import pandas as pd
 
-from opnav import published, scorecard
+from opnav.core import published
+from opnav.report import scorecard
 from opnav.approach.report import rows_paper_a
 from opnav.landing.report import rows_paper_b
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import atomic_write_text, write_table
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_scorecard", argv=sys.argv[1:])

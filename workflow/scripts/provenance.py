@@ -1,13 +1,13 @@
 """results/provenance.{csv,md,json} and results/paper/provenance.tex: the
-Python, package versions and git commit of this run (opnav.provenance)."""
+Python, package versions and git commit of this run (opnav.core.provenance)."""
 
 import sys
 
 import pandas as pd
 
-from opnav import provenance
-from opnav.snakeio import mock_snakemake, script_context
-from opnav.tables import atomic_write_text, write_json, write_table
+from opnav.core import provenance
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import atomic_write_text, write_json, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("provenance", argv=sys.argv[1:])

@@ -7,10 +7,11 @@ import sys
 
 import pandas as pd
 
-from opnav import figures, studies
-from opnav.snakeio import load_csv, mock_snakemake, script_context
-from opnav.study_plots import fig_study
-from opnav.tables import atomic_write_text, write_table
+from opnav.core import figures
+from opnav import studies
+from opnav.core.snakeio import load_csv, mock_snakemake, script_context
+from opnav.report.study_plots import fig_study
+from opnav.core.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("study_fov_outputs", argv=sys.argv[1:])

@@ -6,7 +6,7 @@ import sys
 
 import pandas as pd
 
-from opnav.snakeio import mock_snakemake, save_csv, script_context
+from opnav.core.snakeio import mock_snakemake, save_csv, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("study_runs", argv=sys.argv[1:])

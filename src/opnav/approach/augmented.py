@@ -48,9 +48,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.rotations import skew
+from opnav.core.rotations import skew
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 
 from .dynamics import ARCSEC
 from . import kalman

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from opnav.rotations import skew
+from opnav.core.rotations import skew
 
 from .dynamics import ARCSEC, R_MARS_KM
 

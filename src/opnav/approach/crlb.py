@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from opnav.rotations import skew
+from opnav.core.rotations import skew
 
 from . import kalman
 from .augmented import augmented_jacobian, augmented_noise

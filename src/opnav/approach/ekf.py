@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 
 from . import kalman
 from .camera import misalignment_small

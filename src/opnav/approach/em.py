@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 
 from .camera import misalignment_small
 from .ekf import Window, ekf_step

@@ -30,7 +30,7 @@ Description
 
 Implementation
     Each step is written once, for one batch member, as plain loops compiled with
-    :func:`opnav.compiled.kernel` (``_predict_mean1``, ``_predict_cov1``, ``_condition1``, ``_loglik1``); the
+    :func:`opnav.core.compiled.kernel` (``_predict_mean1``, ``_predict_cov1``, ``_condition1``, ``_loglik1``); the
     batched Python API (:func:`predict`, :func:`condition_on`, :func:`propagate`,
     :func:`innovation_loglik`) loops them over the members, and
     :func:`opnav.approach.ekf.filter_window` runs the EM-EKF's whole window for every seed
@@ -57,7 +57,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 
 LOG2PI = np.log(2.0 * np.pi)
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from opnav import figures
+from opnav.core import figures
 
 RCOLORS = {"headline": "k", "bias_free": "#CC79A7", "truth_start": "0.55"}
 

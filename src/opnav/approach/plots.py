@@ -1,6 +1,6 @@
 """Figures of paper A (A-F4, A-F5, A-F6, A-X1). Plotting only; numbers come from the runs.
 
-Every figure uses the shared style (:func:`opnav.figures.style`) and draws
+Every figure uses the shared style (:func:`opnav.core.figures.style`) and draws
 the paper's numbers with ``figures.PUBLISHED_STYLE``, labelled "published".
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from opnav import figures
+from opnav.core import figures
 
 
 

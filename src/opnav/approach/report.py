@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from opnav.tables import cell_num, cell_pm
-from opnav.verdicts import NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED
+from opnav.core.tables import cell_num, cell_pm
+from opnav.core.verdicts import NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED
 
 from . import cases
 from . import scenario as sc
@@ -741,8 +741,8 @@ def summary_json(long: pd.DataFrame, table: pd.DataFrame, setup: Setup | dict) -
 
 
 # ------------------------------------------------------------ manuscript and scorecard
-# (the page views of paper A's wide tables, opnav.manuscript.COMPACT_VIEWS; paper A's
-# scorecard rows, scored by opnav.scorecard)
+# (the page views of paper A's wide tables, opnav.report.manuscript.COMPACT_VIEWS; paper A's
+# scorecard rows, scored by opnav.report.scorecard)
 def _label_or(r, text: str) -> str:
     """``text`` (the data to converge) for a converged row, else its label with the seed count."""
     lab = r.get("label")

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 
 from .ekf import FilterResult, Window
 from .kalman import carray

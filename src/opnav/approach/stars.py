@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.rotations import skew
+from opnav.core.rotations import skew
 
 from .camera import misalignment_exact, rot_x
 from .dynamics import ARCSEC

@@ -16,7 +16,7 @@ eq.        function                                                    units
            (IMU model; planet rotation neglected, assumption 1)
 3-5        ``ekf.NavState`` (state r, v, R_LtoB, p), error state          m, m/s, rad, m
            [dr, dv, dtheta, dp] with ``R_true = Exp(-dtheta) R_est``
-           (``measurement`` docstring; ``opnav.rotations.exp_so3``)
+           (``measurement`` docstring; ``opnav.core.rotations.exp_so3``)
 6-10       ``ekf.transition_matrix`` (Phi, eq. 8-10),                     Phi: m, s, dimensionless blocks
            ``ekf.propagate``, ``ekf.process_noise``
 11-12      ``measurement.bearing`` (unit line of sight in {B})            dimensionless

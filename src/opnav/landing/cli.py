@@ -22,8 +22,8 @@ def _run(args) -> int:
 
     config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
     # the planner's registry and the seed's limits are checked as the config's
-    # landing.single.method / run_index (opnav.checks), naming the flag
-    from opnav.config import ConfigError
+    # landing.single.method / run_index (opnav.core.checks), naming the flag
+    from opnav.core.config import ConfigError
     from opnav.landing.scenario import camera_scenarios, headline_scenario
 
     landing = with_flags(config, {"landing.single.method": ("--method", args.method),

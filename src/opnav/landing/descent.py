@@ -87,9 +87,9 @@ from opnav.landing.planner import PlanState, plan_batch
 from opnav.landing.records import append_call, new_calls, record_plan_inputs, stack_calls
 from opnav.landing.scenario import Scenario, build_scenario
 from opnav.landing.trajectory import euler_rpy_deg
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 from opnav.landing.ekf import _cho_solve, _cholesky
-from opnav.rotations import exp_so3, log_so3_into
+from opnav.core.rotations import exp_so3, log_so3_into
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
            "tracking_step", "vision_cutoff_altitude"]

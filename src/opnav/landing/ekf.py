@@ -35,12 +35,12 @@ flies the runs of a chunk as one batch (``opnav.landing.descent``); a single
 run is the batch of shape ().
 
 Compiled: each step is written once as plain loops over one run's 3-vectors
-and 12 x 12 matrices (``opnav.compiled.kernel``: ``_transition`` eq. 6-10,
+and 12 x 12 matrices (``opnav.core.compiled.kernel``: ``_transition`` eq. 6-10,
 ``_oc``, ``_propagate``, ``_linearise``/``_update`` eq. 11-18, ``_init``,
 ``_inject``, ``_nullspace``), and a ``*_batch`` kernel loops over the runs; the
 Python functions below flatten the leading dimensions and call them. The
 bearing and its Jacobian blocks are the kernels of ``opnav.landing.measurement``,
-Exp is ``opnav.rotations.exp_so3_into``. The pre-kernel numpy EKF
+Exp is ``opnav.core.rotations.exp_so3_into``. The pre-kernel numpy EKF
 (tests/descent_reference.py) is the reference the tests compare against.
 Measured per run and filter step (3 update iterations, site + landmark; one
 loaded 2-core machine): update 1090 -> 145 us in a batch of 4 runs, 55 -> 16 us
@@ -50,7 +50,7 @@ Update: the stacked unit bearings of the known landmark and the unknown one
 (eq. 11-18: ``measurement.line_of_sight`` and ``measurement.blocks``, their
 one home), isotropic noise ``sigma_b`` rad per component, gain by a Cholesky
 solve, Joseph form. The attitude correction ``Exp`` is
-``opnav.rotations.exp_so3_into``.
+``opnav.core.rotations.exp_so3_into``.
 
 Landmark initialisation (Fig. 3 strategy): from its first bearing ``b`` and a
 depth guess ``d`` (the estimated line of sight cut with the ground plane),
@@ -66,9 +66,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 from opnav.landing.measurement import blocks, line_of_sight
-from opnav.rotations import exp_so3_into
+from opnav.core.rotations import exp_so3_into
 
 __all__ = ["NavState", "transition_matrix", "oc_transition", "process_noise", "propagate",
            "update", "linearise", "init_landmark", "inject", "nullspace", "init_jacobian", "Bearing"]

@@ -27,7 +27,7 @@ Pre-integration (:func:`preintegrate`) groups the samples of each filter
 interval ``Delta t = n_sub dt`` and returns the rotation, velocity and position
 increments in the body frame at the start of the interval; the filter's
 closed-form propagation (``opnav.landing.ekf.propagate``) applies them. It is
-a compiled kernel (``opnav.compiled``), a loop over intervals and samples.
+a compiled kernel (``opnav.core.compiled``), a loop over intervals and samples.
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
-from opnav.rotations import exp_so3, exp_so3_into, log_so3
+from opnav.core.compiled import kernel, warms
+from opnav.core.rotations import exp_so3, exp_so3_into, log_so3
 
 __all__ = ["synthesize", "add_noise", "Preintegrated", "preintegrate", "dead_reckon"]
 

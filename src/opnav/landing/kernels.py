@@ -3,7 +3,7 @@
 Description
 -----------
 One planning call (SPEC B.3, paper B sec. 2.2), each step a kernel
-(``opnav.compiled.kernel``: numba, on-disk cache, no fastmath), each equation
+(``opnav.core.compiled.kernel``: numba, on-disk cache, no fastmath), each equation
 once: the plane holding the velocity (:func:`plane`), eq. 19 (:func:`baseline`),
 eq. 21-22 (:func:`error_radius`), eq. 23-25 (:func:`depth_error`), eq. 26
 (:func:`plane_depth`, :func:`ground_point`), the closed form of the paper's H
@@ -34,7 +34,7 @@ import types
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 from opnav.landing import ekf
 from opnav.landing import measurement as me
 

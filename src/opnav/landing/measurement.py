@@ -20,7 +20,7 @@ rotation applied on the body side::
 
     R_LtoB_true = Exp(-dtheta) @ R_LtoB_est  ~=  (I - [dtheta x]) @ R_LtoB_est
 
-where ``Exp(phi) = opnav.rotations.exp_so3(phi)`` (= ``Rotation.from_rotvec(phi).as_matrix()``)
+where ``Exp(phi) = opnav.core.rotations.exp_so3(phi)`` (= ``Rotation.from_rotvec(phi).as_matrix()``)
 and ``[a x]`` is the cross-product matrix. Equivalently
 ``R_BtoL_true = R_BtoL_est @ Exp(dtheta)``. This is the paper's
 ``dq = q (x) q_hat^-1 ~= [dtheta/2, 1]`` with JPL quaternions, and it is the
@@ -55,7 +55,7 @@ basis orthogonal to ``b`` (``t1, t2`` orthogonal to ``u`` in {L}); then
 (``t_B = R_LtoB t``).
 
 ONE home: eq. 12 and 15-18 are written once, as compiled kernels over one
-landmark (``opnav.compiled.kernel``): :func:`line_of_sight` (u, 1/|rho|),
+landmark (``opnav.core.compiled.kernel``): :func:`line_of_sight` (u, 1/|rho|),
 :func:`blocks` (b and H_C) and :func:`tangent_rows` (the tangent-plane rows).
 The filter's kernels (``opnav.landing.ekf``) and the planner's call them
 directly; the Python functions below run them over arbitrary leading dimensions
@@ -75,8 +75,8 @@ import math
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
-from opnav.rotations import skew
+from opnav.core.compiled import kernel, warms
+from opnav.core.rotations import skew
 
 __all__ = ["line_of_sight", "blocks", "tangent_rows", "bearing", "bearing_jacobian", "jacobian_blocks", "selection_jacobian",
            "tangent_basis", "tangent_jacobian", "tangent_jacobian_scalar", "BehindCameraError",

@@ -1,8 +1,8 @@
 """Figures of paper B (B-F4 to B-F7), drawn from computed results only.
 
 Every function takes arrays computed elsewhere, draws under the shared style
-(``opnav.figures.style``) and returns the figure; the workflow scripts save it
-with ``opnav.figures.save``. Units are on every axis.
+(``opnav.core.figures.style``) and returns the figure; the workflow scripts save it
+with ``opnav.core.figures.save``. Units are on every axis.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from opnav import figures
+from opnav.core import figures
 
 __all__ = ["fig_true_states", "fig_depth_error_map", "fig_nav_error_envelopes",
            "fig_planning_time"]

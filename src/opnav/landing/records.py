@@ -21,7 +21,7 @@ record: it is measured by replaying these inputs (``opnav.landing.timing``).
 
 Files: :func:`save` / :func:`load` write and read a dict of arrays (``.npz``,
 atomically; a truncated or corrupt file raises
-``opnav.snakeio.CorruptIntermediate`` naming it and its rebuild command), for
+``opnav.core.snakeio.CorruptIntermediate`` naming it and its rebuild command), for
 the Monte-Carlo chunks and the timing replay alike.
 """
 
@@ -105,7 +105,7 @@ def stack_calls(rec: dict) -> dict:
 
 def save(path, data: dict) -> None:
     """Write a dict of arrays (``.npz``, compressed, atomically)."""
-    from opnav.tables import atomic_target
+    from opnav.core.tables import atomic_target
 
     with atomic_target(path) as tmp:
         np.savez_compressed(tmp, **data)
@@ -113,10 +113,10 @@ def save(path, data: dict) -> None:
 
 def load(path) -> dict:
     """Read a :func:`save` file; a truncated or corrupt one raises
-    :class:`opnav.snakeio.CorruptIntermediate` naming it and its rebuild command."""
+    :class:`opnav.core.snakeio.CorruptIntermediate` naming it and its rebuild command."""
     import zipfile
 
-    from opnav.snakeio import corrupt_intermediate
+    from opnav.core.snakeio import corrupt_intermediate
 
     try:
         with np.load(path, allow_pickle=False) as z:

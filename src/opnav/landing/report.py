@@ -5,10 +5,10 @@ manuscript and the scorecard.
 one camera scenario); :func:`scenario_summary` is that scenario's summary JSON
 (the headline numbers the manuscript and the scorecard read).
 :data:`COMPACT_VIEWS` are the page views of B-T3 and B-X1 (tables too wide for a
-page; :mod:`opnav.manuscript` gathers both papers'); :func:`rows_paper_b` are paper
+page; :mod:`opnav.report.manuscript` gathers both papers'); :func:`rows_paper_b` are paper
 B's scorecard rows (timing claim, the "almost the same accuracy" claim read as an
 equivalence test that must be able to fail, the yaw claim, the initial attitude),
-scored by :mod:`opnav.scorecard` with the rule of :mod:`opnav.verdicts`.
+scored by :mod:`opnav.report.scorecard` with the rule of :mod:`opnav.core.verdicts`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from opnav.tables import cell_num, cell_pm
-from opnav.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
+from opnav.core.tables import cell_num, cell_pm
+from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
 
 # pandas is imported by the functions that build frames: the jobs that only combine the
 # scenarios' summaries (combine_scenarios) do without its ~0.13 s of import

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from opnav import published
+from opnav.core import published
 from opnav.landing.trajectory import Truth, truth_states
 
 if TYPE_CHECKING:  # pandas only for the B-T1/B-T2 tables: not imported by every Monte-Carlo job

@@ -18,7 +18,7 @@ from typing import Any
 import yaml
 
 
-from opnav.errors import ConfigError  # noqa: E402  (defined in the base layer; its home for users)
+from opnav.core.errors import ConfigError  # noqa: E402  (defined in the base layer; its home for users)
 
 __all__ = ["ConfigError", "validate_config", "load_config", "read_config_file", "validate_study_value"]
 
@@ -49,13 +49,13 @@ def describe_validation_error(exc: BaseException) -> str:
 
 
 #: The project schema, shipped as package data.
-SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "config.schema.yaml"
+SCHEMA_PATH = Path(__file__).resolve().parents[1] / "schemas" / "config.schema.yaml"
 
 
 def repo_root(start: Path | None = None) -> Path:
     """The checkout that holds ``config/config.yaml`` (searching upwards from ``start``)."""
     here = (start or Path.cwd()).resolve()
-    for cand in [here, *here.parents, Path(__file__).resolve().parents[2]]:
+    for cand in [here, *here.parents, Path(__file__).resolve().parents[3]]:
         if (cand / "config" / "config.yaml").is_file() and (cand / "Snakefile").is_file():
             return cand
     raise ConfigError(
@@ -84,7 +84,7 @@ def read_yaml(path: str | Path) -> Any:
     """The YAML document in the package file ``path`` (the config schemas), read with
     libyaml's safe loader where available (the pure-Python one is ~10x slower, and every
     workflow parse reads these files). User config files go through :func:`load_config`,
-    whose error messages name the line and column. (``opnav.published``, a lower layer,
+    whose error messages name the line and column. (``opnav.core.published``, a lower layer,
     makes the same loader choice for the published values.)"""
     return yaml.load(Path(path).read_text(), Loader=_YAML_LOADER)
 
@@ -184,7 +184,7 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
     The layers: every number anywhere must be finite (:func:`non_finite_keys`);
     the JSON schema (integer keys take ints only); and, with ``physics``, on each
     section the schema passed, the cross-key checks of
-    :func:`opnav.checks.config_problems` (``results_dir``; durations, rates,
+    :func:`opnav.core.checks.config_problems` (``results_dir``; durations, rates,
     geometry, camera scenarios, method names, ...; the parameter studies, each value
     checked as its own config; the job-graph bounds). ``root`` is the checkout,
     ``workdir`` where a relative ``results_dir`` lands (default ``root``);
@@ -202,7 +202,7 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
             where = f"config key '{key}'" if key else "config (top level)"
             lines.append(f"invalid {where}: {err.message}")
     if physics:
-        from opnav.checks import config_problems
+        from opnav.core.checks import config_problems
 
         broken = {_top(line) for line in lines}
         if "" not in broken:        # a top-level schema error: no section is safe to read

@@ -35,7 +35,7 @@ from typing import Callable
 #: Modules holding kernels, imported by :func:`warm` (each registers its warm-up on import).
 KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
                                     "opnav.approach.em", "opnav.approach.augmented",
-                                    "opnav.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
+                                    "opnav.core.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
                                     "opnav.landing.kernels",
                                     "opnav.landing.descent", "opnav.landing.imu")
 
@@ -46,7 +46,7 @@ _KERNELS: list = []  # every dispatcher made by kernel(), for cache_stats
 def kernel_sources(modules: tuple[str, ...] | None = None) -> list[Path]:
     """This file and the source file of every kernel module (``KERNEL_MODULES``), found
     without importing them (``opnav.x.y`` -> ``<package>/x/y.py``)."""
-    root = Path(__file__).resolve().parent
+    root = Path(__file__).resolve().parents[1]  # the opnav package
     out = [Path(__file__).resolve()]
     for name in KERNEL_MODULES if modules is None else modules:
         parts = name.split(".")

@@ -2,7 +2,7 @@
 
 Inputs: the A-summary.json dict (:func:`opnav.approach.report.summary`), the A-T1 frame
 (:func:`opnav.approach.report.table1_frame`, read from its CSV) and the published values
-(``published.paper_a()``). Output: claims-table rows (:func:`opnav.claims.row`).
+(``published.paper_a()``). Output: claims-table rows (:func:`opnav.report.claims.row`).
 
 Variants (the A-T1 ``variant`` label): ``literal`` is the paper as written (plain EM on
 sliding segments, EM starting from the filter's estimate); every other scenario or scheme
@@ -18,8 +18,8 @@ from typing import Any, Mapping
 
 import pandas as pd
 
-from opnav import claims as C
-from opnav.claims import Outcome, fmt, join
+from opnav.report import claims as C
+from opnav.report.claims import Outcome, fmt, join
 
 AS_WRITTEN = "literal"
 DIAGNOSTIC = "reference-start"
@@ -303,7 +303,7 @@ def _claim_pixels(t1, target: float) -> dict:
 
 # ------------------------------------------------------------ navigation error
 def _claim_nav_before(t1, head_pub) -> dict:
-    from opnav.verdicts import REPRODUCED, judge
+    from opnav.core.verdicts import REPRODUCED, judge
 
     outs = {}
     for v in _variants(t1, full_only=True):

@@ -1,9 +1,9 @@
 """The claims table: one row per distinct published claim of each paper, with a verdict.
 
-The scorecard (:mod:`opnav.scorecard`) sets every published *number* beside ours, cell
+The scorecard (:mod:`opnav.report.scorecard`) sets every published *number* beside ours, cell
 by cell; this module answers the reader's question instead: which of the papers'
 *claims* reproduce. Each paper's rows are computed from its summary files by
-:mod:`opnav.approach.claims` (paper A) and :mod:`opnav.landing.claims` (paper B) and
+:mod:`opnav.report.approach_claims` (paper A) and :mod:`opnav.report.landing_claims` (paper B) and
 assembled here. Columns (:data:`COLUMNS`) and verdicts (:data:`VERDICTS`):
 
 ``reproduced``

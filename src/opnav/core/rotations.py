@@ -49,7 +49,7 @@ import math
 
 import numpy as np
 
-from opnav.compiled import kernel, warms
+from opnav.core.compiled import kernel, warms
 
 __all__ = ["skew", "cross", "exp_so3", "exp_so3_into", "log_so3", "log_so3_into"]
 

@@ -1,5 +1,5 @@
 """The reproduced-vs-published scorecard: every published number of both papers beside
-ours, with the verdict of :mod:`opnav.verdicts` (its module docstring states the rule).
+ours, with the verdict of :mod:`opnav.core.verdicts` (its module docstring states the rule).
 Each paper's rows come from its report module (:func:`opnav.approach.report.rows_paper_a`,
 :func:`opnav.landing.report.rows_paper_b`); here they are scored and laid out.
 """
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from opnav.verdicts import (K_SPREAD, MAX_BAND_REL, NOT_REPRODUCED, NOT_REPRODUCIBLE,  # noqa: F401
+from opnav.core.verdicts import (K_SPREAD, MAX_BAND_REL, NOT_REPRODUCED, NOT_REPRODUCIBLE,  # noqa: F401
                             REL_TOL, REPRODUCED, Verdict, judge, tolerance)
 
 

@@ -16,7 +16,7 @@ import re
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
-from opnav.tables import MISSING, is_missing  # noqa: F401 (re-exported)
+from opnav.core.tables import MISSING, is_missing  # noqa: F401 (re-exported)
 
 _DIGITS = ["Zero", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine"]
 
@@ -311,7 +311,7 @@ def format_sci(x: float) -> str:
 
 def claims_glance_latex(df: "pd.DataFrame") -> str:
     """The at-a-glance table as a LaTeX tabular (wrapping text columns, one row per claim)."""
-    from opnav.claims import VERDICT_SHORT
+    from opnav.report.claims import VERDICT_SHORT
 
     lines = [r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.38\linewidth}"
              r">{\raggedright\arraybackslash}p{0.16\linewidth}>{\raggedright\arraybackslash}p{0.25\linewidth}"
@@ -328,7 +328,7 @@ def claims_glance_latex(df: "pd.DataFrame") -> str:
 
 def claims_detail_latex(df: "pd.DataFrame") -> str:
     """Every claim with all its columns, as a LaTeX description list (the claims table in full)."""
-    from opnav.claims import VERDICT_TEXT
+    from opnav.report.claims import VERDICT_TEXT
 
     out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
     for r in df.itertuples():

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import yaml
 
-PUBLISHED_FILE = Path(__file__).with_name("data") / "published.yaml"
+PUBLISHED_FILE = Path(__file__).resolve().parents[1] / "data" / "published.yaml"
 
 
 @lru_cache(maxsize=1)

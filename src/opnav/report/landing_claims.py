@@ -2,7 +2,7 @@
 
 Input: the B-summary.json dict (every camera scenario under ``scenarios``, the headline
 scenario's name under ``headline_scenario``) and the published values
-(``published.paper_b()``). Output: claims-table rows (:func:`opnav.claims.row`).
+(``published.paper_b()``). Output: claims-table rows (:func:`opnav.report.claims.row`).
 
 The paper gives no camera: both our scenarios are readings of it, so a claim that holds in
 one and not the other *depends on a choice the paper leaves open* (the camera), and the
@@ -16,9 +16,9 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
-from opnav import claims as C
-from opnav.claims import fmt, join
-from opnav.verdicts import REPRODUCED as V_REPRODUCED, judge
+from opnav.report import claims as C
+from opnav.report.claims import fmt, join
+from opnav.core.verdicts import REPRODUCED as V_REPRODUCED, judge
 
 #: "almost the same" is not tested when a baseline picks the depth method's landmark this often
 SAME_PICK_MAX_PCT = 90.0

@@ -2,7 +2,7 @@
 
 One panel per metric, one line per method (paper A: per scenario variant and
 estimator, the variant's colour and the estimator's line style; colours are
-:func:`opnav.figures.color`'s, as in every figure). ``statistic: mean`` draws the mean over runs with its 95 %
+:func:`opnav.core.figures.color`'s, as in every figure). ``statistic: mean`` draws the mean over runs with its 95 %
 confidence interval as error bars (a share's within 0..100 %); ``sd`` / ``rms`` draw the spread or RMS over
 runs, paper-A estimate errors always as their RMS about the truth, with the 1-sigma CRLB beside it
 (dashed, black). Axis labels are symbols with units; the x label is the study's title. A panel
@@ -19,7 +19,7 @@ from typing import Mapping
 import numpy as np
 import pandas as pd
 
-from opnav import figures
+from opnav.core import figures
 from opnav.studies import METRICS, _slug, shown_statistic
 
 

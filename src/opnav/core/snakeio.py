@@ -74,9 +74,9 @@ def resource_line() -> str:
     process so far, its finished child processes included (LaTeX, say):
     ``resource.getrusage``; the peak memory is ``VmHWM`` of ``/proc/self/status``
     (``ru_maxrss`` keeps the forking parent's peak across ``exec`` on Linux), else
-    ``ru_maxrss`` (KiB on Linux). A job that imported ``opnav.compiled`` also gets the
+    ``ru_maxrss`` (KiB on Linux). A job that imported ``opnav.core.compiled`` also gets the
     kernel signatures it loaded from numba's cache and compiled itself
-    (:func:`opnav.compiled.cache_stats`; after rule ``compile_kernels``, none compiled)."""
+    (:func:`opnav.core.compiled.cache_stats`; after rule ``compile_kernels``, none compiled)."""
     me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     user, sys_ = me.ru_utime + kids.ru_utime, me.ru_stime + kids.ru_stime
     rss_kib = float(me.ru_maxrss)
@@ -86,7 +86,7 @@ def resource_line() -> str:
                 rss_kib = float(line.split()[1])
     out = (f"{RESOURCE_PREFIX} cpu_s={user + sys_:.3f} user_s={user:.3f} "
            f"sys_s={sys_:.3f} max_rss_mb={rss_kib / 1024:.1f}")
-    compiled = sys.modules.get("opnav.compiled")  # a job that used kernels (not imported here)
+    compiled = sys.modules.get("opnav.core.compiled")  # a job that used kernels (not imported here)
     if compiled is not None:
         stats = compiled.cache_stats()
         out += f" kernels_loaded={stats['loaded']} kernels_compiled={stats['compiled']}"
@@ -218,7 +218,7 @@ def save_pickle(path, obj) -> None:
     """Pickle ``obj`` to ``path`` atomically (complete or absent)."""
     import pickle
 
-    from opnav.tables import atomic_target
+    from opnav.core.tables import atomic_target
 
     with atomic_target(path) as tmp, open(tmp, "wb") as fh:
         pickle.dump(obj, fh)
@@ -249,7 +249,7 @@ def save_csv(path, df) -> None:
     with its row count and checksum, which :func:`load_csv` checks."""
     import hashlib
 
-    from opnav.tables import atomic_target
+    from opnav.core.tables import atomic_target
 
     body = df.to_csv(index=False, lineterminator="\n")
     head = f"{CSV_STAMP} rows={len(df)} sha256={hashlib.sha256(body.encode()).hexdigest()}\n"
@@ -315,7 +315,7 @@ def copy_workflow(repo: Path, dst: Path, kernel_cache: bool = True) -> Path:
     """Copy the workflow of checkout ``repo`` into ``dst`` (for tests and benchmarks
     that run snakemake in a scratch directory). ``kernel_cache``: numba's cache files
     (``__pycache__/*.nbi``, ``*.nbc``) come along, so the copy loads the kernels the
-    checkout compiled (entries are keyed by source content, :mod:`opnav.compiled`);
+    checkout compiled (entries are keyed by source content, :mod:`opnav.core.compiled`);
     without, the copy compiles them itself, as a fresh clone does. Bytecode is never
     copied."""
     import shutil

@@ -2,7 +2,7 @@
 
 Every plot of the pipeline is drawn by a plots module (:mod:`opnav.approach.plots`,
 :mod:`opnav.approach.peer_plots`, :mod:`opnav.landing.plots`,
-:mod:`opnav.study_plots`) under :func:`style` (one matplotlib style file,
+:mod:`opnav.report.study_plots`) under :func:`style` (one matplotlib style file,
 ``opnav.mplstyle``, sized for a journal column), coloured by :func:`color` (one
 colour per method and per scenario variant, the same in every figure of both
 papers: :data:`PALETTE`), and written by :func:`save`, which produces PDF and PNG
@@ -24,9 +24,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import zlib  # noqa: E402
 
-from opnav.tables import atomic_target  # noqa: E402
+from opnav.core.tables import atomic_target  # noqa: E402
 
-STYLE = Path(__file__).with_name("opnav.mplstyle")
+STYLE = Path(__file__).resolve().parents[1] / "opnav.mplstyle"
 
 #: Column and full-page widths (inches) for the manuscript.
 COLUMN_WIDTH_IN = 3.5

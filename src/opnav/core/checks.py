@@ -27,7 +27,7 @@ one line per problem naming the keys:
   the B-F5 instant inside the descent on a filter step; memory bounds;
 * both: ``results_dir`` non-empty and outside the checkout's tracked folders.
 
-Use: :func:`opnav.config.validate_config` calls :func:`config_problems` after
+Use: :func:`opnav.core.config.validate_config` calls :func:`config_problems` after
 the schema (Snakefile validation and the ``opnav`` CLI both go through it).
 Every check reads the package's own models (camera, guidance, constants), so
 it follows them when they change. Units as in the config.
@@ -87,7 +87,7 @@ def config_problems(config: dict, root: str | Path | None = None,
     relative outputs go (default: ``root``); sections in ``skip`` (their schema failed)
     are not read; ``sections`` (default all) limits the checks to those sections;
     ``plan_studies(config)`` plans the studies, raising :class:`ConfigError` (handed in
-    by :func:`opnav.config.validate_config`: :mod:`opnav.studies` imports this module)."""
+    by :func:`opnav.core.config.validate_config`: :mod:`opnav.studies` imports this module)."""
     want = set(sections) if sections is not None else {"results_dir", "approach", "landing", "studies",
                                                         "limits"}
     todo = want - set(skip)
@@ -142,7 +142,7 @@ def study_spec_defaults() -> dict:
     merge it into a new dict and never change it."""
     import yaml
 
-    schema = Path(__file__).resolve().parent / "schemas" / "studies.schema.yaml"
+    schema = Path(__file__).resolve().parents[1] / "schemas" / "studies.schema.yaml"
     props = yaml.load(schema.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     return {k: v["default"] for k, v in props["additionalProperties"]["properties"].items() if "default" in v}
 
