@@ -255,3 +255,20 @@ def test_without_basilisk_the_workflow_skips_a_p1_with_one_line(workdir):
     lines = [ln for ln in out.splitlines() if "skipping A-P1" in ln]
     assert len(lines) == 1 and "pip install" in lines[0], lines
     assert "approach_peer_ukf" not in proc.stdout and "approach_tables" in proc.stdout
+
+
+def test_basilisk_bias_moves_with_the_user_guide_tuning():
+    """Issue 44, item 2: the peer's bias state must move, i.e. its estimate must not equal its
+    start (0) and, with the config's tuning (the module's user guide), must still change after
+    the first update somewhere in the roll arc (the roll separates the bias, fixed in the
+    camera frame, from the position error, fixed in space). Mutation tried: the earlier
+    ``bias_process_sigma_px: 1e-6`` gives no change after the first update and fails."""
+    pytest.importorskip("Basilisk")
+    cfg = approach_cfg()
+    r = peers.run_peer(cfg, "roll", headline_case(cfg), [0], stride=50)
+    assert np.all(np.abs(r["theta_final_arcsec"]).max(1) > 0)  # not its start
+    assert r["bias_changes_after_first"][0] > 0, r["theta_hist_arcsec"][0, :, :]
+    # the move is in whole pixels (the module rounds its bias states: one pixel = one IFOV)
+    steps = np.diff(r["theta_hist_arcsec"][0], axis=0)
+    q = r["bias_quantum_arcsec"]
+    np.testing.assert_allclose(steps / q, np.round(steps / q), atol=1e-6)

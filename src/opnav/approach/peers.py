@@ -52,6 +52,31 @@ Description
     (:func:`theta_from_bias_px`); both pinned by tests, one against the module's
     own measurement model.
 
+Why the bias hardly moves (read from ``pixelLineBiasUKF.c``, issue 44)
+    Two lines of the module's source decide what its bias state can do on paper A's data:
+
+    * ``pixelLineBiasUKFMeasModel``: ``obs[3..5] = round(h(x_hat) - circle)``, where ``h``
+      uses the predicted *position* only. The bias "pseudo-measurement" is the rounded
+      pre-fit residual, and its noise is the circle's own ``uncertainty`` (here about
+      0.03 px 1-sigma). It tells the filter that the bias equals whatever the predicted
+      position does not explain: at the first update the bias jumps to the whole pixel
+      nearest (prior lateral position error + misalignment) / X, and afterwards the
+      position absorbs the rest, so the residual keeps returning the same whole pixel.
+    * ``pixelLineBiasUKFMeasUpdate``: ``state[6..8] = round(state[6..8])`` after every
+      update: the bias lives on whole pixels (one pixel = the IFOV, 10 arcsec here), and a
+      per-update step below 0.5 px is discarded.
+
+    So the bias moves once (start -> first update) and afterwards only when the predicted
+    position drifts by half a pixel against the data; its reported 3-sigma is that of a
+    continuous state, not of its one-pixel resolution. Tuning (``peers.basilisk``) follows
+    the module's user guide: bias covariance 5 px^2 (22.4 arcsec 1-sigma) and ``qNoise``
+    bias (0.1 px)^2 per update; with the earlier 1e-6 px the per-step covariance growth was
+    nil and the bias could never change after the first update. The summary records the
+    value after the first update, how often the bias changed later, and the quantum
+    (A-P1-summary.json ``ukf_first_update_*``, ``ukf_seeds_moving_after_first_update``,
+    ``ukf_bias_quantum_arcsec``). The truth-start diagnostic lands on the truth exactly only
+    because paper A's headline misalignment is a whole number of pixels (10, 20 arcsec).
+
 Two-body approximation
     The module has no Sun. :func:`two_body_check` computes the Sun's tidal
     acceleration relative to Mars along the truth arc and the position error
@@ -356,7 +381,7 @@ def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec
     Rvar, z, dx0 = simulate_case(setup, geo, case, seeds, setup.initial_error.mode, truth)
     sBN, sCB = ukf_inputs(geo, case.install_deg)
     r_true = geo.X_true[:, :3] - geo.X_mars[:, :3]
-    est, sig3, rad_b, pos_fin, pos_rms, hist, hist_sig = [], [], [], [], [], [], []
+    est, sig3, rad_b, pos_fin, pos_rms, hist, hist_sig, first, moves = [], [], [], [], [], [], [], [], []
     for s in range(z.shape[0]):
         x0 = (geo.X_true[0] if start == "truth" else geo.X_ref[0] + dx0[s]) - geo.X_mars[0]
         run = run_ukf(circles_from_los(z[s], cam), circle_variance(z[s], Rvar, cam), geo.t, sBN, sCB,
@@ -366,6 +391,9 @@ def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec
         sd_px = np.sqrt(np.diagonal(run.covar[:, 6:8, 6:8], axis1=1, axis2=2))
         sd = sc.arcsec(sd_px[:, ::-1] * cam.pitch)  # tx from the line bias, ty from the pixel bias
         est.append(th[-1])
+        first.append(th[1])  # after the first measurement update
+        # samples after the first update at which the (whole-pixel) bias state changed
+        moves.append(int(np.count_nonzero(np.any(np.diff(run.state[1:, 6:8], axis=0) != 0, axis=1))))
         sig3.append(3.0 * sd[-1])
         rad_b.append(run.state[-1, 8])
         e = np.linalg.norm(run.state[:, :3] - r_true[:n + 1], axis=-1)
@@ -376,6 +404,8 @@ def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec
     n = len(geo.t) - 1 if steps is None else min(steps, len(geo.t) - 1)
     return {"variant": variant, "case_id": case.case_id, "seed_indices": np.asarray(seeds), "start": start,
             "truth_arcsec": truth, "theta_final_arcsec": np.stack(est), "sigma3_final_arcsec": np.stack(sig3),
+            "theta_first_update_arcsec": np.stack(first), "bias_changes_after_first": np.asarray(moves),
+            "bias_quantum_arcsec": float(sc.arcsec(cam.pitch)),
             "radius_bias_px": np.asarray(rad_b), "pos_err_final_km": np.asarray(pos_fin),
             "pos_err_rms_km": np.asarray(pos_rms), "t_hist_s": geo.t[1:n + 1:stride],
             "theta_hist_arcsec": np.stack(hist), "sigma3_hist_arcsec": np.stack(hist_sig),
@@ -513,6 +543,13 @@ def summary(table, peer: list[dict]) -> dict:
         h = p["runs"]["headline"]
         v["ukf_pos_err_final_km"] = float(np.mean(h["pos_err_final_km"]))
         v["ukf_truth_bias_pixel_px"], v["ukf_truth_bias_line_px"] = map(float, h["truth_bias_px"])
+        # what the bias state does (module docstring, 'Why the bias hardly moves'): its value after
+        # the first update (seed mean), the seeds whose bias changed later in the arc, its quantum
+        v["ukf_first_update_x_arcsec"], v["ukf_first_update_y_arcsec"] = map(
+            float, np.mean(h["theta_first_update_arcsec"], axis=0))
+        v["ukf_seeds_moving_after_first_update"] = int(np.count_nonzero(h["bias_changes_after_first"]))
+        v["ukf_bias_changes_after_first_mean"] = float(np.mean(h["bias_changes_after_first"]))
+        v["ukf_bias_quantum_arcsec"] = h["bias_quantum_arcsec"]
         b = p["runs"]["bias_free"]
         v["ukf_bias_free_within_own_3sigma_all"] = bool(np.all(
             np.abs(b["theta_final_arcsec"]) <= b["sigma3_final_arcsec"]))
