@@ -135,6 +135,7 @@ def _recorded_calls(scn, method, runs=(0, 1)):
     return out
 
 
+@pytest.mark.slow  # the paper path (CasADi) over many calls: 2-6 CPU-s a method
 @pytest.mark.parametrize("method", ["depth", "svd", "logdet", "svd_w", "gdop_w", "cond_w"])
 def test_compiled_call_picks_the_papers_definition_pick_away_from_ties(scn, method):
     """On a descent's recorded planning calls the compiled call and the paper's
