@@ -28,3 +28,22 @@ def test_cli_runs_one_case_and_prints_json(capsys):
 def test_cli_rejects_bad_values(capsys):
     assert main(["approach", "--seeds", "0"]) == 2
     assert "--seeds" in capsys.readouterr().err
+
+
+def test_cli_names_the_data_its_bound_covers(capsys):
+    """Issue 44, item 5: the literal start carries every sample from t0, so the bound printed
+    for the last segment is that of samples 1..end with the prior, and the text must say so
+    (it said 'samples 2151..2200' before). Sliding prior windows name only their own window."""
+    from opnav.approach import pipeline
+    from approach_helpers import approach_cfg
+
+    argv = ["approach", "--seeds", "1", "--N0", "50", "--N", "20", "--M", "2", "--L", "3", "--method", "plain"]
+    assert main(argv + ["--variant", "literal"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["crlb_arcsec"]["data"].startswith("samples 1..110 ")
+    assert out["crlb_all_data_arcsec"]["data"].startswith("samples 1..110 ")
+    cfg = approach_cfg(N0=50, N=20, M=2, L=3)
+    d = pipeline.bound_data(cfg, "prior")
+    assert (d["first_sample"], d["last_sample"], d["n_samples"]) == (91, 110, 20)
+    cfg["segments"]["mode"] = "growing"
+    assert pipeline.bound_data(cfg, "roll")["first_sample"] == 51

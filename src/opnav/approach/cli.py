@@ -48,7 +48,7 @@ def run(args) -> int:
     from opnav.core.config import ConfigError, load_config
     from . import scenario as sc
     from .cases import Case, run_case
-    from .pipeline import bound_curve, segment_bounds
+    from .pipeline import bound_curve, bound_data, segment_bounds
     from .report import bound_cause, reading_text, row_label
     from .setup import Setup
 
@@ -79,7 +79,6 @@ def run(args) -> int:
     curve0 = bound_curve(setup, geo, Rvar, truth, args.variant, zero_q=True)
     s = setup.segments
     used = min(s.data_samples, len(curve) - 1)
-    last = s.windows()[-1]
     th = r["theta_final_arcsec"]
     st = r["stalled"]
     tz = "unobservable" if r["tz_unobservable"] else None
@@ -101,10 +100,13 @@ def run(args) -> int:
                             "per_seed": th.round(4)},
         # the bound of the data the estimate used: the last window (sliding) or all data from N0 (growing)
         "crlb_arcsec": {"tx": float(bound[0]), "ty": float(bound[1]), "tz": tz or float(bound[2]),
-                        "data": f"samples {last[0] + 1}..{last[1]} ({s.mode} segment)"},
+                        "data": bound_data(setup, args.variant)["text"]},
         # the same with Q = 0: the simulated truth carries no process noise
         "crlb_q0_arcsec": {"tx": float(bound0[0]), "ty": float(bound0[1]), "tz": tz or float(bound0[2])},
         "crlb_all_data_arcsec": {"tx": float(curve[used, 0]), "ty": float(curve[used, 1]), "data_samples": int(used),
+                                 "data": (f"samples 1..{s.N0 + used} (all data from t0 with the prior)"
+                                          if sc.START_OF[args.variant] == "filter" else
+                                          f"samples {s.N0 + 1}..{s.N0 + used} (all data after N0)"),
                                  "tz": tz or float(curve[used, 2])},
         "crlb_all_data_q0_arcsec": {"tx": float(curve0[used, 0]), "ty": float(curve0[used, 1]),
                                     "tz": tz or float(curve0[used, 2])},

@@ -92,6 +92,30 @@ def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, thet
     return segment_bounds_many(setup, geo, [(Rvar, theta_arcsec, zero_q)], variant)[0]
 
 
+def bound_data(setup: Setup | dict, variant: str) -> dict:
+    """The samples the last segment's bound (:func:`segment_bounds`) rests on: ``first`` and
+    ``last`` sample indices (1-based after t0 = sample 0), whether the prior enters, and a
+    phrase naming them. ``literal``: every sample from t0 (its window starts from the theta = 0
+    filter, which carries them all); ``growing``: every sample after N0; ``sliding``: the
+    last window."""
+    setup = Setup.of(setup)
+    s = setup.segments
+    a, b = s.windows()[-1]
+    if sc.START_OF[variant] == "filter":
+        first, why = 1, "all data from t0 with the prior P_X0: the literal start carries every earlier sample"
+    elif s.mode == "growing":
+        first, why = s.N0 + 1, f"all data after N0 = {s.N0} (growing segments), {_start_phrase(variant)}"
+    else:
+        first, why = a + 1, f"the last sliding window, {_start_phrase(variant)}"
+    return {"first_sample": int(first), "last_sample": int(b), "n_samples": int(b - first + 1),
+            "text": f"samples {first}..{b} ({why})"}
+
+
+def _start_phrase(variant: str) -> str:
+    return ("started from the true state with the filter's P (diagnostic)" if sc.START_OF[variant] == "truth"
+            else "started from the prior propagated without data")
+
+
 def segment_bounds_many(setup: Setup | dict, geo: sc.Geometry, items, variant: str,
                         curves: list[np.ndarray] | None = None) -> list[np.ndarray]:
     """:func:`segment_bounds` of several ``(Rvar, theta_arcsec, zero_q)`` items, every window
