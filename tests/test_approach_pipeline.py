@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 from opnav.core import published
 from opnav.approach import cases, pipeline, report
 from opnav.approach import scenario as sc
+from opnav.approach.setup import Setup
 
 from approach_helpers import approach_cfg
 
@@ -159,3 +160,29 @@ def test_roll_rate_bounds_agree_with_the_roll_variant_and_the_target_rate_meets_
     at = pipeline.roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, [rate, 0.99 * rate], 150)[:, :2].max(1)
     assert at[0] <= target < at[1]
     assert rate > rate0
+
+
+def test_convergence_label_is_relative_to_the_bound_of_the_data_used():
+    """Issue 44, item 5: 'converged' means within em.converge_frac_of_bound bounds of the ML
+    estimate of the data used, not an absolute 0.5 arcsec. The same runs are all converged when
+    the bound they are measured in is huge, none when it is tiny, and the label's distance is
+    the arcsec distance over that bound. Mutation tried: the old absolute rule
+    (converge_tol_arcsec) ignores the bound and fails."""
+    from opnav.approach import cases
+    from opnav.approach import scenario as sc
+
+    cfg = approach_cfg(N0=100, N=50, M=2, L=2)
+    case = cases.headline_case(cfg)
+    geo = sc.build_geometry(cfg, "roll")
+    d = cases.prepare_cases(cfg, "roll", [case], range(3), geo=geo)
+    b = cases.label_bounds(Setup.of(cfg), geo, [case], "roll")[0]
+    assert np.all(b[:2] > 0)
+    lab = {}
+    for scale in (1e6, 1.0, 1e-6):
+        r = cases.run_cases(cfg, "roll", [case], range(3), geo=geo, method="plain", data=d,
+                            seg_bounds=[b * scale])[0]
+        lab[scale] = r["label"]
+        dist = np.abs(r["theta_final_arcsec"] - r["theta_ml_arcsec"])[:, :2] / (b[:2] * scale)
+        np.testing.assert_allclose(r["dist_to_ml_over_bound"], dist.max(1), rtol=1e-12)
+    assert np.all(lab[1e6] == "converged")
+    assert not np.any(lab[1e-6] == "converged")

@@ -24,7 +24,8 @@ Written rules (Table 1 columns)
     segment both |tx - tx_final| and |ty - ty_final| are at most
     ``em.converge_tol_arcsec``; the table reports the median over seeds. Only a
     run labelled *converged* has one (:func:`opnav.approach.em.convergence_labels`:
-    within ``em.converge_tol_arcsec`` of the ML estimate of its last segment's data;
+    within ``em.converge_frac_of_bound`` times the 1-sigma bound of its last segment's
+    data (tx and ty each, :func:`label_bounds`) of that data's ML estimate;
     *stalled* when not and its contraction per map toward it is ``em.stall_rate`` or
     more; else *not converged*). The label reads the data, not the start.
     *Navigation error before / after compensation* (km): for each seed, the
@@ -242,11 +243,13 @@ def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed
 
 def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
               geo: sc.Geometry | None = None, method: str | None = None, init_mode: str | None = None,
-              data: CaseData | None = None) -> list[dict]:
+              data: CaseData | None = None, seg_bounds: list | None = None) -> list[dict]:
     """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
     of the stacked filter arrays (runs are independent; each keeps its own stream).
     ``data``: the :func:`prepare_cases` of these arguments, shared by several EM schemes
-    (``method``, ``setup.segments``)."""
+    (``method``, ``setup.segments``). ``seg_bounds``: per case, the 1-sigma bound (arcsec) of
+    the data the last segment's estimate used (3,), for the convergence label; computed
+    (:func:`label_bounds`) when not given."""
     setup = Setup.of(setup)
     em_set = setup.em
     method = method or em_set.method
@@ -295,7 +298,11 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     rate = contraction_per_map(theta_seg_start, theta, theta_ml, maps_per_segment(method, M))
     dist_ml = np.abs(sc.arcsec(theta - theta_ml))[:, :2].max(1)
     moved = np.abs(sc.arcsec(theta - theta_init))[:, :2].max(1)
-    label = convergence_labels(dist_ml, rate, em_set.converge_tol_arcsec, em_set.stall_rate)
+    if seg_bounds is None:
+        seg_bounds = label_bounds(setup, geo, case_list, variant)
+    bnd = np.repeat(np.stack([np.asarray(b, float)[:2] for b in seg_bounds]), ns, axis=0)  # (S, 2)
+    dist_rel = (np.abs(sc.arcsec(theta - theta_ml))[:, :2] / bnd).max(1)  # in bounds of the data used
+    label = convergence_labels(dist_rel, rate, em_set.converge_frac_of_bound, em_set.stall_rate)
 
     f1 = run_filter(z, theta, dx0, geo.P0, win, predicted=False)
     err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
@@ -346,6 +353,8 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
             "theta_ml_arcsec": sc.arcsec(theta_ml[sl]),
             "ml_converged": ml_done[sl],
             "dist_to_ml_arcsec": dist_ml[sl],
+            "dist_to_ml_over_bound": dist_rel[sl],
+            "label_bound_arcsec": np.asarray(seg_bounds[i], float),
             "nav_err_before_km": nb[sl],
             "nav_err_after_km": na[sl],
             "err_before_t_km": err_before[sl],
@@ -356,6 +365,17 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
             "t_s": geo.t,
         })
     return out
+
+
+def label_bounds(setup: Setup, geo: sc.Geometry, case_list: list[Case], variant: str) -> list[np.ndarray]:
+    """Per case, the 1-sigma bound (3,), arcsec, of the data its last segment's estimate used
+    (:func:`opnav.approach.pipeline.segment_bounds`), evaluated at the case's configured start
+    theta, not its truth: the convergence label's scale (the bound changes with theta by a
+    relative O(theta), about 1e-4 here)."""
+    from .pipeline import segment_bounds_many
+
+    items = [(geo.measurement_variance(c.sigma3_px), c.init_arcsec, False) for c in case_list]
+    return [b[-1] for b in segment_bounds_many(setup, geo, items, variant)]
 
 
 def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indices, data_samples: int,

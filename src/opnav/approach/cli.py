@@ -115,8 +115,10 @@ def run(args) -> int:
                   "contraction_per_map": [float(v) for v in r["contraction_per_map"]],
                   "ml_estimate_same_data_arcsec": r["theta_ml_arcsec"][:, :2].round(4).tolist(),
                   "distance_to_ml_arcsec": [float(v) for v in r["dist_to_ml_arcsec"]],
-                  "rule": (f"converged if within {setup.em.converge_tol_arcsec:g} arcsec of the ML estimate of "
-                           f"the data used; else stalled if the contraction per map toward it is >= "
+                  "distance_to_ml_over_bound": [float(v) for v in r["dist_to_ml_over_bound"]],
+                  "rule": (f"converged if within {setup.em.converge_frac_of_bound:g} x the 1-sigma bound of the "
+                           f"data used ({bound_data(setup, args.variant)['text']}; tx and ty each) of that "
+                           f"data's ML estimate; else stalled if the contraction per map toward it is >= "
                            f"{setup.em.stall_rate:g}, not converged otherwise")},
         "iterations": {"em_maps": int(r["theta_iter_arcsec"].shape[1]),
                        "per_segment": int(r["maps_per_segment"]), "segments": s.L},

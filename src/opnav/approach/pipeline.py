@@ -197,7 +197,11 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
     runs_list = clist + [replace(c, init_mode="sampled") for c in head]
     if ("data", n) not in shared:
         shared[("data", n)] = cases.prepare_cases(setup, variant, runs_list, seeds, geo=geo)
-    runs = cases.run_cases(setup, variant, runs_list, seeds, geo=geo, method=method, data=shared[("data", n)])
+    lkey = ("label_bounds", setup.segments)
+    if lkey not in shared:
+        shared[lkey] = cases.label_bounds(setup, geo, runs_list, variant)
+    runs = cases.run_cases(setup, variant, runs_list, seeds, geo=geo, method=method, data=shared[("data", n)],
+                           seg_bounds=shared[lkey])
     sampled = runs[len(clist):]
     bkey = ("bounds", setup.segments)
     if bkey not in shared:

@@ -542,8 +542,8 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
             groups.setdefault(l_ or "unlabelled", []).append(scen)
         parts.append(f"{lab.replace('+', ' ')}: " + "; ".join(f"{l_} in {_join(sc_)}" for l_, sc_ in groups.items()))
     out["stall"] = ("An EM run is labelled converged when it ends within "
-                    f"{setup.em.converge_tol_arcsec:g} arcsec of the maximum-likelihood estimate of the data it "
-                    "used, stalled when it does not and its contraction per map toward that estimate is about 1 "
+                    f"{setup.em.converge_frac_of_bound:g} times the 1-sigma bound of the data it used (in tx and ty) "
+                    "of the maximum-likelihood estimate of that data, stalled when it does not and its contraction per map toward that estimate is about 1 "
                     f"(at least {setup.em.stall_rate:g}), whatever its start; whether a converged estimate means "
                     "anything is read from the bound of that data. Headline rows: " + " | ".join(parts) + ".")
 

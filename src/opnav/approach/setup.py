@@ -204,13 +204,15 @@ class Segments(_Section):
 
 @dataclass(frozen=True)
 class EMSettings(_Section):
-    """``em``: scheme (plain / squarem), unobservable-direction tolerance, the convergence
-    labels' tolerance to the ML estimate (arcsec) and stall rate (contraction per map), and
-    the map budget of the ML reference."""
+    """``em``: scheme (plain / squarem), unobservable-direction tolerance, the data-to-converge
+    tolerance (arcsec, Table 1's column), the convergence label's tolerance to the ML estimate
+    as a fraction of the bound of the data used, its stall rate (contraction per map), and the
+    map budget of the ML reference."""
 
     method: str
     tz_tol: float
     converge_tol_arcsec: float
+    converge_frac_of_bound: float
     stall_rate: float
     ml_max_maps: int
 
