@@ -34,14 +34,21 @@ SCORE_INPUTS = {
 }
 
 
+#: the replication sample's summaries (workflow/rules/replication.smk), where it is flown
+REPLICATION_INPUTS = {k: p for k, p in globals().get("REPLICATION_SUMMARIES", {}).items() if p in _targets}
+
+
 rule paper_claims:
-    """The claims table (one row per published claim, opnav.report.claims) and the generated
-    abstract, conclusion and limitations (claims.json)."""
+    """The claims table (one row per published claim, opnav.report.claims) judged by the analysis
+    plan (analysis_plan.csv), the replication sample's verdicts where it was flown, the derived
+    inputs (inputs.csv) and the generated abstract, conclusion and limitations (claims.json)."""
     input:
         **{f"summary_{k}": p for k, p in SUMMARIES.items() if k in ("A", "B")},
         **{k: p for k, p in SCORE_INPUTS.items() if k == "a_table1"},
+        **REPLICATION_INPUTS,
         published=src("data/published.yaml"),
-        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "core/verdicts.py", "report/manuscript.py",
+        plan=src("data/analysis_plan.yaml"),
+        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/manuscript.py",
                  "core/published.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
@@ -49,6 +56,15 @@ rule paper_claims:
         tex=f"{PAPER}/claims_glance.tex",
         detail=f"{PAPER}/claims_detail.tex",
         json=f"{PAPER}/claims.json",
+        plan=f"{PAPER}/analysis_plan.csv",
+        inputs=f"{PAPER}/inputs.csv",
+    params:
+        profile=config["profile"],
+        # the smallest data-to-converge count each EM mode can report (its first window, samples)
+        windows={"sliding": config["approach"]["segments"]["N"], "growing": config["approach"]["growing"]["N"]},
+        dt_s=config["approach"]["dt_s"],
+        landing=canonical({k: config["landing"][k] for k in ("duration_s", "gravity_mps2", "initial_state", "yaw_deg",
+                                                               "terminal_accel_mps2")}),
     log:
         f"{PAPER}/logs/paper_claims.log",
     localrule: True

@@ -7,7 +7,8 @@ by cell; this module answers the reader's question instead: which of the papers'
 assembled here. Columns (:data:`COLUMNS`) and verdicts (:data:`VERDICTS`):
 
 ``reproduced``
-    the paper as written (our reading of it, no addition) gives the claim;
+    the paper as written (our reading of it, no addition) gives the claim (a
+    negative control that also gives it is flagged, not a reason to withhold it);
 ``reproduced_with_addition``
     only a variant that adds something the paper does not state gives it; ``named``
     says what (a variant that uses the true state never counts: it is a diagnostic,
@@ -16,12 +17,29 @@ assembled here. Columns (:data:`COLUMNS`) and verdicts (:data:`VERDICTS`):
     no faithful variant gives it; the cause says what we get instead;
 ``not_reproducible``
     not reproduced, and an information bound (Cramér-Rao) of the stated
-    measurements and prior says no unbiased estimator could give it; ``named`` is the bound;
+    measurements and prior says no unbiased estimator could give it; ``named`` is the
+    bound (only an information bound: a Monte-Carlo floor of one filter is evidence
+    for "not reproduced" or "depends on a choice");
 ``depends_on_choice``
     whether it reproduces depends on a choice the paper leaves open; ``named`` is that choice;
 ``not_tested``
     our runs cannot test it (e.g. the compared methods pick the same landmarks, so
-    equal accuracy follows by construction); ``named`` says why.
+    equal accuracy follows by construction); ``named`` says why;
+``unstable``
+    the main sample and the replication sample (an independent seed base) give
+    different verdicts; the cause gives both;
+``suspect``
+    an accuracy beats its own information bound by more than the plan's factor
+    (judged with the seeds' spread): a leak or a bug, never "reproduced".
+
+``flags`` qualifies a verdict without changing it: ``control_also_meets: closest``
+(the claim holds, but a negative control meets it too, so the test cannot credit the
+method), ``beats_bound: 14x``, ``floor_not_bound`` (a Monte-Carlo floor of one filter,
+evidence but not an information bound), ``sample_too_small: quick profile``.
+
+Every margin, tolerance and threshold of a verdict is a fixed number of the analysis
+plan (``data/analysis_plan.yaml``, :func:`load_plan`), with its reason; the scorer
+reads them from there and :meth:`Plan.unused` names any the verdicts never read.
 
 Accuracy claims are scored as accuracy: our error about the truth against the
 published error and the bound, never "our estimate within 10 % of a published
@@ -32,12 +50,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
 
 import pandas as pd
+import yaml
+
+from opnav.core import published
 
 COLUMNS = ["paper", "claim_id", "claim", "published", "ours_as_written", "ours_best", "best_variant",
-           "bound", "verdict", "named", "cause", "evidence"]
+           "bound", "ours_replication", "verdict", "verdict_replication", "flags", "named", "would_take",
+           "cause", "evidence", "sample"]
 
 REPRODUCED = "reproduced"
 WITH_ADDITION = "reproduced_with_addition"
@@ -45,16 +68,21 @@ NOT_REPRODUCED = "not_reproduced"
 NOT_REPRODUCIBLE = "not_reproducible"
 DEPENDS = "depends_on_choice"
 NOT_TESTED = "not_tested"
-VERDICTS = (REPRODUCED, WITH_ADDITION, NOT_REPRODUCED, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED)
+UNSTABLE = "unstable"
+SUSPECT = "suspect"
+VERDICTS = (REPRODUCED, WITH_ADDITION, NOT_REPRODUCED, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED, UNSTABLE, SUSPECT)
 #: verdicts that must name something (the addition, the choice, the bound, the reason)
-NEEDS_NAMED = (WITH_ADDITION, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED)
+NEEDS_NAMED = (WITH_ADDITION, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED, UNSTABLE, SUSPECT)
+#: a cause is one sentence a reader takes in at once (issue 42: about 40 words)
+MAX_CAUSE_WORDS = 45
 
-#: how each verdict reads in running text (abstract, conclusion)
 #: the verdicts as the at-a-glance table prints them
 VERDICT_SHORT = {
     "reproduced": "reproduced", "reproduced_with_addition": "with an addition", "not_reproduced": "not reproduced",
     "not_reproducible": "not reproducible", "depends_on_choice": "depends on a choice", "not_tested": "not tested",
+    "unstable": "unstable", "suspect": "suspect",
 }
+#: how each verdict reads in running text (abstract, conclusion)
 VERDICT_TEXT = {
     REPRODUCED: "reproduced",
     WITH_ADDITION: "reproduced only with an addition",
@@ -62,7 +90,132 @@ VERDICT_TEXT = {
     NOT_REPRODUCIBLE: "not reproducible under the stated assumptions",
     DEPENDS: "depends on a choice the paper leaves open",
     NOT_TESTED: "not tested",
+    UNSTABLE: "unstable between two independent samples",
+    SUSPECT: "suspect: better than its own information bound",
 }
+
+
+# ------------------------------------------------------------ the analysis plan
+PLAN_FILE = published.PUBLISHED_FILE.with_name("analysis_plan.yaml")
+COMPARISONS = ("band", "equivalence", "superiority", "order", "sign")
+_CLAIM_KEYS = ("paper", "sentence", "where", "quantity", "units", "comparison", "margins", "variants", "depends_on")
+
+
+class PlanError(ValueError):
+    """The analysis plan is malformed or lacks an entry a verdict needs (one line, naming the key)."""
+
+
+def _margin_ok(m: Any) -> bool:
+    return (isinstance(m, dict) and isinstance(m.get("value"), (int, float)) and not isinstance(m.get("value"), bool)
+            and math.isfinite(float(m["value"])) and isinstance(m.get("reason"), str) and m["reason"].strip() != "")
+
+
+class Plan:
+    """The parsed analysis plan (``data/analysis_plan.yaml``), which records what the scorer reads.
+
+    :meth:`margin` and :meth:`guard` return a fixed number of the plan and remember
+    that it was read; :meth:`unused` lists every claim, margin and guard never read, so
+    a test can fail on a plan entry no verdict uses. A missing entry raises
+    :class:`PlanError` naming it."""
+
+    def __init__(self, raw: Mapping[str, Any], source: str = "analysis_plan.yaml"):
+        self.source = source
+        if not isinstance(raw, Mapping) or not isinstance(raw.get("claims"), Mapping):
+            raise PlanError(f"{source}: needs a 'claims' mapping")
+        for sect in ("guards", "replication", "inputs"):
+            if not isinstance(raw.get(sect, {}), Mapping):
+                raise PlanError(f"{source}: '{sect}' must be a mapping")
+        for cid, c in raw["claims"].items():
+            if not isinstance(c, Mapping):
+                raise PlanError(f"{source}: claims.{cid} must be a mapping")
+            for k in _CLAIM_KEYS:
+                if k not in c:
+                    raise PlanError(f"{source}: claims.{cid}.{k} is missing")
+            if c["comparison"] not in COMPARISONS:
+                raise PlanError(f"{source}: claims.{cid}.comparison {c['comparison']!r} is not one of {COMPARISONS}")
+            for name, m in (c["margins"] or {}).items():
+                if not _margin_ok(m):
+                    raise PlanError(f"{source}: claims.{cid}.margins.{name} needs a numeric 'value' and a 'reason'")
+        for name, m in raw.get("guards", {}).items():
+            if not _margin_ok(m):
+                raise PlanError(f"{source}: guards.{name} needs a numeric 'value' and a 'reason'")
+        self.raw = raw
+        self.claims: dict = dict(raw["claims"])
+        self._read: set[str] = set()
+
+    def entry(self, claim_id: str) -> dict:
+        """The plan entry of a claim (raises :class:`PlanError` if there is none)."""
+        if claim_id not in self.claims:
+            raise PlanError(f"{self.source}: claim {claim_id} has no entry (claims.{claim_id})")
+        self._read.add(f"claims.{claim_id}")
+        return self.claims[claim_id]
+
+    def margin(self, claim_id: str, name: str) -> float:
+        """A margin, tolerance or threshold of a claim's verdict (a fixed number of the plan)."""
+        c = self.entry(claim_id)
+        if name not in (c.get("margins") or {}):
+            raise PlanError(f"{self.source}: claims.{claim_id}.margins.{name} is missing")
+        self._read.add(f"claims.{claim_id}.margins.{name}")
+        return float(c["margins"][name]["value"])
+
+    def guard(self, name: str) -> float:
+        """A rule that applies to every claim (``guards``)."""
+        g = self.raw.get("guards", {})
+        if name not in g:
+            raise PlanError(f"{self.source}: guards.{name} is missing")
+        self._read.add(f"guards.{name}")
+        return float(g[name]["value"])
+
+    def variants(self, claim_id: str) -> dict:
+        return dict(self.entry(claim_id).get("variants") or {})
+
+    def keys(self) -> list[str]:
+        """Every entry a verdict may read: claims, their margins, guards."""
+        out = []
+        for cid, c in self.claims.items():
+            out.append(f"claims.{cid}")
+            out += [f"claims.{cid}.margins.{m}" for m in (c.get("margins") or {})]
+        out += [f"guards.{g}" for g in self.raw.get("guards", {})]
+        return out
+
+    def unused(self) -> list[str]:
+        """Plan entries no verdict has read (in plan order)."""
+        return [k for k in self.keys() if k not in self._read]
+
+    def table(self) -> pd.DataFrame:
+        """results/paper/analysis_plan.csv: one row per claim, margins with their reasons."""
+        rows = []
+        for cid, c in self.claims.items():
+            ms = c.get("margins") or {}
+            v = c.get("variants") or {}
+            rows.append({
+                "claim_id": cid, "paper": c["paper"], "sentence": " ".join(str(c["sentence"]).split()),
+                "where": c["where"], "quantity": c["quantity"], "units": c["units"], "comparison": c["comparison"],
+                "margin": "; ".join(f"{k} = {m['value']:g}" for k, m in ms.items()),
+                "margin_reason": "; ".join(f"{k}: {' '.join(m['reason'].split())}" for k, m in ms.items()),
+                "variants": "; ".join(f"{k}: {join(x if isinstance(x, list) else [x], none='none')}"
+                                      for k, x in v.items() if k != "controls"),
+                "controls": join(list(v.get("controls") or []), none=""),
+                "depends_on": c["depends_on"]})
+        return pd.DataFrame(rows, columns=PLAN_COLUMNS)
+
+
+PLAN_COLUMNS = ["claim_id", "paper", "sentence", "where", "quantity", "units", "comparison", "margin",
+                "margin_reason", "variants", "controls", "depends_on"]
+INPUT_COLUMNS = ["input", "ours", "published", "how_derived", "what_would_match"]
+
+
+def load_plan(path: str | Path | None = None) -> Plan:
+    """The analysis plan, parsed and checked (a fresh :class:`Plan`: its record of what
+    was read starts empty)."""
+    p = Path(path) if path is not None else PLAN_FILE
+    try:
+        raw = yaml.safe_load(p.read_text())
+    except OSError as exc:
+        raise PlanError(f"{p}: cannot read the analysis plan ({exc.strerror})") from None
+    except yaml.YAMLError as exc:
+        raise PlanError(f"{p}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    return Plan(raw, p.name)
 
 
 def fmt(x: Any, nd: int = 3, unit: str = "") -> str:
@@ -89,34 +242,82 @@ def join(items: Iterable[str], none: str = "none") -> str:
 
 @dataclass
 class Outcome:
-    """One variant's reading of one claim: does it give the claim, and what it shows."""
+    """One variant's reading of one claim: does it give the claim, and what it shows.
+
+    ``bound``/``n``: for an accuracy, the information bound (1-sigma) of the data the
+    variant used and the number of seeds behind ``err`` (the RMS error), for the bound
+    guard (:func:`beats_bound`)."""
     label: str
     ok: bool
     text: str                 # our value, as text with units
     score: float = math.inf   # lower is better (to pick the best variant)
     diagnostic: bool = False  # uses the truth: never earns "reproduced"
     beyond: bool = False      # beyond the paper (what practitioners do): never earns "reproduced" either
+    err: float = math.nan
+    bound: float = math.nan
+    n: int = 0
     extra: dict = field(default_factory=dict)
 
 
+def beats_bound(err: float, bound: float, n: int, plan: Plan) -> float | None:
+    """The factor by which an RMS error ``err`` over ``n`` seeds beats its information
+    bound ``bound`` (same units), or None if it does not by more than the plan's
+    ``bound_factor``. The seeds' spread enters as ``spread_k`` standard errors of an
+    RMS over ``n`` seeds (about ``err / sqrt(2 n)``): the error must stay below
+    ``bound / bound_factor`` even at ``err (1 + spread_k / sqrt(2 n))``."""
+    factor, k = plan.guard("bound_factor"), plan.guard("spread_k")
+    if not (math.isfinite(err) and math.isfinite(bound)) or bound <= 0 or n < 1:
+        return None
+    upper = err * (1.0 + k / math.sqrt(2.0 * n))
+    if upper * factor < bound:
+        return math.inf if err <= 0 else bound / err
+    return None
+
+
+@dataclass
+class Decision:
+    verdict: str
+    lit: Outcome | None
+    best: Outcome | None
+    named: str
+    flags: list = field(default_factory=list)
+
+
 def decide(outcomes: Mapping[str, Outcome], as_written: str, describe: Callable[[str], str],
-           bound_blocks: str = "") -> tuple[str, Outcome | None, Outcome | None, str]:
+           bound_blocks: str = "", plan: Plan | None = None) -> Decision:
     """The verdict of a claim from its per-variant outcomes.
 
     ``as_written``: the label of the paper-as-written variant; ``describe(label)``: the
     addition a variant makes (for ``named``); ``bound_blocks``: non-empty (the bound, as
-    text) when an information bound of the as-written variant excludes the claim.
-    Returns (verdict, as-written outcome, best faithful outcome or None, named)."""
+    text) when an *information bound* of the as-written variant excludes the claim (a
+    Monte-Carlo floor of one filter is not one: pass it as evidence, not here);
+    ``plan``: the analysis plan, for the bound guard (any non-diagnostic variant whose
+    error beats its bound by more than the plan's factor makes the claim ``suspect``).
+    Negative controls that also meet a claim are the paper-B scorer's flag
+    (``control_also_meets``), not a verdict."""
     lit = outcomes.get(as_written)
     faithful = [o for k, o in outcomes.items() if k != as_written and not o.diagnostic and not o.beyond]
     best = min(faithful, key=lambda o: (not o.ok, o.score, o.label), default=None)
+    flags: list = []
+    if plan is not None:
+        hits = []
+        for o in outcomes.values():
+            r = None if o.diagnostic else beats_bound(o.err, o.bound, o.n, plan)
+            if r is not None:
+                hits.append((r, o.label))
+        if hits:
+            r, lab = max(hits)
+            flags.append(("beats_bound", f"{fmt(r, 2)}x ({lab})"))
+            return Decision(SUSPECT, lit, best, f"{lab} is {fmt(r, 2)} times below its own bound", flags)
     if lit is not None and lit.ok:
-        return REPRODUCED, lit, None, ""
-    if best is not None and best.ok:
-        return WITH_ADDITION, lit, best, describe(best.label)
-    if bound_blocks:
-        return NOT_REPRODUCIBLE, lit, best, bound_blocks
-    return NOT_REPRODUCED, lit, best, ""
+        verdict, named = REPRODUCED, ""
+    elif best is not None and best.ok:
+        verdict, named = WITH_ADDITION, describe(best.label)
+    elif bound_blocks:
+        return Decision(NOT_REPRODUCIBLE, lit, None if best is None else best, bound_blocks, flags)
+    else:
+        return Decision(NOT_REPRODUCED, lit, best, "", flags)
+    return Decision(verdict, lit, None if verdict == REPRODUCED else best, named, flags)
 
 
 def diagnostic_note(outcomes: Mapping[str, Outcome]) -> str:
@@ -135,24 +336,43 @@ def diagnostic_note(outcomes: Mapping[str, Outcome]) -> str:
     return "; ".join(out)
 
 
-def row(paper: str, claim_id: str, claim: str, published: str, verdict: str, cause: str,
-        evidence: str, ours_as_written: str = "", ours_best: str = "", best_variant: str = "",
-        bound: str = "", named: str = "") -> dict:
-    """One claims-table row, checked: a stated verdict, ``named`` where the verdict needs
-    it, and a cause of one sentence."""
-    if verdict not in VERDICTS:
-        raise ValueError(f"{claim_id}: verdict {verdict!r} is not one of {VERDICTS}")
-    if verdict in NEEDS_NAMED and not named:
-        raise ValueError(f"{claim_id}: verdict {verdict} needs 'named'")
+def flag_text(flags: Iterable) -> str:
+    """Flags as the table writes them: 'name: value' joined by '; '."""
+    out = []
+    for f in flags:
+        name, value = (f, "") if isinstance(f, str) else f
+        out.append(f"{name}: {value}" if value != "" else str(name))
+    return "; ".join(out)
+
+
+def _one_sentence(claim_id: str, cause: str) -> str:
     cause = " ".join(cause.split())
     if not cause.endswith("."):
         cause += "."
     if ". " in cause.replace("e.g. ", "").replace("i.e. ", "").replace("vs. ", ""):
         raise ValueError(f"{claim_id}: the cause must be one sentence: {cause!r}")
+    n = len(cause.split())
+    if n > MAX_CAUSE_WORDS:
+        raise ValueError(f"{claim_id}: the cause has {n} words (at most {MAX_CAUSE_WORDS}): {cause!r}")
+    return cause[0].upper() + cause[1:]
+
+
+def row(paper: str, claim_id: str, claim: str, published: str, verdict: str, cause: str,
+        evidence: str, ours_as_written: str = "", ours_best: str = "", best_variant: str = "",
+        bound: str = "", named: str = "", flags: Iterable = (), would_take: str = "",
+        sample: str = "full", ours_replication: str = "", verdict_replication: str = "") -> dict:
+    """One claims-table row, checked: a stated verdict, ``named`` where the verdict needs
+    it, and a cause of one sentence of at most :data:`MAX_CAUSE_WORDS` words."""
+    if verdict not in VERDICTS:
+        raise ValueError(f"{claim_id}: verdict {verdict!r} is not one of {VERDICTS}")
+    if verdict in NEEDS_NAMED and not named:
+        raise ValueError(f"{claim_id}: verdict {verdict} needs 'named'")
     return {"paper": paper, "claim_id": claim_id, "claim": claim, "published": published,
             "ours_as_written": ours_as_written, "ours_best": ours_best, "best_variant": best_variant,
-            "bound": bound, "verdict": verdict, "named": named, "cause": cause[0].upper() + cause[1:],
-            "evidence": evidence}
+            "bound": bound, "ours_replication": ours_replication, "verdict": verdict,
+            "verdict_replication": verdict_replication, "flags": flag_text(flags), "named": named,
+            "would_take": would_take, "cause": _one_sentence(claim_id, cause), "evidence": evidence,
+            "sample": sample}
 
 
 def frame(rows: Iterable[dict]) -> pd.DataFrame:
@@ -162,6 +382,68 @@ def frame(rows: Iterable[dict]) -> pd.DataFrame:
     if dup:
         raise ValueError(f"claim ids defined twice: {dup}")
     return df.fillna("")
+
+
+def check_plan_covers(df: pd.DataFrame, plan: Plan) -> None:
+    """Every claim row has a plan entry (raises :class:`PlanError` naming the first that has none)."""
+    for cid in df["claim_id"]:
+        plan.entry(cid)
+
+
+def _add_flag(flags: str, name: str, value: str) -> str:
+    new = f"{name}: {value}"
+    return f"{flags}; {new}" if flags else new
+
+
+def with_replication(main: pd.DataFrame, rep: pd.DataFrame) -> pd.DataFrame:
+    """The main table with the replication sample's reading beside it.
+
+    ``rep``: the claims table of the same claims scored on the replication sample (an
+    independent seed base). Its verdict and as-written value fill ``verdict_replication``
+    and ``ours_replication``; a claim whose two verdicts differ reads ``unstable``, with
+    both verdicts in the cause and the main one kept in ``flags``. Claims the
+    replication does not score keep their verdict, with an empty replication."""
+    out = main.copy()
+    r = rep.set_index("claim_id")
+    for i, row_ in out.iterrows():
+        cid = row_["claim_id"]
+        if cid not in r.index:
+            continue
+        v1, v2 = row_["verdict"], r.loc[cid, "verdict"]
+        out.at[i, "verdict_replication"] = v2
+        out.at[i, "ours_replication"] = r.loc[cid, "ours_as_written"]
+        if v1 != v2 and NOT_TESTED not in (v1, v2):
+            out.at[i, "flags"] = _add_flag(out.at[i, "flags"], "verdict_main", v1)
+            out.at[i, "verdict"] = UNSTABLE
+            out.at[i, "named"] = f"{VERDICT_SHORT[v1]} in the main sample, {VERDICT_SHORT[v2]} in the replication"
+            out.at[i, "cause"] = _one_sentence(cid, (
+                f"The main sample reads {VERDICT_SHORT[v1]} and the replication sample, on an independent seed "
+                f"base, reads {VERDICT_SHORT[v2]}, so this verdict moves with the seeds and neither is reported"))
+    return out
+
+
+def mark_sample(df: pd.DataFrame, profile: str) -> pd.DataFrame:
+    """``sample`` = the profile's sample ('full' or 'quick'); quick rows carry the flag
+    ``sample_too_small: quick profile`` (its sample is too small for verdicts)."""
+    out = df.copy()
+    quick = profile != "full"
+    out["sample"] = "quick" if quick else "full"
+    if quick:
+        out["flags"] = [_add_flag(f, "sample_too_small", f"{profile} profile") for f in out["flags"]]
+    return out
+
+
+def sample_sentence(df: pd.DataFrame) -> str:
+    """Page 1's sentence on the sample (empty for a full-profile table)."""
+    if df.empty or (df["sample"] == "full").all():
+        return ""
+    return ("This build is the quick profile: its Monte-Carlo samples are too small for verdicts, so every "
+            "verdict below only shows that the pipeline runs, not what the papers' claims are.")
+
+
+def inputs_frame(rows: Iterable[dict]) -> pd.DataFrame:
+    """results/paper/inputs.csv: inputs we derive (not claims, outside the verdict counts)."""
+    return pd.DataFrame(list(rows), columns=INPUT_COLUMNS).fillna("")
 
 
 # ------------------------------------------------------------ generated prose
@@ -237,6 +519,8 @@ _CONCLUSION = [
     (NOT_REPRODUCED, "Not reproduced: ", "{s} ({i})", "; the claims table gives each cause."),
     (DEPENDS, "Decided by a choice the paper leaves open: ", "{s} ({i}: {n})", "."),
     (NOT_TESTED, "Not tested by our runs: ", "{s} ({i}: {n})", "."),
+    (UNSTABLE, "Different between two independent samples, so not reported either way: ", "{s} ({i}: {n})", "."),
+    (SUSPECT, "Better than its own information bound, so suspect rather than reproduced: ", "{s} ({i}: {n})", "."),
 ]
 
 

@@ -1,14 +1,16 @@
 """Paper B's claims (depth-error landmark selection), each scored over our camera scenarios.
 
 Input: the B-summary.json dict (every camera scenario under ``scenarios``, the headline
-scenario's name under ``headline_scenario``) and the published values
-(``published.paper_b()``). Output: claims-table rows (:func:`opnav.report.claims.row`).
+scenario's name under ``headline_scenario``), the published values
+(``published.paper_b()``) and the analysis plan (:func:`opnav.report.claims.load_plan`),
+which holds every margin the verdicts use. Output: claims-table rows
+(:func:`opnav.report.claims.row`) and derived-input rows (:func:`input_rows`).
 
 The paper gives no camera: both our scenarios are readings of it, so a claim that holds in
 one and not the other *depends on a choice the paper leaves open* (the camera), and the
-timing claim likewise depends on how the SVD baseline is implemented. Readings of the
-qualitative claims are the landing report's (paired equivalence test with negative
-controls; paired time to converge); here they are only collected. Units: m, s, %, deg.
+timing claim likewise depends on how the SVD baseline is implemented. The paired
+statistics are the landing summary's (paired intervals, same-pick rates, times to
+converge); the margins they are judged against are the plan's. Units: m, s, %, deg.
 """
 
 from __future__ import annotations
@@ -17,16 +19,15 @@ import math
 from typing import Any, Mapping
 
 from opnav.report import claims as C
-from opnav.report.claims import fmt, join
-from opnav.core.verdicts import REPRODUCED as V_REPRODUCED, judge
+from opnav.report.claims import Plan, fmt, join
 
-#: "almost the same" is not tested when a baseline picks the depth method's landmark this often
-SAME_PICK_MAX_PCT = 90.0
-
-
-def _clause(text: str) -> str:
-    """A generated sentence as a clause of another: no final stop, inner stops as semicolons."""
-    return " ".join(str(text).split()).rstrip(".").replace(". ", "; ")
+#: the per-run errors the paired equivalence intervals cover (landing.equivalence.PRIMARY_METRICS)
+PRIMARY = ("lastlm_pos_err_m", "lmrms_pos_err_m")
+#: where only B-T3's pair table pairs two methods: descent RMS and touchdown error (95 % intervals)
+PAIR_METRICS = ("rms_pos", "final_pos")
+NAMES = {"svd": "SVD", "gdop": "GDOP", "cond": "condition number", "depth": "depth", "random": "random",
+         "center": "image centre", "closest": "closest"}
+CAMERA = "the camera, which the paper does not give"
 
 
 def _scenarios(summary: Mapping[str, Any]) -> tuple[str, dict]:
@@ -36,87 +37,183 @@ def _scenarios(summary: Mapping[str, Any]) -> tuple[str, dict]:
     return head, {k: scen[k] for k in order}
 
 
-def _across(per: dict[str, tuple[str, str]], head: str, choice: str) -> tuple[str, str]:
+def _across(per: dict[str, str], head: str, why_not_tested: dict[str, str]) -> tuple[str, str]:
     """Combine per-scenario verdicts: the same everywhere -> that verdict; else depends on the camera."""
-    verdicts = {v for v, _ in per.values()}
+    verdicts = set(per.values())
     if len(verdicts) == 1:
         v = verdicts.pop()
-        return v, (per[head][1] if v == C.NOT_TESTED else "")
-    return C.DEPENDS, choice
+        return v, (why_not_tested.get(head, "") if v == C.NOT_TESTED else "")
+    return C.DEPENDS, CAMERA
 
 
-def _claim_same_accuracy(head: str, scen: dict) -> dict:
-    per, texts = {}, {}
-    for name, s in scen.items():
-        eq = s.get("equivalence")
-        if not eq:
-            per[name] = (C.NOT_TESTED, "no paired equivalence test in this summary")
-            texts[name] = "not evaluated"
+def _name(m: str) -> str:
+    return NAMES.get(m, m)
+
+
+# ------------------------------------------------------------ paired intervals
+def paired(s: Mapping[str, Any], method: str, reference: str) -> dict | None:
+    """The paired intervals of ``method`` minus ``reference`` in one scenario summary:
+    {metric: (mean, lo, hi, reference mean)} (m), or None if the summary pairs them nowhere.
+    The equivalence section (90 % intervals of the landmark-phase errors) where it holds
+    the pair, else B-T3's pair table (95 % intervals of the descent RMS and touchdown errors)."""
+    eq = s.get("equivalence") or {}
+    if eq.get("reference") == reference or (reference == "svd" and "reference" not in eq and eq):
+        res = (eq.get("methods") or {}).get(method) or {}
+        means = {q: ((eq.get("metrics") or {}).get(q) or {}).get("means", {}) for q in PRIMARY}
+        if all(q in res for q in PRIMARY):
+            return {q: (float(res[q]["mean"]), float(res[q]["lo"]), float(res[q]["hi"]),
+                        float(means[q].get(reference, math.nan))) for q in PRIMARY}
+    pairs = s.get("pairs") or {}
+    meth = s.get("methods") or {}
+    for a, b, sign in ((method, reference, 1.0), (reference, method, -1.0)):
+        p = pairs.get(f"{a}_vs_{b}")
+        if p is None:
             continue
-        d = eq["methods"]["depth"]
-        pick = float(d.get("same_pick_pct", math.nan))
-        ctrl = list(s.get("controls_equivalent") or eq.get("controls_equivalent") or [])
-        if not math.isnan(pick) and pick >= SAME_PICK_MAX_PCT:
-            per[name] = (C.NOT_TESTED, f"depth and SVD pick the same landmark in {fmt(pick)} % of the planning calls")
-        elif bool(d.get("equivalent")) and not ctrl:
-            per[name] = (C.REPRODUCED, "")
+        out = {}
+        for q in PAIR_METRICS:
+            m, lo, hi = (float(p[f"d_{q}_m"]), float(p[f"d_{q}_lo_m"]), float(p[f"d_{q}_hi_m"]))
+            if sign < 0:
+                m, lo, hi = -m, -hi, -lo
+            out[f"{q}_err_m"] = (m, lo, hi, float((meth.get(reference) or {}).get(f"{q}_err_m_mean", math.nan)))
+        return out
+    return None
+
+
+def _within(iv: dict, rel: float) -> bool:
+    """Every metric's interval inside +-rel x the reference's mean (equivalence)."""
+    return all(math.isfinite(r) and -rel * r < lo and hi < rel * r for _, lo, hi, r in iv.values())
+
+
+def _below(iv: dict, margin: float) -> bool:
+    """Every metric's interval below -margin (superiority: the method's error smaller)."""
+    return all(hi < -margin for _, _, hi, _ in iv.values())
+
+
+def _iv_text(iv: dict, what: str) -> str:
+    q, (m, lo, hi, r) = next(iter(iv.items()))
+    return f"{m:+.2g} m [{lo:+.2g}, {hi:+.2g}] against {what} {fmt(r)} m"
+
+
+def _same_pick(s: Mapping[str, Any], method: str) -> float:
+    eq = (s.get("equivalence") or {}).get("methods") or {}
+    v = (eq.get(method) or {}).get("same_pick_pct")
+    return float(v) if v is not None else math.nan
+
+
+def _compare(s, compared, controls, test) -> tuple[dict, list, list]:
+    """(per baseline: intervals or None, baselines that fail, controls that pass) in one scenario."""
+    ivs = {b: paired(s, "depth", b) for b in compared}
+    fail = [b for b, iv in ivs.items() if iv is not None and not test(iv)]
+    met = [c for c in controls if (iv := paired(s, c, "svd")) is not None and test(iv)]
+    return ivs, fail, met
+
+
+def _accuracy_claim(cid: str, head: str, scen: dict, plan: Plan, superior: bool) -> dict:
+    v = plan.variants(cid)
+    compared, controls = list(v.get("compared") or ["svd"]), list(v.get("controls") or [])
+    if superior:
+        margin = plan.margin(cid, "superiority_margin_m")
+        test = lambda iv: _below(iv, margin)  # noqa: E731
+    else:
+        rel = plan.margin(cid, "margin_rel")
+        test = lambda iv: _within(iv, rel)  # noqa: E731
+    pick_max = plan.margin(cid, "same_pick_max_pct")
+    per, why, texts, flags = {}, {}, {}, []
+    for name, s in scen.items():
+        ivs, fail, met = _compare(s, compared, controls, test)
+        missing = [b for b, iv in ivs.items() if iv is None]
+        pick = _same_pick(s, "depth")
+        if ivs.get("svd") is None:
+            per[name], why[name] = C.NOT_TESTED, "no paired comparison with SVD in this summary"
+        elif math.isfinite(pick) and pick >= pick_max:
+            per[name] = C.NOT_TESTED
+            why[name] = f"depth and SVD pick the same landmark in {fmt(pick)} % of the planning calls"
         else:
-            per[name] = (C.NOT_REPRODUCED, "")
-        means = (eq.get("metrics", {}).get("lastlm_pos_err_m", {}) or {}).get("means", {})
-        texts[name] = (f"{'equivalent' if d.get('equivalent') else 'not equivalent'} to SVD"
-                       + (f" (last-update error {fmt(means.get('depth'))} m vs {fmt(means.get('svd'))} m)" if means else "")
-                       + f", same pick {fmt(pick)} %"
-                       + (f", controls also equivalent: {join(ctrl)}" if ctrl else ""))
-    verdict, named = _across(per, head, "the camera, which the paper does not give")
-    eqh = (scen[head].get("equivalence") or {}).get("methods", {}).get("depth", {})
-    ctrl_h = list(scen[head].get("controls_equivalent") or (scen[head].get("equivalence") or {}).get("controls_equivalent") or [])
-    cause = (f"In the {head} scenario {_clause(eqh.get('text', texts[head]))}"
-             + (f"; but the same rule also finds the control{'s' if len(ctrl_h) > 1 else ''} {join(ctrl_h)} "
-                "equivalent, so it cannot credit the depth-error metric" if ctrl_h else "")
-             + "".join(f"; in {k}: {texts[k]}" for k in scen if k != head))
+            per[name] = C.NOT_REPRODUCED if fail else C.REPRODUCED
+        if met and per[name] == C.REPRODUCED:
+            flags.append(("control_also_meets", f"{', '.join(met)} ({name})"))
+        if missing:
+            flags.append(("not_compared", f"{', '.join(_name(b) for b in missing)} ({name})"))
+        texts[name] = (("better than" if superior else "within the margin of") + " "
+                       + join([_name(b) for b in compared if ivs.get(b) is not None and b not in fail], none="none")
+                       + (f", not {join([_name(b) for b in fail])}" if fail else "")
+                       + (f" (vs SVD {_iv_text(ivs['svd'], 'SVD')})" if ivs.get("svd") else ""))
+    verdict, named = _across(per, head, why)
+    s = scen[head]
+    ivs, fail, met = _compare(s, compared, controls, test)
+    what = "smaller errors than" if superior else "errors within the margin of"
+    if verdict == C.NOT_TESTED:
+        cause = f"In the {head} camera {why[head]}" + (
+            ", so equal accuracy follows by construction, not from the metric" if "same landmark" in why[head] else "")
+    elif verdict == C.DEPENDS:
+        cause = (f"Depth has {what} the baselines in "
+                 + join([k for k, x in per.items() if x == C.REPRODUCED]) + " but not in "
+                 + join([k for k, x in per.items() if x != C.REPRODUCED]) + ", and the paper gives no camera")
+    elif verdict == C.REPRODUCED:
+        cause = (f"In the {head} camera depth has {what} " + join([_name(b) for b in compared if ivs.get(b)])
+                 + (f", but so does the control {join(met)}, so the test cannot credit the depth-error metric"
+                    if met else " while no control does, so the test credits the metric"))
+    else:
+        cause = (f"In the {head} camera depth does not have {what} " + join([_name(b) for b in fail])
+                 + (f" (vs SVD {_iv_text(ivs['svd'], 'SVD')})" if ivs.get("svd") else ""))
+    claim = ("Navigation accuracy higher than conventional methods (Highlights)" if superior else
+             "Accuracy almost the same as SVD, GDOP and condition number (Fig. 6)")
+    pub = "higher accuracy" if superior else "almost the same (3-sigma envelopes)"
     others = [k for k in scen if k != head]
-    return C.row("B", "B-C1", "Accuracy almost the same as SVD, GDOP and condition number (Fig. 6)", "almost the same (3-sigma envelopes)", verdict, cause, "B-T3, B-F6, B-X1",
-                 ours_as_written=f"{texts[head]} ({head} camera)",
+    return C.row("B", cid, claim, pub, verdict, cause, "B-T3, B-F6, B-X1", ours_as_written=f"{texts[head]} ({head} camera)",
                  ours_best="; ".join(texts[k] for k in others), best_variant=join(others, none=""),
-                 named=named)
+                 named=named, flags=flags)
 
 
-def _claim_faster(head: str, scen: dict) -> dict:
-    per, texts = {}, {}
+def _claim_faster(head: str, scen: dict, plan: Plan) -> dict:
+    cid = "B-C2"
+    step = plan.margin(cid, "min_difference_s")
+    per, why, texts = {}, {}, {}
     for name, s in scen.items():
         cf = (s.get("converges_faster") or {}).get("depth")
         if not cf:
-            per[name] = (C.NOT_TESTED, "no paired time-to-converge in this summary")
-            texts[name] = "not evaluated"
+            per[name], why[name], texts[name] = C.NOT_TESTED, "no paired time to converge in this summary", "not evaluated"
             continue
-        per[name] = (C.REPRODUCED if cf.get("verdict") == "faster" else C.NOT_REPRODUCED, "")
-        texts[name] = (f"{cf.get('verdict')}: depth minus SVD {fmt(cf.get('mean_s'))} s "
-                       f"[{fmt(cf.get('lo_s'))}, {fmt(cf.get('hi_s'))}] s over {cf.get('n_runs')} runs")
-    verdict, named = _across(per, head, "the camera, which the paper does not give")
-    cf = (scen[head].get("converges_faster") or {}).get("depth") or {}
-    cause = (f"In the {head} scenario {_clause(cf.get('text', texts[head]))}"
-             + "".join(f"; in {k}: {texts[k]}" for k in scen if k != head))
+        m, lo, hi = float(cf.get("mean_s", math.nan)), float(cf.get("lo_s", math.nan)), float(cf.get("hi_s", math.nan))
+        faster = math.isfinite(hi) and hi < 0 and m <= -step
+        per[name] = C.REPRODUCED if faster else C.NOT_REPRODUCED
+        texts[name] = (f"depth minus SVD {fmt(m)} s [{fmt(lo)}, {fmt(hi)}] over {cf.get('n_runs')} runs, "
+                       f"below {fmt(cf.get('threshold_m'))} m")
+    verdict, named = _across(per, head, why)
+    if verdict == C.DEPENDS:
+        cause = (f"Depth converges faster than SVD by at least one filter step ({step:g} s) in "
+                 + join([k for k, x in per.items() if x == C.REPRODUCED]) + " only, so it depends on the camera")
+    elif verdict == C.REPRODUCED:
+        cause = f"In every camera depth reaches the threshold sooner than SVD by at least one filter step ({step:g} s)"
+    elif verdict == C.NOT_TESTED:
+        cause = f"In the {head} camera there is {why[head]}"
+    else:
+        cause = (f"In no camera does depth reach the threshold sooner than SVD by one filter step ({step:g} s) "
+                 f"or more ({head}: {texts[head]})")
     others = [k for k in scen if k != head]
-    return C.row("B", "B-C2", "Position converges slightly faster with depth-error selection (Fig. 6)",
+    return C.row("B", cid, "Position converges slightly faster with depth-error selection (Fig. 6)",
                  "slightly faster", verdict, cause, "B-F6, B-T3", ours_as_written=f"{texts[head]} ({head} camera)",
-                 ours_best="; ".join(texts[k] for k in others), best_variant=join(others, none=""),
-                 named=named)
+                 ours_best="; ".join(texts[k] for k in others), best_variant=join(others, none=""), named=named)
 
 
-def _claim_yaw(head: str, scen: dict) -> dict:
-    per, texts = {}, {}
+def _claim_yaw(head: str, scen: dict, plan: Plan) -> dict:
+    cid = "B-C3"
+    plan.entry(cid)
+    per, why, texts = {}, {}, {}
     for name, s in scen.items():
         y = s.get("yaw_converges")
         if y is None:
-            per[name] = (C.NOT_TESTED, "no yaw envelope in this summary")
-            texts[name] = "not evaluated"
+            per[name], why[name], texts[name] = C.NOT_TESTED, "no yaw envelope in this summary", "not evaluated"
         else:
-            per[name] = (C.REPRODUCED if not y else C.NOT_REPRODUCED, "")
+            per[name] = C.REPRODUCED if not y else C.NOT_REPRODUCED
             texts[name] = "yaw does not converge" if not y else "yaw converges"
-    verdict, named = _across(per, head, "the camera, which the paper does not give")
-    cause = (f"In the {head} scenario {_clause(scen[head].get('yaw_reason', texts[head]))}"
-             + "".join(f"; in {k}: {texts[k]}" for k in scen if k != head))
-    return C.row("B", "B-C3", "Yaw does not converge (one known landmark)", "does not converge",
+    verdict, named = _across(per, head, why)
+    cause = ("With one known landmark the yaw is unobservable, and in "
+             + join([k for k in scen if per[k] == C.REPRODUCED]) + " its 3-sigma envelope does not shrink"
+             if verdict == C.REPRODUCED else
+             f"In the {head} camera {texts[head]}, "
+             + ("which one known landmark should not allow" if verdict == C.NOT_REPRODUCED else "unlike the other camera"))
+    return C.row("B", cid, "Yaw does not converge (one known landmark)", "does not converge",
                  verdict, cause, "B-F6", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
 
 
@@ -127,8 +224,10 @@ PATH_NAMES = {"compiled": "compiled implementation",
 OTHER_PATH = {"compiled": "paper", "paper": "compiled"}
 
 
-def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any]) -> dict:
+def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any], plan: Plan) -> dict:
+    cid = "B-C4"
     p = float(pub["depth_time_reduction_vs_svd_pct"])
+    rel, k = plan.margin(cid, "rel_tol"), plan.margin(cid, "spread_k")
     outs = {}
     for name, s in scen.items():
         d = (s.get("methods") or {}).get("depth") or {}
@@ -137,62 +236,191 @@ def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any]) -> dict:
         for key, lab in (("time_reduction_vs_svd_pct", path), ("time_reduction_vs_svd_alt_pct", alt)):
             if d.get(key) is None:
                 continue
-            v = judge(p, float(d[key]), d.get(f"{key}_std"), unit="%")
-            outs[(name, lab)] = (float(d[key]), v.verdict == V_REPRODUCED)
+            sd = d.get(f"{key}_std")
+            sd = float(sd) if sd is not None and math.isfinite(float(sd)) else 0.0
+            v = float(d[key])
+            outs[(name, lab)] = (v, abs(v - p) <= max(rel * abs(p), k * sd))
+    claim, pubtxt = f"Median planning time {p:g} % below SVD (Fig. 7)", f"{p:g} % less"
     if not outs:
-        return C.row("B", "B-C4", f"Median planning time {p:g} % below SVD (Fig. 7)",
-                     f"{p:g} % less", C.NOT_TESTED, "No planning call was timed in this build.", "B-F7",
+        return C.row("B", cid, claim, pubtxt, C.NOT_TESTED, "No planning call was timed in this build.", "B-F7",
                      named="no timing in this build")
     first = next(iter(outs))
     lit = (head, first[1]) if (head, first[1]) in outs else first
-    txt = {k: f"{fmt(v, 3)} % less time" if v >= 0 else f"{fmt(-v, 3)} % more time" for k, (v, _) in outs.items()}
+    txt = {kk: f"{fmt(v, 3)} % less time" if v >= 0 else f"{fmt(-v, 3)} % more time" for kk, (v, _) in outs.items()}
+    meets = [kk for kk, (_, ok) in outs.items() if ok and kk != lit]
+    band = f"{fmt(p - rel * p)} to {fmt(p + rel * p)} %"
     if outs[lit][1]:
-        verdict, named = C.REPRODUCED, ""
-    elif any(ok for _, ok in outs.values()):
+        verdict, named, wt = C.REPRODUCED, "", ""
+        cause = f"On the same replayed calls depth's median call takes {txt[lit]} than SVD's, inside the band {band}"
+    elif meets:
         verdict = C.DEPENDS
         named = "how the SVD baseline is implemented and which camera is flown"
+        wt = "SVD timed as " + join([f"{kk[1]} ({kk[0]} camera)" for kk in meets])
+        cause = (f"Depth's median call takes {txt[lit]} than SVD's as we implement it, outside {band}, and the "
+                 "saving reaches the band only with another SVD implementation, so the metric decides less than the baseline does")
     else:
-        verdict, named = C.NOT_REPRODUCED, ""
-    best = min((k for k in outs if k != lit), key=lambda k: (abs(outs[k][0] - p), k), default=None)
-    cause = (f"On the same replayed planning calls depth's median call takes {txt[lit]} than SVD's "
-             f"({lit[0]} camera, {lit[1]}) against the published {p:g} %, "
-             "and " + join([f"{txt[k]} ({k[1]}, {k[0]} camera)" for k in outs if k != lit])
-             + "; the size of the saving depends on how the SVD baseline is implemented")
-    return C.row("B", "B-C4", f"Median planning time {p:g} % below SVD (Fig. 7)",
-                 f"{p:g} % less", verdict, cause, "B-F7, B-T3",
+        verdict, named, wt = C.NOT_REPRODUCED, "", ""
+        cause = (f"Depth's median call takes {txt[lit]} than SVD's on the same replayed calls, and no timed SVD "
+                 f"implementation or camera brings the saving into {band}")
+    best = min((kk for kk in outs if kk != lit), key=lambda kk: (abs(outs[kk][0] - p), kk), default=None)
+    return C.row("B", cid, claim, pubtxt, verdict, cause, "B-F7, B-T3",
                  ours_as_written=f"{txt[lit]} ({lit[1]}, {lit[0]} camera)",
                  ours_best=txt[best] if best else "", best_variant=f"{best[1]} ({best[0]} camera)" if best else "",
-                 named=named)
+                 named=named, would_take=wt)
 
 
-def _claim_attitude(summary: Mapping[str, Any], pub: Mapping[str, Any]) -> list[dict]:
+def _claim_optimum(head: str, scen: dict, plan: Plan) -> dict:
+    """Fig. 5's single optimum: read where the summary counts the optima per planning call."""
+    cid = "B-C8"
+    plan.entry(cid)
+    per, why, texts = {}, {}, {}
+    for name, s in scen.items():
+        n = s.get("multi_optimum_pct")
+        if n is None:
+            per[name] = C.NOT_TESTED
+            why[name] = "the pipeline does not count the depth error's local optima per planning call"
+            texts[name] = "not counted"
+        else:
+            per[name] = C.REPRODUCED if float(n) == 0.0 else C.NOT_REPRODUCED
+            texts[name] = f"more than one optimum in {fmt(n)} % of the planning calls"
+    verdict, named = _across(per, head, why)
+    cause = (f"In the {head} camera {why.get(head) or texts[head]}, so the golden-section search's premise "
+             + ("is untested" if verdict == C.NOT_TESTED else "holds" if verdict == C.REPRODUCED else "fails somewhere"))
+    return C.row("B", cid, "The depth error has a single optimum over the viewing angles (Fig. 5)", "one optimum",
+                 verdict, cause, "B-F5", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
+
+
+def _claim_fastest(head: str, scen: dict, plan: Plan) -> dict:
+    cid = "B-C9"
+    plan.entry(cid)
+    per, why, texts = {}, {}, {}
+    for name, s in scen.items():
+        meth = s.get("methods") or {}
+        t = {m: (meth.get(m) or {}).get("median_plan_time_us") for m in ("depth", "svd", "gdop", "cond")}
+        t = {m: float(v) for m, v in t.items() if v is not None and math.isfinite(float(v))}
+        if "depth" not in t or "svd" not in t:
+            per[name], why[name], texts[name] = C.NOT_TESTED, "depth or SVD was not timed", "not timed"
+            continue
+        order = sorted(t, key=lambda m: (t[m], m))
+        base = [m for m in order if m != "depth"]
+        per[name] = C.REPRODUCED if order[0] == "depth" and base[0] == "svd" else C.NOT_REPRODUCED
+        texts[name] = " < ".join(f"{_name(m)} {fmt(t[m])} us" for m in order)
+    verdict, named = _across(per, head, why)
+    if verdict == C.NOT_TESTED:
+        cause = f"In the {head} camera {why[head]}"
+    else:
+        cause = (f"Median planning calls in the {head} camera order as {texts[head]}"
+                 + {C.REPRODUCED: "", C.NOT_REPRODUCED: ", not depth first and SVD the fastest baseline"}.get(
+                     verdict, ", and the order differs between cameras"))
+    return C.row("B", cid, "Depth takes the least planning time of the four; SVD is the fastest baseline (Fig. 7)",
+                 "depth < SVD < GDOP, condition number", verdict, cause, "B-F7, B-T3",
+                 ours_as_written=f"{texts[head]} ({head} camera)", named=named)
+
+
+def _claim_envelopes(head: str, scen: dict, plan: Plan) -> dict:
+    cid = "B-C10"
+    rel = plan.margin(cid, "envelope_rel")
+    compared = list(plan.variants(cid).get("compared") or ["svd"])
+    cols = ("rms_vel_err_mps_3sigma", "rms_att_err_deg_3sigma")
+    per, why, texts = {}, {}, {}
+    for name, s in scen.items():
+        meth = s.get("methods") or {}
+        d = meth.get("depth") or {}
+        ratios = {}
+        for b in compared:
+            mb = meth.get(b) or {}
+            for c in cols:
+                if d.get(c) is not None and mb.get(c) not in (None, 0):
+                    ratios[(b, c)] = float(d[c]) / float(mb[c])
+        if not ratios:
+            per[name], why[name], texts[name] = C.NOT_TESTED, "no velocity or attitude envelopes in this summary", "n/a"
+            continue
+        off = {kk: r for kk, r in ratios.items() if abs(r - 1.0) > rel}
+        per[name] = C.NOT_REPRODUCED if off else C.REPRODUCED
+        worst = max(ratios, key=lambda kk: (abs(ratios[kk] - 1.0), kk))
+        texts[name] = (f"depth / {_name(worst[0])} {'velocity' if 'vel' in worst[1] else 'attitude'} 3-sigma "
+                       f"{fmt(ratios[worst])} (largest departure of {len(ratios)})")
+    verdict, named = _across(per, head, why)
+    cause = (f"In the {head} camera {why[head]}" if per.get(head) == C.NOT_TESTED else
+             f"In the {head} camera the largest departure is {texts[head]}, "
+             + (f"inside {100 * rel:g} % of the baseline's envelope" if per.get(head) == C.REPRODUCED
+                else f"outside {100 * rel:g} % of the baseline's envelope" if per.get(head) == C.NOT_REPRODUCED
+                else why.get(head, "")))
+    return C.row("B", cid, "Velocity and attitude error envelopes almost the same (Fig. 6)", "almost the same",
+                 verdict, cause, "B-T3, B-F6", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
+
+
+def _small_sample(summary: Mapping[str, Any], plan: Plan) -> list:
+    n = summary.get("n_runs")
+    if n is None:
+        return []
+    return [("sample_too_small", f"{int(n)} runs")] if int(n) < plan.guard("min_full_seeds") else []
+
+
+def claim_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan) -> list[dict]:
+    """Paper B's claims-table rows (ids B-C1 ... B-C4, B-C7 ... B-C10, stable)."""
+    head, scen = _scenarios(summary)
+    rows = [_accuracy_claim("B-C1", head, scen, plan, superior=False), _claim_faster(head, scen, plan),
+            _claim_yaw(head, scen, plan), _claim_timing(head, scen, pub, plan),
+            _accuracy_claim("B-C7", head, scen, plan, superior=True), _claim_optimum(head, scen, plan),
+            _claim_fastest(head, scen, plan), _claim_envelopes(head, scen, plan)]
+    small = C.flag_text(_small_sample(scen[head], plan))
+    if small:
+        for r in rows:
+            if r["claim_id"] in ("B-C1", "B-C2", "B-C3", "B-C7", "B-C10"):
+                r["flags"] = f"{r['flags']}; {small}" if r["flags"] else small
+    return rows
+
+
+# ------------------------------------------------------------ derived inputs
+def terminal_accel_to_match(landing_cfg: Mapping[str, Any], tilt_deg: float, azimuth_deg: float) -> list[float]:
+    """The terminal horizontal acceleration (m/s^2) under which our guidance starts with the
+    published thrust tilt and azimuth (least squares over ``landing.terminal_accel_mps2``)."""
+    from scipy.optimize import least_squares
+
+    from opnav.landing.scenario import thrust_tilt_azimuth_deg
+
+    def resid(a):
+        t, z = thrust_tilt_azimuth_deg({**landing_cfg, "terminal_accel_mps2": [float(a[0]), float(a[1])]})
+        return [t - tilt_deg, (z - azimuth_deg + 180.0) % 360.0 - 180.0]
+
+    a0 = landing_cfg.get("terminal_accel_mps2") or [0.0, 0.0]
+    sol = least_squares(resid, x0=[float(a0[0]), float(a0[1])], xtol=1e-12, ftol=1e-12)
+    return [float(sol.x[0]), float(sol.x[1])]
+
+
+def input_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan,
+               landing_cfg: Mapping[str, Any] | None = None) -> list[dict]:
+    """Paper B's derived inputs (inputs.csv): Table 1's initial pitch and yaw, how we derive
+    them and what would match the published values."""
     if "initial_tilt_deg" not in summary:
         return []
     att = pub["table1_initial_state"]["att_deg"]
     tilt_pub, az_pub = -float(att[1]), -float(att[0])
     tilt, az = float(summary["initial_tilt_deg"]), float(summary["initial_azimuth_deg"])
-    vt = judge(tilt_pub, tilt, abs_tol=1.0, unit="deg")
-    va = judge(az_pub, az, abs_tol=1.0, unit="deg")
-    rows = [C.row("B", "B-C5", "Initial pitch (Table 1), read as the thrust tilt",
-                  f"{att[1]:g} deg (tilt {tilt_pub:g} deg)",
-                  C.REPRODUCED if vt.verdict == V_REPRODUCED else C.NOT_REPRODUCED,
-                  f"The Table 1 position, velocity and the touchdown give a thrust tilt of {fmt(tilt)} deg against "
-                  f"the published {tilt_pub:g} deg ({vt.reason})", "B-T1, B-F4", ours_as_written=f"{fmt(tilt)} deg")]
-    choice = "the terminal horizontal acceleration (landing.terminal_accel_mps2), which the paper does not state"
-    rows.append(C.row("B", "B-C6", "Initial yaw (Table 1), read as the thrust azimuth",
-                      f"{att[0]:g} deg (azimuth {az_pub:g} deg)",
-                      C.DEPENDS if va.verdict == V_REPRODUCED else C.NOT_REPRODUCED,
-                      f"Our thrust azimuth is {fmt(az)} deg against the published {az_pub:g} deg ({va.reason}), and "
-                      f"it is set by {choice}", "B-T1, B-F4", ours_as_written=f"{fmt(az)} deg",
-                      named=choice if va.verdict == V_REPRODUCED else ""))
-    return rows
+    ins = plan.raw.get("inputs", {})
+    match = ""
+    if landing_cfg is not None:
+        a = terminal_accel_to_match(landing_cfg, tilt_pub, az_pub)
+        t2, z2 = _tilt_az({**landing_cfg, "terminal_accel_mps2": a})
+        match = (f"terminal horizontal acceleration ({a[0]:.3g}, {a[1]:.3g}) m/s^2 gives tilt {t2:.2f} deg, "
+                 f"azimuth {z2:.2f} deg")
+    return [
+        {"input": "B Table 1 initial pitch (thrust tilt)", "ours": f"{fmt(tilt)} deg",
+         "published": f"{att[1]:g} deg (tilt {tilt_pub:g} deg)",
+         "how_derived": ins.get("initial_pitch", {}).get("how_derived", ""),
+         "what_would_match": match},
+        {"input": "B Table 1 initial yaw (thrust azimuth)", "ours": f"{fmt(az)} deg",
+         "published": f"{att[0]:g} deg (azimuth {az_pub:g} deg)",
+         "how_derived": ins.get("initial_yaw", {}).get("how_derived", ""),
+         "what_would_match": match},
+    ]
 
 
-def claim_rows(summary: Mapping[str, Any], pub: Mapping[str, Any]) -> list[dict]:
-    """Paper B's claims-table rows (ids B-C1 ... B-C6, stable)."""
-    head, scen = _scenarios(summary)
-    return [_claim_same_accuracy(head, scen), _claim_faster(head, scen), _claim_yaw(head, scen),
-            _claim_timing(head, scen, pub), *_claim_attitude(summary, pub)]
+def _tilt_az(cfg):
+    from opnav.landing.scenario import thrust_tilt_azimuth_deg
+
+    return thrust_tilt_azimuth_deg(cfg)
 
 
 #: the claims the abstract quotes with their cause
