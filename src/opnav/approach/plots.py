@@ -12,12 +12,14 @@ from opnav.core import figures
 
 
 
-def _plain_log_ticks(ax):
+def _plain_log_ticks(ax, which: str = "y"):
+    """Log-axis tick labels as plain numbers (0.5, 1, 2, 5, 10, ...), not 10^k or 4 x 10^0."""
     from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
-    ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
-    ax.yaxis.set_minor_formatter(NullFormatter())
+    for axis in (ax.xaxis, ax.yaxis) if which == "both" else (ax.yaxis,):
+        axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(FormatStrFormatter("%g"))
+        axis.set_minor_formatter(NullFormatter())
 
 
 def _band(ax, x, y, color, label, ls="-"):
@@ -69,7 +71,7 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, axes = plt.subplots(3, 1, figsize=(figures.PAGE_WIDTH_IN, 5.2), sharex=True)
+        fig, axes = plt.subplots(3, 1, figsize=(figures.PAGE_WIDTH_IN, 5.6), sharex=True, layout="constrained")
         truth = None
         for key, r in runs.items():
             th = r["theta_iter_arcsec"]
@@ -96,15 +98,14 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
             lo, hi = ax.get_ylim()
             span = max(abs(truth[i]), 5.0) * 3
             ax.set_ylim(max(lo, truth[i] - span), min(hi, truth[i] + span))
-        axes[0].plot([], [], color="k", ls=":", lw=0.8, label="truth +- 1-sigma bound of the data used")
+        axes[0].plot([], [], color="k", ls=":", lw=0.8, label=r"truth $\pm 1\sigma$ bound of the data used")
         if all(r.get("tz_unobservable", True) for r in runs.values()):
             axes[2].text(0.01, 0.05, "$\\theta_z$: unobservable (held at its initial value)",
                          transform=axes[2].transAxes, fontsize=7)
         axes[-1].set_xlabel("data used (samples); EM iterations spread over each segment")
         h, lab = axes[0].get_legend_handles_labels()
-        fig.legend(h, lab, loc="lower center", fontsize=6, ncol=2, frameon=False)
+        fig.legend(h, lab, loc="outside lower center", fontsize=6, ncol=2, frameon=False)
         axes[0].set_title(f"A-F4 bias estimate, variant: {variant}", fontsize=8)
-        fig.tight_layout(rect=(0, 0.02 + 0.025 * ((len(lab) + 1) // 2), 1, 1))
     return fig
 
 
@@ -114,22 +115,22 @@ def fig_nav_accuracy(runs: dict, variant: str):
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.6), sharex=True)
+        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.0), sharex=True, layout="constrained")
         for key, r in runs.items():
             d = r["seg_data_used"]
             col = _color(r)
             for ax, comp in zip(axes, ("lat", "rng")):
                 _band_log(ax, d, r[f"seg_{comp}_err_km"], col, f"median error, {run_label(r)}")
                 ax.plot(d, r[f"seg_{comp}_3sig_km"].mean(0), color=col, ls=":")
-        axes[0].plot([], [], color="k", ls=":", label="filter 3-sigma of that component (same colour)")
+        axes[0].plot([], [], color="k", ls=":", label=r"filter's $3\sigma$ of that component (same colour)")
         for ax, name in zip(axes, ("lateral (across the line of sight)", "range (along it)")):
             ax.set_xlabel("data used (samples)")
             ax.set_ylabel(f"{name.split()[0]} error (km)")
             ax.set_yscale("log")
             _plain_log_ticks(ax)
             ax.set_title(f"A-F5 {name}, {variant}", fontsize=8)
-        axes[0].legend(fontsize=5.5)
-        fig.tight_layout()
+        h, lab = axes[0].get_legend_handles_labels()
+        fig.legend(h, lab, loc="outside lower center", fontsize=6, ncol=2, frameon=False)
     return fig
 
 
@@ -150,7 +151,7 @@ def fig_consistency(runs: dict, variant: str):
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.6), sharex=True)
+        fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.0), sharex=True, layout="constrained")
         first = True
         n = 1
         for key, r in runs.items():
@@ -162,19 +163,20 @@ def fig_consistency(runs: dict, variant: str):
             for ax, q in zip(axes, ("nees_pos", "nis")):
                 if first:
                     ax.plot(t, np.nanmean(smp["consistency_t"]["before"][q], 0), color="k", ls="--",
-                            label="theta = 0")
+                            label=r"$\theta = 0$")
                 ax.plot(t, np.nanmean(smp["consistency_t"]["after"][q], 0), color=_color(r),
-                        label=f"theta = estimate, {run_label(r)}")
+                        label=rf"$\theta = \hat\theta$, {run_label(r)}")
             first = False
         lo, hi = chi2_band(3, n)
         for ax, name in zip(axes, ("position NEES (3 dof)", "NIS (3 dof)")):
-            ax.axhspan(lo, hi, color="0.6", alpha=0.35, lw=0, label=f"95 % chi-square band, {n} seeds")
+            ax.axhspan(lo, hi, color="0.6", alpha=0.35, lw=0, label=f"95 % $\\chi^2$ band of the mean of {n} seeds")
             ax.set_yscale("log")
+            _plain_log_ticks(ax)
             ax.set_xlabel("time (s)")
             ax.set_ylabel(name)
             ax.set_title(f"A-X4 {name}, {variant}", fontsize=8)
-        axes[0].legend(fontsize=5.5)
-        fig.tight_layout()
+        h, lab = axes[0].get_legend_handles_labels()
+        fig.legend(h, lab, loc="outside lower center", fontsize=6, ncol=2, frameon=False)
     return fig
 
 
@@ -185,18 +187,18 @@ def fig_compensation(runs: dict, variant: str, pub: dict):
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, axes = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 2.7), sharey=True)
+        fig, axes = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 3.1), sharey=True, layout="constrained")
         first = True
         for method, r in runs.items():
             t = r["t_s"]
             split = r.get("err_split_t_km", {})
             if first:
                 axes[0].plot(t, r["err_before_t_km"].mean(0), color="k", ls="--", lw=1.2, zorder=3,
-                             label="before (theta = 0)")
+                             label=r"before ($\theta = 0$)")
                 if "true_theta" in split:
                     lat, rng = split["true_theta"]
                     axes[0].plot(t, np.hypot(lat, rng).mean(0), color="0.5", ls=":", lw=1.2, zorder=3,
-                                 label="true theta (diagnostic floor)")
+                                 label=r"true $\theta$ (diagnostic floor)")
                 for j, ax in enumerate(axes[1:]):
                     if "before" in split:
                         ax.plot(t, split["before"][j].mean(0), color="k", ls="--", lw=1.2, zorder=3)
@@ -217,9 +219,8 @@ def fig_compensation(runs: dict, variant: str, pub: dict):
             ax.set_title(name, fontsize=7)
         axes[0].set_ylabel("position error (km)")
         h, lab = axes[0].get_legend_handles_labels()
-        fig.legend(h, lab, loc="lower center", fontsize=6, ncol=2, frameon=False)
+        fig.legend(h, lab, loc="outside lower center", fontsize=6, ncol=2, frameon=False)
         fig.suptitle(f"A-F6 before vs after compensation, {variant}", fontsize=8)
-        fig.tight_layout(rect=(0, 0.02 + 0.04 * ((len(lab) + 1) // 2), 1, 1))
     return fig
 
 
@@ -228,12 +229,12 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
     import matplotlib.pyplot as plt
 
     with figures.style():
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.8))
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.2), layout="constrained")
         for v, c in curves.items():
             d = np.arange(len(c))
             col = figures.color(v)
             lab = v + (" (diagnostic)" if v == "reference-start" else "")
-            a1.plot(d[1:], c[1:, 0], color=col, label=f"CRLB tx, {lab}")
+            a1.plot(d[1:], c[1:, 0], color=col, label=f"CRLB $t_x$, {lab}")
             row = x1[x1["variant"] == v]
             if len(row):
                 r = row.iloc[0]
@@ -242,14 +243,14 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
                 if "mle_rmse_x_arcsec" in r and not np.isnan(r["mle_rmse_x_arcsec"]):
                     a1.plot([r["mle_samples"]], [r["mle_rmse_x_arcsec"]], "s", color=col)
         a1.axhline(target, **{**figures.PUBLISHED_STYLE, "linestyle": "--", "marker": None,
-                              "label": f"published accuracy claim ({target:g} arcsec)"})
+                              "label": f'published accuracy claim ({target:g}")'})
         a1.plot([], [], "o", color="k", mfc="none", label="RMS error, plain EM (segments)")
         a1.plot([], [], "s", color="k", label="RMS error, ML (SQUAREM, one window)")
         a1.set_xscale("log")
         a1.set_yscale("log")
-        a1.set_xlabel(f"data used after N0 = {N0} (samples)")
-        a1.set_ylabel("1-sigma bound / RMS error (arcsec)")
-        a1.legend(fontsize=5.5)
+        a1.set_xlabel(f"data used after $N_0$ = {N0} (samples)")
+        a1.set_ylabel(r"$1\sigma$ bound / RMS error (arcsec)")
+        _plain_log_ticks(a1, "both")
         for v, c in conv.items():
             col = figures.color(v)
             for method, ls in (("plain", "-"), ("squarem", "--")):
@@ -258,9 +259,10 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
                         label=f"{v}, {method}")
         a2.set_yscale("log")
         a2.set_xlabel("EM map evaluations")
-        a2.set_ylabel("|theta - theta_ML| (arcsec), median")
-        a2.legend(fontsize=5.5, ncol=2)
-        fig.tight_layout()
+        a2.set_ylabel(r"$|\theta - \theta_{ML}|$ (arcsec), median")
+        h1, l1 = a1.get_legend_handles_labels()
+        h2, l2 = a2.get_legend_handles_labels()
+        fig.legend(h1 + h2, l1 + l2, loc="outside lower center", fontsize=6, ncol=3, frameon=False)
     return fig
 
 

@@ -24,6 +24,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import zlib  # noqa: E402
 
+import numpy as np  # noqa: E402
+
 from opnav.core.tables import atomic_target  # noqa: E402
 
 STYLE = Path(__file__).resolve().parents[1] / "opnav.mplstyle"
@@ -125,3 +127,166 @@ def save(fig: "matplotlib.figure.Figure", paths: Iterable[str | Path] | str | Pa
     finally:
         plt.close(fig)
     return out
+
+
+# ------------------------------------------------------------ legends clear of data and text
+#: inside corners tried in this order before a legend goes outside its axes
+LEGEND_CORNERS = ("upper right", "upper left", "lower left", "lower right", "center right", "center left",
+                  "upper center", "lower center")
+
+
+def _renderer(fig):
+    fig.canvas.draw()
+    return fig.canvas.get_renderer()
+
+
+def _texts(fig, renderer) -> list[tuple[str, "Bbox"]]:
+    """(name, display box) of every visible tick label, axis label, title and text of ``fig``."""
+    out = []
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        for axis, nm in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            for tick in axis._update_ticks():  # the ticks drawn (inside the view), as Axis.draw
+                for t in (tick.label1, tick.label2):
+                    if t.get_visible() and t.get_text():
+                        out.append((f"{nm} tick label {t.get_text()!r}", t.get_window_extent(renderer)))
+            lab = axis.label
+            if lab.get_visible() and lab.get_text():
+                out.append((f"{nm} label {lab.get_text()!r}", lab.get_window_extent(renderer)))
+            off = axis.get_offset_text()
+            if off.get_visible() and off.get_text():
+                out.append((f"{nm} offset text {off.get_text()!r}", off.get_window_extent(renderer)))
+        for t in (ax.title, ax._left_title, ax._right_title, *ax.texts):
+            if t.get_visible() and t.get_text():
+                out.append((f"text {t.get_text()!r}", t.get_window_extent(renderer)))
+    for t in fig.texts + ([fig._suptitle] if fig._suptitle is not None else []):
+        if t.get_visible() and t.get_text():
+            out.append((f"figure text {t.get_text()!r}", t.get_window_extent(renderer)))
+    return out
+
+
+def _data_hits(ax, box, renderer) -> list[str]:
+    """The data artists of ``ax`` (lines, spans, bands, markers, bars, images) drawn inside
+    ``box`` (display coordinates; only the part of it inside the axes counts, where the
+    data are drawn)."""
+    from matplotlib.collections import QuadMesh
+    from matplotlib.transforms import Bbox
+
+    inter = Bbox.intersection(box, ax.bbox)
+    if inter is None or inter.width < 1 or inter.height < 1:
+        return []
+    region = inter.padded(-1.0)  # touching is not covering
+    hits = []
+    for line in ax.get_lines():
+        if not line.get_visible():
+            continue
+        path = line.get_transform().transform_path(line.get_path()).cleaned(remove_nans=True)
+        covered = False
+        if len(path.vertices) >= 2 and line.get_linestyle() not in ("None", "none", "", " "):
+            covered = path.intersects_bbox(region, filled=False)
+        if not covered and line.get_marker() not in (None, "None", "none", "", " "):
+            v = path.vertices
+            covered = bool(((v[:, 0] > region.x0) & (v[:, 0] < region.x1)
+                            & (v[:, 1] > region.y0) & (v[:, 1] < region.y1)).any())
+        if covered:
+            hits.append(f"line {line.get_label()!r}")
+    for coll in ax.collections:
+        if not coll.get_visible():
+            continue
+        if isinstance(coll, QuadMesh):
+            if Bbox.intersection(coll.get_window_extent(renderer), region) is not None:
+                hits.append("mesh")
+            continue
+        offsets = coll.get_offsets()
+        if len(offsets) and coll.get_offset_transform() is not None and len(coll.get_paths()) <= 1 + len(offsets) \
+                and not coll.get_transform().contains_branch(ax.transData):
+            pts = coll.get_offset_transform().transform(offsets)
+            pts = pts[np.isfinite(pts).all(1)]
+            if ((pts[:, 0] > region.x0) & (pts[:, 0] < region.x1) & (pts[:, 1] > region.y0)
+                    & (pts[:, 1] < region.y1)).any():
+                hits.append(f"markers {coll.get_label()!r}")
+            continue
+        for p in coll.get_paths():
+            dp = coll.get_transform().transform_path(p).cleaned(remove_nans=True)
+            if len(dp.vertices) >= 2 and dp.intersects_bbox(region, filled=True):
+                hits.append(f"area {coll.get_label()!r}")
+                break
+    for patch in ax.patches:
+        if not patch.get_visible():
+            continue
+        dp = patch.get_transform().transform_path(patch.get_path())
+        if dp.intersects_bbox(region, filled=patch.get_fill()):
+            hits.append(f"patch {patch.get_label()!r}")
+    for im in ax.images:
+        if im.get_visible() and Bbox.intersection(im.get_window_extent(renderer), region) is not None:
+            hits.append("image")
+    return hits
+
+
+def _crosses_frame(box, frame) -> bool:
+    """Whether a legend box lies partly inside and partly outside its axes' frame."""
+    inside = box.overlaps(frame.padded(-1.0))
+    contained = (box.x0 >= frame.x0 - 1 and box.x1 <= frame.x1 + 1 and box.y0 >= frame.y0 - 1
+                 and box.y1 <= frame.y1 + 1)
+    return inside and not contained
+
+
+def legend_collisions(fig) -> list[str]:
+    """Every legend of ``fig`` (axes and figure legends) that covers plotted data of any
+    axes, or a tick label, axis label, title or text: one line per legend and what it
+    covers (empty: every legend is clear). Computed on the drawn figure, as saved."""
+    renderer = _renderer(fig)
+    legends = [(ax, ax.get_legend()) for ax in fig.axes if ax.get_legend() is not None] + \
+              [(None, leg) for leg in fig.legends]
+    texts = _texts(fig, renderer)
+    out = []
+    for owner, leg in legends:
+        if not leg.get_visible():
+            continue
+        box = leg.get_window_extent(renderer)
+        name = f"legend of {owner.get_title() or owner.get_ylabel() or 'axes'!r}" if owner else "figure legend"
+        hit = [n for n, bb in texts if bb.overlaps(box.padded(-1.0))]
+        if owner is not None and _crosses_frame(box, owner.bbox):
+            hit.append("the frame of its axes (its ticks)")
+        for ax in fig.axes:
+            if ax.get_visible() and ax.axison:
+                hit += _data_hits(ax, box, renderer)
+        if hit:
+            out.append(f"{name} covers " + ", ".join(dict.fromkeys(hit)))
+    return out
+
+
+def _clear(leg, fig) -> bool:
+    renderer = _renderer(fig)
+    box = leg.get_window_extent(renderer)
+    if any(bb.overlaps(box.padded(-1.0)) for _, bb in _texts(fig, renderer)):
+        return False
+    return not any(_data_hits(ax, box, renderer) for ax in fig.axes if ax.get_visible() and ax.axison)
+
+
+def place_legend(ax, *args, outside: str = "right", **kw):
+    """The legend of ``ax`` in the first inside corner (:data:`LEGEND_CORNERS`) where it
+    covers no data and no text of the figure as drawn now, else outside the axes
+    (``outside``: "right" or "below"). Call it after the figure's content is drawn; a
+    figure with constrained layout makes room for an outside legend itself."""
+    fig = ax.figure
+    for loc in LEGEND_CORNERS:
+        leg = ax.legend(*args, loc=loc, **kw)
+        if _clear(leg, fig):
+            return leg
+    if outside == "below":
+        return ax.legend(*args, loc="upper center", bbox_to_anchor=(0.5, -0.18), **kw)
+    return ax.legend(*args, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, **kw)
+
+
+def plain_number(x: float) -> str:
+    """A tick or colour-bar label as a plain number (no e-notation): 3 significant
+    digits, thousands without exponent (12,300), small values as decimals (0.00123)."""
+    x = float(x)
+    if x == 0 or not np.isfinite(x):
+        return f"{x:g}"
+    if abs(x) >= 1000:
+        return f"{x:,.0f}"
+    digits = max(0, 2 - int(np.floor(np.log10(abs(x)))))
+    return f"{x:.{digits}f}".rstrip("0").rstrip(".") if "." in f"{x:.{digits}f}" else f"{x:.{digits}f}"

@@ -40,7 +40,7 @@ def fig_true_states(t, r, v, rpy_deg):
                 ax.plot(t, data[:, k], label=names[k])
             ax.set_xlabel("time (s)")
             ax.set_ylabel(f"{lab} ({unit})")
-            ax.legend(loc="best")
+            figures.place_legend(ax)
         return fig
 
 
@@ -78,7 +78,6 @@ def fig_depth_error_map(dm: dict):
         ax.set_xlabel("image u (px)")
         ax.set_ylabel("image v (px)")
         ax.set_title("(a) detected landmarks", fontsize="small")
-        ax.legend(loc="upper left", fontsize="x-small")
         ax = axs[1]
         fx, fd = dm["field_xy"], dm["field_dr"]
         ax.scatter(fx[:, 0] / 1e3, fx[:, 1] / 1e3, c=fd, s=1, cmap="viridis", norm=norm,
@@ -105,25 +104,29 @@ def fig_depth_error_map(dm: dict):
         ax.set_xlabel("x (km)")
         ax.set_ylabel("y (km)")
         ax.set_title("(b) whole field, no image constraint", fontsize="small")
-        ax.legend(loc="lower left", fontsize=4.5, framealpha=0.8)
         cb = fig.colorbar(sc, ax=axs[:2], label="depth estimation error (m)", shrink=0.7,
                           location="bottom", pad=0.02)
         # a log range of less than a decade gets one major tick: five labelled ones instead
         ticks = np.geomspace(norm.vmin, norm.vmax, 5)
-        cb.set_ticks(ticks, labels=[f"{x:.3g}" for x in ticks])
+        cb.set_ticks(ticks, labels=[figures.plain_number(x) for x in ticks])
         cb.ax.minorticks_off()
         ax = axs[2]
         ax.semilogy(dm["beta_deg"], dm["curve_dr"], color="C0")
         for lo, hi in dm["interval_deg"]:
             ax.axvspan(lo, hi, color="0.9", zorder=0)
         ax.axvline(dm["opt_beta_deg"], color="red", ls="--", lw=0.8,
-                   label=f"golden section {dm['opt_beta_deg']:.1f} deg")
+                   label=rf"golden section $\beta$ = {dm['opt_beta_deg']:.1f}°")
         ax.axvline(dm["unconstrained_beta_deg"], color="orange", ls=":", lw=1.0,
-                   label=f"unconstrained {dm['unconstrained_beta_deg']:.1f} deg")
-        ax.set_xlabel("signed beta (deg)")
+                   label=rf"unconstrained $\beta$ = {dm['unconstrained_beta_deg']:.1f}°")
+        ax.set_xlabel(r"signed $\beta$ (deg)")
         ax.set_ylabel("in-plane depth error (m)")
         ax.set_title("(c) velocity's plane (grey: visible)", fontsize="small")
-        ax.legend(loc="upper right", fontsize="x-small")
+        handles, labels = [], []   # one legend for the three panels, below them: clear of the data
+        for a in axs:
+            for h, lab in zip(*a.get_legend_handles_labels()):
+                handles.append(h)
+                labels.append(f"({'abc'[list(axs).index(a)]}) {lab}")
+        fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize="x-small", frameon=False)
         return fig
 
 
@@ -171,12 +174,12 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
                     ax.axvspan(ends["last vision update"], float(t[-1]), color="0.92", zorder=0)
                 ax.set_title(f"{name} {axes[j]}", fontsize="medium")
                 if j == 0:
-                    ax.set_ylabel(f"3 x RMS error ({unit})")
+                    ax.set_ylabel(f"$3\\times$ RMS error ({unit})")
                 if i == 2:
                     ax.set_xlabel("time (s)")
         h, lab = axs[0, 0].get_legend_handles_labels()
         fig.legend(h, lab, loc="outside lower center", ncol=min(5, len(lab)), fontsize="x-small")
-        fig.suptitle("3 x RMS over the runs about zero (bias included); grey: IMU-only coast",
+        fig.suptitle(r"$3\times$ RMS over the runs about zero (bias included); grey: IMU-only coast",
                      fontsize="small")
         return fig
 
@@ -237,9 +240,9 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
         ax.set_ylim(top=ax.get_ylim()[1] * 2.0)   # room for the labels of the tallest boxes
         if any(hatch):                            # which box is which path, where no box is
             from matplotlib.patches import Patch
-            ax.legend(handles=[Patch(facecolor=(0.5, 0.5, 0.5, 0.5), edgecolor="k", label=main_name),
-                               Patch(facecolor="white", edgecolor="0.3", hatch="///", label=alt_name)],
-                      fontsize="x-small", loc="upper left", framealpha=0.9)
+            figures.place_legend(ax, handles=[Patch(facecolor=(0.5, 0.5, 0.5, 0.5), edgecolor="k", label=main_name),
+                                              Patch(facecolor="white", edgecolor="0.3", hatch="///", label=alt_name)],
+                                 fontsize="x-small", framealpha=0.9)
         ax.set_ylabel("planning-call time (µs)")
         n_alt = max((tmg.timed_calls(timing, m, "alt") for m in methods), default=0)
         ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"

@@ -6,7 +6,7 @@ estimator, the variant's colour and the estimator's line style; colours are
 confidence interval as error bars (a share's within 0..100 %); ``sd`` / ``rms`` draw the spread or RMS over
 runs, paper-A estimate errors always as their RMS about the truth, with the 1-sigma CRLB beside it
 (dashed, black). Axis labels are symbols with units; the x label is the study's title. A panel
-whose values are all the same number is left to the table. A
+in which no line moves with the swept value is left to the table. A
 single numeric swept key gives a numeric x axis (log scale when the values span
 a decade or more); otherwise the values are categories, in the study's order.
 """
@@ -105,16 +105,25 @@ def _wrap(text: str, width: int) -> str:
     return "\n".join(textwrap.wrap(text, width)) if "$" not in text else text
 
 
-def _constant(tidy: pd.DataFrame, metric: str, stat: str) -> bool:
-    """A panel whose every plotted value is the same number (e.g. 100 % everywhere): it
-    shows nothing a sentence cannot, so the figure leaves it to the table."""
-    v = tidy.loc[tidy["metric"] == metric, stat].to_numpy(float)
+def _flat(v: np.ndarray) -> bool:
     v = v[np.isfinite(v)]
-    return v.size > 1 and float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.abs(v).max()))
+    return float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.abs(v).max())) if v.size else True
+
+
+def _constant(tidy: pd.DataFrame, metric: str, stat: str) -> bool:
+    """A panel in which no line moves with the swept value (every method's and variant's
+    value the same at every instance, e.g. a stall flag at 100 % for one estimator and 0 %
+    for another): it shows nothing a sentence cannot, so the figure leaves it to the table."""
+    d = tidy[tidy["metric"] == metric]
+    if d["instance"].nunique() < 2:
+        return False
+    by = [c for c in ("variant", "method") if c in d.columns]
+    return all(_flat(g[stat].to_numpy(float)) for _, g in (d.groupby(by, sort=False) if by else [(None, d)]))
 
 
 def fig_study(tidy: pd.DataFrame, study: Mapping):
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, NullFormatter
 
     metrics = [m for m in study["metrics"] if not _constant(tidy, m, plotted_statistic(study, m))] \
         or list(study["metrics"])
@@ -167,12 +176,15 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
             ax.set_xlabel(xlabel)
             if metric.endswith(("_us", "_s")) and np.nanmin(d[stat].to_numpy(float)) > 0:
                 ax.set_yscale("log")  # times span decades between methods
+                ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: figures.plain_number(v)))
             if ticks is not None:
                 ax.set_xticks(range(len(ticks)), ticks, rotation=30 if len(ticks) > 4 else 0)
             else:
                 xs = np.array(sorted(xmap.values()))
                 if xs.min() > 0 and xs.max() / xs.min() >= 10:
                     ax.set_xscale("log")
+                    ax.set_xticks(xs, [figures.plain_number(x) for x in xs])
+                    ax.xaxis.set_minor_formatter(NullFormatter())
         for ax in axs.ravel()[len(metrics):]:
             ax.set_visible(False)
         handles, labels = axs.ravel()[0].get_legend_handles_labels()
