@@ -85,7 +85,7 @@ rule approach_crlb:
     against the roll rate with the rate that reaches the claimed accuracy in the published data."""
     input:
         A_SRC,
-        src("core/published.py", "data/published.yaml"),
+        src("core/published.py", "data/published.yaml", "approach/readings.py"),
         kernels=kernels("approach"),
     output:
         f"{A_WORK}/crlb.pkl",
@@ -124,7 +124,7 @@ rule approach_tables:
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
         stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
-        code=src("approach/report.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
+        code=src("approach/report.py", "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
         x1=report_table(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),

@@ -6,7 +6,8 @@ from pathlib import Path
 
 from opnav.core import published
 from opnav.approach import scenario as sc
-from opnav.approach.cases import headline_case
+from opnav.approach import readings
+from opnav.approach.cases import headline_case, table1_cases
 from opnav.approach.pipeline import bound_curve, roll_rate_study
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
@@ -29,5 +30,12 @@ with script_context(snakemake) as log:
         curves["roll_rate"] = roll_rate_study(setup, samples, setup.accuracy_target_arcsec)
         log.info("roll rate reaching %g arcsec in %d samples: %s deg/s", setup.accuracy_target_arcsec, samples,
                  curves["roll_rate"]["rate_to_target_deg_s"])
+    # two of the paper's statements read against the model (opnav.approach.readings)
+    pa = published.paper_a()
+    installs = [c.install_deg for c in table1_cases(setup) if c.group == "install"]
+    curves["readings"] = {"installation": readings.installation_check(setup, installs, case.truth_arcsec),
+                          "sample_time": readings.sample_time_reading(setup, pa["headline"], pa["simulation"])}
+    log.info("installation by construction: %s; sample time: %s", curves["readings"]["installation"]["by_construction"],
+             curves["readings"]["sample_time"]["bound_after_samples_arcsec"])
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], curves)

@@ -3,7 +3,7 @@
 import sys
 
 from opnav.core import published
-from opnav.approach import report
+from opnav.approach import readings, report
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_json, write_table
@@ -38,5 +38,10 @@ with script_context(snakemake) as log:
         summ["stars"] = report.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
     summ["profile"] = snakemake.params.profile
     summ["text"] = report.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
+    if "readings" in curves:  # the installation rows and the sample time (opnav.approach.readings)
+        summ["installation"] = curves["readings"]["installation"]
+        summ["sample_time"] = curves["readings"]["sample_time"]
+        summ["text"]["installation"] = readings.installation_text(summ["installation"])
+        summ["text"]["sample_time"] = readings.sample_time_text(summ["sample_time"])
     write_json(snakemake.output.summary, summ)
     log.info("wrote %d Table-1 rows", len(t1))

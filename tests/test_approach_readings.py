@@ -1,0 +1,33 @@
+"""Paper A's installation rows and sample time read against the model (issue 44, item 5)."""
+
+import numpy as np
+
+from opnav.approach import camera, readings
+from opnav.core import published
+
+from approach_helpers import approach_cfg
+
+
+def test_installation_cancels_from_the_measurement_by_construction():
+    """The chain A_m A_c^b A_b^i with the commanded body attitude gives the same data for every
+    installation angle (rounding only). Mutation tried: a body attitude that ignores the
+    installation (A_b^i = A_c^i) changes the data by ~1 and fails."""
+    chk = readings.installation_check(approach_cfg(), [0.0, 45.0, 90.0, 135.0, 180.0], (10.0, 20.0, 10.0), n=20)
+    assert chk["by_construction"] and chk["max_rel_change"] < 1e-12
+    # a body-frame deviation would not cancel: ty takes tz's value at 90 deg (rot_x(90) (tx, ty, tz))
+    np.testing.assert_allclose(chk["body_frame_theta_cam_arcsec"][2], camera.rot_x(np.pi / 2) @ [10.0, 20.0, 10.0])
+    assert "by construction" in readings.installation_text(chk)
+
+
+def test_sample_time_reading_puts_both_steps_side_by_side():
+    """250 samples 'about 4 min' imply 0.96 s a sample; the config's step is beside it, and the
+    roll variant's bound after 250 samples is smaller at the longer step (more roll turned)."""
+    cfg = approach_cfg(N0=200, N=50, L=5)
+    pa = published.paper_a()
+    st = readings.sample_time_reading(cfg, pa["headline"], pa["simulation"])
+    assert st["dt_s"]["paper_4_min"] == 240.0 / 250
+    assert st["dt_s"]["config"] == cfg["dt_s"]
+    assert abs(st["minutes_for_samples"]["paper_4_min"] - 4.0) < 1e-12
+    b = st["bound_after_samples_arcsec"]["roll"]
+    assert b["paper_4_min"] < b["config"]
+    assert "0.96 s a sample" in readings.sample_time_text(st)
