@@ -44,6 +44,7 @@ include: "workflow/rules/landing.smk"
 include: "workflow/rules/landing_extra.smk"
 include: "workflow/rules/landing_timing.smk"
 include: "workflow/rules/studies.smk"
+include: "workflow/rules/replication.smk"
 include: "workflow/rules/paper.smk"
 
 

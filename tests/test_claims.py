@@ -302,13 +302,22 @@ def test_a_verdict_that_flips_between_samples_is_unstable():
     main = C.frame(rows_b(summary_b(), PUB["paper_b"]))
     rep = C.frame(rows_b(summary_b(**{"interior": {"faster": (-0.2, -0.5, 0.1)},
                                       "site-tilt": {"faster": (-0.2, -0.5, 0.1)}}), PUB["paper_b"]))
-    out = C.with_replication(main, rep).set_index("claim_id")
+    out = C.with_replication(main, rep, C.replication_plan(C.load_plan(), {"enabled": False})).set_index("claim_id")
     assert out.loc["B-C2", "verdict"] == C.UNSTABLE
     assert out.loc["B-C2", "verdict_replication"] == C.NOT_REPRODUCED
     assert "reproduced" in out.loc["B-C2", "cause"] and "not reproduced" in out.loc["B-C2", "cause"]
     assert "verdict_main: reproduced" in out.loc["B-C2", "flags"]
     assert out.loc["B-C1", "verdict"] == C.REPRODUCED and out.loc["B-C1", "verdict_replication"] == C.REPRODUCED
     assert out.loc["B-C1", "ours_replication"] != ""
+    assert out.loc["B-C8", "verdict_replication"] == "", "not among the plan's replicated claims"
+
+
+def test_the_plan_states_the_replication_size_the_config_flies():
+    plan = C.load_plan()
+    cfg = {"enabled": True, "seed_offset": 1000003, "approach_n_seeds": 10, "landing_n_runs": 100}
+    assert "B-C2" in C.replication_plan(plan, cfg)
+    with pytest.raises(C.PlanError, match=r"replication\.landing_n_runs = 100 but the config's"):
+        C.replication_plan(plan, {**cfg, "landing_n_runs": 300})
 
 
 def test_quick_profile_rows_say_the_sample_is_too_small():

@@ -42,7 +42,7 @@ def _run(tmp_path, rep_faster=None, profile="full"):
         inp["rep_summary_B"] = str(rb)
     out = {k: str(tmp_path / f"out.{k}") for k in ("csv", "md", "tex", "detail", "json", "plan", "inputs")}
     lc = CFG["landing"]
-    params = {"profile": profile, "windows": {"sliding": 50, "growing": 250}, "dt_s": 0.5,
+    params = {"profile": profile, "replication": CFG["replication"], "windows": {"sliding": 50, "growing": 250}, "dt_s": 0.5,
               "landing": {k: lc[k] for k in ("duration_s", "gravity_mps2", "initial_state", "yaw_deg",
                                              "terminal_accel_mps2")}}
     runpy.run_path(str(REPO / "workflow" / "scripts" / "paper_claims.py"),

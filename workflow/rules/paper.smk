@@ -35,7 +35,7 @@ SCORE_INPUTS = {
 
 
 #: the replication sample's summaries (workflow/rules/replication.smk), where it is flown
-REPLICATION_INPUTS = {k: p for k, p in globals().get("REPLICATION_SUMMARIES", {}).items() if p in _targets}
+REPLICATION_INPUTS = dict(REPLICATION_SUMMARIES)
 
 
 rule paper_claims:
@@ -60,6 +60,7 @@ rule paper_claims:
         inputs=f"{PAPER}/inputs.csv",
     params:
         profile=config["profile"],
+        replication=canonical(config["replication"]),
         # the smallest data-to-converge count each EM mode can report (its first window, samples)
         windows={"sliding": config["approach"]["segments"]["N"], "growing": config["approach"]["growing"]["N"]},
         dt_s=config["approach"]["dt_s"],

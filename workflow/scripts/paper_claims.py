@@ -40,9 +40,10 @@ with script_context(snakemake) as log:
     summ, rows = score(inp, "", pub, plan, windows)
     df = claims.frame(rows)
     claims.check_plan_covers(df, plan)
+    rep_ids = claims.replication_plan(plan, dict(par.replication))
     if any(k.startswith("rep_") for k in inp.keys()):
         _, rep_rows = score(inp, "rep_", pub, claims.load_plan(inp["plan"]), windows)
-        df = claims.with_replication(df, claims.frame(rep_rows))
+        df = claims.with_replication(df, claims.frame(rep_rows), rep_ids)
     df = claims.mark_sample(df, str(par.profile))
     unused = plan.unused()
     if unused:

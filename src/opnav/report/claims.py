@@ -395,16 +395,36 @@ def _add_flag(flags: str, name: str, value: str) -> str:
     return f"{flags}; {new}" if flags else new
 
 
-def with_replication(main: pd.DataFrame, rep: pd.DataFrame) -> pd.DataFrame:
+def replication_plan(plan: Plan, cfg: Mapping[str, Any]) -> list[str]:
+    """The claims the replication sample re-judges (plan ``replication.claims``), after
+    checking that the plan states the size the config flies (one line naming the key)."""
+    rep = plan.raw.get("replication") or {}
+    for k in ("seed_offset", "approach_n_seeds", "landing_n_runs"):
+        if k not in rep:
+            raise PlanError(f"{plan.source}: replication.{k} is missing (the plan states the sample's size)")
+        if cfg.get("enabled", True) and k in cfg and rep[k] != cfg[k]:
+            raise PlanError(f"{plan.source}: replication.{k} = {rep[k]} but the config's replication.{k} = {cfg[k]}: "
+                            "the plan must state the size that is flown")
+    ids = list(rep.get("claims") or [])
+    unknown = [c for c in ids if c not in plan.claims]
+    if unknown:
+        raise PlanError(f"{plan.source}: replication.claims names claims without an entry: {unknown}")
+    return ids
+
+
+def with_replication(main: pd.DataFrame, rep: pd.DataFrame, ids: Iterable[str] | None = None) -> pd.DataFrame:
     """The main table with the replication sample's reading beside it.
 
     ``rep``: the claims table of the same claims scored on the replication sample (an
     independent seed base). Its verdict and as-written value fill ``verdict_replication``
     and ``ours_replication``; a claim whose two verdicts differ reads ``unstable``, with
     both verdicts in the cause and the main one kept in ``flags``. Claims the
-    replication does not score keep their verdict, with an empty replication."""
+    replication does not score (or, given ``ids``, not among them) keep their verdict, with
+    an empty replication."""
     out = main.copy()
     r = rep.set_index("claim_id")
+    if ids is not None:
+        r = r[r.index.isin(list(ids))]
     for i, row_ in out.iterrows():
         cid = row_["claim_id"]
         if cid not in r.index:
