@@ -31,3 +31,18 @@ def test_sample_time_reading_puts_both_steps_side_by_side():
     b = st["bound_after_samples_arcsec"]["roll"]
     assert b["paper_4_min"] < b["config"]
     assert "0.96 s a sample" in readings.sample_time_text(st)
+
+
+def test_study_estimator_growing_squarem_converges_where_sliding_plain_stalls():
+    """A-X5's converging estimator (issue 44, item 5): SQUAREM over growing windows reaches the
+    ML estimate of all the data in the roll variant, where sliding plain EM stalls, and its
+    bound is that of all the data after N0 (below the last window's)."""
+    from opnav.approach import study
+
+    cfg = approach_cfg(N0=200, N=50, M=5, L=8)
+    cfg["initial_error"]["mode"] = "sampled"
+    cfg["growing"].update(N=100, M=5)
+    em = study.run_runs(cfg, "roll", "em", [0, 1])
+    gr = study.run_runs(cfg, "roll", "em_growing_squarem", [0, 1])
+    assert (em["converged_pct"] == 0).all() and (gr["converged_pct"] == 100).all()
+    assert (gr["crlb_used_x_arcsec"] < em["crlb_used_x_arcsec"]).all()

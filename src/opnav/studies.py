@@ -78,6 +78,7 @@ METRICS: dict[str, dict[str, tuple[str, str | None]]] = {
         "crlb_used_x_arcsec": ("1-sigma CRLB of tx, data the estimator used (arcsec)", None),
         "crlb_used_y_arcsec": ("1-sigma CRLB of ty, data the estimator used (arcsec)", None),
         "stalled_pct": ("EM seeds the stall rule flags (%)", None),
+        "converged_pct": ("EM seeds labelled converged (%)", None),
         "nav_err_after_km": ("RMS nav. error after compensation (km)", None),
         "data_to_converge_samples": ("data needed to converge (samples)", None),
     },
@@ -91,7 +92,7 @@ DEFAULT_METRICS = {"landing": ["final_pos_err_m", "rms_pos_err_m", "mean_nees_po
                    "approach": ["err_x_arcsec", "err_y_arcsec", "nav_err_after_km"]}
 DEFAULT_METHODS = {"landing": ["depth", "svd"], "approach": ["em", "augmented"]}
 #: Paper-A estimators: em = EM-EKF with approach.em.method; augmented = augmented EKF.
-APPROACH_METHODS = ("em", "em_plain", "em_squarem", "augmented")
+APPROACH_METHODS = ("em", "em_plain", "em_squarem", "em_growing_squarem", "augmented")
 STATISTICS = ("mean", "sd", "rms")
 _LETTER = {"approach": "A", "landing": "B"}
 
@@ -252,7 +253,7 @@ SIM_KEYS = {
                 "camera", "landmarks", "filter", "planner", "mc.base_seed", "mc.bounds", "timing.max_calls"),
     "approach": ("base_seed", "dt_s", "mars_elements", "geometry", "initial_error", "prior_sigma",
                  "process_noise_diag", "camera", "truth_bias_arcsec", "theta_init_arcsec", "segments",
-                 "roll", "crlb", "stars", "em", "nav_error", "alternatives"),
+                 "roll", "crlb", "stars", "em", "nav_error", "alternatives", "growing"),
 }
 
 

@@ -13,7 +13,7 @@ STUDIES_DIR = res("studies")
 STUDY_SHAPES = {
     # paper B: the Monte Carlo's view plus the replay budget of the planning times
     "landing": {**B_SIM, "timing": {"max_calls": config["landing"]["timing"]["max_calls"]}},
-    "approach": cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives"),
+    "approach": cfg("approach", *A_SCENARIO, "em", "nav_error", "alternatives", "growing"),
 }
 
 

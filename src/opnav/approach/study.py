@@ -6,7 +6,10 @@ Monte-Carlo seeds ``seeds`` (streams ``SeedSequence([base_seed, 1, seed])``: the
 measurements for every value and estimator, so comparisons are paired) with one estimator:
 
 * ``em``: the EM-EKF with ``approach.em.method`` (:func:`opnav.approach.cases.run_case`);
-  ``em_plain`` / ``em_squarem``: the EM-EKF with that scheme;
+  ``em_plain`` / ``em_squarem``: the EM-EKF with that scheme; ``em_growing_squarem``:
+  SQUAREM over growing windows (``approach.growing``: the same data, N0 to the end), the
+  Table-1 scheme that converges to the ML estimate of all the data (its ``crlb_used`` is
+  the bound of all data after N0);
 * ``augmented``: the augmented EKF (:func:`opnav.approach.alternatives.run_case_alternatives`),
   from the same start.
 
@@ -46,12 +49,15 @@ def run_runs(setup: Setup | dict, variant: str, method: str, seeds, shared: dict
     geo, crlb = shared[key]["geo"], shared[key]["crlb"]
     used = setup.segments.data_samples
     if method.startswith("em"):
-        scheme = setup.em.method if method == "em" else method.removeprefix("em_")
-        r = cases.run_case(setup, variant, case, seeds, geo=geo, method=scheme)
-        if "crlb_used" not in shared[key]:
-            shared[key]["crlb_used"] = segment_bounds(setup, geo, geo.measurement_variance(case.sigma3_px),
-                                                      case.truth_arcsec, variant)[-1]
-        crlb_used = shared[key]["crlb_used"]
+        name = method.removeprefix("em").lstrip("_")
+        mode = "growing" if name.startswith("growing") else "sliding"
+        scheme = name.removeprefix("growing").lstrip("_") or setup.em.method
+        s = setup.scheme(mode)
+        r = cases.run_case(s, variant, case, seeds, geo=geo, method=scheme)
+        if ("crlb_used", mode) not in shared[key]:
+            shared[key][("crlb_used", mode)] = segment_bounds(s, geo, geo.measurement_variance(case.sigma3_px),
+                                                              case.truth_arcsec, variant)[-1]
+        crlb_used = shared[key][("crlb_used", mode)]
         stalled = 100.0 * np.asarray(r["stalled"], float)
     elif method == "augmented":
         r = alt.run_case_alternatives(setup, variant, case, seeds, geo, methods=("augmented",))
@@ -68,5 +74,7 @@ def run_runs(setup: Setup | dict, variant: str, method: str, seeds, shared: dict
         "crlb_x_arcsec": float(crlb[0]), "crlb_y_arcsec": float(crlb[1]),
         "crlb_used_x_arcsec": float(crlb_used[0]), "crlb_used_y_arcsec": float(crlb_used[1]),
         "stalled_pct": stalled,
+        "converged_pct": (100.0 * (np.asarray(r["label"]) == "converged").astype(float) if "label" in r
+                          else np.full(len(seeds), np.nan)),
         "data_samples": used,
     })

@@ -55,7 +55,7 @@ PALETTE: dict[str, str] = {
 }
 #: Other spellings of the same method (table labels, study estimator names).
 ALIASES: dict[str, str] = {
-    "em_plain": "plain", "em_squarem": "squarem", "EM-EKF (plain)": "plain",
+    "em_plain": "plain", "em_squarem": "squarem", "em_growing_squarem": "growing-squarem", "EM-EKF (plain)": "plain",
     "EM-EKF (SQUAREM)": "squarem", "augmented EKF": "augmented", "batch ML (IPOPT)": "batch_ml",
 }
 
