@@ -180,8 +180,6 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     z (S, n+1, 3) (index 0 ignored), theta (S, 3) rad, x0 (S, 6), P0 (S, 6, 6) or (6, 6).
     ``predicted=False``: ``xp, Pp`` are not kept (None; the RTS smoother needs them, the
     Bryson-Frazier smoother and the E-step do not); every other output is the same.
-    CPU against the stacked numpy loop it replaced (f02dab2): 0.04-0.06 of it for 3 seeds,
-    0.17-0.26 for 20, 0.39-0.48 for 80 (50-2000 samples; ``bench_approach.py --kernels``).
     """
     S, n = z.shape[0], win.n
     A = misalignment_small(np.asarray(theta, float))

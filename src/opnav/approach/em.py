@@ -256,10 +256,8 @@ def em_map(theta, z, x0, P0, win, tz_tol):
     and :func:`estep`, seed by seed), then :func:`mstep`. Returns theta', LL(theta), the
     unobservable mask and the filtered state at the window's end ``(x (S, 6), P (S, 6, 6))``.
 
-    CPU against the separate stacked-numpy filter, smoother and E-step it replaced (f02dab2;
-    ``benchmarks/bench_approach.py --kernels --before f02dab2``): 0.05-0.07 of it for 3 seeds,
-    0.13-0.15 for 20, 0.21-0.32 for 80 (50-2000 samples); a full-profile Table-1 group
-    (roll, size, every EM scheme) 29.5 -> 9.3 CPU-s."""
+    Fused because the EM iterations dominate paper A's CPU; its measured gain is in
+    docs/performance.md ("Measurements formerly in docstrings")."""
     S, n = z.shape[0], win.n
     A = misalignment_small(np.asarray(theta, float))
     Rvar = win.Rvar if win.Rvar.ndim == 3 else win.Rvar[:, None, :]

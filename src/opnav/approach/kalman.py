@@ -34,15 +34,9 @@ Implementation
     batched Python API (:func:`predict`, :func:`condition_on`, :func:`propagate`,
     :func:`innovation_loglik`) loops them over the members, and
     :func:`opnav.approach.ekf.filter_window` runs the EM-EKF's whole window for every seed
-    in one call. Measured against the stacked numpy steps they replaced (f02dab2, one
-    process, CPU, a loaded 2-core machine): a single batched call is *not* faster (time
-    update of 60 members 76 -> 64 us, of one 6 x 6 covariance 17 -> 15 us: the Python
-    around either dominates), and the Cramér-Rao recursion of :mod:`opnav.approach.crlb`,
-    which still calls :func:`predict` and :func:`condition_on` once per sample, takes
-    0.22-0.30 s before and 0.47-0.55 s now for a full-profile group's bounds (about 3 % of
-    its Monte-Carlo job); the gain is in the compiled window passes, where the loop over
-    samples is compiled too: one EM map 0.05-0.32 of its numpy time over 50-2000 samples
-    and 3-80 seeds (``benchmarks/bench_approach.py --kernels --before f02dab2``).
+    in one call. A single batched call is no faster than numpy (the Python around it
+    dominates); the gain is in the compiled window passes, where the loop over samples is
+    compiled too (measurements: docs/performance.md, "Measurements formerly in docstrings").
 
 Shapes
     Leading axes ``...`` (seeds, windows, or none) broadcast: ``m (..., d)``,

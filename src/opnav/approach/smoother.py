@@ -207,9 +207,7 @@ def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> S
     slice) of the smoothed moments (``xs (S, n+1, c)``, ``Ps (S, n+1, c, c)``; the E-step
     needs the position only); each entry is the one of the full moments, bit for bit.
     Compiled (:func:`_bryson_frazier_window`, with the steps :func:`bf_moments` and
-    :func:`bf_back` that the EM map's fused pass shares); CPU against the stacked numpy
-    recursion it replaced (f02dab2): 0.08-0.09 of it for 3 seeds, 0.21-0.26 for 20, 0.36-0.50
-    for 80 (50-2000 samples; ``benchmarks/bench_approach.py --kernels --before f02dab2``).
+    :func:`bf_back` that the EM map's fused pass shares).
     The RTS form :func:`rts` and :func:`lag_one_recursive` (eq. 7-9, 18) stay numpy: the
     pipeline does not run them (tests and :func:`opnav.approach.em.expected_complete_loglik`
     check against them).
