@@ -18,7 +18,7 @@ A_SRC = with_kernels("approach", src(
     "approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
     "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
     "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py",
-    "approach/stars.py"))
+    "approach/stars.py", "approach/consider.py"))
 
 
 A_MC = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__{m}.pkl"
