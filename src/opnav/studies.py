@@ -607,36 +607,38 @@ def wide_table(tidy: pd.DataFrame, study: Mapping) -> pd.DataFrame:
 
 
 def caption(study: Mapping) -> str:
-    """The study's caption, from its spec (report and manuscript)."""
+    """The study's caption, from its spec (report and manuscript): at most three sentences
+    (what is swept and compared; what is plotted and what the table adds; the study's own
+    note, its first sentence) and no config key (the keys are in the study's CSV and spec)."""
     paper = {"approach": "paper A", "landing": "paper B"}[study["paper"]]
-    vals = "; ".join(", ".join(f"{k.split('.')[-1]} = {_slug(v)}" for k, v in vs.items())
-                     for vs in study["instances"].values())
-    keys = ", ".join(f"``{k}``" for k in study["keys"])
-    how = "every combination" if study["grid"] and len(study["keys"]) > 1 else "values"
+    swept = study.get("title") or ", ".join(k.split(".")[-1] for k in study["keys"])
+    vals = ("; " if len(study["keys"]) > 1 else ", ").join(
+        ", ".join(_slug(v) for v in vs.values()) for vs in study["instances"].values())
+    fixed = study.get("fixed") or {}
+    fixed_text = (" (" + ", ".join(f"{k.split('.')[-1]} = {_slug(v)}" for k, v in fixed.items()) + " at every value)"
+                  if fixed else "")
     who = ", ".join(study["methods"])
     if study["variants"]:
         who += " under the scenario variants " + ", ".join(study["variants"])
-        runs = (f"{study['runs']} paired Monte-Carlo seeds of the headline case (T1-01) per value, "
-                "the same seeds for every value, variant and estimator")
+        runs = f"{study['runs']} paired seeds of the headline case per value"
     else:
-        runs = (f"{study['runs']} paired runs per value and method (run indices 0-{study['runs'] - 1}, "
-                "the same random streams for every value and method)")
-    stat = {"mean": "mean over runs with its 95 % confidence interval (Student t)",
-            "sd": "spread (sample sd over runs)", "rms": "RMS over runs"}[study["statistic"]]
+        runs = f"{study['runs']} paired runs per value and method"
+    if study["paper"] == "approach" and study["statistic"] == "sd":
+        stat = "RMS about the truth of the estimate errors and the mean of the other metrics"
+    else:
+        stat = {"mean": "mean over runs with its 95 % confidence interval",
+                "sd": "spread (sd over runs)", "rms": "RMS over runs"}[study["statistic"]]
     mets = ", ".join(METRICS[study["paper"]][m][0] for m in study["metrics"])
-    fixed = study.get("fixed") or {}
-    fixed_text = ("; " + ", ".join(f"``{k}`` = {_slug(v)}" for k, v in fixed.items()) + " for every value"
-                  if fixed else "")
-    return (f"Study '{study['name']}' ({paper}): {keys} swept, {how} {vals}{fixed_text}; all other settings as "
-            f"configured. Compared: {who}; {runs}. Plotted: the {stat} of {mets}"
+    note = re.split(r"(?<=[.!?])\s+(?=[A-Z])", " ".join(str(study.get("note") or "").split()))[0]
+    return (f"Study '{study['name']}' ({paper}): {swept} at {vals}{fixed_text}, all else as configured; "
+            f"compared: {who}, {runs}. Plotted: the {stat} of {mets}"
             + (" beside the 1-sigma Cramer-Rao bound" if study["paper"] == "approach"
                and study["statistic"] != "mean" else "")
-            + ". The CSV table (tidy, one row per value, method and metric) gives n, mean, sd, RMS, "
-            f"median, the 95 % interval of the mean and the paired difference against {study['methods'][0]}"
-            + (f"; the slopes table, the log-log slope of each against {study['keys'][0]}"
-               if study.get("slopes") else "") + "."
-            + _timing_text(study)
-            + (f" {study['note']}" if study.get("note") else ""))
+            + f"; the CSV table adds n, sd, RMS, median, the 95 % interval and the paired difference against "
+            f"{study['methods'][0]}"
+            + (f", and the log-log slopes against {swept}" if study.get("slopes") else "")
+            + _timing_text(study) + "."
+            + (f" {note}" if note else ""))
 
 
 #: per-run metrics measured by replaying the runs' planning calls (opnav.landing.timing)
@@ -650,8 +652,6 @@ def _timing_text(study: Mapping) -> str:
     n = study.get("timing_calls")
     per_job = min(int(study.get("runs_per_job") or study["runs"]), int(study["runs"]))
     which = ("every recorded planning call" if not n else
-             f"at most {n} of a job's recorded planning calls (landing.timing.max_calls; jobs of "
-             f"{per_job} runs), evenly spaced over them, so a run's median rests on about "
-             f"{max(n // per_job, 1)} calls (a run with none is left out)")
-    return (" Planning times: by replay through the run's method, one call at a time and apart "
-            "from the filter's work (time.perf_counter_ns; CPU: the thread clock), of " + which + ".")
+             f"at most {n} of a job's recorded planning calls (jobs of {per_job} runs), evenly spaced, "
+             f"so a run's median rests on about {max(n // per_job, 1)} calls")
+    return "; planning times by replay, apart from the filter's work, of " + which

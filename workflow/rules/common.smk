@@ -116,6 +116,8 @@ def report_table(stem, caption_id, category, subcategory=None):
     """Table outputs; the CSV goes into `snakemake --report` with its caption, under its
     output id as subcategory unless one is given (never the report's catch-all "Other")."""
     csv, tex, md = table_outputs(stem)
+    if (Path(workflow.basedir) / "workflow" / "report" / f"{caption_id}.table.rst").is_file():
+        caption_id += ".table"  # the table's own caption where a figure shares its id
     return [report(csv, caption=_caption(caption_id), category=category,
                    subcategory=subcategory or caption_id), tex, md]
 

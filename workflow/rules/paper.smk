@@ -166,8 +166,35 @@ rule provenance:
         "../scripts/provenance.py"
 
 
+rule paper_page_one:
+    """Page 1 (short abstract, verdict figure), the report's claims at a glance and the table
+    of what we did differently, from the claims table (opnav.report.manuscript, verdict_plot,
+    differences)."""
+    input:
+        claims=rules.paper_claims.output.csv,
+        published=src("data/published.yaml"),
+        choices=src("data/differences.yaml"),
+        code=src("report/manuscript.py", "report/verdict_plot.py", "report/differences.py"),
+    output:
+        abstract=f"{PAPER}/abstract.tex",
+        fig_pdf=f"{PAPER}/verdicts.pdf",
+        fig_png=report(f"{PAPER}/verdicts.png", caption=_caption("verdicts"), category="Claims",
+                       subcategory="verdicts"),
+        glance=f"{PAPER}/claims_glance.csv",
+        differences=f"{PAPER}/differences.tex",
+        runinfo=f"{PAPER}/runinfo.tex",
+    params:
+        config=canonical({k: config[k] for k in ("approach", "landing")}),
+        results=RESULTS,
+    log:
+        f"{PAPER}/logs/paper_page_one.log",
+    localrule: True
+    script:
+        "../scripts/paper_page_one.py"
+
+
 PAPER_INPUTS = [rules.paper_floats.output, rules.paper_macros.output, rules.paper_scorecard.output,
-                rules.paper_claims.output, rules.provenance.output]
+                rules.paper_claims.output, rules.provenance.output, rules.paper_page_one.output]
 
 LATEX_HINT = (
     "opnav: LaTeX not found, skipping results/paper/main.pdf; to build it install: "

@@ -166,6 +166,8 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
     for p in map(Path, paths):
         cid = output_id(p)
         cap_file = captions_dir / f"{cid}.rst"
+        if p.suffix == ".tex" and (captions_dir / f"{cid}.table.rst").is_file():  # a table's own caption
+            cap_file = captions_dir / f"{cid}.table.rst"
         if not cap_file.is_file():  # a generated caption beside the output (parameter studies)
             cap_file = p.parent / f"{cid}.rst"
         if not cap_file.is_file():
@@ -344,3 +346,107 @@ def claims_detail_latex(df: "pd.DataFrame") -> str:
         out.append(" ".join(parts))
     out.append(r"\end{description}")
     return "\n".join(out) + "\n"
+
+
+# ------------------------------------------------------------ page 1: the short abstract
+#: the abstract's length limit (words, LaTeX markup not counted)
+ABSTRACT_MAX_WORDS = 200
+#: the words of the framing sentences main.tex writes before the generated findings
+ABSTRACT_FRAMING_WORDS = 50
+#: verdicts a reader counts as "not reproduced" in the broad sense (each group gets its cause)
+_NOT_OK = ("not_reproducible", "not_reproduced", "depends_on_choice", "suspect", "unstable", "not_tested")
+_PAPER_WORDS = {"A": "Paper A", "B": "Paper B"}
+
+
+def _col(r: Mapping, key: str) -> str:
+    v = r.get(key, "")
+    return "" if v is None or (isinstance(v, float) and math.isnan(v)) or str(v) == "nan" else str(v).strip()
+
+
+def _sentence(text: str) -> str:
+    text = " ".join(text.split()).rstrip(" .;")
+    return (text[0].upper() + text[1:] + ".") if text else ""
+
+
+def word_count(text: str) -> int:
+    """Words of a (plain or LaTeX) text: tokens with a letter or digit, markup stripped."""
+    plain = re.sub(r"\\[A-Za-z]+\*?|[{}$]", " ", text)
+    return sum(1 for w in plain.split() if re.search(r"[A-Za-z0-9]", w))
+
+
+def abstract_findings(df: "pd.DataFrame") -> str:
+    """The findings of page 1 in plain sentences (plain text; :func:`prose_tex` makes it LaTeX),
+    generated from the claims table: per paper, the verdict counts; for each group of claims
+    not reproduced as written, the group's one cause (the cause of its first claim, which the
+    others share when the table names the same bound, choice or flag) and what it would take.
+    Groups are dropped from the largest paper's tail until the whole is at most
+    :data:`ABSTRACT_MAX_WORDS` words with the framing sentence of ``main.tex``."""
+    from opnav.report.claims import VERDICT_SHORT, VERDICTS
+
+    rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
+    if not rows:
+        return "No claim was evaluated in this build."
+    papers = list(dict.fromkeys(r["paper"] for r in rows))
+    per_paper: dict[str, list[str]] = {}
+    for p in papers:
+        g = [r for r in rows if r["paper"] == p]
+        counts = [(v, sum(1 for r in g if r["verdict"] == v)) for v in VERDICTS]
+        parts = [f"{n} {VERDICT_SHORT[v]}" for v, n in counts if n]
+        s = [_sentence(f"{_PAPER_WORDS.get(p, 'Paper ' + p)}: of its {len(g)} claims, " + ", ".join(parts[:-1])
+                       + (" and " if len(parts) > 1 else "") + parts[-1])]
+        groups = [(v, [r for r in g if r["verdict"] == v]) for v in VERDICTS if v in _NOT_OK]
+        for v, grp in sorted([x for x in groups if x[1]], key=lambda x: -len(x[1])):  # largest group first (stable)
+            ids = [r["claim_id"] for r in grp]
+            cause = _col(grp[0], "cause")
+            head = (f"{', '.join(ids[:-1])} and {ids[-1]} are" if len(ids) > 1 else f"{ids[0]} is") \
+                + f" {VERDICT_SHORT[v]}"
+            unit = _sentence(f"{head} because {cause[0].lower() + cause[1:]}" if cause else head)
+            take = _col(grp[0], "would_take")
+            if take:
+                unit += " " + _sentence(f"What it would take: {take}")
+            s.append(unit)
+        per_paper[p] = s
+    budget = ABSTRACT_MAX_WORDS - ABSTRACT_FRAMING_WORDS
+    while sum(word_count(" ".join(s)) for s in per_paper.values()) > budget:
+        longest = max(per_paper, key=lambda p: (len(per_paper[p]), word_count(" ".join(per_paper[p])),
+                                                papers.index(p)))  # ties: the later paper gives way
+        if len(per_paper[longest]) <= 1:
+            break
+        per_paper[longest].pop()
+    return " ".join(" ".join(s) for s in per_paper.values())
+
+
+def page_one_abstract_tex(df: "pd.DataFrame", sample_sentence: str = "") -> str:
+    """The generated part of page 1's abstract as LaTeX: the findings and, for a quick-profile
+    table, the sentence that its sample is too small for verdicts (first)."""
+    text = abstract_findings(df)
+    return prose_tex(" ".join(t for t in (sample_sentence, text) if t)) + "\n"
+
+
+def sample_sentence_of(df: "pd.DataFrame") -> str:
+    """The claims table's own sentence on its sample (quick profile: too small for verdicts);
+    empty for a full build or a table without the ``sample`` column."""
+    if "sample" not in df.columns:
+        return ""
+    from opnav.report.claims import sample_sentence
+
+    return sample_sentence(df)
+
+
+def run_info_tex(bench_tables: Iterable["pd.DataFrame"], cpus: int | None, machine: str) -> str:
+    r"""``\RunInfo``: the measured cost of the build's heavy jobs (the sum of their Snakemake
+    benchmark files: wall seconds ``s`` and ``cpu_time``) and the machine, one sentence."""
+    wall = cpu = 0.0
+    n = 0
+    for t in bench_tables:
+        if len(t):
+            wall += float(t["s"].iloc[-1])
+            cpu += float(t["cpu_time"].iloc[-1]) if "cpu_time" in t else 0.0
+            n += 1
+    if n:
+        text = (f"The {n} heavy jobs of this build (Monte Carlos, bounds, timing; their Snakemake benchmark "
+                f"files) took {wall / 60:.1f} min of job time and {cpu / 60:.1f} CPU-min on a "
+                f"{cpus or '?'}-core {machine} machine; docs/performance.md holds dated measurements of whole builds.")
+    else:
+        text = "This build recorded no benchmark; docs/performance.md holds dated measurements of whole builds."
+    return "\\newcommand{\\RunInfo}{" + prose_tex(text) + "}\n"

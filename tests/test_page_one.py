@@ -1,0 +1,94 @@
+"""Page 1 (issue 45 item 1, 2): the short abstract from the claims table, the verdict figure
+(one row per claim) and the table of what we did differently, read from the configuration."""
+
+import copy
+
+import pandas as pd
+import pytest
+
+from conftest import REPO
+from opnav.core import published
+from opnav.core.config import load_config
+from opnav.report import differences, manuscript
+
+#: a cause as long as the claims table allows (opnav.report.claims.MAX_CAUSE_WORDS)
+LONG_CAUSE = ("the Cramér-Rao bound of the data it used is 20.6 arcsec, the prior's own sigma_r / rho, so a camera "
+              "that keeps Mars on its boresight cannot tell the misalignment from a lateral position error of "
+              "the same size at this range, far above the claimed accuracy")
+
+
+def _table(n_a=10, n_b=10, columns=None):
+    verdicts = ["reproduced", "not_reproducible", "not_reproducible", "depends_on_choice", "reproduced_with_addition",
+                "not_reproduced", "suspect", "unstable", "not_tested", "not_reproducible"]
+    rows = []
+    for p, n in (("A", n_a), ("B", n_b)):
+        for i in range(n):
+            rows.append({"paper": p, "claim_id": f"{p}-C{i + 1}", "claim": f"Claim {i} of paper {p} (sec. 3)",
+                         "published": "2 arcsec", "ours_as_written": "20.6 arcsec (converged 20/20)",
+                         "ours_best": "1.2 arcsec", "best_variant": "roll", "verdict": verdicts[i % len(verdicts)],
+                         "cause": LONG_CAUSE, "would_take": "a roll of 0.1 deg/s about the boresight, which the "
+                         "pipeline measures, gives 2 arcsec in 250 samples", "flags": "", "sample": "full"})
+    df = pd.DataFrame(rows)
+    return df[columns] if columns else df
+
+
+def test_abstract_is_at_most_200_words_with_the_causes_of_each_group():
+    from opnav.report.claims import MAX_CAUSE_WORDS
+
+    assert len(LONG_CAUSE.split()) >= MAX_CAUSE_WORDS - 3
+    df = _table()
+    tex = manuscript.page_one_abstract_tex(df)
+    main = (REPO / "paper" / "main.tex").read_text()
+    framing = main[main.index(r"\begin{abstract}"):main.index(r"\input{\resultsdir/paper/abstract.tex}")]
+    assert manuscript.word_count(framing.replace(r"\begin{abstract}", "")) <= manuscript.ABSTRACT_FRAMING_WORDS
+    assert manuscript.word_count(tex) + manuscript.ABSTRACT_FRAMING_WORDS <= manuscript.ABSTRACT_MAX_WORDS
+    assert "of its 10 claims" in tex and "because the Cram" in tex  # counts, then a group's cause
+    assert "What it would take" in tex
+    text = manuscript.abstract_findings(df)
+    assert "((" not in text and not any(c.count("(") > 1 for c in text.split(". "))  # no nested parentheses
+    # a generated number, not fixed text: another table, another abstract
+    df2 = _table(n_a=4, n_b=3)
+    assert "of its 4 claims" in manuscript.abstract_findings(df2)
+
+
+def test_abstract_of_a_quick_table_says_its_sample_is_too_small():
+    df = _table(3, 3).assign(sample="quick")
+    tex = manuscript.page_one_abstract_tex(df, manuscript.sample_sentence_of(df))
+    assert tex.startswith("This build is the quick profile")
+    assert manuscript.sample_sentence_of(_table(3, 3)) == ""
+    assert manuscript.sample_sentence_of(_table(3, 3).drop(columns="sample")) == ""  # an older table
+
+
+def test_verdict_figure_has_a_row_per_claim_and_tolerates_older_tables():
+    import matplotlib.pyplot as plt
+
+    from opnav.report import verdict_plot
+
+    df = _table(9, 10)
+    fig = verdict_plot.fig_verdicts(df)
+    cells = [p for p in fig.axes[0].patches]
+    assert len(cells) == len(df)  # one coloured verdict cell per claim
+    assert {tuple(round(c, 3) for c in p.get_facecolor()[:3]) for p in cells} >= {(0.0, 0.62, 0.451)}  # reproduced
+    plt.close(fig)
+    old = _table(3, 3, columns=["paper", "claim_id", "claim", "published", "ours_as_written", "verdict", "cause"])
+    fig = verdict_plot.fig_verdicts(old)
+    assert len(fig.axes[0].patches) == 6
+    plt.close(fig)
+
+
+def test_differences_read_ours_from_the_configuration():
+    cfg = load_config()
+    pub = published.load()
+    rows = differences.rows(cfg, pub)
+    by = {r["choice"]: r for r in rows}
+    assert by["sample time"]["ours"] == f"{cfg['approach']['dt_s']:g} s"
+    assert by["sample time"]["paper_value"] == f"{pub['paper_a']['simulation']['dt_s']:g} s"
+    assert by["range noise"]["paper_value"] == differences.NOT_GIVEN
+    cfg2 = copy.deepcopy(cfg)
+    cfg2["approach"]["segments"]["N"] = 77
+    assert "77" in {r["choice"]: r for r in differences.rows(cfg2, pub)}["EM segments (N0, N, M, L)"]["ours"]
+    bad = {"paper_a": [{"choice": "x", "keys": ["approach.no_such_key"], "text": "{approach.no_such_key}",
+                        "where": "sec:approach"}]}
+    with pytest.raises(KeyError, match="approach.no_such_key"):
+        differences.rows(cfg, pub, bad)
+    assert r"\ref{sec:landing}" in differences.latex(rows)

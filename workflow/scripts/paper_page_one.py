@@ -1,0 +1,36 @@
+"""Page 1 of the manuscript and the report's landing page, from the claims table: the short
+abstract (abstract.tex), the verdict figure (one row per claim), the claims at a glance as
+CSV for the HTML report's first page, and the table of what we did differently
+(differences.tex: every open or changed choice, ours from the run's configuration)."""
+
+import os
+import platform
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from opnav.core import figures, published
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import atomic_write_text
+from opnav.report import differences, manuscript, verdict_plot
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("paper_page_one", argv=sys.argv[1:])
+
+with script_context(snakemake) as log:
+    out = snakemake.output
+    df = pd.read_csv(snakemake.input.claims, keep_default_na=False)
+    sample = manuscript.sample_sentence_of(df)
+    atomic_write_text(out.abstract, manuscript.page_one_abstract_tex(df, sample))
+    figures.save(verdict_plot.fig_verdicts(df), [out.fig_pdf, out.fig_png])
+    glance = df[[c for c in ("claim_id", "claim", "published", "ours_as_written", "verdict") if c in df.columns]]
+    glance.assign(claim=glance["claim"].map(verdict_plot.short_claim)).to_csv(out.glance, index=False)
+    rows = differences.rows(dict(snakemake.params.config), published.load())
+    atomic_write_text(out.differences, differences.latex(rows))
+    # the heavy jobs' benchmark files (read, not inputs: this is a description of the build)
+    bench = sorted(Path(snakemake.params.results).glob("*/benchmarks/*.tsv"))
+    atomic_write_text(out.runinfo, manuscript.run_info_tex(
+        (pd.read_csv(b, sep="\t") for b in bench), os.cpu_count(), platform.machine()))
+    log.info("page 1: abstract %d words, %d claims, %d choices", manuscript.word_count(
+        manuscript.page_one_abstract_tex(df, sample)), len(df), len(rows))
