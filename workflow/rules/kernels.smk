@@ -22,5 +22,8 @@ rule compile_kernels:
         res("kernels", "logs", "compile_{kpaper}.log"),
     wildcard_constraints:
         kpaper="|".join(KERNEL_PAPERS),
+    message:
+        "compiling paper {wildcards.kpaper}'s numba kernels into the on-disk cache: first build only, "
+        "up to about a minute of CPU per paper with no output until it ends (measured: docs/performance.md)"
     script:
         "../scripts/compile_kernels.py"

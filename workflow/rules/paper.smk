@@ -47,7 +47,7 @@ rule paper_claims:
         **{k: p for k, p in SCORE_INPUTS.items() if k == "a_table1"},
         **REPLICATION_INPUTS,
         published=src("data/published.yaml"),
-        plan=src("data/analysis_plan.yaml"),
+        plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
         code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/manuscript.py",
                  "core/published.py"),
     output:

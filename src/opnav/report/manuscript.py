@@ -352,9 +352,11 @@ def claims_detail_latex(df: "pd.DataFrame") -> str:
 #: the abstract's length limit (words, LaTeX markup not counted)
 ABSTRACT_MAX_WORDS = 200
 #: the words of the framing sentences main.tex writes before the generated findings
-ABSTRACT_FRAMING_WORDS = 50
+ABSTRACT_FRAMING_WORDS = 40
 #: verdicts a reader counts as "not reproduced" in the broad sense (each group gets its cause)
-_NOT_OK = ("not_reproducible", "not_reproduced", "depends_on_choice", "suspect", "unstable", "not_tested")
+#: (in the order the abstract gives them: what an information bound excludes, what needs an addition first)
+_NOT_OK = ("not_reproducible", "reproduced_with_addition", "suspect", "unstable", "not_reproduced",
+           "depends_on_choice", "not_tested")
 _PAPER_WORDS = {"A": "Paper A", "B": "Paper B"}
 
 
@@ -374,13 +376,49 @@ def word_count(text: str) -> int:
     return sum(1 for w in plain.split() if re.search(r"[A-Za-z0-9]", w))
 
 
+#: how a group of claims with one verdict reads: (plural predicate, singular predicate)
+_PREDICATE = {
+    "reproduced": ("are reproduced", "is reproduced"),
+    "reproduced_with_addition": ("reproduce only with an addition", "reproduces only with an addition"),
+    "not_reproduced": ("are not reproduced", "is not reproduced"),
+    "not_reproducible": ("are not reproducible", "is not reproducible"),
+    "depends_on_choice": ("depend on a choice the paper leaves open", "depends on a choice the paper leaves open"),
+    "not_tested": ("are not tested", "is not tested"),
+    "unstable": ("differ between two independent samples", "differs between two independent samples"),
+    "suspect": ("are suspect, better than their own information bound", "is suspect, better than its own information bound"),
+}
+
+
+def _ids(ids: list[str]) -> str:
+    return ", ".join(ids[:-1]) + " and " + ids[-1] if len(ids) > 1 else ids[0]
+
+
+def group_sentences(grp: list[Mapping], verdict: str, said: set | None = None) -> str:
+    """One group of claims with one verdict: which claims and what the verdict names when they
+    share it (the addition, the choice, the bound); else why (the first claim's cause, named as
+    such when the group has several); then what it would take, unless ``said`` (the texts
+    already written) holds it."""
+    said = set() if said is None else said
+    ids = [r["claim_id"] for r in grp]
+    named = {_col(r, "named") for r in grp}
+    shared = named.pop() if len(named) == 1 else ""
+    s = _sentence(f"{_ids(ids)} {_PREDICATE[verdict][len(ids) == 1]}" + (f": {shared}" if shared else ""))
+    cause = _col(grp[0], "cause")
+    if cause and not shared:
+        s += " " + _sentence(f"{'Why' if len(ids) == 1 else 'For ' + ids[0]}: {cause}")
+    take = _col(grp[0], "would_take")
+    if take and take not in said:
+        said.add(take)
+        s += " " + _sentence(f"What it would take: {take}")
+    return s
+
+
 def abstract_findings(df: "pd.DataFrame") -> str:
     """The findings of page 1 in plain sentences (plain text; :func:`prose_tex` makes it LaTeX),
-    generated from the claims table: per paper, the verdict counts; for each group of claims
-    not reproduced as written, the group's one cause (the cause of its first claim, which the
-    others share when the table names the same bound, choice or flag) and what it would take.
-    Groups are dropped from the largest paper's tail until the whole is at most
-    :data:`ABSTRACT_MAX_WORDS` words with the framing sentence of ``main.tex``."""
+    generated from the claims table: per paper, the verdict counts, then each group of claims
+    not reproduced as written (:func:`group_sentences`, in :data:`_NOT_OK`'s order). Groups are
+    dropped from the longer paper's tail until the whole, with the framing sentences of
+    ``main.tex``, is at most :data:`ABSTRACT_MAX_WORDS` words."""
     from opnav.report.claims import VERDICT_SHORT, VERDICTS
 
     rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
@@ -394,22 +432,15 @@ def abstract_findings(df: "pd.DataFrame") -> str:
         parts = [f"{n} {VERDICT_SHORT[v]}" for v, n in counts if n]
         s = [_sentence(f"{_PAPER_WORDS.get(p, 'Paper ' + p)}: of its {len(g)} claims, " + ", ".join(parts[:-1])
                        + (" and " if len(parts) > 1 else "") + parts[-1])]
-        groups = [(v, [r for r in g if r["verdict"] == v]) for v in VERDICTS if v in _NOT_OK]
-        for v, grp in sorted([x for x in groups if x[1]], key=lambda x: -len(x[1])):  # largest group first (stable)
-            ids = [r["claim_id"] for r in grp]
-            cause = _col(grp[0], "cause")
-            head = (f"{', '.join(ids[:-1])} and {ids[-1]} are" if len(ids) > 1 else f"{ids[0]} is") \
-                + f" {VERDICT_SHORT[v]}"
-            unit = _sentence(f"{head} because {cause[0].lower() + cause[1:]}" if cause else head)
-            take = _col(grp[0], "would_take")
-            if take:
-                unit += " " + _sentence(f"What it would take: {take}")
-            s.append(unit)
+        said: set = set()
+        for v in _NOT_OK:  # the order of _NOT_OK: what an information bound says first
+            grp = [r for r in g if r["verdict"] == v]
+            if grp:
+                s.append(group_sentences(grp, v, said))
         per_paper[p] = s
     budget = ABSTRACT_MAX_WORDS - ABSTRACT_FRAMING_WORDS
     while sum(word_count(" ".join(s)) for s in per_paper.values()) > budget:
-        longest = max(per_paper, key=lambda p: (len(per_paper[p]), word_count(" ".join(per_paper[p])),
-                                                papers.index(p)))  # ties: the later paper gives way
+        longest = max(per_paper, key=lambda p: (word_count(" ".join(per_paper[p])), papers.index(p)))
         if len(per_paper[longest]) <= 1:
             break
         per_paper[longest].pop()

@@ -53,8 +53,8 @@ def fig_verdicts(df):
     import matplotlib.pyplot as plt
     from matplotlib.patches import Rectangle
 
-    cols = [("claim_id", "id", 0.06, 8), ("claim", "claim", 0.30, 44), ("published", "published", 0.15, 20),
-            ("ours_as_written", "ours, as written", 0.17, 24), ("ours_best", "ours, best variant", 0.17, 24)]
+    cols = [("claim_id", "id", 0.06, 8), ("claim", "claim", 0.27, 40), ("published", "published", 0.16, 22),
+            ("ours_as_written", "ours, as written", 0.18, 26), ("ours_best", "ours, best variant", 0.18, 26)]
     cols = [c for c in cols if c[0] in df.columns]
     verdict_cols = [c for c in ("verdict", "verdict_replication") if c in df.columns
                     and df[c].astype(str).str.strip().replace("nan", "").ne("").any()]
@@ -62,7 +62,7 @@ def fig_verdicts(df):
     total = sum(c[2] for c in cols) + vw * len(verdict_cols)
     scale = 1.0 / total
     n = len(df)
-    row_h = 0.3  # inches
+    row_h = 0.26  # inches
     with figures.style():
         fig = plt.figure(figsize=(figures.PAGE_WIDTH_IN, row_h * (n + 1.6)))
         ax = fig.add_axes((0, 0, 1, 1))
