@@ -293,6 +293,10 @@ def test_converging_faster_needs_a_whole_filter_step():
 def test_timing_depends_on_the_svd_implementation_and_says_what_it_would_take():
     r = by_id(rows_b(summary_b(**both(red=8.0, red_alt=29.0)), PUB["paper_b"]))["B-C4"]
     assert r["verdict"] == C.DEPENDS and "paper's definition" in r["would_take"]
+    assert r["named"] == "how the SVD baseline is implemented" and "another SVD implementation" in r["cause"]
+    r = by_id(rows_b(summary_b(interior={"red": 8.0, "red_alt": 80.0}), PUB["paper_b"]))["B-C4"]
+    assert r["verdict"] == C.DEPENDS and r["named"] == "which camera is flown"
+    assert r["would_take"] == "timing on the compiled implementation in the site-tilt camera"
     r = by_id(rows_b(summary_b(**both(red=8.0)), PUB["paper_b"]))["B-C4"]
     assert r["verdict"] == C.NOT_REPRODUCED and r["would_take"] == "" and "8 % less" in r["cause"]
 
@@ -325,7 +329,8 @@ def test_quick_profile_rows_say_the_sample_is_too_small():
     q = C.mark_sample(df, "quick")
     assert (q["sample"] == "quick").all() and q["flags"].str.contains("sample_too_small: quick profile").all()
     assert "too small for verdicts" in C.sample_sentence(q)
-    assert "sample_too_small: 4 runs" in q.set_index("claim_id").loc["B-C1", "flags"]
+    assert "sample_too_small: 4 runs" in df.set_index("claim_id").loc["B-C1", "flags"]
+    assert q.set_index("claim_id").loc["B-C1", "flags"] == "sample_too_small: quick profile"
     f = C.mark_sample(C.frame(rows_b(summary_b(), PUB["paper_b"])), "full")
     assert (f["sample"] == "full").all() and C.sample_sentence(f) == ""
     assert not f["flags"].str.contains("sample_too_small").any()

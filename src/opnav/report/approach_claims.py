@@ -427,7 +427,8 @@ def _claim_nav_before(t1, head_pub, sim, plan: Plan) -> dict:
     else:
         rng, th = float(sim["range_km"]), math.hypot(*head_pub["truth_arcsec"][:2])
         lat = rng * math.radians(th / 3600.0)
-        cause = (f"Lateral error is about range x misalignment, {fmt(rng)} km x {fmt(th)} arcsec = {fmt(lat)} km, and "
+        cause = (f"Lateral error is about range x misalignment, {rng:.2g}".replace("e+0", "e").replace("e+", "e")
+                 + f" km x {fmt(th)} arcsec = {fmt(lat)} km, and "
                  f"our theta = 0 filter ends at {fmt(b)} km, so the published {fmt(pub)} km implies another range or "
                  "error rule")
     return _result(dict(paper="A", claim_id=cid, claim="Navigation error before compensation (Table 1 column)",

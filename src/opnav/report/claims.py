@@ -448,8 +448,9 @@ def mark_sample(df: pd.DataFrame, profile: str) -> pd.DataFrame:
     out = df.copy()
     quick = profile != "full"
     out["sample"] = "quick" if quick else "full"
-    if quick:
-        out["flags"] = [_add_flag(f, "sample_too_small", f"{profile} profile") for f in out["flags"]]
+    if quick:  # one sample flag: the profile's (a row's own seed count says the same)
+        out["flags"] = [_add_flag("; ".join(x for x in f.split("; ") if x and not x.startswith("sample_too_small:")),
+                                  "sample_too_small", f"{profile} profile") for f in out["flags"]]
     return out
 
 
