@@ -12,15 +12,19 @@ min_version("9.0")
 
 
 # Every config file (this default and each --configfile, which Snakemake has read
-# already) through opnav's own loader too: a key given twice or an alias bomb (which
-# Snakemake's loader accepts) is refused naming the file and line. (A file Snakemake
-# cannot parse at all it refuses itself, before this file is read.) config_exit is the
-# one way every config problem leaves the workflow.
+# already, with YAML 1.1) through opnav's strict reader too (opnav.core.yamlfile, the
+# one `opnav --config` uses): a key given twice, a non-string key, a YAML 1.1 form that
+# YAML 1.2 reads otherwise (010, 1:30, yes/no/on/off, 1e-6), anchors, aliases and merge
+# keys, __use_yte__, an unexpanded $VAR or a control character is refused in one line
+# naming the file, the line and the key. (A file Snakemake cannot parse at all it refuses
+# itself, before this file is read; a YTE template it has evaluated by then.)
+# config_exit is the one way every config problem leaves the workflow.
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(workflow.basedir) / "src"))
-from opnav.core.config import ConfigError, read_config_file  # noqa: E402
+from opnav.core.errors import ConfigError  # noqa: E402
+from opnav.core.yamlfile import read_config_file  # noqa: E402
 from opnav.core.snakeio import config_exit  # noqa: E402
 
 _config_files = [Path(workflow.basedir, "config", "config.yaml")]
@@ -49,6 +53,12 @@ include: "workflow/rules/paper.smk"
 
 
 onstart:
+    # results_dir is this checkout's (and this profile's): its marker names them, and a
+    # later parse from another checkout is refused (opnav.core.checks.owner_problems).
+    # Written here, when jobs are about to run, so a dry run writes nothing.
+    from opnav.core.checks import claim_results_dir
+
+    claim_results_dir(config["results_dir"], workflow.basedir, config)
     # Every job is a fresh interpreter that imports the package. Where bytecode
     # caching is off (PYTHONDONTWRITEBYTECODE, set on some CI images) each job would
     # compile it again (~0.1-0.2 CPU-s a job): compile it once per run instead.

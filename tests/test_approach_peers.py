@@ -236,7 +236,7 @@ def test_basilisk_bias_free_sanity_roll(start):
 
 # ------------------------------------------------------------ workflow
 def test_peer_variants_outside_table1_variants_are_refused():
-    from opnav.core.checks import approach_problems
+    from opnav.core.checks import approach_rules as approach_problems
 
     cfg = approach_cfg()
     cfg["peers"]["variants"] = ["prior", "roll"]

@@ -1,9 +1,18 @@
-"""Bad input is refused before any job runs, with one line naming the key.
+"""Bad input is refused before any job runs, with one line naming the key, flag or file.
 
-Each case is an overlay on config/config.yaml + config/quick.yaml, checked with
-:func:`opnav.core.config.validate_config`, which is what the Snakefile runs before it
-builds the DAG (one `snakemake -n` case below proves that path) and what the
-CLI runs before it computes anything.
+The battery (issue 46; :func:`test_battery_counts` prints its counts by class):
+
+* config values: each an overlay on config/config.yaml + config/quick.yaml, checked
+  in process with :func:`opnav.preflight.check_config`, which is what the Snakefile
+  runs before it builds the DAG (a few `snakemake -n` cases, marked slow, prove that
+  path) and what the CLI runs before it computes anything (BAD_CONFIGS: rounds one
+  and two; NEW_CONFIGS: round three's classes);
+* config files: through `opnav landing --config FILE` in process, whose reader
+  (:func:`opnav.core.yamlfile.read_config_file`) the Snakefile calls on every
+  --configfile (BAD_FILES, YAML_TRAPS);
+* the CLI: `opnav ...` in process (BAD_CLI, NEW_CLI);
+* accepted and correct: inputs near the traps that must pass with the right value
+  (ACCEPTED_FILES, ACCEPTED_CLI).
 """
 
 import copy
@@ -12,7 +21,8 @@ import pytest
 import yaml
 
 from conftest import REPO, run_snakemake
-from opnav.core.config import ConfigError, _merge, validate_config
+from opnav.core.config import ConfigError, _merge
+from opnav.preflight import check_config as validate_config
 
 
 def _raw_quick() -> dict:
@@ -165,6 +175,118 @@ BAD_CONFIGS = [
     ("limits: {max_jobs: 0}", "limits.max_jobs"),
 ]
 
+# Round three (issue 46): (class, overlay, text the error must contain: the key)
+NEW_CONFIGS = [
+    # names anywhere in the config against the one registry (the schema's $defs.method)
+    ("names", "landing: {tuning: {method: oracle}}", "'landing.tuning.method': 'oracle' is not one of"),
+    ("names", "landing: {equivalence: {reference: oracle}}", "'landing.equivalence.reference': 'oracle'"),
+    ("names", "landing: {equivalence: {controls: [oracle]}}", "'landing.equivalence.controls[0]': 'oracle'"),
+    ("names", "landing: {equivalence: {methods: [oracle]}}", "'landing.equivalence.methods[0]': 'oracle'"),
+    ("names", "landing: {mc: {methods: [depth, Depth]}}", "'landing.mc.methods[1]': 'Depth'"),
+    ("names", "landing: {extra: {methods: [logdet, ' svd']}}", "'landing.extra.methods[1]'"),
+    ("names", "landing: {single: {method: 7}}", "'landing.single.method'"),
+    ("names", "landing: {equivalence: {controls: [depth]}}", "'landing.equivalence.controls': depth has a metric"),
+    ("names", "landing: {equivalence: {methods: [svd]}}", "'landing.equivalence.methods': svd is also the reference"),
+    ("names", "landing: {equivalence: {controls: [center]}, extra: {methods: [logdet]}}",
+     "'landing.equivalence.controls': 'random' sets the equivalence margin"),
+    ("names", "approach: {variants: [literal, roll, oracle]}", "'approach.variants[2]': 'oracle'"),
+    ("names", "approach: {table1_variants: [stars]}", "'approach.table1_variants[0]': 'stars'"),
+    ("names", "approach: {growing: {methods: [squarem, squarem]}}", "'approach.growing.methods': duplicated"),
+    ("names", "approach: {peers: {variants: [roll, roll]}}", "'approach.peers.variants': duplicated"),
+    ("names", "approach: {em: {method: oracle}}", "'approach.em.method'"),
+    # physical minimum and maximum of every number
+    ("ranges", "approach: {roll: {rate_deg_s: 1.0e+300}}", "'approach.roll.rate_deg_s': 1e+300 is greater"),
+    ("ranges", "approach: {em: {converge_tol_arcsec: 1.0e+300}}", "'approach.em.converge_tol_arcsec'"),
+    ("ranges", "approach: {camera: {radius_to_centroid_ratio: 1.0e+300}}",
+     "'approach.camera.radius_to_centroid_ratio'"),
+    ("ranges", "landing: {initial_state: {att_deg: [1.0e+300, 0, 0]}}", "'landing.initial_state.att_deg[0]'"),
+    ("ranges", "approach: {camera: {ifov_arcsec: 1.0e+300}}", "'approach.camera.ifov_arcsec'"),
+    ("ranges", "approach: {stars: {every_K: 1000000}}", "'approach.stars.every_K'"),
+    ("ranges", "approach: {stars: {mag_limit: -100}}", "'approach.stars.mag_limit': -100 is less than"),
+    ("ranges", "approach: {stars: {per_image: 5000}}", "'approach.stars.per_image'"),
+    ("ranges", "approach: {stars: {slew_deg: 1000}}", "'approach.stars.slew_deg'"),
+    ("ranges", "approach: {process_noise_diag: [1.0e+300, 0, 0, 0, 0, 0]}", "'approach.process_noise_diag[0]'"),
+    ("ranges", "approach: {roll: {steps_deg: [1.0e+9]}}", "'approach.roll.steps_deg[0]'"),
+    ("ranges", "approach: {growing: {N: 10000000}}", "'approach.growing.N'"),
+    ("ranges", "approach: {base_seed: 100000000000000000000000}", "'approach.base_seed'"),
+    ("ranges", "approach: {accuracy_target_arcsec: 1.0e+9}", "'approach.accuracy_target_arcsec'"),
+    ("ranges", "approach: {geometry: {v_inf_dir: [1.0e+300, 0, 0]}}", "'approach.geometry.v_inf_dir[0]'"),
+    ("ranges", "approach: {roll_rate_study: {rates_deg_s: [0.1, 1.0e+9]}}", "'approach.roll_rate_study.rates_deg_s[1]'"),
+    ("ranges", "landing: {gravity_mps2: [0, 0, -1.0e+300]}", "'landing.gravity_mps2[2]'"),
+    ("ranges", "landing: {mc: {base_seed: 100000000000000000000000}}", "'landing.mc.base_seed'"),
+    ("ranges", "landing: {mc: {converged_pos_err_m: 1.0e+300}}", "'landing.mc.converged_pos_err_m'"),
+    ("ranges", "landing: {single: {run_index: 10000000000}}", "'landing.single.run_index'"),
+    ("ranges", "landing: {planner: {margin_px: 1.0e+300}}", "'landing.planner.margin_px'"),
+    ("ranges", "landing: {scenarios: {interior: {sigma_px: 1.0e+300}}}", "'landing.scenarios.interior.sigma_px'"),
+    ("ranges", "landing: {landmarks: {near_site: {r_min_m: 1.0e+300}}}", "'landing.landmarks.near_site.r_min_m'"),
+    ("ranges", "landing: {filter: {min_update_altitude_m: 1.0e+300}}", "'landing.filter.min_update_altitude_m'"),
+    ("ranges", "landing: {initial_state: {v_mps: [0, 0, -1.0e+300]}}", "'landing.initial_state.v_mps[2]'"),
+    ("ranges", "landing: {figures: {f5_time_s: 1.0e+300}}", "'landing.figures.f5_time_s'"),
+    ("ranges", "landing: {tuning: {candidates: [[5.0, 3.5]]}}", "'landing.tuning.candidates[0][1]': 3.5 is not of type"),
+    ("ranges", "landing: {tuning: {candidates: [[5.0, 3, 1]]}}", "'landing.tuning.candidates[0]'"),
+    ("ranges", "landing: {tuning: {candidates: [[500.0, 3]]}}", "'landing.tuning.candidates[0][0]'"),
+    ("ranges", "landing: {tuning: {candidates: [[5.0, 30]]}}", "'landing.tuning.candidates[0][1]'"),
+    ("ranges", "limits: {max_jobs: 100000000000}", "'limits.max_jobs'"),
+    ("ranges", "limits: {max_study_values: 100000000000}", "'limits.max_study_values'"),
+    # cross-key rules
+    ("cross-key", "landing: {tuning: {base_seed: 20230410}}", "'landing.tuning.base_seed': 20230410 equals"),
+    ("cross-key", "landing: {filter: {update_altitude_margin_m: 10000}}",
+     "'landing.filter.update_altitude_margin_m': min_update_altitude_m + update_altitude_margin_m"),
+    ("cross-key", "landing: {filter: {min_update_altitude_m: 6000, update_altitude_margin_m: 600}}",
+     "'landing.filter.update_altitude_margin_m'"),
+    ("cross-key", "landing: {landmarks: {near_site: {r_min_m: 20000}}}",
+     "'landing.landmarks.near_site.r_min_m': 20000 m is not inside the landmark field"),
+    ("cross-key", "landing: {mc: {converged_pos_err_m: 7000}}", "'landing.mc.converged_pos_err_m': 7000 m is not below"),
+    ("cross-key", "landing: {tuning: {n_runs: 100000}}", "'landing.tuning.n_runs': 100000 runs x 198 filter steps"),
+    ("cross-key", "approach: {roll_rate_study: {search_deg_s: [20.0, 0.001]}}",
+     "'approach.roll_rate_study.search_deg_s': the bracket [20, 0.001]"),
+    ("cross-key", "approach: {roll_rate_study: {search_deg_s: [1.0, 1.0]}}", "'approach.roll_rate_study.search_deg_s'"),
+    ("cross-key", "approach: {em: {converge_tol_arcsec: 3}}", "'approach.em.converge_tol_arcsec': 3 arcsec exceeds"),
+    ("cross-key", "approach: {convergence_study: {tol_arcsec: 5}}", "'approach.convergence_study.tol_arcsec'"),
+    ("cross-key", "approach: {accuracy_target_arcsec: 0.1}", "'approach.em.converge_tol_arcsec': 0.5 arcsec exceeds"),
+    ("cross-key", "approach: {camera: {ifov_arcsec: 700}}", "'approach.camera.ifov_arcsec': 700 arcsec x 1024 px"),
+    ("cross-key", "approach: {stars: {every_K: 100000}}",
+     "'approach.stars.every_K': 100000: the first star image"),
+    ("cross-key", "approach: {stars: {per_image: 200, catalogue_size: 100}}", "'approach.stars.per_image': 200 stars"),
+    ("cross-key", "studies: {big: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, runs: 100000, "
+                  "runs_per_job: 100000}}", "'studies.big.runs' (study 'big'): 100000 runs x 198 filter steps"),
+    # user-chosen names: file names and rule names
+    ("user names", "studies: {runs: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "'studies.runs': the name makes the rule study_runs"),
+    ("user names", "studies: {pixel_outputs: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "'studies.pixel_outputs': the name makes the rule study_pixel_outputs"),
+    ("user names", "studies: {" + "a" * 250 + ": {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "has 250 characters, at most 40"),
+    ("user names", "landing: {scenarios: {" + "b" * 250 + ": {}}}", "'landing.scenarios': 'bbbb"),
+    ("user names", "landing: {headline_scenario: " + "c" * 60 + "}", "'landing.headline_scenario'"),
+    ("user names", "studies: {'a b': {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "'studies': 'a b' is not a valid name"),
+    ("user names", "studies: {'../x': {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "'studies': '../x' is not a valid name"),
+    ("user names", "landing: {scenarios: {'Wide/1': {}}}", "'landing.scenarios': 'Wide/1' is not a valid name"),
+    ("user names", "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, title: '" + "t" * 300 + "'}}",
+     "'studies.s.title'"),
+    ("user names", "studies: {s: {paper: landing, grid: true, vary: {landing.camera.fov_deg: [45.0], "
+                   "landing.camera.tilt_deg: [45.00000000001], landing.camera.tilt_azimuth_deg: [-107.00000000001], "
+                   "landing.camera.sigma_px: [0.500000000001], landing.filter.meas_noise_scale: [5.00000000001], "
+                   "landing.filter.depth_sigma_frac: [0.1000000000001], landing.planner.n_sigma_v: [3.0000000000001], "
+                   "landing.planner.tol_rad: [0.0010000000001], landing.imu.sigma_a_mps2: [0.00050000000001]}}}",
+     "'studies.s.vary' (study 's'): value"),
+    # sweeping a map: refused (the stated rule: a value never replaces a whole map)
+    ("user names", "studies: {s: {paper: landing, vary: {landing.camera: [{fov_deg: 45.0}]}}}",
+     "'studies.s.vary.landing.camera' (study 's'): key 'landing.camera' is a map"),
+    ("user names", "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, "
+                   "fixed: {landing.camera: {fov_deg: 45.0}}}}", "'studies.s.fixed.landing.camera'"),
+    # where outputs go (item 3)
+    ("results_dir", "results_dir: '/proc/opnav'", "'results_dir': '/proc/opnav' is under /proc"),
+    ("results_dir", "results_dir: '/sys/opnav'", "'results_dir': '/sys/opnav' is under /sys"),
+    ("results_dir", "results_dir: '/dev/shm/opnav'", "'results_dir': '/dev/shm/opnav' is under /dev"),
+    ("results_dir", "results_dir: \"res\\nults\"", "'results_dir': 'res\\nults' holds a control character"),
+    ("results_dir", "results_dir: \"res\\tults\"", "'results_dir': 'res\\tults' holds a control character"),
+    ("results_dir", "results_dir: '$HOME/opnav-out'", "'results_dir': '$HOME/opnav-out' holds $HOME"),
+    ("results_dir", "results_dir: '${HOME}/opnav-out'", "'results_dir': '${HOME}/opnav-out' holds ${HOME}"),
+]
+
 
 def _overlaid(overlay: str) -> dict:
     cfg = copy.deepcopy(_BASE)
@@ -182,6 +304,17 @@ def test_bad_config_refused_naming_key(overlay, key):
                for line in text.splitlines()), text
 
 
+@pytest.mark.parametrize("cls,overlay,key", NEW_CONFIGS, ids=[f"{c}:{o[:60]}" for c, o, _ in NEW_CONFIGS])
+def test_round_three_config_refused_naming_key(cls, overlay, key):
+    """Issue 46's classes, in process through the workflow's pre-flight: refused in one
+    line per problem naming the key (and what was given)."""
+    with pytest.raises(ConfigError) as err:
+        validate_config(_overlaid(overlay), root=REPO, workflow=True)
+    text = str(err.value)
+    assert key in text, text
+    assert all(line.startswith("invalid config key") for line in text.splitlines()), text
+
+
 def test_quick_and_full_profiles_pass():
     validate_config(_overlaid("{}"), root=REPO, workflow=True)
     # a slow, nearly parabolic approach that does not reach Mars is legal
@@ -197,15 +330,25 @@ def test_every_problem_gets_its_own_line():
     assert any("landing.imu.rate_hz" in ln for ln in lines)
 
 
-def test_method_names_follow_the_planner_registry(monkeypatch):
-    """A method the planner registers is accepted; the check has no copy of the list."""
+def test_the_name_registry_is_the_planners():
+    """The schema's registry of method names ($defs.method) is the planner's, the core's
+    pickers are the planner's pickers, and the core's copies of the papers' constants are
+    theirs (core cannot import the papers). Mutation: a method added to the planner alone
+    fails it."""
+    from opnav.approach import dynamics, stars
+    from opnav.core import checks
     from opnav.landing import planner
 
-    validate_config(_overlaid("landing: {single: {method: svd}}"), root=REPO)
-    monkeypatch.setattr(planner, "available_methods", lambda: ("depth", "cond", "gdop", "logdet",
-                                                               "mineig", "random", "center"))
-    with pytest.raises(ConfigError, match="landing.mc.methods"):
-        validate_config(_overlaid("{}"), root=REPO)
+    schema = yaml.safe_load((REPO / "src" / "opnav" / "schemas" / "landing.schema.yaml").read_text())
+    assert schema["$defs"]["method"]["enum"] == list(planner.available_methods())
+    assert set(checks.PICKERS) == set(planner.PICKERS)
+    assert checks.R_MARS_KM == dynamics.R_MARS_KM
+    a = yaml.safe_load((REPO / "src" / "opnav" / "schemas" / "approach.schema.yaml").read_text())
+    mag = a["properties"]["stars"]["properties"]["mag_limit"]
+    assert (mag["minimum"], mag["maximum"]) == stars.MAG_RANGE
+    a_variants = a["properties"]["variants"]["items"]["enum"]
+    from opnav.approach.scenario import VARIANTS
+    assert a_variants == list(VARIANTS)
 
 
 def test_schema_limits_are_numbers():
@@ -224,6 +367,7 @@ def test_schema_limits_are_numbers():
         walk(yaml.safe_load(f.read_text()))
 
 
+@pytest.mark.slow
 def test_snakefile_refuses_before_any_job(tmp_path):
     """The workflow's own validation: no job runs, the key is named, nothing is written."""
     from conftest import copy_workflow
@@ -281,12 +425,26 @@ def test_tracked_folders_come_from_git(tmp_path):
     assert not results_dir_problems("scratch/out", tmp_path)
 
 
-def test_yaml_anchors_and_merge_keys_still_work(tmp_path):
-    from opnav.core.config import read_config_file
+def test_results_dir_owned_by_one_checkout(tmp_path):
+    """The marker names the checkout and profile: another checkout, or the other
+    profile, pointed at the same folder is refused in one line; the owner passes (also
+    with an edited config); a symlink loop is named. Mutation: owner_problems returning
+    [] fails the first assertion."""
+    from opnav.core.checks import OWNER_MARKER, claim_results_dir, results_dir_problems
 
-    f = tmp_path / "ok.yaml"
-    f.write_text("x: &c {fov_deg: 45.0}\nlanding: {camera: {<<: *c, tilt_deg: 40.0}}\n")
-    assert read_config_file(f)["landing"]["camera"] == {"fov_deg": 45.0, "tilt_deg": 40.0}
+    out = tmp_path / "shared"
+    cfg = _overlaid(f"results_dir: {out}")
+    claim_results_dir(out, tmp_path / "checkout-a", cfg)
+    assert (out / OWNER_MARKER).is_file()
+    other = results_dir_problems(cfg, tmp_path / "checkout-b")
+    assert len(other) == 1 and "belongs to the checkout" in other[0] and "checkout-a" in other[0], other
+    assert results_dir_problems(cfg, tmp_path / "checkout-a") == []
+    assert results_dir_problems({**cfg, "landing": {}}, tmp_path / "checkout-a") == []
+    quick = results_dir_problems({**cfg, "profile": "other"}, tmp_path / "checkout-a")
+    assert len(quick) == 1 and "profile's outputs" in quick[0], quick
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    loop = results_dir_problems(str(tmp_path / "loop" / "x"), tmp_path)
+    assert len(loop) == 1 and "symlink loop" in loop[0], loop
 
 
 def _bomb(levels=9):
@@ -299,27 +457,78 @@ def _bomb(levels=9):
 # (file content (str or bytes, None: absent), text the one-line error must contain)
 BAD_FILES = [
     ("landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n",
-     "{f}, line 3, column 1: not valid YAML: duplicate key 'landing' (first given on line 1)"),
-    ("landing:\n  mc: {n_runs: 8, n_runs: 9}\n", "{f}, line 2"),
+     "{f}, line 3: key 'landing': given twice (first on line 1)"),
+    ("landing:\n  mc: {n_runs: 8, n_runs: 9}\n", "{f}, line 2: key 'landing.mc.n_runs': given twice"),
     ("landing:\n\tmc: {n_runs: 8}\n", "{f}, line 2, column 1: not valid YAML"),
     ("- landing\n- approach\n", "{f}, line 1: the top level must be a mapping of config keys (approach, landing, ...), not a list"),
     ("", "{f}: empty (no config keys)"),
     ("# nothing but a comment\n", "{f}: empty (no config keys)"),
     ("42\n", "{f}, line 1: the top level must be a mapping"),
-    ("landing: !!python/object/apply:os.system ['true']\n", "{f}, line 1, column 10: not valid YAML"),
-    ("landing: !custom {a: 1}\n", "{f}, line 1"),
+    ("landing: !!python/object/apply:os.system ['true']\n", "{f}, line 1: key 'landing': the tag"),
+    ("landing: !custom {a: 1}\n", "{f}, line 1: key 'landing': the tag '!custom' is refused"),
     (b"\x7fELF\x02\x01\x01\x00\x00\x00\xff\xfe", "{f}, line 1: not UTF-8 text"),
     (b"landing: {}\x00\n", "{f}, line 1: a NUL byte"),
     (None, "{f}: not found"),
-    (_bomb(), "{f}: its aliases expand to more than 100000 nodes"),
-    ("a: &a [*a]\n", "{f}, line 1: a recursive alias"),
-    ("a: 1\n---\nb: 2\n", "{f}, line 2, column 1: not valid YAML"),
+    (_bomb(), "{f}, line 1: key 'a0': an anchor (&a0)"),
+    ("a: &a [*a]\n", "{f}, line 1: key 'a': an anchor (&a)"),
+    ("a: 1\n---\nb: 2\n", "{f}, line 2: more than one YAML document"),
     ("landing: {mc: {n_runs: [1, 2}\n", "{f}, line 1"),
-    ("1: {a: 2}\n", "{f}: top-level key 1 is not a name"),
+    ("1: {a: 2}\n", "{f}, line 1: key '1': not a name"),
+]
+
+# Round three (issue 46 item 2): forms two YAML readers read differently, and what no
+# config needs; each refused in one line naming the file, line and key.
+YAML_TRAPS = [
+    ("approach:\n  base_seed: 020200704\n",
+     "{f}, line 2: key 'approach.base_seed': 020200704 has a leading zero: YAML 1.1 reads 4260292 (octal)"),
+    ("landing:\n  mc: {n_runs: 010}\n", "{f}, line 2: key 'landing.mc.n_runs': 010 has a leading zero"),
+    ("approach: {dt_s: 09}\n", "{f}, line 1: key 'approach.dt_s': 09 has a leading zero"),
+    ("approach:\n  dt_s: 1:30\n", "{f}, line 2: key 'approach.dt_s': 1:30 is the base-60 number 90"),
+    ("paper:\n  build_pdf: yes\n", "{f}, line 2: key 'paper.build_pdf': 'yes' is the boolean True"),
+    ("paper: {build_pdf: off}\n", "{f}, line 1: key 'paper.build_pdf': 'off' is the boolean False"),
+    ("paper: {build_pdf: On}\n", "key 'paper.build_pdf': 'On' is the boolean True"),
+    ("paper: {build_pdf: NO}\n", "key 'paper.build_pdf': 'NO' is the boolean False"),
+    ("on: 1\n", "{f}, line 1: key 'on': not a name: YAML reads this key as the bool True"),
+    ("no:\n  a: 1\n", "{f}, line 1: key 'no': not a name"),
+    ("landing:\n  mc:\n    yes: 3\n", "{f}, line 3: key 'landing.mc.yes': not a name"),
+    ("landing: {null: 1}\n", "{f}, line 1: key 'landing.null': not a name"),
+    ("landing: {~: 1}\n", "key 'landing.~': not a name"),
+    ("landing: {2.5: 1}\n", "key 'landing.2.5': not a name"),
+    ("landing: {planner: {tol_rad: 1e-3}}\n", "key 'landing.planner.tol_rad': 1e-3 is the string '1e-3' in YAML 1.1"),
+    ("landing: {planner: {tol_rad: 1.0e-3}, camera: {fov_deg: 6e1}}\n", "key 'landing.camera.fov_deg': 6e1"),
+    ("approach: {geometry: {range_km: 1.0e6}}\n", "write 1.0e+6"),
+    ("landing: {mc: {n_runs: 1_000}}\n", "key 'landing.mc.n_runs': 1_000 is 1000 in YAML 1.1"),
+    ("landing: {mc: {base_seed: 0b101}}\n", "key 'landing.mc.base_seed': 0b101 is 5 in YAML 1.1"),
+    ("landing: {mc: {base_seed: 0o17}}\n", "key 'landing.mc.base_seed': 0o17"),
+    ("landing: {site: {lon_deg: 2020-07-04}}\n", "key 'landing.site.lon_deg': '2020-07-04' reads as a date"),
+    ("landing: {mc: {n_runs: =}}\n", "key 'landing.mc.n_runs': '=' is a YAML 1.1 special key"),
+    ("x: &c {fov_deg: 45.0}\nlanding: {camera: {<<: *c, tilt_deg: 40.0}}\n", "{f}, line 1: key 'x': an anchor (&c)"),
+    ("landing: {camera: {<<: {fov_deg: 45.0}}}\n", "{f}, line 1: key 'landing.camera': a '<<' merge key"),
+    ("landing: {mc: {n_runs: !!int 3}}\n", "key 'landing.mc.n_runs': the tag 'tag:yaml.org,2002:int' is refused"),
+    ("landing: {mc: {methods: !!set {depth: null}}}\n", "key 'landing.mc.methods': the tag"),
+    ("__use_yte__: true\napproach: {dt_s: 0.5}\n", "{f}, line 1: key '__use_yte__': YTE templates are refused"),
+    ("approach: {dt_s: 0.5}\n__use_yte__: true\n", "{f}, line 2: key '__use_yte__'"),
+    ("results_dir: $HOME/opnav-out\n", "{f}, line 1: key 'results_dir': '$HOME/opnav-out' holds $HOME"),
+    ("results_dir: '${USER}-out'\n", "key 'results_dir': '${{USER}}-out' holds ${{USER}}"),
+    ("results_dir: \"a\\x1bb\"\n", "key 'results_dir': value 'a\\x1bb' holds an escape"),
+    ("results_dir: \"a\\nb\"\n", "key 'results_dir': value 'a\\nb' holds a newline"),
+    ("results_dir: \"a\\u0085b\"\n", "key 'results_dir': value"),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, note: \"x\\u202ey\"}}\n",
+     "key 'studies.s.note': value 'x\\u202ey' holds the invisible format character U+202E"),
+    ("landing:\n  \"mc\\tx\": 1\n", "{f}, line 2: key 'landing': key 'mc\\tx' holds a tab"),
+    ("landing: {\"\": 1}\n", "{f}, line 1: key 'landing': an empty key"),
+    ("? [a, b]\n: 1\n", "{f}, line 1: a list or mapping used as a key"),
+    ("landing: {? {a: 1} : 2}\n", "{f}, line 1: key 'landing': a list or mapping used as a key"),
+    ("a: " + "[" * 40 + "]" * 40 + "\n", "nested more than 32 levels deep"),
+    ("landing:\n  mc: {n_runs: 8}\n" + "# padding\n" * 120_000, "bytes, over the 1000000 a config may have"),
+    ('{"landing": {"mc": {"n_runs": 8}}, "landing": {}}', "{f}, line 1: key 'landing': given twice"),
+    ('{"__use_yte__": true, "approach": {}}', "{f}: key '__use_yte__': YTE templates are refused"),
+    ('{"results_dir": "$HOME/x"}', "{f}: key 'results_dir': '$HOME/x' holds $HOME"),
 ]
 
 
-@pytest.mark.parametrize("content,expected", BAD_FILES, ids=[str(c)[:40] for c, _ in BAD_FILES])
+@pytest.mark.parametrize("content,expected", BAD_FILES + YAML_TRAPS,
+                         ids=[str(c)[:40] for c, _ in BAD_FILES + YAML_TRAPS])
 def test_bad_config_file_refused_naming_file_and_line(content, expected, tmp_path, capsys, no_work):
     """Through the CLI (`opnav --config FILE`): one line naming the file (and the line)."""
     from opnav.cli import EXIT_USER, main
@@ -343,6 +552,7 @@ def test_a_directory_is_not_a_config_file(tmp_path):
         read_config_file(tmp_path)
 
 
+@pytest.mark.slow
 def test_snakefile_reports_every_problem_in_one_line_each(tmp_path):
     """Problems found by the studies planner, the scenario checks, the growing windows,
     the headline scenario and the job bound all leave through the Snakefile's one wrapper:
@@ -418,24 +628,67 @@ BAD_CLI = [
     (["--config", "{tmp}/nan.yaml", "approach"], "approach.dt_s"),
     (["--config", "{tmp}/tilt.yaml", "landing"], "landing.camera"),
     # round two (issue 33)
-    (["approach", "--pixel-sigma", "1e-300"], "--pixel-sigma: invalid config key 'approach.camera.sigma3_px[0]'"),
+    (["approach", "--pixel-sigma", "1e-300"], "--pixel-sigma 1e-300: invalid config key 'approach.camera.sigma3_px[0]'"),
     (["approach", "--set", "approach.variants=[literal]"],
-     "--set approach.variants: invalid config key 'approach.table1_variants'"),
+     "--set approach.variants=[literal]: invalid config key 'approach.table1_variants'"),
     (["approach", "--set", "approach.nosuch=1"], "--set approach.nosuch: no config key"),
     (["approach", "--set", "approach.dt_s"], "expected KEY.PATH=VALUE"),
     (["approach", "--set", "approach.dt_s=[1"], "--set approach.dt_s: the value '[1' is not valid YAML"),
-    (["landing", "--set", "landing.camera={fov_deg: 45, fov_deg: 50}"], "duplicate key 'fov_deg'"),
+    (["landing", "--set", "landing.camera={fov_deg: 45, fov_deg: 50}"], "--set landing.camera: key 'fov_deg': given twice"),
     (["landing", "--set", "landing.headline_scenario=nadir"], "--set landing.headline_scenario"),
     (["landing", "--set", "landing.scenarios.interior.fov_deg=10"], "landing.scenarios.interior"),
-    (["landing", "--set", "results_dir=docs/out"], "--set results_dir: invalid config key 'results_dir'"),
+    (["landing", "--set", "results_dir=docs/out"], "--set results_dir=docs/out: invalid config key 'results_dir'"),
     (["study", "fov", "--set", "landing.mc.runs_per_job=1", "--set", "landing.mc.n_runs=25000"], "limits.max_jobs"),
-    (["study", "fov", "--set", "approach.growing.N=7"], "--set approach.growing.N: invalid config key"),
+    (["study", "fov", "--set", "approach.growing.N=7"], "--set approach.growing.N=7: invalid config key"),
     (["landing", "--config", "{tmp}/dup.yaml"], "dup.yaml, line 3"),
     (["study", "nope", "--config", "{tmp}/nan.yaml"], "approach.dt_s"),
     (["study", "s", "--config", "{tmp}/study.yaml"], "'studies.s.vary' (study 's'): values"),
     (["study", "s", "--config", "{tmp}/study.yaml", "--cores", "0"], "--cores"),
     (["study", "s", "--config", "{tmp}/study.yaml", "--cores", "x"], "--cores"),
     (["study"], "NAME"),
+]
+
+# Round three (issue 46 item 5): --set takes any key path and refuses empty and null
+# values with the strict reader's rules; a wrong count names the flag; a line caused by
+# a flag names the flag and the value the user gave.
+NEW_CLI = [
+    (["landing", "--set", "landing.mc.n_runs="], "--set landing.mc.n_runs: no value after '='"),
+    (["landing", "--set", "landing.mc.n_runs= "], "--set landing.mc.n_runs: no value after '='"),
+    (["approach", "--set", "approach=null"], "--set approach: the value 'null' is null"),
+    (["landing", "--set", "landing.mc.n_runs=~"], "--set landing.mc.n_runs: the value '~' is null"),
+    (["landing", "--set", "landing.duration_s=1"],
+     "--set landing.duration_s=1: invalid config key 'landing.figures.f5_time_s'"),
+    (["approach", "--bias", "1", "2", "3", "4"], "argument --bias: takes 3 value(s), got 4 (1 2 3 4)"),
+    (["landing", "--seed", "1", "2"], "argument --seed: takes 1 value(s), got 2"),
+    (["approach", "--init", "1", "2"], "argument --init: expected 3 arguments"),
+    (["approach", "--pixel-sigma", "60"], "--pixel-sigma 60.0: invalid config key 'approach.camera.sigma3_px[2]'"),
+    (["landing", "--set", "landing.mc.base_seed=010"], "--set landing.mc.base_seed: 010 has a leading zero"),
+    (["landing", "--set", "paper.build_pdf=yes"], "--set paper.build_pdf: 'yes' is the boolean True"),
+    (["landing", "--set", "landing.planner.tol_rad=1e-3"], "--set landing.planner.tol_rad: 1e-3 is the string"),
+    (["landing", "--set", "approach.dt_s=1:30"], "--set approach.dt_s: 1:30 is the base-60 number 90"),
+    (["landing", "--set", "results_dir=$HOME/x"], "--set results_dir: '$HOME/x' holds $HOME"),
+    (["landing", "--set", "results_dir=/proc/opnav"], "--set results_dir=/proc/opnav: invalid config key 'results_dir'"),
+    (["landing", "--set", "landing.scenarios.site-tilt.zoom=2"],
+     "--set landing.scenarios.site-tilt.zoom: no config key 'landing.scenarios.site-tilt.zoom'"),
+    (["landing", "--set", "landing.scenarios.nosuch.fov_deg=75"],
+     "--set landing.scenarios.nosuch.fov_deg: no config key"),
+    (["landing", "--set", "landing.tuning.method=oracle"],
+     "--set landing.tuning.method=oracle: invalid config key 'landing.tuning.method': 'oracle' is not one of"),
+    (["landing", "--set", "landing.equivalence.controls=[oracle]"], "--set landing.equivalence.controls=[oracle]"),
+    (["landing", "--set", "landing..mc=1"], "expected KEY.PATH=VALUE"),
+    (["landing", "--set", "=1"], "expected KEY.PATH=VALUE"),
+    (["landing", "--set", "landing.camera=7"], "--set landing.camera=7: invalid config key 'landing.camera'"),
+    (["landing", "--set", "landing.mc.n_runs=3.0"], "--set landing.mc.n_runs=3.0: invalid config key 'landing.mc.n_runs'"),
+    (["landing", "--set", "landing.filter.update_altitude_margin_m=10000"],
+     "--set landing.filter.update_altitude_margin_m=10000: invalid config key 'landing.filter.update_altitude_margin_m'"),
+    (["landing", "--set", "landing.tuning.base_seed=20230410"], "--set landing.tuning.base_seed=20230410"),
+    (["landing", "--set", "landing.mc={n_runs: 4,n_runs: 5}"], "--set landing.mc: key 'n_runs': given twice"),
+    (["landing", "--set", "landing.camera.fov_deg=\"45\\n\""], "--set landing.camera.fov_deg: value '45\\n' holds a newline"),
+    (["study", "fov", "--set", "approach.stars.mag_limit=-100"],
+     "--set approach.stars.mag_limit=-100: invalid config key 'approach.stars.mag_limit'"),
+    (["study", "fov", "--set", "landing.tuning.method=oracle"], "--set landing.tuning.method=oracle"),
+    (["landing", "--config", "{tmp}/trap.yaml"], "trap.yaml, line 1: key 'landing.mc.base_seed': 010 has a leading zero"),
+    (["study", "fov", "--config", "{tmp}/yte.yaml"], "yte.yaml, line 1: key '__use_yte__'"),
 ]
 
 
@@ -454,7 +707,7 @@ def no_work(monkeypatch):
         monkeypatch.setattr(mod, name, forbidden)
 
 
-@pytest.mark.parametrize("argv,named", BAD_CLI, ids=[" ".join(a) for a, _ in BAD_CLI])
+@pytest.mark.parametrize("argv,named", BAD_CLI + NEW_CLI, ids=[" ".join(a) for a, _ in BAD_CLI + NEW_CLI])
 def test_bad_cli_refused_naming_flag(argv, named, tmp_path, capsys, no_work):
     from opnav.cli import EXIT_USER, main
 
@@ -463,6 +716,8 @@ def test_bad_cli_refused_naming_flag(argv, named, tmp_path, capsys, no_work):
     _write(tmp_path, "tilt.yaml", "landing: {camera: {tilt_deg: 0}}\n")
     _write(tmp_path, "dup.yaml", "landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n")
     _write(tmp_path, "study.yaml", "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}\n")
+    _write(tmp_path, "trap.yaml", "landing: {mc: {base_seed: 010}}\n")
+    _write(tmp_path, "yte.yaml", "__use_yte__: true\n")
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     try:
         rc = main(argv)
@@ -508,3 +763,93 @@ def test_json_output_is_strict():
 
     back = json.loads(text, parse_constant=refuse)
     assert back == {"a": None, "b": [None, 1.5], "c": None, "d": [1.0, None], "e": "nan", "f": 3}
+
+
+# ------------------------------------------------------------------ accepted and correct
+
+# (file content, dotted key, the value it must have): near the traps, read alike by
+# Snakemake's reader and ours, accepted with that value.
+ACCEPTED_FILES = [
+    ("landing: {planner: {tol_rad: 1.0e-3}}\n", "landing.planner.tol_rad", 0.001),
+    ("landing: {planner: {tol_rad: 1.0e-3}}\r\n", "landing.planner.tol_rad", 0.001),
+    ('{"landing": {"planner": {"tol_rad": 1e-3}}}', "landing.planner.tol_rad", 0.001),
+    ("paper: {build_pdf: false}\n", "paper.build_pdf", False),
+    ("paper: {build_pdf: True}\n", "paper.build_pdf", True),
+    ("landing: {mc: {n_runs: 0x10}}\n", "landing.mc.n_runs", 16),
+    ("landing: {camera: {fov_deg: +45}}\n", "landing.camera.fov_deg", 45),
+    ("landing: {mc: {n_runs: 0}}\n", "landing.mc.n_runs", 0),
+    (b"\xef\xbb\xbflanding: {mc: {n_runs: 8}}\n", "landing.mc.n_runs", 8),
+    ("studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, note: 'yes, 1:30 and 010'}}\n",
+     "studies.s.note", "yes, 1:30 and 010"),
+    ("landing: {scenarios: {'on': {}}}\n", "landing.scenarios.on", {}),
+    ("results_dir: 'out/a$'\n", "results_dir", "out/a$"),
+    ("approach: {base_seed: !!str 5}\n", "approach.base_seed", "5"),
+]
+
+
+@pytest.mark.parametrize("content,key,value", ACCEPTED_FILES, ids=[str(c)[:40] for c, _, _ in ACCEPTED_FILES])
+def test_accepted_file_reads_as_snakemake_reads_it(content, key, value, tmp_path):
+    """Accepted with the value both readers give: ours and Snakemake's (JSON first, then
+    PyYAML, snakemake.common.configfile)."""
+    from snakemake.common.configfile import load_configfile
+
+    from opnav.core.yamlfile import read_config_file
+
+    f = tmp_path / "ok.yaml"
+    f.write_bytes(content if isinstance(content, bytes) else content.encode())
+    ours = read_config_file(f)
+    node = ours
+    for part in key.split("."):
+        node = node[part]
+    assert node == value and type(node) is type(value), (node, value)
+    assert ours == load_configfile(str(f))
+
+
+def _cli_config(argv):
+    from opnav.cli import build_parser, load_cli_config
+
+    return load_cli_config(build_parser().parse_args(argv))
+
+
+def test_set_takes_any_key_path():
+    """--set a key of a camera scenario (its name holds '-'), a key the scenario's overlay
+    does not hold yet, and a whole list; the values are the user's."""
+    cfg = _cli_config(["landing", "--set", "landing.scenarios.site-tilt.fov_deg=75",
+                       "--set", "landing.mc.methods=[depth, svd]", "--set", "landing.planner.tol_rad=1.0e-3"])
+    assert cfg["landing"]["scenarios"]["site-tilt"]["fov_deg"] == 75
+    assert cfg["landing"]["mc"]["methods"] == ["depth", "svd"]
+    assert cfg["landing"]["planner"]["tol_rad"] == 0.001
+
+
+def test_user_errors_exit_2_and_numerical_failures_3(monkeypatch, capsys):
+    """A ValueError naming a config key from inside the package is the user's (2); any
+    other failure of a computation is numerical (3)."""
+    import opnav.landing.descent as descent
+    from opnav.cli import EXIT_NUMERICAL, EXIT_USER, main
+
+    def user(*a, **k):
+        raise ValueError("landing.timing.max_calls_paper must be >= 0, got -1")
+
+    monkeypatch.setattr(descent, "run_descent", user)
+    assert main(["landing"]) == EXIT_USER
+    assert "opnav: error: landing.timing.max_calls_paper" in capsys.readouterr().err
+
+    def numerical(*a, **k):
+        raise ValueError("Eigenvalues did not converge")
+
+    monkeypatch.setattr(descent, "run_descent", numerical)
+    assert main(["landing"]) == EXIT_NUMERICAL
+
+
+def test_battery_counts():
+    """The battery's size by class (issue 46's done-when: at least 150 cases)."""
+    import collections
+
+    counts = collections.Counter({"config values, rounds 1-2": len(BAD_CONFIGS),
+                                  "config files, rounds 1-2": len(BAD_FILES),
+                                  "YAML traps (files)": len(YAML_TRAPS),
+                                  "CLI, rounds 1-2": len(BAD_CLI), "CLI, round 3": len(NEW_CLI),
+                                  "accepted files": len(ACCEPTED_FILES)})
+    counts.update(cls for cls, _, _ in NEW_CONFIGS)
+    print("\n" + "\n".join(f"{n:4d}  {k}" for k, n in counts.items()) + f"\n{sum(counts.values()):4d}  total")
+    assert sum(counts.values()) >= 150

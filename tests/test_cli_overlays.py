@@ -45,12 +45,12 @@ def test_set_reaches_any_key_and_changes_the_result(capsys):
 
 
 @pytest.mark.parametrize("sets, fragment", [
-    (["approach.camera.ifov_arcsec=-1"], "--set approach.camera.ifov_arcsec: invalid config key 'approach.camera.ifov_arcsec'"),
+    (["approach.camera.ifov_arcsec=-1"], "--set approach.camera.ifov_arcsec=-1: invalid config key 'approach.camera.ifov_arcsec'"),
     (["approach.camera.ifov=10"], "--set approach.camera.ifov: no config key 'approach.camera.ifov'"),
     (["nosuch.key=1"], "no config key 'nosuch.key'"),
     (["approach.segments.N"], "expected KEY.PATH=VALUE"),
     (["approach.segments.N=[1,"], "--set approach.segments.N: the value '[1,' is not valid YAML"),
-    (["approach.segments.N=many"], "--set approach.segments.N: invalid config key 'approach.segments.N'"),
+    (["approach.segments.N=many"], "--set approach.segments.N=many: invalid config key 'approach.segments.N'"),
 ])
 def test_bad_set_is_refused_naming_the_flag_and_key(capsys, sets, fragment):
     argv = [*CASE, "--config", QUICK]

@@ -63,7 +63,7 @@ def test_closest_approach_closed_form_matches_numerical_integration(range_km, ai
     import numpy as np
 
     from opnav.approach import dynamics
-    from opnav.core.checks import _hyperbola_min_range_km, _integrated_min_range_km
+    from opnav.approach.preflight import _hyperbola_min_range_km, _integrated_min_range_km
 
     d = np.array([0.3 + dx, -0.9, 0.1 + dz])
     d /= np.linalg.norm(d)
@@ -84,7 +84,7 @@ def test_the_approach_check_uses_the_closest_approach_of_the_configured_arc():
     """The configured arc's closest range is the closed form's, and an arc aimed
     at Mars is refused naming geometry."""
     from opnav.approach import dynamics, scenario
-    from opnav.core.checks import _approach_min_range_km, _integrated_min_range_km, approach_problems
+    from opnav.approach.preflight import _approach_min_range_km, _integrated_min_range_km, approach_problems
 
     a = load_config(REPO / "config" / "config.yaml")["approach"]
     T = 5.0e5

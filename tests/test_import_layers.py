@@ -7,11 +7,13 @@
   import the core and their own paper only, never the other paper;
 * the report (``opnav.report.*``: claims, scorecard, manuscript, study plots, each
   paper's claims) and ``opnav.studies``: import anything below them;
-* the edge (the CLIs, ``__main__``): may import anything.
+* the edge (the CLIs, ``__main__``, ``opnav.preflight``: the config checks that need the
+  papers' physics and the study planner, which the Snakefile and the CLIs call): may
+  import anything.
 
-A module imports only its own layer or a lower one. ``EDGE_EXCEPTIONS`` lists core
-modules that still reach up (config validation calls the physics checks and the study
-planner); each is a debt, named here, and the test fails when one is added.
+A module imports only its own layer or a lower one, with no exception: config loading
+(``opnav.core.config``, ``opnav.core.checks``) imports nothing above the core, and
+importing it loads no numba, scipy or pandas (a test runs ``python -X importtime``).
 
 Every ``import`` counts, function-level (lazy) ones included: a lazy import that closes
 a cycle is still a cycle in the design.
@@ -24,9 +26,9 @@ from conftest import REPO
 
 SRC = REPO / "src"
 PAPERS = ("opnav.approach", "opnav.landing")
-EDGE = {"opnav.__main__", "opnav.cli", "opnav.approach.cli", "opnav.landing.cli"}
-#: core modules still allowed to import upwards (a debt: issue 41 item 3 removes them)
-EDGE_EXCEPTIONS = {"opnav.core.config", "opnav.core.checks"}
+EDGE = {"opnav.__main__", "opnav.cli", "opnav.approach.cli", "opnav.landing.cli", "opnav.preflight"}
+#: core modules allowed to import upwards: none (issue 41 item 3 removed config and checks)
+EDGE_EXCEPTIONS: set[str] = set()
 RANK = {"core": 0, "approach": 1, "landing": 1, "report": 2, "edge": 3}
 #: Cycles known and left to their owners (each a frozenset of module names). None
 #: now: the landing Monte Carlo / ranking / replay / descent component was broken
@@ -130,3 +132,22 @@ def test_the_checker_sees_a_cycle_and_an_upward_import():
     assert _layer("opnav.landing.descent") == "landing" and _layer("opnav.report.manuscript") == "report"
     assert _layer("opnav.core.tables") == "core" and _layer("opnav.approach.cli") == "edge"
     assert RANK[_layer("opnav.core.tables")] < RANK[_layer("opnav.approach.em")] < RANK[_layer("opnav.report.claims")]
+
+
+def test_loading_a_config_imports_no_heavy_package():
+    """`python -X importtime` of loading the checkout's config (core.config): no numba,
+    scipy, pandas or paper package among the imports (issue 41 item 3). Mutation: a
+    top-level `import numpy` or a physics check called from core.config fails it."""
+    import os
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-X", "importtime", "-c",
+                           "from opnav.core.config import load_config; load_config()"],
+                          capture_output=True, text=True, cwd=REPO,
+                          env={**os.environ, "PYTHONPATH": str(SRC)}, timeout=60)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    names = {line.rsplit("|", 1)[-1].strip() for line in proc.stderr.splitlines() if line.startswith("import time")}
+    heavy = sorted(n for n in names if n.split(".")[0] in ("numba", "scipy", "pandas", "numpy", "matplotlib")
+                   or n.startswith(("opnav.approach", "opnav.landing", "opnav.report", "opnav.studies")))
+    assert not heavy, heavy

@@ -43,4 +43,4 @@ def test_cli_scenario_flag_flies_that_camera(capsys):
 def test_cli_rejects_unknown_method(capsys):
     assert main(["landing", "--method", "nope"]) == 2
     err = capsys.readouterr().err
-    assert "--method" in err and "unknown planning method 'nope'" in err
+    assert "--method" in err and "'nope' is not one of" in err

@@ -11,6 +11,7 @@ from scipy import stats
 from conftest import REPO
 from opnav import studies
 from opnav.core.config import SCHEMA_PATH, ConfigError, load_config, validate_config
+from opnav.preflight import check_config
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.planner import available_methods
 
@@ -29,7 +30,7 @@ def _shapes(cfg):
 
 
 def _plan(cfg):
-    return studies.plan(cfg, _shapes(cfg), lambda c: validate_config(c, SCHEMA_PATH), available_methods())
+    return studies.plan(cfg, _shapes(cfg), lambda c: check_config(c), available_methods())
 
 
 def _with_study(cfg, name, **spec):

@@ -26,7 +26,7 @@ import sys
 from typing import Any
 
 from opnav import __version__
-from opnav.core.config import ConfigError, validate_config
+from opnav.core.errors import ConfigError
 
 #: Exit code of every user error (argparse's own code for a bad flag).
 EXIT_USER = 2
@@ -35,10 +35,54 @@ EXIT_NUMERICAL = 3
 
 
 class Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line (no usage block)."""
+    """An argument parser whose errors are one line (no usage block) naming the flag: an
+    extra value after a flag of fixed arity (``--bias 1 2 3 4``) is reported against that
+    flag, not as an unrecognised argument."""
+
+    def parse_known_args(self, args=None, namespace=None):  # noqa: D102
+        self._argv = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
+
+    def _arity(self) -> dict[str, int]:
+        """``{option string: fixed number of values}`` of this parser and its subparsers."""
+        out: dict[str, int] = {}
+        stack = [self]
+        while stack:
+            p = stack.pop()
+            for a in p._actions:
+                if isinstance(a, argparse._SubParsersAction):
+                    stack += list(a.choices.values())
+                elif a.option_strings:
+                    single = a.nargs is None and isinstance(a, (argparse._StoreAction, argparse._AppendAction))
+                    n = a.nargs if isinstance(a.nargs, int) else (1 if single else None)
+                    if n:
+                        out.update(dict.fromkeys(a.option_strings, n))
+        return out
 
     def error(self, message: str):  # noqa: D102
+        m = re.match(r"unrecognized arguments: (\S+)", message)
+        argv = getattr(self, "_argv", [])
+        if m and m.group(1) in argv:
+            i = argv.index(m.group(1))
+            j = i - 1
+            while j >= 0 and not (argv[j].startswith("-") and not _is_number(argv[j])):
+                j -= 1
+            arity = self._arity()
+            if j >= 0 and argv[j] in arity:
+                end = next((k for k in range(i, len(argv)) if argv[k].startswith("-") and not _is_number(argv[k])),
+                           len(argv))
+                given = end - j - 1
+                message = (f"argument {argv[j]}: takes {arity[argv[j]]} value(s), got {given} "
+                           f"({' '.join(argv[j + 1:j + 1 + given])})")
         self.exit(EXIT_USER, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def finite_float(text: str) -> float:
@@ -71,32 +115,54 @@ def _set(config: dict, dotted: str, value: Any) -> None:
 _KEY_RE = re.compile(r"config key '([^'\[]+)")
 
 
-def with_flags(config: dict, flags: dict[str, tuple[str, Any]], *, workflow: bool = False) -> dict:
+def _shown(value: Any) -> str:
+    """A flag's value as the user typed it (lists space-separated, as nargs flags take them)."""
+    if isinstance(value, (list, tuple)):
+        return " ".join(_shown(v) for v in value)
+    return "null" if value is None else str(value).lower() if isinstance(value, bool) else str(value)
+
+
+def with_flags(config: dict, flags: dict[str, tuple], *, workflow: bool = False) -> dict:
     """Set config keys from command-line flags and validate the result.
 
-    ``flags`` maps a dotted config key to ``(flag, value)``; ``None`` values are
-    skipped. The whole config is validated again (schema limits and the physics
-    checks of :mod:`opnav.core.checks`), and every error line about a flag's key (or
-    a parent or child of it) is prefixed with the flag. Raises
-    :class:`~opnav.core.config.ConfigError`.
+    ``flags`` maps a dotted config key to ``(flag, value)`` or ``(flag, value, shown)``
+    (``shown``: the user's value where the flag sets a derived one, e.g. ``--pixel-sigma``
+    sets three 3-sigma values); ``None`` values are skipped. The whole config is checked
+    again (:func:`opnav.preflight.check_config`: schema, core checks, the papers' physics
+    checks). Each error line about a flag's key (or a parent or child of it) is prefixed
+    with the flag and the user's value; a line the flags caused that names another key
+    (``--set landing.duration_s=1`` moving the B-F5 instant out of the descent) is prefixed
+    with every flag given, so no line blames a key the user did not touch without naming
+    the one they did. Raises :class:`~opnav.core.errors.ConfigError`.
     """
+    import copy
+
+    from opnav.preflight import check_config, problems
+
     given = {k: fv for k, fv in flags.items() if fv[1] is not None}
-    for key, (_, value) in given.items():
+    before = copy.deepcopy(config) if given else None
+    for key, (_, value, *_rest) in given.items():
         _set(config, key, value)
     try:
-        return validate_config(config, workflow=workflow)
+        return check_config(config, workflow=workflow)
     except ConfigError as exc:
+        old = set(problems(before, workflow=workflow)) if before is not None else set()
         lines = []
         for line in str(exc).splitlines():
             m = _KEY_RE.search(line)
             bad = m.group(1) if m else ""
             # the flag of the key the line names (or a parent or child of it), else of a
             # key the line mentions (approach.table1_variants ... not in approach.variants)
-            names = [flag for key, (flag, _) in given.items()
+            names = [key for key in given
                      if bad and (bad == key or key.startswith(bad + ".") or bad.startswith(key + "."))]
-            names = names or [flag for key, (flag, _) in given.items()
-                              if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", line)]
-            lines.append(f"{'/'.join(dict.fromkeys(names))}: {line}" if names else line)
+            names = names or [key for key in given if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", line)]
+            if not names and line not in old:
+                names = list(given)                # caused by the flags, about another key
+            shown = [f"{given[k][0]} {_shown(given[k][2] if len(given[k]) > 2 else given[k][1])}"
+                     if not given[k][0].startswith("--set ") else
+                     f"{given[k][0]}={_shown(given[k][2] if len(given[k]) > 2 else given[k][1])}"
+                     for k in names]
+            lines.append(f"{', '.join(dict.fromkeys(shown))}: {line}" if shown else line)
         raise ConfigError("\n".join(lines)) from None
 
 
@@ -152,49 +218,61 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
                         "flags are applied after it")
 
 
-_SET_KEY_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
+#: A --set key: dotted names, each as the schema's names are (scenario names hold "-").
+_SET_KEY_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_-]*(\.[A-Za-z0-9_][A-Za-z0-9_-]*)*")
 
 
-def parse_set(text: str) -> tuple[str, Any]:
-    """``KEY.PATH=VALUE`` -> (dotted key, YAML-parsed value); raises :class:`ConfigError`."""
-    import yaml
+def parse_set(text: str) -> tuple[str, Any, str]:
+    """``KEY.PATH=VALUE`` -> (dotted key, value, the value's text): the value read by the
+    config files' strict reader (:func:`opnav.core.yamlfile.read_value`: YAML 1.1 traps,
+    duplicate keys, control characters refused); an empty or null value is refused (a
+    config key cannot be unset). Raises :class:`ConfigError` naming the flag and key."""
+    from opnav.core.yamlfile import read_value
 
     key, sep, raw = text.partition("=")
     key = key.strip()
     if not sep or not _SET_KEY_RE.fullmatch(key):
         raise ConfigError(f"--set {text!r}: expected KEY.PATH=VALUE, e.g. --set landing.camera.fov_deg=75")
-    from opnav.core.config import _StrictLoader
-
-    try:
-        value = yaml.load(raw, Loader=_StrictLoader)    # a key twice in a {...} value is refused too
-    except yaml.YAMLError as exc:
-        what = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(f"--set {key}: the value {raw!r} is not valid YAML: {what}") from None
-    return key, value
+    return key, read_value(raw, f"--set {key}"), raw.strip()
 
 
 def load_cli_config(args, *, workflow: bool = False) -> dict:
     """The config of one subcommand run: the defaults (``config/config.yaml``), the top-level
     ``opnav --config`` overlay, the subcommand's ``--config`` overlays, then its ``--set``
-    keys, validated by the same schema and physics checks as the pipeline's config (with
-    ``workflow``, also the workflow's: studies, growing windows, job bounds). A ``--set``
-    key must exist; its errors name the flag."""
+    keys, checked once by the workflow's own pre-flight (:func:`opnav.preflight.check_config`:
+    schema, core checks, the papers' physics checks; with ``workflow``, also the studies,
+    growing windows and job bounds). A ``--set`` key must exist, or be a key the schema
+    allows under an existing map (a camera scenario's ``fov_deg``); its errors name the flag,
+    the key and the value given."""
     from opnav.core.config import load_config
 
     overlays = [*([args.config] if getattr(args, "config", None) else []), *getattr(args, "overlays", [])]
-    config = load_config(overlays=overlays, workflow=workflow and not getattr(args, "sets", []))
-    flags = {}
+    config = load_config(overlays=overlays, validate=False)
+    flags, new = {}, {}
     for text in getattr(args, "sets", []):
-        key, value = parse_set(text)
+        key, value, raw = parse_set(text)
         node, parts = config, key.split(".")
         for i, part in enumerate(parts):
+            if isinstance(node, dict) and part not in node and i == len(parts) - 1:
+                new[key] = sorted(node)      # a new key of an existing map: the schema decides
+                break
             if not isinstance(node, dict) or part not in node:
                 where = ".".join(parts[:i]) or "the top level"
                 have = ", ".join(sorted(node)) if isinstance(node, dict) else "no sub-keys"
                 raise ConfigError(f"--set {key}: no config key '{key}' ({where} has: {have})")
             node = node[part]
-        flags[key] = (f"--set {key}", value)
-    return with_flags(config, flags, workflow=workflow) if flags else config
+        flags[key] = (f"--set {key}", value, raw)
+    try:
+        return with_flags(config, flags, workflow=workflow)
+    except ConfigError as exc:
+        lines = str(exc).splitlines()
+        for key, have in new.items():      # the schema's "'x' was unexpected", said as above
+            parent, _, last = key.rpartition(".")
+            unexpected = f"invalid config key '{parent}': Additional properties are not allowed ('{last}' was"
+            if any(unexpected in ln for ln in lines):
+                raise ConfigError(f"--set {key}: no config key '{key}' ({parent} has: "
+                                  f"{', '.join(have) or 'no keys'})") from None
+        raise
 
 
 def _register_study(sub) -> None:
@@ -249,7 +327,7 @@ def run_study(args) -> int:
         if args.sets:  # --set keys reach Snakemake as one more overlay
             sets = {}
             for text in args.sets:
-                key, value = parse_set(text)
+                key, value, _ = parse_set(text)
                 _set(sets, key, value)
             extra = Path(tmp, "set.yaml")
             extra.write_text(yaml.safe_dump(sets))
@@ -316,8 +394,17 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         msg = " ".join(str(exc).split()) or type(exc).__name__
+        if isinstance(exc, ValueError) and _NAMES_A_KEY.search(msg):
+            # a check inside the package that names the user's key: a user error
+            print(f"opnav: error: {msg}", file=sys.stderr)
+            return EXIT_USER
         print(f"opnav: numerical failure ({type(exc).__name__}): {msg}", file=sys.stderr)
         return EXIT_NUMERICAL
+
+
+#: A dotted config key in an error message (a ValueError raised by a check inside the
+#: package about the user's value, e.g. opnav.approach.stars on approach.stars.every_K).
+_NAMES_A_KEY = re.compile(r"\b(?:approach|landing)\.[a-z_]+[a-z0-9_.]*\b")
 
 
 if __name__ == "__main__":  # pragma: no cover

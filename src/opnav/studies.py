@@ -293,6 +293,10 @@ def _value_sets(name: str, spec: Mapping) -> list[dict[str, Any]]:
 
 _PLANS: dict[str, dict] = {}
 
+#: Longest value label (``fov_deg~45``): it names the value's files, within a file name's
+#: 255 characters with the study id and name around it.
+MAX_LABEL_CHARS = 150
+
 
 def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
          validate: Callable[[dict], Any] | None = None,
@@ -303,7 +307,7 @@ def plan(config: Mapping, shapes: Mapping[str, Mapping] | None = None,
     ``shapes[paper]`` is the simulation's view of ``config[paper]`` (default
     :func:`simulation_shapes`); ``validate(cfg)`` raises :class:`ConfigError` (or
     ``ValueError``) for a bad merged config, or ``validate_paper(cfg, paper)`` (the
-    workflow's: :func:`opnav.core.config.validate_study_value`, which checks that paper's
+    workflow's: :func:`opnav.preflight.validate_study_value`, which checks that paper's
     section alone); ``landing_methods`` are the planner's method names (default: its
     registry). Raises one :class:`ConfigError` with one line per problem of every
     study, each naming ``studies.<name>...``. Without shapes, validate and methods the
@@ -355,9 +359,14 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
                 bad(f"{field}.{key}", f"key '{key}' is not under '{paper}.' (the study's paper)")
                 continue
             try:
-                get_path(config, key)
+                current = get_path(config, key)
             except KeyError:
                 bad(f"{field}.{key}", f"key '{key}' is not a config key")
+                continue
+            if isinstance(current, Mapping):   # the rule: a map is never replaced whole
+                bad(f"{field}.{key}", f"key '{key}' is a map ({', '.join(sorted(current))}): a value would "
+                                      f"replace all its keys; {'sweep' if field == 'vary' else 'fix'} its keys "
+                                      f"instead (e.g. {key}.{next(iter(sorted(current)), 'x')})")
                 continue
             if not _in_shape(shapes[paper], parts[1:]):
                 bad(f"{field}.{key}", f"key '{key}' is not read by the {paper} simulation, so setting "
@@ -411,6 +420,10 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
         # the validated (defaults filled, possibly normalised) values
         values = {k: get_path(merged, k) for k in values}
         label = instance_label(values)
+        if len(label) > MAX_LABEL_CHARS:
+            bad("vary", f"value {shown} makes the label {label[:40]!r}... of {len(label)} characters (it names "
+                        f"files; at most {MAX_LABEL_CHARS}): sweep fewer keys or shorter values")
+            continue
         if label in seen:
             bad("vary", f"values {seen[label]} and {values} coincide (label {label!r})")
             continue

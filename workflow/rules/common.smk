@@ -1,6 +1,7 @@
 # Shared helpers: config validation, output paths, and the final outputs (final_outputs).
 from opnav.core.compiled import KERNEL_MODULES, kernel_sources  # noqa: E402
-from opnav.core.config import ConfigError, validate_config  # noqa: E402
+from opnav.core.errors import ConfigError  # noqa: E402
+from opnav.preflight import check_config  # noqa: E402
 from opnav.core.snakeio import compact_params_change_reasons  # noqa: E402
 
 # "Params have changed" reasons name the changed keys, not whole config sections.
@@ -11,9 +12,10 @@ compact_params_change_reasons()
 # integers), the cross-key physics checks of opnav.core.checks (camera scenarios, growing
 # windows, headline scenario, results_dir), every parameter study's values, and the
 # job-graph bounds (limits), before the DAG is built: the same function the `opnav`
-# CLI uses. config_exit (Snakefile) is the one way out for them.
+# CLI uses (opnav.preflight: the core's checks, then each paper's physics checks, then
+# the studies). config_exit (Snakefile) is the one way out for them.
 try:
-    validate_config(config, root=workflow.basedir, workdir=Path.cwd(), workflow=True)
+    check_config(config, root=workflow.basedir, workdir=Path.cwd(), workflow=True)
 except ConfigError as exc:
     config_exit(exc)
 

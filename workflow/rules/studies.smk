@@ -7,7 +7,7 @@
 # simulations are flown once, and editing one study's values queues only the new
 # values' jobs. Outputs: results/studies/<name>/.
 from opnav import studies as _studies
-from opnav.core.config import validate_study_value
+from opnav.preflight import validate_study_value
 
 STUDIES_DIR = res("studies")
 STUDY_SHAPES = {
@@ -23,7 +23,7 @@ if STUDY_SHAPES != _studies.simulation_shapes(config):
     raise RuntimeError("opnav.studies.SIM_KEYS differs from the rules' simulation keys (B_SIM, "
                        "A_SCENARIO): update it")
 try:
-    STUDIES = _studies.plan(config, validate_paper=validate_study_value)   # cached: validate_config planned it
+    STUDIES = _studies.plan(config, validate_paper=validate_study_value)   # cached: check_config planned it
 except ConfigError as exc:
     config_exit(exc)
 STUDY_SIMS = {i.digest: i.sim for s in STUDIES.values() for i in s.instances}

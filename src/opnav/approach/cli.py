@@ -63,6 +63,8 @@ def run(args) -> int:
               "bias": list(args.bias) if args.bias else None,
               "init": list(args.init) if args.init else None}
     flags = {key: ("--" + name.replace("_", "-"), values[name]) for name, key in FLAG_KEYS.items()}
+    if px is not None:  # errors state the user's value, not the derived radius 3-sigma
+        flags[FLAG_KEYS["pixel_sigma"]] = ("--pixel-sigma", px, args.pixel_sigma)
     setup = Setup.from_config(with_flags(config, flags)["approach"])  # the edge: parsed once
     px = setup.camera.sigma3_px
     truth = setup.truth_bias_arcsec

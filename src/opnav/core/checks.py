@@ -1,36 +1,31 @@
-"""Config-time physics and consistency checks, run before any job.
+"""Config checks that need no physics: cross-key rules and bounds, run before any job.
 
 Description
 -----------
-The JSON schema checks each key alone (type, range); :func:`config_problems`
-checks what only several keys together decide, so that a config that would
-crash, hang or quietly produce garbage inside a job is refused at once, with
-one line per problem naming the keys:
+The JSON schema checks each key alone (type, range, the registry of names);
+:func:`config_problems` checks what several keys decide together without any paper's
+model, so it runs wherever a config is loaded (:func:`opnav.core.config.validate_config`,
+fast, no numba), one line per problem naming the keys:
 
-* paper A: the arc and roll-step durations versus ``approach.dt_s``; the
-  approach direction non-zero and not along the ecliptic pole (the aim-offset
-  direction is ``v_inf_dir x z``); the arc starting outside Mars and not
-  hitting it; Mars (at its closest along the arc, two-body Mars-centred
-  hyperbola) fitting the detector; the truth misalignment keeping Mars on the
-  detector; ``table1_variants`` inside ``variants`` and ``peers.variants``
-  inside ``table1_variants``; memory bounds (data
-  length, seeds x samples);
-* paper B: ``duration_s`` a multiple of ``filter.dt_s``, ``imu.rate_hz x
-  filter.dt_s`` an integer; the lander above ground (and above the
-  measurement-cut-off altitude, and above its initial position errors) and its
-  nominal guidance trajectory not through the ground; a planning margin that
-  leaves part of the detector; the landing site in the configured camera's view at the
-  start and while the filter measures (a parameter study runs these checks on
-  every swept value: :func:`opnav.studies.plan`);
-  every method name known to :func:`opnav.landing.planner.available_methods`
-  (the planner's own registry); the B-X1 reference among the flown methods;
-  the B-F5 instant inside the descent on a filter step; memory bounds;
-* both: ``results_dir`` non-empty and outside the checkout's tracked folders.
+* ``results_dir``: a usable folder outside the checkout's tracked folders, not under
+  /proc, /sys or /dev, no control character, no symlink loop (:func:`results_dir_problems`);
+* names: lists without duplicates; ``table1_variants`` within ``variants``, ``peers``
+  within ``table1_variants``; the B-X1 reference and the equivalence reference flown;
+  negative controls among the pickers without a metric, apart from the tested methods;
+  ``headline_scenario`` among ``scenarios``; study names that cannot collide with a
+  rule of the workflow (:data:`RESERVED_STUDY_NAMES`);
+* numbers against each other: seeds of separate streams distinct, brackets ordered,
+  a tolerance no larger than the quantity it tolerates, the landing vision cut-off
+  (altitude plus margin) below the start altitude, the near-site landmark radius inside
+  the field, the convergence threshold below the start altitude, the camera field of
+  view under 180 deg, memory bounds (:func:`approach_rules`, :func:`landing_rules`);
+* with ``workflow``: the growing windows, the job-graph bounds and each study's size
+  (:func:`job_problems`).
 
-Use: :func:`opnav.core.config.validate_config` calls :func:`config_problems` after
-the schema (Snakefile validation and the ``opnav`` CLI both go through it).
-Every check reads the package's own models (camera, guidance, constants), so
-it follows them when they change. Units as in the config.
+The checks that need a paper's physics (the approach arc against Mars, the landing site
+in the camera's view, ...) live in the paper packages (:mod:`opnav.approach.preflight`,
+:mod:`opnav.landing.preflight`); :func:`opnav.preflight.check_config` runs both kinds and
+the study planner, and is what the Snakefile and the CLI call.
 """
 
 from __future__ import annotations
@@ -39,18 +34,18 @@ import functools
 import math
 import re
 from pathlib import Path
+from typing import Mapping
 
-import numpy as np
-
-__all__ = ["config_problems", "approach_problems", "landing_problems", "results_dir_problems",
-           "TRACKED_DIRS", "MAX_APPROACH_SAMPLES", "MAX_APPROACH_SEED_SAMPLES",
-           "MAX_LANDING_IMU_SAMPLES", "MAX_LANDING_RUN_STEPS"]
+__all__ = ["config_problems", "approach_rules", "landing_rules", "results_dir_problems", "job_problems",
+           "growing_problems", "study_size_problem", "study_spec_defaults", "TRACKED_DIRS",
+           "MAX_APPROACH_SAMPLES", "MAX_APPROACH_SEED_SAMPLES", "MAX_LANDING_IMU_SAMPLES",
+           "MAX_LANDING_RUN_STEPS", "RESERVED_STUDY_NAMES", "PICKERS"]
 
 #: Memory bounds. An approach arc of n samples keeps n one-step STMs (6x6) per
 #: geometry and (seeds x n) filter states and covariances per batch.
 MAX_APPROACH_SAMPLES = 200_000
 MAX_APPROACH_SEED_SAMPLES = 2_000_000
-#: A descent keeps its truth at every IMU sample; a Monte Carlo keeps per-run
+#: A descent keeps its truth at every IMU sample; a Monte Carlo (and a study) keeps per-run
 #: histories of every filter step.
 MAX_LANDING_IMU_SAMPLES = 1_000_000
 MAX_LANDING_RUN_STEPS = 5_000_000
@@ -60,63 +55,196 @@ MAX_LANDING_RUN_STEPS = 5_000_000
 TRACKED_DIRS = ("paper", "src", "config", "workflow", "profiles", "tests", "benchmarks", ".git",
                 ".snakemake")
 
+#: Study names whose rules (``study_<name>``, ``study_<name>_outputs``, studies.smk) would
+#: collide with a rule the workflow has: ``runs`` (rule study_runs); a name ending in
+#: ``_outputs`` is refused too (``pixel_outputs`` would make study_pixel_outputs, study
+#: pixel's table rule).
+RESERVED_STUDY_NAMES = ("runs",)
 
-def _multiple(value: float, step: float, tol: float = 1e-9) -> bool:
+#: The planning "methods" without a metric (opnav.landing.planner's pickers): the negative
+#: controls of the equivalence test. tests/test_bad_input.py keeps it equal to the planner's.
+PICKERS = ("random", "center", "closest")
+
+#: Mars' mean radius, km, as opnav.approach.dynamics has it (a test keeps them equal): the
+#: approach arc's start must lie outside it.
+R_MARS_KM = 3389.5
+
+
+def multiple(value: float, step: float, tol: float = 1e-9) -> bool:
+    """``value`` is a positive integer multiple of ``step`` (to a relative ``tol``)."""
     k = round(value / step)
     return k >= 1 and abs(k * step - value) <= tol * max(1.0, abs(value))
 
 
-def _duplicates(items) -> list:
+def duplicates(items) -> list:
+    """The items given more than once, in order of their second appearance."""
     seen, dup = set(), []
     for x in items:
-        if x in seen and x not in dup:
+        key = repr(x) if isinstance(x, (list, dict)) else x
+        if key in seen and x not in dup:
             dup.append(x)
-        seen.add(x)
+        seen.add(key)
     return dup
 
 
 def config_problems(config: dict, root: str | Path | None = None,
                     workdir: str | Path | None = None, *, skip=(), sections=None,
-                    workflow: bool = False, plan_studies=None) -> list[str]:
-    """Every problem of a schema-valid ``config`` (defaults filled), one line each,
-    naming the key(s): ``results_dir``, the ``approach`` and ``landing`` sections and,
-    with ``workflow`` (the Snakefile, ``opnav study``), what only the workflow reads:
-    paper A's growing windows, the ``studies`` (each value checked as its own config,
-    :func:`opnav.studies.plan`) and the job-graph bounds (:func:`job_problems`).
-    ``root`` is the checkout (default: the working directory), ``workdir`` where
-    relative outputs go (default: ``root``); sections in ``skip`` (their schema failed)
-    are not read; ``sections`` (default all) limits the checks to those sections;
-    ``plan_studies(config)`` plans the studies, raising :class:`ConfigError` (handed in
-    by :func:`opnav.core.config.validate_config`: :mod:`opnav.studies` imports this module)."""
+                    workflow: bool = False) -> list[str]:
+    """Every physics-free problem of a schema-valid ``config`` (defaults filled), one line
+    each naming the key(s) (module docstring). ``root`` is the checkout (default: the
+    working directory), ``workdir`` where relative outputs go (default: ``root``); sections
+    in ``skip`` (their schema failed) are not read; ``sections`` (default all) limits the
+    checks to those sections; ``workflow`` adds what only the workflow reads (growing
+    windows, job-graph bounds, study names and sizes)."""
     want = set(sections) if sections is not None else {"results_dir", "approach", "landing", "studies",
                                                         "limits"}
     todo = want - set(skip)
     out: list[str] = []
     if "results_dir" in todo:
         out += results_dir_problems(config, root, workdir)
-    unsound = set(skip)                 # sections whose values the later checks cannot trust
-    for name, check in (("approach", approach_problems), ("landing", landing_problems)):
+    for name, check in (("approach", approach_rules), ("landing", landing_rules)):
         if name in todo and name in config:
-            found = check(config[name])
-            out += found
-            # camera scenarios and the headline scenario are not what a study flies
-            if any(not re.match(r"invalid config key 'landing\.(scenarios|headline_scenario)\b", ln)
-                   for ln in found):
-                unsound.add(name)
+            out += check(config[name], workflow=workflow)
     if not workflow:
         return out
     if "approach" in todo and "approach" not in set(skip):
         out += growing_problems(config["approach"])
-    jobs = []                           # counted, not built: first, as planning a study costs per value
+    if "studies" in todo and "landing" not in set(skip):
+        out += study_rules(config)
     if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
-        jobs = job_problems(config)
-    if ("studies" in todo and config.get("studies") and not jobs and plan_studies is not None
-            and not unsound & {"approach", "landing", "limits"}):
-        try:
-            plan_studies(config)
-        except ValueError as exc:        # ConfigError: one line per problem
-            out += str(exc).splitlines()
-    return out + jobs
+        out += job_problems(config)
+    return out
+
+
+def _k(section: str, key: str) -> str:
+    return f"invalid config key '{section}.{key}': "
+
+
+def approach_rules(a: dict, *, workflow: bool = False) -> list[str]:
+    """Physics-free cross-key rules of the ``approach`` section (module docstring)."""
+    out: list[str] = []
+    k = functools.partial(_k, "approach")
+    s = a["segments"]
+    n = s["N0"] + s["L"] * s["N"]
+    if n > MAX_APPROACH_SAMPLES:
+        return [k("segments") + f"N0 + L*N = {n} samples exceeds the limit {MAX_APPROACH_SAMPLES} (memory)"]
+    lo, hi = a["roll_rate_study"]["search_deg_s"]
+    if not lo < hi:
+        out.append(k("roll_rate_study.search_deg_s") + f"the bracket [{lo:g}, {hi:g}] deg/s must be (low, high) "
+                   "with low < high")
+    target = a["accuracy_target_arcsec"]
+    for key, tol in (("em.converge_tol_arcsec", a["em"]["converge_tol_arcsec"]),
+                     ("convergence_study.tol_arcsec", a["convergence_study"]["tol_arcsec"])):
+        if tol > target:
+            out.append(k(key) + f"{tol:g} arcsec exceeds approach.accuracy_target_arcsec = {target:g} arcsec "
+                       "(a run within a tolerance wider than the accuracy it is judged by would count as converged)")
+    cam = a["camera"]
+    fov_deg = cam["pixels"] * cam["ifov_arcsec"] / 3600.0
+    if fov_deg >= 180.0:
+        out.append(k("camera.ifov_arcsec") + f"{cam['ifov_arcsec']:g} arcsec x {cam['pixels']} px = {fov_deg:.4g} deg "
+                   "of field of view (a pinhole camera sees less than 180 deg)")
+    for key in ("variants", "table1_variants", "methods", "growing.methods", "peers.variants"):
+        node = a
+        for part in key.split("."):
+            node = node[part]
+        dup = duplicates(node)
+        if dup:
+            out.append(k(key) + f"duplicated {', '.join(map(str, dup))}")
+    extra = [v for v in a["table1_variants"] if v not in a["variants"]]
+    if extra:
+        out.append(k("table1_variants") + f"{', '.join(extra)} not in approach.variants ({', '.join(a['variants'])})")
+    peers = a.get("peers", {}).get("variants", [])
+    extra = [v for v in peers if v not in a["table1_variants"]]
+    if extra:  # A-P1 sets the peer beside the A-X2 results of those variants
+        out.append(k("peers.variants") + f"{', '.join(extra)} not in approach.table1_variants "
+                   f"({', '.join(a['table1_variants'])})")
+    if a["geometry"]["range_km"] <= R_MARS_KM:
+        out.append(k("geometry.range_km") + f"the arc starts inside Mars ({a['geometry']['range_km']:g} km <= Mars "
+                   f"radius {R_MARS_KM} km)")
+    st = a["stars"]
+    if workflow and "stars" in a["variants"] and s["N0"] + st["every_K"] > n:
+        out.append(k("stars.every_K") + f"{st['every_K']}: the first star image (sample N0 + every_K = "
+                   f"{s['N0'] + st['every_K']}) lies beyond the arc's last sample ({n} = N0 + L*N); the stars "
+                   "variant (in approach.variants) would have no image")
+    if st["per_image"] > st["catalogue_size"]:
+        out.append(k("stars.per_image") + f"{st['per_image']} stars per image exceed the catalogue's "
+                   f"{st['catalogue_size']} (approach.stars.catalogue_size)")
+    return out
+
+
+def landing_rules(c: dict, *, workflow: bool = False) -> list[str]:
+    """Physics-free cross-key rules of the ``landing`` section (module docstring)."""
+    out: list[str] = []
+    k = functools.partial(_k, "landing")
+    T, Dt = c["duration_s"], c["filter"]["dt_s"]
+    n_steps = max(1, round(T / Dt))
+    z0 = c["initial_state"]["r_m"][2]
+    if c["tuning"]["base_seed"] == c["mc"]["base_seed"]:
+        out.append(k("tuning.base_seed") + f"{c['tuning']['base_seed']} equals landing.mc.base_seed: the tuning runs "
+                   "must be out of sample (a separate random stream)")
+    f = c["filter"]
+    cut = f["min_update_altitude_m"] + f["update_altitude_margin_m"]
+    if z0 > 0 and cut >= z0:
+        out.append(k("filter.update_altitude_margin_m") + f"min_update_altitude_m + update_altitude_margin_m = "
+                   f"{cut:g} m is not below the start altitude {z0:g} m (landing.initial_state.r_m[2]): the "
+                   "filter would take no vision update")
+    conv = c["mc"]["converged_pos_err_m"]
+    if z0 > 0 and conv >= z0:
+        out.append(k("mc.converged_pos_err_m") + f"{conv:g} m is not below the start altitude {z0:g} m: every run "
+                   "would count as converged")
+    lm = c["landmarks"]
+    if lm["near_site"]["count"] and lm["near_site"]["r_min_m"] >= lm["half_width_m"]:
+        out.append(k("landmarks.near_site.r_min_m") + f"{lm['near_site']['r_min_m']:g} m is not inside the landmark "
+                   f"field (landing.landmarks.half_width_m = {lm['half_width_m']:g} m)")
+    for key, runs in (("mc.n_runs", c["mc"]["n_runs"]), ("tuning.n_runs", c["tuning"]["n_runs"])):
+        if runs * n_steps > MAX_LANDING_RUN_STEPS:
+            out.append(k(key) + f"{runs} runs x {n_steps} filter steps exceeds the limit {MAX_LANDING_RUN_STEPS} "
+                       "(memory)")
+    lists = {"mc.methods": c["mc"]["methods"], "extra.methods": c["extra"]["methods"],
+             "equivalence.methods": c["equivalence"]["methods"], "equivalence.controls": c["equivalence"]["controls"]}
+    for key, names in lists.items():
+        dup = duplicates(names)
+        if dup:
+            out.append(k(key) + f"duplicated {', '.join(dup)}")
+    flown = list(c["mc"]["methods"]) + list(c["extra"]["methods"])
+    if c["extra"]["reference"] not in flown:
+        out.append(k("extra.reference") + f"{c['extra']['reference']!r} is not flown (not in landing.mc.methods or "
+                   "landing.extra.methods)")
+    eq = c["equivalence"]
+    not_pickers = [m for m in eq["controls"] if m not in PICKERS]
+    if not_pickers:
+        out.append(k("equivalence.controls") + f"{', '.join(not_pickers)} has a metric; negative controls are the "
+                   f"pickers without one ({', '.join(PICKERS)})")
+    both = [m for m in eq["methods"] if m in eq["controls"] or m == eq["reference"]]
+    if both:
+        out.append(k("equivalence.methods") + f"{', '.join(both)} is also the reference or a control")
+    if "random" not in [*flown, *eq["controls"]]:
+        out.append(k("equivalence.controls") + "'random' sets the equivalence margin and is not flown (add it to "
+                   "landing.equivalence.controls or landing.extra.methods)")
+    scen = c.get("scenarios") or {}
+    head = c.get("headline_scenario")
+    if head is not None and scen and head not in scen:
+        out.append(k("headline_scenario") + f"{head!r} is not one of landing.scenarios ({', '.join(scen)})")
+    if c["extra"]["n_boot"] == 1:
+        out.append(k("extra.n_boot") + "1 resample gives no interval; use 0 (paired t only) or >= 2")
+    return out
+
+
+def study_rules(config: dict) -> list[str]:
+    """Study names that cannot collide with a rule; a paper-B study within the Monte
+    Carlo's memory bound (runs x filter steps)."""
+    out = []
+    c = config["landing"]
+    n_steps = max(1, round(c["duration_s"] / c["filter"]["dt_s"]))
+    for name, spec in (config.get("studies") or {}).items():
+        if name in RESERVED_STUDY_NAMES or name.endswith("_outputs"):
+            out.append(f"invalid config key 'studies.{name}': the name makes the rule study_{name}, which the "
+                       "workflow has already (choose another name)")
+        runs = spec.get("runs", study_spec_defaults()["runs"])
+        if spec.get("paper") == "landing" and runs * n_steps > MAX_LANDING_RUN_STEPS:
+            out.append(f"invalid config key 'studies.{name}.runs' (study '{name}'): {runs} runs x {n_steps} filter "
+                       f"steps exceeds the limit {MAX_LANDING_RUN_STEPS} (memory, as landing.mc.n_runs)")
+    return out
 
 
 #: Default upper bound on a study's value sets (config ``limits.max_study_values``).
@@ -205,7 +333,9 @@ def job_problems(config: dict) -> list[str]:
 def results_dir_problems(config_or_dir, root: str | Path | None = None,
                          workdir: str | Path | None = None) -> list[str]:
     """``results_dir`` (the key of ``config_or_dir``, a config mapping, or the path
-    itself): non-empty, no NUL byte, at most :data:`MAX_PATH_CHARS` characters (and
+    itself): non-empty, no NUL or other control character, no unexpanded ``$VAR``, not
+    under /proc, /sys or /dev, no symlink loop, not owned by another checkout or profile
+    (:func:`owner_problems`, given a config and ``root``), at most :data:`MAX_PATH_CHARS` characters (and
     255 per component), ``~`` expanded (in the config, in place) or refused if it
     names no home; a writable directory (or creatable in a writable one), not a
     file; not the checkout ``root`` (default: the working directory) nor a folder
@@ -220,6 +350,13 @@ def results_dir_problems(config_or_dir, root: str | Path | None = None,
         return [k + "empty (generated files would land in the checkout)"]
     if "\0" in results_dir:
         return [k + "contains a NUL byte"]
+    ctrl = next((ch for ch in results_dir if ord(ch) < 32 or 127 <= ord(ch) < 160), None)
+    if ctrl is not None:
+        return [k + f"{results_dir[:60]!r} holds a control character (U+{ord(ctrl):04X}); a folder name has none"]
+    env = re.search(r"\$(?:\{[^}]*\}|[A-Za-z_][A-Za-z0-9_]*)", results_dir)
+    if env:
+        return [k + f"{results_dir[:60]!r} holds {env.group(0)}, which is not expanded (a folder literally named "
+                f"{env.group(0)!r} would be made); write the path itself"]
     if len(results_dir) > MAX_PATH_CHARS or any(len(x) > 255 for x in Path(results_dir).parts):
         return [k + f"{len(results_dir)} characters (at most {MAX_PATH_CHARS}, and 255 per folder name)"]
     if results_dir.startswith("~"):
@@ -231,8 +368,15 @@ def results_dir_problems(config_or_dir, root: str | Path | None = None,
             cfg["results_dir"] = expanded
     base = Path(root or Path.cwd()).resolve()
     p = Path(results_dir)
-    p = (p if p.is_absolute() else Path(workdir or base) / p).resolve()
     shown = repr(results_dir if len(results_dir) <= 80 else results_dir[:77] + "...")
+    p = p if p.is_absolute() else Path(workdir or base) / p
+    try:
+        p = p.resolve(strict=False)
+    except (RuntimeError, OSError) as exc:      # a symlink loop (RuntimeError before Python 3.13)
+        return [k + f"{shown} cannot be resolved ({' '.join(str(exc).split())[:80]}): a symlink loop?"]
+    for top in KERNEL_DIRS:
+        if p.parts[:2] == ("/", top) or Path(os.path.abspath(results_dir)).parts[:2] == ("/", top):
+            return [k + f"{shown} is under /{top} (a kernel file system, not a place for results)"]
     if p == base:
         return [k + f"{shown} is the checkout itself"]
     if p in base.parents:
@@ -254,11 +398,63 @@ def results_dir_problems(config_or_dir, root: str | Path | None = None,
         return [k + f"{shown}: {q} is a file, so the folder cannot be made"]
     if not os.access(q, os.W_OK | os.X_OK):
         return [k + f"{shown}: {q} is not writable"]
+    if cfg is not None and root is not None and p.is_dir():
+        return owner_problems(p, root, str(cfg.get("profile", "full")))
     return []
 
 
 #: results_dir's length limit (characters).
 MAX_PATH_CHARS = 1024
+#: Top-level folders of kernel file systems results_dir may not be under (root passes
+#: os.access there).
+KERNEL_DIRS = ("proc", "sys", "dev")
+
+#: The marker inside results_dir naming the checkout (and config) that writes there.
+OWNER_MARKER = ".opnav-owner.json"
+
+
+def owner_problems(results_dir: str | Path, root: str | Path, profile: str) -> list[str]:
+    """A results_dir another checkout (or another profile) owns: its :data:`OWNER_MARKER`
+    names a different checkout, or the same checkout's other ``profile`` (full and quick
+    outputs would mix). Editing the config and rebuilding in place is the normal use, so
+    the config digest the marker records is information, not a refusal."""
+    import json
+
+    marker = Path(results_dir) / OWNER_MARKER
+    try:
+        owner = json.loads(marker.read_text())
+    except FileNotFoundError:
+        return []
+    except (OSError, ValueError) as exc:
+        return [f"invalid config key 'results_dir': its owner marker {marker} is unreadable ({exc}); remove it "
+                "if this checkout owns the folder"]
+    here = str(Path(root).resolve())
+    if owner.get("checkout") != here:
+        return [f"invalid config key 'results_dir': {str(results_dir)!r} belongs to the checkout "
+                f"{owner.get('checkout')!r} ({marker}); two checkouts writing one folder take each other's "
+                "outputs as up to date: give this checkout its own results_dir"]
+    if owner.get("profile") not in (None, profile):
+        return [f"invalid config key 'results_dir': {str(results_dir)!r} holds the {owner.get('profile')!r} "
+                f"profile's outputs ({marker}); give the {profile!r} profile its own results_dir"]
+    return []
+
+
+def claim_results_dir(results_dir: str | Path, root: str | Path, config: Mapping) -> Path:
+    """Write :data:`OWNER_MARKER` into ``results_dir`` (made if missing): the checkout, the
+    profile and a digest of the config (the Snakefile's ``onstart``, so a dry run writes
+    nothing). Returns the marker's path."""
+    import hashlib
+    import json
+
+    d = Path(results_dir)
+    d.mkdir(parents=True, exist_ok=True)
+    digest = hashlib.sha256(json.dumps(config, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+    marker = d / OWNER_MARKER
+    tmp = marker.with_suffix(".tmp")
+    tmp.write_text(json.dumps({"checkout": str(Path(root).resolve()), "profile": config.get("profile"),
+                               "config_digest": digest}, indent=1) + "\n")
+    tmp.replace(marker)
+    return marker
 
 
 def tracked_dirs(root: Path) -> tuple[Path, ...]:
@@ -292,303 +488,3 @@ def _tracked_dirs(root: str) -> tuple[Path, ...]:
             continue
         dirs.update(a for a in f.parents if a != Path("."))
     return tuple(sorted(dirs))
-
-
-# --------------------------------------------------------------------- paper A
-
-def _approach_min_range_km(a: dict, T: float) -> float:
-    """Closest range to Mars over [0, T] (s) of the arc that
-    :func:`opnav.approach.scenario.initial_truth` starts, km: Mars-centred two-body
-    motion, in closed form (the hyperbolic Kepler equation; e.g. Vallado,
-    *Fundamentals of Astrodynamics and Applications*, ch. 2). The arc is a hyperbola (its energy is v_inf^2 / 2 > 0): the range
-    falls until periapsis and rises after it, so the minimum is the periapsis radius
-    p / (1 + e) if periapsis comes within [0, T], else the range at the nearer end
-    (at T from the hyperbolic Kepler equation e sinh H - H = M). At or below Mars'
-    radius the arc has reached the surface: Mars' radius. (The Sun's tide over an
-    approach arc moves it by far less than Mars' radius.) This runs in every
-    Snakemake parse, where importing scipy.integrate cost more than the check; a
-    nearly parabolic arc (energy lost in round-off) is integrated instead
-    (:func:`_integrated_min_range_km`)."""
-    from opnav.approach import dynamics, scenario
-
-    X0 = scenario.initial_truth(a) - dynamics.kepler_state(
-        dynamics.KeplerElements.from_config(a["mars_elements"]), 0.0)
-    args = (X0[:3], X0[3:], T, dynamics.MU_MARS, dynamics.R_MARS_KM)
-    try:
-        return _hyperbola_min_range_km(*args)
-    except ValueError:                               # nearly parabolic
-        return _integrated_min_range_km(*args)
-
-
-def _hyperbola_min_range_km(r0, v0, T: float, mu: float, r_surface: float) -> float:
-    """Closest range over [0, T] s of the two-body hyperbola through (r0 km, v0 km/s)
-    about a body of ``mu`` (km^3/s^2), floored to ``r_surface`` km (see
-    :func:`_approach_min_range_km`)."""
-    r0, v0 = np.asarray(r0, float), np.asarray(v0, float)
-    r, v2, rv = float(np.linalg.norm(r0)), float(v0 @ v0), float(r0 @ v0)
-    energy = v2 / 2.0 - mu / r
-    if not energy > 1e-6 * mu / r:                   # relative to its two ~equal terms
-        raise ValueError("not a well-conditioned hyperbola (nearly parabolic)")
-    a = mu / (2.0 * energy)                              # |semi-major axis|, km
-    h2 = float(np.sum(np.cross(r0, v0) ** 2))
-    e = math.sqrt(1.0 + 2.0 * energy * h2 / mu ** 2)
-    n = math.sqrt(mu / a ** 3)                           # mean motion, rad/s
-    # hyperbolic anomaly now: r = a (e cosh H - 1), r . v = sqrt(mu a) e sinh H
-    H0 = math.asinh(rv / (math.sqrt(mu * a) * e))
-    M0 = e * math.sinh(H0) - H0
-    if rv >= 0.0:                                        # receding already
-        rmin = r
-    elif -M0 / n <= T:                                   # periapsis within the arc
-        rmin = h2 / mu / (1.0 + e)
-    else:                                                # still approaching at T
-        M, H = M0 + n * T, H0
-        for _ in range(100):                             # Newton; f' = e cosh H - 1 > 0
-            step = (e * math.sinh(H) - H - M) / (e * math.cosh(H) - 1.0)
-            H -= step
-            if abs(step) <= 1e-14 * max(1.0, abs(H)):
-                break
-        rmin = min(r, a * (e * math.cosh(H) - 1.0))
-    return r_surface if rmin <= r_surface else rmin
-
-
-def _integrated_min_range_km(r0, v0, T: float, mu: float, r_surface: float) -> float:
-    """:func:`_hyperbola_min_range_km` by scipy's DOP853 integration of the same
-    two-body motion (stopped at the surface) and a bounded search around the
-    closest sample: any conic, and the reference the closed form is tested against."""
-    from scipy.integrate import solve_ivp
-    from scipy.optimize import minimize_scalar
-
-    def rhs(t, X):
-        return np.concatenate([X[3:], -mu * X[:3] / np.linalg.norm(X[:3]) ** 3])
-
-    def surface(t, X):
-        return np.linalg.norm(X[:3]) - r_surface
-
-    surface.terminal = True
-    sol = solve_ivp(rhs, (0.0, T), np.concatenate([r0, v0]), method="DOP853", rtol=1e-11,
-                    atol=1e-7, dense_output=True, events=surface)
-    if sol.status == 1:                              # reached the surface
-        return r_surface
-    rng = np.linalg.norm(sol.y[:3], axis=0)
-    i = int(np.argmin(rng))
-    lo, hi = sol.t[max(i - 1, 0)], sol.t[min(i + 1, len(sol.t) - 1)]
-    rmin = float(rng[i])
-    if hi > lo:
-        best = minimize_scalar(lambda t: np.linalg.norm(sol.sol(t)[:3]), bounds=(lo, hi),
-                               method="bounded", options={"xatol": 1e-7 * max(T, 1.0)})
-        rmin = min(rmin, float(best.fun))
-    # a grazing dip below the surface within one step has no sign change for the event
-    return r_surface if rmin <= r_surface else rmin
-
-
-def approach_problems(a: dict) -> list[str]:
-    """Cross-key problems of the ``approach`` section (see module docstring)."""
-    from opnav.approach import dynamics, scenario
-
-    out: list[str] = []
-    k = "invalid config key 'approach."
-    dt = a["dt_s"]
-    s = a["segments"]
-    n = scenario.n_samples(a)
-    if n > MAX_APPROACH_SAMPLES:
-        out.append(f"{k}segments': N0 + L*N = {n} samples exceeds the limit "
-                   f"{MAX_APPROACH_SAMPLES} (memory)")
-        return out
-    for key, seeds, samples in (("n_seeds", a["n_seeds"], n),
-                                ("convergence_study.n_seeds", a["convergence_study"]["n_seeds"],
-                                 s["N0"] + a["convergence_study"]["data_samples"])):
-        if seeds * samples > MAX_APPROACH_SEED_SAMPLES:
-            out.append(f"{k}{key}': {seeds} seeds x {samples} samples exceeds the limit "
-                       f"{MAX_APPROACH_SEED_SAMPLES} (memory)")
-    if s["N0"] + a["convergence_study"]["data_samples"] > MAX_APPROACH_SAMPLES:
-        out.append(f"{k}convergence_study.data_samples': N0 + data_samples exceeds the limit "
-                   f"{MAX_APPROACH_SAMPLES} (memory)")
-    if out:
-        return out
-    roll = a["roll"]
-    if roll["steps_deg"] and not _multiple(roll["step_interval_s"], dt):
-        out.append(f"{k}roll.step_interval_s': {roll['step_interval_s']} s is not a multiple of "
-                   f"approach.dt_s = {dt} s")
-    for key in ("variants", "table1_variants", "methods"):
-        node = a
-        for part in key.split("."):
-            node = node[part]
-        dup = _duplicates(node)
-        if dup:
-            out.append(f"{k}{key}': duplicated {', '.join(map(str, dup))}")
-    extra = [v for v in a["table1_variants"] if v not in a["variants"]]
-    if extra:
-        out.append(f"{k}table1_variants': {', '.join(extra)} not in approach.variants "
-                   f"({', '.join(a['variants'])})")
-    peers = a.get("peers", {}).get("variants", [])
-    extra = [v for v in peers if v not in a["table1_variants"]]
-    if extra:  # A-P1 sets the peer beside the A-X2 results of those variants
-        out.append(f"{k}peers.variants': {', '.join(extra)} not in approach.table1_variants "
-                   f"({', '.join(a['table1_variants'])})")
-    dup = _duplicates(peers)
-    if dup:
-        out.append(f"{k}peers.variants': duplicated {', '.join(map(str, dup))}")
-    g = a["geometry"]
-    d = np.asarray(g["v_inf_dir"], float)
-    dn = float(np.linalg.norm(d))
-    if dn == 0:
-        out.append(f"{k}geometry.v_inf_dir': the approach direction is zero")
-        return out
-    if float(np.linalg.norm(np.cross(d / dn, [0.0, 0.0, 1.0]))) < 1e-6:
-        out.append(f"{k}geometry.v_inf_dir': {list(g['v_inf_dir'])} is along the ecliptic pole "
-                   "(the aim-offset direction v_inf_dir x z is undefined)")
-        return out
-    if g["range_km"] <= dynamics.R_MARS_KM:
-        out.append(f"{k}geometry.range_km': the arc starts inside Mars "
-                   f"({g['range_km']} km <= Mars radius {dynamics.R_MARS_KM} km)")
-        return out
-    T = dt * max(n, s["N0"] + a["convergence_study"]["data_samples"])
-    rmin = _approach_min_range_km(a, T)
-    if rmin <= dynamics.R_MARS_KM:
-        out.append(f"{k}geometry': the arc reaches Mars' surface within its {T:g} s "
-                   "(dt_s x samples); raise geometry.aim_offset_km or range_km, or shorten the arc")
-        return out
-    cam = a["camera"]
-    disc = scenario.mars_disc_px(rmin, cam["ifov_arcsec"])
-    if disc > cam["pixels"]:
-        out.append(f"{k}camera': Mars ({disc:.0f} px across at its closest, {rmin:.0f} km) does "
-                   f"not fit the {cam['pixels']} px detector; raise camera.ifov_arcsec or "
-                   "geometry.range_km")
-    half_fov = cam["pixels"] * cam["ifov_arcsec"] / 2.0
-    for key in ("truth_bias_arcsec", "theta_init_arcsec"):
-        off = math.hypot(a[key][0], a[key][1])
-        if off >= half_fov:
-            out.append(f"{k}{key}': a misalignment of {off:g} arcsec (x, y) puts Mars off the "
-                       f"detector (half field of view {half_fov:g} arcsec)")
-    return out
-
-
-# --------------------------------------------------------------------- paper B
-
-def landing_problems(c: dict) -> list[str]:
-    """Cross-key problems of the ``landing`` section (see module docstring)."""
-    from opnav.landing.planner import available_methods
-    from opnav.landing.trajectory import truth_states
-
-    out: list[str] = []
-    k = "invalid config key 'landing."
-    T, Dt, rate = c["duration_s"], c["filter"]["dt_s"], c["imu"]["rate_hz"]
-    if not _multiple(T, Dt):
-        out.append(f"{k}duration_s': {T} s is not a multiple of landing.filter.dt_s = {Dt} s")
-    if not _multiple(rate * Dt, 1.0):
-        out.append(f"{k}imu.rate_hz': rate_hz x filter.dt_s = {rate} x {Dt} = {rate * Dt:g} "
-                   "is not a positive integer")
-    n_steps = max(1, round(T / Dt))
-    if T * rate > MAX_LANDING_IMU_SAMPLES:
-        out.append(f"{k}imu.rate_hz': duration_s x rate_hz = {T * rate:.0f} IMU samples exceeds "
-                   f"the limit {MAX_LANDING_IMU_SAMPLES} (memory)")
-    for key, runs in (("mc.n_runs", c["mc"]["n_runs"]),):
-        if runs * n_steps > MAX_LANDING_RUN_STEPS:
-            out.append(f"{k}{key}': {runs} runs x {n_steps} filter steps exceeds the limit "
-                       f"{MAX_LANDING_RUN_STEPS} (memory)")
-    f5 = c["figures"]["f5_time_s"]
-    if not (0 <= f5 < T) or (f5 > 0 and not _multiple(f5, Dt)):
-        out.append(f"{k}figures.f5_time_s': {f5} s must be a filter step "
-                   f"(multiple of filter.dt_s = {Dt} s) in [0, duration_s = {T} s)")
-
-    known = available_methods()
-    lists = {"mc.methods": c["mc"]["methods"], "extra.methods": c["extra"]["methods"],
-             "extra.reference": [c["extra"]["reference"]],
-             "single.method": [c["single"]["method"]]}
-    for key, names in lists.items():
-        bad = [m for m in names if m not in known]
-        if bad:
-            out.append(f"{k}{key}': unknown planning method {', '.join(map(repr, bad))} "
-                       f"(known: {', '.join(known)})")
-        dup = _duplicates(names)
-        if dup:
-            out.append(f"{k}{key}': duplicated {', '.join(dup)}")
-    if c["extra"]["n_boot"] == 1:
-        out.append(f"{k}extra.n_boot': 1 resample gives no interval; use 0 (paired t only) or >= 2")
-    flown = list(c["mc"]["methods"]) + list(c["extra"]["methods"])
-    if c["extra"]["reference"] not in flown:
-        out.append(f"{k}extra.reference': {c['extra']['reference']!r} is not flown "
-                   "(not in landing.mc.methods or landing.extra.methods)")
-
-    r0 = np.asarray(c["initial_state"]["r_m"], float)
-    alt_min = c["filter"]["min_update_altitude_m"]
-    if r0[2] <= 0:
-        out.append(f"{k}initial_state.r_m': the lander starts at altitude {r0[2]:g} m, "
-                   "not above the ground z = 0")
-        return out
-    if c["mc"]["bounds"]["r_m"] >= r0[2]:
-        out.append(f"{k}mc.bounds.r_m': initial position errors up to {c['mc']['bounds']['r_m']:g} m "
-                   f"would start estimates below the ground (the lander starts at {r0[2]:g} m)")
-    out += _margin_problems(c["planner"]["margin_px"], c["camera"], f"{k}planner.margin_px'")
-    scenarios = _scenario_cameras(c, out)
-    for name, cam in scenarios.items():
-        out += _margin_problems(c["planner"]["margin_px"], cam, f"{k}scenarios.{name}'")
-    if r0[2] <= alt_min:
-        out.append(f"{k}initial_state.r_m': the lander starts at {r0[2]:g} m, not above "
-                   f"filter.min_update_altitude_m = {alt_min:g} m (no measurement would be taken)")
-    if out or not _multiple(T, Dt):
-        return out
-    t = Dt * np.arange(n_steps + 1)
-    try:
-        tr = truth_states(t, r0, c["initial_state"]["v_mps"], T, c["gravity_mps2"], c["yaw_deg"])
-    except (ValueError, np.linalg.LinAlgError) as exc:
-        return [*out, f"{k}initial_state': the nominal guidance trajectory is undefined: {exc}"]
-    below = np.nonzero(tr.r[:-1, 2] < 0)[0]
-    if below.size:
-        out.append(f"{k}initial_state': the nominal guidance trajectory goes below ground at "
-                   f"t = {t[below[0]]:g} s (initial_state.r_m / v_mps / duration_s)")
-        return out
-    measuring = tr.r[:, 2] > alt_min                 # where the filter takes bearings
-    to_site_B = np.einsum("kij,kj->ki", tr.R_LtoB, -tr.r)
-    for key, cam in {"camera": c["camera"], **{f"scenarios.{n}": v for n, v in scenarios.items()}}.items():
-        out += _view_problems(cam, f"{k}{key}'", t, to_site_B, measuring)
-    return out
-
-
-def _scenario_cameras(c: dict, out: list[str]) -> dict[str, dict]:
-    """``{scenario: merged camera}`` of the camera scenarios (``landing.scenarios``) whose
-    camera differs from ``landing.camera`` (each is checked as the base camera is); a
-    ``landing.headline_scenario`` that names none of them is appended to ``out``."""
-    from opnav.landing.scenario import camera_scenarios
-
-    scen = c.get("scenarios") or {}
-    head = c.get("headline_scenario")
-    if head is not None and scen and head not in scen:
-        out.append(f"invalid config key 'landing.headline_scenario': {head!r} is not one of "
-                   f"landing.scenarios ({', '.join(scen)})")
-        return {}
-    try:
-        merged = camera_scenarios(c)
-    except ValueError as exc:
-        out.append(f"invalid config key 'landing.scenarios': {exc}")
-        return {}
-    return {n: s["camera"] for n, s in merged.items() if s["camera"] != c["camera"]}
-
-
-def _margin_problems(margin: float, cam: dict, key: str) -> list[str]:
-    half = cam["pixels"] / 2.0
-    if margin >= half:
-        return [f"{key}: landing.planner.margin_px = {margin:g} px leaves no part of the "
-                f"{cam['pixels']} px detector to plan landmarks in (must be < {half:g})"]
-    return []
-
-
-def _view_problems(camera: dict, key: str, t, to_site_B, measuring) -> list[str]:
-    """The landing site in ``camera``'s view at the start and while the filter measures."""
-    from opnav.landing.camera import camera_from_config
-
-    fov = camera["fov_deg"]
-    try:
-        cam = camera_from_config(camera)
-    except ValueError as exc:
-        return [f"{key}: {exc}"]
-    seen = cam.in_view(to_site_B)
-    if not seen[0]:
-        return [f"{key}: the landing site is not in the camera's view at t = 0 "
-                f"(fov_deg {fov:g}, tilt_deg {camera['tilt_deg']:g}, "
-                f"tilt_azimuth_deg {camera['tilt_azimuth_deg']:g})"]
-    if not np.all(seen[measuring]):
-        t_out = t[np.nonzero(measuring & ~seen)[0][0]]
-        return [f"{key}: the landing site leaves the camera's view at t = {t_out:g} s "
-                f"of the nominal descent (fov_deg {fov:g}, tilt_deg {camera['tilt_deg']:g})"]
-    return []

@@ -1,10 +1,13 @@
-"""Configuration: load a YAML config, validate it against the project schema.
+"""Configuration: read the user's YAML files strictly, validate against the project schema.
 
-The schema (``opnav/schemas/config.schema.yaml``, shipped with the package, and
-the section files it references) is the single source of defaults, types and ranges. Snakemake
-validates with :func:`snakemake.utils.validate`; the command-line tools use
-:func:`load_config`, which applies the same schema with the same defaults so a
-CLI run and a pipeline run see the same parameters.
+The schema (``opnav/schemas/config.schema.yaml``, shipped with the package, and the
+section files it references) is the single source of defaults, types, ranges and the
+registry of names. :func:`load_config` reads every file with the strict reader
+(:mod:`opnav.core.yamlfile`, also the Snakefile's for every ``--configfile``), merges them
+as ``snakemake --configfile`` does, and validates with the schema and the physics-free
+cross-key checks (:mod:`opnav.core.checks`). It imports nothing above the core (no paper
+package, numba, scipy or pandas): the checks that need a paper's physics and the study
+planner run in :func:`opnav.preflight.check_config`, which the Snakefile and the CLI call.
 """
 
 from __future__ import annotations
@@ -19,8 +22,9 @@ import yaml
 
 
 from opnav.core.errors import ConfigError  # noqa: E402  (defined in the base layer; its home for users)
+from opnav.core.yamlfile import read_config_file
 
-__all__ = ["ConfigError", "validate_config", "load_config", "read_config_file", "validate_study_value"]
+__all__ = ["ConfigError", "validate_config", "load_config", "read_config_file", "schema_problems", "core_problems"]
 
 
 _INSTANCE_RE = re.compile(r"On instance((?:\[[^\]]+\])*)")
@@ -174,24 +178,10 @@ def _copy(value: Any) -> Any:
     return copy.deepcopy(value)
 
 
-def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: bool = True,
-                    root: str | Path | None = None, workdir: str | Path | None = None,
-                    sections: tuple[str, ...] | None = None, workflow: bool = False) -> dict:
-    """Validate ``config`` in place (filling defaults); raise :class:`ConfigError`
-    with one line per problem, each naming its key: every problem of every layer
-    in one pass, before any job runs.
-
-    The layers: every number anywhere must be finite (:func:`non_finite_keys`);
-    the JSON schema (integer keys take ints only); and, with ``physics``, on each
-    section the schema passed, the cross-key checks of
-    :func:`opnav.core.checks.config_problems` (``results_dir``; durations, rates,
-    geometry, camera scenarios, method names, ...; the parameter studies, each value
-    checked as its own config; the job-graph bounds). ``root`` is the checkout,
-    ``workdir`` where a relative ``results_dir`` lands (default ``root``);
-    ``sections`` limits the physics checks to those sections (a study value's
-    config: its paper's); ``workflow`` adds what only the workflow reads (the studies,
-    growing windows, job-graph bounds): the Snakefile and ``opnav study`` set it.
-    """
+def schema_problems(config: dict, schema_path: Path = SCHEMA_PATH) -> list[str]:
+    """The schema's problems of ``config`` (filling defaults in place), one line each naming
+    its key: every number anywhere finite (:func:`non_finite_keys`), then the JSON schema
+    (types, ranges, patterns, the registry of names; integer keys take ints only)."""
     bad = non_finite_keys(config)
     lines = [f"invalid config key '{k}': {v} is not a finite number "
              "(NaN and infinity are refused)" for k, v in bad.items()]
@@ -200,158 +190,63 @@ def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, physics: b
         key = _dotted(err.absolute_path)
         if key not in bad:
             where = f"config key '{key}'" if key else "config (top level)"
-            lines.append(f"invalid {where}: {err.message}")
-    if physics:
+            lines.append(f"invalid {where}: {_message(err)}")
+    return lines
+
+
+def _message(err) -> str:
+    """jsonschema's message, shortened where it would print a long instance."""
+    if err.validator == "pattern" and isinstance(err.instance, str):
+        shown = err.instance if len(err.instance) <= 60 else err.instance[:57] + "..."
+        return f"{shown!r} is not a valid name here (pattern {err.validator_value})"
+    if err.validator == "maxLength" and isinstance(err.instance, str):
+        return (f"{err.instance[:24]!r}{'...' if len(err.instance) > 24 else ''} has {len(err.instance)} characters, "
+                f"at most {err.validator_value} (it names files and rules)")
+    msg = err.message
+    return msg if len(msg) <= 300 else msg[:297] + "..."
+
+
+def core_problems(config: dict, schema_path: Path = SCHEMA_PATH, *, root: str | Path | None = None,
+                  workdir: str | Path | None = None, sections: tuple[str, ...] | None = None,
+                  workflow: bool = False) -> list[str]:
+    """The problem lines of the schema and :mod:`opnav.core.checks` (no physics): what
+    :func:`validate_config` raises; :func:`opnav.preflight.check_config` adds the paper
+    packages' physics checks and the studies to the same lines."""
+    lines = schema_problems(config, schema_path)
+    broken = {section_of(line) for line in lines}
+    if "" not in broken:        # a top-level schema error: no section is safe to read
         from opnav.core.checks import config_problems
 
-        broken = {_top(line) for line in lines}
-        if "" not in broken:        # a top-level schema error: no section is safe to read
-            lines += config_problems(config, root, workdir, skip=broken, sections=sections, workflow=workflow,
-                                     plan_studies=_plan_studies)
+        lines += config_problems(config, root, workdir, skip=broken, sections=sections, workflow=workflow)
+    return list(dict.fromkeys(lines))
+
+
+def validate_config(config: dict, schema_path: Path = SCHEMA_PATH, *, root: str | Path | None = None,
+                    workdir: str | Path | None = None, sections: tuple[str, ...] | None = None,
+                    workflow: bool = False) -> dict:
+    """Validate ``config`` in place (filling defaults); raise :class:`ConfigError` with one
+    line per problem, each naming its key: the schema (:func:`schema_problems`) and the
+    physics-free cross-key checks of :func:`opnav.core.checks.config_problems`
+    (``results_dir``, names, bounds). ``root`` is the checkout, ``workdir`` where a relative
+    ``results_dir`` lands (default ``root``); ``sections`` limits the cross-key checks to
+    those sections; ``workflow`` adds what only the workflow reads (growing windows,
+    job-graph bounds, study names and sizes). The physics checks and the study planner
+    run in :func:`opnav.preflight.check_config` (the Snakefile's and the CLI's)."""
+    lines = core_problems(config, schema_path, root=root, workdir=workdir, sections=sections,
+                          workflow=workflow)
     if lines:
-        raise ConfigError("\n".join(dict.fromkeys(lines)))
+        raise ConfigError("\n".join(lines))
     return config
 
 
-def _plan_studies(config: dict) -> None:
-    from opnav.studies import plan
-
-    plan(config, validate_paper=validate_study_value)
-
-
-def validate_study_value(merged: dict, paper: str) -> None:
-    """A parameter study's value: its merged config (every study removed) through the
-    schema and the physics checks of the study's paper section (:func:`opnav.studies.plan`)."""
-    validate_config(merged, sections=(paper,))
-
-
-def _top(line: str) -> str:
+def section_of(line: str) -> str:
     """The top-level section a problem line names ('' for the top level itself)."""
     m = re.match(r"invalid config key '([^'.\[]+)", line)
     return m.group(1) if m else ""
 
 
-#: Upper bound on the nodes of a config file once its aliases are expanded (a "billion
-#: laughs" file of a few lines expands to 10^9; every config of the project has < 5,000).
-MAX_YAML_NODES = 100_000
-
-
-class _StrictLoader(_YAML_LOADER):  # type: ignore[misc, valid-type]
-    """The safe loader, refusing a key given twice in one mapping (YAML keeps the
-    last silently: a duplicated ``landing:`` block would drop the first)."""
-
-    def construct_mapping(self, node, deep=False):
-        seen: dict = {}
-        for key_node, _ in node.value:
-            if key_node.tag == "tag:yaml.org,2002:merge":
-                continue                 # `<<: *anchor`: its keys may be overridden
-            key = self.construct_object(key_node, deep=True)
-            try:
-                hash(key)
-            except TypeError:
-                continue                 # SafeConstructor raises its own error below
-            if key in seen:
-                raise yaml.constructor.ConstructorError(
-                    None, None, f"duplicate key {key!r} (first given on line {seen[key] + 1})",
-                    key_node.start_mark)
-            seen[key] = key_node.start_mark.line
-        return super().construct_mapping(node, deep=deep)
-
-
-def _expanded_nodes(node, budget: int) -> int:
-    """The number of nodes of the document once every alias is expanded, counting
-    stops past ``budget``; raises ``ValueError`` for a recursive alias."""
-    memo: dict[int, int] = {}
-    active: set[int] = set()
-
-    def size(n) -> int:
-        i = id(n)
-        if i in memo:
-            return memo[i]
-        if i in active:
-            raise ValueError("a recursive alias (an anchor used inside itself)")
-        active.add(i)
-        total = 1
-        if isinstance(n, yaml.SequenceNode):
-            for c in n.value:
-                total += size(c)
-                if total > budget:
-                    break
-        elif isinstance(n, yaml.MappingNode):
-            for k, v in n.value:
-                total += size(k) + size(v)
-                if total > budget:
-                    break
-        active.discard(i)
-        memo[i] = total
-        return total
-
-    return size(node)
-
-
-def read_config_file(path: str | Path) -> dict:
-    """The mapping in the user config file ``path`` (a YAML document), or
-    :class:`ConfigError` naming the file and, for a parse error, the line: the file
-    missing, unreadable, not UTF-8 text, empty, not valid YAML (a tab in the
-    indentation, an unknown ``!!tag``), a key given twice, aliases expanding past
-    :data:`MAX_YAML_NODES` nodes, or a top level that is not a mapping. The loader of
-    every user config: the ``opnav`` CLI's and the Snakefile's (which re-reads the
-    ``--configfile`` files Snakemake has read)."""
-    f = Path(path)
-    if not f.exists():
-        raise ConfigError(f"config file {f}: not found")
-    if not f.is_file():
-        raise ConfigError(f"config file {f}: not a regular file")
-    try:
-        raw = f.read_bytes()
-    except OSError as exc:
-        raise ConfigError(f"config file {f}: cannot be read ({exc.strerror or exc})") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[:exc.start].count(b"\n") + 1
-        raise ConfigError(f"config file {f}, line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); "
-                          "a YAML config is expected") from None
-    if "\0" in text:
-        line = text[:text.index("\0")].count("\n") + 1
-        raise ConfigError(f"config file {f}, line {line}: a NUL byte (binary data); a YAML config is expected")
-    loader = _StrictLoader(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:
-            raise ConfigError(f"config file {f}: empty (no config keys); give a mapping such as "
-                              "'landing: {mc: {n_runs: 10}}'")
-        try:
-            n = _expanded_nodes(node, MAX_YAML_NODES)
-        except ValueError as exc:
-            raise ConfigError(f"config file {f}, line {node.start_mark.line + 1}: {exc}") from None
-        if n > MAX_YAML_NODES:
-            raise ConfigError(f"config file {f}: its aliases expand to more than {MAX_YAML_NODES} "
-                              "nodes (an alias bomb?); write the values out")
-        if not isinstance(node, yaml.MappingNode):
-            kind = "a list" if isinstance(node, yaml.SequenceNode) else f"the scalar {node.value[:40]!r}"
-            raise ConfigError(f"config file {f}, line {node.start_mark.line + 1}: the top level must be a "
-                              f"mapping of config keys (approach, landing, ...), not {kind}")
-        data = loader.construct_document(node)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
-        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        what = " ".join(filter(None, [getattr(exc, "context", None), getattr(exc, "problem", None)])) \
-            or str(exc).splitlines()[0]
-        lines = text.splitlines()
-        if mark and mark.line < len(lines) and "\t" in lines[mark.line][:mark.column + 1]:
-            what += " (a tab: YAML indents with spaces)"
-        raise ConfigError(f"config file {f}{where}: not valid YAML: {what}") from None
-    finally:
-        loader.dispose()
-    bad = [k for k in data if not isinstance(k, str)]
-    if bad:
-        raise ConfigError(f"config file {f}: top-level key {bad[0]!r} is not a name")
-    return data
-
-
 def load_config(path: str | Path | None = None, overlays: list[str | Path] = (), *,
-                workflow: bool = False) -> dict:
+                workflow: bool = False, validate: bool = True) -> dict:
     """Read ``path`` (default: the checkout's ``config/config.yaml``, or, for an
     installed package run outside a checkout, nothing: the schema's defaults,
     which a test keeps equal to ``config/config.yaml``), merge the
@@ -359,8 +254,10 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = (),
     does), validate, return.
 
     ``config/quick.yaml`` is an overlay: ``load_config(overlays=[quick])``.
-    Every file is read by :func:`read_config_file` (errors name the file and
-    line); a bad value raises :class:`ConfigError` naming the key.
+    Every file is read by :func:`read_config_file` (the strict reader: errors name the
+    file, line and key); a bad value raises :class:`ConfigError` naming the key
+    (:func:`validate_config`: schema and physics-free checks; ``validate=False`` returns
+    the merged files unvalidated, for a caller that sets more keys and checks once).
     """
     if path is None:
         try:
@@ -373,6 +270,8 @@ def load_config(path: str | Path | None = None, overlays: list[str | Path] = (),
         _merge(config, read_config_file(f))
     # results_dir is relative to the checkout that holds config/config.yaml
     root = Path(path).resolve().parents[1] if path is not None and Path(path).parent.name == "config" else None
+    if not validate:
+        return config
     return validate_config(config, SCHEMA_PATH, root=root, workflow=workflow)
 
 

@@ -1,0 +1,80 @@
+"""Every check of a config before any job: the workflow's validation step and the CLI's.
+
+:func:`check_config` runs, in one pass, one line per problem naming its key:
+
+1. the schema and the physics-free cross-key checks (:func:`opnav.core.config.core_problems`,
+   what :func:`opnav.core.config.load_config` runs everywhere);
+2. the physics checks of each paper section that passed step 1, where the physics is
+   (:func:`opnav.approach.preflight.approach_problems`,
+   :func:`opnav.landing.preflight.landing_problems`);
+3. with ``workflow`` (the Snakefile, ``opnav study``): every parameter study planned, each
+   value checked as its own config by steps 1 and 2 for its paper
+   (:func:`opnav.studies.plan` with :func:`validate_study_value`), once the sections it
+   reads are sound and the job graph is within its bounds.
+
+It sits above the core and the papers (it imports both), so the core's config loader
+imports no paper package, numba or scipy.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from opnav.core.config import SCHEMA_PATH, schema_problems, section_of
+from opnav.core.errors import ConfigError
+
+__all__ = ["check_config", "problems", "validate_study_value"]
+
+#: Lines of the landing section that do not make it unsound for a study: a study flies
+#: the base camera, not the scenarios.
+_SCENARIO_ONLY = re.compile(r"invalid config key 'landing\.(scenarios|headline_scenario)\b")
+
+
+def problems(config: dict, *, root: str | Path | None = None, workdir: str | Path | None = None,
+             sections: tuple[str, ...] | None = None, workflow: bool = False) -> list[str]:
+    """Every problem line of ``config`` (validated in place, defaults filled): module docstring."""
+    from opnav.core.checks import config_problems
+
+    lines = schema_problems(config, SCHEMA_PATH)
+    unsound = {section_of(ln) for ln in lines}       # a schema problem: the section cannot be read
+    if "" in unsound:
+        return lines
+    found = config_problems(config, root, workdir, skip=set(unsound), sections=sections, workflow=workflow)
+    lines += found
+    unsound |= {section_of(ln) for ln in found if not _SCENARIO_ONLY.match(ln)}
+    want = set(sections) if sections is not None else {"approach", "landing", "studies"}
+    for name in ("approach", "landing"):
+        if name in want and name not in unsound and name in config:
+            if name == "approach":
+                from opnav.approach.preflight import approach_problems as check
+            else:
+                from opnav.landing.preflight import landing_problems as check
+            found = check(config[name])
+            lines += found
+            unsound |= {section_of(ln) for ln in found if not _SCENARIO_ONLY.match(ln)}
+    if (workflow and "studies" in want and config.get("studies")
+            and not unsound & {"approach", "landing", "limits", "studies"}):
+        from opnav.studies import plan
+
+        try:
+            plan(config, validate_paper=validate_study_value)
+        except ConfigError as exc:
+            lines += str(exc).splitlines()
+    return list(dict.fromkeys(lines))
+
+
+def check_config(config: dict, *, root: str | Path | None = None, workdir: str | Path | None = None,
+                 sections: tuple[str, ...] | None = None, workflow: bool = False) -> dict:
+    """``config`` validated in place by :func:`problems`, or :class:`ConfigError` (one line
+    per problem)."""
+    lines = problems(config, root=root, workdir=workdir, sections=sections, workflow=workflow)
+    if lines:
+        raise ConfigError("\n".join(lines))
+    return config
+
+
+def validate_study_value(merged: dict, paper: str) -> None:
+    """A parameter study's value: its merged config (every study removed) through the
+    schema, the core checks and the physics checks of the study's paper section."""
+    check_config(merged, sections=(paper,))
