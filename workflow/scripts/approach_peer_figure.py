@@ -2,18 +2,17 @@
 
 import sys
 
-import pandas as pd
 
 from opnav.core import figures
 from opnav.approach import peer_plots
-from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.snakeio import load_pickle, load_table, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_peer_figure", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     peer = [load_pickle(p) for p in snakemake.input.peer]
-    table = pd.read_csv(snakemake.input.table)
+    table = load_table(snakemake.input.table)
     with figures.style():
         fig = peer_plots.peer_figure(peer, table)
         figures.save(fig, snakemake.output.fig)

@@ -2,12 +2,11 @@
 
 import sys
 
-import pandas as pd
 
 from opnav.core import figures
 from opnav.approach import plots
 from opnav.approach.setup import Setup
-from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
+from opnav.core.snakeio import load_pickle, load_table, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x1_figure", argv=sys.argv[1:])
@@ -19,6 +18,6 @@ with script_context(snakemake) as log:
     for p in snakemake.input.conv:
         c = load_pickle(p)
         conv[c["variant"]] = c
-    x1 = pd.read_csv(snakemake.input.x1)
+    x1 = load_table(snakemake.input.x1)
     fig = plots.fig_crlb(curves, conv, x1, setup.accuracy_target_arcsec, setup.segments.N0)
     figures.save(fig, snakemake.output.fig)

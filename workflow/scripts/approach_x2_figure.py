@@ -2,18 +2,17 @@
 
 import sys
 
-import pandas as pd
 
 from opnav.core import figures
 from opnav.approach import plots
 from opnav.approach.report import METHOD_LABELS
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_table, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x2_figure", argv=sys.argv[1:])
 
 
 with script_context(snakemake) as log:
-    long = pd.read_csv(snakemake.input.long)
+    long = load_table(snakemake.input.long)
     figures.save(plots.fig_alternatives(long, METHOD_LABELS), snakemake.output.fig)
     log.info("A-X2 figure: %d methods x %d variants", long["method"].nunique(), long["variant"].nunique())

@@ -2,11 +2,10 @@
 name, with each scenario's camera), ``headline_scenario``, and the headline
 scenario's keys also at the top level (the manuscript's default numbers)."""
 
-import json
 import sys
 
 from opnav.landing.report import combine_scenarios
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -14,7 +13,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     names = list(snakemake.params.scenarios)
-    parts = {n: json.loads(open(p).read()) for n, p in zip(names, snakemake.input.parts)}
+    parts = {n: load_json(p) for n, p in zip(names, snakemake.input.parts)}
     write_json(snakemake.output[0], combine_scenarios(parts, snakemake.params.headline,
                                                       dict(snakemake.params.cameras)))
     log.info("%s: scenarios %s, headline %s", snakemake.output[0], names, snakemake.params.headline)

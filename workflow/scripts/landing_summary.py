@@ -3,7 +3,6 @@ on, planning time beside the published 29.03 %), its summary JSON (headline
 numbers for the manuscript and the scorecard), B-F6 (navigation-error 3-sigma
 envelopes) and B-F7 (planning-time box plots)."""
 
-import json
 import sys
 
 import pandas as pd
@@ -12,7 +11,7 @@ from opnav.core import figures, published
 from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
 from opnav.landing.report import accuracy_tests, scenario_summary, summary_table
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -40,8 +39,7 @@ with script_context(snakemake) as log:
                          "deviation over runs); the published 29.03 % (depth vs SVD) is "
                          "labelled published. Converged: final position error below "
                          f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
-    with open(snakemake.input.single) as fh:
-        single = json.load(fh)
+    single = load_json(snakemake.input.single)
     every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
     acc = accuracy_tests(every, snakemake.params.equivalence, float(snakemake.params.converged_pos_err_m))
     out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
@@ -49,8 +47,7 @@ with script_context(snakemake) as log:
                            yaw_ratio=float(snakemake.params.yaw_ratio),
                            published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
                            accuracy=acc)
-    with open(snakemake.input.tuning) as fh:
-        out["tuning"] = json.load(fh)        # chosen on a separate seed stream: out["nees"] is held out
+    out["tuning"] = load_json(snakemake.input.tuning)        # chosen on a separate seed stream: out["nees"] is held out
     write_json(snakemake.output.summary, out)
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f6)

@@ -8,10 +8,9 @@ and the sample sentence for the manuscript's macros."""
 import json
 import sys
 
-import pandas as pd
 
 from opnav.core import published
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
 from opnav.report import claims
 from opnav.report.approach_claims import HEADLINE_IDS as A_HEAD, claim_rows as rows_a, input_rows as inputs_a
@@ -25,8 +24,8 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 def score(inp, prefix, pub, plan, windows):
     """The claims rows of one sample (main: prefix '', replication: 'rep_')."""
     keys = inp.keys()
-    summ = {k: json.loads(open(inp[f"{prefix}summary_{k}"]).read()) for k in ("A", "B") if f"{prefix}summary_{k}" in keys}
-    t1 = pd.read_csv(inp[f"{prefix}a_table1"]) if f"{prefix}a_table1" in keys else None
+    summ = {k: load_json(inp[f"{prefix}summary_{k}"]) for k in ("A", "B") if f"{prefix}summary_{k}" in keys}
+    t1 = load_table(inp[f"{prefix}a_table1"]) if f"{prefix}a_table1" in keys else None
     rows = rows_a(summ["A"], t1, pub["paper_a"], plan, windows) if "A" in summ and t1 is not None else []
     rows += rows_b(summ["B"], pub["paper_b"], plan) if "B" in summ else []
     return summ, rows

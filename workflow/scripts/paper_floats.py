@@ -7,10 +7,9 @@ through a compact view computed from their CSV, written under compact/.
 import sys
 from pathlib import Path
 
-import pandas as pd
 
 from opnav.report.manuscript import COMPACT_VIEWS, float_block, output_id, table1_grouped_latex
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -26,7 +25,7 @@ with script_context(snakemake) as log:
             if view is None:
                 paths.append(p)
                 continue
-            for suffix, df in view(pd.read_csv(p.with_suffix(".csv"))):
+            for suffix, df in view(load_table(p.with_suffix(".csv"))):
                 stem = f"{p.stem}_{suffix}" if suffix else p.stem
                 out = compact_dir / f"{stem}.tex"
                 write_table(df, [out])
@@ -35,5 +34,5 @@ with script_context(snakemake) as log:
         atomic_write_text(snakemake.output[part], text or "% no outputs yet\n")
         log.info("%s: %d floats", part, len(paths))
     a_t1 = list(snakemake.input.a_table1) if "a_table1" in snakemake.input.keys() else []
-    atomic_write_text(snakemake.output.table1, table1_grouped_latex(pd.read_csv(a_t1[0])) if a_t1
+    atomic_write_text(snakemake.output.table1, table1_grouped_latex(load_table(a_t1[0])) if a_t1
                       else "% paper A Table 1 not built\n")

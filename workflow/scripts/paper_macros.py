@@ -1,11 +1,10 @@
 """results/paper/macros.tex: one \\newcommand per number the manuscript quotes."""
 
-import json
 import sys
 
 from opnav.core import published
 from opnav.report.manuscript import format_sci, macros_from_summary, prose_tex, render_macros
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -16,10 +15,10 @@ with script_context(snakemake) as log:
     for key in ("A", "B", "AX2", "BX1", "AP1"):
         name = f"summary_{key}"
         if name in snakemake.input.keys():
-            macros.update(macros_from_summary(json.loads(open(snakemake.input[name]).read()), key))
-    sc = json.loads(open(snakemake.input.scorecard).read())
+            macros.update(macros_from_summary(load_json(snakemake.input[name]), key))
+    sc = load_json(snakemake.input.scorecard)
     macros.update(macros_from_summary(sc, "Score"))
-    cl = json.loads(open(snakemake.input.claims).read())
+    cl = load_json(snakemake.input.claims)
     macros.update(macros_from_summary({k: v for k, v in cl.items() if k != "text"}, "Claims"))
     macros.update({f"ClaimsText{k.title()}": prose_tex(v) for k, v in cl["text"].items()})
     macros.update(macros_from_summary({"profile": snakemake.params.profile}, "Run"))

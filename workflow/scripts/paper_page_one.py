@@ -11,7 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from opnav.core import figures, published
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text
 from opnav.report import differences, manuscript, verdict_plot
 
@@ -20,7 +20,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     out = snakemake.output
-    df = pd.read_csv(snakemake.input.claims, keep_default_na=False)
+    df = load_table(snakemake.input.claims, keep_default_na=False)
     sample = manuscript.sample_sentence_of(df)
     atomic_write_text(out.abstract, manuscript.page_one_abstract_tex(df, sample))
     figures.save(verdict_plot.fig_verdicts(df), [out.fig_pdf, out.fig_png])

@@ -3,13 +3,12 @@
 import json
 import sys
 
-import pandas as pd
 
 from opnav.core import published
 from opnav.report import scorecard
 from opnav.approach.report import rows_paper_a
 from opnav.landing.report import rows_paper_b
-from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -19,11 +18,11 @@ with script_context(snakemake) as log:
     inp = snakemake.input
     rows = []
     if "a_table1" in inp.keys():
-        summary_a = json.loads(open(inp["summary_A"]).read()) if "summary_A" in inp.keys() else {}
-        rows += rows_paper_a(pd.read_csv(inp["a_table1"]), summary_a, published.paper_a())
+        summary_a = load_json(inp["summary_A"]) if "summary_A" in inp.keys() else {}
+        rows += rows_paper_a(load_table(inp["a_table1"]), summary_a, published.paper_a())
     if "b_summary_table" in inp.keys():
-        summary_b = json.loads(open(inp["summary_B"]).read()) if "summary_B" in inp.keys() else {}
-        rows += rows_paper_b(pd.read_csv(inp["b_summary_table"]), summary_b, published.paper_b())
+        summary_b = load_json(inp["summary_B"]) if "summary_B" in inp.keys() else {}
+        rows += rows_paper_b(load_table(inp["b_summary_table"]), summary_b, published.paper_b())
     df = scorecard.score_rows(rows)
     write_table(df, snakemake.output.table, caption="Scorecard: published values beside ours.")
     atomic_write_text(snakemake.output.longtable, scorecard.to_longtable(df))

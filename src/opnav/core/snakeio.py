@@ -285,13 +285,64 @@ def load_csv(path, **kw):
         raise corrupt_intermediate(path, exc) from exc
 
 
+def _checked_text(path) -> tuple[str, bool]:
+    """The text of the intermediate ``path`` and whether a checksum sidecar vouched for it
+    (:func:`opnav.core.tables.write_checksum`); a sidecar that disagrees raises ValueError."""
+    import hashlib
+    import re
+
+    from opnav.core.tables import checksum_path
+
+    data = Path(path).read_bytes()
+    side = checksum_path(path)
+    if not side.exists():
+        return data.decode("utf-8"), False
+    m = re.fullmatch(r"sha256=([0-9a-f]{64}) bytes=(\d+)\s*", side.read_text())
+    if not m:
+        raise ValueError(f"unreadable checksum sidecar {side.name}")
+    if len(data) != int(m.group(2)):
+        raise ValueError(f"{len(data)} bytes, {m.group(2)} written (cut or edited)")
+    if hashlib.sha256(data).hexdigest() != m.group(1):
+        raise ValueError("checksum mismatch with its .sha256 sidecar (edited)")
+    return data.decode("utf-8"), True
+
+
+def load_table(path, **kw):
+    """Read a table (CSV) another job wrote, checked: against its checksum sidecar where
+    :func:`opnav.core.tables.write_table` wrote one, else validated (ends with a newline,
+    every row as many fields as the header), so a cut or edited file raises
+    :class:`CorruptIntermediate` naming it and the command that rebuilds it instead of
+    losing rows silently. ``kw`` goes to :func:`pandas.read_csv`."""
+    import csv
+    import io
+
+    import pandas as pd
+
+    try:
+        text, vouched = _checked_text(path)
+        if not vouched:
+            if text and not text.endswith("\n"):
+                raise ValueError("no newline at the end (cut inside its last row?)")
+            sep = kw.get("sep", ",")
+            widths = {len(row) for row in csv.reader(io.StringIO(text), delimiter=sep)}
+            if len(widths) > 1:
+                raise ValueError(f"rows of {sorted(widths)} fields (cut or edited)")
+        return pd.read_csv(io.StringIO(text), **kw)
+    except FileNotFoundError:
+        raise
+    except (OSError, UnicodeDecodeError, ValueError, pd.errors.ParserError, csv.Error) as exc:
+        raise corrupt_intermediate(path, exc) from exc
+
+
 def load_json(path):
-    """Read an intermediate JSON file; a truncated or corrupt one raises
+    """Read a JSON summary another job wrote, checked against its checksum sidecar where
+    :func:`opnav.core.tables.write_json` wrote one; a cut, edited or unparsable file raises
     :class:`CorruptIntermediate` naming it and the rebuild command."""
     import json
 
     try:
-        return json.loads(Path(path).read_bytes().decode("utf-8"))
+        text, _ = _checked_text(path)
+        return json.loads(text)
     except FileNotFoundError:
         raise
     except (OSError, UnicodeDecodeError, ValueError) as exc:

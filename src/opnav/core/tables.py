@@ -124,8 +124,29 @@ def write_table(df: pd.DataFrame, paths: Iterable[str | Path] | str | Path,
         else:
             raise ValueError(f"unknown table format for {p} (use .csv, .tex or .md)")
         atomic_write_text(p, text)
+        if p.suffix == ".csv":
+            write_checksum(p, text)
         written.append(p)
     return written
+
+
+#: Suffix of the checksum sidecar of a CSV table or JSON summary (``A-T1_table1.csv.sha256``),
+#: which :func:`opnav.core.snakeio.load_table` and :func:`~opnav.core.snakeio.load_json` check.
+CHECKSUM_SUFFIX = ".sha256"
+
+
+def checksum_path(path: str | Path) -> Path:
+    """The checksum sidecar of ``path``."""
+    p = Path(path)
+    return p.with_name(p.name + CHECKSUM_SUFFIX)
+
+
+def write_checksum(path: str | Path, text: str) -> None:
+    """Write the sidecar of ``path`` whose contents are ``text``: SHA-256 and byte count."""
+    import hashlib
+
+    data = text.encode("utf-8")
+    atomic_write_text(checksum_path(path), f"sha256={hashlib.sha256(data).hexdigest()} bytes={len(data)}\n")
 
 
 def json_ready(x):
@@ -151,10 +172,13 @@ def json_ready(x):
 
 
 def write_json(path: str | Path, obj) -> None:
-    """Write ``obj`` as sorted, indented JSON (via :func:`json_ready`), atomically."""
+    """Write ``obj`` as sorted, indented JSON (via :func:`json_ready`), atomically, with its
+    checksum sidecar (:func:`write_checksum`)."""
     import json
 
-    atomic_write_text(path, json.dumps(json_ready(obj), indent=2, sort_keys=True) + "\n")
+    text = json.dumps(json_ready(obj), indent=2, sort_keys=True) + "\n"
+    atomic_write_text(path, text)
+    write_checksum(path, text)
 
 
 # ------------------------------------------------------------ table cells
