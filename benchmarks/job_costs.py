@@ -8,7 +8,9 @@ per group of logs (the part's folder and the log name's first word: ``landing/mc
 peak memory, sorted by total CPU; then the compiled kernels (``kernels_loaded=``,
 ``kernels_compiled=`` on the same line, :mod:`opnav.core.compiled`): how many jobs loaded
 them from numba's cache, and every job but ``compile_kernels`` that compiled some
-itself (a warm-up missing a signature the pipeline calls). Usage::
+itself (a warm-up missing a signature the pipeline calls); then each job's start-up CPU
+(``startup_cpu_s=`` and its parts, :mod:`opnav.core.startup`): the mean per job and the
+groups whose start-up is largest. Usage::
 
     python benchmarks/job_costs.py results/quick
     python benchmarks/job_costs.py results --top 20
@@ -23,6 +25,9 @@ from pathlib import Path
 
 _LINE = re.compile(r"job resources: cpu_s=([0-9.]+) user_s=([0-9.]+) sys_s=([0-9.]+) max_rss_mb=([0-9.]+)")
 _KERNELS = re.compile(r"kernels_loaded=(\d+) kernels_compiled=(\d+)")
+_STARTUP = re.compile(r"startup_cpu_s=([0-9.]+) before_work_s=([0-9.]+) imports_s=([0-9.]+) kernel_load_s=([0-9.]+)")
+#: rule compile_kernels' logs: its compiling is its work, and its start-up is not a job's
+_COMPILE_LOG = "kernels"
 
 
 def _last_matches(root: Path, pattern: re.Pattern) -> list[tuple[str, re.Match]]:
@@ -41,6 +46,34 @@ def kernel_counts(root: Path) -> list[tuple[str, int, int]]:
     """(log path relative to ``root``, kernel signatures loaded, compiled) of every job
     log whose resource line counts kernels."""
     return [(p, int(m.group(1)), int(m.group(2))) for p, m in _last_matches(root, _KERNELS)]
+
+
+def startups(root: Path) -> list[tuple[str, float, float, float, float]]:
+    """(log path relative to ``root``, start-up CPU seconds, of them before the work, in
+    imports during it, making kernels callable) of every job log whose resource line has
+    them (:mod:`opnav.core.startup`; logs of commits before issue 47 have none), the
+    ``compile_kernels`` jobs' aside."""
+    return [(p, *(float(m.group(i)) for i in range(1, 5))) for p, m in _last_matches(root, _STARTUP)
+            if Path(p).parent.parent.name != _COMPILE_LOG]
+
+
+def startup_lines(root: Path, top: int = 8) -> list[str]:
+    """The start-up summary: the mean per job and its parts, then the groups of logs
+    (:func:`family`) with the largest mean start-up."""
+    rows = startups(root)
+    if not rows:
+        return ["start-up: no job log carries the start-up figure (a commit before issue 47?)"]
+    n = len(rows)
+    mean = [sum(r[i] for r in rows) / n for i in range(1, 5)]
+    out = [f"start-up CPU per job: mean {mean[0]:.2f} s over {n} jobs (before the work {mean[1]:.2f}, "
+           f"imports during it {mean[2]:.2f}, making kernels callable {mean[3]:.2f}); "
+           f"{sum(r[1] for r in rows):.1f} CPU-s in all"]
+    groups: dict[str, list[float]] = {}
+    for r in rows:
+        groups.setdefault(family(r[0]), []).append(r[1])
+    ranked = sorted(groups.items(), key=lambda kv: -sum(kv[1]) / len(kv[1]))[:top]
+    out.append("  largest mean start-up: " + ", ".join(f"{g} {sum(v) / len(v):.2f} s ({len(v)})" for g, v in ranked))
+    return out
 
 
 def costs(root: Path) -> list[tuple[str, float, float]]:
@@ -81,6 +114,8 @@ def main(argv=None) -> int:
     print(f"{'total':40s} {len(rows):5d} {total:9.1f}")
     for path, cpu, rss in sorted(rows, key=lambda r: -r[1])[:a.top]:
         print(f"  {cpu:8.2f} s {rss:6.0f} MB  {path}")
+    for line in startup_lines(a.results):
+        print(line)
     kernels = kernel_counts(a.results)
     if kernels:
         compiling = [(p, c) for p, _, c in kernels if c and not Path(p).parent.parent.name == "kernels"]

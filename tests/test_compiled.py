@@ -8,6 +8,7 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
 from conftest import REPO
 
 from opnav.core import compiled
@@ -44,6 +45,7 @@ def _run(tmp_path):
     return json.loads(out.stdout.splitlines()[-1])
 
 
+@pytest.mark.slow  # four processes that import numba and compile: 5-6 CPU-s
 def test_cache_loaded_by_the_next_process_and_invalidated_by_a_callee_change(tmp_path):
     (tmp_path / "ka.py").write_text(CALLEE.format("1.0"))
     (tmp_path / "kb.py").write_text(CALLER)

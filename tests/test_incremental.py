@@ -89,15 +89,16 @@ def test_raising_n_runs_flies_only_the_new_runs(quick_results, edits):
     scenario and method and nothing else is flown again (each run's stream depends
     on its index only)."""
     cfg = yaml.safe_load((quick_results / "config" / "quick.yaml").read_text())
-    assert cfg["landing"]["mc"] == {"n_runs": 4, "runs_per_job": 4}
+    assert cfg["landing"]["mc"] == {"n_runs": 4, "runs_per_job": 4, "methods_per_job": 10}
     jobs = edits["n_runs_6"]
-    chunks = [w for r, w in jobs if r == "landing_mc_chunk"]
-    assert chunks and {w["bchunk"] for w in chunks} == {"r0004-0005"}, chunks
-    methods = {w["bmethod"] for w in chunks}
-    # one new chunk per (camera scenario, method), every scenario
-    assert len(chunks) == len({(w["bscn"], w["bmethod"]) for w in chunks}) == 2 * len(methods)
-    assert {w["bscn"] for w in chunks} == {"site-tilt", "interior"} and len(methods) >= 4
-    assert {w["bmethod"] for r, w in jobs if r == "landing_mc_gather"} == methods
+    # the quick profile flies every method of a chunk in one job (landing_mc_pack1)
+    packs = [w for r, w in jobs if r.startswith("landing_mc_pack")]
+    assert packs and {w["bchunk"] for w in packs} == {"r0004-0005"}, packs
+    assert not [w for r, w in jobs if r == "landing_mc_chunk"]
+    # one new chunk per camera scenario (every method), every scenario
+    assert sorted(w["bscn"] for w in packs) == ["interior", "site-tilt"]
+    methods = {w["bmethod"] for r, w in jobs if r == "landing_mc_gather"}
+    assert len(methods) >= 4
     assert not {r for r, _ in jobs} & {"study_runs", "landing_single", "approach_mc"}
 
 
@@ -147,5 +148,5 @@ def test_editing_a_kernel_module_reruns_its_users_in_the_same_run(quick_results)
     finally:
         path.write_bytes(text)
         os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
-    assert {"compile_kernels", "landing_mc_chunk", "landing_timing"} <= rules, sorted(rules)
+    assert {"compile_kernels", "landing_mc_pack1", "landing_timing"} <= rules, sorted(rules)
     assert not {r for r in rules if r.startswith("approach_")}, sorted(rules)

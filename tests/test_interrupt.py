@@ -42,7 +42,7 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     copy_workflow(wd)
     # four runs per job: with the compiled descent a run takes a fraction of a second, so a
     # job of one run could end between seeing it in flight and the signal (CI, 08:13 UTC)
-    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 12, runs_per_job: 4}}\n")
+    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 12, runs_per_job: 4, methods_per_job: 1}}\n")
     target = "results/quick/landing/mc/site-tilt/depth.npz"  # the quick profile's results_dir
     args = [target, "--cores", "1", "--configfile", "config/quick.yaml", "small.yaml"]
     chunks = wd / "results" / "quick" / "landing" / "mc" / "site-tilt" / "chunks" / "depth"

@@ -39,10 +39,12 @@ import json
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:  # pandas (0.3 CPU-s of import) in the functions that make tables: a
+    import pandas as pd  # Monte-Carlo job imports this module for config_digest alone
 
 from opnav.core.checks import MAX_APPROACH_SEED_SAMPLES, MAX_STUDY_VALUES, study_size_problem, study_spec_defaults
 from opnav.core.errors import ConfigError
@@ -469,6 +471,7 @@ def gather_runs(parts: Iterable[tuple[str, pd.DataFrame]], study: Mapping,
     beyond ``study["runs"]`` dropped (kept chunks of a larger earlier study), paper-B
     derived metrics added, the swept values beside each row; rows in (value, [variant,]
     method, run) order, whatever the chunking."""
+    import pandas as pd
     frames = []
     for label, df in parts:
         df = df.copy()
@@ -523,6 +526,7 @@ def loglog_slopes(tidy: pd.DataFrame, study: Mapping) -> pd.DataFrame:
     log(statistic) against log(first swept key), the statistic being
     :func:`shown_statistic`'s (+1: proportional). Values or statistics <= 0 are left out;
     NaN below two points."""
+    import pandas as pd
     key = study["keys"][0]
     unit = (["variant"] if "variant" in tidy else []) + ["method", "metric"]
     rows = []
@@ -560,6 +564,7 @@ def summarize(runs: pd.DataFrame, metrics: Iterable[str], methods: Iterable[str]
     metric columns. The paired difference is against the first of ``methods``
     on the same (instance, variant, run).
     """
+    import pandas as pd
     methods = list(methods)
     ref = methods[0]
     unit = ["instance"] + (["variant"] if "variant" in runs else [])
@@ -595,6 +600,7 @@ def summarize(runs: pd.DataFrame, metrics: Iterable[str], methods: Iterable[str]
 
 def wide_table(tidy: pd.DataFrame, study: Mapping) -> pd.DataFrame:
     """The human view: one row per value x [variant x] method, '<stat> [lo, hi]' per metric."""
+    import pandas as pd
     stat = study["statistic"]
     inst = study["instances"]
     rows = []

@@ -78,6 +78,16 @@ def b_mc(scn, methods):
     return [f"{LANDING}/mc/{scn}/{m}.npz" for m in methods]
 
 
+# landing.mc.methods_per_job > 1 (tiny profiles): the Monte Carlo's methods (paper,
+# B-X1 extras, equivalence controls, in that order) in packs of that many, one job per
+# pack, scenario and chunk (rules landing_mc_pack1, ...) that flies each method's chunk in
+# turn and writes the same files as landing_mc_chunk, which flies the methods in no pack.
+_B_K = config["landing"]["mc"]["methods_per_job"]
+B_MC_METHODS = list(dict.fromkeys([*B_METHODS, *config["landing"]["extra"]["methods"], *B_EQ_METHODS]))
+B_PACKS = [B_MC_METHODS[i:i + _B_K] for i in range(0, len(B_MC_METHODS), _B_K)] if _B_K > 1 else []
+_B_PACKED = [m for p in B_PACKS for m in p]
+
+
 rule landing_mc_chunk:
     """One Monte-Carlo job: runs of one planning method in one camera scenario (scatter)."""
     input:
@@ -87,7 +97,7 @@ rule landing_mc_chunk:
         f"{LANDING}/mc/{{bscn}}/chunks/{{bmethod}}/{{bchunk}}.npz",
     wildcard_constraints:
         bscn=B_SCN_RE,
-        bmethod="[a-z][a-z0-9_-]*",
+        bmethod="".join(f"(?!{m}(?![a-z0-9_-]))" for m in _B_PACKED) + "[a-z][a-z0-9_-]*",   # not in a pack
         bchunk=CHUNK_PATTERN,
     params:
         landing=lambda wc: B_SIMS[wc.bscn],
@@ -106,6 +116,36 @@ rule landing_mc_chunk:
         f"{LANDING}/benchmarks/mc_{{bscn}}_{{bmethod}}_chunk{{bchunk}}.tsv"
     script:
         "../scripts/landing_mc_chunk.py"
+
+
+for _i, _pack in enumerate(B_PACKS, 1):
+
+    rule:
+        """One Monte-Carlo job for several methods (landing.mc.methods_per_job): each
+        method's chunk of runs in one camera scenario, one method after the other."""
+        name:
+            f"landing_mc_pack{_i}"
+        input:
+            B_SRC,
+            kernels=kernels("landing"),
+        output:
+            [f"{LANDING}/mc/{{bscn}}/chunks/{m}/{{bchunk}}.npz" for m in _pack],
+        wildcard_constraints:
+            bscn=B_SCN_RE,
+            bchunk=CHUNK_PATTERN,
+        params:
+            landing=lambda wc: B_SIMS[wc.bscn],
+            runs=lambda wc: chunk_runs(wc.bchunk),
+            methods=_pack,
+            pick_ratio=[m in B_METHODS for m in _pack],
+            batch_size=config["landing"]["mc"]["batch_size"],
+        priority: 10
+        log:
+            f"{LANDING}/logs/mc_{{bscn}}_pack{_i}_chunk{{bchunk}}.log",
+        benchmark:
+            f"{LANDING}/benchmarks/mc_{{bscn}}_pack{_i}_chunk{{bchunk}}.tsv"
+        script:
+            "../scripts/landing_mc_chunk.py"
 
 
 rule landing_mc_gather:

@@ -13,10 +13,8 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     modules = tuple(snakemake.params.modules)
-    here = compiled.warm(modules)
+    here = compiled.warm(modules, progress=log.info)  # a line as each module starts and ends
     stats = compiled.cache_stats()
-    for module in sorted(here):
-        log.info("%s: %.3f s", module, here[module])
     # load times from the filled cache: benchmarks/bench_pipeline.py (a fresh process each job pays)
     log.info("kernels: %d signatures compiled and %d loaded (%.2f s)", stats["compiled"], stats["loaded"],
              sum(here.values()))

@@ -1,4 +1,5 @@
-"""One Monte-Carlo job of paper B: runs `params.runs` of `wildcards.method` (scatter)."""
+"""One Monte-Carlo job of paper B: runs `params.runs` of `wildcards.method` (scatter), or of
+each of `params.methods` in turn (rules landing_mc_pack*, landing.mc.methods_per_job)."""
 
 import hashlib
 import sys
@@ -12,17 +13,20 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
     snakemake = mock_snakemake("landing_mc_chunk", argv=sys.argv[1:], bscn="site-tilt", bmethod="depth", bchunk="r0000-0001")
 
 with script_context(snakemake) as log:
-    method = snakemake.wildcards.bmethod
+    if hasattr(snakemake.params, "methods"):   # a pack: its outputs in the order of its methods
+        methods, pick_ratios = list(snakemake.params.methods), [bool(p) for p in snakemake.params.pick_ratio]
+    else:
+        methods, pick_ratios = [snakemake.wildcards.bmethod], [bool(snakemake.params.pick_ratio)]
     runs = list(snakemake.params.runs)
-    pick_ratio = bool(snakemake.params.pick_ratio)
     # runs of an earlier, smaller chunk beside this one are taken over, not flown again,
     # when flown with the same simulation, method, diagnostics and source code (the
     # rule's inputs are the src modules): the reuse key
     code = sorted(hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in snakemake.input)
-    key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio,
-                         "code": code})
-    data, flown = run_chunk_reusing(snakemake.output[0], key, snakemake.params.landing, method, runs,
-                                    pick_ratio=pick_ratio, batch_size=int(snakemake.params.batch_size))
-    save(snakemake.output[0], data, method)
-    log.info("%s: runs %s..%s (%d flown, %d taken from earlier chunks), %d planning calls", method,
-             runs[0], runs[-1], len(flown), len(runs) - len(flown), len(data["plan_index"]))
+    for method, pick_ratio, out in zip(methods, pick_ratios, snakemake.output, strict=True):
+        key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio,
+                             "code": code})
+        data, flown = run_chunk_reusing(out, key, snakemake.params.landing, method, runs,
+                                        pick_ratio=pick_ratio, batch_size=int(snakemake.params.batch_size))
+        save(out, data, method)
+        log.info("%s: runs %s..%s (%d flown, %d taken from earlier chunks), %d planning calls", method,
+                 runs[0], runs[-1], len(flown), len(runs) - len(flown), len(data["plan_index"]))

@@ -20,6 +20,8 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Iterator
 
+from opnav.core import startup
+
 
 @contextlib.contextmanager
 def script_context(snakemake) -> Iterator[logging.Logger]:
@@ -31,6 +33,7 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
     process's CPU seconds and peak memory, start-up and imports included), which
     ``benchmarks/job_costs.py`` sums per rule.
     """
+    startup.begin()  # the job's own work starts here (opnav.core.startup)
     log_path = snakemake.log[0] if len(getattr(snakemake, "log", [])) else None
     logger = logging.getLogger("opnav")
     if log_path is None:
@@ -50,7 +53,10 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         old_err, old_out = sys.stderr, sys.stdout
         sys.stderr = sys.stdout = fh
         try:
+            logger.info("started: %.2f CPU-s before the work (interpreter, Snakemake's preamble, imports)",
+                        startup.seconds()["before_work_s"])
             yield logger
+            logger.info(startup.line())
             logger.info(resource_line())
         except Exception as exc:
             # the traceback goes to the rule's log; Snakemake shows one line naming it
@@ -76,7 +82,8 @@ def resource_line() -> str:
     (``ru_maxrss`` keeps the forking parent's peak across ``exec`` on Linux), else
     ``ru_maxrss`` (KiB on Linux). A job that imported ``opnav.core.compiled`` also gets the
     kernel signatures it loaded from numba's cache and compiled itself
-    (:func:`opnav.core.compiled.cache_stats`; after rule ``compile_kernels``, none compiled)."""
+    (:func:`opnav.core.compiled.cache_stats`; after rule ``compile_kernels``, none compiled),
+    and last the job's start-up CPU (:func:`opnav.core.startup.fields`)."""
     me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     user, sys_ = me.ru_utime + kids.ru_utime, me.ru_stime + kids.ru_stime
     rss_kib = float(me.ru_maxrss)
@@ -90,7 +97,7 @@ def resource_line() -> str:
     if compiled is not None:
         stats = compiled.cache_stats()
         out += f" kernels_loaded={stats['loaded']} kernels_compiled={stats['compiled']}"
-    return out
+    return f"{out} {startup.fields()}"
 
 
 def stand_in(input=None, output=None, params=None, log=None, wildcards=None,
