@@ -10,7 +10,7 @@ every metric of :mod:`opnav.landing.metrics` on the same inputs:
 * ``fast``       ``metric(ctx, cand)``: the compiled closed form (svd, gdop, cond;
   ``kernels.h_metric``) or the batched tangent update / Gram eigenvalues;
 * ``reference``  ``metric.reference(ctx, cand)``: the paper's definition, H of
-  eq. 14-18 from CasADi (``Function.map``), LAPACK SVD / pinv / information.
+  eq. 14-18 from CasADi (``Function.map``), LAPACK SVD / pinv.
 
 A second table times the Jacobian alone by each route (per-candidate
 Function, ``Function.map`` serial and thread, numpy).
@@ -91,7 +91,7 @@ def run(n: int = 50, reps: int = 30, seed: int = 0) -> pd.DataFrame:
             vals = np.ravel(np.asarray(fn(), dtype=float))  # also the warm-up
             meta[name, impl] = float(np.max(np.abs(vals - ref) / np.maximum(np.abs(ref), 1e-300)))
             jobs[name, impl] = fn
-    jobs["ctx", ""] = lambda: MetricContext(**kw).info()
+    jobs["ctx", ""] = lambda: MetricContext(**kw)
     times = {k: [] for k in jobs}
     for _ in range(reps):
         for k, fn in jobs.items():
@@ -137,7 +137,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     df = run(a.n, a.reps)
     with pd.option_context("display.width", 200, "display.max_rows", 200):
-        print(f"MetricContext build + info precompute: {df.attrs['us_ctx']:.1f} us per planning call")
+        print(f"MetricContext build: {df.attrs['us_ctx']:.1f} us per planning call")
         print(df.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
         print()
         print("us per call (n = %d evaluations), median of %d:" % (a.n, a.reps))

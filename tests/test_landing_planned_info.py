@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from opnav.landing import ekf
 from opnav.landing.measurement import selection_jacobian
-from opnav.landing.planned_info import planned_nav_logdet, planned_posterior
+from opnav.landing.planned_info import PLANNED_METRICS, planned_metric, planned_nav_logdet, planned_posterior
 from opnav.core.rotations import exp_so3
 
 
@@ -120,16 +120,22 @@ def _scenario(name):
     return build_scenario(camera_scenarios(load_config()["landing"])[name])
 
 
+@pytest.mark.parametrize("name", PLANNED_METRICS)
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**31), st.sampled_from(["interior", "site-tilt"]), st.sampled_from([1, 2, 3, 5]),
        st.booleans(), st.sampled_from([0.02, 0.1, 0.5]), st.sampled_from([0.5, 1.0, 2.0]),
        st.sampled_from([1.0, 5.0]))
-def test_compiled_logdet_nav_is_planned_info_and_plans_as_it(seed, camera, n_obs, oc, frac, dt, scale):
-    """The compiled objective (``kernels.planned_nav`` through ``plan_one``, the Monte
-    Carlo's path) equals ``planned_info`` in numpy (the reference, the paper path's
-    objective) to round-off for any strategy, noise scale and OC flag, +inf exactly
-    where the candidate cannot be initialised or is behind the camera; off a plateau the
-    two paths' planning calls (search, edge rule, pick) agree."""
+def test_compiled_baseline_is_its_numpy_definition_and_plans_as_it(name, seed, camera, n_obs, oc, frac, dt,
+                                                                    scale):
+    """Each B-X1 information baseline compiled (``kernels.planned`` through ``plan_one``, the
+    Monte Carlo's path) equals its numpy definition (``planned_info.planned_metric``: the
+    information form P0^-1 + A^T A of the candidate's own initialisation, the filter's noise
+    sigma_b x scale, n_obs planned observations; the paper path's objective) to round-off for
+    hypothesis-drawn states, strategies, noise scales and OC flags, +inf exactly where the
+    candidate cannot be initialised or is behind the camera; off a plateau the two paths'
+    planning calls (search, edge rule, pick) agree. Mutations tried: the kernel given the true
+    noise (nav_constants' sigma_f := sigma_b) fails every kind at scale 5; the site's rows
+    without Phi_k (nav_constants) fails every kind at n_obs >= 2."""
     from opnav.landing.planner import PlanState, alternative_path, candidate_scores, plan_one
 
     scn = _scenario(camera)
@@ -144,15 +150,38 @@ def test_compiled_logdet_nav_is_planned_info_and_plans_as_it(seed, camera, n_obs
     st_ = PlanState(r, v, a, R, P)
     field = scn.field.__class__(np.ascontiguousarray(cand))
     det = np.arange(len(cand))
-    res, q = plan_one("logdet_nav", st_, scn.camera, field, cfg, -1, det)
-    got = candidate_scores("logdet_nav", st_, scn.camera, field, cfg, q, det)
-    want = -planned_nav_logdet(r, v, a, R, P, np.asarray(cfg.p_known), cand, scn.camera.sigma_b * scale, frac,
-                               n_obs, dt, cfg.g, oc, scn.camera.boresight_B)
+    res, q = plan_one(name, st_, scn.camera, field, cfg, -1, det)
+    got = candidate_scores(name, st_, scn.camera, field, cfg, q, det)
+    want = -planned_metric(name, r, v, a, R, P, np.asarray(cfg.p_known), cand, scn.camera.sigma_b * scale, frac,
+                           n_obs, dt, cfg.g, oc, scn.camera.boresight_B)
     fin = np.isfinite(want)
     assert not fin[-1] and np.array_equal(np.isfinite(got), fin) and np.array_equal(got[~fin], want[~fin])
-    np.testing.assert_allclose(got[fin], want[fin], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(got[fin], want[fin], rtol=1e-9, atol=1e-9 * np.abs(want[fin]).max())
     if np.ptp(want[fin]) <= 1e-6 * np.abs(want[fin]).max():
         return    # a plateau (n_obs = 1: one bearing adds nothing to its own initialisation): round-off decides
-    ref, _ = plan_one("logdet_nav", st_, scn.camera, field, alternative_path(cfg), -1, det)
+    ref, _ = plan_one(name, st_, scn.camera, field, alternative_path(cfg), -1, det)
     assert (res.index, res.edge, res.n_evals, res.note) == (ref.index, ref.edge, ref.n_evals, ref.note)
     assert res.beta == pytest.approx(ref.beta, abs=1e-9, nan_ok=True)
+
+
+def test_information_form_definitions_by_hand():
+    """``planned_metric`` is what each name says, on one candidate written out by hand from
+    ``planned_posterior`` (the Woodbury covariance): logdet = -log det Sigma, mineig =
+    1 / lambda_max(Sigma), svd_w / cond_w / gdop_w of the singular values of A P0^1/2 with
+    P0^1/2 a symmetric root (rank min(4 n_obs - 2, 11)), logdet_nav = -log det Sigma[:9, :9]."""
+    from scipy.linalg import sqrtm
+
+    from opnav.landing.planned_info import planned_rows
+
+    r, v, a, R, P, cand = _state(4)
+    kw = (np.zeros(3), cand, 5 * 2.5e-3, 0.1, 3, 1.0, G, True)
+    Sig, _ = planned_posterior(r, v, a, R, P, *kw)
+    A, P0, _ = planned_rows(r, v, a, R, P, *kw)
+    got = {n: planned_metric(n, r, v, a, R, P, *kw) for n in PLANNED_METRICS}
+    for i in range(len(cand)):
+        s = np.linalg.svd(A[i] @ np.real(sqrtm(P0[i])), compute_uv=False)[:10]
+        want = {"logdet": -np.linalg.slogdet(Sig[i])[1], "mineig": 1 / np.linalg.eigvalsh(Sig[i])[-1],
+                "svd_w": s[-1], "cond_w": s[-1] / s[0], "gdop_w": 1 / np.sum(s**-2.0),
+                "logdet_nav": -np.linalg.slogdet(Sig[i][:9, :9])[1]}
+        for n in PLANNED_METRICS:
+            assert got[n][i] == pytest.approx(want[n], rel=1e-6), n

@@ -384,7 +384,7 @@ def test_the_timed_compiled_call_is_the_planning_call(recorded):
                                diagnose=False)
             call = planner.compiled_call(m, st, cam, field_, scn.planner, ex, det)
             call()
-            out = call.args[-1][K.NQ:]
+            out = call.args[-1][-9:]
             if out[8] == K.OK:
                 assert (int(out[0]), int(out[3])) == (res.index, res.n_evals)
                 assert out[1] == res.beta

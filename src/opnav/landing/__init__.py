@@ -38,7 +38,7 @@ eq.        function                                                    units
            the call ``kernels.plan_core`` (``planner.plan_batch``): plane,
            visible interval, ``kernels.golden_section``, nearest pick
 sec. 2.2   ``metrics.make_metric`` (svd, gdop, cond from the 6 x 12 H,     1/m (svd), 1/m^2 (gdop), 1 (cond)
-           closed form ``kernels.h_metric``; B-X1 logdet, mineig,
-           whitened variants), ``planner.OBJECTIVE_METHODS``
+           closed form ``kernels.h_metric``), ``planner.OBJECTIVE_METHODS``;
+           B-X1 information baselines: ``planned_info.planned_metric``
 =========  ==========================================================  ===============================
 """

@@ -10,18 +10,17 @@ eq. 21-22 (:func:`error_radius`), eq. 23-25 (:func:`depth_error`), eq. 26
 baselines (:func:`h_metric`), the candidate validity rule (:func:`candidate_ok`),
 the visible interval (:func:`visible_interval`), the golden-section search
 (:func:`golden_section`), the nearest detected landmark (:func:`nearest`), the
-tie rule (:func:`best_index`; on bounds, :func:`tie_pick`, whose mineig brackets
-come from :func:`mineig_bracket`, svd_w and cond_w's from :func:`whitened_bounds`)
-and the call itself (:func:`plan_core`, compiled by :func:`plan_run` for every
+tie rule (:func:`best_index`) and the call itself (:func:`plan_core`, compiled by :func:`plan_run` for every
 :data:`KINDS`; run by the interpreter with a Python objective through
 :func:`interpreted` for the paper's definitions, ``opnav.landing.planner``;
-B-X1 metrics: :func:`info_metric`, ``logdet_nav``: :func:`planned_nav`).
+B-X1's information baselines logdet, mineig, svd_w, gdop_w, cond_w and logdet_nav: one
+family, :func:`planned` of the candidate's planned rows, :func:`planned_rows`).
 
 Per-run constants ``q`` (float64 (NQ,)): 0-2 C (m), 3-5 v_hat, 6-8 w_hat, 9 |CD|
 (m), 10 gamma (rad), 11 objective kind (:data:`KINDS`), 12 b (m), 13 r_e (m),
 14-16 unit line of sight to the known landmark u, 17 x = 1/rho_known (1/m),
 18-20 boresight in {L}, 21 known landmark usable (1/0), 22 min_range (m),
-23 boresight check on (1/0); the B-X1 kinds' slots from :data:`Q_R` on.
+23 boresight check on (1/0); the planned-information kinds' slots from :data:`Q_R` on.
 
 Objectives are minimised: the depth error (m), or minus a metric (larger is
 better for every metric). ``+inf`` where the line of sight misses the ground,
@@ -38,25 +37,26 @@ from opnav.core.compiled import kernel, warms
 from opnav.landing import ekf
 from opnav.landing import measurement as me
 
-#: objective kinds compiled here (``q[11]``); the whitened ones are their base + 5
+#: objective kinds compiled here (``q[11]``); the whitened ones are their H base + 5
 KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8, logdet_nav=9)
 DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W, COND_W, LOGDET_NAV = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
-#: q slots of the B-X1 kinds (:func:`info_constants`): R_LtoB (3 x 3, row-major), 1/sigma
-#: (rad^-1); logdet, mineig: log det Lambda_k, Sigma_k (12 x 12); whitened: L, G_k L (2 x 12);
-#: mineig: Sigma_k's eigenvalues s (12, descending) and eigenvectors V (12 x 12, columns)
-Q_R, Q_SCALE, Q_LD, Q_SIG, Q_L, Q_A, Q_S, Q_V, NQ = 24, 33, 34, 35, 35, 179, 203, 215, 359
-#: logdet_nav's slots (:func:`nav_constants`; its prior P at Q_SIG): velocity (m/s), acceleration
-#: (m/s^2), gravity (m/s^2), known landmark (m), sigma_f (rad), depth_sigma_frac, n_obs, dt (s), oc
-Q_NV, Q_NA, Q_NG, Q_NK, Q_NSF, Q_NDF, Q_NOBS, Q_NDT, Q_NOC = 179, 182, 185, 188, 191, 192, 193, 194, 195
+#: q slots of the planned-information kinds (:func:`nav_constants`): R_LtoB (3 x 3, row-major),
+#: the prior P (12 x 12), velocity (m/s), acceleration (m/s^2), gravity (m/s^2), known landmark
+#: (m), sigma_f (rad), depth_sigma_frac, n_obs, dt (s), oc; from Q_TAB on, per planned image k
+#: (NT slots each): Phi_k's navigation block (9 x 9) and the site's whitened rows mapped to the
+#: planning instant (2 x 12), candidate-independent, filled once per call
+Q_R, Q_SIG = 24, 33
+Q_NV, Q_NA, Q_NG, Q_NK, Q_NSF, Q_NDF, Q_NOBS, Q_NDT, Q_NOC, NQ = 177, 180, 183, 186, 189, 190, 191, 192, 193, 194
+Q_TAB, NT = NQ, 81 + 24
+#: structural rank of the planned whitened rows A P0^1/2 (m = 4 n_obs - 2 rows): min(m, 11),
+#: yaw being unobservable (the 12th singular value measured ~3e-17 of the first, OC or not)
+PLANNED_RANK = 11
 #: the tie rule's relative tolerance: candidates whose score lies within
 #: TIE_RTOL * |best| of the best score are tied, and the lowest landmark index
 #: wins. Paths agree to round-off (~1e-12 relative: closed form vs LAPACK's
 #: smallest structural singular value), far inside it; mineig's plateau
 #: (spread ~2e-15, ``opnav.landing.metrics``) is one tie
 TIE_RTOL = 1e-9
-#: :func:`score_bounds`: mineig's brackets are narrowed to this relative width, then those
-#: that may hold the best to each of :data:`NARROWING` in turn (:func:`tie_pick`)
-MINEIG_RTOL, NARROWING = 1e-2, (1e-4, 1e-7)
 #: status codes of :func:`plane` / :func:`plan_core` (``depth_error.REASONS`` says them)
 OK, ZERO_VELOCITY, NOT_ABOVE, NOT_DESCENDING, ZERO_BASELINE, NO_INTERVAL = 0, 1, 2, 3, 4, 5
 INVPHI = (math.sqrt(5.0) - 1.0) / 2.0
@@ -192,304 +192,16 @@ def sv_metric(base, l1, l2, l3, l4) -> float:
 
 
 @kernel
-def info_constants(R_LtoB, P, sigma, q) -> None:
-    """Fill the B-X1 slots of q (kind q[11], after :func:`metric_constants`) once per call for
-    prior P (12 x 12), noise sigma^2 I_6 (rad^2), the known landmark's rows G_k (:func:`info_metric`):
-    Sigma_k = (P^-1 + G_k^T G_k)^-1 and log det Lambda_k (:func:`logdet_spd`), or L = chol(P) and G_k L."""
-    for i in range(9):
-        q[Q_R + i] = R_LtoB[i // 3, i % 3]
-    q[Q_SCALE] = 1.0 / sigma
-    if q[21] == 0.0:                                 # known landmark unusable: all invalid
-        return
-    G = np.empty((2, 12))
-    me.tangent_rows(R_LtoB, np.array([q[14] / q[17], q[15] / q[17], q[16] / q[17]]), q[Q_SCALE], G)
-    for j in range(9, 12):
-        G[0, j] = G[1, j] = 0.0
-    if int(q[11]) >= SVD_W:
-        L = np.linalg.cholesky(P)
-        for j in range(12):
-            q[Q_A + j] = q[Q_A + 12 + j] = 0.0
-            for i in range(12):
-                q[Q_L + 12 * i + j] = L[i, j]
-                q[Q_A + j] += G[0, i] * L[i, j]
-                q[Q_A + 12 + j] += G[1, i] * L[i, j]
-        return
-    Pi, Lam, s = np.linalg.inv(P), np.empty((12, 12)), np.empty(12)
-    for i in range(12):
-        for j in range(12):
-            Lam[i, j] = 0.5 * (Pi[i, j] + Pi[j, i]) + G[0, i] * G[0, j] + G[1, i] * G[1, j]
-        s[i] = 1.0 / math.sqrt(Lam[i, i])
-    q[Q_LD] = logdet_spd(Lam, 12, np.empty((12, 12)))
-    for i in range(12):                              # Sigma_k from the equilibrated information
-        for j in range(12):
-            Lam[i, j] *= s[i] * s[j]
-    Sig = np.linalg.inv(Lam)
-    for i in range(12):
-        for j in range(12):
-            q[Q_SIG + 12 * i + j] = 0.5 * (Sig[i, j] + Sig[j, i]) * s[i] * s[j]
-    if int(q[11]) == MINEIG:                         # mineig_bracket's eigenbasis
-        w, V = np.linalg.eigh(q[Q_SIG:Q_SIG + 144].reshape((12, 12)))
-        for i in range(12):
-            q[Q_S + i] = w[11 - i]
-            for j in range(12):
-                q[Q_V + 12 * i + j] = V[i, 11 - j]
-
-
-@kernel
-def info_metric(kind, d0, d1, d2, q) -> float:
-    """The B-X1 metric (larger is better) of a valid candidate at offset d (m), its tangent-plane
-    rows G = T^T H / sigma (2 x 12, ``measurement.tangent_rows``), :func:`info_constants`: logdet
-    = log det Lambda_k + log det(I_2 + G Sigma_k G^T), mineig = 1 / lambda_max of the Woodbury
-    posterior (:func:`mineig_bracket` to round-off; -inf if not positive); whitened: :func:`sv_metric` of [G_k; G] L (4 x 12: the
-    singular values of R^-1/2 H P^1/2 for R = sigma^2 I_6, as b^T H = 0) by its Gram's eigenvalues."""
-    if kind == MINEIG:
-        lo, hi = mineig_bracket(d0, d1, d2, q, 0.0, math.inf, 2.0 ** -52)
-        return 2.0 / (lo + hi) if hi > 0 else -math.inf
-    Q = np.zeros((4, 4))
-    gram(kind, d0, d1, d2, q, Q)
-    if kind >= SVD_W:
-        return whitened_metric(kind, Q)
-    a, b = 1.0 + Q[2, 0], 0.5 * (Q[2, 1] + Q[3, 0])
-    e = 1.0 + Q[3, 1] - b * b / a                  # Schur complement, >= 1
-    return q[Q_LD] + math.log(a) + math.log(e)
-
-
-@kernel
-def gram(kind, d0, d1, d2, q, Q) -> None:
-    """Q (4 x 4) <- the Gram of [G_k L; G L] (whitened kinds: L = chol(P), lower triangular) or, in
-    Q[2:, :2], G Sigma_k G^T (logdet) for the candidate's rows G (:func:`info_metric`). G's
-    columns 3-5 (velocity) are zero (``measurement.tangent_rows``): skipped, as L's upper
-    triangle (measured per score: logdet 0.34 -> 0.23 us, gdop_w 0.55 -> 0.40 us)."""
-    G = np.empty((2, 12))
-    me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
-    M, GM, A = q[Q_SIG:Q_SIG + 144].reshape((12, 12)), np.zeros((2, 12)), q[Q_A:Q_A + 24].reshape((2, 12))
-    w = kind >= SVD_W
-    for k in range(12):                            # GM = G M (M: Sigma_k, or L)
-        if 3 <= k < 6:
-            continue
-        for j in range(k + 1 if w else 12):
-            GM[0, j] += G[0, k] * M[k, j]
-            GM[1, j] += G[1, k] * M[k, j]
-    for a in range(2):
-        for b in range(2):
-            x = 0.0
-            for k in range(12):                    # G L (G_k L)^T, or G Sigma_k G^T
-                x += GM[a, k] * (A[b, k] if w else G[b, k])
-            Q[2 + a, b] = Q[b, 2 + a] = x
-    if not w:
-        return
-    for a in range(2):
-        for b in range(a + 1):
-            x = y = 0.0
-            for k in range(12):                    # G_k L (G_k L)^T, G L (G L)^T
-                x += A[a, k] * A[b, k]
-                y += GM[a, k] * GM[b, k]
-            Q[a, b] = Q[b, a] = x
-            Q[2 + a, 2 + b] = Q[2 + b, 2 + a] = y
-
-
-@kernel
-def whitened_metric(kind, Q) -> float:
-    """svd_w, gdop_w, cond_w (:func:`sv_metric`) of the whitened Gram Q (:func:`gram`): gdop_w =
-    1 / trace(Q^-1) without the eigenvalues (:func:`inv_trace4`), else by LAPACK eigvalsh."""
-    if kind == GDOP_W:
-        it = inv_trace4(Q)
-        return 1.0 / it if it < math.inf else 0.0
-    lam = np.linalg.eigvalsh(Q)
-    return sv_metric(kind - 5, lam[3], lam[2], lam[1], lam[0])
-
-
-@kernel
-def whitened_bounds(q, xyz, cand):
-    """:func:`score_bounds` of svd_w and cond_w (score = -metric, metric = sqrt(l4) or sqrt(l4 / l1),
-    l the eigenvalues of the Gram Q, :func:`gram`) with few eigenproblems: the candidate whose
-    metric may be largest (by the upper bound sqrt(min_i Q_ii) or sqrt(min_i Q_ii / L), L =
-    |Q^2 e|/|Q e| <= l1 for e the column of Q of largest norm) is scored first; every other
-    one is scored exactly only if it may reach t = (1 - TIE_RTOL) m of the best metric m so far:
-    not if l4 < t^2 (svd_w) or l4 < t^2 L (cond_w), shown by its bound or by a Cholesky failure
-    of Q - mu I (:func:`cholesky_shifted`; mu less 64 eps trace Q, the Cholesky's and eigvalsh's
-    round-off). Such a candidate lies beyond the tie bound of the best (lo = -t (1 - 1e-12),
-    hi = 0), so :func:`tie_pick` leaves it out. Needed by measurement (5,000 candidates): an
-    edge call costs 0.32 us a candidate against 1.4 us for scoring each by eigvalsh; a 10-run
-    Monte-Carlo job (interior) 1.05 against 3.80 CPU-s for svd_w, 1.35 against 3.76 for cond_w."""
-    n, kind = cand.size, int(q[11])
-    lo, hi = np.full(n, math.inf), np.full(n, math.inf)
-    if n == 0:
-        return lo, hi
-    Qs, ub, C, trs = np.zeros((n, 4, 4)), np.full(n, -1.0), np.empty((4, 4)), np.zeros(n)
-    lmax = np.ones(n)                                # L (cond_w); 1 for svd_w: one rule for both
-    for j in range(n):
-        d0, d1, d2 = xyz[cand[j], 0] - q[0], xyz[cand[j], 1] - q[1], xyz[cand[j], 2] - q[2]
-        if not candidate_ok(d0, d1, d2, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), q):
-            continue                                 # invalid: +inf
-        Q = Qs[j]
-        gram(kind, d0, d1, d2, q, Q)
-        tr, mind, e, en = 0.0, math.inf, 0, -1.0
-        for i in range(4):
-            tr += Q[i, i]
-            mind = min(mind, Q[i, i])
-            ni = Q[0, i] ** 2 + Q[1, i] ** 2 + Q[2, i] ** 2 + Q[3, i] ** 2
-            if ni > en:
-                e, en = i, ni
-        if kind == COND_W and en > 0.0:  # L = |Q y| / |y|, y = Q e
-            y2 = 0.0
-            for i in range(4):
-                z = Q[i, 0] * Q[0, e] + Q[i, 1] * Q[1, e] + Q[i, 2] * Q[2, e] + Q[i, 3] * Q[3, e]
-                y2 += z * z
-            lmax[j] = math.sqrt(y2 / en) * (1 - 1e-12) - 4 * 2.0 ** -52 * tr
-        ub[j], trs[j] = math.sqrt(max(mind + 4 * 2.0 ** -52 * tr, 0.0) / lmax[j]), tr
-    s = np.argmax(ub)
-    if ub[s] < 0.0:
-        return lo, hi
-    best = -whitened_metric(kind, Qs[s])
-    lo[s] = hi[s] = best
-    for j in range(n):
-        if j == s or ub[j] < 0.0:
-            continue
-        t = -_tie_limit(best) * (1 - 1e-12)          # the metric a candidate must reach
-        if t > 0.0 and (ub[j] < t or not cholesky_shifted(
-                Qs[j], 4, t * t * lmax[j] - 64 * 2.0 ** -52 * trs[j], C)):
-            lo[j], hi[j] = -t, 0.0
-            continue
-        lo[j] = hi[j] = -whitened_metric(kind, Qs[j])
-        best = min(best, lo[j])
-    return lo, hi
-
-
-@kernel
-def _above(s, W, mu) -> bool:
-    """lambda_max(diag(s) - W^T W) > mu (:func:`mineig_bracket`'s inertia count)."""
-    for i in range(12):
-        if s[i] == mu:                             # mu on a pole: its neighbour above
-            mu = np.nextafter(mu, math.inf)
-    n_above, e00, e01, e11 = 0, 1.0, 0.0, 1.0      # I_2 - W D^-1 W^T
-    for i in range(12):
-        r = 1.0 / (s[i] - mu)
-        n_above += s[i] > mu
-        e00 -= W[0, i] * W[0, i] * r
-        e01 -= W[0, i] * W[1, i] * r
-        e11 -= W[1, i] * W[1, i] * r
-    det = e00 * e11 - e01 * e01
-    return n_above + (1 if det < 0 else 2 if e00 + e11 > 0 else 0) - 2 >= 1
-
-
-@kernel
-def mineig_bracket(d0, d1, d2, q, lo0, hi0, rtol):
-    """(lo, hi) in [lo0, hi0] with lo <= lambda_max(Sigma_post) <= hi for the candidate at offset d (m), mineig =
-    1 / lambda_max, without a 12 x 12 eigenproblem (bounds for :func:`tie_pick`). In the eigenbasis V
-    of Sigma_k (s descending, :func:`info_constants`), Sigma_post = diag(s) - W^T W, W = L^T Z diag(s)
-    (2 x 12), Z = G V, L L^T = (I + Z diag(s) Z^T)^-1 (Woodbury). With the top k <= 3 eigenvalues
-    (k the least with s_k <= s_0 / 2): block A = diag(s_t) - W_t^T W_t, coupling C = W_t^T W_r, rest
-    <= s_k I; lo = lambda_max(A) (Rayleigh-Ritz), hi = the larger eigenvalue of [[lo, |C|_F], [|C|_F,
-    s_k]] (for unit x = (a, b): x^T Sigma_post x <= lo a^2 + 2 |C| a b + s_k b^2), at most s_0.
-    Then bisection until hi - lo <= rtol hi: Sigma_post - mu I has #(s_i > mu) + #pos(I_2 - W
-    D^-1 W^T) - 2 positive eigenvalues, D = diag(s - mu) (Haynsworth inertia additivity on [[D, W^T],
-    [W, I_2]]), so lambda_max > mu iff that count is >= 1 (a root in round-off: measured 2.5 us
-    against 4.8 us for LAPACK on the 12 x 12 Sigma_post). Widened by 1e-12 relative + 64 eps s_0,
-    the round-off of the count near the root (brackets of other narrowings hold the score)."""
-    G = np.empty((2, 12))
-    me.tangent_rows(q[Q_R:Q_R + 9].reshape((3, 3)), np.array([d0, d1, d2]), q[Q_SCALE], G)
-    s, V = q[Q_S:Q_S + 12], q[Q_V:Q_V + 144].reshape((12, 12))
-    Z = np.zeros((2, 12))
-    for i in range(12):
-        for j in range(12):
-            Z[0, j] += G[0, i] * V[i, j]
-            Z[1, j] += G[1, i] * V[i, j]
-    a, b, c = 1.0, 0.0, 1.0                        # M = I + Z diag(s) Z^T
-    for j in range(12):
-        a += s[j] * Z[0, j] * Z[0, j]
-        b += s[j] * Z[0, j] * Z[1, j]
-        c += s[j] * Z[1, j] * Z[1, j]
-    l00 = math.sqrt(c / (a * c - b * b))           # L = chol(M^-1)
-    l10 = -b / (a * c - b * b) / l00
-    l11 = math.sqrt(max(a / (a * c - b * b) - l10 * l10, 0.0))
-    W = np.empty((2, 12))
-    for j in range(12):
-        W[0, j] = (l00 * Z[0, j] + l10 * Z[1, j]) * s[j]
-        W[1, j] = l11 * Z[1, j] * s[j]
-    k = 1
-    while k < 3 and s[k] > 0.5 * s[0]:
-        k += 1
-    A, c2 = np.zeros((3, 3)), 0.0
-    for i in range(k):
-        A[i, i] = s[i]
-        for j in range(k):
-            A[i, j] -= W[0, i] * W[0, j] + W[1, i] * W[1, j]
-        for j in range(k, 12):
-            c2 += (W[0, i] * W[0, j] + W[1, i] * W[1, j]) ** 2
-    lo = max_eig_sym3(A)
-    for i in range(k, 12):                         # e_i's Rayleigh quotients: an untouched s_i stays
-        lo = max(lo, s[i] - W[0, i] * W[0, i] - W[1, i] * W[1, i])
-    hi = min(0.5 * (lo + s[k]) + math.sqrt(0.25 * (lo - s[k]) ** 2 + c2), s[0], hi0)
-    lo = min(max(lo, lo0), hi)
-    mu = lo * (1.0 + 0.25 * TIE_RTOL)              # on a plateau (lambda_max = lo): one test
-    if mu < hi and not _above(s, W, mu):
-        hi = mu
-    for _ in range(64):
-        if not hi - lo > rtol * hi:
-            break
-        mu = 0.5 * (lo + hi)
-        if _above(s, W, mu):
-            lo = mu
-        else:
-            hi = mu
-    pad = 64 * 2.0 ** -52 * s[0]
-    return lo * (1 - 1e-12) - pad, hi * (1 + 1e-12) + pad
-
-
-@kernel
-def score_bounds(q, xyz, cand):
-    """(lo, hi) of :func:`score_point` of landmarks ``xyz[cand]`` (lo <= score <= hi): mineig's
-    :func:`narrow` to :data:`MINEIG_RTOL`, every other kind's its score (lo = hi)."""
-    if int(q[11]) == SVD_W or int(q[11]) == COND_W:
-        return whitened_bounds(q, xyz, cand)
-    lo, hi = np.empty(cand.size), np.empty(cand.size)
-    for j in range(cand.size):
-        lo[j], hi[j] = narrow(q, xyz, cand[j], -math.inf, math.inf, MINEIG_RTOL)
-    return lo, hi
-
-
-@kernel
-def narrow(q, xyz, i, lo, hi, rtol):
-    """Bounds lo <= score <= hi of landmark ``xyz[i]`` (:func:`score_point`) narrowed, within
-    the given ones, to hi - lo <= rtol |hi| or a plateau (mineig, :func:`mineig_bracket`:
-    score = -1 / lambda_max); every other kind, or rtol = 0: its score (lo = hi)."""
-    p0, p1, p2 = xyz[i, 0], xyz[i, 1], xyz[i, 2]
-    d0, d1, d2 = p0 - q[0], p1 - q[1], p2 - q[2]
-    if (rtol == 0.0 or int(q[11]) != MINEIG
-            or not candidate_ok(d0, d1, d2, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), q)):
-        f = score_point(p0, p1, p2, q)
-        return f, f
-    a, b = mineig_bracket(d0, d1, d2, q, -1.0 / lo if lo < 0 else 0.0, -1.0 / hi if hi < 0 else math.inf,
-                          rtol)
-    return -1.0 / a if a > 0 else -math.inf, -1.0 / b if b > 0 else math.inf
-
-
-@kernel
-def inv_trace4(Q) -> float:
-    """trace(Q^-1) of a symmetric 4 x 4 Q (lower triangle read) as |C^-1|_F^2, C its Cholesky
-    factor; +inf if Q is not positive definite. gdop_w = 1 / trace(Q^-1) (:func:`sv_metric`'s
-    gdop of Q's eigenvalues): measured 0.5 us a score against 1.3 us through numba's LAPACK
-    eigvalsh (its workspace query and copies were 3/4 of a whitened score)."""
-    C, x, t = np.zeros((4, 4)), np.empty(4), 0.0
-    if not cholesky_shifted(Q, 4, 0.0, C):
-        return math.inf
-    for c in range(4):                             # column c of C^-1, forward substitution
-        for i in range(c, 4):
-            v = 1.0 if i == c else 0.0
-            for k in range(c, i):
-                v -= C[i, k] * x[k]
-            x[i] = v / C[i, i]
-            t += x[i] * x[i]
-    return t
-
-
-@kernel
-def nav_constants(v, a, R_LtoB, P, c, q) -> None:
-    """Fill logdet_nav's slots of q (after :func:`metric_constants`) once per call: the planning
-    state's velocity v (m/s), acceleration a (m/s^2), attitude R_LtoB, prior P (12 x 12), and the
-    filter's model from :func:`plan_run`'s ``c``: sigma_f = noise scale x sigma_b (rad), the new
-    landmark's depth 1-sigma / depth, n_obs observations dt = t_s (s) apart, oc, gravity (m/s^2)."""
+def nav_constants(r, v, a, R_LtoB, P, c, q) -> None:
+    """Fill the planned-information slots of q (after :func:`metric_constants`) once per call: the
+    planning state (position r m, velocity v m/s, acceleration a m/s^2, attitude R_LtoB, prior P
+    12 x 12), the filter's model from :func:`plan_run`'s ``c`` (sigma_f = noise scale x sigma_b
+    rad, the new landmark's depth 1-sigma / depth, n_obs observations dt = t_s s apart, oc,
+    gravity m/s^2), and the candidate-independent part of every planned image k (``Q_TAB``): the
+    transition Phi_k to the predicted pose r + v t + a t^2 / 2 (``ekf._transition``, eq. 6-10,
+    attitude held; its landmark block is the identity, so its 9 x 9 navigation block is kept) and
+    the site's rows whitened by 1/sigma_f (``measurement.tangent_rows``, landmark columns zero)
+    times Phi_k. q must hold ``Q_TAB + NT n_obs`` slots (:func:`work_size`)."""
     for i in range(9):
         q[Q_R + i] = R_LtoB[i // 3, i % 3]
     for i in range(12):
@@ -499,6 +211,33 @@ def nav_constants(v, a, R_LtoB, P, c, q) -> None:
         q[Q_NV + i], q[Q_NA + i], q[Q_NG + i], q[Q_NK + i] = v[i], a[i], c[C_NAV + 4 + i], c[C_PKNOWN + i]
     q[Q_NSF], q[Q_NDF], q[Q_NOBS] = c[C_NAV] * c[C_SIGMA], c[C_NAV + 1], c[C_NAV + 2]
     q[Q_NDT], q[Q_NOC] = c[C_TS], c[C_NAV + 3]
+    Phi, G = np.empty((12, 12)), np.empty((2, 12))
+    rk, vk, dk, g = np.empty(3), np.empty(3), np.empty(3), q[Q_NG:Q_NG + 3]
+    for k in range(int(q[Q_NOBS])):
+        t = k * q[Q_NDT]
+        for i in range(3):
+            rk[i] = r[i] + v[i] * t + 0.5 * a[i] * t * t
+            vk[i] = v[i] + a[i] * t
+            dk[i] = q[Q_NK + i] - rk[i]
+        ekf._transition(r, v, R_LtoB, rk, vk, R_LtoB, t, g, Phi)
+        base = Q_TAB + NT * k
+        for i in range(9):
+            for j in range(9):
+                q[base + 9 * i + j] = Phi[i, j]
+        me.tangent_rows(R_LtoB, dk, 1.0 / q[Q_NSF], G)
+        for b in range(2):
+            for j in range(12):
+                x = 0.0
+                if j < 9:
+                    for i in range(9):
+                        x += G[b, i] * Phi[i, j]
+                q[base + 81 + 12 * b + j] = x
+
+
+def work_size(n_obs: int) -> int:
+    """Length of :func:`plan_run`'s ``work`` for ``n_obs`` planned observations: q (``Q_TAB +
+    NT n_obs``), then out (9)."""
+    return Q_TAB + NT * int(n_obs) + 9
 
 
 @kernel
@@ -550,57 +289,49 @@ def logdet_spd(A, n, C) -> float:
 
 
 @kernel
-def planned_nav(d0, d1, d2, rho, q) -> float:
-    """logdet_nav's objective (minimised): log det (nats) of the navigation block (9 x 9) of the
-    planned posterior of the candidate at offset d = p - r (m), |d| = rho, as ``planned_info``
-    specifies it, step by step: its initialisation from its noise-free bearing (``ekf._init``: the
-    12 x 12 P0 with its own block), the site's and its tangent-plane rows whitened by 1/sigma_f
-    (``measurement.tangent_rows``) at the n_obs predicted poses r + v t + a t^2 / 2 (attitude
-    held; the first image the site's only), mapped to the planning instant by Phi
-    (``ekf._transition``, eq. 6-10), projected off the unit yaw direction (``ekf._nullspace``) if
-    oc; Sigma = P0 - (A P0)^T S^-1 A P0 with S = I + A P0 A^T = L L^T (Woodbury, as X^T X for X =
-    L^-1 A P0); its log det by :func:`logdet_spd`. +inf where the candidate cannot be
+def planned_rows(d0, d1, d2, rho, q, p0, P0, A) -> int:
+    """The candidate at offset d = p - r (m), |d| = rho, as ``planned_info.planned_rows`` specifies
+    it: P0 (12 x 12) its initialisation from its noise-free bearing (``ekf._init``, p0 its ground
+    point), A (m x 12, m = 4 n_obs - 2) the whitened tangent-plane rows of the n_obs planned images
+    at the planning instant: the site's from the call's table (:func:`nav_constants`), the
+    candidate's (``measurement.tangent_rows`` at the predicted pose, times Phi_k), projected off the
+    unit yaw direction (``ekf._nullspace``) if oc. Returns m, or -1 where the candidate cannot be
     initialised (its line of sight misses the ground)."""
     R, P, r = q[Q_R:Q_R + 9].reshape((3, 3)), q[Q_SIG:Q_SIG + 144].reshape((12, 12)), q[0:3]
     b = np.empty(3)
     for i in range(3):
         b[i] = (R[i, 0] * d0 + R[i, 1] * d1 + R[i, 2] * d2) / rho
-    p0, P0, J, JP = np.empty(3), np.empty((12, 12)), np.empty((3, 9)), np.empty((3, 9))
+    J, JP = np.empty((3, 9)), np.empty((3, 9))
     if not ekf._init(r, R, P, b, q[Q_NDF], q[Q_NSF], p0, P0, J, JP):
-        return math.inf
+        return -1
     n_obs = int(q[Q_NOBS])
     m = 4 * n_obs - 2
-    A, G, Phi = np.empty((m, 12)), np.empty((2, 12)), np.empty((12, 12))
-    v, g = q[Q_NV:Q_NV + 3], q[Q_NG:Q_NG + 3]
-    rk, vk, dk = np.empty(3), np.empty(3), np.empty(3)
+    G, dk = np.empty((2, 12)), np.empty(3)
     row = 0
     for k in range(n_obs):
         t = k * q[Q_NDT]
+        base = Q_TAB + NT * k
+        for a in range(2):                            # the site (its landmark columns zero)
+            for c in range(12):
+                A[row + a, c] = q[base + 81 + 12 * a + c]
+        row += 2
+        if k == 0:                                    # the first image initialises the candidate
+            continue
         for i in range(3):
-            rk[i] = r[i] + v[i] * t + 0.5 * q[Q_NA + i] * t * t
-            vk[i] = v[i] + q[Q_NA + i] * t
-        if k:
-            ekf._transition(r, v, R, rk, vk, R, t, g, Phi)
-        for s in range(2 if k else 1):               # the site (its landmark columns zero), then p0
-            for i in range(3):
-                dk[i] = (q[Q_NK + i] if s == 0 else p0[i]) - rk[i]
-            me.tangent_rows(R, dk, 1.0 / q[Q_NSF], G)
-            if s == 0:
-                G[0, 9:] = 0.0
-                G[1, 9:] = 0.0
-            for a in range(2):
-                for c in range(12):
-                    if k == 0:
-                        A[row + a, c] = G[a, c]
-                    else:
-                        x = 0.0
-                        for j in range(12):
-                            x += G[a, j] * Phi[j, c]
-                        A[row + a, c] = x
-            row += 2
+            dk[i] = p0[i] - (r[i] + q[Q_NV + i] * t + 0.5 * q[Q_NA + i] * t * t)
+        me.tangent_rows(R, dk, 1.0 / q[Q_NSF], G)
+        for a in range(2):                            # G Phi_k: Phi_k's landmark block is I
+            for c in range(9):
+                x = 0.0
+                for j in range(9):
+                    x += G[a, j] * q[base + 9 * j + c]
+                A[row + a, c] = x
+            for c in range(9, 12):
+                A[row + a, c] = G[a, c]
+        row += 2
     if q[Q_NOC] != 0.0:                               # A (I - N N^T), N the unit yaw direction
         N = np.empty(12)
-        ekf._nullspace(r, v, R, p0, N)
+        ekf._nullspace(r, q[Q_NV:Q_NV + 3], R, p0, N)
         N /= math.sqrt(np.sum(N * N))
         for a in range(m):
             x = 0.0
@@ -608,6 +339,41 @@ def planned_nav(d0, d1, d2, rho, q) -> float:
                 x += A[a, c] * N[c]
             for c in range(12):
                 A[a, c] -= x * N[c]
+    return m
+
+
+@kernel
+def planned(kind, d0, d1, d2, rho, q) -> float:
+    """The planned-information objective (minimised: minus the metric) of kind ``kind`` for the
+    candidate at offset d (m), |d| = rho, from :func:`planned_rows` (P0, A), as
+    ``planned_info.planned_metric`` defines each: with S = I + A P0 A^T = L L^T and X = L^-1 A P0,
+    the posterior Sigma = P0 - X^T X (Woodbury) and the information Lambda = P0^-1 + A^T A:
+    logdet_nav = -log det Sigma[:9, :9] (nats), logdet = log det Lambda = log det S - log det P0,
+    mineig = lambda_min(Lambda) = 1 / lambda_max(Sigma) (LAPACK eigvalsh of Sigma), and svd_w,
+    gdop_w, cond_w (:func:`sv_metric`'s rules) of the PLANNED_RANK-or-fewer structural singular
+    values of the whitened rows A P0^1/2 (LAPACK SVD of A chol(P0): their Gram A P0 A^T squares
+    a condition number ~1e4, its eigenvalues agreed with the SVD to only 2e-5). +inf where the
+    candidate cannot be initialised."""
+    p0, P0 = np.empty(3), np.empty((12, 12))
+    n_obs = int(q[Q_NOBS])
+    A = np.empty((4 * n_obs - 2, 12))
+    m = planned_rows(d0, d1, d2, rho, q, p0, P0, A)
+    if m < 0:
+        return math.inf
+    if kind >= SVD_W and kind <= COND_W:             # singular values of A P0^1/2 (LAPACK SVD)
+        sv = np.linalg.svd(A @ np.linalg.cholesky(P0))[1]
+        rk = min(m, PLANNED_RANK)
+        s1, sr = sv[0], sv[rk - 1]
+        if not sr > 0.0:
+            return 0.0
+        if kind == SVD_W:
+            return -sr
+        if kind == COND_W:
+            return -sr / s1
+        x = 0.0
+        for i in range(rk):
+            x += 1.0 / (sv[i] * sv[i])
+        return -1.0 / x
     X, S = np.empty((m, 12)), np.empty((m, m))
     for a in range(m):                                # X <- A P0
         for c in range(12):
@@ -623,21 +389,33 @@ def planned_nav(d0, d1, d2, rho, q) -> float:
             S[a, b_] = x
     L = np.empty((m, m))
     if not cholesky_shifted(S, m, 0.0, L):
-        return -math.inf
-    for c in range(9):                                # X <- L^-1 A P0 (the navigation columns)
+        return math.inf
+    if kind == LOGDET:
+        ld = 0.0
+        for a in range(m):
+            ld += 2.0 * math.log(L[a, a])
+        return -(ld - logdet_spd(P0, 12, np.empty((12, 12))))
+    nc = 9 if kind == LOGDET_NAV else 12
+    for c in range(nc):                               # X <- L^-1 A P0
         for a in range(m):
             x = X[a, c]
             for j in range(a):
                 x -= L[a, j] * X[j, c]
             X[a, c] = x / L[a, a]
-    Sig = np.empty((9, 9))
-    for i in range(9):
-        for j in range(9):
+    Sig = np.empty((nc, nc))
+    for i in range(nc):
+        for j in range(nc):
             x = P0[i, j]
             for a in range(m):
                 x -= X[a, i] * X[a, j]
             Sig[i, j] = x
-    return logdet_spd(Sig, 9, np.empty((9, 9)))
+    if kind == LOGDET_NAV:
+        return logdet_spd(Sig, 9, np.empty((9, 9)))
+    for i in range(12):                               # symmetric to round-off: its lower triangle
+        for j in range(i):
+            Sig[j, i] = Sig[i, j]
+    lmax = np.linalg.eigvalsh(Sig)[11]
+    return -1.0 / lmax if lmax > 0.0 else math.inf
 
 
 @kernel
@@ -695,12 +473,10 @@ def score_point(p0, p1, p2, q) -> float:
         c0, c1, c2 = d1 * q[5] - d2 * q[4], d2 * q[3] - d0 * q[5], d0 * q[4] - d1 * q[3]  # d x v_hat
         return depth_error(rho, (d0 * q[3] + d1 * q[4] + d2 * q[5]) / rho,
                            math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / rho, q[12], q[13])
-    if kind == LOGDET_NAV:
-        return planned_nav(d0, d1, d2, rho, q) if in_view(d0, d1, d2, rho, q) else math.inf
+    if kind >= LOGDET:
+        return planned(kind, d0, d1, d2, rho, q) if in_view(d0, d1, d2, rho, q) else math.inf
     if not candidate_ok(d0, d1, d2, rho, q):
         return math.inf
-    if kind >= LOGDET:
-        return -info_metric(kind, d0, d1, d2, q)
     y = 1.0 / rho
     w0, w1, w2 = d0 * y, d1 * y, d2 * y
     u0, u1, u2 = q[14], q[15], q[16]
@@ -833,49 +609,6 @@ def _tie_limit(best) -> float:
 
 
 @kernel
-def tie_pick(q, xyz, cand, lo, hi) -> int:
-    """:func:`best_index` of the scores of ``xyz[cand]`` known by bounds lo <= score <= hi
-    (:func:`score_bounds`), each refined to its score (:func:`score_point`) only where the
-    bounds cannot decide: with best in [min lo, min hi], a candidate whose lo exceeds
-    the tie bound of min hi is out, one whose hi is within that of min lo is tied; the
-    first undecided one fixes best (every candidate with lo <= min hi refined) and is
-    refined itself. Equal to ``best_index(score_points(...))`` (same tie rule) where
-    the bounds hold; with lo = hi it is that, without refinement."""
-    n = cand.size
-    if n == 0:
-        return -1
-    blo, bhi = lo.min(), hi.min()
-    if blo == math.inf:
-        return -1
-    for rtol in NARROWING:                          # narrow the bounds that may hold the best
-        for k in range(n):
-            if lo[k] <= _tie_limit(bhi) and hi[k] - lo[k] > rtol * abs(hi[k]):
-                lo[k], hi[k] = narrow(q, xyz, cand[k], lo[k], hi[k], rtol)
-        blo, bhi = lo.min(), hi.min()
-    exact = blo == bhi
-    for j in range(n):
-        if lo[j] > _tie_limit(bhi):
-            continue
-        if hi[j] <= _tie_limit(blo):
-            return j
-        if not exact:                               # fix best: refine every possible minimum
-            for k in range(n):
-                if lo[k] <= bhi and lo[k] < hi[k]:
-                    lo[k], hi[k] = narrow(q, xyz, cand[k], lo[k], hi[k], 0.0)
-            blo = bhi = hi.min()
-            exact = True
-            if blo == math.inf:
-                return -1
-            if lo[j] > _tie_limit(bhi):
-                continue
-        if lo[j] < hi[j]:
-            lo[j], hi[j] = narrow(q, xyz, cand[j], lo[j], hi[j], 0.0)
-        if hi[j] <= _tie_limit(bhi):
-            return j
-    return -1
-
-
-@kernel
 def _nearest_of(x, y, xyz, det, exclude) -> int:
     best, bd = -1, math.inf
     for i in det:
@@ -970,8 +703,7 @@ def edge_pick(q, xyz, det, exclude):
     """The edge rule: (pick, landmarks scored): every detected landmark less
     ``exclude`` scored (:func:`score_points`), the tie rule picks (-1: none finite)."""
     cand = det[det != exclude]
-    lo, hi = score_bounds(q, xyz, cand)
-    j = tie_pick(q, xyz, cand, lo, hi)
+    j = best_index(score_points(q, xyz, cand))
     return (cand[j] if j >= 0 else -1), cand.size
 
 
@@ -1019,10 +751,11 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
     run: ``c`` (:data:`NC`) = [t_s (s), n_sigma_v, tol (rad), tan half-FOV less
     margin, min_range (m), R_BtoC (9, row-major), boresight_B (3), known landmark
     (3, m), grid (5, :func:`field_grid`), sigma_b (rad: the B-X1 kinds' bearing
-    noise sigma_b^2 I_6), logdet_nav's filter model (:func:`nav_constants`: noise
-    scale, depth_sigma_frac, obs_per_landmark, oc (1/0), gravity (3, m/s^2))]; ``P``
-    the prior (12 x 12); ``work`` (NQ + 9) receives q and out (status at work[NQ + 8]; 0 ok)."""
-    q, out = work[:NQ], work[NQ:]
+    noise sigma_b: the filter's is its noise scale times it), the planned-information kinds'
+    filter model (:func:`nav_constants`: noise scale, depth_sigma_frac, obs_per_landmark, oc
+    (1/0), gravity (3, m/s^2))]; ``P`` the prior (12 x 12); ``work`` (:func:`work_size` of
+    obs_per_landmark) receives q and out (its last 9 slots; status last, 0 ok)."""
+    q, out = work[:work.size - 9], work[work.size - 9:]
     st = plane(r, v, q)
     q[11] = kind
     if st == OK and kind == DEPTH:
@@ -1031,10 +764,8 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
             st = ZERO_BASELINE
     elif st == OK:
         metric_constants(r, R_LtoB, c[C_BS:C_BS + 3], 1.0, c[C_PKNOWN:C_PKNOWN + 3], c[C_MINRANGE], q)
-        if kind == LOGDET_NAV:
-            nav_constants(v, a, R_LtoB, P, c, q)
-        elif kind >= LOGDET:
-            info_constants(R_LtoB, P, c[C_SIGMA], q)
+        if kind >= LOGDET:
+            nav_constants(r, v, a, R_LtoB, P, c, q)
     if st != OK:
         out[3], out[8] = 0, st
         return
@@ -1058,15 +789,14 @@ def _warm() -> None:
     c = np.zeros(NC)
     c[:5], c[C_RBC:C_RBC + 9:4], c[C_BS + 2], c[C_GRID:C_SIGMA], c[C_SIGMA], c[C_NAV:NC] = (
         (1.0, 3.0, 1e-3, 0.5, 1e-6), 1.0, -1.0, grid, 1e-3, (5.0, 0.1, 3.0, 1.0, 0.0, 0.0, -3.711))
-    work = np.zeros(NQ + 9)
+    work = np.zeros(work_size(3))
     for kind in KINDS.values():
         plan_run(kind, np.array([10.0, 0, 1000.0]), np.array([-5.0, 0, -20.0]), np.zeros(3), R, P, c,
                  xyz, det, np.int64(-1), cells, work)
-        q = work[:NQ]
+        q = work[:-9]
         score_points(q, xyz, det)
         edge_pick(q, xyz, det, np.int64(-1))
         evaluations(q, np.array([-0.1, 0.1]), xyz, det, 1)
     valid_points(q, xyz)
-    info_constants(R, P, 1.0, q)
     sv_metric(SVD, 1.0, 1.0, 1.0, 1.0)
     nearest(0.0, 0.0, xyz, det, np.int64(3), grid, cells)

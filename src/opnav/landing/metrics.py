@@ -1,5 +1,4 @@
-"""Observability / information metrics for landmark selection (paper B, sec. 2.2;
-SPEC B.3 baselines and B-X1).
+"""The paper's H baselines for landmark selection (paper B, sec. 2.2; SPEC B.3).
 
 Description
 -----------
@@ -11,10 +10,10 @@ lander state and the known landmark, from the two-landmark bearing Jacobian H
 ``svd``     sigma_min(H): smallest *structural* singular value (see below)
 ``gdop``    1 / trace[(H^T H)^+]  (paper's GDOP-type metric, pseudo-inverse)
 ``cond``    1 / cond(H) = sigma_min / sigma_max (structural)
-``logdet``  D-optimal  log det(P^-1 + H^T R^-1 H)          (B-X1, beyond paper)
-``mineig``  E-optimal  lambda_min(P^-1 + H^T R^-1 H)        (B-X1, beyond paper)
-``svd_w``, ``gdop_w``, ``cond_w``: the same of the whitened H_w = R^-1/2 H P^1/2 (B-X1)
 ==========  ================================================================
+
+B-X1's information baselines (logdet, mineig, svd_w, gdop_w, cond_w, logdet_nav)
+score the candidate's planned observations, not this H: ``planned_info``.
 
 Rank choice (documented deviation from a literal reading of the SPEC): each
 unit-bearing block of H has its bearing as left null vector (b^T H_C = 0,
@@ -24,7 +23,7 @@ rounding noise (~1e-16). We use the four *structural* singular values s1 >= ..
 trace[(H^T H)^+]^-1 with the pseudo-inverse rank tolerance at rank 4; the
 reference uses ``pinv(H, rcond=1e-10)``).
 
-Closed form (the H baselines' fast path, compiled: ``kernels.h_metric``): the
+Closed form (the fast path, compiled: ``kernels.h_metric``): the
 structural singular values do not depend on the attitude and, with x = 1/rho_1,
 y = 1/rho_2 (1/m) and c = u . w (unit lines of sight to the known landmark and
 the candidate), a = 1 + x^2, d = 1 + 2 y^2, m = (a + d)/2, e = (a - d)/2,
@@ -35,30 +34,13 @@ equal to the SVD of the CasADi-derived H. H mixes units (1/m position columns, 1
 attitude columns): s4 ~ 1/range, s1 ~ sqrt(2), so ``svd`` mostly rewards short
 ranges and ``svd``, ``gdop``, ``cond`` rank candidates alike in the descent.
 
-Information metrics need ``ctx.P`` (12 x 12 prior of [r (m), v (m/s), dtheta (rad),
-p (m)]) and ``ctx.R_meas`` (6 x 6, rad^2): log det of Lambda = P^-1 + H^T R^-1 H
-(:func:`chol_logdet`), lambda_min as 1 / lambda_max of the posterior covariance.
-Caution: one epoch of two bearings informs neither velocity nor the new landmark's
-depth, so with a large isotropic landmark prior lambda_min is that prior's for every
-candidate (spread ~2e-15): ``mineig`` ties everywhere (the tie rule: lowest index). Fast path for
-``R_meas`` = sigma^2 I_6 (the descent's), compiled (``kernels.info_constants``,
-``kernels.info_metric``): a bearing's information is that of its tangent-plane
-rows G = sigma^-1 T^T H (2 x 12, ``measurement.tangent_rows``): log det Lambda =
-log det Lambda_k + log det(I_2 + G Sigma_k G^T) after the known landmark,
-Sigma_post by Woodbury, its lambda_max by bisection on an inertia count in Sigma_k's
-eigenbasis (``kernels.mineig_bracket``: the edge rule scores thousands of candidates from
-brackets and narrows only those that may be the best, ``kernels.tie_pick``); whitened: [G_k; G] L (L = chol(P)), the eigenvalues of
-its 4 x 4 Gram matrix (gdop_w: its inverse's trace; the edge rule's svd_w and cond_w score
-exactly only the candidates a bound and a Cholesky test cannot rule out,
-``kernels.whitened_bounds``). Any other ``R_meas``: the definition (``metric.reference``).
-
 Validity (``kernels.candidate_ok``): a candidate within ``ctx.min_range_m`` of the
 lander or behind the camera (b . boresight_B <= 0; None disables), or with the
 known landmark so, scores -inf; bad inputs raise ``ValueError`` naming the field.
 ``metric(ctx, cand_L (n, 3))`` is the fast path, ``metric.reference`` the paper's
 definition (the tests' reference and the "as the paper defines it" timing path):
-H of eq. 14-18 from CasADi (``Function.map``), then LAPACK (SVD, pseudo-inverse,
-the 12 x 12 information).
+H of eq. 14-18 from CasADi (``Function.map``), then LAPACK (SVD, pseudo-inverse).
+``chol_logdet`` is the project's one log-det rule (``planned_info``, ``kernels.logdet_spd``).
 """
 
 from __future__ import annotations
@@ -70,10 +52,7 @@ import numpy as np
 
 from opnav.landing import kernels as K
 
-METRIC_NAMES = ("svd", "gdop", "cond", "logdet", "mineig", "svd_w", "gdop_w", "cond_w")
-H_METRICS = ("svd", "gdop", "cond")
-#: whitened baselines (B-X1): the paper's H metric of H_w = R^-1/2 H P^1/2
-WHITENED = {"svd_w": "svd", "gdop_w": "gdop", "cond_w": "cond"}
+METRIC_NAMES = H_METRICS = ("svd", "gdop", "cond")
 #: structural rank of the 6 x 12 two-bearing Jacobian (2 per unit bearing)
 STRUCTURAL_RANK = 4
 #: pseudo-inverse rank tolerance of the reference GDOP, relative to sigma_max
@@ -137,33 +116,16 @@ class MetricContext:
         return c[key]
 
     def q(self, kind: int = 0) -> np.ndarray:
-        """The kernels' per-run constants (``kernels.NQ``) of objective ``kind`` (``kernels.KINDS``):
-        ``kernels.metric_constants``, and ``kernels.info_constants`` for the B-X1 kinds."""
+        """The kernels' per-run constants (``kernels.NQ``) of H baseline ``kind`` (``kernels.KINDS``):
+        ``kernels.metric_constants``."""
         def build(ctx):
             q = np.zeros(K.NQ)
             bs = ctx.boresight_B
             K.metric_constants(ctx.r_L, ctx.R_LtoB, np.zeros(3) if bs is None else np.asarray(bs, float),
                                0.0 if bs is None else 1.0, ctx.p_known_L, ctx.min_range_m, q)
             q[11] = kind
-            if kind >= K.LOGDET:   # ctx.info() checks P and R_meas
-                K.info_constants(ctx.R_LtoB, ctx.info()[0], math.sqrt(ctx.R_meas[0, 0]), q)
             return q
         return self.cached(("q", kind), build)
-
-    def info(self):
-        """(P, R_meas, P^-1, R_meas^-1) for the information and whitened metrics."""
-        def build(ctx):
-            if ctx.P is None or ctx.R_meas is None:
-                missing = [k for k in ("P", "R_meas") if getattr(ctx, k) is None]
-                raise ValueError(f"information metrics need MetricContext.{' and '.join(missing)}")
-            try:
-                np.linalg.cholesky(ctx.P)
-                np.linalg.cholesky(ctx.R_meas)
-            except np.linalg.LinAlgError:
-                raise ValueError("MetricContext.P and R_meas must be positive definite") from None
-            Pinv, W = np.linalg.inv(ctx.P), np.linalg.inv(ctx.R_meas)
-            return ctx.P, ctx.R_meas, 0.5 * (Pinv + Pinv.T), 0.5 * (W + W.T)
-        return self.cached("info", build)
 
 
 def chol_logdet(A: np.ndarray, jitter: float | None = None) -> np.ndarray:
@@ -199,22 +161,11 @@ def chol_logdet(A: np.ndarray, jitter: float | None = None) -> np.ndarray:
 
 
 def _scores_from_H(name: str, H: np.ndarray, ctx: MetricContext) -> np.ndarray:
-    """The paper's definition on explicit H (n, 6, 12): LAPACK SVD / pseudo-inverse
-    of H (or of the whitened H_w), the 12 x 12 information."""
-    if name in WHITENED:
-        Ci, L = np.linalg.inv(np.linalg.cholesky(ctx.info()[1])), np.linalg.cholesky(ctx.P)
-        return _sv_metric(WHITENED[name], np.linalg.svd(Ci @ H @ L, compute_uv=False))
+    """The paper's definition on explicit H (n, 6, 12): LAPACK SVD / pseudo-inverse of H."""
     if name == "gdop":
         Hp = np.linalg.pinv(H, rcond=PINV_RCOND)  # (H^T H)^+ = H^+ H^+T
         return 1.0 / np.einsum("nij,nij->n", Hp, Hp)
-    if name in H_METRICS:
-        return _sv_metric(name, np.linalg.svd(H, compute_uv=False))
-    P, Rm, Pinv, W = ctx.info()
-    Lam = Pinv + np.swapaxes(H, -1, -2) @ W @ H
-    Lam = 0.5 * (Lam + np.swapaxes(Lam, 1, 2))
-    if name == "logdet":
-        return chol_logdet(Lam)
-    return np.linalg.eigvalsh(Lam)[:, 0]
+    return _sv_metric(name, np.linalg.svd(H, compute_uv=False))
 
 
 def _sv_metric(base: str, s: np.ndarray) -> np.ndarray:
@@ -255,9 +206,6 @@ class Metric:
         return out
 
     def __call__(self, ctx: MetricContext, cand_L) -> np.ndarray:
-        Rm = None if self.name in H_METRICS else ctx.info()[1]
-        if Rm is not None and not np.array_equal(Rm, Rm[0, 0] * np.eye(6)):  # no compiled form
-            return self.reference(ctx, cand_L)
         q = ctx.q(K.KINDS[self.name])
         return self._scored(ctx, cand_L, lambda c: -K.score_points(q, c, np.arange(len(c))))
 

@@ -1,13 +1,16 @@
 """The information a candidate landmark would give the filter, specified as the
-filter would get it (B-X1 method ``logdet_nav``; beyond paper B).
+filter would get it: B-X1's information baselines (``logdet``, ``mineig``,
+``svd_w``, ``gdop_w``, ``cond_w``, ``logdet_nav``; beyond paper B).
 
 Description
 -----------
-The B-X1 information metrics of :mod:`opnav.landing.metrics` (``logdet``,
-``mineig``) score one two-bearing observation of the candidate with the
-current landmark's covariance in the landmark block and the true pixel noise.
-This module scores what the Fig. 3 strategy would actually do with the
-candidate ``p_c`` (m, {L}) from the current estimate (r, v, R_LtoB, P):
+Every information baseline scores what the Fig. 3 strategy would actually do with
+the candidate ``p_c`` (m, {L}) from the current estimate (r, v, R_LtoB, P), steps
+1-3 below (:func:`planned_rows`), and differs only in what it reads of the planned
+information (:func:`planned_metric`; step 4 is ``logdet_nav``'s). An earlier form
+scored one two-bearing observation with the true pixel noise and the current
+landmark's covariance (issue 43: that mis-specification, not the metrics, made them
+lose to depth); it is gone, no study needs it.
 
 1. **its own initialisation**: the prior covariance ``P0`` (12 x 12) is the
    filter's ``ekf.init_landmark`` for the candidate's (noise-free) bearing: the
@@ -42,14 +45,12 @@ Candidates behind the camera or whose line of sight
 misses the ground score ``-inf``.
 
 Two implementations of the one specification above: the Monte Carlo's planner runs
-the compiled one (``kernels.planned_nav``, per candidate: ``ekf._init``,
-``measurement.tangent_rows``, ``ekf._transition``, ``ekf._nullspace``, the Woodbury
-posterior by a Cholesky factor); this module is the reference in numpy, batched over
-candidates (the tests compare the two, and the planner's ``paper`` path and the
-timing replay's other path run it). Measured (full config, 2 descents each, one
-process): 0.11 against 1.85 CPU-s (interior), 2.9 against 9.8 CPU-s (site-tilt,
-where nearly every call is an edge call scoring every detected landmark: about 4 us
-a candidate compiled), with the same picks on every call.
+the compiled one (``kernels.planned_rows`` and ``kernels.planned``, per candidate:
+``ekf._init``, ``measurement.tangent_rows``, ``ekf._nullspace``, the Woodbury
+posterior by a Cholesky factor; the transitions Phi_k and the site's rows once per
+call, ``kernels.nav_constants``); this module is the reference in numpy, batched over
+candidates, in the information form (the tests compare the two, and the planner's
+``paper`` path and the timing replay's other path run it). Costs: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -60,7 +61,12 @@ from opnav.landing import ekf
 from opnav.landing.measurement import tangent_jacobian
 from opnav.landing.metrics import chol_logdet
 
-__all__ = ["planned_nav_logdet", "planned_posterior"]
+__all__ = ["planned_nav_logdet", "planned_posterior", "planned_rows", "planned_metric", "PLANNED_METRICS"]
+
+#: the B-X1 information baselines scored from the planned observations (:func:`planned_metric`)
+PLANNED_METRICS = ("logdet", "mineig", "svd_w", "gdop_w", "cond_w", "logdet_nav")
+#: structural rank of the whitened planned rows A P0^1/2 (yaw unobservable; kernels.PLANNED_RANK)
+PLANNED_RANK = 11
 
 
 def _states(r, v, R_LtoB, P, n: int) -> ekf.NavState:
@@ -73,15 +79,14 @@ def _states(r, v, R_LtoB, P, n: int) -> ekf.NavState:
                         P=np.broadcast_to(np.asarray(P, float), (n, 12, 12)).copy())
 
 
-def planned_posterior(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
-                      n_obs: int, dt: float, g, oc: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """``(Sigma_post (n, 12, 12), ok (n,))``: the planned posterior covariance of
-    ``[dr, dv, dtheta, dp]`` at the planning instant after observing each
-    candidate of ``cand`` (n, 3) ``n_obs`` times, one image every ``dt`` s
-    (module docstring), from one planning state (r (3,), ...: position m,
-    velocity m/s, acceleration m/s^2 with gravity ``g``, R_LtoB, P) or one per
-    candidate (r (n, 3), ...); ``ok`` False where the candidate cannot be
-    initialised (its line of sight misses the ground)."""
+def planned_rows(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
+                 n_obs: int, dt: float, g, oc: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(A (n, m, 12), P0 (n, 12, 12), ok (n,))``, m = 4 n_obs - 2: each candidate's
+    prior ``P0`` (its own initialisation) and the whitened tangent-plane rows ``A``
+    of its planned observations (module docstring, steps 1-3), mapped to the
+    planning instant and, if ``oc``, projected off the unit yaw direction; the
+    planned information is ``P0^-1 + A^T A``. ``ok`` False where the candidate
+    cannot be initialised (its line of sight misses the ground)."""
     cand = np.asarray(cand, float).reshape(-1, 3)
     n = len(cand)
     st = _states(r, v, R_LtoB, P, n)
@@ -89,7 +94,6 @@ def planned_posterior(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_s
     d = np.einsum("nij,nj->ni", st.R, cand - st.r)
     b = d / np.linalg.norm(d, axis=1, keepdims=True)
     new, ok = ekf.init_landmark(st, b, depth_sigma_frac, sigma_f)     # its own initialisation
-    P0 = new.P
     p_known = np.asarray(p_known, float)
     rows = []
     for k in range(int(n_obs)):
@@ -107,6 +111,19 @@ def planned_posterior(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_s
         N = ekf.nullspace(new.r, new.v, new.R, new.p)
         N = N / np.linalg.norm(N, axis=-1, keepdims=True)
         A = A - np.einsum("nij,nj,nk->nik", A, N, N)
+    return A, new.P, ok
+
+
+def planned_posterior(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
+                      n_obs: int, dt: float, g, oc: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """``(Sigma_post (n, 12, 12), ok (n,))``: the planned posterior covariance of
+    ``[dr, dv, dtheta, dp]`` at the planning instant after observing each
+    candidate of ``cand`` (n, 3) ``n_obs`` times, one image every ``dt`` s
+    (module docstring), from one planning state (r (3,), ...: position m,
+    velocity m/s, acceleration m/s^2 with gravity ``g``, R_LtoB, P) or one per
+    candidate (r (n, 3), ...): :func:`planned_rows`, then Woodbury; ``ok`` False
+    where the candidate cannot be initialised (its line of sight misses the ground)."""
+    A, P0, ok = planned_rows(r, v, a, R_LtoB, P, p_known, cand, sigma_f, depth_sigma_frac, n_obs, dt, g, oc)
     AP = A @ P0
     S = np.eye(A.shape[1]) + AP @ np.swapaxes(A, 1, 2)
     Sig = P0 - np.swapaxes(AP, 1, 2) @ np.linalg.solve(S, AP)
@@ -128,4 +145,48 @@ def planned_nav_logdet(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_
     if boresight_B is not None:
         st = _states(r, v, R_LtoB, np.eye(12), len(cand))
         ok = ok & (np.einsum("nij,nj->ni", st.R, cand - st.r) @ boresight_B > 0)
+    return np.where(ok, out, -np.inf)
+
+
+def planned_metric(name: str, r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
+                   n_obs: int, dt: float, g, oc: bool = True, boresight_B=None) -> np.ndarray:
+    """The B-X1 information baseline ``name`` (:data:`PLANNED_METRICS`, larger is better) of each
+    candidate (n,) as its definition says, from the candidate's planned observations
+    (:func:`planned_rows`: its own initialisation P0, the filter's noise ``sigma_f``, ``n_obs``
+    observations on the predicted poses) and the information Lambda = P0^-1 + A^T A:
+
+    * ``logdet`` (D-optimal): log det Lambda (:func:`metrics.chol_logdet`, nats);
+    * ``mineig`` (E-optimal): lambda_min(Lambda), as 1 / lambda_max of its inverse taken through
+      the Jacobi-equilibrated Lambda (Lambda's entries span ~1e14: eigvalsh of it directly loses
+      the smallest eigenvalue);
+    * ``svd_w``, ``gdop_w``, ``cond_w``: sigma_min, 1 / sum sigma_i^-2, sigma_min / sigma_max of
+      the ``min(m, PLANNED_RANK)`` structural singular values of the whitened H, A P0^1/2 (LAPACK
+      SVD; A is already whitened by 1/sigma_f);
+    * ``logdet_nav``: :func:`planned_nav_logdet`.
+
+    ``-inf`` for candidates that cannot be initialised or lie behind the camera. The numpy
+    definition: ``kernels.planned`` is tested equal to it."""
+    if name == "logdet_nav":
+        return planned_nav_logdet(r, v, a, R_LtoB, P, p_known, cand, sigma_f, depth_sigma_frac, n_obs, dt,
+                                  g, oc, boresight_B)
+    if name not in PLANNED_METRICS:
+        raise ValueError(f"unknown planned metric {name!r}; expected one of {PLANNED_METRICS}")
+    cand = np.asarray(cand, float).reshape(-1, 3)
+    A, P0, ok = planned_rows(r, v, a, R_LtoB, P, p_known, cand, sigma_f, depth_sigma_frac, n_obs, dt, g, oc)
+    Lam = np.linalg.inv(P0) + np.swapaxes(A, 1, 2) @ A
+    Lam = 0.5 * (Lam + np.swapaxes(Lam, 1, 2))
+    if name == "logdet":
+        out = chol_logdet(Lam)
+    elif name == "mineig":
+        s = 1.0 / np.sqrt(np.diagonal(Lam, axis1=1, axis2=2))
+        Sig = np.linalg.inv(Lam * s[:, :, None] * s[:, None, :]) * s[:, :, None] * s[:, None, :]
+        out = 1.0 / np.linalg.eigvalsh(0.5 * (Sig + np.swapaxes(Sig, 1, 2)))[:, -1]
+    else:
+        k = min(A.shape[1], PLANNED_RANK)
+        sv = np.linalg.svd(A @ np.linalg.cholesky(P0), compute_uv=False)[:, :k]
+        out = {"svd_w": sv[:, -1], "cond_w": sv[:, -1] / sv[:, 0],
+               "gdop_w": 1.0 / np.sum(sv ** -2.0, axis=1)}[name]
+    if boresight_B is not None:
+        R = np.asarray(R_LtoB, float)
+        ok = ok & ((cand - np.asarray(r, float)) @ R.T @ np.asarray(boresight_B, float) > 0)
     return np.where(ok, out, -np.inf)

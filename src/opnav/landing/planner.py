@@ -26,15 +26,15 @@ the vertical plane holding the estimated velocity) differs:
 Degenerate geometry or no visible interval: the detected landmark nearest to
 the boresight's ground point, ``note`` says why.
 
-Objectives: ``depth`` (eq. 23-25), the H baselines, the B-X1 metrics and
-``logdet_nav`` (``kernels.KINDS``) are compiled (``kernels.objective``);
+Objectives: ``depth`` (eq. 23-25), the H baselines and the B-X1 information
+baselines (``kernels.KINDS``) are compiled (``kernels.objective``);
 :data:`PICKERS` search nothing.
 
 Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer would
 run) and ``paper`` (the paper's definition through the same call's source run by
 the interpreter, ``kernels.interpreted``: the law-of-sines depth error of
 ``depth_error``; H from CasADi and LAPACK's SVD / pseudo-inverse,
-``metrics.Metric.reference``; ``logdet_nav``: ``planned_info`` in numpy);
+``metrics.Metric.reference``; the information baselines: ``planned_info`` in numpy);
 timing replays both. One planner:
 :func:`plan_batch` plans run by run with :func:`plan_one`; :func:`plan` is one
 timed call of it.
@@ -57,6 +57,7 @@ from opnav.landing.camera import Camera
 from opnav.landing.depth_error import (REASONS, PlaneGeometry, baseline, depth_error_at_landmarks,
                                        error_radius, plane_geometry, signed_depth_error)
 from opnav.landing.landmarks import LandmarkField
+from opnav.landing.planned_info import PLANNED_METRICS, planned_metric
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig", "plan",
            "plan_one", "plan_batch", "compiled_kind", "compiled_call", "candidate_scores", "PICKERS", "PATHS",
@@ -167,7 +168,7 @@ def _metric_context(state: PlanState, cfg: PlannerConfig, camera: Camera) -> met
 def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera: Camera, q: np.ndarray):
     """``(f(beta, q), scores(q, xyz, cand), status)`` of a method the interpreter
     runs on the paper path (``cfg.eval_path == "paper"``): the paper's definitions and
-    ``planned_info`` for ``logdet_nav``; minimised, ``+inf`` where the line of sight misses the ground."""
+    ``planned_info.planned_metric`` for the information baselines; minimised, ``+inf`` where the line of sight misses the ground."""
     if method == "depth":               # the paper's eq. 23-25 (law of sines, numpy)
         b = baseline(state.v, state.a, cfg.t_s)
         if not b > 0:
@@ -178,15 +179,13 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
         scores = lambda q, xyz, cand: depth_error_at_landmarks(state.r, state.v, state.a, xyz[cand],
                                                                cfg.t_s, r_e)
         return f, scores, K.OK
-    if method == "logdet_nav":
-        from opnav.landing.planned_info import planned_nav_logdet
-
+    if method in PLANNED_METRICS:
         kw = dict(sigma_f=camera.sigma_b * cfg.noise_scale, depth_sigma_frac=cfg.depth_sigma_frac,
                   n_obs=cfg.obs_per_landmark, dt=cfg.t_s, g=cfg.g, oc=cfg.oc,
                   boresight_B=camera.boresight_B)
         p_known = np.asarray(cfg.p_known, float)
-        score = lambda pts: -planned_nav_logdet(state.r, state.v, state.a, state.R_LtoB, state.P,
-                                                p_known, pts, **kw)
+        score = lambda pts: -planned_metric(method, state.r, state.v, state.a, state.R_LtoB, state.P,
+                                            p_known, pts, **kw)
     else:
         ctx = _metric_context(state, cfg, camera)
         score = lambda pts: -metrics.make_metric(method).reference(ctx, pts)
@@ -196,14 +195,6 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
         return float(score(np.array([[x, y, z]]))[0]) if hit else math.inf
 
     return f, lambda q, xyz, cand: score(xyz[cand]), K.OK
-
-
-def _exact_bounds(scores):
-    """``kernels.score_bounds`` of an interpreted objective: its scores, known exactly (lo = hi)."""
-    def bounds(q, xyz, cand):
-        s = np.asarray(scores(q, xyz, cand), float)
-        return s, s.copy()
-    return bounds
 
 
 # ----------------------------------------------------------------- planning
@@ -248,14 +239,15 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
         work = args[-1]
     else:
         work = np.empty(K.NQ + 9)
-    q, out = work[:K.NQ], work[K.NQ:]
+    q, out = work[:-9], work[-9:]
     if kind < 0:
         st = K.plane(state.r, state.v, q)
         if st == K.OK:
             f, scores, st = _python_objective(method, state, cfg, camera, q)
         if st == K.OK:
             core = K.interpreted(K.plan_core, golden_section=K.interpreted(K.golden_section, objective=f),
-                                 edge_pick=K.interpreted(K.edge_pick, score_bounds=_exact_bounds(scores)))
+                                 edge_pick=K.interpreted(K.edge_pick, score_points=lambda q, xyz, cand: np.asarray(
+                                     scores(q, xyz, cand), float)))
             core(q, camera.R_BtoC @ state.R_LtoB, c[K.C_KFOV], c[K.C_TOL], xyz, detected, exclude,
                  c[K.C_GRID:K.C_GRID + 5], cells, out)
         else:
@@ -279,7 +271,7 @@ def _kernel_args(kind: int, state: PlanState, setup: tuple, exclude: int, detect
     then out)."""
     xyz, c, cells = setup
     return (kind, state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected, exclude, cells,
-            np.empty(K.NQ + 9))
+            np.empty(K.work_size(c[K.C_NAV + 2])))
 
 
 def compiled_call(method: str, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
@@ -390,7 +382,7 @@ def _pick_closest(field_, cand, state, camera, rng) -> int:
 PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center,
                                 "closest": _pick_closest}
 #: methods with a search: the compiled kinds, the metrics, the planned information
-OBJECTIVE_METHODS = tuple(K.KINDS) + tuple(m for m in metrics.METRIC_NAMES if m not in K.KINDS)
+OBJECTIVE_METHODS = tuple(K.KINDS)
 
 
 def available_methods() -> tuple[str, ...]:
