@@ -120,6 +120,7 @@ def _scenario(name):
     return build_scenario(camera_scenarios(load_config()["landing"])[name])
 
 
+@pytest.mark.slow   # 3-6 s a kind (30 drawn cases, both paths)
 @pytest.mark.parametrize("name", PLANNED_METRICS)
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**31), st.sampled_from(["interior", "site-tilt"]), st.sampled_from([1, 2, 3, 5]),
