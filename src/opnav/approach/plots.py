@@ -13,13 +13,9 @@ from opnav.core import figures
 
 
 def _plain_log_ticks(ax, which: str = "y"):
-    """Log-axis tick labels as plain numbers (0.5, 1, 2, 5, 10, ...), not 10^k or 4 x 10^0."""
-    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
-
+    """Log-axis tick labels as plain numbers (:func:`opnav.core.figures.plain_log_labels`)."""
     for axis in (ax.xaxis, ax.yaxis) if which == "both" else (ax.yaxis,):
-        axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-        axis.set_major_formatter(FormatStrFormatter("%g"))
-        axis.set_minor_formatter(NullFormatter())
+        figures.plain_log_labels(axis)
 
 
 def _band(ax, x, y, color, label, ls="-"):
@@ -260,6 +256,7 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
         a2.set_yscale("log")
         a2.set_xlabel("EM map evaluations")
         a2.set_ylabel(r"$|\theta - \theta_{ML}|$ (arcsec), median")
+        _plain_log_ticks(a2)
         h1, l1 = a1.get_legend_handles_labels()
         h2, l2 = a2.get_legend_handles_labels()
         fig.legend(h1 + h2, l1 + l2, loc="outside lower center", fontsize=6, ncol=3, frameon=False)

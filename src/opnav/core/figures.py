@@ -290,3 +290,15 @@ def plain_number(x: float) -> str:
         return f"{x:,.0f}"
     digits = max(0, 2 - int(np.floor(np.log10(abs(x)))))
     return f"{x:.{digits}f}".rstrip("0").rstrip(".") if "." in f"{x:.{digits}f}" else f"{x:.{digits}f}"
+
+
+def plain_log_labels(axis) -> None:
+    """Label a log axis (``ax.xaxis`` / ``ax.yaxis``; call after plotting) with plain numbers
+    (0.5, 1, 2, 5, 10, 1,000), no 10^k: 1-2-5 steps over at most 2.5 decades, decades beyond."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    lo, hi = sorted(axis.get_view_interval())
+    decades = np.log10(hi / lo) if lo > 0 else np.inf
+    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0) if decades <= 2.5 else (1.0,)))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: plain_number(v)))
+    axis.set_minor_formatter(NullFormatter())

@@ -112,6 +112,7 @@ def fig_depth_error_map(dm: dict):
         cb.ax.minorticks_off()
         ax = axs[2]
         ax.semilogy(dm["beta_deg"], dm["curve_dr"], color="C0")
+        figures.plain_log_labels(ax.yaxis)
         for lo, hi in dm["interval_deg"]:
             ax.axvspan(lo, hi, color="0.9", zorder=0)
         ax.axvline(dm["opt_beta_deg"], color="red", ls="--", lw=0.8,
@@ -168,6 +169,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
                     ax.plot(t, env, color=figures.color(m), lw=1.0, label=_label(m),
                             ls=("-", "--", "-.", ":")[k % 4])
                 ax.set_yscale("log")
+                figures.plain_log_labels(ax.yaxis)
                 for (lab, x), ls in zip(ends.items(), (":", "--")):
                     ax.axvline(x, color="0.4", lw=0.7, ls=ls, label=f"{lab} (median, {x:.0f} s)")
                 if "last vision update" in ends:
@@ -226,6 +228,7 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             patch.set_edgecolor(c if h else "k")
             patch.set_hatch(h)
         ax.set_yscale("log")
+        figures.plain_log_labels(ax.yaxis)
         labels = []
         for m in methods:
             ev = tmg.median_evals(timing, m)
