@@ -131,3 +131,23 @@ def test_pdf_selection_drops_variants_not_studies():
     assert in_pdf("results/studies/prior/A-X5_prior.pdf", drop)       # the 'prior' study stays
     assert not in_pdf("results/studies/prior/A-X5_prior.tex", drop)   # a study's table: CSV only
     assert not in_pdf("results/approach/A-T1_table1.tex", drop)       # shown grouped
+
+
+def test_tables_are_printed_legibly():
+    """Issue 45 item 3: a wide, short table is transposed (a row per quantity); a wide, long
+    one is split into stacked parts that repeat the columns naming a row; headers wrap."""
+    import pandas as pd
+
+    from opnav.report.manuscript import legible_latex
+
+    short = pd.DataFrame({"method": ["depth", "svd"], **{f"quantity number {i} (m)": [1.0, 2.0] for i in range(12)}})
+    tex = legible_latex(short)
+    head, body = tex.split(r"\midrule")
+    assert tex.count(r"\begin{tabular}{@{}lll@{}}") == 1 and "depth & svd" in head  # methods became columns
+    assert "quantity number 0 (m) & 1 & 2" in body  # a row per quantity
+    long = pd.DataFrame({"variant": ["a"] * 20, "method": [f"m{i}" for i in range(20)],
+                         **{f"a rather long header {i}": range(20) for i in range(10)}})
+    tex = legible_latex(long, max_cols=7)
+    parts = tex.split(r"\toprule")[1:]
+    assert len(parts) == 2 and all("variant & method" in p for p in parts)  # key columns in each part
+    assert r"\begin{tabular}[b]{@{}l@{}}a rather long \\ header 0\end{tabular}" in tex  # a wrapped header

@@ -1,16 +1,17 @@
 """Figure/table floats for the manuscript, one file per paper.
 
-Tables too wide for a page (ids in opnav.report.manuscript.COMPACT_VIEWS) are shown
-through a compact view computed from their CSV, written under compact/.
+Every table is printed from its CSV, under compact/: through a compact view where one is
+defined (opnav.report.manuscript.COMPACT_VIEWS), with wrapped headers and, when much wider
+than long, transposed (opnav.report.manuscript.legible_latex).
 """
 
 import sys
 from pathlib import Path
 
 
-from opnav.report.manuscript import COMPACT_VIEWS, float_block, output_id, table1_grouped_latex
+from opnav.report.manuscript import COMPACT_VIEWS, float_block, legible_latex, output_id, table1_grouped_latex
 from opnav.core.snakeio import load_table, mock_snakemake, script_context
-from opnav.core.tables import atomic_write_text, write_table
+from opnav.core.tables import atomic_write_text
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_floats", argv=sys.argv[1:])
@@ -21,14 +22,15 @@ with script_context(snakemake) as log:
     for part in ("approach", "landing"):
         paths = []
         for p in map(Path, snakemake.input[part]):
-            view = COMPACT_VIEWS.get(output_id(p)) if p.suffix == ".tex" else None
-            if view is None:
+            if p.suffix != ".tex" or not p.with_suffix(".csv").is_file():
                 paths.append(p)
                 continue
+            # every table from its CSV: the compact view of a wide one, then legible_latex
+            view = COMPACT_VIEWS.get(output_id(p), lambda df: [("", df)])
             for suffix, df in view(load_table(p.with_suffix(".csv"))):
                 stem = f"{p.stem}_{suffix}" if suffix else p.stem
                 out = compact_dir / f"{stem}.tex"
-                write_table(df, [out])
+                atomic_write_text(out, legible_latex(df))
                 paths.append(out)
         text = float_block(paths, snakemake.params.captions_dir, relative_to=snakemake.params.paper_dir)
         atomic_write_text(snakemake.output[part], text or "% no outputs yet\n")

@@ -481,3 +481,74 @@ def run_info_tex(bench_tables: Iterable["pd.DataFrame"], cpus: int | None, machi
     else:
         text = "This build recorded no benchmark; docs/performance.md holds dated measurements of whole builds."
     return "\\newcommand{\\RunInfo}{" + prose_tex(text) + "}\n"
+
+
+# ------------------------------------------------------------ tables legible at print size
+#: a header wraps at this many characters a line; a table wider than TRANSPOSE_COLS columns
+#: with fewer than half as many rows is printed transposed (a row per quantity)
+HEADER_WRAP = 14
+TRANSPOSE_COLS = 9
+
+
+def _cell_tex(x: Any, float_format: str = "{:.4g}") -> str:
+    if isinstance(x, float):
+        return MISSING if not math.isfinite(x) else float_format.format(x)
+    if is_missing(x):
+        return MISSING
+    return latex_escape(str(x))
+
+
+def _header_tex(text: str, width: int = HEADER_WRAP) -> str:
+    """A header cell wrapped onto short lines (a narrow column for short numbers)."""
+    import textwrap
+
+    lines = textwrap.wrap(str(text), width) or [""]
+    if len(lines) == 1:
+        return latex_escape(lines[0])
+    return r"\begin{tabular}[b]{@{}l@{}}" + r" \\ ".join(latex_escape(l) for l in lines) + r"\end{tabular}"
+
+
+def legible_view(df: "pd.DataFrame") -> "pd.DataFrame":
+    """The table as printed: transposed (first column as the header row, a row per
+    quantity) when it is much wider than long, else as it is."""
+    if df.shape[1] > TRANSPOSE_COLS and len(df) * 2 < df.shape[1] and len(df):
+        first = df.columns[0]
+        t = df.set_index(first).T.reset_index()
+        t.columns = [str(first) if i == 0 else str(c) for i, c in enumerate(t.columns)]
+        return t.rename(columns={t.columns[0]: ""})
+    return df
+
+
+def _key_columns(df: "pd.DataFrame") -> int:
+    """How many leading columns name a row (text columns, at most two): repeated in every part."""
+    n = 0
+    for c in df.columns[:2]:
+        if df[c].map(lambda x: isinstance(x, str)).all():
+            n += 1
+        else:
+            break
+    return max(n, 1)
+
+
+def _tabular(v: "pd.DataFrame") -> str:
+    lines = [r"\begin{tabular}{@{}" + "l" * v.shape[1] + "@{}}", r"\toprule",
+             " & ".join(_header_tex(c) for c in v.columns) + r" \\", r"\midrule"]
+    for row in v.itertuples(index=False):
+        lines.append(" & ".join(_cell_tex(x) for x in row) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}"]
+    return "\n".join(lines)
+
+
+def legible_latex(df: "pd.DataFrame", max_cols: int = 7) -> str:
+    """A booktabs tabular for the manuscript that stays legible at print size: headers wrapped
+    onto short lines, wide-and-short tables transposed (:func:`legible_view`), and a table
+    still wider than ``max_cols`` columns split into stacked parts that repeat the columns
+    naming a row."""
+    v = legible_view(df)
+    if v.shape[1] <= max_cols:
+        return _tabular(v) + "\n"
+    k = _key_columns(v)
+    rest = list(v.columns[k:])
+    step = max_cols - k
+    parts = [_tabular(v[list(v.columns[:k]) + rest[i:i + step]]) for i in range(0, len(rest), step)]
+    return (r"\begin{tabular}{@{}l@{}}" + "\n" + "\\\\[6pt]\n".join(parts) + "\n" + r"\end{tabular}" + "\n")
