@@ -100,15 +100,16 @@ rule approach_crlb:
 
 
 rule approach_stars:
-    """The stars variant (beyond the paper): per stars.study_per_image, the bound of (tx, ty, tz)
-    against the data, and the EM-EKF and augmented-EKF estimates."""
+    """The stars variant (beyond the paper, real stars): the bound of (tx, ty, tz) and the
+    estimates against stars per image, attitude knowledge and magnitude limit, and the attitude
+    knowledge at which the bound reaches the target."""
     input:
         A_SRC + src("approach/alternatives.py", "approach/batch_ml.py"),
         kernels=kernels("approach"),
     output:
         f"{A_WORK}/stars.pkl",
     params:
-        approach=cfg("approach", *A_EM, "growing", "alternatives"),
+        approach=cfg("approach", *A_EM, "growing", "alternatives", "accuracy_target_arcsec"),
     log:
         f"{APPROACH}/logs/stars.log",
     benchmark:

@@ -209,12 +209,14 @@ def time_em(setup: Setup | dict, variant: str, case: cases.Case, seed_indices, g
 
 
 def stars_study(setup: Setup | dict, log=None) -> list[dict]:
-    """The ``stars`` variant (beyond the paper) with ``stars.study_per_image`` stars per image,
-    headline case, ``n_seeds`` seeds: per star count, the bound of (tx, ty, tz) after all the data
-    (with Q and Q = 0) and its curve against the data (samples after N0; the report reads the
-    data to reach the claimed accuracy from it), beside the estimates of the
-    EM-EKF (growing windows with SQUAREM, and the paper's sliding plain EM) and of the
-    augmented EKF on the same measurements (arcsec)."""
+    """The ``stars`` variant (beyond the paper), headline case, ``n_seeds`` seeds, one row per
+    swept value (``sweep``): stars per image (``stars.study_per_image``: the bound of (tx, ty, tz)
+    after all the data with Q and Q = 0 and its curve against the data, beside the EM-EKF with
+    growing windows and SQUAREM, the paper's sliding plain EM and the augmented EKF), the
+    per-image attitude knowledge (``stars.study_attitude_sigma_arcsec``) and the magnitude limit
+    (``stars.study_mag_limit``) (the bound and the growing-window SQUAREM EM-EKF). Every row also
+    holds the stars-only bound (the star images' information alone) and the stars per image
+    along the arc."""
     from dataclasses import replace
 
     from .pipeline import bound_curves
@@ -222,29 +224,79 @@ def stars_study(setup: Setup | dict, log=None) -> list[dict]:
     setup = Setup.of(setup)
     case = cases.headline_case(setup)
     seeds = range(setup.n_seeds)
+    st0 = setup.stars
+    plan = ([("per_image", float(m), replace(st0, per_image=int(m)), True) for m in st0.study_per_image]
+            + [("attitude_sigma_arcsec", float(a), replace(st0, attitude_sigma_arcsec=float(a)), False)
+               for a in st0.study_attitude_sigma_arcsec]
+            + [("mag_limit", float(g), replace(st0, mag_limit=float(g)), False) for g in st0.study_mag_limit])
     out = []
-    for m in setup.stars.study_per_image:
-        s_m = setup.replace(stars=replace(setup.stars, per_image=int(m)))
+    for sweep, value, st, full in plan:
+        s_m = setup.replace(stars=st)
         geo = sc.build_geometry(s_m, "stars")
         Rvar = geo.measurement_variance(case.sigma3_px)
         c, c0 = bound_curves(s_m, geo, [(Rvar, case.truth_arcsec, False), (Rvar, case.truth_arcsec, True)], "stars")
         d = min(s_m.segments.data_samples, len(c) - 1)
-        row = {"per_image": int(m), "every_K": s_m.stars.every_K, "images": int(np.sum(geo.stars.idx <= geo.t.size - 1)),
+        n_img = int(np.sum(geo.stars.idx <= geo.t.size - 1))
+        J = geo.stars.info_per_sample(geo.t.size - 1).sum(0)
+        ns = geo.stars.n_stars
+        row = {"sweep": sweep, "value": value, "per_image": int(st.per_image), "every_K": st.every_K,
+               "attitude_sigma_arcsec": st.attitude_sigma_arcsec, "mode_drift_arcsec": st.mode_drift_arcsec,
+               "mag_limit": st.mag_limit, "images": n_img,
+               "stars_per_image": {"min": int(ns.min()), "median": float(np.median(ns)), "max": int(ns.max())},
+               "floor_arcsec": float(np.hypot(st.attitude_sigma_arcsec / np.sqrt(n_img), st.mode_drift_arcsec)),
+               "crlb_stars_only_arcsec": sc.arcsec(np.sqrt(np.diag(np.linalg.pinv(J)))),
                "truth_arcsec": np.asarray(case.truth_arcsec, float), "total_samples": int(d),
                "crlb_all_arcsec": c[d], "crlb_all_q0_arcsec": c0[d],
                "crlb_curve_arcsec": c, "estimators": {}}
-        for name, st, method in (("em_growing_squarem", s_m.scheme("growing"), "squarem"),
-                                 ("em_plain", s_m, "plain")):
-            r = cases.run_case(st, "stars", case, seeds, geo=geo, method=method)
+        ems = (("em_growing_squarem", s_m.scheme("growing"), "squarem"),) + ((("em_plain", s_m, "plain"),) if full else ())
+        for name, sx, method in ems:
+            r = cases.run_case(sx, "stars", case, seeds, geo=geo, method=method)
             row["estimators"][name] = {"theta_final_arcsec": r["theta_final_arcsec"], "label": r["label"],
+                                       "theta_ml_arcsec": r["theta_ml_arcsec"],
                                        "data_to_converge": r["data_to_converge"]}
-        a = run_case_alternatives(s_m, "stars", case, seeds, geo, methods=("augmented",))["methods"]["augmented"]
-        row["estimators"]["augmented"] = {"theta_final_arcsec": a["theta_final_arcsec"],
-                                          "sigma_final_arcsec": a["sigma_final_arcsec"],
-                                          "data_to_converge": a["data_to_converge"]}
+        if full:
+            a = run_case_alternatives(s_m, "stars", case, seeds, geo, methods=("augmented",))["methods"]["augmented"]
+            row["estimators"]["augmented"] = {"theta_final_arcsec": a["theta_final_arcsec"],
+                                              "sigma_final_arcsec": a["sigma_final_arcsec"],
+                                              "data_to_converge": a["data_to_converge"]}
         if log:
-            log.info("stars %d per image: bound %s arcsec, EM growing %s, augmented %s", m, np.round(c[d], 3),
-                     np.round(row["estimators"]["em_growing_squarem"]["theta_final_arcsec"].mean(0), 3),
-                     np.round(a["theta_final_arcsec"].mean(0), 3))
+            log.info("stars %s = %g: %s stars per image, bound %s arcsec (stars only %s), EM growing %s", sweep, value,
+                     row["stars_per_image"], np.round(c[d], 3), np.round(row["crlb_stars_only_arcsec"], 3),
+                     np.round(row["estimators"]["em_growing_squarem"]["theta_final_arcsec"].mean(0), 3))
         out.append(row)
+    thr = attitude_threshold(setup, setup.accuracy_target_arcsec)
+    for row in out:
+        row["attitude_threshold_arcsec"] = thr
     return out
+
+
+def attitude_threshold(setup: Setup | dict, target_arcsec: float, hi_arcsec: float = 3600.0,
+                       iterations: int = 30) -> float:
+    """The per-image attitude knowledge (1-sigma, arcsec) at which the bound of tx and ty after all
+    the data of the ``stars`` variant (configured stars, drift and magnitude limit) reaches
+    ``target_arcsec``: bisection (the bound grows with it); 0 if not even perfect knowledge reaches
+    it, ``hi_arcsec`` if any knowledge up to it does."""
+    from dataclasses import replace
+
+    from .pipeline import bound_curves
+
+    setup = Setup.of(setup)
+    case = cases.headline_case(setup)
+    geo0 = sc.build_geometry(setup, "stars")
+    Rvar = geo0.measurement_variance(case.sigma3_px)
+
+    def worst(a):
+        s = setup.replace(stars=replace(setup.stars, attitude_sigma_arcsec=float(a)))
+        g = sc.build_geometry(s, "stars")
+        c = bound_curves(s, g, [(Rvar, case.truth_arcsec, False)], "stars")[0]
+        return float(c[min(s.segments.data_samples, len(c) - 1), :2].max())
+
+    if worst(0.0) > target_arcsec:
+        return 0.0
+    if worst(hi_arcsec) <= target_arcsec:
+        return hi_arcsec
+    lo, hi = 0.0, hi_arcsec
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if worst(mid) <= target_arcsec else (lo, mid)
+    return lo

@@ -25,8 +25,10 @@ Scenario variants (SPEC A.3b)
                          the filter's ``P_N0``; information the measurements do
                          not hold.
     ``stars``            beyond the paper: as prior (no roll), plus star-field images every
-                         ``stars.every_K`` samples (:mod:`opnav.approach.stars`), which
-                         measure the camera attitude directly.
+                         ``stars.every_K`` samples (:mod:`opnav.approach.stars`: Hipparcos
+                         stars, magnitude-dependent centroid noise, per-image attitude
+                         knowledge and a star/Mars mode drift), which measure the camera
+                         attitude directly.
 Units: km, km/s, s, rad.
 """
 
@@ -62,7 +64,7 @@ class Geometry:
     variant: str
     ifov_arcsec: float = 10.0  # pixel size of the camera the variances are made for
     stars: object = None  # stars.StarField (``stars`` variant), else None
-    star_sigma_rad: float = 0.0  # star centroid 1-sigma, rad
+    star_sigma_rad: float = 0.0  # star centroid 1-sigma at stars.sigma_ref_mag, rad
 
     @property
     def dx_true(self) -> np.ndarray:
@@ -88,7 +90,7 @@ class Geometry:
 
         rngs = [np.random.default_rng(np.random.SeedSequence([base_seed, case_index, int(i), 1]))
                 for i in seed_indices]
-        return stars.simulate(self.stars, theta_true_rad, rngs, self.star_sigma_rad)
+        return stars.simulate(self.stars, theta_true_rad, rngs)
 
     def measurement_variance(self, sigma3_px) -> np.ndarray:
         """Rvar (n+1, 3), km^2, from the pinhole camera at the reference range (paper eq. 3-4)."""
@@ -150,10 +152,15 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
         from . import stars
 
         st = setup.stars
-        sig = stars.sigma_rad(st.sigma_px, cam.ifov_arcsec)
+        sig = stars.sigma_rad(st.sigma_px, cam.ifov_arcsec)  # at sigma_ref_mag
+
+        def sigma_of_mag(m):
+            return stars.sigma_rad(stars.centroid_sigma_px(m, st.sigma_px, st.sigma_ref_mag, st.sigma_floor_px),
+                                   cam.ifov_arcsec)
+
         field = stars.star_field(C, setup.segments.N0, st.every_K, st.per_image, st.mag_limit, st.slew_deg,
-                                 0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC, sig,
-                                 stars.catalogue(st.catalogue_seed, st.catalogue_size))
+                                 0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC, sigma_of_mag, stars.catalogue(),
+                                 st.attitude_sigma_arcsec * ARCSEC, st.mode_drift_arcsec * ARCSEC)
     return Geometry(t, X_true, X_ref, X_mars, Phi, C, u_ref, u_true,
                     np.linalg.norm(u_ref, axis=1), setup.Q, setup.prior_sigma.P0, e_fixed, variant,
                     cam.ifov_arcsec, field, sig)

@@ -151,18 +151,23 @@ class Roll(_Section):
 
 @dataclass(frozen=True)
 class Stars(_Section):
-    """``stars``: star images every ``every_K`` samples, ``per_image`` brightest stars up to
-    ``mag_limit``, the star-mode slew (deg), centroid 1-sigma (px), the synthetic catalogue's
-    size and seed, and the stars study's stars per image."""
+    """``stars``: star images every ``every_K`` samples, up to ``per_image`` brightest Hipparcos
+    stars to ``mag_limit``, the star-mode slew (deg), the centroid 1-sigma (px) at
+    ``sigma_ref_mag`` and its floor (px), the per-image attitude-knowledge 1-sigma and the
+    star-mode / Mars-mode drift 1-sigma (arcsec per axis), and the stars study's sweeps."""
 
     every_K: int
     per_image: int
     mag_limit: float
     slew_deg: float
     sigma_px: float
-    catalogue_size: int
-    catalogue_seed: int
+    sigma_ref_mag: float
+    sigma_floor_px: float
+    attitude_sigma_arcsec: float
+    mode_drift_arcsec: float
     study_per_image: tuple
+    study_attitude_sigma_arcsec: tuple
+    study_mag_limit: tuple
 
 
 @dataclass(frozen=True)

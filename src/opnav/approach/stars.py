@@ -22,19 +22,42 @@ Description
     to the EM M-step's normal equations, to the CRLB's theta block and to the augmented EKF.
 
 Catalogue
-    Synthetic, drawn once from ``stars.catalogue_seed`` (no star catalogue ships with the
-    installed packages): ``stars.catalogue_size`` directions uniform on the sphere, magnitudes
-    from the differential count law ``dN/dm ~ 10^(0.46 m)`` between 0 and 10 (Bahcall &
-    Soneira's slope near the galactic average), so about 12 % of the stars are brighter than
-    magnitude 8: with the default 350 000 stars, about 41 000, the real sky's count to V = 8,
-    and about 5 per square degree to magnitude 9.5 (some 40 in a 2.8 deg field). Only
-    directions and magnitudes matter here (no colours, no proper motion).
+    Real stars: the 42,212 Hipparcos stars brighter than magnitude 8.03 vendored in
+    ``opnav/data/hipparcos_mag8.npz`` (from cedar-solve 0.5.1's tetra3 database, Apache-2.0;
+    provenance and licence beside it), ICRS at epoch 2024, rotated here into the ecliptic
+    J2000 frame of the approach dynamics (obliquity 84381.406 arcsec, IAU 2006). About one
+    star per square degree to magnitude 8: the 2.84 deg field holds a handful, so an image
+    holds ``min(per_image, stars in the field)`` stars (the rest of its rows carry no
+    information: zero sensitivity).
+
+Noise and attitude knowledge (issue 44: what paper A objects to)
+    * Centroid noise grows with magnitude (photon-limited: 1/SNR ~ 10^(0.2 m)) above a floor:
+      ``sigma(m) = hypot(sigma_floor_px, sigma_px 10^(0.2 (m - sigma_ref_mag)))`` px per axis.
+    * Each star image's attitude is known only to ``attitude_sigma_arcsec`` (1-sigma per axis,
+      independent per image): the camera may be the only sensor and its star and Mars modes
+      are not synchronised (paper A's objection), so the attitude of a star image relative to
+      the Mars images comes from propagation across the slew. And a constant ``mode_drift_arcsec``
+      (1-sigma per axis, drawn once per run) separates the star mode from the Mars mode
+      (thermo-elastic and slew-dependent: what the stars calibrate is the star-mode camera).
+      Both rotate every star of an image together, like theta: the star data measure
+      ``theta + drift + delta_i``, so the bound has a floor near
+      ``hypot(attitude / sqrt(images), drift)`` whatever the number of stars.
+    * The estimators know these statistics: the joint covariance of all star rows
+      ``R = diag(sigma^2) + G_i s_a^2 G_i^T (per image) + G s_d^2 G^T (all images)`` is whitened
+      by its Cholesky factor ``L`` (block lower-triangular, so each image's whitened rows
+      depend on it and earlier images only): ``G~ = L^-1 G``, ``y~ = L^-1 y``, weights 1. The
+      whitened images are independent, and every consumer (CRLB, EM M-step, augmented EKF)
+      adds them image by image as before; exact for all-data and growing windows; a sliding
+      window that starts after an image uses the later images' whitened rows, which also hold
+      what the drift shares with earlier images (an approximation there when the drift is on).
 Units: rad (directions, theta), px and arcsec in the config.
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from importlib import resources
 
 import numpy as np
 
@@ -43,27 +66,43 @@ from opnav.core.rotations import skew
 from .camera import misalignment_exact, rot_x
 from .dynamics import ARCSEC
 
-MAG_RANGE = (0.0, 10.0)
-COUNT_SLOPE = 0.46  # d log10 N / dm
+CATALOGUE_FILE = "hipparcos_mag8.npz"
+OBLIQUITY_J2000_RAD = 84381.406 * ARCSEC  # IAU 2006 mean obliquity at J2000
+NO_STAR_SIGMA_RAD = 1.0  # rows of an image with fewer stars than per_image: no information (G = 0)
 
 
 @dataclass(frozen=True)
 class StarField:
     """The star images of an arc (no per-seed data): sample index of each image (I,), the
     directions in the calibrated camera frame (I, m, 3), the focal-plane coordinates
-    without misalignment ``p0`` (I, 2m), their sensitivity to theta at 0, ``G`` (I, 2m, 3),
-    and the weights ``w = 1 / sigma^2`` (rad^-2, (I, 2m)). Every image holds m stars."""
+    without misalignment ``p0`` (I, 2m), the *whitened* sensitivity to theta ``G`` (I, 2m, 3)
+    and weights ``w`` (ones; module docstring), the raw sensitivity ``G_raw``, the centroid
+    1-sigma of each row ``sigma`` (rad, (I, 2m)), the magnitudes ``mag`` (I, m; NaN: no
+    star), the HIP numbers ``hip`` (I, m; 0: no star), the stars in each image ``n_stars``
+    (I,), the whitening factor ``L`` (2mI, 2mI) and the attitude and drift 1-sigmas (rad).
+    Every image has m rows pairs; those beyond ``n_stars`` carry no information."""
 
     idx: np.ndarray
     v: np.ndarray
     p0: np.ndarray
     G: np.ndarray
     w: np.ndarray
+    G_raw: np.ndarray = None
+    sigma: np.ndarray = None
+    mag: np.ndarray = None
+    hip: np.ndarray = None
+    n_stars: np.ndarray = None
+    L: np.ndarray = None
+    attitude_sigma_rad: float = 0.0
+    drift_sigma_rad: float = 0.0
 
     def select(self, a: int, b: int) -> "StarField":
         """The images of samples a+1..b, with indices relative to a (a window's)."""
         k = (self.idx > a) & (self.idx <= b)
-        return StarField(self.idx[k] - a, self.v[k], self.p0[k], self.G[k], self.w[k])
+        sub = (lambda x: None if x is None else x[k])
+        return StarField(self.idx[k] - a, self.v[k], self.p0[k], self.G[k], self.w[k], sub(self.G_raw),
+                         sub(self.sigma), sub(self.mag), sub(self.hip), sub(self.n_stars), None,
+                         self.attitude_sigma_rad, self.drift_sigma_rad)
 
     def info_per_sample(self, n: int) -> np.ndarray:
         """Information on theta each sample 0..n adds, (n+1, 3, 3), rad^-2 (zero without image)."""
@@ -75,16 +114,29 @@ class StarField:
         return out
 
 
-def catalogue(seed: int, size: int) -> tuple[np.ndarray, np.ndarray]:
-    """Synthetic star catalogue (module docstring): unit directions (size, 3), magnitudes (size,)."""
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 0x57A2]))
-    d = rng.standard_normal((size, 3))
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    lo, hi = MAG_RANGE
-    u = rng.random(size)
-    a = np.log(10.0) * COUNT_SLOPE
-    mag = np.log(np.exp(a * lo) + u * (np.exp(a * hi) - np.exp(a * lo))) / a  # inverse CDF of 10^(0.46 m)
-    return d, mag
+def catalogue() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The vendored Hipparcos catalogue (module docstring): unit directions in the ecliptic J2000
+    frame (N, 3), visual magnitudes (N,) and HIP numbers (N,)."""
+    return _catalogue()
+
+
+@functools.lru_cache(maxsize=1)
+def _catalogue():
+    with resources.files("opnav").joinpath("data", CATALOGUE_FILE).open("rb") as f:
+        d = np.load(f)
+        ra, dec = d["ra_rad"].astype(float), d["dec_rad"].astype(float)
+        mag, hip = d["vmag"].astype(float), d["hip"].astype(np.int64)
+    eq = np.stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], axis=1)
+    ecl = eq @ rot_x(OBLIQUITY_J2000_RAD).T  # equatorial -> ecliptic: rotate the frame about x by epsilon
+    for a in (ecl, mag, hip):
+        a.setflags(write=False)
+    return ecl, mag, hip
+
+
+def centroid_sigma_px(mag: np.ndarray, sigma_px: float, ref_mag: float, floor_px: float) -> np.ndarray:
+    """Centroid 1-sigma per focal-plane axis, px, of stars of magnitude ``mag`` (module docstring):
+    ``hypot(floor_px, sigma_px 10^(0.2 (mag - ref_mag)))``."""
+    return np.hypot(floor_px, sigma_px * 10.0 ** (0.2 * (np.asarray(mag, float) - ref_mag)))
 
 
 def focal_plane(d: np.ndarray) -> np.ndarray:
@@ -103,44 +155,79 @@ def sensitivity(v: np.ndarray) -> np.ndarray:
 
 
 def star_field(C: np.ndarray, N0: int, every_K: int, per_image: int, mag_limit: float, slew_deg: float,
-               half_fov_rad: float, sigma_rad: float, cat: tuple[np.ndarray, np.ndarray]) -> StarField:
+               half_fov_rad: float, sigma_of_mag, cat, attitude_sigma_rad: float = 0.0,
+               drift_sigma_rad: float = 0.0) -> StarField:
     """The star images of an arc whose Mars-tracking attitude is ``C`` (n+1, 3, 3): one every
-    ``every_K`` samples after ``N0``, each with the ``per_image`` brightest catalogue stars
-    brighter than ``mag_limit`` in the slewed camera's field (``ValueError`` if a field has fewer, or
-    if the arc holds no image)."""
-    dirs, mag = cat
+    ``every_K`` samples after ``N0``, each with up to ``per_image`` of the brightest catalogue
+    stars brighter than ``mag_limit`` in the slewed camera's field (``ValueError`` if a field has
+    none, or if the arc holds no image). ``sigma_of_mag``: centroid 1-sigma (rad) of a magnitude
+    (:func:`centroid_sigma_px` times the IFOV); ``cat``: :func:`catalogue`'s directions,
+    magnitudes and HIP numbers; the attitude and drift 1-sigmas per axis, rad."""
+    dirs, mag, hip = cat
     bright = mag <= mag_limit
-    dirs, mag = dirs[bright], mag[bright]
+    dirs, mag, hip = dirs[bright], mag[bright], hip[bright]
     n = C.shape[0] - 1
     idx = np.arange(N0 + every_K, n + 1, every_K)
     if idx.size == 0:
         raise ValueError(f"approach.stars.every_K: the first star image (sample N0 + every_K = {N0 + every_K}) "
                          f"lies beyond the arc's last sample {n}; lower every_K or lengthen the arc")
     R = rot_x(np.deg2rad(slew_deg))
-    vs = []
-    for k in idx:
+    I, m = idx.size, per_image
+    v = np.zeros((I, m, 3))
+    v[..., 2] = 1.0  # rows without a star: the boresight, zero weight below
+    mags = np.full((I, m), np.nan)
+    hips = np.zeros((I, m), dtype=np.int64)
+    n_stars = np.zeros(I, dtype=int)
+    for i, k in enumerate(idx):
         A = R @ C[k]
-        v = dirs @ A.T
-        p = focal_plane(np.where(v[:, 2:3] > 0, v, np.nan))
+        vk = dirs @ A.T
+        p = focal_plane(np.where(vk[:, 2:3] > 0, vk, np.nan))
         inside = np.nonzero(np.all(np.abs(p) <= np.tan(half_fov_rad), axis=1))[0]
-        if inside.size < per_image:
-            raise ValueError(f"approach.stars: only {inside.size} stars brighter than magnitude {mag_limit:g} in the "
-                             f"field of image at sample {k}; lower stars.per_image or raise mag_limit/catalogue_size")
-        pick = inside[np.argsort(mag[inside], kind="stable")[:per_image]]
-        vs.append(v[pick])
-    v = np.stack(vs) if vs else np.zeros((0, per_image, 3))
-    p0 = focal_plane(v).reshape(len(idx), -1)
-    G = sensitivity(v).reshape(len(idx), -1, 3)
-    w = np.full(p0.shape, 1.0 / sigma_rad**2)
-    return StarField(idx, v, p0, G, w)
+        if inside.size == 0:
+            raise ValueError(f"approach.stars: no star brighter than magnitude {mag_limit:g} in the field of the "
+                             f"image at sample {k}; raise stars.mag_limit (catalogue complete to 8.0)")
+        pick = inside[np.lexsort((hip[inside], mag[inside]))[:m]]  # brightest; ties by HIP number
+        j = pick.size
+        v[i, :j], mags[i, :j], hips[i, :j], n_stars[i] = vk[pick], mag[pick], hip[pick], j
+    real = np.repeat(~np.isnan(mags), 2, axis=1)  # (I, 2m)
+    p0 = focal_plane(v).reshape(I, -1)
+    G_raw = np.where(real[..., None], sensitivity(v).reshape(I, -1, 3), 0.0)
+    sig_star = np.broadcast_to(np.asarray(sigma_of_mag(np.nan_to_num(mags, nan=0.0)), float), mags.shape)
+    sig = np.where(real, np.repeat(sig_star, 2, axis=1), NO_STAR_SIGMA_RAD)
+    # joint covariance of all rows, whitened (module docstring)
+    D = I * 2 * m
+    Gf = G_raw.reshape(D, 3)
+    Rall = np.diag(sig.reshape(D) ** 2) + drift_sigma_rad**2 * Gf @ Gf.T
+    for i in range(I):
+        blk = slice(i * 2 * m, (i + 1) * 2 * m)
+        Rall[blk, blk] += attitude_sigma_rad**2 * G_raw[i] @ G_raw[i].T
+    L = np.linalg.cholesky(Rall)
+    from scipy.linalg import solve_triangular
+
+    G = solve_triangular(L, Gf, lower=True).reshape(I, 2 * m, 3)
+    return StarField(idx, v, p0, G, np.ones((I, 2 * m)), G_raw, sig, mags, hips, n_stars, L,
+                     float(attitude_sigma_rad), float(drift_sigma_rad))
 
 
-def simulate(field: StarField, theta_true_rad: np.ndarray, rngs: list[np.random.Generator],
-             sigma_rad: float) -> np.ndarray:
-    """Star measurements ``y = p(A_exact(theta) v) - p0 + noise`` (S, I, 2m), rad."""
+def simulate(field: StarField, theta_true_rad: np.ndarray, rngs: list[np.random.Generator]) -> np.ndarray:
+    """Whitened star measurements ``L^-1 y`` (S, I, 2m), rad: ``y = p(A_exact(theta) A_exact(e_i) v)
+    - p0 + noise`` per image i, with the attitude error ``e_i = drift + delta_i`` of each run
+    (drift drawn once, then delta_i per image, then the centroid noise, from the run's stream);
+    rows without a star hold noise only."""
+    from scipy.linalg import solve_triangular
+
     A = misalignment_exact(theta_true_rad)
-    clean = focal_plane(field.v @ A.T).reshape(field.p0.shape) - field.p0
-    return np.stack([clean + sigma_rad * g.standard_normal(clean.shape) for g in rngs])
+    I, m2 = field.p0.shape
+    real = np.repeat(field.n_stars[:, None] > np.arange(m2 // 2)[None], 2, axis=1)
+    out = []
+    for g in rngs:
+        drift = field.drift_sigma_rad * g.standard_normal(3)
+        delta = field.attitude_sigma_rad * g.standard_normal((I, 3))
+        clean = np.stack([focal_plane(field.v[i] @ (A @ misalignment_exact(drift + delta[i])).T).reshape(-1)
+                          for i in range(I)]) - field.p0
+        y = np.where(real, clean, 0.0) + field.sigma * g.standard_normal((I, m2))
+        out.append(solve_triangular(field.L, y.reshape(-1), lower=True).reshape(I, m2))
+    return np.stack(out)
 
 
 def normal_equations(field: StarField, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -166,6 +253,6 @@ def theta_information_update(P: np.ndarray, J: np.ndarray, cols=slice(6, 9)) -> 
     return 0.5 * (out + np.swapaxes(out, -1, -2))
 
 
-def sigma_rad(sigma_px: float, ifov_arcsec: float) -> float:
+def sigma_rad(sigma_px, ifov_arcsec: float):
     """Star centroid noise, rad, from the 1-sigma pixel error and the IFOV."""
-    return sigma_px * ifov_arcsec * ARCSEC
+    return np.asarray(sigma_px, float) * ifov_arcsec * ARCSEC
