@@ -247,7 +247,7 @@ NEW_CONFIGS = [
     ("cross-key", "approach: {camera: {ifov_arcsec: 700}}", "'approach.camera.ifov_arcsec': 700 arcsec x 1024 px"),
     ("cross-key", "approach: {stars: {every_K: 100000}}",
      "'approach.stars.every_K': 100000: the first star image"),
-    ("cross-key", "approach: {stars: {per_image: 200, catalogue_size: 100}}", "'approach.stars.per_image': 200 stars"),
+    ("cross-key", "approach: {stars: {sigma_floor_px: 5.0}}", "'approach.stars.sigma_floor_px': 5 px exceeds"),
     ("cross-key", "studies: {big: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}, runs: 100000, "
                   "runs_per_job: 100000}}", "'studies.big.runs' (study 'big'): 100000 runs x 198 filter steps"),
     # user-chosen names: file names and rule names

@@ -67,6 +67,7 @@ from .camera import misalignment_exact, rot_x
 from .dynamics import ARCSEC
 
 CATALOGUE_FILE = "hipparcos_mag8.npz"
+MAG_RANGE = (-2, 8.03)  # magnitude limits a config may ask for: brighter than Sirius (-1.44) .. the catalogue's end
 OBLIQUITY_J2000_RAD = 84381.406 * ARCSEC  # IAU 2006 mean obliquity at J2000
 NO_STAR_SIGMA_RAD = 1.0  # rows of an image with fewer stars than per_image: no information (G = 0)
 

@@ -166,9 +166,10 @@ def approach_rules(a: dict, *, workflow: bool = False) -> list[str]:
         out.append(k("stars.every_K") + f"{st['every_K']}: the first star image (sample N0 + every_K = "
                    f"{s['N0'] + st['every_K']}) lies beyond the arc's last sample ({n} = N0 + L*N); the stars "
                    "variant (in approach.variants) would have no image")
-    if st["per_image"] > st["catalogue_size"]:
-        out.append(k("stars.per_image") + f"{st['per_image']} stars per image exceed the catalogue's "
-                   f"{st['catalogue_size']} (approach.stars.catalogue_size)")
+    if st["sigma_floor_px"] > st["sigma_px"] * 10.0 ** (0.2 * (st["mag_limit"] - st["sigma_ref_mag"])):
+        out.append(k("stars.sigma_floor_px") + f"{st['sigma_floor_px']:g} px exceeds the centroid 1-sigma of the "
+                   f"faintest star imaged (sigma_px x 10^(0.2 (mag_limit - sigma_ref_mag))): the magnitude model "
+                   "would not act; lower it or raise approach.stars.sigma_px")
     return out
 
 
