@@ -297,6 +297,11 @@ def test_timing_depends_on_the_svd_implementation_and_says_what_it_would_take():
     r = by_id(rows_b(summary_b(interior={"red": 8.0, "red_alt": 80.0}), PUB["paper_b"]))["B-C4"]
     assert r["verdict"] == C.DEPENDS and r["named"] == "which camera is flown"
     assert r["would_take"] == "timing on the compiled implementation in the site-tilt camera"
+    # a timing whose spread is wider than half the published value tests nothing
+    s = summary_b(**both(red=-19.5))
+    s["scenarios"]["interior"]["methods"]["depth"]["time_reduction_vs_svd_pct_std"] = 2743.0
+    r = by_id(rows_b(s, PUB["paper_b"]))["B-C4"]
+    assert r["verdict"] == C.NOT_TESTED and "band_too_wide: compiled implementation, interior camera" in r["flags"]
     r = by_id(rows_b(summary_b(**both(red=8.0)), PUB["paper_b"]))["B-C4"]
     assert r["verdict"] == C.NOT_REPRODUCED and r["would_take"] == "" and "8 % less" in r["cause"]
 
