@@ -1,5 +1,6 @@
 """Rerun the bad-input battery of tests/test_bad_input.py as a user meets it, and count
-the outcomes by category (issue 33's first paragraph).
+the outcomes by category (issue 33's first paragraph; issue 46's classes: NEW_CONFIGS,
+YAML_TRAPS, NEW_CLI).
 
 Every bad overlay goes through `snakemake -n --configfile config/quick.yaml FILE` (the
 pipeline's own path: Snakefile, rule files, DAG), every bad config file through both
@@ -74,7 +75,7 @@ def main(argv=None) -> int:
         tmp = Path(tmp)
         smk = [sys.executable, "-m", "snakemake", "-n", "--cores", "1", "--configfile", "config/quick.yaml"]
         if args.only in (None, "configs"):
-            for i, (overlay, key) in enumerate(t.BAD_CONFIGS):
+            for i, (overlay, key) in enumerate([*t.BAD_CONFIGS, *((o, k) for _, o, k in t.NEW_CONFIGS)]):
                 if args.k not in overlay:
                     continue
                 f = tmp / f"bad{i}.yaml"
@@ -82,7 +83,7 @@ def main(argv=None) -> int:
                 rc, out, dt = _run([*smk, str(f)], REPO)
                 rows.append(("config", overlay[:70], classify(rc, out, key), dt, out))
         if args.only in (None, "files"):
-            for i, (content, expected) in enumerate(t.BAD_FILES):
+            for i, (content, expected) in enumerate([*t.BAD_FILES, *t.YAML_TRAPS]):
                 if args.k not in str(content):
                     continue
                 f = tmp / f"file{i}.yaml"
@@ -99,9 +100,10 @@ def main(argv=None) -> int:
                                ("tilt.yaml", "landing: {camera: {tilt_deg: 0}}\n"),
                                ("dup.yaml", "landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n"),
                                ("study.yaml", "studies: {s: {paper: landing, vary: "
-                                              "{landing.camera.fov_deg: [45, 45.0]}}}\n")):
+                                              "{landing.camera.fov_deg: [45, 45.0]}}}\n"),
+                               ("trap.yaml", "landing: {mc: {base_seed: 010}}\n"), ("yte.yaml", "__use_yte__: true\n")):
                 (tmp / name).write_text(text)
-            for argv_, named in t.BAD_CLI:
+            for argv_, named in [*t.BAD_CLI, *t.NEW_CLI]:
                 if args.k not in " ".join(argv_):
                     continue
                 argv_ = [a.replace("{tmp}", str(tmp)) for a in argv_]

@@ -230,6 +230,8 @@ NEW_CONFIGS = [
     ("ranges", "limits: {max_study_values: 100000000000}", "'limits.max_study_values'"),
     # cross-key rules
     ("cross-key", "landing: {tuning: {base_seed: 20230410}}", "'landing.tuning.base_seed': 20230410 equals"),
+    ("cross-key", "landing: {tuning: {base_seed: 21230413}}\nreplication: {enabled: true, seed_offset: 1000003}",
+     "'landing.tuning.base_seed': 21230413 equals landing.mc.base_seed + replication.seed_offset"),
     ("cross-key", "landing: {filter: {update_altitude_margin_m: 10000}}",
      "'landing.filter.update_altitude_margin_m': min_update_altitude_m + update_altitude_margin_m"),
     ("cross-key", "landing: {filter: {min_update_altitude_m: 6000, update_altitude_margin_m: 600}}",
@@ -853,3 +855,31 @@ def test_battery_counts():
     counts.update(cls for cls, _, _ in NEW_CONFIGS)
     print("\n" + "\n".join(f"{n:4d}  {k}" for k, n in counts.items()) + f"\n{sum(counts.values()):4d}  total")
     assert sum(counts.values()) >= 150
+
+
+# (overlay file content, text the Snakefile's refusal must hold)
+SNAKEMAKE_CASES = [
+    ("approach:\n  base_seed: 020200704\n", "line 2: key 'approach.base_seed': 020200704 has a leading zero"),
+    ("__use_yte__: true\napproach: {dt_s: 0.5}\n", "line 1: key '__use_yte__': YTE templates are refused"),
+    ("landing: {tuning: {method: oracle}}\n", "invalid config key 'landing.tuning.method': 'oracle'"),
+    ("studies: {runs: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}\n",
+     "invalid config key 'studies.runs': the name makes the rule study_runs"),
+    ("results_dir: /proc/opnav\n", "invalid config key 'results_dir': '/proc/opnav' is under /proc"),
+]
+
+
+@pytest.mark.slow
+def test_snakemake_dry_run_refuses_round_three_input(tmp_path):
+    """End to end through `snakemake -n`: the same refusals as in process, one line after
+    'ConfigError (no job was run):', no traceback, no rule error, nothing written."""
+    from conftest import copy_workflow, run_snakemake
+
+    (tmp_path / "wf").mkdir()
+    wd = copy_workflow(tmp_path / "wf")
+    for i, (content, expected) in enumerate(SNAKEMAKE_CASES):
+        (wd / f"bad{i}.yaml").write_text(content)
+        proc = run_snakemake(wd, "-n", "--cores", "1", "--configfile", "config/quick.yaml", f"bad{i}.yaml")
+        out = proc.stdout + proc.stderr
+        assert proc.returncode != 0 and "ConfigError (no job was run):" in out, out[-2000:]
+        assert expected in out and "Traceback" not in out and "CreateRuleException" not in out, out[-2000:]
+    assert not (wd / "results").exists()

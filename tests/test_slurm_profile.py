@@ -8,18 +8,28 @@ import yaml
 from conftest import REPO
 
 
-def _cluster_rules() -> set[str]:
-    """Every rule of workflow/rules/*.smk that is not `localrule: True` (those go to SLURM),
-    read from the rule files' text: a `rule NAME:` block up to the next rule."""
-    out = set()
+def _rule_blocks():
+    """(file, name or None, text) of every rule of workflow/rules/*.smk: a `rule NAME:` (or a
+    `rule:` named in its `name:`, made in a loop) block up to the next rule."""
     for f in (REPO / "workflow" / "rules").glob("*.smk"):
         for block in filter(str.strip, re.split(r"(?m)^\s*(?=rule\b)", f.read_text())[1:]):
             m = re.match(r"rule\s+(\w+)\s*:", block)
-            if not re.search(r"localrule:\s*True", block):
-                # a rule named in `name:` (studies.smk) is local, or this reading misses it
-                assert m, f"{f.name}: a cluster rule named in `name:` (give it resources and a name here)"
-                out.add(m.group(1))
-    return out
+            yield f.name, m.group(1) if m else None, block
+
+
+def _cluster_rules() -> set[str]:
+    """The named rules that are not `localrule: True` (those go to SLURM)."""
+    return {name for _, name, block in _rule_blocks()
+            if name and not re.search(r"localrule:\s*True", block)}
+
+
+def test_a_rule_made_in_a_loop_carries_its_own_resources():
+    """A rule named in `name:` (one per study, per method pack) cannot have a profile entry:
+    if it goes to SLURM, it declares runtime and mem_mb itself."""
+    bad = [f"{f}: {block.splitlines()[0:4]}" for f, name, block in _rule_blocks()
+           if name is None and not re.search(r"localrule:\s*True", block)
+           and not re.search(r"resources:.*?runtime=.*?mem_mb=", block, re.S)]
+    assert not bad, bad
 
 
 def test_every_cluster_rule_has_runtime_and_memory():

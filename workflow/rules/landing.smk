@@ -140,6 +140,9 @@ for _i, _pack in enumerate(B_PACKS, 1):
             pick_ratio=[m in B_METHODS for m in _pack],
             batch_size=config["landing"]["mc"]["batch_size"],
         priority: 10
+        resources:  # SLURM: a dynamic rule has no profiles/slurm entry; landing_mc_chunk's per method
+            runtime=10 * len(_pack),
+            mem_mb=1400,
         log:
             f"{LANDING}/logs/mc_{{bscn}}_pack{_i}_chunk{{bchunk}}.log",
         benchmark:

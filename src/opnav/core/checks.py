@@ -105,6 +105,8 @@ def config_problems(config: dict, root: str | Path | None = None,
     for name, check in (("approach", approach_rules), ("landing", landing_rules)):
         if name in todo and name in config:
             out += check(config[name], workflow=workflow)
+    if "landing" in todo and not set(skip) & {"landing", "replication"}:
+        out += seed_rules(config)
     if not workflow:
         return out
     if "approach" in todo and "approach" not in set(skip):
@@ -229,6 +231,19 @@ def landing_rules(c: dict, *, workflow: bool = False) -> list[str]:
     if c["extra"]["n_boot"] == 1:
         out.append(k("extra.n_boot") + "1 resample gives no interval; use 0 (paired t only) or >= 2")
     return out
+
+
+def seed_rules(config: dict) -> list[str]:
+    """Paper B's random streams distinct: the tuning runs' seed is neither the Monte
+    Carlo's nor the replication sample's (``landing.mc.base_seed`` + ``replication.seed_offset``,
+    when the replication is flown)."""
+    c, rep = config["landing"], config.get("replication") or {}
+    tuning, mc = c["tuning"]["base_seed"], c["mc"]["base_seed"]
+    if rep.get("enabled") and "seed_offset" in rep and tuning == mc + rep["seed_offset"]:
+        return [f"invalid config key 'landing.tuning.base_seed': {tuning} equals landing.mc.base_seed + "
+                f"replication.seed_offset = {mc} + {rep['seed_offset']}: the tuning runs would fly the replication "
+                "sample's stream"]
+    return []
 
 
 def study_rules(config: dict) -> list[str]:
