@@ -2,6 +2,7 @@
 (one row per claim) and the table of what we did differently, read from the configuration."""
 
 import copy
+import re
 
 import pandas as pd
 import pytest
@@ -92,3 +93,21 @@ def test_differences_read_ours_from_the_configuration():
     with pytest.raises(KeyError, match="approach.no_such_key"):
         differences.rows(cfg, pub, bad)
     assert r"\ref{sec:landing}" in differences.latex(rows)
+
+
+def test_conclusion_states_each_finding_once():
+    """Issue 45 item 5: an addition shared by four claims is named once (it was repeated per
+    claim), every claim appears once, and the limitations name the claims that hinge on a choice."""
+    df = _table(10, 10)
+    df["named"] = ""
+    addition = "a camera that rolls about its boresight, growing windows and SQUAREM"
+    df.loc[df["verdict"] == "reproduced_with_addition", "named"] = addition
+    df.loc[df["claim_id"] == "B-C1", "verdict"] = "reproduced_with_addition"
+    df.loc[df["claim_id"] == "B-C1", "named"] = addition
+    text = manuscript.conclusion_text(df)
+    assert text.count(addition) == 2  # once per paper, for all the claims that share it
+    for cid in df["claim_id"]:
+        assert len(re.findall(rf"\b{cid}\b(?!\d)", text)) == 1 + text.count(f"For {cid}:"), cid
+    lim = manuscript.limitations_text(df)
+    hinge = df.loc[df["verdict"].isin(["depends_on_choice", "not_tested", "unstable"]), "claim_id"]
+    assert all(c in lim for c in hinge)

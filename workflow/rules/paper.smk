@@ -183,6 +183,7 @@ rule paper_page_one:
         glance=f"{PAPER}/claims_glance.csv",
         differences=f"{PAPER}/differences.tex",
         runinfo=f"{PAPER}/runinfo.tex",
+        conclusion=f"{PAPER}/conclusion.tex",
     params:
         config=canonical({k: config[k] for k in ("approach", "landing")}),
         results=RESULTS,

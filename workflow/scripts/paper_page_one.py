@@ -24,6 +24,9 @@ with script_context(snakemake) as log:
     sample = manuscript.sample_sentence_of(df)
     atomic_write_text(out.abstract, manuscript.page_one_abstract_tex(df, sample))
     figures.save(verdict_plot.fig_verdicts(df), [out.fig_pdf, out.fig_png])
+    atomic_write_text(out.conclusion, "\\newcommand{\\PageConclusion}{" + manuscript.prose_tex(
+        manuscript.conclusion_text(df)) + "}\n\\newcommand{\\PageLimitations}{" + manuscript.prose_tex(
+        manuscript.limitations_text(df)) + "}\n")
     glance = df[[c for c in ("claim_id", "claim", "published", "ours_as_written", "verdict") if c in df.columns]]
     glance.assign(claim=glance["claim"].map(verdict_plot.short_claim)).to_csv(out.glance, index=False)
     rows = differences.rows(dict(snakemake.params.config), published.load())

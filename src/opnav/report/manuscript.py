@@ -394,23 +394,58 @@ def _ids(ids: list[str]) -> str:
 
 
 def group_sentences(grp: list[Mapping], verdict: str, said: set | None = None) -> str:
-    """One group of claims with one verdict: which claims and what the verdict names when they
-    share it (the addition, the choice, the bound); else why (the first claim's cause, named as
-    such when the group has several); then what it would take, unless ``said`` (the texts
-    already written) holds it."""
+    """One group of claims with one verdict, each idea once: the claims that share what the
+    verdict names (the addition, the choice, the bound) in one sentence that names it once;
+    a claim with nothing named gets its cause ('Why', or 'For <id>' in a group); then what
+    it would take, unless ``said`` (the texts already written) holds it."""
     said = set() if said is None else said
-    ids = [r["claim_id"] for r in grp]
-    named = {_col(r, "named") for r in grp}
-    shared = named.pop() if len(named) == 1 else ""
-    s = _sentence(f"{_ids(ids)} {_PREDICATE[verdict][len(ids) == 1]}" + (f": {shared}" if shared else ""))
-    cause = _col(grp[0], "cause")
-    if cause and not shared:
-        s += " " + _sentence(f"{'Why' if len(ids) == 1 else 'For ' + ids[0]}: {cause}")
-    take = _col(grp[0], "would_take")
-    if take and take not in said:
-        said.add(take)
-        s += " " + _sentence(f"What it would take: {take}")
-    return s
+    by_named: dict[str, list[Mapping]] = {}
+    for r in grp:
+        by_named.setdefault(_col(r, "named"), []).append(r)
+    out = []
+    for named, rows in by_named.items():
+        ids = [r["claim_id"] for r in rows]
+        out.append(_sentence(f"{_ids(ids)} {_PREDICATE[verdict][len(ids) == 1]}" + (f": {named}" if named else "")))
+        cause = _col(rows[0], "cause")
+        if cause and not named and verdict != "reproduced":
+            out.append(_sentence(f"{'Why' if len(ids) == 1 else 'For ' + ids[0]}: {cause}"))
+        take = _col(rows[0], "would_take")
+        if take and take not in said:
+            said.add(take)
+            out.append(_sentence(f"What it would take: {take}"))
+    return " ".join(out)
+
+
+def conclusion_text(df: "pd.DataFrame") -> str:
+    """The conclusion (plain text), each finding once: per paper, what reproduced as written,
+    then every other group as page 1 words it (:func:`group_sentences`), nothing dropped."""
+    rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
+    if not rows:
+        return "No claim was evaluated in this build."
+    out = []
+    for p in dict.fromkeys(r["paper"] for r in rows):
+        g = [r for r in rows if r["paper"] == p]
+        said: set = set()
+        for v in ("reproduced", *_NOT_OK):
+            grp = [r for r in g if r["verdict"] == v]
+            if grp:
+                out.append(group_sentences(grp, v, said))
+    return " ".join(out)
+
+
+def limitations_text(df: "pd.DataFrame") -> str:
+    """The limitations (plain text), from the claims table: what every verdict is conditional
+    on, which claims hinge on an open choice directly, and what cannot be recovered."""
+    rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
+    hinge = [r["claim_id"] for r in rows if r["verdict"] in ("depends_on_choice", "not_tested", "unstable")]
+    s = ["Every verdict is conditional on our readings of what the papers leave open, listed in the "
+         "table of what we did differently beside the papers' own values; a different reading could change a verdict"]
+    if hinge:
+        s.append(f"{_ids(hinge)} {'hinge' if len(hinge) > 1 else 'hinges'} on such a reading, or on a test "
+                 "our runs cannot make, directly")
+    s.append("The published runs' own noise realisations cannot be recovered, so each published value is "
+             "compared with the distribution of ours over seeds or runs, never with one run")
+    return " ".join(_sentence(x) for x in s)
 
 
 def abstract_findings(df: "pd.DataFrame") -> str:
