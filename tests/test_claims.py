@@ -149,6 +149,13 @@ def test_a_margin_missing_from_the_plan_stops_the_scorer_naming_it(tmp_path):
     assert "claims.A-C1.margins.target_arcsec" in plan.unused()
 
 
+def test_only_a_claim_the_plan_gives_an_information_bound_can_be_not_reproducible(tmp_path):
+    t = table(literal={"err": 10.0, "bound": 20.6}, roll={"err": 8.0, "bound": 9.0})
+    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C1"]["verdict"] == C.NOT_REPRODUCIBLE
+    plan = _plan_without(tmp_path, ["claims", "A-C1", "bound"])
+    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"], plan))["A-C1"]["verdict"] == C.NOT_REPRODUCED
+
+
 def test_a_malformed_margin_is_refused_in_one_line(tmp_path):
     raw = yaml.safe_load(C.PLAN_FILE.read_text())
     raw["claims"]["A-C6"]["margins"]["rel_tol"] = {"value": 0.1}

@@ -139,6 +139,12 @@ def _worst_vs_bound(g: pd.DataFrame) -> tuple[float, float, int]:
     return _err(best), _bound(best), int(best["n_seeds"])
 
 
+def _bound_rule(plan: Plan, claim_id: str, blocks: str) -> str:
+    """``blocks`` (an information bound excluding the claim) only where the plan says the
+    claim has one (``bound: information``): elsewhere no bound may make it not reproducible."""
+    return blocks if plan.entry(claim_id).get("bound") == "information" else ""
+
+
 def _small_sample(t1: pd.DataFrame, plan: Plan) -> list:
     n = int(_rows(t1, AS_WRITTEN)["n_seeds"].min()) if len(_rows(t1, AS_WRITTEN)) else 0
     return [("sample_too_small", f"{n} seeds")] if n < plan.guard("min_full_seeds") else []
@@ -210,7 +216,7 @@ def _claim_headline_accuracy(t1, head_pub, summary, plan: Plan) -> dict:
     lit_bound = _bound(lit)
     blocks = (f"CRLB {fmt(lit_bound)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lit_bound > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, blocks, plan=plan)
+    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
     cause = _accuracy_cause(d, outs, target, lit_bound, f"{target:g} arcsec")
     wt = "" if d.verdict == C.REPRODUCED else _roll_would_take(summary, head_pub, target)
     return _result(dict(paper="A", claim_id=cid, claim=f"Accuracy better than {target:g} arcsec (headline case, truth "
@@ -243,7 +249,7 @@ def _claim_table_accuracy(t1, pub_rows, plan: Plan) -> dict:
     lb = float(lit[["crlb_x_arcsec", "crlb_y_arcsec"]].astype(float).min(axis=None))
     blocks = (f"CRLB at least {fmt(lb)} arcsec in every case (data used), above {target:g} arcsec"
               if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, blocks, plan=plan)
+    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
     worst = {v: float(_rows(t1, v).apply(_err, axis=1).max()) for v in outs}
     cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec in every case", lit_err=worst.get(AS_WRITTEN),
                             best_err=worst.get(d.best.label) if d.best is not None else None)
@@ -279,7 +285,7 @@ def _claim_pixel_accuracy(t1, plan: Plan) -> dict:
     lb = max([_bound(r) for _, r in lit.iterrows()], default=math.nan)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, blocks, plan=plan)
+    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
     worst = {v: float(pix[pix["variant"] == v].apply(_err, axis=1).max()) for v in outs}
     cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec at every pixel accuracy",
                             lit_err=worst.get(AS_WRITTEN),
@@ -361,7 +367,7 @@ def _claim_little_data(t1, head_pub, summary, plan: Plan) -> dict:
     lb = _bound(lit)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, blocks, plan=plan)
+    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
     cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec within {factor:g} x {fmt(pub_n)} samples")
     wt = "" if d.verdict == C.REPRODUCED else _roll_would_take(summary, head_pub, target)
     return _result(dict(paper="A", claim_id=cid, claim="Little data, stable convergence (headline case)",
@@ -404,7 +410,7 @@ def _claim_pixels(t1, plan: Plan) -> dict:
     lb = max([_bound(r) for _, r in lit.iterrows()], default=math.nan)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, blocks)
+    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks))
     if d.verdict == C.REPRODUCED:
         cause = "As written EM needs more data for each worse pixel accuracy, on data that can tell the misalignment"
     elif d.verdict == C.NOT_REPRODUCIBLE:
