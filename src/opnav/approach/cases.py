@@ -18,7 +18,8 @@ Description
        with the previous segment's estimate;
     4. run the EKF over the whole arc again with the final estimate, and the Schmidt
        (consider) EKF that also carries the estimate's covariance (the squared bound of the
-       data it used; :mod:`opnav.approach.consider`), whose position NEES is reported
+       data it used plus its squared distance to that data's ML estimate;
+       :mod:`opnav.approach.consider`), whose position NEES is reported
        beside the compensated filter's and the true-theta filter's.
 
 Written rules (Table 1 columns)
@@ -310,10 +311,12 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
 
     f1 = run_filter(z, theta, dx0, geo.P0, win, predicted=False)
     # compensation that carries the estimate's uncertainty (issue 44): the Schmidt EKF with
-    # P_theta = the squared bound of the data the estimate used (no truth; dx_true only for NEES)
+    # P_theta = the squared bound of the data the estimate used plus the squared distance to that
+    # data's ML estimate (an iterate that stopped short carries its own known error; no truth;
+    # dx_true only for the NEES)
     P_th = np.zeros((theta.shape[0], 3, 3))
-    P_th[:, [0, 1, 2], [0, 1, 2]] = sc.rad(np.repeat(np.stack([np.asarray(b, float) for b in seg_bounds]), ns,
-                                                     axis=0)) ** 2
+    P_th[:, [0, 1, 2], [0, 1, 2]] = (sc.rad(np.repeat(np.stack([np.asarray(b, float) for b in seg_bounds]), ns,
+                                                      axis=0)) ** 2 + (theta - theta_ml) ** 2)
     fc = run_consider(z, theta, P_th, dx0, geo.P0, win, dx_true=dx_true, keep_cov=False)
     err_after = np.linalg.norm(f1.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
     err_consider = np.linalg.norm(fc.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)

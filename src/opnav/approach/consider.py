@@ -23,9 +23,11 @@ Description
     Star images (``stars`` variant) are measurements of theta alone, which the consider
     filter does not update: they are not used here (the estimate already holds them).
 
-    The estimate's covariance used: the 1-sigma bound of the data that estimate used
-    (:func:`opnav.approach.cases.label_bounds`, diagonal), the covariance an efficient
-    estimate of that data would have; no truth enters it.
+    The estimate's covariance used (:func:`opnav.approach.cases.run_cases`): the squared
+    1-sigma bound of the data that estimate used (:func:`opnav.approach.cases.label_bounds`,
+    diagonal: the covariance an efficient estimate of that data would have) plus the squared
+    distance of the estimate to that data's ML estimate (an EM iterate that stopped short of it
+    carries that error too); no truth enters it.
 Units: km, km/s, rad.
 """
 
