@@ -690,6 +690,8 @@ NEW_CLI = [
      "--set approach.stars.mag_limit=-100: invalid config key 'approach.stars.mag_limit'"),
     (["study", "fov", "--set", "landing.tuning.method=oracle"], "--set landing.tuning.method=oracle"),
     (["landing", "--config", "{tmp}/trap.yaml"], "trap.yaml, line 1: key 'landing.mc.base_seed': 010 has a leading zero"),
+    (["approach", "--variant", "stars", "--set", "approach.stars.every_K=100000"],
+     "invalid config key 'approach.stars.every_K': 100000: the first star image"),
     (["study", "fov", "--config", "{tmp}/yte.yaml"], "yte.yaml, line 1: key '__use_yte__'"),
 ]
 

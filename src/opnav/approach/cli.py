@@ -65,7 +65,14 @@ def run(args) -> int:
     flags = {key: ("--" + name.replace("_", "-"), values[name]) for name, key in FLAG_KEYS.items()}
     if px is not None:  # errors state the user's value, not the derived radius 3-sigma
         flags[FLAG_KEYS["pixel_sigma"]] = ("--pixel-sigma", px, args.pixel_sigma)
-    setup = Setup.from_config(with_flags(config, flags)["approach"])  # the edge: parsed once
+    checked = with_flags(config, flags)["approach"]
+    if args.variant == "stars":          # the arc the flags make must hold a star image
+        from opnav.core.checks import stars_arc_problems
+
+        bad = stars_arc_problems(checked, "--variant stars would have no image (lower it or lengthen the arc)")
+        if bad:
+            raise ConfigError(bad[0])
+    setup = Setup.from_config(checked)  # the edge: parsed once
     px = setup.camera.sigma3_px
     truth = setup.truth_bias_arcsec
     init = setup.theta_init_arcsec

@@ -164,15 +164,25 @@ def approach_rules(a: dict, *, workflow: bool = False) -> list[str]:
         out.append(k("geometry.range_km") + f"the arc starts inside Mars ({a['geometry']['range_km']:g} km <= Mars "
                    f"radius {R_MARS_KM} km)")
     st = a["stars"]
-    if workflow and "stars" in a["variants"] and s["N0"] + st["every_K"] > n:
-        out.append(k("stars.every_K") + f"{st['every_K']}: the first star image (sample N0 + every_K = "
-                   f"{s['N0'] + st['every_K']}) lies beyond the arc's last sample ({n} = N0 + L*N); the stars "
-                   "variant (in approach.variants) would have no image")
+    if workflow and "stars" in a["variants"]:
+        out += stars_arc_problems(a, "the stars variant (in approach.variants) would have no image")
     if st["sigma_floor_px"] > st["sigma_px"] * 10.0 ** (0.2 * (st["mag_limit"] - st["sigma_ref_mag"])):
         out.append(k("stars.sigma_floor_px") + f"{st['sigma_floor_px']:g} px exceeds the centroid 1-sigma of the "
                    f"faintest star imaged (sigma_px x 10^(0.2 (mag_limit - sigma_ref_mag))): the magnitude model "
                    "would not act; lower it or raise approach.stars.sigma_px")
     return out
+
+
+def stars_arc_problems(a: dict, why: str = "the stars variant would have no image") -> list[str]:
+    """The stars variant's first image (sample N0 + stars.every_K) within the arc (N0 + L*N
+    samples): checked for the workflow when approach.variants flies stars, and by
+    ``opnav approach --variant stars`` for the arc its flags make."""
+    s, K = a["segments"], a["stars"]["every_K"]
+    n = s["N0"] + s["L"] * s["N"]
+    if s["N0"] + K > n:
+        return [f"invalid config key 'approach.stars.every_K': {K}: the first star image (sample N0 + every_K = "
+                f"{s['N0'] + K}) lies beyond the arc's last sample ({n} = N0 + L*N); {why}"]
+    return []
 
 
 def landing_rules(c: dict, *, workflow: bool = False) -> list[str]:
