@@ -183,6 +183,8 @@ def test_accuracy_is_scored_as_accuracy_and_flips():
     # literal far from the truth, the roll variant within 2 arcsec: only with an addition, named
     r = by_id(rows_a(SUMMARY_A, table(literal={"err": 10.0}), PUB["paper_a"]))["A-C1"]
     assert r["verdict"] == C.WITH_ADDITION and "roll" in r["named"] and r["best_variant"] == "roll"
+    r = by_id(rows_a(SUMMARY_A, table(literal={"err": 10.0, "bound": 1.0}), PUB["paper_a"]))["A-C2"]
+    assert r["would_take"].startswith("a boresight roll (roll,")
     # an estimate at the truth that did not converge is not accuracy
     r = by_id(rows_a(SUMMARY_A, table(literal={"label": "stalled"}, roll={"err": 9.0}), PUB["paper_a"]))["A-C1"]
     assert r["verdict"] == C.NOT_REPRODUCED

@@ -281,6 +281,8 @@ class Decision:
     best: Outcome | None
     named: str
     flags: list = field(default_factory=list)
+    #: of the faithful variants that give the claim, the one adding least (fewest '+' parts)
+    smallest: Outcome | None = None
 
 
 def decide(outcomes: Mapping[str, Outcome], as_written: str, describe: Callable[[str], str],
@@ -313,6 +315,8 @@ def decide(outcomes: Mapping[str, Outcome], as_written: str, describe: Callable[
         verdict, named = REPRODUCED, ""
     elif best is not None and best.ok:
         verdict, named = WITH_ADDITION, describe(best.label)
+        smallest = min((o for o in faithful if o.ok), key=lambda o: (o.label.count("+"), o.score, o.label))
+        return Decision(verdict, lit, best, named, flags, smallest)
     elif bound_blocks:
         return Decision(NOT_REPRODUCIBLE, lit, None if best is None else best, bound_blocks, flags)
     else:
