@@ -332,8 +332,9 @@ def test_a_verdict_that_flips_between_samples_is_unstable():
 
 def test_the_plan_states_the_replication_size_the_config_flies():
     plan = C.load_plan()
-    cfg = {"enabled": True, "seed_offset": 1000003, "approach_n_seeds": 10, "landing_n_runs": 100}
-    assert "B-C2" in C.replication_plan(plan, cfg)
+    from pathlib import Path
+    cfg = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())["replication"]
+    assert cfg["enabled"] and "B-C2" in C.replication_plan(plan, cfg), "the full profile flies what the plan states"
     with pytest.raises(C.PlanError, match=r"replication\.landing_n_runs = 100 but the config's"):
         C.replication_plan(plan, {**cfg, "landing_n_runs": 300})
 
