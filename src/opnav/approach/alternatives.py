@@ -230,9 +230,10 @@ def stars_study(setup: Setup | dict, log=None) -> list[dict]:
                for a in st0.study_attitude_sigma_arcsec]
             + [("mag_limit", float(g), replace(st0, mag_limit=float(g)), False) for g in st0.study_mag_limit])
     out = []
+    geo0 = sc.build_geometry(setup, "stars")
     for sweep, value, st, full in plan:
         s_m = setup.replace(stars=st)
-        geo = sc.build_geometry(s_m, "stars")
+        geo = sc.with_stars(geo0, s_m)  # the same arc, these stars
         Rvar = geo.measurement_variance(case.sigma3_px)
         c, c0 = bound_curves(s_m, geo, [(Rvar, case.truth_arcsec, False), (Rvar, case.truth_arcsec, True)], "stars")
         d = min(s_m.segments.data_samples, len(c) - 1)
@@ -287,7 +288,7 @@ def attitude_threshold(setup: Setup | dict, target_arcsec: float, hi_arcsec: flo
 
     def worst(a):
         s = setup.replace(stars=replace(setup.stars, attitude_sigma_arcsec=float(a)))
-        g = sc.build_geometry(s, "stars")
+        g = sc.with_stars(geo0, s)
         c = bound_curves(s, g, [(Rvar, case.truth_arcsec, False)], "stars")[0]
         return float(c[min(s.segments.data_samples, len(c) - 1), :2].max())
 

@@ -147,23 +147,37 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
         raise ValueError(f"approach.camera: Mars ({disc_px:.0f} px across) does not fit the "
                          f"{cam.pixels} px detector; raise camera.ifov_arcsec or the range")
     C, u_ref, u_true = _camera_frame(X_true, X_ref, X_mars, roll)
-    field, sig = None, 0.0
-    if variant == "stars":
-        from . import stars
-
-        st = setup.stars
-        sig = stars.sigma_rad(st.sigma_px, cam.ifov_arcsec)  # at sigma_ref_mag
-
-        def sigma_of_mag(m):
-            return stars.sigma_rad(stars.centroid_sigma_px(m, st.sigma_px, st.sigma_ref_mag, st.sigma_floor_px),
-                                   cam.ifov_arcsec)
-
-        field = stars.star_field(C, setup.segments.N0, st.every_K, st.per_image, st.mag_limit, st.slew_deg,
-                                 0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC, sigma_of_mag, stars.catalogue(),
-                                 st.attitude_sigma_arcsec * ARCSEC, st.mode_drift_arcsec * ARCSEC)
+    field, sig = (star_field_of(setup, C) if variant == "stars" else (None, 0.0))
     return Geometry(t, X_true, X_ref, X_mars, Phi, C, u_ref, u_true,
                     np.linalg.norm(u_ref, axis=1), setup.Q, setup.prior_sigma.P0, e_fixed, variant,
                     cam.ifov_arcsec, field, sig)
+
+
+def star_field_of(setup: Setup | dict, C: np.ndarray):
+    """The ``stars`` variant's star images along the Mars-tracking attitude ``C`` (n+1, 3, 3)
+    with the setup's ``stars`` and ``camera`` (:func:`opnav.approach.stars.star_field`), and the
+    centroid 1-sigma at ``stars.sigma_ref_mag`` (rad)."""
+    from . import stars
+
+    setup = Setup.of(setup)
+    st, cam = setup.stars, setup.camera
+
+    def sigma_of_mag(m):
+        return stars.sigma_rad(stars.centroid_sigma_px(m, st.sigma_px, st.sigma_ref_mag, st.sigma_floor_px),
+                               cam.ifov_arcsec)
+
+    field = stars.star_field(C, setup.segments.N0, st.every_K, st.per_image, st.mag_limit, st.slew_deg,
+                             0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC, sigma_of_mag, stars.catalogue(),
+                             st.attitude_sigma_arcsec * ARCSEC, st.mode_drift_arcsec * ARCSEC)
+    return field, float(stars.sigma_rad(st.sigma_px, cam.ifov_arcsec))
+
+
+def with_stars(geo: Geometry, setup: Setup | dict) -> Geometry:
+    """The same ``stars`` arc with the star images of ``setup.stars`` (no orbit propagated again)."""
+    from dataclasses import replace
+
+    field, sig = star_field_of(setup, geo.C)
+    return replace(geo, stars=field, star_sigma_rad=sig)
 
 
 def _camera_frame(X_true, X_ref, X_mars, roll_rad):
