@@ -228,6 +228,8 @@ NEW_CONFIGS = [
     ("ranges", "landing: {tuning: {candidates: [[5.0, 30]]}}", "'landing.tuning.candidates[0][1]'"),
     ("ranges", "limits: {max_jobs: 100000000000}", "'limits.max_jobs'"),
     ("ranges", "limits: {max_study_values: 100000000000}", "'limits.max_study_values'"),
+    ("ranges", "replication: {approach_n_seeds: 100000}", "'replication.approach_n_seeds'"),
+    ("cross-key", "replication: {enabled: true, landing_n_runs: 90000}", "'replication.landing_n_runs': 90000 runs"),
     # cross-key rules
     ("cross-key", "landing: {tuning: {base_seed: 20230410}}", "'landing.tuning.base_seed': 20230410 equals"),
     ("cross-key", "landing: {tuning: {base_seed: 21230413}}\nreplication: {enabled: true, seed_offset: 1000003}",

@@ -249,11 +249,17 @@ def seed_rules(config: dict) -> list[str]:
     when the replication is flown)."""
     c, rep = config["landing"], config.get("replication") or {}
     tuning, mc = c["tuning"]["base_seed"], c["mc"]["base_seed"]
+    out = []
     if rep.get("enabled") and "seed_offset" in rep and tuning == mc + rep["seed_offset"]:
-        return [f"invalid config key 'landing.tuning.base_seed': {tuning} equals landing.mc.base_seed + "
-                f"replication.seed_offset = {mc} + {rep['seed_offset']}: the tuning runs would fly the replication "
-                "sample's stream"]
-    return []
+        out.append(f"invalid config key 'landing.tuning.base_seed': {tuning} equals landing.mc.base_seed + "
+                   f"replication.seed_offset = {mc} + {rep['seed_offset']}: the tuning runs would fly the replication "
+                   "sample's stream")
+    n_steps = max(1, round(c["duration_s"] / c["filter"]["dt_s"]))
+    runs = rep.get("landing_n_runs", 0)
+    if rep.get("enabled") and runs * n_steps > MAX_LANDING_RUN_STEPS:
+        out.append(f"invalid config key 'replication.landing_n_runs': {runs} runs x {n_steps} filter steps exceeds "
+                   f"the limit {MAX_LANDING_RUN_STEPS} (memory, as landing.mc.n_runs)")
+    return out
 
 
 def study_rules(config: dict) -> list[str]:
