@@ -4,7 +4,6 @@ with a plan entry and every plan entry read, a control that also meets a claim, 
 beating its own bound, a verdict that flips between two samples, and causes a reader takes
 in at once."""
 
-import copy
 
 import pandas as pd
 import pytest
