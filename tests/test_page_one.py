@@ -111,3 +111,19 @@ def test_conclusion_states_each_finding_once():
     lim = manuscript.limitations_text(df)
     hinge = df.loc[df["verdict"].isin(["depends_on_choice", "not_tested", "unstable"]), "claim_id"]
     assert all(c in lim for c in hinge)
+
+
+def test_plan_and_inputs_appendix_is_latin_script_latex():
+    """The analysis plan quotes paper A in Chinese: the appendix prints its English rendering
+    (pdflatex without CJK fonts stops on the first Chinese character)."""
+    from opnav.report import claims
+
+    plan = claims.load_plan().table()
+    tex = manuscript.plan_latex(plan)
+    assert not re.search(r"[\u2e80-\u9fff\uff00-\uffef\u3000-\u303f\u2033]", tex)
+    assert tex.count(r"\item[") == len(plan)
+    assert manuscript.latin_text("估计精度优于2″ (estimation accuracy better than 2 arcsec), headline case") == \
+        "estimation accuracy better than 2 arcsec, headline case"
+    ins = pd.DataFrame([{"input": "A sample time", "ours": "0.5 s", "published": "0.5 s", "how_derived": "x",
+                         "what_would_match": "y"}])
+    assert r"\item[A sample time] Ours 0.5 s" in manuscript.inputs_latex(ins)

@@ -172,6 +172,8 @@ rule paper_page_one:
     differences)."""
     input:
         claims=rules.paper_claims.output.csv,
+        plan=rules.paper_claims.output.plan,
+        inputs=rules.paper_claims.output.inputs,
         published=src("data/published.yaml"),
         choices=src("data/differences.yaml"),
         code=src("report/manuscript.py", "report/verdict_plot.py", "report/differences.py"),
@@ -184,6 +186,8 @@ rule paper_page_one:
         differences=f"{PAPER}/differences.tex",
         runinfo=f"{PAPER}/runinfo.tex",
         conclusion=f"{PAPER}/conclusion.tex",
+        plan_tex=f"{PAPER}/analysis_plan.tex",
+        inputs_tex=f"{PAPER}/inputs.tex",
     params:
         config=canonical({k: config[k] for k in ("approach", "landing")}),
         results=RESULTS,

@@ -29,6 +29,10 @@ with script_context(snakemake) as log:
         manuscript.limitations_text(df)) + "}\n")
     glance = df[[c for c in ("claim_id", "claim", "published", "ours_as_written", "verdict") if c in df.columns]]
     glance.assign(claim=glance["claim"].map(verdict_plot.short_claim)).to_csv(out.glance, index=False)
+    # the appendix tables of the claims job: the analysis plan and the inputs we derive
+    atomic_write_text(out.plan_tex, manuscript.plan_latex(pd.read_csv(snakemake.input.plan, keep_default_na=False)))
+    atomic_write_text(out.inputs_tex, manuscript.inputs_latex(pd.read_csv(snakemake.input.inputs,
+                                                                          keep_default_na=False)))
     rows = differences.rows(dict(snakemake.params.config), published.load())
     atomic_write_text(out.differences, differences.latex(rows))
     # the heavy jobs' benchmark files (read, not inputs: this is a description of the build)

@@ -587,3 +587,55 @@ def legible_latex(df: "pd.DataFrame", max_cols: int = 7) -> str:
     step = max_cols - k
     parts = [_tabular(v[list(v.columns[:k]) + rest[i:i + step]]) for i in range(0, len(rest), step)]
     return (r"\begin{tabular}{@{}l@{}}" + "\n" + "\\\\[6pt]\n".join(parts) + "\n" + r"\end{tabular}" + "\n")
+
+
+# ------------------------------------------------------------ appendix: the analysis plan and the inputs
+_CJK = re.compile(r"[\u2e80-\u9fff\uff00-\uffef\u3000-\u303f]+")
+
+
+def latin_text(text: str) -> str:
+    """A plan sentence for a Latin-script PDF: a Chinese original is replaced by its
+    parenthesised English rendering where the plan gives one (else a pointer to the CSV);
+    the double prime as arcsec."""
+    text = str(text).replace("\u2033", " arcsec")
+    if not _CJK.search(text):
+        return text
+    m = re.search(r"\(([^()]*[A-Za-z][^()]*)\)", text)
+    rest = _CJK.sub(" ", text[m.end():] if m else "").strip(" ,;")
+    head = m.group(1) if m else "original in Chinese, see analysis_plan.csv"
+    return head + (f", {rest}" if rest and _CJK.search(rest) is None else "")
+
+
+def plan_latex(plan: "pd.DataFrame") -> str:
+    """The analysis plan (results/paper/analysis_plan.csv) as a LaTeX description list, one
+    item per claim: the paper's sentence and where, what is compared and how, the margin with
+    its reason, the variants and controls, what the verdict depends on."""
+    out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
+    for r in plan.to_dict("records"):
+        c = {k: latin_text(_col(r, k)) for k in r}
+        s = rf"\item[{latex_escape(c.get('claim_id', ''))}] " + prose_tex(_sentence(c.get("sentence", "")))
+        if c.get("where"):
+            s += " " + prose_tex(f"({c['where']}).")
+        parts = [f"Compared: {c.get('quantity', '')}" + (f" ({c['units']})" if c.get("units") else ""),
+                 f"{c.get('comparison', '')} with {c.get('margin', '')}" if c.get("margin") else c.get("comparison", ""),
+                 c.get("margin_reason", ""),
+                 f"variants: {c['variants']}" if c.get("variants") else "",
+                 f"controls: {c['controls']}" if c.get("controls") else "",
+                 f"depends on: {c['depends_on']}" if c.get("depends_on") else ""]
+        s += " " + prose_tex("; ".join(p for p in parts if p) + ".")
+        out.append(s)
+    out.append(r"\end{description}")
+    return "\n".join(out) + "\n"
+
+
+def inputs_latex(inputs: "pd.DataFrame") -> str:
+    """The inputs we derive (results/paper/inputs.csv) as a description list."""
+    out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
+    for r in inputs.to_dict("records"):
+        c = {k: latin_text(_col(r, k)) for k in r}
+        out.append(rf"\item[{prose_tex(c.get('input', ''))}] "
+                   + prose_tex(f"Ours {c.get('ours', '')}; published {c.get('published', '')}. "
+                               f"How we derive it: {c.get('how_derived', '')}. "
+                               f"What would match: {c.get('what_would_match', '')}."))
+    out.append(r"\end{description}")
+    return "\n".join(out) + "\n"
