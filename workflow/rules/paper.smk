@@ -3,7 +3,7 @@
 import os
 import shutil
 
-from opnav.report import manuscript
+from opnav.report import differences, manuscript
 from opnav.core import provenance
 
 PAPER = res("paper")
@@ -189,7 +189,7 @@ rule paper_page_one:
         plan_tex=f"{PAPER}/analysis_plan.tex",
         inputs_tex=f"{PAPER}/inputs.tex",
     params:
-        config=canonical({k: config[k] for k in ("approach", "landing")}),
+        config=canonical(differences.subset(config)),  # only the keys the table of choices reads
         results=RESULTS,
     log:
         f"{PAPER}/logs/paper_page_one.log",

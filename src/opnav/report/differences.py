@@ -45,6 +45,22 @@ def value_text(v: Any) -> str:
     return str(v)
 
 
+def subset(config: Mapping[str, Any], spec: Mapping | None = None) -> dict:
+    """The part of ``config`` the table reads (its ``keys``, nested as in the config): the
+    rule's params, so editing any other key reruns nothing of page 1."""
+    spec = yaml.safe_load(DIFFERENCES.read_text()) if spec is None else spec
+    out: dict = {}
+    for items in spec.values():
+        for it in items:
+            for k in it["keys"]:
+                parts = k.split(".")
+                node = out
+                for part in parts[:-1]:
+                    node = node.setdefault(part, {})
+                node[parts[-1]] = lookup(config, k)
+    return out
+
+
 def rows(config: Mapping[str, Any], published: Mapping[str, Any], spec: Mapping | None = None) -> list[dict]:
     """One row per choice: paper, choice, ours, paper's value, where its effect is shown."""
     spec = yaml.safe_load(DIFFERENCES.read_text()) if spec is None else spec
