@@ -252,3 +252,24 @@ def test_pair_comparison_on_hand_made_calls():
     assert pc["d_final_pos_m"] == pytest.approx(-1.5)          # (1-2 + 2-4) / 2
     assert pc["d_final_pos_rel_pct"] == pytest.approx(-50.0)    # of b's mean 3 m
     assert pc["d_final_pos_lo_m"] < -1.5 < pc["d_final_pos_hi_m"]
+
+
+def test_first_runs_keeps_the_paired_runs_and_their_calls():
+    """B-X1 with fewer runs for its own methods (landing.extra.n_runs): every method is cut to
+    runs 0..n-1, tracks and planning calls alike; a method lacking one of them is refused."""
+    from opnav.landing.montecarlo import first_runs
+
+    a = _calls_data([0, 0, 1, 1, 2], [1, 4, 1, 4, 1], [5, 6, 7, 8, 9], [0.1, 0.2, 0.3, 0.4, 0.5],
+                    [1.0, 2.0, 3.0])
+    for k in ("updated", "lm_updated", "cut_alt_m", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
+              "sig_yaw_deg", "init_error"):
+        a.setdefault(k, np.zeros((3, 1)))
+    from opnav.landing.records import CALL_KEYS
+
+    for k in CALL_KEYS:
+        a.setdefault(k, np.zeros(5))
+    b = first_runs(a, 2)
+    assert list(b["run_index"]) == [0, 1] and list(b["plan_run"]) == [0, 0, 1, 1]
+    assert list(b["plan_index"]) == [5, 6, 7, 8] and b["err_r"].shape[0] == 2
+    with pytest.raises(ValueError, match="lacks some of runs 0..3"):
+        first_runs(a, 4)

@@ -69,13 +69,37 @@ B_SRC = with_kernels("landing", src(
 B_SCN_RE = "|".join(B_SCENARIOS)
 
 
+# B-X1's runs per scenario (landing.extra.n_runs): the methods only B-X1 flies fly runs
+# 0..n-1 (their cost is set by the edge calls' planned posteriors, not by the paper's sample)
+# (its names of no configured scenario do not apply: the default names the default scenarios)
+_BX1_RUNS = config["landing"]["extra"].get("n_runs", {})
+
+
+def b_runs(scn, method):
+    """Runs flown by ``method`` in scenario ``scn``: landing.mc.n_runs, or, for a method only
+    B-X1 flies, landing.extra.n_runs[scn] where set (never more)."""
+    n = config["landing"]["mc"]["n_runs"]
+    if method not in B_METHODS and method not in B_EQ_METHODS and scn in _BX1_RUNS:
+        n = min(n, int(_BX1_RUNS[scn]))
+    return n
+
+
+def b_chunks(scn, method):
+    """The chunk labels of ``method``'s Monte Carlo in scenario ``scn`` (:func:`b_runs`)."""
+    if b_runs(scn, method) == config["landing"]["mc"]["n_runs"]:
+        return B_CHUNKS
+    return [chunk_label(c) for c in mc_chunks(b_runs(scn, method), config["landing"]["mc"]["runs_per_job"])]
+
+
 def b_mc(scn, methods):
     """Each method's Monte Carlo in scenario ``scn``: the gathered file, or the one chunk
     itself when one job flies every run (no gather job to start: ``montecarlo.stack_runs``
     already holds the runs and their planning calls in run order, as gathered)."""
-    if len(B_CHUNKS) == 1:
-        return [f"{LANDING}/mc/{scn}/chunks/{m}/{B_CHUNKS[0]}.npz" for m in methods]
-    return [f"{LANDING}/mc/{scn}/{m}.npz" for m in methods]
+    out = []
+    for m in methods:
+        ch = b_chunks(scn, m)
+        out.append(f"{LANDING}/mc/{scn}/chunks/{m}/{ch[0]}.npz" if len(ch) == 1 else f"{LANDING}/mc/{scn}/{m}.npz")
+    return out
 
 
 # landing.mc.methods_per_job > 1 (tiny profiles): the Monte Carlo's methods (paper,
@@ -154,7 +178,7 @@ for _i, _pack in enumerate(B_PACKS, 1):
 rule landing_mc_gather:
     """All runs of one method in one scenario, in run order (gather)."""
     input:
-        lambda wc: [f"{LANDING}/mc/{wc.bscn}/chunks/{wc.bmethod}/{c}.npz" for c in B_CHUNKS],
+        lambda wc: [f"{LANDING}/mc/{wc.bscn}/chunks/{wc.bmethod}/{c}.npz" for c in b_chunks(wc.bscn, wc.bmethod)],
     output:
         f"{LANDING}/mc/{{bscn}}/{{bmethod}}.npz",
     wildcard_constraints:
@@ -238,12 +262,13 @@ rule landing_summary:
         tuning=f"{LANDING}/tuning.json",
         code=with_kernels("landing", src(
             "landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
-            "landing/report.py", "landing/equivalence.py", "landing/ranking.py",
+            "landing/report.py", "landing/equivalence.py", "landing/ranking.py", "landing/trajectory.py",
             "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),
         kernels=kernels("landing"),
     output:
         t3=report_table(f"{LANDING}/B-T3_summary_{{bscn}}", "B-T3", "Paper B"),
         summary=f"{LANDING}/summaries/B-summary_{{bscn}}.json",
+        end_phase=table_outputs(f"{LANDING}/B-T3_end_phase_{{bscn}}"),
         f6=report_figure(f"{LANDING}/B-F6_nav_error_envelopes_{{bscn}}", "B-F6", "Paper B", "{bscn}"),
         f7=report_figure(f"{LANDING}/B-F7_planning_time_{{bscn}}", "B-F7", "Paper B", "{bscn}"),
     wildcard_constraints:
@@ -257,6 +282,8 @@ rule landing_summary:
         eval_path=config["landing"]["planner"]["eval_path"],
         landing=cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg",
                     "terminal_accel_mps2"),
+        # the vision cut-off (the end-phase table counts what it does in truth)
+        cutoff={k: config["landing"]["filter"][k] for k in ("min_update_altitude_m", "update_altitude_margin_m")},
     log:
         f"{LANDING}/logs/summary_{{bscn}}.log",
     localrule: True

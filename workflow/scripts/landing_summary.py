@@ -10,7 +10,9 @@ import pandas as pd
 from opnav.core import figures, published
 from opnav.landing import plots, timing
 from opnav.landing.montecarlo import load
-from opnav.landing.report import accuracy_tests, scenario_summary, summary_table
+from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading,
+                                  scenario_summary, summary_table)
+from opnav.landing.trajectory import truth_states
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
 
@@ -48,6 +50,25 @@ with script_context(snakemake) as log:
                            published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
                            accuracy=acc)
     out["tuning"] = load_json(snakemake.input.tuning)        # chosen on a separate seed stream: out["nees"] is held out
+    # NEES read as it is (held out): consistent, under- or overconfident
+    out["nees_reading"] = {m: nees_reading(v) for m, v in out["nees"].items()}
+    out["nees_text"] = out["nees_reading"].get("depth", {}).get("text", "")
+    # the descent's end from the per-step records against the true altitude
+    c, cut = snakemake.params.landing, snakemake.params.cutoff
+    t = next(iter(data.values()))["t"]
+    alt = truth_states(t, c["initial_state"]["r_m"], c["initial_state"]["v_mps"], float(c["duration_s"]),
+                       c["gravity_mps2"], float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2")).r[:, 2]
+    end = end_phase_table(every, alt, float(cut["update_altitude_margin_m"]))
+    write_table(end, snakemake.output.end_phase,
+                caption=(f"B-T3 end phase ({scn} camera): per method, over its runs, the time of the last "
+                         "landmark update and of the last vision update (median, min, max, s), the "
+                         "median time between them, and the runs taking a vision update with the true "
+                         f"altitude below 1 m and below the vision cut-off's margin "
+                         f"({float(cut['update_altitude_margin_m']):g} m; the cut-off compares the "
+                         f"estimated altitude less that margin with {float(cut['min_update_altitude_m']):g} m), "
+                         "counted from the per-step records."))
+    out["end_phase"] = {r["method"]: {k: v for k, v in r.items() if k != "method"} for r in end.to_dict("records")}
+    out["end_phase_text"] = end_phase_text(out["end_phase"], scn, float(cut["min_update_altitude_m"]))
     write_json(snakemake.output.summary, out)
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f6)

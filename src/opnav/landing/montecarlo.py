@@ -46,7 +46,7 @@ from opnav.landing.records import CALL_KEYS, load
 
 __all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
-           "same_pick_pct", "pick_quality", "landmark_phase", "phase_rms", "time_below", "nees_band", "nees_consistency"]
+           "same_pick_pct", "pick_quality", "first_runs", "end_phase", "landmark_phase", "phase_rms", "time_below", "nees_band", "nees_consistency"]
 
 _TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
            "sig_yaw_deg", "nees_r", "nees_v", "updated", "lm_updated", "cut_alt_m")
@@ -215,6 +215,22 @@ def gather(parts: list[dict]) -> dict:
     return out
 
 
+def first_runs(data: dict, n: int) -> dict:
+    """``data`` (:func:`gather`'s layout) restricted to its runs of index < ``n`` (tracks by
+    ``run_index``, planning calls by ``plan_run``): the paired runs every method of B-X1
+    flew. Raises ``ValueError`` if it lacks one of runs 0..n-1."""
+    keep = np.asarray(data["run_index"]) < n
+    if int(keep.sum()) != n or not np.array_equal(np.sort(data["run_index"][keep]), np.arange(n)):
+        raise ValueError(f"Monte Carlo of {str(data.get('method', '?'))!r} lacks some of runs 0..{n - 1}")
+    calls = np.asarray(data["plan_run"]) < n
+    out = dict(data)
+    for k in _TRACKS + ("n_landmarks", "init_error", "run_index"):
+        out[k] = np.asarray(data[k])[keep]
+    for k in CALL_KEYS + ("plan_run",):
+        out[k] = np.asarray(data[k])[calls]
+    return out
+
+
 def per_run_stats(data: dict) -> pd.DataFrame:
     """Per run: final and RMS error norms (m, m/s, deg) and mean NEES."""
     import pandas as pd
@@ -300,6 +316,41 @@ def last_update_index(updated: np.ndarray):
     last = u.shape[-1] - 1 - np.argmax(u[..., ::-1], axis=-1)
     out = np.where(u.any(axis=-1), last, 0)
     return int(out) if u.ndim == 1 else out
+
+
+def end_phase(data: dict, alt_true_m: np.ndarray, margin_m: float, ground_m: float = 1.0) -> dict:
+    """The end of the descent counted from the per-step records of ``data`` (gathered
+    Monte Carlo: ``t`` (s), ``updated`` and ``lm_updated`` (runs, times)) and the true
+    altitude at each filter time ``alt_true_m`` (m; the truth is the same in every run):
+    per run the time of its last landmark update and of its last vision update (s; NaN if
+    none), summarised by median, minimum and maximum over the runs; the gap between the two
+    (s, median); the runs taking a vision update with the true altitude below ``ground_m``
+    (1 m: on the ground, to a lander's scale) and below ``margin_m`` (the vision cut-off's
+    own margin on the estimated altitude), and the lowest true altitude of a vision update
+    (m). The cut-off itself compares the ESTIMATED altitude less the margin
+    (``descent.vision_cutoff_altitude``): these counts say what that does in truth."""
+    t = np.asarray(data["t"], float)
+    z = np.asarray(alt_true_m, float)
+    upd, lm = np.asarray(data["updated"], bool), np.asarray(data["lm_updated"], bool)
+    if z.shape != t.shape or upd.shape[-1] != t.size:
+        raise ValueError(f"end_phase: {t.size} filter times, {z.size} true altitudes, {upd.shape[-1]} records")
+    out = {"n_runs": int(upd.shape[0]), "ground_m": float(ground_m), "margin_m": float(margin_m)}
+    last = {}
+    for key, u in (("last_lm_t_s", lm), ("last_vis_t_s", upd)):
+        tl = np.where(u.any(axis=1), t[last_update_index(u)], np.nan)
+        last[key] = tl
+        ok = np.isfinite(tl)
+        out[f"{key}_median"] = float(np.median(tl[ok])) if ok.any() else None
+        out[f"{key}_min"] = float(tl[ok].min()) if ok.any() else None
+        out[f"{key}_max"] = float(tl[ok].max()) if ok.any() else None
+        out[f"{key.split('_t_')[0]}_runs"] = int(ok.sum())
+    gap = last["last_vis_t_s"] - last["last_lm_t_s"]
+    out["vision_after_last_lm_s_median"] = float(np.nanmedian(gap)) if np.isfinite(gap).any() else None
+    out["runs_vision_below_ground_m"] = int((upd & (z < ground_m)[None, :]).any(axis=1).sum())
+    out["runs_vision_below_margin"] = int((upd & (z < margin_m)[None, :]).any(axis=1).sum())
+    zu = np.where(upd, z[None, :], np.inf)
+    out["min_true_alt_vision_m"] = float(zu.min()) if upd.any() else None
+    return out
 
 
 def pick_quality(d: dict) -> dict:

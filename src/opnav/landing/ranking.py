@@ -118,10 +118,15 @@ def pair_comparison(a: dict, b: dict, level: float = 0.95) -> dict:
     the share of planning calls where they chose the same landmark (%), the
     median |delta beta*| (deg), and the paired difference a - b of the per-run
     RMS and final (touchdown) position error norms (m) with its paired-t
-    interval at ``level``, also relative to b's mean (%)."""
+    interval at ``level``, also relative to b's mean (%); the same of the error at the last
+    landmark update (``d_lastlm_pos``) and RMS over the landmark phase (``d_lmrms_pos``) where
+    the runs record landmark updates."""
     sa, sb = per_run_stats(a), per_run_stats(b)
     out = {"same_pick_pct": same_pick_pct(a, b), "median_abs_dbeta_deg": median_abs_dbeta_deg(a, b)}
-    for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos")):
+    for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos"),
+                      ("lastlm_pos_err_m", "lastlm_pos"), ("lmrms_pos_err_m", "lmrms_pos")):
+        if key not in sa or key not in sb:
+            continue
         x, y = sa[key].to_numpy(), sb[key].to_numpy()
         if x.shape != y.shape or x.size == 0:
             raise ValueError("pair_comparison: the two methods must have flown the same runs")

@@ -143,8 +143,10 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
     did), ``converges_faster`` (each method of ``methods`` vs ``reference``,
     first time below ``converged_pos_err_m``), ``errors`` (per method: mean,
     median and 3-sigma of the error at the last landmark update, RMS over the
-    landmark phase and at touchdown, m) and ``nees`` (per method,
-    ``montecarlo.nees_consistency``)."""
+    landmark phase and at touchdown, m), ``nees`` (per method,
+    ``montecarlo.nees_consistency``) and ``equivalence_vs_baselines``: the same paired
+    test of each method of ``methods`` against each of the paper's H baselines flown
+    (svd, gdop, cond: the claim names all three; same margins, alpha and runs)."""
     from opnav.landing import equivalence as eqv
     from opnav.landing.montecarlo import nees_consistency, per_run_stats, same_pick_pct, time_below
 
@@ -168,7 +170,14 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
     faster = {m: eqv.converges_faster(time_below(data[m], converged_pos_err_m), t_ref, m, ref,
                                       converged_pos_err_m, float(eq_cfg["alpha"]))
               for m in eq_cfg["methods"]}
+    by_base = {}
+    for b in ("svd", "gdop", "cond"):
+        if b in data:
+            tested_b = [m for m in eq_cfg["methods"] if m != b]
+            by_base[b] = eqv.equivalence(stats, b, tested_b, float(eq_cfg["margin_frac"]), float(eq_cfg["alpha"]),
+                                         {m: same_pick_pct(data[m], data[b]) for m in tested_b})
     return {"equivalence": eq,
+            "equivalence_vs_baselines": by_base,
             "controls": list(eq_cfg["controls"]),
             "controls_equivalent": [c for c in eq_cfg["controls"] if eq["methods"][c]["equivalent"]],
             "converges_faster": faster, "errors": errors,
@@ -400,3 +409,84 @@ def rows_paper_b(t3: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
             rows.append({"paper": "B", "item": item, "published": published_v, "ours": ours,
                          "unit": "deg", "verdict": v.verdict, "reason": f"{v.reason}; {why}"})
     return rows
+
+
+# ------------------------------------------------------------ the descent's end and NEES, in words
+
+def end_phase_table(data: dict[str, dict], alt_true_m: np.ndarray, margin_m: float,
+                    ground_m: float = 1.0) -> "pd.DataFrame":
+    """The end-phase table of one scenario: one row per method of ``data`` (gathered Monte
+    Carlo), :func:`opnav.landing.montecarlo.end_phase` of its per-step records against the
+    true altitude ``alt_true_m`` at each filter time (m)."""
+    import pandas as pd
+
+    from opnav.landing.montecarlo import end_phase
+
+    return pd.DataFrame([{"method": m, **end_phase(d, alt_true_m, margin_m, ground_m)} for m, d in data.items()])
+
+
+def _fmt(x, f="{:.0f}") -> str:
+    return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f.format(x)
+
+
+def _per_method(end: dict, key: str, f: str, methods: list[str], unit: str = " s") -> str:
+    vals = [_fmt(end[m][key], f) for m in methods]
+    if len(set(vals)) == 1:
+        return vals[0] + unit
+    return " / ".join(vals) + unit + " (" + " / ".join(methods) + ")"
+
+
+def end_phase_text(end: dict[str, dict], scenario: str, min_update_alt_m: float,
+                   methods: tuple = ("depth", "svd", "random")) -> str:
+    """The manuscript's sentences about the end of the descent in camera ``scenario``, from
+    its end-phase rows (``end``: method -> :func:`opnav.landing.montecarlo.end_phase`), for
+    ``methods`` among them: when landmark updates and vision updates stop (medians over the
+    runs), and how many runs take vision updates with the true altitude below the ground
+    threshold and below the cut-off's margin."""
+    ms = [m for m in methods if m in end] or list(end)[:3]
+    e0 = end[ms[0]]
+    n = e0["n_runs"]
+    lm = _per_method(end, "last_lm_t_s_median", "{:.0f}", ms)
+    vis = _per_method(end, "last_vis_t_s_median", "{:.0f}", ms)
+    gap = _per_method(end, "vision_after_last_lm_s_median", "{:.0f}", ms)
+    below = [end[m]["runs_vision_below_ground_m"] for m in ms]
+    below_m = [end[m]["runs_vision_below_margin"] for m in ms]
+    gaps = [end[m]["vision_after_last_lm_s_median"] for m in ms]
+    if all(g is not None and g <= 0.5 for g in gaps):
+        s = (f"In the {scenario} camera, landmark updates continue until vision ends (medians: last "
+             f"landmark update {lm}, last vision update {vis}). ")
+    else:
+        s = (f"In the {scenario} camera, landmark updates stop at a median {lm} and vision updates "
+             f"(then the site's bearing alone) at {vis}, {gap} later. ")
+    cut = (f"Vision stops once the estimated altitude less {e0['margin_m']:g} m falls to "
+           f"{min_update_alt_m:g} m")
+    if not any(below) and not any(below_m):
+        return s + (f"{cut}; no run of {n} takes a vision update with the true altitude below "
+                    f"{e0['margin_m']:g} m.")
+    def counts(c):
+        return " / ".join(str(x) for x in c) + (" (" + " / ".join(ms) + ")" if len(ms) > 1 else "")
+    return s + (f"{cut}, and an estimate a few metres high keeps it on: of {n} runs, {counts(below)} "
+                f"take vision updates with the true altitude below {e0['ground_m']:g} m and "
+                f"{counts(below_m)} below {e0['margin_m']:g} m (lowest {_fmt(e0['min_true_alt_vision_m'], '{:.2f}')} m"
+                f" for {ms[0]}).")
+
+
+def nees_reading(nees: dict) -> dict:
+    """The filter's consistency read from its held-out NEES (``montecarlo.nees_consistency``):
+    per state (pos, vel) ``consistent`` if the time-averaged NEES of the run mean lies inside
+    the 95 % band of an n-run mean, ``underconfident`` below it (the covariance larger than the
+    errors), ``overconfident`` above it; and a sentence saying so with the numbers."""
+    lo, hi = nees["band"]
+    out = {}
+    for q in ("pos", "vel"):
+        x = nees[f"{q}_mean"]
+        out[q] = "consistent" if lo <= x <= hi else "underconfident" if x < lo else "overconfident"
+    word = {"pos": "position", "vel": "velocity"}
+    parts = [f"{word[q]} {nees[f'{q}_mean']:.2f} ({out[q]}; in the band at {nees[f'{q}_in_band_pct']:.1f} % "
+             f"of the filter times)" for q in ("pos", "vel")]
+    verdict = out["pos"] if out["pos"] == out["vel"] else f"{out['pos']} in position, {out['vel']} in velocity"
+    out["verdict"] = verdict
+    out["text"] = (f"On the held-out runs the filter is {verdict}: its mean NEES over {nees['n_runs']} runs is "
+                   + "; ".join(parts) + f", against the 95 % band [{lo:.2f}, {hi:.2f}] of a "
+                   f"{nees['n_runs']}-run mean for 3 degrees of freedom.")
+    return out
