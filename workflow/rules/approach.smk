@@ -118,6 +118,25 @@ rule approach_stars:
         "../scripts/approach_stars.py"
 
 
+rule approach_stars_outputs:
+    """A-X6: the stars study's table and figure (bound, floor, EM-EKF against attitude knowledge
+    and magnitude limit)."""
+    input:
+        stars=f"{A_WORK}/stars.pkl",
+        code=src("approach/report.py", "approach/star_plots.py", "core/figures.py", "core/tables.py",
+                 "opnav.mplstyle"),
+    output:
+        table=report_table(f"{APPROACH}/A-X6_stars", "A-X6", "Paper A"),
+        fig=report_figure(f"{APPROACH}/A-X6_stars", "A-X6", "Paper A"),
+    params:
+        target=config["approach"]["accuracy_target_arcsec"],
+    log:
+        f"{APPROACH}/logs/stars_outputs.log",
+    localrule: True
+    script:
+        "../scripts/approach_stars_outputs.py"
+
+
 rule approach_tables:
     """A-T1 (Table 1 with published values), A-X1 table and verdict, A-summary.json."""
     input:

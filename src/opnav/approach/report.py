@@ -444,6 +444,33 @@ def stars_summary(study: list[dict], target_arcsec: float) -> dict:
     return out
 
 
+def stars_frame(study: list[dict]) -> pd.DataFrame:
+    """A-X6: one row per stars-study row (:func:`opnav.approach.alternatives.stars_study`): the
+    swept setting, stars per image along the arc, the bound of tx, ty (all data; star images
+    alone), the attitude floor and the EM-EKF's (growing windows, SQUAREM) seed mean and RMS
+    error of (tx, ty), arcsec."""
+    rows = []
+    for r in study:
+        truth = np.asarray(r["truth_arcsec"], float)
+        e = r["estimators"]["em_growing_squarem"]
+        th = np.asarray(e["theta_final_arcsec"], float)
+        rows.append({
+            "sweep": r.get("sweep", "per_image"), "value": float(r.get("value", r["per_image"])),
+            "per_image": int(r["per_image"]), "attitude_sigma_arcsec": r.get("attitude_sigma_arcsec", math.nan),
+            "mode_drift_arcsec": r.get("mode_drift_arcsec", math.nan), "mag_limit": r.get("mag_limit", math.nan),
+            "images": int(r["images"]),
+            **{f"stars_per_image_{k}": float(v) for k, v in r.get("stars_per_image", {}).items()},
+            "crlb_x_arcsec": float(r["crlb_all_arcsec"][0]), "crlb_y_arcsec": float(r["crlb_all_arcsec"][1]),
+            "crlb_stars_only_x_arcsec": float(r["crlb_stars_only_arcsec"][0]) if "crlb_stars_only_arcsec" in r else math.nan,
+            "crlb_stars_only_y_arcsec": float(r["crlb_stars_only_arcsec"][1]) if "crlb_stars_only_arcsec" in r else math.nan,
+            "floor_arcsec": r.get("floor_arcsec", math.nan),
+            "em_est_x_mean_arcsec": float(th[:, 0].mean()), "em_est_y_mean_arcsec": float(th[:, 1].mean()),
+            "em_rmse_xy_arcsec": float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2))),
+            "em_label": row_label(e["label"])[0], "n_seeds": int(th.shape[0]),
+        })
+    return pd.DataFrame(rows)
+
+
 def stars_text(st: dict, target: float) -> str:
     """The manuscript's stars sentences, from :func:`stars_summary`: the estimates per stars per
     image, then the attitude-knowledge and magnitude sweeps and whether star calibration answers
