@@ -464,7 +464,8 @@ def owner_problems(results_dir: str | Path, root: str | Path, profile: str) -> l
     if owner.get("checkout") != here:
         return [f"invalid config key 'results_dir': {str(results_dir)!r} belongs to the checkout "
                 f"{owner.get('checkout')!r} ({marker}); two checkouts writing one folder take each other's "
-                "outputs as up to date: give this checkout its own results_dir"]
+                "outputs as up to date: give this checkout its own results_dir (or, if that checkout was moved "
+                "here, delete the marker)"]
     if owner.get("profile") not in (None, profile):
         return [f"invalid config key 'results_dir': {str(results_dir)!r} holds the {owner.get('profile')!r} "
                 f"profile's outputs ({marker}); give the {profile!r} profile its own results_dir"]
