@@ -17,7 +17,7 @@ A_METHODS = config["approach"]["methods"]
 A_SRC = with_kernels("approach", src(
     "approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
     "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
-    "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py",
+    "approach/setup.py", "approach/scenario.py", "approach/cases.py", "approach/pipeline.py", "approach/bounds.py",
     "approach/stars.py", "approach/consider.py"))
 
 

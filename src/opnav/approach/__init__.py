@@ -32,11 +32,17 @@ SPEC A.3c  convergence labels: distance to the ML estimate of the      em.ml_est
            data used, contraction per map toward it                    em.convergence_labels
 SPEC A.4   A-X2 alternatives: augmented EKF, batch ML (CasADi/IPOPT)   augmented.run_augmented, batch_ml.BatchML,      rad, arcsec
                                                                        alternatives.run_case_alternatives
+issue 44   compensation carrying theta_hat's covariance (Schmidt EKF)  consider.run_consider                           km, rad
+issue 44   star images of Hipparcos stars, attitude knowledge, drift   stars.star_field, stars.simulate,               rad, px
+                                                                       scenario.star_field_of
+issue 44   installation rows and the sample time read against model   readings.installation_check,                    arcsec, s
+                                                                       readings.sample_time_reading
 =========  ==========================================================  ==============================================  ====================
 
 Layers
     ``setup`` (the config parsed once, frozen) -> ``dynamics``, ``camera``, ``kalman`` ->
-    ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml`` -> ``scenario``,
-    ``cases`` -> ``pipeline``, ``alternatives``, ``study``, ``peers`` ->
-    ``report`` (tables and texts), ``plots``, ``peer_plots``; ``cli`` at the edge.
+    ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml``, ``consider`` ->
+    ``scenario``, ``cases`` -> ``pipeline``, ``alternatives``, ``study``, ``peers``,
+    ``readings`` -> ``report`` (tables and texts), ``plots``, ``peer_plots``, ``star_plots``;
+    ``cli`` at the edge.
 """

@@ -388,7 +388,7 @@ def label_bounds(setup: Setup, geo: sc.Geometry, case_list: list[Case], variant:
     (:func:`opnav.approach.pipeline.segment_bounds`), evaluated at the case's configured start
     theta, not its truth: the convergence label's scale (the bound changes with theta by a
     relative O(theta), about 1e-4 here)."""
-    from .pipeline import segment_bounds_many
+    from .bounds import segment_bounds_many
 
     items = [(geo.measurement_variance(c.sigma3_px), c.init_arcsec, False) for c in case_list]
     return [b[-1] for b in segment_bounds_many(setup, geo, items, variant)]
