@@ -319,6 +319,25 @@ def test_round_three_config_refused_naming_key(cls, overlay, key):
     assert all(line.startswith("invalid config key") for line in text.splitlines()), text
 
 
+@pytest.mark.parametrize("where", ["studies", "landing.scenarios", "approach.camera", "", "landing.mc.methods[0]"])
+def test_non_string_keys_given_in_process_are_refused(where):
+    """A config another reader made (Snakemake's YAML 1.1: `on:` is True) with a key that
+    is not a string: refused in one line naming where, before any layer sorts or indexes
+    by name (studies.plan's json.dumps raised TypeError). Mutation: dropping the
+    non_string_keys layer fails the studies and scenarios cases with a TypeError."""
+    cfg = _overlaid("landing: {mc: {methods: [{a: 1}]}}" if where.endswith("[0]") else "{}")
+    node = cfg
+    for part in filter(None, where.replace("[0]", "").split(".")):
+        node = node[part]
+    if where.endswith("[0]"):
+        node = node[0]
+    node[True] = {}
+    with pytest.raises(ConfigError) as err:
+        validate_config(cfg, root=REPO, workflow=True)
+    shown = where.split(".")[0] if where else "(top level)"
+    assert "the key True is not a string" in str(err.value) and shown in str(err.value), str(err.value)
+
+
 def test_quick_and_full_profiles_pass():
     validate_config(_overlaid("{}"), root=REPO, workflow=True)
     # a slow, nearly parabolic approach that does not reach Mars is legal

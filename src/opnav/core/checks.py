@@ -269,6 +269,9 @@ def study_rules(config: dict) -> list[str]:
     c = config["landing"]
     n_steps = max(1, round(c["duration_s"] / c["filter"]["dt_s"]))
     for name, spec in (config.get("studies") or {}).items():
+        if not isinstance(name, str):                   # a YAML 1.1 key (on:, 1:) given in process
+            out.append(f"invalid config key 'studies': the study name {name!r} is not a string")
+            continue
         if name in RESERVED_STUDY_NAMES or name.endswith("_outputs"):
             out.append(f"invalid config key 'studies.{name}': the name makes the rule study_{name}, which the "
                        "workflow has already (choose another name)")

@@ -165,6 +165,22 @@ def non_finite_keys(value: Any, path: tuple = ()) -> dict[str, float]:
     return out
 
 
+def non_string_keys(value: Any, path: tuple = ()) -> list[tuple[str, Any]]:
+    """(dotted key of the mapping, key) of every key that is not a string anywhere in
+    ``value`` (a config mapping as another reader than :mod:`opnav.core.yamlfile` made it)."""
+    out: list[tuple[str, Any]] = []
+    if isinstance(value, dict):
+        for n, v in value.items():
+            if not isinstance(n, str):
+                out.append((_dotted(path), n))
+            else:
+                out += non_string_keys(v, (*path, n))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            out += non_string_keys(v, (*path, i))
+    return out
+
+
 def _dotted(path) -> str:
     out = ""
     for p in path:
@@ -182,6 +198,10 @@ def schema_problems(config: dict, schema_path: Path = SCHEMA_PATH) -> list[str]:
     """The schema's problems of ``config`` (filling defaults in place), one line each naming
     its key: every number anywhere finite (:func:`non_finite_keys`), then the JSON schema
     (types, ranges, patterns, the registry of names; integer keys take ints only)."""
+    keys = non_string_keys(config)
+    if keys:        # every later layer indexes and sorts by name: refuse first
+        return [f"invalid {f'config key {where!r}' if where else 'config (top level)'}: the key {k!r} is not a "
+                "string (YAML 1.1 reads on/off/yes/no, null and numbers as such; quote it)" for where, k in keys]
     bad = non_finite_keys(config)
     lines = [f"invalid config key '{k}': {v} is not a finite number "
              "(NaN and infinity are refused)" for k, v in bad.items()]
