@@ -92,6 +92,9 @@ def label_columns(r: dict, target_arcsec: float) -> dict:
         "moved_arcsec": float(np.mean(r["moved_arcsec"])),
         "contraction_per_map": rate,
         "dist_to_ml_arcsec": dist,
+        # the label's scale (issue 44): the distance in 1-sigma bounds of the data used (max of tx, ty)
+        "dist_to_ml_over_bound": (float(np.mean(r["dist_to_ml_over_bound"])) if "dist_to_ml_over_bound" in r
+                                  else math.nan),
         "ml_x_mean": float(np.mean(r["theta_ml_arcsec"][:, 0])),
         "ml_y_mean": float(np.mean(r["theta_ml_arcsec"][:, 1])),
         "identifiable": bound <= target_arcsec,
@@ -561,6 +564,7 @@ def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame, roll_rate: 
             "nees_pos_true_theta_mean": _num(r, "nees_pos_true_theta_mean"),
             "contraction_per_map": _num(r, "contraction_per_map"),
             "dist_to_ml_arcsec": _num(r, "dist_to_ml_arcsec"),
+            "dist_to_ml_over_bound": _num(r, "dist_to_ml_over_bound"),
             "data_to_converge_samples": _num(r, "data_to_converge_samples"),
             "nav_err_before_km": r["nav_err_before_km"], "nav_err_after_km": r["nav_err_after_km"],
             **{k: _num(r, k) for k in NAV_SPLIT_KEYS},
