@@ -75,3 +75,34 @@ def test_quick_profile_packs_methods_full_profile_does_not(tmp_path):
     assert not [r for r, _ in full if r.startswith("landing_mc_pack")]
     chunks = [w for r, w in full if r == "landing_mc_chunk"]
     assert len(chunks) == len({(w["bscn"], w["bmethod"]) for w in chunks}) >= 2 * 4
+
+
+@pytest.mark.slow
+def test_a_study_value_in_a_pack_writes_what_its_own_job_writes(tmp_path):
+    """jobs.study_values_per_job: the quick profile's landing study pack (its params from
+    the workflow), its second value flown alone and after the first: the same table (and
+    each file holds its own value: swapping the pack's outputs fails this)."""
+    import pandas as pd
+
+    from opnav.core.snakeio import load_csv, mock_snakemake
+
+    script = REPO / "workflow" / "scripts" / "study_runs.py"
+    pack = next(sm for sm in (mock_snakemake(f"study_runs_pack{i}", configfiles=[REPO / "config" / "quick.yaml"])
+                              for i in (1, 2)) if sm.params.paper == "landing")
+    p = pack.params
+    assert len(p.sims) >= 2 and p.sims[0] != p.sims[1]
+
+    def job(idx, tag):
+        outs = [str(tmp_path / tag / f"{i}.csv") for i in idx]
+        smk = stand_in(output=outs, log=[str(tmp_path / tag / "job.log")],
+                       params={"paper": "landing", "sims": [p.sims[i] for i in idx], "units": [p.units[i] for i in idx],
+                               "runs": [p.runs[i] for i in idx], "labels": [p.labels[i] for i in idx]})
+        runpy.run_path(str(script), init_globals={"snakemake": smk})
+        return [load_csv(o) for o in outs]
+
+    (alone,) = job([1], "alone")
+    first, second = job([0, 1], "pack")
+    timed = [c for c in alone if c.endswith("_us")]   # measured planning times (wall, CPU): never equal twice
+    assert timed and len(timed) < len(alone.columns) // 4, timed
+    pd.testing.assert_frame_equal(alone.drop(columns=timed), second.drop(columns=timed))
+    assert not first.drop(columns=timed).equals(second.drop(columns=timed))

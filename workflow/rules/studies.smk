@@ -32,6 +32,18 @@ STUDY_SRC = {"landing": B_SRC + src("landing/study.py"),
              "approach": A_X2_SRC + src("approach/study.py")}
 
 
+# jobs.study_values_per_job > 1 (tiny profiles): each paper's study values (simulation
+# digests, in the order the studies list them) in packs of that many, one job per pack
+# (rules study_runs_pack1, ...) flying every chunk of each; rule study_runs flies the rest.
+_S_K = config["jobs"]["study_values_per_job"]
+STUDY_PACKS = []
+for _p in ("approach", "landing"):
+    _d = list(dict.fromkeys(d for (pp, d, _) in STUDY_JOB_UNITS if pp == _p))
+    STUDY_PACKS += [(_p, [u for u in STUDY_JOB_UNITS if u[0] == _p and u[1] in _d[i:i + _S_K]])
+                    for i in range(0, len(_d), _S_K)] if _S_K > 1 else []
+_S_PACKED = sorted({d for _, units in STUDY_PACKS for _, d, _ in units})
+
+
 rule study_runs:
     """One study job: a chunk of runs at one value (simulation config), every method
     (paper A: variant and estimator) that a study of that value compares."""
@@ -42,7 +54,7 @@ rule study_runs:
         f"{STUDIES_DIR}/runs/{{spaper}}/{{sdigest}}/{{schunk}}.csv",
     wildcard_constraints:
         spaper="approach|landing",
-        sdigest="[0-9a-f]+",
+        sdigest="".join(f"(?!{d}(?![0-9a-f]))" for d in _S_PACKED) + "[0-9a-f]+",   # not in a pack
         schunk=CHUNK_PATTERN,
     params:
         sim=lambda wc: STUDY_SIMS[wc.sdigest],
@@ -54,6 +66,32 @@ rule study_runs:
         f"{STUDIES_DIR}/benchmarks/runs_{{spaper}}_{{sdigest}}_{{schunk}}.tsv"
     script:
         "../scripts/study_runs.py"
+
+
+for _i, (_p, _units) in enumerate(STUDY_PACKS, 1):
+
+    rule:
+        """Several study values' jobs in one (jobs.study_values_per_job): each value's
+        chunks in turn, each written as rule study_runs writes it."""
+        name:
+            f"study_runs_pack{_i}"
+        input:
+            STUDY_SRC[_p],
+            kernels=kernels(_p),
+        output:
+            [f"{STUDIES_DIR}/runs/{_p}/{d}/{c}.csv" for _, d, c in _units],
+        params:
+            paper=_p,
+            sims=[STUDY_SIMS[d] for _, d, _ in _units],
+            runs=[chunk_runs(c) for _, _, c in _units],
+            units=[STUDY_JOB_UNITS[u] for u in _units],
+            labels=[f"{d} {c}" for _, d, c in _units],
+        log:
+            f"{STUDIES_DIR}/logs/runs_pack{_i}.log",
+        benchmark:
+            f"{STUDIES_DIR}/benchmarks/runs_pack{_i}.tsv"
+        script:
+            "../scripts/study_runs.py"
 
 
 STUDY_TARGETS = {}

@@ -18,6 +18,11 @@ code compiled in after the callee's file changed. A kernel's cache entry here is
 keyed by the content of every kernel module as well (:func:`kernel_set_digest`):
 editing any kernel module recompiles every kernel, once.
 
+A kernel becomes a numba dispatcher on its first call (:class:`LazyKernel`), so a job
+that imports a kernel module for its plain-Python parts (a table, a figure) does not
+import numba; a job that calls kernels loads only the signatures it calls. Each dispatch
+that loads or compiles is timed into the job's start-up (:mod:`opnav.core.startup`).
+
 A module that holds kernels registers a warm-up function with :func:`warms`; the
 function calls each of its kernels once with arguments of the types the pipeline
 passes (float64 arrays, int64 indices), so the cached signatures are the ones used.
@@ -28,6 +33,7 @@ import functools
 import hashlib
 import importlib
 import importlib.util
+import sys
 import time
 from pathlib import Path
 from typing import Callable
@@ -42,7 +48,7 @@ KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf"
                                     "opnav.landing.descent", "opnav.landing.imu")
 
 _WARMUPS: dict[str, Callable[[], None]] = {}
-_KERNELS: list = []  # every dispatcher made by kernel(), for cache_stats
+_KERNELS: list = []  # every LazyKernel made by kernel(), for cache_stats
 
 
 def kernel_sources(modules: tuple[str, ...] | None = None) -> list[Path]:
@@ -113,23 +119,96 @@ def _timed_dispatch(compile_for_args):
     return timed
 
 
+class LazyKernel:
+    """A kernel before its first use: the plain function (``py_func``) and the settings of
+    the numba dispatcher it becomes when first called (or asked for a dispatcher attribute,
+    ``stats``, ``signatures``...). A job that imports a kernel module and calls none of its
+    kernels (a table, a figure, the manuscript) does not import numba (0.2-0.4 CPU-s).
+
+    Once made, the dispatcher takes the proxy's place in the namespace of every loaded
+    module that holds the proxy (``from m import k`` included), so later calls go to numba
+    straight; a reference kept elsewhere (a tuple, a partial made before the first call)
+    goes through :meth:`__call__`, one Python call more. numba types a proxy it meets as a
+    global of a kernel it compiles as the dispatcher's type (:func:`_typeof_lazy`)."""
+
+    def __init__(self, f, settings: dict):
+        self.py_func = f
+        self._settings = settings
+        self._dispatcher = None
+        functools.update_wrapper(self, f)
+
+    def dispatcher(self):
+        """The numba dispatcher (made on first use)."""
+        d = self._dispatcher
+        if d is None:
+            d = self._dispatcher = _dispatcher(self.py_func, self._settings)
+            _rebind(self, d)
+        return d
+
+    def __call__(self, *args):
+        return self.dispatcher()(*args)
+
+    def __getattr__(self, name):  # only for names the proxy does not have: the dispatcher's
+        if name.startswith("__") or name in ("_dispatcher", "_settings", "py_func"):
+            raise AttributeError(name)
+        return getattr(self.dispatcher(), name)
+
+    def __repr__(self):
+        return f"<kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
+
+
+def _rebind(proxy: LazyKernel, d) -> None:
+    """Put dispatcher ``d`` where ``proxy`` is a module global (its own module, and every
+    loaded module that imported it by name)."""
+    home = proxy.py_func.__module__
+    for name, mod in list(sys.modules.items()):
+        if mod is None or not (name == home or name.split(".", 1)[0] == "opnav"):
+            continue
+        ns = getattr(mod, "__dict__", None)
+        if ns is None:
+            continue
+        for key, value in list(ns.items()):
+            if value is proxy:
+                ns[key] = d
+
+
+@functools.lru_cache(maxsize=None)
+def _register_typeof() -> None:
+    """numba's ``typeof`` of a :class:`LazyKernel` (a global of a kernel being compiled,
+    or an argument): its dispatcher's type."""
+    from numba.core.typing.typeof import typeof_impl
+
+    @typeof_impl.register(LazyKernel)
+    def _typeof_lazy(val, c):
+        return typeof_impl(val.dispatcher(), c)
+
+
+def _dispatcher(f, settings: dict):
+    """The numba dispatcher of kernel ``f``: numba's on-disk cache keyed by the kernel set
+    too, its dispatch misses timed (:func:`_timed_dispatch`)."""
+    from numba import njit
+
+    _register_typeof()
+    d = njit(**settings)(f)
+    if settings["cache"]:
+        d._cache = _kernel_cache_type()(d.py_func)  # keyed by the kernel set too
+    d._compile_for_args = _timed_dispatch(d._compile_for_args)
+    return d
+
+
 def kernel(fn=None, **options):
     """``numba.njit`` with the project's settings: on-disk cache, no fastmath (IEEE
-    results, so compiled and reference paths agree to round-off), the GIL released.
+    results, so compiled and reference paths agree to round-off), the GIL released; made
+    on first use (:class:`LazyKernel`: importing a kernel module does not import numba).
 
     Use as ``@kernel`` or ``@kernel(parallel=False)``.
     """
     settings = {"cache": True, "fastmath": False, "nogil": True, **options}
 
     def make(f):
-        from numba import njit
-
-        dispatcher = njit(**settings)(f)
-        if settings["cache"]:
-            dispatcher._cache = _kernel_cache_type()(dispatcher.py_func)  # keyed by the kernel set too
-        dispatcher._compile_for_args = _timed_dispatch(dispatcher._compile_for_args)
-        _KERNELS.append(dispatcher)
-        return dispatcher
+        proxy = LazyKernel(f, settings)
+        _KERNELS.append(proxy)
+        return proxy
 
     return make if fn is None else make(fn)
 
@@ -182,6 +261,7 @@ def cache_stats() -> dict[str, int]:
     """Kernel signatures this process took from the on-disk cache (``loaded``) and
     compiled itself (``compiled``, callees compiled for a caller included): after the
     workflow's ``compile_kernels`` a job should compile none."""
-    return {"loaded": sum(sum(d.stats.cache_hits.values()) for d in _KERNELS),
-            "compiled": sum(sum(d.stats.cache_misses.values()) for d in _KERNELS)}
+    made = [k._dispatcher for k in _KERNELS if k._dispatcher is not None]
+    return {"loaded": sum(sum(d.stats.cache_hits.values()) for d in made),
+            "compiled": sum(sum(d.stats.cache_misses.values()) for d in made)}
 
