@@ -71,3 +71,23 @@ def test_a_kernel_call_counts_as_compiling_then_as_loading(tmp_path):
     assert first["compile_s"] > 0 and first["kernels_s"] == 0, first
     assert second["kernels_s"] > 0 and second["compile_s"] == 0, second
     assert second["startup_s"] == second["before_work_s"] + second["imports_s"] + second["kernels_s"]
+
+
+def test_job_costs_reads_the_startup_figures(tmp_path):
+    """benchmarks/job_costs.startup_lines: the mean over the jobs' logs, compile_kernels'
+    logs left out (its compiling is its work), a log without the figure not counted."""
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    from job_costs import startup_lines, startups
+
+    line = ("2026-12-04 INFO job resources: cpu_s=9.0 user_s=8.0 sys_s=1.0 max_rss_mb=100.0 "
+            "startup_cpu_s={} before_work_s={} imports_s={} kernel_load_s={} kernel_compile_s=0.000\n")
+    for rel, vals in (("landing/logs/mc_a.log", (1.0, 0.5, 0.25, 0.25)),
+                      ("approach/logs/mc_b.log", (0.6, 0.4, 0.2, 0.0)),
+                      ("kernels/logs/compile_landing.log", (9.0, 1.0, 0.0, 8.0))):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(line.format(*vals))
+    (tmp_path / "landing" / "logs" / "old.log").write_text("job resources: cpu_s=1.0 user_s=1.0 sys_s=0.0 "
+                                                           "max_rss_mb=1.0\n")
+    assert sorted(p for p, *_ in startups(tmp_path)) == ["approach/logs/mc_b.log", "landing/logs/mc_a.log"]
+    text = "\n".join(startup_lines(tmp_path))
+    assert "mean 0.80 s over 2 jobs (before the work 0.45, imports during it 0.23, making kernels callable 0.12)" in text, text
