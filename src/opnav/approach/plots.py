@@ -329,6 +329,7 @@ def fig_alternatives(long, method_labels: dict):
                               label="before compensation" if j == 0 else None)
             if logy:
                 ax.set_yscale("log")
+                figures.plain_log_labels(ax.yaxis)
             ax.set_xticks(np.arange(len(variants)), variants)
             ax.set_ylabel(label)
         handles, labels = [], []
