@@ -133,7 +133,7 @@ def fig_study(tidy: pd.DataFrame, study: Mapping):
     nrow = math.ceil(len(metrics) / ncol)
     units = [(v, m) for v in (study["variants"] or [""]) for m in study["methods"]]
     with figures.style():
-        fig, axs = plt.subplots(nrow, ncol, figsize=(figures.PAGE_WIDTH_IN, 2.3 * nrow + 0.6),
+        fig, axs = plt.subplots(nrow, ncol, figsize=(figures.PAGE_WIDTH_IN, 1.8 * nrow + 0.45),
                                 squeeze=False, constrained_layout=True)
         for ax, metric in zip(axs.ravel(), metrics):
             bound = METRICS[study["paper"]][metric][1]
