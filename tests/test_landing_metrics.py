@@ -405,3 +405,36 @@ def test_paper_baselines_rank_identically_in_descent_geometry():
     orders = [np.argsort(make_metric(n)(ctx, cand)) for n in H_METRICS]
     np.testing.assert_array_equal(orders[0], orders[1])
     np.testing.assert_array_equal(orders[0], orders[2])
+
+
+@settings(max_examples=25, deadline=None)
+@given(r=lander, R=quat, seed=seeds)
+def test_lapack_svd_of_H_equals_the_closed_form(r, R, seed):
+    """svd_lapack (``kernels.h_lapack``: the 6 x 12 H built in place and numba's LAPACK SVD, the
+    "real SVD" timed beside the closed form) scores every candidate as svd's closed form
+    (``kernels.h_metric``) to round-off, invalid ones +inf alike. Mutation tried: the [b x]
+    block's sign flipped in one row fails."""
+    from opnav.landing.camera import Camera  # noqa: F401  (the planner's camera type)
+    from opnav.landing.landmarks import LandmarkField
+    from opnav.landing.planner import PlannerConfig, PlanState, candidate_scores, plan_one
+    from opnav.landing.scenario import build_scenario, camera_scenarios
+    from opnav.core.config import load_config
+
+    scn = _SCN.get("s") or _SCN.setdefault("s", build_scenario(camera_scenarios(load_config()["landing"])["interior"]))
+    rng = np.random.default_rng(seed)
+    cand = _ground(rng, 30, half=6000.0)
+    st_ = PlanState(np.asarray(r, float), V0, np.zeros(3), R, np.eye(12))
+    field = LandmarkField(np.ascontiguousarray(cand))
+    det = np.arange(len(cand))
+    out = {}
+    for m in ("svd", "svd_lapack"):
+        _, q = plan_one(m, st_, scn.camera, field, scn.planner, -1, det)
+        if q is None:
+            return
+        out[m] = candidate_scores(m, st_, scn.camera, field, scn.planner, q, det)
+    fin = np.isfinite(out["svd"])
+    assert np.array_equal(fin, np.isfinite(out["svd_lapack"]))
+    np.testing.assert_allclose(out["svd_lapack"][fin], out["svd"][fin], rtol=1e-9)
+
+
+_SCN: dict = {}

@@ -17,7 +17,8 @@ rule landing_timing:
         bscn=B_SCN_RE,
     params:
         landing=lambda wc: B_SIMS[wc.bscn],
-        methods=X1_METHODS,
+        # and a real (LAPACK) SVD of the same H beside svd's closed form (timed only: B-C4's "SVD")
+        methods=X1_METHODS + ["svd_lapack"],
         max_calls=config["landing"]["timing"]["max_calls"],
         max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
     priority: 10        # a long job on the critical path (speed only)

@@ -38,8 +38,11 @@ from opnav.landing import ekf
 from opnav.landing import measurement as me
 
 #: objective kinds compiled here (``q[11]``); the whitened ones are their H base + 5
-KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8, logdet_nav=9)
-DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W, COND_W, LOGDET_NAV = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
+KINDS = dict(depth=0, svd=1, gdop=2, cond=3, logdet=4, mineig=5, svd_w=6, gdop_w=7, cond_w=8, logdet_nav=9,
+             svd_lapack=10)
+DEPTH, SVD, GDOP, COND, LOGDET, MINEIG, SVD_W, GDOP_W, COND_W, LOGDET_NAV, SVD_LAPACK = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10
+#: structural rank of the paper's 6 x 12 H (two per unit bearing)
+H_RANK = 4
 #: q slots of the planned-information kinds (:func:`nav_constants`): R_LtoB (3 x 3, row-major),
 #: the prior P (12 x 12), velocity (m/s), acceleration (m/s^2), gravity (m/s^2), known landmark
 #: (m), sigma_f (rad), depth_sigma_frac, n_obs, dt (s), oc; from Q_TAB on, per planned image k
@@ -178,6 +181,32 @@ def h_metric(kind, x, y, c, s2) -> float:
     lp1 = m + math.sqrt(e2 + k1 * k1)
     lp2 = m + math.sqrt(e2 + k2 * k2)
     return sv_metric(kind, max(lp1, lp2), min(lp1, lp2), max(D1 / lp1, D2 / lp2), min(D1 / lp1, D2 / lp2))
+
+
+@kernel
+def h_lapack(r, R_LtoB, p_known, d0, d1, d2) -> float:
+    """svd (larger is better) of the candidate at offset d = p - r (m) by a real SVD: the 6 x 12
+    H of eq. 14-18 built in place (``measurement.line_of_sight``, ``measurement.blocks``: rows of
+    the known landmark [-H_C, 0, [b x], 0], of the candidate [-H_C, 0, [b x], H_C]) and numba's
+    LAPACK SVD of it, its fourth (smallest structural) singular value. The same metric as
+    :func:`h_metric`'s closed form to round-off; timed beside it (B-F7: which "SVD" is timed)."""
+    H = np.zeros((6, 12))
+    u, b, HC, p = np.empty(3), np.empty(3), np.empty((3, 3)), np.empty(3)
+    p[0], p[1], p[2] = r[0] + d0, r[1] + d1, r[2] + d2
+    for s in range(2):
+        inv = me.line_of_sight(r, p_known if s == 0 else p, u)
+        me.blocks(R_LtoB, u, inv, b, HC)
+        o = 3 * s
+        for i in range(3):
+            for j in range(3):
+                H[o + i, j] = -HC[i, j]
+                if s == 1:
+                    H[o + i, 9 + j] = HC[i, j]
+        H[o + 0, 7], H[o + 0, 8] = -b[2], b[1]              # [b x]
+        H[o + 1, 6], H[o + 1, 8] = b[2], -b[0]
+        H[o + 2, 6], H[o + 2, 7] = -b[1], b[0]
+    sv = np.linalg.svd(H)[1]
+    return sv[H_RANK - 1]
 
 
 @kernel
@@ -473,10 +502,12 @@ def score_point(p0, p1, p2, q) -> float:
         c0, c1, c2 = d1 * q[5] - d2 * q[4], d2 * q[3] - d0 * q[5], d0 * q[4] - d1 * q[3]  # d x v_hat
         return depth_error(rho, (d0 * q[3] + d1 * q[4] + d2 * q[5]) / rho,
                            math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / rho, q[12], q[13])
-    if kind >= LOGDET:
+    if LOGDET <= kind <= LOGDET_NAV:
         return planned(kind, d0, d1, d2, rho, q) if in_view(d0, d1, d2, rho, q) else math.inf
     if not candidate_ok(d0, d1, d2, rho, q):
         return math.inf
+    if kind == SVD_LAPACK:
+        return -h_lapack(q[0:3], q[Q_R:Q_R + 9].reshape((3, 3)), q[Q_NK:Q_NK + 3], d0, d1, d2)
     y = 1.0 / rho
     w0, w1, w2 = d0 * y, d1 * y, d2 * y
     u0, u1, u2 = q[14], q[15], q[16]
@@ -764,8 +795,13 @@ def plan_run(kind, r, v, a, R_LtoB, P, c, xyz, det, exclude, cells, work) -> Non
             st = ZERO_BASELINE
     elif st == OK:
         metric_constants(r, R_LtoB, c[C_BS:C_BS + 3], 1.0, c[C_PKNOWN:C_PKNOWN + 3], c[C_MINRANGE], q)
-        if kind >= LOGDET:
+        if LOGDET <= kind <= LOGDET_NAV:
             nav_constants(r, v, a, R_LtoB, P, c, q)
+        elif kind == SVD_LAPACK:                      # the attitude and site of the H it builds
+            for i in range(9):
+                q[Q_R + i] = R_LtoB[i // 3, i % 3]
+            for i in range(3):
+                q[Q_NK + i] = c[C_PKNOWN + i]
     if st != OK:
         out[3], out[8] = 0, st
         return

@@ -64,6 +64,9 @@ __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "Pl
            "available_methods", "alternative_path"]
 
 PATHS = ("compiled", "paper")
+#: compiled kinds whose paper path is another method's definition (svd_lapack: a real SVD of
+#: the 6 x 12 H, compiled; its definition is svd's, CasADi H and LAPACK)
+PAPER_OF = {"svd_lapack": "svd"}
 #: candidates closer than this to the lander are invalid (m; ``kernels.candidate_ok``)
 MIN_RANGE_M = 1e-6
 
@@ -188,7 +191,7 @@ def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera:
                                             p_known, pts, **kw)
     else:
         ctx = _metric_context(state, cfg, camera)
-        score = lambda pts: -metrics.make_metric(method).reference(ctx, pts)
+        score = lambda pts: -metrics.make_metric(PAPER_OF.get(method, method)).reference(ctx, pts)
 
     def f(beta, q):
         hit, x, y, z = K.ground_point(beta, q)

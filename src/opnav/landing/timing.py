@@ -37,10 +37,16 @@ interpreted code (the paper's definition, the pickers); on the
 ``t``-th call of a pass that pass's variants run in their configured order
 rotated left by ``t`` (never ordered by a clock), so slow drifts of the machine
 (frequency, other processes) fall on every method alike and every variant comes
-first in turn. A compiled call is timed warm, right after an untimed call of the same variant on
-the same inputs, so that it measures its own work and not the caches the call
-before it evicted; the interpreted calls (milliseconds of numpy, CasADi and
-LAPACK, which that work dominates) are timed once. Measured (interior, 30 calls
+first in turn. Every call is timed warm, right after an untimed call of the same variant on
+the same inputs (its pick), so that it measures its own work and not the caches the call
+before it evicted, and as the mean of back-to-back repetitions: the count doubles (1, 2, 4,
+...) until the bracket's CPU time reaches :data:`CLOCK_SHARE_INV` (20) times the clock's own
+cost, measured per replay (:func:`clock_cost_ns`: two perf_counter_ns and two thread_time_ns
+readings, ~2 us here against a 3-6 us compiled call, a third of a one-call bracket); so the
+clock is below 5 % of every timed bracket (:func:`clock_share` reports it; the interpreted
+calls, milliseconds, need one). ``svd_lapack`` (a real LAPACK SVD of the same H, compiled)
+is timed beside svd's closed form; :func:`vs_depth` compares depth with each, with paired
+bootstrap intervals over the replayed calls. Measured (interior, 30 calls
 of the quick profile, thread CPU, timed once): in a rotation each variant has the
 same predecessor on every call, and depth placed after svd_w (4-5 ms of compiled
 edge-call work) took 46-52 us a call against SVD's 14-21 us (-141 % and -215 %),
@@ -83,7 +89,8 @@ from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 
 __all__ = ["select_calls", "variants", "pass_keys", "paper_limited", "replay", "timed", "save", "load", "times_ns",
            "median_us", "time_reduction", "timed_calls", "method_text", "summary_frame", "median_evals",
-           "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us"]
+           "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us", "clock_cost_ns",
+           "clock_share", "CLOCK_SHARE_INV", "COMPILED_ONLY", "time_reduction_interval", "vs_depth", "VS_DEPTH"]
 
 
 # ----------------------------------------------------------------- replay
@@ -100,6 +107,11 @@ def select_calls(n_pool: int, max_calls: int, key: str = "landing.timing.max_cal
     return (np.arange(m, dtype=np.int64) * n) // m
 
 
+#: methods timed on the compiled path only (their paper path is another method's: svd_lapack's
+#: is svd's, the CasADi H and LAPACK SVD)
+COMPILED_ONLY = ("svd_lapack",)
+
+
 def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
     """The timed (method, path, PlannerConfig): every method on ``cfg``'s path
     (``"main"``), and, unless ``alt`` is false, every method with a search on the
@@ -111,7 +123,7 @@ def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
     out = []
     for m in methods:
         out.append((m, "main", cfg))
-        if alt and m not in PICKERS:
+        if alt and m not in PICKERS and m not in COMPILED_ONLY:
             out.append((m, "alt", alt_cfg))
     return out
 
@@ -216,6 +228,8 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
                 np.flatnonzero(visible(xyz)), d["plan_rng"][i])
 
     perf, thread = time.perf_counter_ns, time.thread_time_ns
+    clock_ns = clock_cost_ns()
+    reps = np.full((nc, nv), -1, np.int64)
     if nc:
         _, _, _, state, visible, exclude, det, words = inputs(0)
         for m, _, cfg in var:                                     # warm-up, untimed
@@ -242,21 +256,28 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
                 order = group[timed_[q, group]]
                 for s_, v in enumerate(np.roll(order, -(t % len(order)))):
                     m, _, cfg = var[v]
-                    if key[1] == 0:                 # compiled: the kernel's call, warm (module docstring)
-                        res = plan(m, state, cam, field_, visible, cfg, exclude=exclude,
-                                   rng=rng_from_words(words), detected=det, diagnose=False)
+                    # the pick from an untimed call (the descent's stream for a picker), then
+                    # the timed call: the kernel's call (compiled) or plan() (interpreted), warm
+                    res = plan(m, state, cam, field_, visible, cfg, exclude=exclude,
+                               rng=rng_from_words(words), detected=det, diagnose=False)
+                    if key[1] == 0:
                         call = compiled_call(m, state, cam, field_, cfg, next(iter(exclude), -1), det)
                     else:
-                        rng = rng_from_words(words)
                         call = functools.partial(plan, m, state, cam, field_, visible, cfg, exclude=exclude,
-                                                 rng=rng, detected=det, diagnose=False)
-                    t0 = perf()
-                    c0 = thread()
-                    out = call()
-                    c1 = thread()
-                    t1 = perf()
-                    res = res if key[1] == 0 else out
-                    wall[q, v], cpu[q, v] = t1 - t0, c1 - c0
+                                                 rng=rng_from_words(words), detected=det, diagnose=False)
+                    n_rep = 1
+                    while True:                     # back to back until the clock is < 5 % (REPS_RULE)
+                        t0 = perf()
+                        c0 = thread()
+                        for _ in range(n_rep):
+                            call()
+                        c1 = thread()
+                        t1 = perf()
+                        if c1 - c0 >= CLOCK_SHARE_INV * clock_ns or n_rep >= MAX_REPS:
+                            break
+                        n_rep *= 2
+                    wall[q, v], cpu[q, v] = (t1 - t0) // n_rep, (c1 - c0) // n_rep
+                    reps[q, v] = n_rep
                     pick[q, v], evals[q, v], slot[q, v] = res.index, res.n_evals, s_
                 if t % 64 == 63:
                     gc.collect()
@@ -277,9 +298,47 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
             "variant_method": np.array([v[0] for v in var]),
             "variant_path": np.array([v[1] for v in var]),
             "variant_eval_path": np.array([v[2].eval_path for v in var]),
-            "mismatch": mismatch, "checked": checked,
+            "mismatch": mismatch, "checked": checked, "reps": reps, "clock_ns": np.float64(clock_ns),
             "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls),
             "max_calls_paper": np.int64(max_calls_paper)}
+
+
+#: the clock's share of a timed bracket stays below 1 / CLOCK_SHARE_INV (5 %): a call is
+#: repeated back to back, doubling the count, until the bracket's CPU time reaches
+#: CLOCK_SHARE_INV times the clock's own cost (:func:`clock_cost_ns`); the time is the mean
+#: of that bracket's calls (the shorter brackets before it are its warm-up)
+CLOCK_SHARE_INV, MAX_REPS = 20, 1 << 16
+
+
+def clock_cost_ns(n: int = 2000, repeats: int = 5) -> float:
+    """The cost (ns, thread CPU) of one empty timing bracket as :func:`replay` uses it (two
+    ``perf_counter_ns`` and two ``thread_time_ns`` calls): the smallest of ``repeats`` means
+    over ``n`` brackets."""
+    perf, thread = time.perf_counter_ns, time.thread_time_ns
+    best = math.inf
+    for _ in range(repeats):
+        a = thread()
+        for _ in range(n):
+            perf()
+            thread()
+            thread()
+            perf()
+        best = min(best, (thread() - a) / n)
+    return float(best)
+
+
+def clock_share(tm: dict) -> dict:
+    """The clock's measured cost (ns) and its share of the timed brackets (%, ``clock / (reps x
+    call)``): median and maximum over the timed cells, and the repetition counts' range."""
+    reps = np.asarray(tm.get("reps", []))
+    ok = timed(tm) & (reps > 0) if reps.size else np.zeros(0, bool)
+    if not ok.any():
+        return {"clock_ns": float(tm.get("clock_ns", math.nan)), "share_pct_median": None,
+                "share_pct_max": None, "reps_min": None, "reps_max": None}
+    cpu = np.maximum(np.asarray(tm["cpu_ns"])[ok], 1)
+    share = 100.0 * float(tm["clock_ns"]) / (reps[ok] * cpu)
+    return {"clock_ns": float(tm["clock_ns"]), "share_pct_median": float(np.median(share)),
+            "share_pct_max": float(share.max()), "reps_min": int(reps[ok].min()), "reps_max": int(reps[ok].max())}
 
 
 def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
@@ -373,6 +432,33 @@ def median_us(tm: dict, method: str, path: str = "main", clock: str = "wall") ->
     return float(np.median(t) / 1e3) if t.size else math.nan
 
 
+def _reductions(tm: dict, a: str, b: str, clock: str, path_a: str, path_b: str, n_boot: int,
+                seed: int) -> tuple[float, np.ndarray]:
+    """(reduction %, its bootstrap replicates) of :func:`time_reduction`."""
+    if clock not in ("wall", "cpu"):
+        raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
+    ja, jb = _variant(tm, a, path_a), _variant(tm, b, path_b)
+    if ja is None or jb is None:
+        return math.nan, np.zeros(0)
+    both = timed(tm)[:, ja] & timed(tm)[:, jb]
+    if not both.any():
+        return math.nan, np.zeros(0)
+    t = np.asarray(tm[f"{clock}_ns"])[both]
+    ta, tb = t[:, ja], t[:, jb]
+    red = 100.0 * (1.0 - float(np.median(ta)) / float(np.median(tb)))
+    key = (np.asarray(tm["source"]) * (1 << 32) + np.asarray(tm["run"]))[both]
+    clusters, inv = np.unique(key, return_inverse=True)
+    if len(clusters) < 2 or n_boot < 2:
+        return red, np.zeros(0)
+    rng = np.random.default_rng(seed)
+    members = [np.flatnonzero(inv == c) for c in range(len(clusters))]
+    vals = np.empty(n_boot)
+    for i in range(n_boot):
+        idx = np.concatenate([members[c] for c in rng.integers(len(clusters), size=len(clusters))])
+        vals[i] = 100.0 * (1.0 - np.median(ta[idx]) / np.median(tb[idx]))
+    return red, vals
+
+
 def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str = "main",
                    path_b: str = "main", n_boot: int = 200, seed: int = 0) -> tuple[float, float]:
     """``100 (1 - median_a / median_b)`` (%) of the planning times of methods
@@ -382,28 +468,42 @@ def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str
     resampled with replacement, both methods from the same resample (paired).
     ``nan`` if a variant is missing or no call was timed on both; the spread is
     ``nan`` below two clusters or two resamples."""
-    if clock not in ("wall", "cpu"):
-        raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
-    ja, jb = _variant(tm, a, path_a), _variant(tm, b, path_b)
-    if ja is None or jb is None:
-        return math.nan, math.nan
-    both = timed(tm)[:, ja] & timed(tm)[:, jb]
-    if not both.any():
-        return math.nan, math.nan
-    t = np.asarray(tm[f"{clock}_ns"])[both]
-    ta, tb = t[:, ja], t[:, jb]
-    red = 100.0 * (1.0 - float(np.median(ta)) / float(np.median(tb)))
-    key = (np.asarray(tm["source"]) * (1 << 32) + np.asarray(tm["run"]))[both]
-    clusters, inv = np.unique(key, return_inverse=True)
-    if len(clusters) < 2 or n_boot < 2:
-        return red, math.nan
-    rng = np.random.default_rng(seed)
-    members = [np.flatnonzero(inv == c) for c in range(len(clusters))]
-    vals = np.empty(n_boot)
-    for i in range(n_boot):
-        idx = np.concatenate([members[c] for c in rng.integers(len(clusters), size=len(clusters))])
-        vals[i] = 100.0 * (1.0 - np.median(ta[idx]) / np.median(tb[idx]))
-    return red, float(np.std(vals, ddof=1))
+    red, vals = _reductions(tm, a, b, clock, path_a, path_b, n_boot, seed)
+    return red, (float(np.std(vals, ddof=1)) if vals.size >= 2 else math.nan)
+
+
+def time_reduction_interval(tm: dict, a: str, b: str, *, clock: str = "cpu", path_a: str = "main",
+                            path_b: str = "main", n_boot: int = 1000, seed: int = 0,
+                            level: float = 0.95) -> tuple[float, float, float]:
+    """(reduction %, lo, hi): :func:`time_reduction` with its ``level`` percentile interval over
+    the same paired cluster bootstrap of the replayed calls (nan where it has none)."""
+    red, vals = _reductions(tm, a, b, clock, path_a, path_b, n_boot, seed)
+    if vals.size < 2:
+        return red, math.nan, math.nan
+    q = 100.0 * (1.0 - level) / 2.0
+    lo, hi = np.percentile(vals, [q, 100.0 - q])
+    return red, float(lo), float(hi)
+
+
+#: the planning-time comparisons with depth the summary reports (B-C4): (method, path, label)
+VS_DEPTH = (("svd", "main", "svd_closed_form"), ("svd_lapack", "main", "svd_lapack"),
+            ("svd", "alt", "svd_paper"), ("gdop", "main", "gdop"), ("cond", "main", "cond"))
+
+
+def vs_depth(tm: dict, clock: str = "cpu") -> dict:
+    """Depth's planning time against each of :data:`VS_DEPTH` timed in ``tm``: per label the
+    median call (us) of both on the calls timed on both, and depth's reduction (%) with its
+    95 % paired bootstrap interval over the replayed calls (clusters by run); depth on the
+    same path as the baseline (the paper path against svd's paper path)."""
+    out = {}
+    for m, path, label in VS_DEPTH:
+        if _variant(tm, m, path) is None or _variant(tm, "depth", path) is None:
+            continue
+        red, lo, hi = time_reduction_interval(tm, "depth", m, clock=clock, path_a=path, path_b=path)
+        out[label] = {"method": m, "path": path, "depth_median_us": median_us(tm, "depth", path, clock=clock),
+                      "median_us": median_us(tm, m, path, clock=clock), "depth_reduction_pct": red,
+                      "depth_reduction_lo_pct": lo, "depth_reduction_hi_pct": hi}
+    return out
 
 
 def less_time_text(reduction_pct: float) -> str:
@@ -424,7 +524,7 @@ def method_summary(tm: dict) -> dict:
             "timed_calls_paper": _paper_calls(tm), "max_calls_paper": int(tm.get("max_calls_paper", 0)),
             "n_methods": int(len(tm["methods"])), "checked_calls": int(np.sum(tm["checked"])),
             "pick_mismatches": int(np.sum(tm["mismatch"])),
-            "sources_text": ", ".join(str(x) for x in tm["sources"])}
+            "sources_text": ", ".join(str(x) for x in tm["sources"]), "clock": clock_share(tm)}
 
 
 def _paper_calls(tm: dict) -> int:
@@ -447,11 +547,17 @@ def method_text(tm: dict) -> str:
              f"; the paper's definition (interpreted, CasADi H) on {npaper} of them, evenly spaced "
              f"(landing.timing.max_calls_paper = {int(tm.get('max_calls_paper', 0))}), its medians "
              "and its comparisons on those calls")
+    cs = clock_share(tm)
+    clock = ("" if cs["share_pct_max"] is None else
+             f" Each call is timed as the mean of back-to-back repetitions (a doubling count, "
+             f"{cs['reps_min']} to {cs['reps_max']}) until the clock's own cost "
+             f"({cs['clock_ns']:.0f} ns a bracket, measured) is below 5 % of the bracket: "
+             f"{cs['share_pct_median']:.2f} % median, {cs['share_pct_max']:.2f} % at most.")
     return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
             "every method's planning call, one call at a time, interleaved across methods in one "
             f"process (order rotated per call), the same states for every method{paper}; wall clock "
             "perf_counter_ns, CPU clock thread_time_ns; replayed picks equal to the recorded ones "
-            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls.")
+            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + clock)
 
 
 def summary_frame(tm: dict):
