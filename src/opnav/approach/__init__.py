@@ -15,14 +15,14 @@ eq.        what                                                        function 
                                                                        camera.misalignment_exact
 6          EKF time and measurement update (the one predict and the   kalman.predict, kalman.condition_on;            km, km/s
            one update of every filter here), batched over seeds        ekf.run_filter, ekf.predict_only
-7-9        RTS smoother (gain, mean, covariance)                       smoother.rts (smoother.bryson_frazier,          km, km/s
-                                                                       the same moments)
+7-9        RTS smoother (gain, mean, covariance)                       smoother.bryson_frazier (the same moments;      km, km/s
+                                                                       RTS form: tests/approach_reference.rts)
 10-14      observed-data log-likelihood, prediction-error form         kalman.innovation_loglik (ekf.run_filter)       nats
-18         lag-one smoothed cross-covariance P_{k,k-1|N}               smoother.rts (gain form),                       km^2...
-                                                                       smoother.lag_one_recursive
-21-22      expected complete-data log-likelihood Q(theta|theta_r)      em.expected_complete_loglik                     nats
-23, 26     Tr(R^-1 B(theta)) and its closed-form minimiser (M-step)    em.trace_RinvB; em.estep, em.mstep              rad
-24-25      smoothed moments X_{k|N}, P_{k|N}                           smoother.rts                                    km, km/s
+18         lag-one smoothed cross-covariance P_{k,k-1|N}               tests/approach_reference.rts (gain form),       km^2...
+                                                                       .lag_one_recursive (the E-step needs none)
+21-22      expected complete-data log-likelihood Q(theta|theta_r)      tests/approach_reference.expected_complete_loglik nats
+23, 26     Tr(R^-1 B(theta)) and its closed-form minimiser (M-step)    em.estep, em.mstep (reference: .trace_RinvB)    rad
+24-25      smoothed moments X_{k|N}, P_{k|N}                           smoother.bryson_frazier                         km, km/s
 27         H_k = [-A_m^c A_c^i, 0] (sign: d/d r, not d/d r_pM)         ekf.measurement_jacobian                        km/km
 sec. 2.3   segment-wise EM-EKF (N0, N, M, L), Table 1                  cases.run_cases, setup.Segments.windows,        arcsec, km, samples
                                                                        em.em_window

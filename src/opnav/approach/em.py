@@ -197,48 +197,6 @@ def mstep(st: EStats, theta: np.ndarray, tz_tol: float = 1e-6) -> tuple[np.ndarr
     return theta + step, ~keep
 
 
-def trace_RinvB(theta: np.ndarray, z: np.ndarray, s: SmootherResult, win: Window) -> np.ndarray:
-    """Tr(sum R_k^-1 B_k(theta)) evaluated directly from eq. 23 (S,), for checks.
-
-    ``B_k = H P_{k|N} H^T + (z_k - h(X_{k|N}))(...)^T`` with the small-angle ``H``.
-    """
-    from .camera import misalignment_small
-
-    A = misalignment_small(theta)  # (S,3,3)
-    H = -np.einsum("sij,kjl->skil", A, win.C[1:])
-    u = win.u_ref[1:] - np.einsum("kij,skj->ski", win.C[1:], s.xs[:, 1:, :3])
-    res = z[:, 1:] - np.einsum("sij,skj->ski", A, u)
-    w = win.weights(z.shape[0])
-    HPH = np.einsum("skij,skjl,skml->skim", H, s.Ps[:, 1:, :3, :3], H)
-    return (np.einsum("ski,skii->s", w, HPH) + np.einsum("ski,ski,ski->s", w, res, res))
-
-
-def expected_complete_loglik(theta: np.ndarray, z: np.ndarray, s: SmootherResult, win: Window,
-                             mu0: np.ndarray, P0: np.ndarray) -> np.ndarray:
-    """Eq. 21 without constants: the E-step function Q(theta | theta_r) (S,).
-
-    Uses the A term (eq. 22) with the lag-one smoothed covariance ``P_{k,k-1|N}``.
-    """
-    n = win.n
-    P0 = np.broadcast_to(P0, (z.shape[0], 6, 6))
-    d0 = s.xs[:, 0] - mu0
-    E0 = s.Ps[:, 0] + np.einsum("si,sj->sij", d0, d0)
-    val = -0.5 * (np.linalg.slogdet(P0)[1] + np.trace(np.linalg.solve(P0, E0), axis1=1, axis2=2))
-    Qinv = np.linalg.inv(win.Q)
-    val -= 0.5 * n * np.linalg.slogdet(win.Q)[1]
-    Aterm = 0.0
-    for k in range(1, n + 1):
-        Phi = win.Phi[k]
-        dm = s.xs[:, k] - s.xs[:, k - 1] @ Phi.T
-        Ak = (np.einsum("si,sj->sij", dm, dm) + s.Ps[:, k] - s.Plag[:, k] @ Phi.T
-              - Phi @ s.Plag[:, k].transpose(0, 2, 1) + Phi @ s.Ps[:, k - 1] @ Phi.T)
-        Aterm = Aterm + np.einsum("ij,sji->s", Qinv, Ak)
-    val -= 0.5 * Aterm
-    val += 0.5 * np.log(win.weights(z.shape[0])).sum(axis=(1, 2))
-    val -= 0.5 * trace_RinvB(theta, z, s, win)
-    return val
-
-
 @dataclass
 class EMTrace:
     """Per-evaluation history of one EM run over a window."""
