@@ -498,13 +498,15 @@ def planning_time_text(vs: dict, clock: dict) -> str:
     """The manuscript's sentence on planning time (CPU, per call) from ``timing.vs_depth`` and
     ``timing.clock_share``: depth against SVD's closed form, a LAPACK SVD of the same H and the
     paper's definition, each with its paired 95 % interval, and the clock's measured cost."""
+    from opnav.landing import timing as tmg
+
     def part(label, name):
         v = vs.get(label)
         if not v:
             return None
         return (f"{v['depth_median_us']:.2f} against {v['median_us']:.2f} us for {name} (depth "
-                f"{v['depth_reduction_pct']:+.1f} % less, 95 % interval [{v['depth_reduction_lo_pct']:+.1f}, "
-                f"{v['depth_reduction_hi_pct']:+.1f}] %)")
+                f"{tmg.less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
+                f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %)")
     parts = [p for p in (part("svd_closed_form", "the closed-form SVD"),
                          part("svd_lapack", "a LAPACK SVD of the same H"),
                          part("svd_paper", "the paper's definition of SVD (interpreted, depth likewise)")) if p]
