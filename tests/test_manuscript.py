@@ -102,6 +102,8 @@ def test_prose_typography():
     assert r"$\theta$" in t and r"$10^{6}$" in t and r"$\rho\theta$" in t
     assert r"29\,\%" in t and r"\textmu s" in t and r"$^{-0.99}$" in t and r"a\_b" in t
     assert "+-" not in t and "theta" not in t.replace(r"\theta", "")
+    # a component subscript stays a subscript (the plan's "theta_x" printed as theta\_x)
+    assert prose_tex("larger of theta_x and theta_y") == r"larger of $\theta_x$ and $\theta_y$"
 
 
 def test_table1_grouped_has_one_column_group_per_variant_and_marks_unconverged():
