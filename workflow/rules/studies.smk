@@ -86,6 +86,9 @@ for _i, (_p, _units) in enumerate(STUDY_PACKS, 1):
             runs=[chunk_runs(c) for _, _, c in _units],
             units=[STUDY_JOB_UNITS[u] for u in _units],
             labels=[f"{d} {c}" for _, d, c in _units],
+        resources:  # SLURM: a dynamic rule has no profiles/slurm entry; study_runs' per value
+            runtime=10 * len(_units),
+            mem_mb=1000,
         log:
             f"{STUDIES_DIR}/logs/runs_pack{_i}.log",
         benchmark:
