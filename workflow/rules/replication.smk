@@ -122,10 +122,11 @@ if REP_CFG["enabled"]:
             single=f"{LANDING}/single/summary_{{bscn}}.json",
             tuning=f"{LANDING}/tuning.json",
             code=src("landing/montecarlo.py", "landing/timing.py", "landing/report.py", "landing/equivalence.py",
-                     "landing/ranking.py"),
+                     "landing/ranking.py", "landing/trajectory.py"),
         output:
             t3=table_outputs(f"{REP}/landing/B-T3_summary_{{bscn}}"),
             summary=f"{REP}/landing/summaries/B-summary_{{bscn}}.json",
+            end_phase=table_outputs(f"{REP}/landing/B-T3_end_phase_{{bscn}}"),
             f6=figure_outputs(f"{REP}/landing/B-F6_nav_error_envelopes_{{bscn}}"),
             f7=figure_outputs(f"{REP}/landing/B-F7_planning_time_{{bscn}}"),
         wildcard_constraints:
@@ -139,6 +140,7 @@ if REP_CFG["enabled"]:
             eval_path=config["landing"]["planner"]["eval_path"],
             landing=cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg",
                         "terminal_accel_mps2"),
+            cutoff={k: config["landing"]["filter"][k] for k in ("min_update_altitude_m", "update_altitude_margin_m")},
         log:
             f"{REP}/logs/landing_summary_{{bscn}}.log",
         localrule: True
