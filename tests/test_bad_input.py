@@ -390,6 +390,35 @@ def test_schema_limits_are_numbers():
         walk(yaml.safe_load(f.read_text()))
 
 
+def test_every_number_of_the_schema_has_a_minimum_and_a_maximum():
+    """Issue 46 item 1: a number without a physical maximum let 1e300 through (a tolerance
+    of 1e300 labelled every run converged). Walks every schema file, $defs followed.
+    Mutation: deleting approach.roll.rate_deg_s' maximum fails it."""
+    def walk(node, path, defs, out):
+        if isinstance(node, dict):
+            ref = node.get("$ref", "")
+            if ref.startswith("#/$defs/"):
+                walk(defs[ref.split("/")[-1]], path, defs, out)
+            if node.get("type") in ("number", "integer"):
+                lo = "minimum" in node or "exclusiveMinimum" in node
+                hi = "maximum" in node or "exclusiveMaximum" in node
+                if not (lo and hi):
+                    out.append(path)
+            for k, v in node.get("properties", {}).items():
+                walk(v, f"{path}.{k}", defs, out)
+            for key in ("items", "additionalProperties"):
+                if isinstance(node.get(key), dict):
+                    walk(node[key], f"{path}[]", defs, out)
+            for i, v in enumerate(node.get("prefixItems", [])):
+                walk(v, f"{path}[{i}]", defs, out)
+
+    open_ = []
+    for f in sorted((REPO / "src" / "opnav" / "schemas").glob("*.yaml")):
+        schema = yaml.safe_load(f.read_text())
+        walk(schema, f.stem, schema.get("$defs", {}), open_)
+    assert not open_, open_
+
+
 @pytest.mark.slow
 def test_snakefile_refuses_before_any_job(tmp_path):
     """The workflow's own validation: no job runs, the key is named, nothing is written."""
