@@ -6,9 +6,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from opnav.core import published
-from opnav.approach import cases, pipeline, report
+from opnav.approach import cases, labels, pipeline, summaries
 from opnav.approach import scenario as sc
 from opnav.approach.setup import Setup
+from opnav.report import approach_text
 
 from approach_helpers import approach_cfg
 
@@ -42,7 +43,7 @@ def test_seventeen_cases_in_five_groups_match_published_ids():
 
 def test_table1_columns_and_published_values(small):
     cfg, res = small
-    t1 = report.table1_frame(res, published.paper_a())
+    t1 = summaries.table1_frame(res, published.paper_a())
     for c in REQUIRED:
         assert c in t1.columns
     assert {"pub_est_x_mean", "pub_est_y_mean", "pub_nav_err_before_km", "pub_nav_err_after_km",
@@ -58,18 +59,18 @@ def test_table1_columns_and_published_values(small):
 
 def test_verdict_text_comes_from_the_numbers(small):
     cfg, res = small
-    t1 = report.table1_frame(res, published.paper_a())
+    t1 = summaries.table1_frame(res, published.paper_a())
     geo = {v: sc.build_geometry(cfg, v) for v in cfg["variants"]}
     case = cases.headline_case(cfg)
     curves = {v: pipeline.bound_curve(cfg, g, sc.measurement_variance(g, cfg, case.sigma3_px),
                                       case.truth_arcsec, v) for v, g in geo.items()}
-    x1 = report.crlb_rows(cfg, curves, {}, t1)
-    text = report.identifiability_text(cfg, x1)
+    x1 = summaries.crlb_rows(cfg, curves, {}, t1)
+    text = approach_text.identifiability_text(cfg, x1)
     lit = x1[x1.variant == "literal"].iloc[0]
     assert not lit["bound_reaches_target"]
     assert "**literal**" in text and "CANNOT support 2 arcsec" in text
     assert f"{lit['crlb_x_total_arcsec']:.2f}" in text
-    summ = report.summary(cfg, t1, x1)
+    summ = summaries.summary(cfg, t1, x1)
     assert set(summ["variants"]) == {"literal", "reference-start+squarem"}
     assert np.isfinite(summ["variants"]["literal"]["crlb_x_arcsec"])
 
@@ -81,22 +82,22 @@ def _summary_row(scenario, est, bound, label, dist=0.0, rate=0.2):
             "crlb_all_x_arcsec": bound, "label": label, "stalled": label == "stalled",
             "stalled_seeds": 4 if label == "stalled" else 0, "n_seeds": 4, "dist_to_ml_arcsec": dist,
             "data_to_converge_samples": 250.0,
-            "reading": report.reading_text(label, counts, 4, bound, 2.0, dist, rate,
-                                           report.bound_cause(sc.START_OF[scenario], "sliding", 50))}
+            "reading": labels.reading_text(label, counts, 4, bound, 2.0, dist, rate,
+                                           labels.bound_cause(sc.START_OF[scenario], "sliding", 50))}
 
 
 @pytest.mark.parametrize("lit_bound, roll_stalled", [(20.6, True), (1.0, False)])
 def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalled):
     """The finding sentences come out the other way when the numbers do (nothing fixed)."""
     cfg = approach_cfg()
-    summ = {"prior_bound_arcsec": report.prior_bound_arcsec(cfg), "convergence_max_maps": 40, "variants": {
+    summ = {"prior_bound_arcsec": summaries.prior_bound_arcsec(cfg), "convergence_max_maps": 40, "variants": {
         "literal": _summary_row("literal", (0.0, 0.0), lit_bound, "converged"),
         "roll": _summary_row("roll", (0.02, 0.07) if roll_stalled else (10.0, 20.0), 8.2 if roll_stalled else 0.1,
                              "stalled" if roll_stalled else "converged", dist=16.6 if roll_stalled else 0.0,
                              rate=0.999 if roll_stalled else 0.2),
     }}
     pub = published.paper_a()["headline"]
-    txt = report.findings(cfg, summ, pub)
+    txt = approach_text.findings(cfg, summ, pub)
     assert ("no variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
     assert ("add almost nothing to the prior" in txt["bound"]) is bool(lit_bound > 0.8 * summ["prior_bound_arcsec"])
     assert ("stalled (4/4)" in txt["headline_roll"]) is roll_stalled
@@ -108,7 +109,7 @@ def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalle
     assert "stalled" not in txt["headline_literal"]
     assert ("within 3 bound-sigma of the truth: roll." in txt["reading"]) is (not roll_stalled)
     assert ("No row is converged, identifiable" in txt["reading"]) is roll_stalled
-    assert f"{report.prior_bound_arcsec(cfg):.3g} arcsec" in txt["bound"]
+    assert f"{summaries.prior_bound_arcsec(cfg):.3g} arcsec" in txt["bound"]
 
 
 @settings(max_examples=200, deadline=None)

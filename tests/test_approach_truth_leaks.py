@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from opnav.approach import alternatives, cases, pipeline, report
+from opnav.approach import alternatives, cases, pipeline, summaries
 from opnav.approach import scenario as sc
 from opnav.approach.setup import Setup
 
@@ -93,7 +93,7 @@ def test_the_fixed_prior_error_stays_when_the_data_cannot_tell():
     (bound about sigma_r / rho), so the estimate cannot remove that error: its seed-mean error is
     of the order of the bound, not of the noise. A prior mean at the truth would remove it."""
     r, bound, truth = _run("prior", "fixed", seeds=range(3))
-    prior_alone = report.prior_bound_arcsec(_cfg("fixed"))  # sigma_r / rho
+    prior_alone = summaries.prior_bound_arcsec(_cfg("fixed"))  # sigma_r / rho
     assert bound[0] > 0.5 * prior_alone  # the data cannot tell theta much better than the prior
     err = np.abs(r["theta_final_arcsec"][:, :2].mean(0) - truth[:2])
     assert err.max() >= 0.25 * bound[:2].max(), (err, bound)

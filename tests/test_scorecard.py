@@ -49,7 +49,7 @@ def test_score_rows_keeps_prejudged_claims():
 def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
     import pandas as pd
 
-    from opnav.approach.report import rows_paper_a
+    from opnav.report.approach_scorecard import rows_paper_a
 
     t1 = pd.DataFrame([{
         "variant": "literal", "case_id": "T1-01", "truth_x_arcsec": 10.0, "truth_y_arcsec": 20.0,
@@ -126,7 +126,8 @@ def test_rows_paper_b_per_scenario_from_the_summary():
 def test_a_stalled_em_row_says_so_in_the_reason_and_never_converged():
     import pandas as pd
 
-    from opnav.approach.report import reading_text, rows_paper_a
+    from opnav.approach.labels import reading_text
+    from opnav.report.approach_scorecard import rows_paper_a
 
     base = {"variant": "roll", "case_id": "T1-01", "truth_x_arcsec": 10.0, "truth_y_arcsec": 20.0,
             "est_x_mean": 0.02, "est_x_std": 0.002, "crlb_x_arcsec": 8.2, "crlb_y_arcsec": 8.2,

@@ -123,7 +123,7 @@ rule approach_stars_outputs:
     and magnitude limit)."""
     input:
         stars=f"{A_WORK}/stars.pkl",
-        code=src("approach/report.py", "approach/star_plots.py", "core/figures.py", "core/tables.py",
+        code=src("approach/summaries.py", "approach/labels.py", "approach/star_plots.py", "core/figures.py", "core/tables.py",
                  "opnav.mplstyle"),
     output:
         table=report_table(f"{APPROACH}/A-X6_stars", "A-X6", "Paper A"),
@@ -144,7 +144,8 @@ rule approach_tables:
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
         stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
-        code=src("approach/report.py", "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
+        code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
+                 "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
         x1=report_table(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),

@@ -38,7 +38,7 @@ if HAVE_BSK:
             peer=expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
             mc=[A_MC[(v, a_groups(v)[0], m)] for v in A_P1_VARIANTS for m in A_METHODS],
             x2=[A_X2[v] for v in A_P1_VARIANTS],
-            code=src("approach/peers.py", "approach/report.py", "core/tables.py"),
+            code=src("approach/peers.py", "approach/alternatives_summary.py", "core/tables.py"),
         output:
             table=report_table(f"{APPROACH}/A-P1_peer_ukf", "A-P1", "Paper A"),
             long=f"{A_WORK}/peers/A-P1_seeds.csv",

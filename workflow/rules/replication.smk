@@ -50,7 +50,8 @@ if REP_CFG["enabled"]:
             conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
             crlb=f"{A_WORK}/crlb.pkl",
             stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
-            code=src("approach/report.py", "approach/setup.py", "core/tables.py"),
+            code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
+                     "approach/setup.py", "core/tables.py"),
         output:
             t1=table_outputs(f"{REP}/approach/A-T1_table1"),
             x1=table_outputs(f"{REP}/approach/A-X1_crlb"),

@@ -4,7 +4,7 @@ and magnitude limit."""
 import sys
 
 from opnav.core import figures
-from opnav.approach import report, star_plots
+from opnav.approach import star_plots, summaries
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import write_table
 
@@ -12,7 +12,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
     snakemake = mock_snakemake("approach_stars_outputs", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
-    frame = report.stars_frame(load_pickle(snakemake.input.stars))
+    frame = summaries.stars_frame(load_pickle(snakemake.input.stars))
     write_table(frame, snakemake.output.table,
                 caption="A-X6: star calibration on Hipparcos stars against stars per image, attitude knowledge "
                         "per star image and magnitude limit: bound of tx, ty (all data; stars alone), the "

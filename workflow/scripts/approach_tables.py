@@ -3,10 +3,11 @@
 import sys
 
 from opnav.core import published
-from opnav.approach import readings, report
+from opnav.approach import readings, summaries
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_json, write_table
+from opnav.report import approach_text, approach_views
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_tables", argv=sys.argv[1:])
@@ -22,22 +23,22 @@ with script_context(snakemake) as log:
         conv[c["variant"]] = c
     curves = load_pickle(snakemake.input.crlb)
     pub = published.paper_a()
-    t1 = report.table1_frame(results, pub, snakemake.params.profile)
+    t1 = summaries.table1_frame(results, pub, snakemake.params.profile)
     csv, tex, md = snakemake.output.t1
     cap = ("A-T1: paper A Table 1 reproduced; mean and sd over Monte-Carlo seeds; CRLB of the data each "
            "estimate used (Q = 0 beside); EM label from the ML estimate of the data each run used (converged / "
            "stalled / not converged), identifiable when that bound is at most the published accuracy; pub_* = published.")
     write_table(t1, [csv], caption=cap)  # every column
-    write_table(report.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
-    x1 = report.crlb_rows(setup, curves["Q"], conv, t1, curves["Q0"])
+    write_table(approach_views.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
+    x1 = summaries.crlb_rows(setup, curves["Q"], conv, t1, curves["Q0"])
     write_table(x1, snakemake.output.x1,
                 caption="A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.")
-    atomic_write_text(snakemake.output.verdict, report.identifiability_text(setup, x1))
-    summ = report.summary(setup, t1, x1, curves.get("roll_rate"))
+    atomic_write_text(snakemake.output.verdict, approach_text.identifiability_text(setup, x1))
+    summ = summaries.summary(setup, t1, x1, curves.get("roll_rate"))
     if snakemake.input.stars:  # the stars variant (beyond the paper)
-        summ["stars"] = report.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
+        summ["stars"] = summaries.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
     summ["profile"] = snakemake.params.profile
-    summ["text"] = report.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
+    summ["text"] = approach_text.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
     if "readings" in curves:  # the installation rows and the sample time (opnav.approach.readings)
         summ["installation"] = curves["readings"]["installation"]
         summ["sample_time"] = curves["readings"]["sample_time"]

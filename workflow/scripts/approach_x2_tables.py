@@ -2,7 +2,7 @@
 
 import sys
 
-from opnav.approach import report
+from opnav.approach import alternatives_summary
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
@@ -22,14 +22,14 @@ with script_context(snakemake) as log:
     variants = {r["variant"] for r in alt_res}
     for p in snakemake.input.mc:
         em_res.extend(r for r in load_pickle(p) if r["variant"] in variants)
-    long = report.long_frame(alt_res, em_res, em_times)
+    long = alternatives_summary.long_frame(alt_res, em_res, em_times)
     long.to_csv(snakemake.output.long, index=False)
-    table = report.summary_frame(long)
+    table = alternatives_summary.summary_frame(long)
     write_table(table, snakemake.output.table,
                 caption="A-X2: EM-EKF against the augmented EKF and batch ML (IPOPT) on the Table-1 cases; "
                         "errors in arcsec (estimate minus truth), CRLB = Cramer-Rao bound, nav error in km, "
                         "data needed in samples, run time in s per Monte-Carlo seed.")
-    summ = report.summary_json(long, table, setup)
+    summ = alternatives_summary.summary_json(long, table, setup)
     summ["profile"] = snakemake.params.profile
     write_json(snakemake.output.summary, summ)
     log.info("A-X2: %d long rows, %d table rows", len(long), len(table))

@@ -6,7 +6,7 @@ import sys
 
 from opnav.core import published
 from opnav.report import scorecard
-from opnav.approach.report import rows_paper_a
+from opnav.report.approach_scorecard import rows_paper_a
 from opnav.landing.report import rows_paper_b
 from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table

@@ -42,7 +42,9 @@ issue 44   installation rows and the sample time read against model   readings.i
 Layers
     ``setup`` (the config parsed once, frozen) -> ``dynamics``, ``camera``, ``kalman`` ->
     ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml``, ``consider`` ->
-    ``scenario``, ``cases`` -> ``pipeline``, ``alternatives``, ``study``, ``peers``,
-    ``readings`` -> ``report`` (tables and texts), ``plots``, ``peer_plots``, ``star_plots``;
-    ``cli`` at the edge.
+    ``scenario``, ``labels`` (a run's convergence label and reading), ``cases`` -> ``pipeline``,
+    ``alternatives``, ``study``, ``peers``, ``readings`` -> ``summaries``, ``alternatives_summary``
+    (the tables' numbers, A-summary.json), ``plots``, ``peer_plots``, ``star_plots``; ``cli`` at
+    the edge. The tables' page views, the scorecard rows and the prose made from the numbers are
+    in the report layer (``opnav.report.approach_views``, ``approach_scorecard``, ``approach_text``).
 """

@@ -36,7 +36,7 @@ Written rules (shared with the EM-EKF's Table 1, :mod:`opnav.approach.cases`)
       + IPOPT on the final window, / S;
       batch ML with checkpoints: per checkpoint seed.
 The A-X2 tables (long form per case, the per-method table, the summary JSON) are
-in :mod:`opnav.approach.report`.
+in :mod:`opnav.approach.alternatives_summary`.
 Units: arcsec, km, samples, s.
 """
 

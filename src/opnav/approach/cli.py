@@ -49,7 +49,7 @@ def run(args) -> int:
     from . import scenario as sc
     from .cases import Case, run_case
     from .pipeline import bound_curve, bound_data, segment_bounds
-    from .report import bound_cause, reading_text, row_label
+    from .labels import bound_cause, reading_text, row_label
     from .setup import Setup
 
     config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated

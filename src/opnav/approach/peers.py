@@ -499,7 +499,7 @@ def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id:
     """
     import pandas as pd
 
-    from .report import METHOD_LABELS
+    from .alternatives_summary import METHOD_LABELS
 
     rows = []
     for p in peer:

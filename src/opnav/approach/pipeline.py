@@ -10,7 +10,8 @@ Description
       of a group with and without process noise at once.
     * :func:`run_group` - the Monte Carlo of one case group, variant and EM
       scheme (a Snakemake job), each case with its bound attached.
-    Tables, the verdict text and the summary live in :mod:`opnav.approach.report`.
+    The tables' numbers and the summary live in :mod:`opnav.approach.summaries`, the verdict
+    text in :mod:`opnav.report.approach_text`.
 Units: arcsec, km, samples.
 """
 

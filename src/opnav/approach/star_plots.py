@@ -1,6 +1,6 @@
 """A-X6 figure: the stars study (beyond the paper) against attitude knowledge and magnitude limit.
 
-Plotting only (numbers from :func:`opnav.approach.report.stars_frame`).
+Plotting only (numbers from :func:`opnav.approach.summaries.stars_frame`).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Paper A's claims (EM-EKF camera misalignment), each scored over our variants.
 
-Inputs: the A-summary.json dict (:func:`opnav.approach.report.summary`), the A-T1 frame
-(:func:`opnav.approach.report.table1_frame`, read from its CSV), the published values
+Inputs: the A-summary.json dict (:func:`opnav.approach.summaries.summary`), the A-T1 frame
+(:func:`opnav.approach.summaries.table1_frame`, read from its CSV), the published values
 (``published.paper_a()``) and the analysis plan (:func:`opnav.report.claims.load_plan`),
 which holds every margin and threshold a verdict uses. Output: claims-table rows
 (:func:`opnav.report.claims.row`).

@@ -201,12 +201,12 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
 
 # ------------------------------------------------------------ compact tables
 #: Manuscript views of tables too wide for a page, by SPEC id: each paper's report module
-#: holds its own (opnav.approach.report, opnav.landing.report).
+#: holds its own (opnav.report.approach_views, opnav.landing.report).
 def _compact_views() -> dict:
-    from opnav.approach import report as a_report
     from opnav.landing import report as b_report
+    from opnav.report import approach_views
 
-    return {**a_report.COMPACT_VIEWS, **b_report.COMPACT_VIEWS}
+    return {**approach_views.COMPACT_VIEWS, **b_report.COMPACT_VIEWS}
 
 
 COMPACT_VIEWS = _compact_views()

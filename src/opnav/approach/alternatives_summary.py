@@ -1,0 +1,152 @@
+"""A-X2 (the alternatives to the EM-EKF: augmented EKF, batch ML) in numbers: one row per
+variant x method x case, the per-method table and A-X2-summary.json.
+
+Pure functions of :func:`opnav.approach.alternatives.run_case_alternatives` and the EM-EKF
+Monte Carlo (:func:`opnav.approach.pipeline.run_group`). Units: arcsec, km, samples, s.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from . import scenario as sc
+from .labels import row_label
+from .setup import Setup
+from .summaries import seed_sd
+
+
+METHOD_LABELS = {
+    "em_plain": "EM-EKF (plain)",
+    "em_squarem": "EM-EKF (SQUAREM)",
+    "augmented": "augmented EKF",
+    "batch_ml": "batch ML (IPOPT)",
+}
+
+
+def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) -> pd.DataFrame:
+    """One row per variant x method x case: error, spread, CRLB, nav error, data, run time.
+
+    ``em_results``: the EM-EKF Monte-Carlo dicts (:func:`opnav.approach.pipeline.run_group`);
+    ``em_times``: {variant: {"em_plain": s, ...}} measured on the headline case.
+    """
+    nan3 = np.full(3, np.nan)
+    crlb = {(r["variant"], r["case_id"]): r["crlb_total_arcsec"] for r in em_results}
+    crlb0 = {(r["variant"], r["case_id"]): r.get("crlb_total_q0_arcsec", nan3) for r in em_results}
+    rows = []
+
+    def add(variant, case, method, truth, th, nav, data, runtime, extra=None, used=None, used_q0=None):
+        """``used``/``used_q0``: the bound of the data the estimate used (default: all the data)."""
+        err = th[:, :2] - truth[:2]
+        key = (variant, case.case_id)
+        cb = crlb.get(key, nan3) if used is None else used
+        cb0 = crlb0.get(key, nan3) if used_q0 is None else used_q0
+        row = {
+            "variant": variant, "method": method, "method_label": METHOD_LABELS[method],
+            "group": case.group, "case_id": case.case_id,
+            "truth_x_arcsec": truth[0], "truth_y_arcsec": truth[1],
+            "n_seeds": th.shape[0],
+            "err_x_mean_arcsec": float(err[:, 0].mean()), "err_x_std_arcsec": seed_sd(err[:, 0]),
+            "err_y_mean_arcsec": float(err[:, 1].mean()), "err_y_std_arcsec": seed_sd(err[:, 1]),
+            "rmse_xy_arcsec": float(np.sqrt(np.mean(err**2))),
+            # the bound of the data this estimate used (one window for sliding EM; all the data for
+            # the augmented EKF and batch ML), Q = 0 beside it (the truth has no process noise)
+            "crlb_x_arcsec": float(cb[0]), "crlb_y_arcsec": float(cb[1]),
+            "crlb_q0_x_arcsec": float(cb0[0]), "crlb_q0_y_arcsec": float(cb0[1]),
+            "crlb_all_x_arcsec": float(crlb.get(key, nan3)[0]),
+            "nav_err_after_km": float(np.mean(nav)),
+            "data_to_converge_samples": float(np.median(data)) if data is not None else math.nan,
+            "runtime_s_per_seed": runtime,
+        }
+        row.update(extra or {})
+        rows.append(row)
+
+    for r in em_results:
+        if r.get("mode", "sliding") != "sliding":
+            continue
+        m = f"em_{r['method']}"
+        if m not in METHOD_LABELS:
+            continue
+        rt = em_times.get(r["variant"], {}).get(m, math.nan) if r["case_id"] == "T1-01" else math.nan
+        add(r["variant"], r["case"], m, np.asarray(r["truth_arcsec"], float), r["theta_final_arcsec"],
+            r["nav_err_after_km"], r["data_to_converge"], rt,
+            {"nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
+             "label": row_label(r["label"])[0], "stalled_seeds": int(np.sum(r["stalled"]))},
+            used=r["crlb_arcsec"], used_q0=r["crlb_q0_arcsec"])
+    for r in alt_results:
+        for m, d in r["methods"].items():
+            extra = {}
+            if m == "batch_ml":
+                extra = {"ipopt_max_grad_norm": float(np.max(d["grad_norm"])),
+                         "ipopt_all_success": bool(np.all(d["ipopt_success"])),
+                         "ipopt_iterations_median": float(np.median(d["ipopt_iterations"])),
+                         "runtime_solve_s_per_seed": d["runtime_solve_s_per_seed"],
+                         "runtime_build_s": d["runtime_build_s"],
+                         "runtime_checkpoints_s_per_seed": d.get("runtime_checkpoints_s_per_seed", math.nan),
+                         "data_seeds": d.get("checkpoint_seeds", 0)}
+            add(r["variant"], r["case"], m, r["truth_arcsec"], d["theta_final_arcsec"],
+                d["nav_err_after_km"], d.get("data_to_converge"), d["runtime_s_per_seed"], extra)
+    df = pd.DataFrame(rows)
+    vorder = {v: i for i, v in enumerate(sc.VARIANTS)}
+    morder = {m: i for i, m in enumerate(METHOD_LABELS)}
+    df = df.assign(_v=df["variant"].map(vorder), _m=df["method"].map(morder))
+    return df.sort_values(["_v", "_m", "case_id"], kind="stable").drop(columns=["_v", "_m"]).reset_index(drop=True)
+
+
+def summary_frame(long: pd.DataFrame) -> pd.DataFrame:
+    """A-X2 table: per variant and method, the headline case (T1-01) and all-case aggregates."""
+    rows = []
+    for (v, m), g in long.groupby(["variant", "method"], sort=False):
+        h = g[g["case_id"] == "T1-01"]
+        h = h.iloc[0] if len(h) else None
+        rows.append({
+            "variant": v, "method": METHOD_LABELS[m],
+            "n_cases": len(g), "n_seeds": int(g["n_seeds"].max()),
+            "T1-01 err_x mean": h["err_x_mean_arcsec"] if h is not None else math.nan,
+            "T1-01 err_x sd": h["err_x_std_arcsec"] if h is not None else math.nan,
+            "T1-01 err_y mean": h["err_y_mean_arcsec"] if h is not None else math.nan,
+            "T1-01 err_y sd": h["err_y_std_arcsec"] if h is not None else math.nan,
+            "T1-01 CRLB_x": h["crlb_x_arcsec"] if h is not None else math.nan,  # of the data used
+            "T1-01 CRLB_x Q=0": h["crlb_q0_x_arcsec"] if h is not None else math.nan,
+            "T1-01 CRLB_x all data": h["crlb_all_x_arcsec"] if h is not None else math.nan,
+            "T1-01 label": (h["label"] if h is not None and isinstance(h.get("label"), str) else ""),
+            "RMSE_xy all cases": float(np.sqrt(np.mean(g["rmse_xy_arcsec"] ** 2))),
+            "median sd all cases": float(np.median(np.r_[g["err_x_std_arcsec"], g["err_y_std_arcsec"]])),
+            "median CRLB all cases": float(np.median(np.r_[g["crlb_x_arcsec"], g["crlb_y_arcsec"]])),
+            "nav err after km (T1-01)": h["nav_err_after_km"] if h is not None else math.nan,
+            "nav err after km (all)": float(g["nav_err_after_km"].mean()),
+            "data needed (T1-01)": h["data_to_converge_samples"] if h is not None else math.nan,
+            "data needed (median)": float(np.nanmedian(g["data_to_converge_samples"]))
+            if g["data_to_converge_samples"].notna().any() else math.nan,
+            "run time s/seed (T1-01)": h["runtime_s_per_seed"] if h is not None else math.nan,
+        })
+    return pd.DataFrame(rows)
+
+
+def summary_json(long: pd.DataFrame, table: pd.DataFrame, setup: Setup | dict) -> dict:
+    """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json)."""
+    setup = Setup.of(setup)
+    out = {"segments": setup.segments.as_dict(), "alternatives": setup.alternatives.as_dict(), "variants": {}}
+    for _, r in table.iterrows():
+        key = [k for k, lab in METHOD_LABELS.items() if lab == r["method"]][0]
+        out["variants"].setdefault(r["variant"], {})[key] = {
+            "err_x_mean_arcsec": r["T1-01 err_x mean"], "err_x_sd_arcsec": r["T1-01 err_x sd"],
+            "err_y_mean_arcsec": r["T1-01 err_y mean"], "err_y_sd_arcsec": r["T1-01 err_y sd"],
+            "crlb_x_arcsec": r["T1-01 CRLB_x"], "crlb_q0_x_arcsec": r["T1-01 CRLB_x Q=0"],
+            "crlb_all_x_arcsec": r["T1-01 CRLB_x all data"], "label": r["T1-01 label"],
+            "rmse_xy_all_cases_arcsec": r["RMSE_xy all cases"],
+            "nav_err_after_km": r["nav err after km (T1-01)"],
+            "data_to_converge_samples": r["data needed (T1-01)"],
+            "runtime_s_per_seed": r["run time s/seed (T1-01)"],
+        }
+    if "nav_err_before_km" in long:
+        nb = long[long["case_id"] == "T1-01"].dropna(subset=["nav_err_before_km"])
+        out["nav_err_before_km"] = {v: float(g["nav_err_before_km"].iloc[0])
+                                    for v, g in nb.groupby("variant", sort=False)}
+    ml = long[long["method"] == "batch_ml"]
+    if len(ml):
+        out["batch_ml_max_grad_norm"] = float(ml["ipopt_max_grad_norm"].max())
+        out["batch_ml_all_success"] = bool(ml["ipopt_all_success"].all())
+    return out

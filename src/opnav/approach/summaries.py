@@ -1,0 +1,341 @@
+"""Paper A's numbers from the simulation results: A-T1 in long form, the A-X1 bound table,
+the roll-rate and stars studies, and A-summary.json.
+
+Pure functions of the results of :mod:`opnav.approach.pipeline` and
+:mod:`opnav.approach.alternatives`; editing this module reruns only the table rules, never
+the Monte Carlo. The sentences the manuscript makes from these numbers are in
+:mod:`opnav.report.approach_text`. Units: arcsec, km, samples.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from . import cases
+from . import scenario as sc
+from .labels import label_columns, row_label, variant_label
+from .setup import Setup
+
+
+def seed_sd(x: np.ndarray) -> float:
+    return float(x.std(ddof=1)) if x.shape[0] > 1 else math.nan
+
+
+#: A-T1 navigation-error columns (km, RMS over the last nav_error.last_fraction of the arc):
+#: before / after compensation / with the true theta, total and lateral / range parts.
+NAV_SPLIT_KEYS = ("nav_err_true_theta_km", "nav_err_consider_km") + tuple(
+    f"nav_err_{k}_{p}_km" for k in ("before", "after", "true_theta") for p in ("lat", "rng"))
+
+
+def table1_frame(results: list[dict], published: dict, profile: str = "") -> pd.DataFrame:
+    """A-T1 long form: one row per case x variant x EM scheme, published values beside."""
+    pub = {r["case_id"]: r for r in published["table1"]}
+    target = float(published["headline"]["accuracy_claim_arcsec"])
+    rows = []
+    for r in results:
+        c: cases.Case = r["case"]
+        th = r["theta_final_arcsec"]
+        truth = np.asarray(c.truth_arcsec)
+        p = pub.get(c.case_id, {})
+        mode = r.get("mode", "sliding")
+        smp = r.get("sampled")
+        rows.append({
+            "variant": variant_label(r["variant"], r["method"], mode),
+            "scenario": r["variant"],
+            "method": r["method"],
+            "mode": mode,
+            "maps_per_segment": r.get("maps_per_segment", math.nan),
+            "group": c.group,
+            "case_id": c.case_id,
+            "truth_x_arcsec": truth[0], "truth_y_arcsec": truth[1], "truth_z_arcsec": truth[2],
+            "init_x_arcsec": c.init_arcsec[0], "init_y_arcsec": c.init_arcsec[1],
+            "pixel_sigma3_px": c.sigma3_px[0], "install_deg": c.install_deg,
+            "n_seeds": th.shape[0],
+            "est_x_mean": th[:, 0].mean(), "est_x_std": th[:, 0].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "est_y_mean": th[:, 1].mean(), "est_y_std": th[:, 1].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "rmse_x_arcsec": float(np.sqrt(np.mean((th[:, 0] - truth[0]) ** 2))),
+            "rmse_y_arcsec": float(np.sqrt(np.mean((th[:, 1] - truth[1]) ** 2))),
+            # the bound of the data the estimate used (last window when sliding, cumulative when
+            # growing), with Q = 0 beside (the truth has no process noise), and of all the data
+            "crlb_x_arcsec": r["crlb_arcsec"][0], "crlb_y_arcsec": r["crlb_arcsec"][1],
+            "crlb_q0_x_arcsec": r["crlb_q0_arcsec"][0], "crlb_q0_y_arcsec": r["crlb_q0_arcsec"][1],
+            "crlb_all_x_arcsec": r["crlb_total_arcsec"][0], "crlb_all_y_arcsec": r["crlb_total_arcsec"][1],
+            "tz_observable": not r["tz_unobservable"],
+            **label_columns(r, target),
+            # initial error drawn from the prior (headline case only): the spread to set beside the bound
+            "est_x_mean_sampled": smp["theta_final_arcsec"][:, 0].mean() if smp else math.nan,
+            "est_x_std_sampled": seed_sd(smp["theta_final_arcsec"][:, 0]) if smp else math.nan,
+            "est_y_std_sampled": seed_sd(smp["theta_final_arcsec"][:, 1]) if smp else math.nan,
+            "label_sampled": row_label(smp["label"])[0] if smp and "label" in smp else "",
+            "rmse_x_sampled": float(np.sqrt(np.mean((smp["theta_final_arcsec"][:, 0] - truth[0]) ** 2)))
+            if smp else math.nan,
+            # filter consistency (sampled initial error): mean over time and seeds, 3 dof each
+            **{f"{q}_{k}_mean": float(np.nanmean(smp["consistency_t"][k][q])) if smp else math.nan
+               for q in ("nees_pos", "nis") for k in ("before", "after")},
+            # position NEES of the Schmidt (consider) EKF and of the true-theta filter (issue 44)
+            **{f"nees_pos_{k}_mean": float(np.nanmean(smp["consistency_t"][k]["nees_pos"]))
+               if smp and k in smp["consistency_t"] else math.nan for k in ("consider", "true_theta")},
+            "nav_err_before_km": r["nav_err_before_km"].mean(),
+            "nav_err_before_km_std": r["nav_err_before_km"].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "nav_err_after_km": r["nav_err_after_km"].mean(),
+            "nav_err_after_km_std": r["nav_err_after_km"].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            # split across (lat) / along (rng) the line of sight, and the floor with the true theta
+            # (diagnostic: the filter given the true misalignment), mean over seeds
+            **{k: float(np.mean(r[k])) for k in NAV_SPLIT_KEYS if k in r},
+            "pub_est_x_mean": p.get("est_x_arcsec", math.nan),
+            "pub_est_y_mean": p.get("est_y_arcsec", math.nan),
+            "pub_data_to_converge_samples": p.get("data_to_converge_samples", math.nan),
+            "pub_nav_err_before_km": p.get("nav_err_before_km", math.nan),
+            "pub_nav_err_after_km": p.get("nav_err_after_km", math.nan),
+        })
+    df = pd.DataFrame(rows)
+    order = {v: i for i, v in enumerate(sc.VARIANTS)}
+    df["_v"] = df["scenario"].map(order)
+    df = df.sort_values(["_v", "mode", "method", "case_id"], kind="stable").drop(columns="_v").reset_index(drop=True)
+    return df
+
+
+def crlb_rows(setup: Setup | dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: dict | None = None) -> pd.DataFrame:
+    """A-X1 table: the bound per variant beside the EM estimates' spread and EM iterations.
+
+    The EM errors set beside the bound come from the headline case rerun with the initial
+    error drawn from the prior (``*_sampled`` columns of A-T1): with the paper's fixed
+    initial error the spread over seeds is noise only and is not comparable with a
+    Bayesian bound. ``crlb_q0_*``: the bound if the truth, like ours, had no process noise.
+    """
+    setup = Setup.of(setup)
+    s = setup.segments
+    target = setup.accuracy_target_arcsec
+    cs = setup.convergence_study
+    rows = []
+    for v, curve in curves.items():
+        d_total = min(s.data_samples, len(curve) - 1)
+        c0 = (curves_q0 or {}).get(v)
+        row = {
+            "variant": v,
+            "crlb_x_window_arcsec": _first_window_bound(t1, v, curve, s),
+            "crlb_x_250_arcsec": curve[min(250, len(curve) - 1), 0],
+            "crlb_x_total_arcsec": curve[d_total, 0],
+            "crlb_y_total_arcsec": curve[d_total, 1],
+            "crlb_q0_x_total_arcsec": c0[min(d_total, len(c0) - 1), 0] if c0 is not None else math.nan,
+            "total_samples": d_total,
+            "tz_observable": bool(curve[-1, 2] < 0.5 * sc.arcsec(setup.crlb_prior_sigma_rad)),
+            "bound_reaches_target": bool(curve[d_total, :2].max() <= target),
+            "samples_to_target": _first_below(curve[:, :2].max(1), target),
+        }
+        h = t1[(t1["scenario"] == v) & (t1["case_id"] == "T1-01")]
+        for _, r in h.iterrows():
+            tag = r["method"] if r.get("mode", "sliding") == "sliding" else f"growing_{r['method']}"
+            sampled = not pd.isna(r.get("rmse_x_sampled", math.nan))
+            row[f"em_{tag}_est_x_mean"] = r["est_x_mean_sampled"] if sampled else r["est_x_mean"]
+            row[f"em_{tag}_est_x_std"] = r["est_x_std_sampled"] if sampled else r["est_x_std"]
+            row[f"em_{tag}_rmse_x_arcsec"] = r["rmse_x_sampled"] if sampled else r["rmse_x_arcsec"]
+            row[f"em_{tag}_crlb_x_arcsec"] = r["crlb_x_arcsec"]  # the bound of the data it used
+            row[f"em_{tag}_crlb_q0_x_arcsec"] = r["crlb_q0_x_arcsec"]
+            row[f"em_{tag}_label"] = (r["label_sampled"] if sampled and r.get("label_sampled") else r["label"])
+            row[f"em_{tag}_stalled"] = row[f"em_{tag}_label"] == "stalled"
+        c = conv.get(v)
+        if c is not None:
+            ts, tr = c["theta_star_arcsec"], c["truth_arcsec"]
+            row["mle_samples"] = c["data_samples"]
+            row["crlb_x_at_mle_samples"] = curve[min(c["data_samples"], len(curve) - 1), 0]
+            row["mle_x_mean"] = ts[:, 0].mean()
+            row["mle_x_std"] = ts[:, 0].std(ddof=1) if ts.shape[0] > 1 else math.nan
+            row["mle_rmse_x_arcsec"] = float(np.sqrt(np.mean((ts[:, 0] - tr[0]) ** 2)))
+            row["mle_rmse_y_arcsec"] = float(np.sqrt(np.mean((ts[:, 1] - tr[1]) ** 2)))
+            row["maps_plain_median"] = float(np.median(c["plain"]["maps_to_converge"]))
+            row["maps_plain_extrapolated_median"] = float(np.median(c["plain"]["maps_extrapolated"]))
+            row["plain_rate_per_map"] = float(np.median(c["plain"]["rate_per_map"]))
+            row["maps_squarem_median"] = float(np.median(c["squarem"]["maps_to_converge"]))
+            row["max_maps"] = c["max_maps"]
+            row["tol_arcsec"] = cs.tol_arcsec
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _first_window_bound(t1, variant, curve, s):
+    """Bound of one segment's data: from the A-T1 sliding rows when present, else the
+    cumulative curve after N samples."""
+    h = t1[(t1["scenario"] == variant) & (t1["case_id"] == "T1-01") & (t1.get("mode", "sliding") == "sliding")]
+    if len(h) and "crlb_x_arcsec" in h:
+        return float(h["crlb_x_arcsec"].iloc[0])
+    return curve[min(s.N, len(curve) - 1), 0]
+
+
+def prior_bound_arcsec(setup: Setup | dict) -> float:
+    """What the prior alone bounds theta to: the 1-sigma prior position error seen from the
+    initial range, ``sigma_r / rho`` (arcsec), from the config."""
+    setup = Setup.of(setup)
+    return float(sc.arcsec(setup.prior_sigma.r_km / setup.geometry.range_km))
+
+
+def _first_below(values: np.ndarray, target: float) -> float:
+    """First data length whose bound is at or below ``target`` (NaN if never)."""
+    idx = np.nonzero(values <= target)[0]
+    return float(idx[0]) if idx.size else math.nan
+
+
+def nav_note(r) -> str:
+    """What sets a row's navigation error after compensation, from its split (A-T1 columns):
+    ``after X km (lateral L, range R); with the true theta T km (lateral, range); NEES N``."""
+    def g(k):
+        v = _num(r, k)
+        return "n/a" if v is None else f"{v:.3g}"
+    if _num(r, "nav_err_after_rng_km") is None:
+        return ""
+    lat, rng = _num(r, "nav_err_after_lat_km"), _num(r, "nav_err_after_rng_km")
+    part = "range" if rng >= lat else "lateral"
+    nees = _num(r, "nees_pos_after_mean")
+    return (f"after compensation {g('nav_err_after_km')} km (lateral {g('nav_err_after_lat_km')}, range "
+            f"{g('nav_err_after_rng_km')}: the {part} channel sets it); with the true theta "
+            f"{g('nav_err_true_theta_km')} km (lateral {g('nav_err_true_theta_lat_km')}, range "
+            f"{g('nav_err_true_theta_rng_km')})"
+            + (f"; position NEES (initial error drawn from the prior, 3 expected): {nees:.3g} compensated with "
+               f"theta_hat as exact, {g('nees_pos_consider_mean')} with the Schmidt filter carrying the bound of "
+               f"theta_hat's data, {g('nees_pos_true_theta_mean')} with the true theta"
+               if nees is not None else ""))
+
+
+def roll_rate_summary(study: dict) -> dict:
+    """The roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`) for the summary:
+    per rate the worse of (tx, ty) bounds after the published data and after all the data (with
+    Q and Q = 0), arcsec; the log-log slope; the rate reaching the target in that data, deg/s."""
+    worst = {k: np.asarray(study[k])[:, :2].max(1) for k in
+             ("bound_at_samples_arcsec", "bound_all_arcsec", "bound_all_q0_arcsec")}
+    rate = study["rate_to_target_deg_s"]
+    return {"rates_deg_s": [float(r) for r in study["rates_deg_s"]], "samples": int(study["samples"]),
+            "total_samples": int(study["total_samples"]),
+            **{k: [float(v) for v in w] for k, w in worst.items()},
+            "slope_all": float(study["slope_all"]),
+            "rate_to_target_deg_s": None if not math.isfinite(rate) else float(rate),
+            "target_arcsec": float(study["target_arcsec"]), "config_rate_deg_s": float(study["config_rate_deg_s"])}
+
+
+def _stars_key(row: dict) -> str:
+    """Summary key of a stars-study row: ``m<k>`` (stars per image), ``att<v>`` (attitude
+    knowledge, arcsec) or ``mag<v>`` (magnitude limit); '.' written 'p', '-' written 'n'."""
+    if row.get("sweep", "per_image") == "per_image":
+        return f"m{row['per_image']}"
+    tag = {"attitude_sigma_arcsec": "att", "mag_limit": "mag"}[row["sweep"]]
+    return tag + f"{row['value']:g}".replace(".", "p").replace("-", "n")
+
+
+def stars_summary(study: list[dict], target_arcsec: float) -> dict:
+    """The stars study (:func:`opnav.approach.alternatives.stars_study`) for the summary, per row
+    (:func:`_stars_key`): its settings, stars per image along the arc, the bound of tx, ty, tz
+    after all the data (Q and Q = 0) and of the star images alone, the attitude floor
+    ``hypot(sigma_a / sqrt(images), drift)``, samples after N0 until the bound of tx and ty is at
+    most ``target_arcsec``, and per estimator the seed mean and sd of (tx, ty, tz), its RMS error
+    in tx, ty, and its label (EM); plus ``objection``: the attitude knowledge at which the bound
+    reaches the target (``attitude_threshold_arcsec``)."""
+    out = {}
+    for row in study:
+        curve = np.asarray(row["crlb_curve_arcsec"])
+        need = _first_below(curve[:, :2].max(1), target_arcsec)
+        truth = np.asarray(row["truth_arcsec"], float)
+        est = {}
+        for name, e in row["estimators"].items():
+            th = np.asarray(e["theta_final_arcsec"], float)
+            d = {"mean_arcsec": [float(x) for x in th.mean(0)],
+                 "sd_arcsec": [float(x) for x in (th.std(0, ddof=1) if th.shape[0] > 1 else np.full(3, np.nan))],
+                 "rmse_xy_arcsec": float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2)))}
+            if "label" in e:
+                d["label"] = row_label(e["label"])[0]
+            if "theta_ml_arcsec" in e:
+                ml = np.asarray(e["theta_ml_arcsec"], float)
+                d["ml_rmse_xy_arcsec"] = float(np.sqrt(np.mean((ml[:, :2] - truth[:2]) ** 2)))
+            est[name] = d
+        out[_stars_key(row)] = {
+            "sweep": row.get("sweep", "per_image"), "per_image": row["per_image"], "every_K": row["every_K"],
+            "images": row["images"], "total_samples": row["total_samples"],
+            **{k: row[k] for k in ("attitude_sigma_arcsec", "mode_drift_arcsec", "mag_limit", "stars_per_image",
+                                   "floor_arcsec") if k in row},
+            "crlb_arcsec": [float(x) for x in row["crlb_all_arcsec"]],
+            "crlb_q0_arcsec": [float(x) for x in row["crlb_all_q0_arcsec"]],
+            **({"crlb_stars_only_arcsec": [float(x) for x in row["crlb_stars_only_arcsec"]]}
+               if "crlb_stars_only_arcsec" in row else {}),
+            "samples_to_target": None if math.isnan(need) else need, "estimators": est}
+    if study and "attitude_threshold_arcsec" in study[0]:
+        out["objection"] = {"attitude_threshold_arcsec": float(study[0]["attitude_threshold_arcsec"]),
+                            "target_arcsec": float(target_arcsec)}
+    return out
+
+
+def stars_frame(study: list[dict]) -> pd.DataFrame:
+    """A-X6: one row per stars-study row (:func:`opnav.approach.alternatives.stars_study`): the
+    swept setting, stars per image along the arc, the bound of tx, ty (all data; star images
+    alone), the attitude floor and the EM-EKF's (growing windows, SQUAREM) seed mean and RMS
+    error of (tx, ty), arcsec."""
+    rows = []
+    for r in study:
+        truth = np.asarray(r["truth_arcsec"], float)
+        e = r["estimators"]["em_growing_squarem"]
+        th = np.asarray(e["theta_final_arcsec"], float)
+        rows.append({
+            "sweep": r.get("sweep", "per_image"), "value": float(r.get("value", r["per_image"])),
+            "per_image": int(r["per_image"]), "attitude_sigma_arcsec": r.get("attitude_sigma_arcsec", math.nan),
+            "mode_drift_arcsec": r.get("mode_drift_arcsec", math.nan), "mag_limit": r.get("mag_limit", math.nan),
+            "images": int(r["images"]),
+            **{f"stars_per_image_{k}": float(v) for k, v in r.get("stars_per_image", {}).items()},
+            "crlb_x_arcsec": float(r["crlb_all_arcsec"][0]), "crlb_y_arcsec": float(r["crlb_all_arcsec"][1]),
+            "crlb_stars_only_x_arcsec": float(r["crlb_stars_only_arcsec"][0]) if "crlb_stars_only_arcsec" in r else math.nan,
+            "crlb_stars_only_y_arcsec": float(r["crlb_stars_only_arcsec"][1]) if "crlb_stars_only_arcsec" in r else math.nan,
+            "floor_arcsec": r.get("floor_arcsec", math.nan),
+            "em_est_x_mean_arcsec": float(th[:, 0].mean()), "em_est_y_mean_arcsec": float(th[:, 1].mean()),
+            "em_rmse_xy_arcsec": float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2))),
+            "em_label": row_label(e["label"])[0], "n_seeds": int(th.shape[0]),
+        })
+    return pd.DataFrame(rows)
+
+
+def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame, roll_rate: dict | None = None) -> dict:
+    """Headline numbers per variant and EM scheme for the manuscript macros; ``roll_rate``:
+    the roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`), if run."""
+    setup = Setup.of(setup)
+    out = {"profile_segments": setup.segments.as_dict(), "accuracy_target_arcsec": setup.accuracy_target_arcsec,
+           "prior_bound_arcsec": prior_bound_arcsec(setup),
+           "convergence_max_maps": setup.convergence_study.max_maps, "variants": {}}
+    if roll_rate is not None:
+        out["roll_rate"] = roll_rate_summary(roll_rate)
+    for _, r in t1[t1["case_id"] == "T1-01"].iterrows():
+        x = x1[x1["variant"] == r["scenario"]]
+        x = x.iloc[0] if len(x) else {}
+        out["variants"][r["variant"]] = {
+            "scenario": r["scenario"], "method": r["method"], "mode": r.get("mode", "sliding"),
+            "est_x_mean": r["est_x_mean"], "est_x_std": r["est_x_std"],
+            "est_y_mean": r["est_y_mean"], "est_y_std": r["est_y_std"],
+            "est_x_std_sampled": _num(r, "est_x_std_sampled"), "rmse_x_sampled": _num(r, "rmse_x_sampled"),
+            "crlb_x_arcsec": r["crlb_x_arcsec"], "crlb_y_arcsec": r["crlb_y_arcsec"],
+            "crlb_q0_x_arcsec": _num(r, "crlb_q0_x_arcsec"),
+            "crlb_all_x_arcsec": _num(r, "crlb_all_x_arcsec"), "crlb_all_y_arcsec": _num(r, "crlb_all_y_arcsec"),
+            "label": r["label"], "converged_seeds": int(r["converged_seeds"]),
+            "stalled": bool(r["stalled"]), "stalled_seeds": int(r["stalled_seeds"]), "n_seeds": int(r["n_seeds"]),
+            "identifiable": bool(r["identifiable"]), "reading": r["reading"],
+            **{f"{q}_{k}_mean": _num(r, f"{q}_{k}_mean") for q in ("nees_pos", "nis") for k in ("before", "after")},
+            "nees_pos_consider_mean": _num(r, "nees_pos_consider_mean"),
+            "nees_pos_true_theta_mean": _num(r, "nees_pos_true_theta_mean"),
+            "contraction_per_map": _num(r, "contraction_per_map"),
+            "dist_to_ml_arcsec": _num(r, "dist_to_ml_arcsec"),
+            "dist_to_ml_over_bound": _num(r, "dist_to_ml_over_bound"),
+            "data_to_converge_samples": _num(r, "data_to_converge_samples"),
+            "nav_err_before_km": r["nav_err_before_km"], "nav_err_after_km": r["nav_err_after_km"],
+            **{k: _num(r, k) for k in NAV_SPLIT_KEYS},
+            "nav_note": nav_note(r),
+            "iterations_plain_median": _num(x, "maps_plain_median"),
+            "iterations_plain_extrapolated_median": _num(x, "maps_plain_extrapolated_median"),
+            "iterations_squarem_median": _num(x, "maps_squarem_median"),
+            "mle_rmse_x_arcsec": _num(x, "mle_rmse_x_arcsec"),
+            "bound_reaches_target": bool(x["bound_reaches_target"]) if len(x) else None,
+        }
+    return out
+
+
+def _num(row, key):
+    try:
+        v = float(row[key])
+    except (KeyError, TypeError, ValueError):
+        return None
+    return None if math.isnan(v) else (v if math.isfinite(v) else None)
