@@ -10,7 +10,7 @@ import pytest
 from conftest import REPO
 from opnav.core import published
 from opnav.core.config import load_config
-from opnav.report import differences, manuscript
+from opnav.report import claims_prose, differences, manuscript
 
 #: a cause as long as the claims table allows (opnav.report.claims.MAX_CAUSE_WORDS)
 LONG_CAUSE = ("the Cramér-Rao bound of the data it used is 20.6 arcsec, the prior's own sigma_r / rho, so a camera "
@@ -38,26 +38,26 @@ def test_abstract_is_at_most_200_words_with_the_causes_of_each_group():
 
     assert len(LONG_CAUSE.split()) >= MAX_CAUSE_WORDS - 3
     df = _table()
-    tex = manuscript.page_one_abstract_tex(df)
+    tex = claims_prose.page_one_abstract_tex(df)
     main = (REPO / "paper" / "main.tex").read_text()
     framing = main[main.index(r"\begin{abstract}"):main.index(r"\input{\resultsdir/paper/abstract.tex}")]
-    assert manuscript.word_count(framing.replace(r"\begin{abstract}", "")) <= manuscript.ABSTRACT_FRAMING_WORDS
-    assert manuscript.word_count(tex) + manuscript.ABSTRACT_FRAMING_WORDS <= manuscript.ABSTRACT_MAX_WORDS
+    assert claims_prose.word_count(framing.replace(r"\begin{abstract}", "")) <= claims_prose.ABSTRACT_FRAMING_WORDS
+    assert claims_prose.word_count(tex) + claims_prose.ABSTRACT_FRAMING_WORDS <= claims_prose.ABSTRACT_MAX_WORDS
     assert "of its 10 claims" in tex and "A-C2, A-C3 and A-C10 are not reproducible" in tex  # counts, a group
     assert "For A-C2: the Cram" in tex and "What it would take" in tex  # its cause, what it would take
-    text = manuscript.abstract_findings(df)
+    text = claims_prose.abstract_findings(df)
     assert "((" not in text and not any(c.count("(") > 1 for c in text.split(". "))  # no nested parentheses
     # a generated number, not fixed text: another table, another abstract
     df2 = _table(n_a=4, n_b=3)
-    assert "of its 4 claims" in manuscript.abstract_findings(df2)
+    assert "of its 4 claims" in claims_prose.abstract_findings(df2)
 
 
 def test_abstract_of_a_quick_table_says_its_sample_is_too_small():
     df = _table(3, 3).assign(sample="quick")
-    tex = manuscript.page_one_abstract_tex(df, manuscript.sample_sentence_of(df))
+    tex = claims_prose.page_one_abstract_tex(df, claims_prose.sample_sentence_of(df))
     assert tex.startswith("This build is the quick profile")
-    assert manuscript.sample_sentence_of(_table(3, 3)) == ""
-    assert manuscript.sample_sentence_of(_table(3, 3).drop(columns="sample")) == ""  # an older table
+    assert claims_prose.sample_sentence_of(_table(3, 3)) == ""
+    assert claims_prose.sample_sentence_of(_table(3, 3).drop(columns="sample")) == ""  # an older table
 
 
 def test_verdict_figure_has_a_row_per_claim_and_tolerates_older_tables():
@@ -104,11 +104,11 @@ def test_conclusion_states_each_finding_once():
     df.loc[df["verdict"] == "reproduced_with_addition", "named"] = addition
     df.loc[df["claim_id"] == "B-C1", "verdict"] = "reproduced_with_addition"
     df.loc[df["claim_id"] == "B-C1", "named"] = addition
-    text = manuscript.conclusion_text(df)
+    text = claims_prose.conclusion_text(df)
     assert text.count(addition) == 2  # once per paper, for all the claims that share it
     for cid in df["claim_id"]:
         assert len(re.findall(rf"\b{cid}\b(?!\d)", text)) == 1 + text.count(f"For {cid}:"), cid
-    lim = manuscript.limitations_text(df)
+    lim = claims_prose.limitations_text(df)
     hinge = df.loc[df["verdict"].isin(["depends_on_choice", "not_tested", "unstable"]), "claim_id"]
     assert all(c in lim for c in hinge)
 

@@ -168,7 +168,7 @@ rule provenance:
 
 rule paper_page_one:
     """Page 1 (short abstract, verdict figure), the report's claims at a glance and the table
-    of what we did differently, from the claims table (opnav.report.manuscript, verdict_plot,
+    of what we did differently, from the claims table (opnav.report.claims_prose, manuscript, verdict_plot,
     differences)."""
     input:
         claims=rules.paper_claims.output.csv,
@@ -176,7 +176,7 @@ rule paper_page_one:
         inputs=rules.paper_claims.output.inputs,
         published=src("data/published.yaml"),
         choices=src("data/differences.yaml"),
-        code=src("report/manuscript.py", "report/verdict_plot.py", "report/differences.py"),
+        code=src("report/manuscript.py", "report/claims_prose.py", "report/verdict_plot.py", "report/differences.py"),
     output:
         abstract=f"{PAPER}/abstract.tex",
         fig_pdf=f"{PAPER}/verdicts.pdf",

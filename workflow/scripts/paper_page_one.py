@@ -13,7 +13,7 @@ import pandas as pd
 from opnav.core import figures, published
 from opnav.core.snakeio import load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text
-from opnav.report import differences, manuscript, verdict_plot
+from opnav.report import claims_prose, differences, manuscript, verdict_plot
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_page_one", argv=sys.argv[1:])
@@ -21,12 +21,12 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     out = snakemake.output
     df = load_table(snakemake.input.claims, keep_default_na=False)
-    sample = manuscript.sample_sentence_of(df)
-    atomic_write_text(out.abstract, manuscript.page_one_abstract_tex(df, sample))
+    sample = claims_prose.sample_sentence_of(df)
+    atomic_write_text(out.abstract, claims_prose.page_one_abstract_tex(df, sample))
     figures.save(verdict_plot.fig_verdicts(df), [out.fig_pdf, out.fig_png])
     atomic_write_text(out.conclusion, "\\newcommand{\\PageConclusion}{" + manuscript.prose_tex(
-        manuscript.conclusion_text(df)) + "}\n\\newcommand{\\PageLimitations}{" + manuscript.prose_tex(
-        manuscript.limitations_text(df)) + "}\n")
+        claims_prose.conclusion_text(df)) + "}\n\\newcommand{\\PageLimitations}{" + manuscript.prose_tex(
+        claims_prose.limitations_text(df)) + "}\n")
     glance = df[[c for c in ("claim_id", "claim", "published", "ours_as_written", "verdict") if c in df.columns]]
     glance.assign(claim=glance["claim"].map(verdict_plot.short_claim)).to_csv(out.glance, index=False)
     # the appendix tables of the claims job: the analysis plan and the inputs we derive
@@ -39,5 +39,5 @@ with script_context(snakemake) as log:
     bench = sorted(Path(snakemake.params.results).glob("*/benchmarks/*.tsv"))
     atomic_write_text(out.runinfo, manuscript.run_info_tex(
         (pd.read_csv(b, sep="\t") for b in bench), os.cpu_count(), platform.machine()))
-    log.info("page 1: abstract %d words, %d claims, %d choices", manuscript.word_count(
-        manuscript.page_one_abstract_tex(df, sample)), len(df), len(rows))
+    log.info("page 1: abstract %d words, %d claims, %d choices", claims_prose.word_count(
+        claims_prose.page_one_abstract_tex(df, sample)), len(df), len(rows))

@@ -33,7 +33,8 @@ def findings_block(df: pd.DataFrame) -> str:
     """The block (Markdown): per paper its verdict counts and the cause of its largest group
     not reproduced as written (at most four sentences), then id | claim | verdict."""
     from opnav.report.claims import VERDICT_SHORT, VERDICTS
-    from opnav.report.manuscript import _NOT_OK, _PAPER_WORDS, _sentence, group_sentences
+    from opnav.report.claims_prose import _NOT_OK, _PAPER_WORDS, group_sentences
+    from opnav.report.manuscript import _sentence
     from opnav.report.verdict_plot import short_claim
 
     if "sample" in df.columns and (df["sample"] != "full").any():
