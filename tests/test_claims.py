@@ -4,11 +4,13 @@ with a plan entry and every plan entry read, a control that also meets a claim, 
 beating its own bound, a verdict that flips between two samples, and causes a reader takes
 in at once."""
 
+import dataclasses
 
 import pandas as pd
 import pytest
 import yaml
 
+from opnav.approach.summaries import ClaimsSummary
 from opnav.core import published
 from opnav.report import claims as C
 from opnav.report.approach_claims import claim_rows as _rows_a
@@ -49,8 +51,10 @@ def table(literal=None, roll=None, diag=None, **extra):
     return pd.DataFrame(rows)
 
 
-SUMMARY_A = {"profile_segments": {"N": 50}, "accuracy_target_arcsec": 2.0,
-             "roll_rate": {"config_rate_deg_s": 0.1, "rate_to_target_deg_s": 0.236}}
+#: A-summary.json as the pipeline writes it (the parts the claims read), and as they read it
+SUMMARY_A_JSON = {"profile_segments": {"N": 50}, "accuracy_target_arcsec": 2.0,
+                  "roll_rate": {"config_rate_deg_s": 0.1, "rate_to_target_deg_s": 0.236}}
+SUMMARY_A = ClaimsSummary.from_json(SUMMARY_A_JSON)
 
 
 def by_id(rows):
@@ -250,11 +254,11 @@ def test_a_filter_floor_is_not_an_information_bound():
     """A true-theta floor above 20 km is evidence that the claim hinges on the arc length and
     error rule (depends on a choice, flagged), never 'not reproducible'."""
     t = table(literal={"after": 118.0}, roll={"after": 88.0}, diag={"after": 41.8})
-    floor = {**SUMMARY_A, "variants": {"literal": {"nav_err_true_theta_km": 29.4}}}
+    floor = dataclasses.replace(SUMMARY_A, nav_err_true_theta_km=29.4)
     r = by_id(rows_a(floor, t, PUB["paper_a"]))["A-C7"]
     assert r["verdict"] == C.DEPENDS and "arc length" in r["named"]
     assert "floor_not_bound: true-theta filter 29.4 km" in r["flags"]
-    low = {**SUMMARY_A, "variants": {"literal": {"nav_err_true_theta_km": 12.0}}}
+    low = dataclasses.replace(SUMMARY_A, nav_err_true_theta_km=12.0)
     assert by_id(rows_a(low, t, PUB["paper_a"]))["A-C7"]["verdict"] == C.NOT_REPRODUCED
 
 
@@ -383,3 +387,28 @@ def test_variants_beyond_the_paper_never_earn_a_verdict_but_are_named():
     r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))
     assert r["A-C1"]["verdict"] == C.NOT_REPRODUCIBLE and r["A-C1"]["best_variant"] == "roll"
     assert r["A-C9"]["verdict"] == C.REPRODUCED and "stars" in r["A-C9"]["evidence"]
+
+
+def test_claims_summary_finds_the_as_written_row_by_its_fields_not_its_label():
+    """ClaimsSummary.from_json takes the as-written row (literal, plain EM, sliding) by its
+    scenario, method and mode, whatever the key and the order of the rows; what is absent
+    reads as None (N as 0). Mutation tried: dropping the method test picks literal+squarem's
+    5.0 km and fails."""
+    row = {"scenario": "literal", "mode": "sliding"}
+    summ = {"profile_segments": {"N": 50}, "roll_rate": {"config_rate_deg_s": 0.1, "rate_to_target_deg_s": 0.236},
+            "variants": {"literal+squarem": {**row, "method": "squarem", "nav_err_true_theta_km": 5.0},
+                         "literal+growing+squarem": {**row, "mode": "growing", "method": "squarem",
+                                                     "nav_err_true_theta_km": 6.0},
+                         "prior": {**row, "scenario": "prior", "method": "plain", "nav_err_true_theta_km": 7.0},
+                         "any key": {**row, "method": "plain", "nav_err_true_theta_km": 29.4}}}
+    assert ClaimsSummary.from_json(summ) == ClaimsSummary(50.0, 0.236, 0.1, 29.4)
+    assert ClaimsSummary.from_json({}) == ClaimsSummary(0.0, None, None, None)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        SUMMARY_A.window_samples = 10.0
+
+
+def test_paper_a_claims_refuse_a_summary_dict():
+    """No label-keyed dict crosses into the claims: a raw A-summary dict is refused in one line."""
+    with pytest.raises(TypeError, match="ClaimsSummary.from_json"):
+        rows_a({"profile_segments": {"N": 50}}, table(), PUB["paper_a"])
+

@@ -10,7 +10,7 @@ import pandas as pd
 import yaml
 
 from opnav.report import claims as C
-from test_claims import SUMMARY_A, summary_b, table
+from test_claims import SUMMARY_A_JSON, summary_b, table
 
 REPO = Path(__file__).resolve().parents[1]
 CFG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
@@ -30,7 +30,7 @@ class _Job:
 
 def _run(tmp_path, rep_faster=None, profile="full"):
     a_sum, b_sum = tmp_path / "A-summary.json", tmp_path / "B-summary.json"
-    a_sum.write_text(json.dumps(SUMMARY_A))
+    a_sum.write_text(json.dumps(SUMMARY_A_JSON))
     b_sum.write_text(json.dumps(summary_b()))
     t1 = tmp_path / "A-T1.csv"
     table().to_csv(t1, index=False)

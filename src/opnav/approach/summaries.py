@@ -10,6 +10,8 @@ the Monte Carlo. The sentences the manuscript makes from these numbers are in
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any, Mapping
 
 import numpy as np
 import pandas as pd
@@ -339,3 +341,45 @@ def _num(row, key):
     except (KeyError, TypeError, ValueError):
         return None
     return None if math.isnan(v) else (v if math.isfinite(v) else None)
+
+
+#: the scenario that follows paper A as written (the EM start X_N0 from the theta = 0 filter)
+AS_WRITTEN = "literal"
+
+
+def _float_or_none(x) -> float | None:
+    return None if x is None else float(x)
+
+
+@dataclass(frozen=True)
+class ClaimsSummary:
+    """What paper A's claims (:mod:`opnav.report.approach_claims`) read of A-summary.json,
+    by meaning instead of by a row's display label (issue 41 item 4).
+
+    ``window_samples``             N, the samples of one sliding EM window (0 when absent);
+    ``roll_rate_to_target_deg_s``  the roll rate at which the bound reaches the claimed
+                                   accuracy within the published data (None: none in the
+                                   searched range, or no roll-rate study), deg/s;
+    ``roll_rate_config_deg_s``     the configured roll rate (None without the study), deg/s;
+    ``nav_err_true_theta_km``      navigation error of the filter given the true theta in the
+                                   as-written row (scenario :data:`AS_WRITTEN`, plain EM,
+                                   sliding windows, headline case; None when absent), km.
+    """
+
+    window_samples: float
+    roll_rate_to_target_deg_s: float | None = None
+    roll_rate_config_deg_s: float | None = None
+    nav_err_true_theta_km: float | None = None
+
+    @classmethod
+    def from_json(cls, summ: Mapping[str, Any]) -> "ClaimsSummary":
+        """From the dict :func:`summary` writes (A-summary.json); the as-written row is the
+        one whose ``scenario``, ``method`` and ``mode`` say so, whatever its key."""
+        rr = summ.get("roll_rate") or {}
+        row = next((v for v in (summ.get("variants") or {}).values()
+                    if v.get("scenario") == AS_WRITTEN and v.get("method") == "plain"
+                    and v.get("mode", "sliding") == "sliding"), {})
+        return cls(window_samples=float((summ.get("profile_segments") or {}).get("N", 0) or 0),
+                   roll_rate_to_target_deg_s=_float_or_none(rr.get("rate_to_target_deg_s")),
+                   roll_rate_config_deg_s=_float_or_none(rr.get("config_rate_deg_s")),
+                   nav_err_true_theta_km=_float_or_none(row.get("nav_err_true_theta_km")))

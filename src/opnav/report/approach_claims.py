@@ -1,6 +1,6 @@
 """Paper A's claims (EM-EKF camera misalignment), each scored over our variants.
 
-Inputs: the A-summary.json dict (:func:`opnav.approach.summaries.summary`), the A-T1 frame
+Inputs: what the claims read of A-summary.json (:class:`opnav.approach.summaries.ClaimsSummary`), the A-T1 frame
 (:func:`opnav.approach.summaries.table1_frame`, read from its CSV), the published values
 (``published.paper_a()``) and the analysis plan (:func:`opnav.report.claims.load_plan`),
 which holds every margin and threshold a verdict uses. Output: claims-table rows
@@ -20,10 +20,10 @@ from typing import Any, Mapping
 
 import pandas as pd
 
+from opnav.approach.summaries import AS_WRITTEN, ClaimsSummary
 from opnav.report import claims as C
 from opnav.report.claims import Outcome, Plan, fmt, join
 
-AS_WRITTEN = "literal"
 DIAGNOSTIC = "reference-start"
 HEADLINE_CASE = "T1-01"
 
@@ -157,19 +157,18 @@ def _suspect_cause(d: C.Decision, outs: Mapping[str, Outcome]) -> str:
             f"{fmt(o.bound)} arcsec bound of the data it uses, which points to a leak or a bug, not to reproduction")
 
 
-def _roll_would_take(summary: Mapping[str, Any], head_pub: Mapping[str, Any], target: float) -> str:
-    rr = summary.get("roll_rate") or {}
-    need = rr.get("rate_to_target_deg_s")
+def _roll_would_take(summary: ClaimsSummary, head_pub: Mapping[str, Any], target: float) -> str:
+    need = summary.roll_rate_to_target_deg_s
     if need is None:
         return ""
     return (f"a roll rate of {fmt(need)} deg/s, at which the bound reaches {target:g} arcsec within "
-            f"{fmt(head_pub['data_to_converge_samples'])} samples (ours: {fmt(rr.get('config_rate_deg_s'))} deg/s)")
+            f"{fmt(head_pub['data_to_converge_samples'])} samples (ours: {fmt(summary.roll_rate_config_deg_s)} deg/s)")
 
 
-def _roll_clause(d: C.Decision, summary: Mapping[str, Any], head_pub: Mapping[str, Any], target: float) -> str:
+def _roll_clause(d: C.Decision, summary: ClaimsSummary, head_pub: Mapping[str, Any], target: float) -> str:
     """The cause's clause on what it would take (the measured roll rate), where the bound of
     the as-written data excludes the claim."""
-    need = (summary.get("roll_rate") or {}).get("rate_to_target_deg_s")
+    need = summary.roll_rate_to_target_deg_s
     if need is None or d.verdict != C.NOT_REPRODUCIBLE:
         return ""
     return (f"; a {fmt(need)} deg/s boresight roll would bound it at {target:g} arcsec in "
@@ -486,8 +485,7 @@ def _claim_nav_after(t1, head_pub, summary, plan: Plan) -> dict:
     claim depends on the arc length and error rule the paper does not state."""
     cid = "A-C7"
     lim = plan.margin(cid, "limit_km")
-    lit_sum = ((summary.get("variants") or {}).get(AS_WRITTEN) or {})
-    floor = lit_sum.get("nav_err_true_theta_km")
+    floor = summary.nav_err_true_theta_km
     outs = {}
     for v in _variants(t1):
         h = _head(t1, v)
@@ -563,13 +561,17 @@ def _claim_tz(t1, plan: Plan) -> dict:
                  ours_as_written=text)
 
 
-def claim_rows(summary: Mapping[str, Any], t1: pd.DataFrame, pub: Mapping[str, Any], plan: Plan,
+def claim_rows(summary: ClaimsSummary, t1: pd.DataFrame, pub: Mapping[str, Any], plan: Plan,
                windows: Mapping[str, float] | None = None) -> list[dict]:
     """Paper A's claims-table rows (ids A-C1 ... A-C10, stable). ``windows``: the first
     window (samples) of each EM mode (``sliding``: N, ``growing``: the growing N), the
-    smallest data-to-converge count each can report; default the summary's N."""
+    smallest data-to-converge count each can report; default the summary's N. ``summary``:
+    A-summary.json as :meth:`opnav.approach.summaries.ClaimsSummary.from_json` reads it."""
+    if not isinstance(summary, ClaimsSummary):
+        raise TypeError(f"approach_claims.claim_rows: summary must be a ClaimsSummary "
+                        f"(ClaimsSummary.from_json(<A-summary.json>)), got {type(summary).__name__}")
     head = pub["headline"]
-    windows = dict(windows or {"sliding": float((summary.get("profile_segments") or {}).get("N", 0) or 0)})
+    windows = dict(windows or {"sliding": summary.window_samples})
     return [
         _claim_headline_accuracy(t1, head, summary, plan),
         _claim_table_accuracy(t1, pub["table1"], plan),
