@@ -51,7 +51,7 @@ PALETTE: dict[str, str] = {
     # paper B: planning methods (landing.mc.methods, landing.extra.methods)
     "depth": "C0", "svd": "C1", "gdop": "C2", "cond": "C3", "logdet": "C4", "mineig": "C5",
     "random": "C6", "center": "C7", "svd_w": "C8", "gdop_w": "C9", "cond_w": "k",
-    "closest": "#B8860B", "logdet_nav": "#6A3D9A",
+    "closest": "#B8860B", "logdet_nav": "#6A3D9A", "svd_lapack": "#D95F02",  # svd_lapack: SVD's darker shade
 }
 #: Other spellings of the same method (table labels, study estimator names).
 ALIASES: dict[str, str] = {
