@@ -187,8 +187,6 @@ NEW_CONFIGS = [
     ("names", "landing: {single: {method: 7}}", "'landing.single.method'"),
     ("names", "landing: {equivalence: {controls: [depth]}}", "'landing.equivalence.controls': depth has a metric"),
     ("names", "landing: {equivalence: {methods: [svd]}}", "'landing.equivalence.methods': svd is also the reference"),
-    ("names", "landing: {equivalence: {controls: [center]}, extra: {methods: [logdet]}}",
-     "'landing.equivalence.controls': 'random' sets the equivalence margin"),
     ("names", "approach: {variants: [literal, roll, oracle]}", "'approach.variants[2]': 'oracle'"),
     ("names", "approach: {table1_variants: [stars]}", "'approach.table1_variants[0]': 'stars'"),
     ("names", "approach: {growing: {methods: [squarem, squarem]}}", "'approach.growing.methods': duplicated"),

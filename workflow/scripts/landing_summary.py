@@ -15,6 +15,7 @@ from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_tex
 from opnav.landing.trajectory import truth_states
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
+from opnav.report.claims import load_plan
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_summary", argv=sys.argv[1:], bscn="site-tilt")
@@ -43,7 +44,11 @@ with script_context(snakemake) as log:
                          f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
     single = load_json(snakemake.input.single)
     every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
-    acc = accuracy_tests(every, snakemake.params.equivalence, float(snakemake.params.converged_pos_err_m))
+    # B-C1's margin and same-pick threshold: the analysis plan's numbers, its one home
+    plan = load_plan(snakemake.input.plan)
+    acc = accuracy_tests(every, snakemake.params.equivalence, float(snakemake.params.converged_pos_err_m),
+                         margin_rel=plan.margin("B-C1", "margin_rel"),
+                         same_pick_max_pct=plan.margin("B-C1", "same_pick_max_pct"))
     out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
                            eval_path=snakemake.params.eval_path,
                            yaw_ratio=float(snakemake.params.yaw_ratio),

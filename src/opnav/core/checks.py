@@ -231,9 +231,6 @@ def landing_rules(c: dict, *, workflow: bool = False) -> list[str]:
     both = [m for m in eq["methods"] if m in eq["controls"] or m == eq["reference"]]
     if both:
         out.append(k("equivalence.methods") + f"{', '.join(both)} is also the reference or a control")
-    if "random" not in [*flown, *eq["controls"]]:
-        out.append(k("equivalence.controls") + "'random' sets the equivalence margin and is not flown (add it to "
-                   "landing.equivalence.controls or landing.extra.methods)")
     scen = c.get("scenarios") or {}
     head = c.get("headline_scenario")
     if head is not None and scen and head not in scen:

@@ -15,14 +15,13 @@ are rejected, i.e. when the ``1 - 2 alpha`` paired-t interval of the mean
 difference lies inside ``(-delta, +delta)``. Not rejecting is "not shown
 equivalent" (the test must show equivalence, not fail to refute it).
 
-Margin (:func:`margins`): a fixed fraction ``margin_frac`` of the gap between
-the best method's mean and the ``random`` picker's mean of the same metric
-(m): the effect that selection has on that metric in that scenario. A method
-"equivalent" to the reference keeps all but that fraction of the selection
-effect; a method that is as bad as picking at random is not, whenever the
-reference is better than random by more than the margin. If random is not
-worse than the best method the margin is 0 and nothing is shown equivalent
-(selection does not move the metric: the claim is then not testable).
+Margin (:func:`margins`): a fixed fraction ``margin_rel`` of the reference's
+own mean of the same metric (m). The fraction is the analysis plan's (B-C1
+``margin_rel``, ``data/analysis_plan.yaml``: "almost the same" read as within
+10 % of the baseline's mean error), passed in by the caller, so the scorecard,
+the landing summary and the claims table use one number; no other method's
+runs (the controls' in particular) move it. A reference mean that is not
+positive gives margin 0 and nothing is shown equivalent.
 
 Metrics (per run, ``montecarlo.per_run_stats``): the position error norm at
 the last update with a landmark bearing (``lastlm_pos_err_m``) and its RMS
@@ -33,8 +32,8 @@ tested beside them and reported, not part of the verdict.
 
 Negative controls: the same rule applied to ``random``, ``center`` and
 ``closest`` (pickers without a metric, ``opnav.landing.planner.PICKERS``)
-against the same reference; if a control is "equivalent" the test cannot tell
-a metric from no metric and the claim is not reproduced.
+against the same reference; if a control is "equivalent" the claim may hold but
+the test cannot credit the metric (a picker without one meets it too).
 
 Converges faster (:func:`converges_faster`): per run, the first time the
 position error is below a threshold (``montecarlo.time_below``); the paired
@@ -96,29 +95,30 @@ def tost(d, margin: float, alpha: float = 0.05) -> dict:
             "n": int(d.size)}
 
 
-def margins(means: dict[str, float], margin_frac: float, control: str = "random") -> dict:
-    """The equivalence margin of one metric (m): ``margin_frac`` times the gap
-    between ``control``'s mean and the best (smallest) mean of ``means``
-    (method -> mean, m), 0 if that gap is not positive. Returns ``margin``,
-    ``gap``, ``best`` (the methods sharing the smallest mean, a list: ties are
-    ties) and ``frac``."""
-    if control not in means:
-        raise ValueError(f"equivalence margin: the control {control!r} was not flown "
+def margins(means: dict[str, float], reference: str, margin_rel: float) -> dict:
+    """The equivalence margin of one metric (m): ``margin_rel`` times the
+    reference's mean of ``means`` (method -> mean, m), 0 if that mean is not
+    positive. Returns ``margin``, ``rel``, ``reference_mean`` and ``best`` (the
+    methods sharing the smallest mean, a list: ties are ties; reported, it does
+    not set the margin)."""
+    if reference not in means:
+        raise ValueError(f"equivalence margin: the reference {reference!r} was not flown "
                          f"(methods: {sorted(means)})")
+    if not (math.isfinite(float(margin_rel)) and float(margin_rel) > 0.0):
+        raise ValueError(f"equivalence margin: margin_rel must be a positive fraction, got {margin_rel!r}")
     lo = min(means.values())
     best = sorted(m for m, v in means.items() if v == lo)
-    gap = float(means[control] - lo)
-    return {"margin": float(margin_frac) * gap if gap > 0 else 0.0, "gap": gap, "best": best,
-            "frac": float(margin_frac)}
+    r = float(means[reference])
+    return {"margin": float(margin_rel) * r if r > 0 else 0.0, "rel": float(margin_rel),
+            "reference_mean": r, "best": best}
 
 
-def equivalence(stats: dict, reference: str, tested: list[str], margin_frac: float,
-                alpha: float = 0.05, same_pick_pct: dict | None = None,
-                control: str = "random") -> dict:
+def equivalence(stats: dict, reference: str, tested: list[str], margin_rel: float,
+                alpha: float = 0.05, same_pick_pct: dict | None = None) -> dict:
     """Equivalence of each method of ``tested`` with ``reference`` on paired
     runs. ``stats``: method -> per-run table (``montecarlo.per_run_stats``, the
-    same runs in the same order) of every method flown (the margin's best
-    method is taken over all of them); ``same_pick_pct``: method -> share of
+    same runs in the same order) of every method flown; ``margin_rel``: the
+    plan's fraction of the reference's mean (:func:`margins`); ``same_pick_pct``: method -> share of
     planning calls picking the reference's landmark (%). Returns per metric its
     margin (:func:`margins`), and per tested method the :func:`tost` of every
     metric (primary and touchdown), ``equivalent`` (both primary metrics),
@@ -130,11 +130,11 @@ def equivalence(stats: dict, reference: str, tested: list[str], margin_frac: flo
         if not s.index.equals(runs):
             raise ValueError(f"equivalence: {m!r} did not fly the runs of {reference!r}")
     same_pick_pct = same_pick_pct or {}
-    out = {"reference": reference, "alpha": float(alpha), "margin_frac": float(margin_frac),
-           "control": control, "metrics": {}, "methods": {}}
+    out = {"reference": reference, "alpha": float(alpha), "margin_rel": float(margin_rel),
+           "metrics": {}, "methods": {}}
     for q in PRIMARY_METRICS + (TOUCHDOWN_METRIC,):
         means = {m: float(s[q].mean()) for m, s in stats.items()}
-        out["metrics"][q] = {**margins(means, margin_frac, control), "means": means,
+        out["metrics"][q] = {**margins(means, reference, margin_rel), "means": means,
                              "text": METRIC_TEXT[q]}
     ref = stats[reference]
     for m in tested:
@@ -150,7 +150,7 @@ def equivalence(stats: dict, reference: str, tested: list[str], margin_frac: flo
             "verdict": "equivalent" if eq else "not equivalent",
             "text": (f"{m} vs {reference}: {'equivalent' if eq else 'not equivalent'} "
                      f"({100 * (1 - 2 * alpha):.0f} % paired intervals, {m} minus {reference}: {parts}; "
-                     f"margin {margin_frac:g} x the best-vs-{control} gap; same landmark as "
+                     f"margin {margin_rel:g} x {reference}'s mean error; same landmark as "
                      f"{reference} in {sp:.3g} % of the planning calls)")}
     return out
 

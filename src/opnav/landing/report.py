@@ -133,11 +133,17 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
     return df
 
 
-def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: float) -> dict:
+def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: float, *,
+                   margin_rel: float, same_pick_max_pct: float) -> dict:
     """The accuracy claims of one scenario as tests that can fail
     (:mod:`opnav.landing.equivalence`), from the gathered Monte Carlo of every
-    method flown (``data``, the controls included) and ``landing.equivalence``
-    (``eq_cfg``): ``equivalence`` (each method of ``methods`` and each control
+    method flown (``data``, the controls included), ``landing.equivalence``
+    (``eq_cfg``: reference, methods, controls, alpha) and the analysis plan's B-C1
+    numbers, passed in by the caller (the landing package does not read the plan):
+    ``margin_rel`` (margin = that fraction of the reference's mean error) and
+    ``same_pick_max_pct`` (same picks in that share of the calls or more: not
+    tested), both recorded in the result for :func:`same_accuracy_verdict`.
+    Returns ``equivalence`` (each method of ``methods`` and each control
     against ``reference``: margin, metric, paired intervals, same-pick rate),
     ``controls_equivalent`` (the controls that passed: the test is void if any
     did), ``converges_faster`` (each method of ``methods`` vs ``reference``,
@@ -157,8 +163,7 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
         raise ValueError(f"landing.equivalence: methods {missing} were not flown")
     stats = {m: per_run_stats(d) for m, d in data.items()}
     picks = {m: same_pick_pct(data[m], data[ref]) for m in tested}
-    eq = eqv.equivalence(stats, ref, tested, float(eq_cfg["margin_frac"]), float(eq_cfg["alpha"]),
-                         picks)
+    eq = eqv.equivalence(stats, ref, tested, float(margin_rel), float(eq_cfg["alpha"]), picks)
     errors = {}
     for m, st in stats.items():
         errors[m] = {}
@@ -174,10 +179,11 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
     for b in ("svd", "gdop", "cond"):
         if b in data:
             tested_b = [m for m in eq_cfg["methods"] if m != b]
-            by_base[b] = eqv.equivalence(stats, b, tested_b, float(eq_cfg["margin_frac"]), float(eq_cfg["alpha"]),
+            by_base[b] = eqv.equivalence(stats, b, tested_b, float(margin_rel), float(eq_cfg["alpha"]),
                                          {m: same_pick_pct(data[m], data[b]) for m in tested_b})
     return {"equivalence": eq,
             "equivalence_vs_baselines": by_base,
+            "same_pick_max_pct": float(same_pick_max_pct),
             "controls": list(eq_cfg["controls"]),
             "controls_equivalent": [c for c in eq_cfg["controls"] if eq["methods"][c]["equivalent"]],
             "converges_faster": faster, "errors": errors,
@@ -306,36 +312,36 @@ def combine_scenarios(parts: dict[str, dict], headline: str, cameras: dict[str, 
 COMPACT_VIEWS = {"B-T3": compact_b_t3, "B-X1": compact_b_x1}
 
 
-#: "almost the same accuracy" cannot be tested when the depth method and the
-#: baseline pick the same landmark in at least this share of the planning calls
-#: (equal accuracy then follows by construction).
-SAME_PICK_MAX_PCT = 90.0
-
-
 def same_accuracy_verdict(accuracy: dict, method: str = "depth") -> Verdict:
     """Verdict on "almost the same accuracy" (``method`` vs the equivalence
-    reference) from :func:`accuracy_tests`: reproduced only if the paired
-    equivalence test shows ``method`` equivalent on both primary metrics, no
-    negative control (``random``, ``center``, ``closest``) is shown equivalent
-    by the same rule (else the rule cannot tell a metric from none), and the
-    two methods pick different landmarks often enough (same-pick rate below
-    :data:`SAME_PICK_MAX_PCT`). The reason names margin, metric, same-pick rate
-    and the controls' verdicts."""
+    reference) from :func:`accuracy_tests`, by the claims table's rule (B-C1 of
+    the analysis plan; its margin and same-pick threshold are the ones recorded
+    in ``accuracy``): not tested when the two methods pick the same landmark in
+    ``same_pick_max_pct`` of the planning calls or more (equal accuracy then
+    follows by construction) or the margin is 0; else reproduced iff the paired
+    equivalence test shows ``method`` equivalent on both primary metrics. A
+    negative control (``random``, ``center``, ``closest``) that passes too does
+    not change the verdict: the reason says the test cannot credit the metric.
+    The reason names margin, metric, same-pick rate and the controls' verdicts."""
     eq = accuracy["equivalence"]
+    if "same_pick_max_pct" not in accuracy or "margin_rel" not in eq:
+        raise ValueError("landing summary: no same_pick_max_pct / margin_rel from the analysis plan "
+                         "(a summary of an older build: rebuild landing_summary)")
+    pick_max = float(accuracy["same_pick_max_pct"])
     res = eq["methods"][method]
     ctrl = "; ".join(f"{c} {eq['methods'][c]['verdict']}" for c in accuracy["controls"])
     why = f"{res['text']}; negative controls vs {eq['reference']}: {ctrl or 'none'}"
     sp = res["same_pick_pct"]
-    if not math.isnan(sp) and sp >= SAME_PICK_MAX_PCT:
-        return Verdict(NOT_REPRODUCED, f"not tested (same pick >= {SAME_PICK_MAX_PCT:g} %): {why}")
+    if not math.isnan(sp) and sp >= pick_max:
+        return Verdict(NOT_REPRODUCED, f"not tested (same pick >= {pick_max:g} %): {why}")
     from opnav.landing.equivalence import PRIMARY_METRICS
 
     if any(eq["metrics"][q]["margin"] <= 0 for q in PRIMARY_METRICS):
-        return Verdict(NOT_REPRODUCED, f"not tested (random is not worse than the best method, "
+        return Verdict(NOT_REPRODUCED, f"not tested ({eq['reference']}'s mean error is not positive, "
                                        f"margin 0): {why}")
-    if accuracy["controls_equivalent"]:
-        return Verdict(NOT_REPRODUCED, f"the rule cannot fail: controls "
-                                       f"{', '.join(accuracy['controls_equivalent'])} pass it too; {why}")
+    if res["equivalent"] and accuracy["controls_equivalent"]:
+        return Verdict(REPRODUCED, f"{why}; but the controls {', '.join(accuracy['controls_equivalent'])} "
+                                   "pass it too, so the test cannot credit the metric")
     return Verdict(REPRODUCED if res["equivalent"] else NOT_REPRODUCED, why)
 
 
