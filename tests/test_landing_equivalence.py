@@ -146,17 +146,66 @@ def test_margin_is_zero_when_the_reference_error_is_not_positive():
         eqv.margins({"svd": 1.0}, "svd", 0.0)
 
 
+def _step():
+    from opnav.report.claims import load_plan
+
+    return load_plan().margin("B-C2", "min_difference_s")
+
+
 def test_converges_faster_rule():
     rng = np.random.default_rng(1)
     tb = 10 + rng.uniform(0, 5, 200)
-    fast = eqv.converges_faster(tb - 0.8 + 0.1 * rng.standard_normal(200), tb, "depth", "svd", 100.0)
-    assert fast["verdict"] == "faster" and fast["hi_s"] < 0
-    same = eqv.converges_faster(tb + 0.3 * rng.standard_normal(200), tb, "depth", "svd", 100.0)
+    step = _step()
+    fast = eqv.converges_faster(tb - 1.5 * step + 0.1 * rng.standard_normal(200), tb, "depth", "svd", 100.0,
+                                min_difference_s=step)
+    assert fast["verdict"] == "faster" and fast["hi_s"] < 0 and fast["min_difference_s"] == step
+    same = eqv.converges_faster(tb + 0.3 * rng.standard_normal(200), tb, "depth", "svd", 100.0,
+                                min_difference_s=step)
     assert same["verdict"] == "no difference shown"
-    ta = tb + 1.0
+    ta = tb + 1.5 * step
     ta[:50] = np.nan                       # runs that never get there are left out, counted
-    slow = eqv.converges_faster(ta, tb, "depth", "svd", 100.0)
+    slow = eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=step)
     assert slow["verdict"] == "slower" and slow["n_runs"] == 150
+
+
+def test_faster_needs_the_plans_smallest_difference():
+    """A difference the interval shows but smaller than the plan's step (B-C2: one filter
+    step) is not "faster" (the interval-below-zero rule alone calls it faster: tried once)."""
+    rng = np.random.default_rng(2)
+    tb = 10 + rng.uniform(0, 5, 300)
+    step = _step()
+    ta = tb - 0.6 * step + 0.05 * rng.standard_normal(300)
+    r = eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=step)
+    assert r["hi_s"] < 0 and r["verdict"] == "no difference shown"
+    assert eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=0.5 * step)["verdict"] == "faster"
+
+
+@pytest.mark.parametrize("shift", [-1.6, -0.6, 0.0, 0.6])
+def test_faster_reading_agrees_with_the_claims_table(shift):
+    """The scorecard's B-C2 row (the summary's verdict) and the claims table's B-C2 (the
+    plan's step on the summary's interval) agree."""
+    import pandas as pd
+
+    from opnav.core.verdicts import REPRODUCED
+    from opnav.landing.report import rows_paper_b
+    from opnav.report.claims import load_plan
+    from opnav.report.landing_claims import _claim_faster
+
+    rng = np.random.default_rng(4)
+    tb = 10 + rng.uniform(0, 5, 300)
+    cf = eqv.converges_faster(tb + shift * _step() + 0.05 * rng.standard_normal(300), tb, "depth", "svd", 100.0,
+                              min_difference_s=_step())
+    summary = {"converges_faster": {"depth": cf}}
+    claim = _claim_faster("interior", {"interior": summary}, load_plan())["verdict"]
+    eq = {"reference": "svd", "margin_rel": 0.1, "metrics": {q: {"margin": 1.0} for q in eqv.PRIMARY_METRICS},
+          "methods": {"depth": {"equivalent": True, "verdict": "equivalent", "same_pick_pct": 10.0, "text": "",
+                                "lastlm_pos_err_m": {"mean": 0.0}}}}
+    rows = rows_paper_b(pd.DataFrame({"method": ["depth"]}),
+                        {**summary, "equivalence": eq, "controls": [], "controls_equivalent": [],
+                         "same_pick_max_pct": 90.0}, {})
+    ours = next(r for r in rows if "converges a bit faster" in r["item"])["verdict"]
+    assert (ours == REPRODUCED) == (claim == "reproduced")
+    assert (ours == REPRODUCED) == (shift <= -1.5)
 
 
 def test_landmark_phase_and_time_below():

@@ -106,7 +106,8 @@ def test_rows_paper_b_per_scenario_from_the_summary():
                           "random": {"equivalent": ctrl_ok, "verdict": "equivalent" if ctrl_ok else "not equivalent"}}}
         return {"equivalence": eq, "controls": ["random"], "controls_equivalent": ["random"] if ctrl_ok else [],
                 "same_pick_max_pct": 90.0,
-                "converges_faster": {"depth": {"mean_s": -0.5, "verdict": "faster", "text": "faster"}}}
+                "converges_faster": {"depth": {"mean_s": -1.5, "verdict": "faster", "text": "faster",
+                                               "min_difference_s": 1.0}}}
 
     summary = {"scenarios": {"site-tilt": {"methods": methods(99.9), **accuracy(99.9, False)},
                              "interior": {"methods": methods(40.0), **accuracy(40.0, False)},

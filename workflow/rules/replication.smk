@@ -122,7 +122,7 @@ if REP_CFG["enabled"]:
             timing=f"{REP}/landing/timing/{{bscn}}.npz",
             single=f"{LANDING}/single/summary_{{bscn}}.json",
             tuning=f"{LANDING}/tuning.json",
-            plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold
+            plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step
             code=src("landing/montecarlo.py", "landing/timing.py", "landing/report.py", "landing/equivalence.py",
                      "landing/ranking.py", "landing/trajectory.py"),
         output:

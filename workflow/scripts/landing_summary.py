@@ -44,11 +44,13 @@ with script_context(snakemake) as log:
                          f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
     single = load_json(snakemake.input.single)
     every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
-    # B-C1's margin and same-pick threshold: the analysis plan's numbers, its one home
+    # B-C1's margin and same-pick threshold, B-C2's smallest difference: the analysis plan's
+    # numbers, their one home
     plan = load_plan(snakemake.input.plan)
     acc = accuracy_tests(every, snakemake.params.equivalence, float(snakemake.params.converged_pos_err_m),
                          margin_rel=plan.margin("B-C1", "margin_rel"),
-                         same_pick_max_pct=plan.margin("B-C1", "same_pick_max_pct"))
+                         same_pick_max_pct=plan.margin("B-C1", "same_pick_max_pct"),
+                         min_difference_s=plan.margin("B-C2", "min_difference_s"))
     out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
                            eval_path=snakemake.params.eval_path,
                            yaw_ratio=float(snakemake.params.yaw_ratio),

@@ -38,8 +38,10 @@ the test cannot credit the metric (a picker without one meets it too).
 Converges faster (:func:`converges_faster`): per run, the first time the
 position error is below a threshold (``montecarlo.time_below``); the paired
 difference ``a - b`` over runs where both get there, with its two-sided
-``1 - alpha`` paired-t interval: "faster" if the interval is below 0, "slower"
-if above, else "no difference shown".
+``1 - alpha`` paired-t interval: "faster" if the interval is below 0 and the
+mean difference is at least ``min_difference_s`` (the analysis plan's B-C2: one
+filter step; a smaller difference is below the time resolution), "slower" in
+the mirror case, else "no difference shown".
 """
 
 from __future__ import annotations
@@ -155,12 +157,15 @@ def equivalence(stats: dict, reference: str, tested: list[str], margin_rel: floa
     return out
 
 
-def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float = 0.05) -> dict:
+def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float = 0.05, *,
+                     min_difference_s: float) -> dict:
     """Paired comparison of the first times below ``threshold_m`` (s; NaN:
     never) of methods ``a`` and ``b`` on the same runs: mean of ``t_a - t_b``
     over the runs where both get there, its two-sided ``1 - alpha`` paired-t
-    interval (s), the runs used, and ``verdict``: "faster" (interval below 0:
-    ``a`` converges faster), "slower" (above 0) or "no difference shown"."""
+    interval (s), the runs used, and ``verdict``: "faster" (interval below 0
+    and mean at most ``-min_difference_s``: ``a`` converges faster by at least
+    that, s; the analysis plan's B-C2 number, passed in), "slower" (the mirror)
+    or "no difference shown"."""
     t_a, t_b = np.asarray(t_a, float), np.asarray(t_b, float)
     if t_a.shape != t_b.shape:
         raise ValueError("converges_faster: the two methods must have flown the same runs")
@@ -170,9 +175,13 @@ def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float 
         m, lo, hi = (float(d.mean()) if d.size else math.nan), math.nan, math.nan
     else:
         m, _, lo, hi = _t_interval(d, 1.0 - alpha)
-    verdict = ("faster" if hi < 0 else "slower" if lo > 0 else "no difference shown")
+    step = float(min_difference_s)
+    if not (math.isfinite(step) and step >= 0.0):
+        raise ValueError(f"converges_faster: min_difference_s must be >= 0 s, got {min_difference_s!r}")
+    verdict = ("faster" if hi < 0 and m <= -step else "slower" if lo > 0 and m >= step
+               else "no difference shown")
     return {"mean_s": m, "lo_s": lo, "hi_s": hi, "n_runs": int(d.size), "n_total": int(t_a.size),
-            "threshold_m": float(threshold_m), "verdict": verdict,
+            "threshold_m": float(threshold_m), "min_difference_s": step, "verdict": verdict,
             "text": (f"first time below {threshold_m:g} m, {a} minus {b}: {m:+.3g} s "
                      f"[{lo:+.3g}, {hi:+.3g}] ({100 * (1 - alpha):.0f} % paired interval, "
-                     f"{d.size} of {t_a.size} runs): {verdict}")}
+                     f"{d.size} of {t_a.size} runs; smallest difference counted {step:g} s): {verdict}")}

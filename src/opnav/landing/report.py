@@ -134,7 +134,7 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
 
 
 def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: float, *,
-                   margin_rel: float, same_pick_max_pct: float) -> dict:
+                   margin_rel: float, same_pick_max_pct: float, min_difference_s: float) -> dict:
     """The accuracy claims of one scenario as tests that can fail
     (:mod:`opnav.landing.equivalence`), from the gathered Monte Carlo of every
     method flown (``data``, the controls included), ``landing.equivalence``
@@ -142,7 +142,8 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
     numbers, passed in by the caller (the landing package does not read the plan):
     ``margin_rel`` (margin = that fraction of the reference's mean error) and
     ``same_pick_max_pct`` (same picks in that share of the calls or more: not
-    tested), both recorded in the result for :func:`same_accuracy_verdict`.
+    tested), both recorded in the result for :func:`same_accuracy_verdict`, and
+    B-C2's ``min_difference_s`` (s: "converges faster" needs at least that).
     Returns ``equivalence`` (each method of ``methods`` and each control
     against ``reference``: margin, metric, paired intervals, same-pick rate),
     ``controls_equivalent`` (the controls that passed: the test is void if any
@@ -173,7 +174,8 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
                             "3sigma": float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan}
     t_ref = time_below(data[ref], converged_pos_err_m)
     faster = {m: eqv.converges_faster(time_below(data[m], converged_pos_err_m), t_ref, m, ref,
-                                      converged_pos_err_m, float(eq_cfg["alpha"]))
+                                      converged_pos_err_m, float(eq_cfg["alpha"]),
+                                      min_difference_s=float(min_difference_s))
               for m in eq_cfg["methods"]}
     by_base = {}
     for b in ("svd", "gdop", "cond"):
@@ -375,6 +377,9 @@ def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: st
                          "published": float("nan"), "ours": ours, "unit": "m",
                          "verdict": v.verdict, "reason": v.reason})
             cf = summary["converges_faster"][m]
+            if "min_difference_s" not in cf:
+                raise ValueError("landing summary: converges_faster has no min_difference_s from the analysis "
+                                 "plan (a summary of an older build: rebuild landing_summary)")
             rows.append({"paper": "B", "item": f"{tag}position error converges a bit faster with {m} "
                                                f"than {ref}",
                          "published": float("nan"), "ours": cf["mean_s"], "unit": "s",
