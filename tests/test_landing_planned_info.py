@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 from opnav.landing import ekf
 from opnav.landing.measurement import selection_jacobian
-from opnav.landing.planned_info import PLANNED_METRICS, planned_metric, planned_nav_logdet, planned_posterior
+from opnav.landing.planned_info import (PLANNED_METRICS, planned_metric, planned_nav_logdet, planned_posterior,
+                                       whitened_site_bound)
 from opnav.core.rotations import exp_so3
 
 
@@ -186,3 +187,28 @@ def test_information_form_definitions_by_hand():
                 "logdet_nav": -np.linalg.slogdet(Sig[i][:9, :9])[1]}
         for n in PLANNED_METRICS:
             assert got[n][i] == pytest.approx(want[n], rel=1e-6), n
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([2, 3, 5]), st.booleans(), st.sampled_from([0.02, 0.1, 0.5]),
+       st.sampled_from([1e-3, 5e-3]))
+def test_whitened_baselines_are_capped_by_the_site_alone(seed, n_obs, oc, frac, sf):
+    """Why svd_w / gdop_w cannot reward a candidate (planned_info's module docstring): deleting
+    the candidate's rows interlaces the singular values, so svd_w <= sigma_min of the site's
+    whitened rows alone (whitened_site_bound) and gdop_w <= its square, and that bound is the
+    same for every candidate (the site's rows see the navigation prior only; OC's projection
+    moves it by round-off). Mutation tried: planned_metric keeping two singular values fewer
+    (min(m, 11) - 2: the smallest kept is then a site-and-candidate one) fails the cap."""
+    r, v, a, R, P, _ = _state(seed % 1000)
+    rng = np.random.default_rng(seed)
+    cand = np.column_stack([r[0] + rng.uniform(-1500, 1500, 12), r[1] + rng.uniform(-1500, 1500, 12),
+                            np.zeros(12)])
+    args = (r, v, a, R, P, np.zeros(3), cand, sf, frac, n_obs, 1.0, G, oc)
+    bound = whitened_site_bound(*args)
+    ok = np.isfinite(bound)
+    assert ok.sum() >= 6
+    svd_w, gdop_w = planned_metric("svd_w", *args)[ok], planned_metric("gdop_w", *args)[ok]
+    b = bound[ok]
+    assert np.all(svd_w <= b * (1 + 1e-9)) and np.all(gdop_w <= b * b * (1 + 1e-9))
+    assert np.ptp(b) <= 1e-8 * b.max()                          # candidate-independent
+    assert np.ptp(svd_w) > 1e-6 * b.max()                       # (the candidates do differ below it)

@@ -157,8 +157,12 @@ def test_ranking_table_ties_and_paired_difference():
             "svd": _fake_mc(base + 1.0, runs, 800.0, 1),
             "gdop": _fake_mc(base + 1.0, runs, 900.0, 2),     # same errors as svd: a tie
             "random": _fake_mc(base * 0.5, runs, 50.0, 3)}
+    data["svd"]["plan_beta"] = np.tile([0.01, -0.03, np.nan], 6)   # optimum's angle to the velocity, rad
     df = ranking_table(data, _timing(data), "depth", n_boot=100)
     t = df.set_index("method")
+    # median |beta| over the calls with an optimum (mutation tried: no abs fails); none recorded: NaN
+    assert t.loc["svd", "median_abs_beta_deg"] == pytest.approx(math.degrees(0.02))
+    assert math.isnan(t.loc["depth", "median_abs_beta_deg"])
     assert t.loc["random", "rank_accuracy"] == 1
     assert t.loc["depth", "rank_accuracy"] == 2
     assert t.loc["svd", "rank_accuracy"] == t.loc["gdop", "rank_accuracy"] == 3

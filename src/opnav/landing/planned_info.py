@@ -44,6 +44,32 @@ lose to depth); it is gone, no study needs it.
 Candidates behind the camera or whose line of sight
 misses the ground score ``-inf``.
 
+What the whitened baselines reward (issue 43 follow-up; B-X1)
+-------------------------------------------------------------
+``svd_w``, ``gdop_w`` and ``cond_w`` are computed as defined (tested equal to the
+compiled kernel, the kept count ``min(m, 11)`` is the rows' structural rank) and still
+pick landmarks that are useless for navigation; this is what the metrics do, not a
+bug. The rows ``A`` of a plan are the site's ``2 n_obs`` rows plus the candidate's
+``2 (n_obs - 1)``. Deleting rows interlaces singular values (sigma_i(A P0^1/2) >=
+sigma_i(A_site P0^1/2) >= sigma_(i+k)(A P0^1/2), k rows deleted), so the smallest kept
+singular value is bounded by one of the site's own (:func:`whitened_site_bound`; at the
+configured three observations, the site's smallest): the weakest direction of
+re-observing the site over the short planning horizon, whose whitened gain depends on
+the navigation prior only (the site's rows have no landmark columns; with OC the yaw
+projection moves it by round-off).
+``svd_w`` is therefore the candidate-independent ceiling minus however much the
+candidate's rows pull that direction down; ``gdop_w`` (``1 / sum sigma_i^-2``) is
+dominated by the same two smallest values. Neither can reward what a candidate adds:
+its parallax on its own depth shows up in the *largest* singular value (the landmark's
+depth prior ``(depth_sigma_frac d)^2`` dwarfs the rest, so its gain whitens large),
+which ``svd_w`` and ``gdop_w`` ignore and ``cond_w`` (``sigma_min / sigma_max``)
+divides by: cond_w prefers candidates that give the least depth parallax. Over the
+plateau the best scores are set by candidates near the estimated velocity (the focus
+of expansion, ``beta`` ~ 0, no parallax), so their picks cluster there, their depth is
+not resolved, and the filter's position drifts. The descent records the optimum's
+angle to the velocity (``plan_beta``); ``ranking.ranking_table`` reports its median
+per method (``median_abs_beta_deg``), the number the manuscript quotes.
+
 Two implementations of the one specification above: the Monte Carlo's planner runs
 the compiled one (``kernels.planned_rows`` and ``kernels.planned``, per candidate:
 ``ekf._init``, ``measurement.tangent_rows``, ``ekf._nullspace``, the Woodbury
@@ -61,7 +87,8 @@ from opnav.landing import ekf
 from opnav.landing.measurement import tangent_jacobian
 from opnav.landing.metrics import chol_logdet
 
-__all__ = ["planned_nav_logdet", "planned_posterior", "planned_rows", "planned_metric", "PLANNED_METRICS"]
+__all__ = ["planned_nav_logdet", "planned_posterior", "planned_rows", "planned_metric", "whitened_site_bound",
+           "PLANNED_METRICS"]
 
 #: the B-X1 information baselines scored from the planned observations (:func:`planned_metric`)
 PLANNED_METRICS = ("logdet", "mineig", "svd_w", "gdop_w", "cond_w", "logdet_nav")
@@ -190,3 +217,21 @@ def planned_metric(name: str, r, v, a, R_LtoB, P, p_known, cand, sigma_f: float,
         R = np.asarray(R_LtoB, float)
         ok = ok & ((cand - np.asarray(r, float)) @ R.T @ np.asarray(boresight_B, float) > 0)
     return np.where(ok, out, -np.inf)
+
+
+def whitened_site_bound(r, v, a, R_LtoB, P, p_known, cand, sigma_f: float, depth_sigma_frac: float,
+                        n_obs: int, dt: float, g, oc: bool = True) -> np.ndarray:
+    """The ceiling of ``svd_w`` per candidate (n,): the ``j``-th largest singular value of the
+    site's whitened rows alone, ``A_site P0^1/2`` (the ``2 n_obs`` rows of :func:`planned_rows`
+    with zero landmark columns; module docstring), ``j = min(m, PLANNED_RANK) - 2 (n_obs - 1)``
+    (the kept count less the candidate's rows; at ``n_obs <= 3``, the site's smallest).
+    Deleting the candidate's ``2 (n_obs - 1)`` rows interlaces the singular values
+    (sigma_(j + k)(A P0^1/2) <= sigma_j(A_site P0^1/2), k rows deleted), so ``svd_w <=`` this
+    bound and ``gdop_w <=`` its square. The site's rows see the navigation prior only, so the
+    bound does not depend on the candidate (without OC exactly; with OC to round-off). NaN
+    where the candidate cannot be initialised."""
+    A, P0, ok = planned_rows(r, v, a, R_LtoB, P, p_known, cand, sigma_f, depth_sigma_frac, n_obs, dt, g, oc)
+    site = [4 * k + i - (2 if k else 0) for k in range(int(n_obs)) for i in range(2)]
+    j = min(A.shape[1], PLANNED_RANK) - 2 * (int(n_obs) - 1)
+    sv = np.linalg.svd(A[:, site] @ np.linalg.cholesky(P0), compute_uv=False)[:, j - 1]
+    return np.where(ok, sv, np.nan)

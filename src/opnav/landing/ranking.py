@@ -196,7 +196,9 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
     / ``d_lmrms_pos_vs_ref_*`` are method minus
     reference (m; negative = the method is more accurate); ``converged_runs_pct``
     counts runs whose final position error is below ``converged_pos_err_m`` (m),
-    as in B-T3. Time columns (median wall and CPU time of a planning call, us)
+    as in B-T3; ``median_abs_beta_deg`` is the median over calls of the optimum's |beta| (deg),
+    its in-plane angle to the estimated velocity (0: no parallax; ``planned_info`` says why the
+    whitened baselines sit near it). Time columns (median wall and CPU time of a planning call, us)
     come from ``timing``, the replay of the recorded planning calls
     (``opnav.landing.timing.replay``: every method on the same calls)."""
     from opnav.landing import timing as tmg
@@ -249,6 +251,10 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
                                        else same_pick_pct(d, data[reference]))
         row["median_abs_dbeta_vs_ref_deg"] = (0.0 if m == reference
                                               else median_abs_dbeta_deg(d, data[reference]))
+        # the optimum's in-plane angle to the estimated velocity (0: no parallax; planned_info)
+        beta = np.abs(np.asarray(d.get("plan_beta", []), float))
+        row["median_abs_beta_deg"] = (float(np.degrees(np.median(beta[np.isfinite(beta)])))
+                                      if np.isfinite(beta).any() else math.nan)
         lo, hi = row[f"d_{rank_by}_vs_ref_t_lo"], row[f"d_{rank_by}_vs_ref_t_hi"]
         row["vs_ref"] = ("reference" if m == reference else
                          "n/a" if math.isnan(lo) else
