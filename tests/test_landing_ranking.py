@@ -200,6 +200,8 @@ def test_headline_feeds_manuscript_macros():
     data = {"depth": _fake_mc(np.arange(1.0, 6.0), runs, 100.0, 0),
             "svd": _fake_mc(np.arange(1.0, 6.0) * (1 + 1e-5), runs, 800.0, 1),
             "logdet": _fake_mc(np.arange(2.0, 7.0), runs, 900.0, 2)}
+    data["depth"]["plan_beta"] = np.full(15, math.radians(60.0))
+    data["logdet"]["plan_beta"] = np.full(15, -math.radians(2.5))
     df = ranking_table(data, _timing(data), "depth", n_boot=50, rtol=1e-3)
     t = df.set_index("method")
     assert t.loc["svd", "rank_accuracy"] == t.loc["depth", "rank_accuracy"] == 1   # within 0.1 %
@@ -209,6 +211,8 @@ def test_headline_feeds_manuscript_macros():
     # svd is 1e-5 worse in EVERY run: a shared rank (tolerance) but a significant paired difference
     assert h["reference_more_accurate_than_text"] == "svd, logdet"
     assert h["reference_less_accurate_than_text"] == "none"
+    # methods with a recorded optimum, in accuracy order (svd has none: left out)
+    assert h["median_abs_beta_text"] == "depth 60 deg, logdet 2.5 deg"
 
 
 def test_tied_order_is_by_method_name_not_timing():

@@ -308,4 +308,8 @@ def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
     for k in ("ranking_by_accuracy", "ranking_by_time", "reference_more_accurate_than",
               "reference_less_accurate_than", "not_significant_vs_reference", "reference_faster_than"):
         out[f"{k}_text"] = ", ".join(out[k]) if out[k] else "none"
+    # the optimum's median angle to the estimated velocity (0: no parallax), methods that search
+    beta = [(m, float(t.loc[m, "median_abs_beta_deg"])) for m in by_acc if "median_abs_beta_deg" in t
+            and math.isfinite(float(t.loc[m, "median_abs_beta_deg"]))]
+    out["median_abs_beta_text"] = ", ".join(f"{m} {v:.3g} deg" for m, v in beta) if beta else "none"
     return out
