@@ -110,6 +110,7 @@ rule paper_scorecard:
         **SCORE_INPUTS,
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         published=src("data/published.yaml"),
+        plan=src("data/analysis_plan.yaml")[0],  # B-C4's band for the timing rows
         code=src("report/scorecard.py", "core/verdicts.py", "report/approach_scorecard.py", "approach/summaries.py", "landing/report.py", "core/published.py"),
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),

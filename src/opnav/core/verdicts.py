@@ -46,24 +46,28 @@ class Verdict:
     reason: str
 
 
-def tolerance(published: float, spread: float | None, abs_tol: float = 0.0) -> float:
-    """Half-width of the 'reproduced' band around our mean (see module docstring)."""
-    s = 0.0 if spread is None or math.isnan(spread) else K_SPREAD * abs(spread)
-    return max(s, REL_TOL * abs(published), abs_tol)
+def tolerance(published: float, spread: float | None, abs_tol: float = 0.0, *,
+              rel_tol: float = REL_TOL, k_spread: float = K_SPREAD) -> float:
+    """Half-width of the 'reproduced' band around our mean (see module docstring); a
+    claim whose analysis-plan entry states its own rel_tol / spread_k passes them."""
+    s = 0.0 if spread is None or math.isnan(spread) else k_spread * abs(spread)
+    return max(s, rel_tol * abs(published), abs_tol)
 
 
 def judge(published: float, ours: float, spread: float | None = None, abs_tol: float = 0.0,
-          truth: float | None = None, crlb: float | None = None, unit: str = "") -> Verdict:
-    """Verdict for one published number against our mean (and spread, CRLB where known)."""
+          truth: float | None = None, crlb: float | None = None, unit: str = "", *,
+          rel_tol: float = REL_TOL, k_spread: float = K_SPREAD, max_band_rel: float = MAX_BAND_REL) -> Verdict:
+    """Verdict for one published number against our mean (and spread, CRLB where known);
+    ``rel_tol``, ``k_spread``, ``max_band_rel``: the band's numbers (default: this module's)."""
     if ours is None or (isinstance(ours, float) and math.isnan(ours)):
         return Verdict(NOT_REPRODUCED, "no value computed")
-    tol = tolerance(published, spread, abs_tol)
+    tol = tolerance(published, spread, abs_tol, rel_tol=rel_tol, k_spread=k_spread)
     diff = ours - published
     u = f" {unit}" if unit else ""
-    band = 0.0 if spread is None or math.isnan(spread) else K_SPREAD * abs(spread)
-    if abs(diff) <= tol and band > max(MAX_BAND_REL * abs(published), abs_tol):
-        return Verdict(NOT_REPRODUCED, f"inside our band only because it is wide: 2 sd = {band:.3g}{u} "
-                                       f"> {100 * MAX_BAND_REL:.0f} % of the published value")
+    band = 0.0 if spread is None or math.isnan(spread) else k_spread * abs(spread)
+    if abs(diff) <= tol and band > max(max_band_rel * abs(published), abs_tol):
+        return Verdict(NOT_REPRODUCED, f"inside our band only because it is wide: {k_spread:g} sd = {band:.3g}{u} "
+                                       f"> {100 * max_band_rel:.0f} % of the published value")
     if abs(diff) <= tol:
         return Verdict(REPRODUCED, f"|diff| {abs(diff):.3g}{u} within tolerance {tol:.3g}{u}")
     if truth is not None and crlb is not None and not math.isnan(crlb):

@@ -347,7 +347,8 @@ def same_accuracy_verdict(accuracy: dict, method: str = "depth") -> Verdict:
     return Verdict(REPRODUCED if res["equivalent"] else NOT_REPRODUCED, why)
 
 
-def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: str) -> list[dict]:
+def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: str,
+                           timing_band: dict | None = None) -> list[dict]:
     rows: list[dict] = []
     tag = f"[{label}] " if label else ""
     t3 = t3.set_index("method")
@@ -366,7 +367,7 @@ def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: st
                                                + (f" (SVD on the {p} path)" if p else ""),
                          "published": float(pub["depth_time_reduction_vs_svd_pct"]),
                          "ours": float(t3.loc["depth", col]),
-                         "spread": float(spread), "unit": "%"})
+                         "spread": float(spread), "unit": "%", "band": dict(timing_band or {})})
     if isinstance(summary, dict) and "equivalence" in summary:
         ref = summary["equivalence"]["reference"]
         for m in summary["converges_faster"]:
@@ -394,21 +395,23 @@ def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: st
     return rows
 
 
-def rows_paper_b(t3: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
+def rows_paper_b(t3: pd.DataFrame, summary: dict, pub: dict, timing_band: dict | None = None) -> list[dict]:
     """Scorecard rows for paper B: per camera scenario (``summary["scenarios"]``,
     each with its B-T3 rows under ``methods``; else ``t3`` alone) the 29.03 %
     timing claim and the accuracy claims; once, the initial attitude scored as
     thrust tilt and azimuth separately (the paper's triple read as
-    -(yaw, pitch, roll), Z-Y-X, roll 0)."""
+    -(yaw, pitch, roll), Z-Y-X, roll 0). ``timing_band``: the analysis plan's B-C4
+    ``rel_tol``, ``k_spread``, ``max_band_rel`` for the timing rows (passed in by the
+    workflow; without it, :mod:`opnav.core.verdicts`' defaults)."""
     import pandas as pd
 
     rows: list[dict] = []
     scen = summary.get("scenarios") if isinstance(summary, dict) else None
     if scen:
         for name, sc in scen.items():
-            rows += _rows_paper_b_scenario(pd.DataFrame(list(sc["methods"].values())), sc, pub, name)
+            rows += _rows_paper_b_scenario(pd.DataFrame(list(sc["methods"].values())), sc, pub, name, timing_band)
     else:
-        rows += _rows_paper_b_scenario(t3, summary, pub, "")
+        rows += _rows_paper_b_scenario(t3, summary, pub, "", timing_band)
     if isinstance(summary, dict) and "initial_tilt_deg" in summary:
         att = pub["table1_initial_state"]["att_deg"]
         for item, published_v, ours, why in (

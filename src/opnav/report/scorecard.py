@@ -14,14 +14,15 @@ from opnav.core.verdicts import (K_SPREAD, MAX_BAND_REL, NOT_REPRODUCED, NOT_REP
 
 def score_rows(rows: list[dict]) -> pd.DataFrame:
     """Score a list of dicts with keys paper, item, published, ours, spread, unit
-    (and optional truth, crlb, abs_tol, verdict/reason for pre-judged claims)."""
+    (and optional truth, crlb, abs_tol, verdict/reason for pre-judged claims, and ``band``:
+    the rel_tol / k_spread / max_band_rel of the row's claim in the analysis plan)."""
     out = []
     for r in rows:
         if "verdict" in r:
             v = Verdict(r["verdict"], r["reason"])
         else:
             v = judge(r["published"], r["ours"], r.get("spread"), r.get("abs_tol", 0.0),
-                      r.get("truth"), r.get("crlb"), r.get("unit", ""))
+                      r.get("truth"), r.get("crlb"), r.get("unit", ""), **(r.get("band") or {}))
         pub, ours = r.get("published"), r.get("ours")
         diff = (ours - pub) if isinstance(pub, (int, float)) and isinstance(ours, (int, float)) else float("nan")
         out.append({
