@@ -270,6 +270,10 @@ def _dry_run_jobs(proc: subprocess.CompletedProcess) -> list[tuple[str, dict]]:
         wc = re.search(r"^    wildcards: (.*)$", block, re.M)
         pairs = dict(kv.split("=", 1) for kv in wc.group(1).split(", ")) if wc else {}
         jobs.append((m.group(1), pairs))
+    # a rule with a `message:` prints it instead of its header; the project's messages
+    # start "rule NAME (k=v, ...):" so the job still names its rule and wildcards
+    for m in re.finditer(r"^Job \d+: rule (\w+)(?: \(([^)]*)\))?:", proc.stdout, re.M):
+        jobs.append((m.group(1), dict(kv.split("=", 1) for kv in m.group(2).split(", ")) if m.group(2) else {}))
     return jobs
 
 

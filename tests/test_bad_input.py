@@ -630,7 +630,7 @@ def test_snakefile_reports_every_problem_in_one_line_each(tmp_path):
     (wd / "dup.yaml").write_text("landing:\n  mc: {n_runs: 8}\nlanding:\n  duration_s: 198\n")
     proc = run_snakemake(wd, "-n", "--cores", "1", "--configfile", "config/quick.yaml", "dup.yaml")
     out = proc.stdout + proc.stderr
-    assert proc.returncode != 0 and "dup.yaml, line 3, column 1: not valid YAML: duplicate key 'landing'" in out, out
+    assert proc.returncode != 0 and "dup.yaml, line 3: key 'landing': given twice" in out, out
     assert not (wd / "results").exists()
 
 

@@ -49,7 +49,9 @@ def test_unchanged_config_lists_nothing(edits):
 
 @pytest.mark.parametrize("edit, only", [
     # approach_crlb: the roll rate that reaches the target within the published data (issue 28)
-    ("accuracy_target", {"approach_tables", "approach_x1_figure", "approach_crlb"}),
+    # approach_stars: the attitude knowledge at which star calibration reaches the target (issue 44)
+    ("accuracy_target", {"approach_tables", "approach_x1_figure", "approach_crlb", "approach_stars",
+                         "approach_stars_outputs"}),
     ("convergence_tol", {"approach_convergence", "approach_tables", "approach_x1_figure"}),
 ])
 def test_editing_one_key_reruns_only_its_users(edits, edit, only):

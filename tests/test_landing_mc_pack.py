@@ -79,7 +79,7 @@ def test_quick_profile_packs_methods_full_profile_does_not(tmp_path):
 
 @pytest.mark.slow
 def test_a_study_value_in_a_pack_writes_what_its_own_job_writes(tmp_path):
-    """jobs.study_values_per_job: the quick profile's landing study pack (its params from
+    """jobs.study_values_per_job: a landing study pack of the quick profile packed 8 a job (its params from
     the workflow), its second value flown alone and after the first: the same table (and
     each file holds its own value: swapping the pack's outputs fails this)."""
     import pandas as pd
@@ -87,7 +87,9 @@ def test_a_study_value_in_a_pack_writes_what_its_own_job_writes(tmp_path):
     from opnav.core.snakeio import load_csv, mock_snakemake
 
     script = REPO / "workflow" / "scripts" / "study_runs.py"
-    pack = next(sm for sm in (mock_snakemake(f"study_runs_pack{i}", configfiles=[REPO / "config" / "quick.yaml"])
+    packed = tmp_path / "packed.yaml"   # the quick profile with study values packed 8 a job
+    packed.write_text("jobs: {study_values_per_job: 8}\n")
+    pack = next(sm for sm in (mock_snakemake(f"study_runs_pack{i}", configfiles=[REPO / "config" / "quick.yaml", packed])
                               for i in (1, 2)) if sm.params.paper == "landing")
     p = pack.params
     assert len(p.sims) >= 2 and p.sims[0] != p.sims[1]

@@ -23,7 +23,8 @@ rule compile_kernels:
     wildcard_constraints:
         kpaper="|".join(KERNEL_PAPERS),
     message:
-        "compiling paper {wildcards.kpaper}'s numba kernels into the on-disk cache: first build only, "
-        "up to about a minute of CPU per paper with no output until it ends (measured: docs/performance.md)"
+        "rule compile_kernels (kpaper={wildcards.kpaper}): compiling this paper's numba kernels into the "
+        "on-disk cache, first build only: about a minute of CPU per paper, a line per module in its log "
+        "(measured: docs/performance.md)"
     script:
         "../scripts/compile_kernels.py"
