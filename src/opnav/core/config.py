@@ -22,7 +22,7 @@ import yaml
 
 
 from opnav.core.errors import ConfigError  # noqa: E402  (defined in the base layer; its home for users)
-from opnav.core.yamlfile import read_config_file
+from opnav.core.yamlfile import dotted as _dotted, read_config_file
 
 __all__ = ["ConfigError", "validate_config", "load_config", "read_config_file", "schema_problems", "core_problems"]
 
@@ -178,13 +178,6 @@ def non_string_keys(value: Any, path: tuple = ()) -> list[tuple[str, Any]]:
     elif isinstance(value, (list, tuple)):
         for i, v in enumerate(value):
             out += non_string_keys(v, (*path, i))
-    return out
-
-
-def _dotted(path) -> str:
-    out = ""
-    for p in path:
-        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
     return out
 
 

@@ -157,7 +157,8 @@ def _string_problem(s: str, is_key: bool) -> str | None:
     return None
 
 
-def _dotted(path) -> str:
+def dotted(path) -> str:
+    """A key path as the user writes it: ``("a", "b", 0)`` -> ``a.b[0]``."""
     out = ""
     for p in path:
         out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
@@ -170,7 +171,7 @@ class _Where:
 
     def fail(self, mark, path, msg: str):
         line = f", line {mark.line + 1}" if mark is not None else ""
-        key = f": key '{_dotted(path)}'" if path else ""
+        key = f": key '{dotted(path)}'" if path else ""
         raise ConfigError(f"{self.source}{line}{key}: {msg}")
 
 
