@@ -216,12 +216,12 @@ def test_ablation_studies_change_one_value():
     """The A-X3 ablations are studies (config.yaml): the segment sweep keeps the data
     length L N, the pixel sweep keeps the radius / centroid ratio, and every value of
     both changes only its own keys (and draws the initial error from the prior)."""
-    from opnav import studies
+    from opnav.studies import planning
 
     full = load_config()
     cfg = full["approach"]
     shape = {k: cfg[k] for k in cfg}
-    plan = studies.plan(full, {"approach": shape, "landing": full["landing"]}, lambda c: None)
+    plan = planning.plan(full, {"approach": shape, "landing": full["landing"]}, lambda c: None)
     base = cfg["segments"]["L"] * cfg["segments"]["N"]
     seg = plan["segment"]
     assert seg.keys == ("approach.segments.N", "approach.segments.L") and len(seg.instances) >= 2

@@ -70,7 +70,7 @@ def _layer(name: str) -> str:
         return "edge"
     if name.startswith(PAPERS):
         return name.split(".")[1]
-    if name.startswith("opnav.report") or name == "opnav.studies":
+    if name.startswith(("opnav.report", "opnav.studies")):
         return "report"
     return "core"
 

@@ -14,7 +14,7 @@ from opnav.approach.alternatives_summary import METHOD_LABELS
 from opnav.core.config import load_config
 from opnav.landing import plots as lplots
 from opnav.landing.planner import available_methods
-from opnav.studies import APPROACH_METHODS
+from opnav.studies.metrics import APPROACH_METHODS
 
 VARIANTS = ["literal", "prior", "roll", "reference-start"]
 A_ESTIMATORS = ["plain", "squarem", "growing-plain", "growing-squarem", *METHOD_LABELS, *APPROACH_METHODS]

@@ -86,15 +86,15 @@ def test_study_captions_are_three_sentences_without_config_keys():
     """Every configured study's generated caption (the float under its figure)."""
     from opnav.core.config import SCHEMA_PATH, load_config, validate_config
     from opnav.landing.planner import available_methods
-    from opnav import studies
+    from opnav.studies import captions, planning
     from test_studies import _shapes
 
     for overlays in ((), (REPO / "config" / "quick.yaml",)):
         cfg = load_config(overlays=overlays)
-        plan = studies.plan(cfg, _shapes(cfg), lambda c: validate_config(c, SCHEMA_PATH), available_methods())
+        plan = planning.plan(cfg, _shapes(cfg), lambda c: validate_config(c, SCHEMA_PATH), available_methods())
         assert plan
         for name, st in plan.items():
-            cap = studies.caption(st.spec())
+            cap = captions.caption(st.spec())
             assert len(sentences(cap)) <= 3, (name, sentences(cap))
             assert not CONFIG_KEY.search(cap), (name, CONFIG_KEY.search(cap).group(0))
             # it names what the axes show: paper A's spread studies plot RMS errors about the truth

@@ -9,7 +9,7 @@ import pytest
 from scipy import stats
 
 from conftest import REPO
-from opnav import studies
+from opnav.studies import captions, planning, tables, values
 from opnav.core.config import SCHEMA_PATH, ConfigError, load_config, validate_config
 from opnav.preflight import check_config
 from opnav.landing.montecarlo import run_chunk
@@ -30,7 +30,7 @@ def _shapes(cfg):
 
 
 def _plan(cfg):
-    return studies.plan(cfg, _shapes(cfg), lambda c: check_config(c), available_methods())
+    return planning.plan(cfg, _shapes(cfg), lambda c: check_config(c), available_methods())
 
 
 def _with_study(cfg, name, **spec):
@@ -50,8 +50,8 @@ def test_configured_studies_plan_and_share_identical_simulations(quick):
     fov, obs = plan["fov"], plan["obs"]
     assert [i.label for i in fov.instances] == ["fov_deg~45", "fov_deg~60"]
     # fov = 60 deg and obs = 3 are both the configured (main Monte Carlo) simulation: one digest
-    default = studies.config_digest({"paper": "landing",
-                                     "sim": studies.project(quick["landing"], _shapes(quick)["landing"])})
+    default = values.config_digest({"paper": "landing",
+                                     "sim": values.project(quick["landing"], _shapes(quick)["landing"])})
     assert fov.instances[1].digest == obs.instances[1].digest == default
     assert fov.instances[0].digest != default
 
@@ -137,7 +137,7 @@ def test_summary_statistics_known_answers():
     runs = pd.DataFrame({"instance": "v~1", "run": np.r_[np.arange(12), np.arange(12)],
                          "method": ["a"] * 12 + ["b"] * 12, "m": np.r_[a, a + d]})
     runs = runs.sample(frac=1.0, random_state=0)        # order must not matter (paired by run)
-    t = studies.summarize(runs, ["m"], ["a", "b"]).set_index("method")
+    t = tables.summarize(runs, ["m"], ["a", "b"]).set_index("method")
     assert t.loc["a", "mean"] == pytest.approx(a.mean(), rel=1e-12)
     assert t.loc["a", "sd"] == pytest.approx(a.std(ddof=1), rel=1e-12)
     assert t.loc["a", "rms"] == pytest.approx(np.sqrt(np.mean(a**2)), rel=1e-12)
@@ -151,11 +151,11 @@ def test_summary_statistics_known_answers():
 
 
 def test_instance_labels():
-    assert studies.instance_label({"landing.camera.fov_deg": 45.0}) == "fov_deg~45"
-    assert studies.instance_label({"landing.imu.sigma_a_mps2": 2.5e-4}) == "sigma_a_mps2~0.00025"
-    assert studies.instance_label({"approach.camera.sigma3_px": [0.1, 0.1, 0.2]}) == "sigma3_px~0.1,0.1,0.2"
+    assert values.instance_label({"landing.camera.fov_deg": 45.0}) == "fov_deg~45"
+    assert values.instance_label({"landing.imu.sigma_a_mps2": 2.5e-4}) == "sigma_a_mps2~0.00025"
+    assert values.instance_label({"approach.camera.sigma3_px": [0.1, 0.1, 0.2]}) == "sigma3_px~0.1,0.1,0.2"
     # same leaf under two sections: one more component
-    assert studies.instance_label({"landing.camera.pixels": 512, "approach.camera.pixels": 256}) == \
+    assert values.instance_label({"landing.camera.pixels": 512, "approach.camera.pixels": 256}) == \
         "landing.camera.pixels~512_approach.camera.pixels~256"
 
 
@@ -166,12 +166,12 @@ def test_gather_runs_keeps_the_study_units_and_refuses_missing_runs():
             "keys": ["approach.camera.ifov_arcsec"], "instances": {"a": {"approach.camera.ifov_arcsec": 10.0}}}
     rows = [{"run": r, "variant": v, "method": m, "err_x_arcsec": float(10 * r + len(v) + len(m))}
             for r in (0, 1, 2) for v in ("literal", "roll") for m in ("em", "augmented")]
-    runs = studies.gather_runs([("a", pd.DataFrame(rows))], spec)
+    runs = tables.gather_runs([("a", pd.DataFrame(rows))], spec)
     assert sorted(zip(runs["run"], runs["variant"], runs["method"])) == [(0, "roll", "em"), (1, "roll", "em")]
     assert list(runs["err_x_arcsec"]) == [6.0, 16.0]
     short = pd.DataFrame([r for r in rows if not (r["run"] == 1 and r["variant"] == "roll" and r["method"] == "em")])
     with pytest.raises(ValueError, match="1 runs of roll/em, expected 2"):
-        studies.gather_runs([("a", short)], spec)
+        tables.gather_runs([("a", short)], spec)
 
 
 def test_gathered_runs_do_not_depend_on_the_chunking():
@@ -186,8 +186,8 @@ def test_gathered_runs_do_not_depend_on_the_chunking():
     def chunk(i, runs):  # a job flies every method of its chunk, methods in job order
         return pd.DataFrame([rows[(i, r, m)] for m in ("depth", "svd") for r in runs])
 
-    one = studies.gather_runs([("a", chunk("a", [0, 1, 2])), ("b", chunk("b", [0, 1, 2]))], spec)
-    per_run = studies.gather_runs([(i, chunk(i, [r])) for i in ("a", "b") for r in range(3)], spec)
+    one = tables.gather_runs([("a", chunk("a", [0, 1, 2])), ("b", chunk("b", [0, 1, 2]))], spec)
+    per_run = tables.gather_runs([(i, chunk(i, [r])) for i in ("a", "b") for r in range(3)], spec)
     pd.testing.assert_frame_equal(one, per_run)
     assert list(one["method"][:3]) == ["svd"] * 3 and list(one["run"][:3]) == [0, 1, 2]
 
@@ -201,10 +201,10 @@ def test_caption_states_the_replay_budget_of_the_planning_times(quick):
     spec = _plan(cfg)["t"].spec()
     n = quick["landing"]["timing"]["max_calls"]
     assert spec["timing_calls"] == n == 30
-    cap = studies.caption(spec)
+    cap = captions.caption(spec)
     assert f"at most {n} of a job's recorded planning calls" in cap
     assert "jobs of 3 runs" in cap and "about 10 calls" in cap, cap
     quiet = _with_study(quick, "q", paper="landing", vary={"landing.camera.fov_deg": [45.0, 60.0]},
                         metrics=["final_pos_err_m"], runs=2, runs_per_job=2)
-    assert "replay" not in studies.caption(_plan(quiet)["q"].spec())
+    assert "replay" not in captions.caption(_plan(quiet)["q"].spec())
     assert _plan(quick)["ifov"].timing_calls is None          # paper A: no planning calls

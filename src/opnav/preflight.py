@@ -9,7 +9,7 @@
    :func:`opnav.landing.preflight.landing_problems`);
 3. with ``workflow`` (the Snakefile, ``opnav study``): every parameter study planned, each
    value checked as its own config by steps 1 and 2 for its paper
-   (:func:`opnav.studies.plan` with :func:`validate_study_value`), once the sections it
+   (:func:`opnav.studies.planning.plan` with :func:`validate_study_value`), once the sections it
    reads are sound and the job graph is within its bounds.
 
 It sits above the core and the papers (it imports both), so the core's config loader
@@ -55,7 +55,7 @@ def problems(config: dict, *, root: str | Path | None = None, workdir: str | Pat
             unsound |= {section_of(ln) for ln in found if not _SCENARIO_ONLY.match(ln)}
     if (workflow and "studies" in want and config.get("studies")
             and not unsound & {"approach", "landing", "limits", "studies"}):
-        from opnav.studies import plan
+        from opnav.studies.planning import plan
 
         try:
             plan(config, validate_paper=validate_study_value)

@@ -6,7 +6,9 @@
 # value's runs are keyed by the digest of its simulation config, so identical
 # simulations are flown once, and editing one study's values queues only the new
 # values' jobs. Outputs: results/studies/<name>/.
-from opnav import studies as _studies
+from opnav.studies.captions import caption as _study_caption
+from opnav.studies.planning import plan as _plan_studies
+from opnav.studies.values import simulation_shapes as _simulation_shapes
 from opnav.preflight import validate_study_value
 
 STUDIES_DIR = res("studies")
@@ -19,11 +21,11 @@ STUDY_SHAPES = {
 
 # The shapes the rules pass must be those opnav.studies plans with (validate_config
 # checked every study with them, before any rule file was read).
-if STUDY_SHAPES != _studies.simulation_shapes(config):
-    raise RuntimeError("opnav.studies.SIM_KEYS differs from the rules' simulation keys (B_SIM, "
+if STUDY_SHAPES != _simulation_shapes(config):
+    raise RuntimeError("opnav.studies.values.SIM_KEYS differs from the rules' simulation keys (B_SIM, "
                        "A_SCENARIO): update it")
 try:
-    STUDIES = _studies.plan(config, validate_paper=validate_study_value)   # cached: check_config planned it
+    STUDIES = _plan_studies(config, validate_paper=validate_study_value)   # cached: check_config planned it
 except ConfigError as exc:
     config_exit(exc)
 STUDY_SIMS = {i.digest: i.sim for s in STUDIES.values() for i in s.instances}
@@ -102,7 +104,7 @@ for _name, _s in STUDIES.items():
     _dir = f"{STUDIES_DIR}/{_name}"
     _stem = f"{_dir}/{_s.id}_{_name}"
     _spec = canonical(_s.spec())
-    _cap = _studies.caption(_s.spec())
+    _cap = _study_caption(_s.spec())
     _files = _study_runs(_s)
 
     # The table and the figure are one job (the figure is drawn from the table it
@@ -113,7 +115,8 @@ for _name, _s in STUDIES.items():
             f"study_{_name}_outputs"
         input:
             runs=[f for f, _ in _files],
-            code=src("studies.py", "landing/study.py", "core/tables.py", "report/study_plots.py", "core/figures.py",
+            code=src("studies/tables.py", "studies/metrics.py", "studies/values.py", "landing/study.py", "core/tables.py",
+                     "report/study_plots.py", "core/figures.py",
                      "opnav.mplstyle"),
         output:
             table=[report(f"{_stem}.csv", caption=_caption("study"), category="Studies",

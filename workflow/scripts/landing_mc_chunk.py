@@ -7,7 +7,7 @@ from pathlib import Path
 
 from opnav.landing.montecarlo import run_chunk_reusing, save
 from opnav.core.snakeio import mock_snakemake, script_context
-from opnav.studies import config_digest
+from opnav.studies.values import config_digest
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_mc_chunk", argv=sys.argv[1:], bscn="site-tilt", bmethod="depth", bchunk="r0000-0001")

@@ -8,7 +8,7 @@ import sys
 import pandas as pd
 
 from opnav.core import figures
-from opnav import studies
+from opnav.studies.tables import gather_runs, loglog_slopes, tidy_table, wide_table
 from opnav.core.snakeio import load_csv, mock_snakemake, script_context
 from opnav.report.study_plots import fig_study
 from opnav.core.tables import atomic_write_text, write_table
@@ -19,14 +19,14 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     study = snakemake.params.study
     parts = [(label, load_csv(path)) for path, label in zip(snakemake.input.runs, snakemake.params.labels)]
-    runs = studies.gather_runs(parts, study, snakemake.params.converged_pos_err_m)
-    tidy = studies.tidy_table(runs, study)
+    runs = gather_runs(parts, study, snakemake.params.converged_pos_err_m)
+    tidy = tidy_table(runs, study)
     cap = snakemake.params.caption
     write_table(tidy, [snakemake.output.table[0]], caption=cap)
-    write_table(studies.wide_table(tidy, study), snakemake.output.table[1:], caption=cap)
+    write_table(wide_table(tidy, study), snakemake.output.table[1:], caption=cap)
     write_table(runs, [snakemake.output.runs])
     if study["slopes"]:
-        write_table(studies.loglog_slopes(tidy, study), snakemake.output.slopes,
+        write_table(loglog_slopes(tidy, study), snakemake.output.slopes,
                     caption=f"{study['id']} {study['name']}: log-log slopes against {study['keys'][0]}.")
     atomic_write_text(snakemake.output.caption, cap + "\n")
     log.info("study %s: %d runs, %d summary rows", study["name"], len(runs), len(tidy))

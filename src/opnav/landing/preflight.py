@@ -6,7 +6,7 @@ the lander above ground (and above the measurement cut-off altitude, and above i
 initial position errors) and its nominal guidance trajectory not through the ground; a
 planning margin that leaves part of the detector; the landing site in the configured
 camera's view at the start and while the filter measures (a parameter study runs these
-checks on every swept value: :func:`opnav.studies.plan`); the B-F5 instant inside the
+checks on every swept value: :func:`opnav.studies.planning.plan`); the B-F5 instant inside the
 descent on a filter step; the IMU memory bound. (Method names are checked by the schema,
 whose registry tests/test_bad_input.py keeps equal to
 :func:`opnav.landing.planner.available_methods`.) One line per problem naming the key;

@@ -20,7 +20,8 @@ import numpy as np
 import pandas as pd
 
 from opnav.core import figures
-from opnav.studies import METRICS, _slug, shown_statistic
+from opnav.studies.metrics import METRICS, shown_statistic
+from opnav.studies.values import slug
 
 
 _LINESTYLES = ("-", "--", "-.", ":")
@@ -55,12 +56,12 @@ def _x_axis(study: Mapping):
         xlabel = keys[0] + (f" (zipped: {others})" if others else "")
         return {lab: float(x) for lab, x in zip(labels, xs)}, None, xlabel
     order = sorted(range(len(labels)), key=lambda i: _order_key(vals[i], keys))
-    ticks = [", ".join(_slug(vals[i][k]) for k in keys) for i in order]
+    ticks = [", ".join(slug(vals[i][k]) for k in keys) for i in order]
     return ({labels[i]: float(j) for j, i in enumerate(order)}, ticks,
             ", ".join(k.split(".")[-1] for k in keys))
 
 
-#: axis labels with symbols and units (the study tables keep opnav.studies.METRICS' names)
+#: axis labels with symbols and units (the study tables keep opnav.studies.metrics.METRICS' names)
 PLOT_LABELS = {
     "err_x_arcsec": r"$\hat t_x - t_x$ (arcsec)", "err_y_arcsec": r"$\hat t_y - t_y$ (arcsec)",
     "err_z_arcsec": r"$\hat t_z - t_z$ (arcsec)",
@@ -90,7 +91,7 @@ def axis_label(metric: str, paper: str, stat: str) -> str:
 def plotted_statistic(study: Mapping, metric: str) -> str:
     """What a panel draws: paper A's estimate errors as their RMS about the truth (a stalled
     estimate that never moved has a tiny spread but a large error) and its other metrics as
-    their mean, else :func:`opnav.studies.shown_statistic`."""
+    their mean, else :func:`opnav.studies.metrics.shown_statistic`."""
     stat = shown_statistic(study, metric)
     if study["paper"] == "approach" and stat == "sd":
         # errors about the truth as their RMS; any other quantity (a km error norm, data
