@@ -48,8 +48,8 @@ rule paper_claims:
         **REPLICATION_INPUTS,
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
-        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/manuscript.py",
-                 "core/published.py"),
+        code=src("report/claims.py", "report/approach_claims.py", "report/approach_rows.py", "report/landing_claims.py",
+                 "report/manuscript.py", "core/published.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
         md=f"{PAPER}/claims.md",

@@ -8,7 +8,7 @@ which holds every margin and threshold a verdict uses. Output: claims-table rows
 
 Variants (the A-T1 ``variant`` label): ``literal`` is the paper as written (plain EM on
 sliding segments, EM starting from the filter's estimate); every other scenario or scheme
-adds something the paper does not state (:func:`addition`); ``reference-start`` gives the
+adds something the paper does not state (:func:`opnav.report.approach_rows.addition`); ``reference-start`` gives the
 E-step the true state and is a diagnostic, never "reproduced".
 Units: arcsec, km, samples.
 """
@@ -22,121 +22,24 @@ import pandas as pd
 
 from opnav.approach.summaries import AS_WRITTEN, ClaimsSummary
 from opnav.report import claims as C
+from opnav.report.approach_rows import (
+    addition,
+    bound_arcsec,
+    bound_text,
+    converged_seeds,
+    headline_row,
+    is_beyond,
+    label_text,
+    rms_err_arcsec,
+    run_label,
+    short_addition,
+    truthy,
+    variant_labels,
+    variant_outcome,
+    variant_rows,
+    worst_vs_bound,
+)
 from opnav.report.claims import Outcome, Plan, fmt, join
-
-DIAGNOSTIC = "reference-start"
-HEADLINE_CASE = "T1-01"
-
-_ADDITIONS = {
-    "prior": "EM segments started from the prior (another reading of the paper's EM start)",
-    "roll": "a camera that rolls about its boresight (not in the paper)",
-    "squarem": "SQUAREM-accelerated EM",
-    "growing": "growing data windows instead of sliding segments",
-    "reference-start": "the true state as the E-step reference (diagnostic)",
-    "stars": "star-field images that calibrate the camera (beyond the paper)",
-}
-#: variants beyond the paper (what practitioners do): reported, never a best faithful variant
-BEYOND = ("stars",)
-
-
-_SHORT = {"prior": "a prior start", "roll": "a boresight roll", "squarem": "SQUAREM", "growing": "growing windows",
-          "reference-start": "the true reference", "stars": "star images"}
-
-
-def short_addition(label: str) -> str:
-    """The additions of a variant label in a few words ('a boresight roll, growing windows and SQUAREM')."""
-    return join([_SHORT.get(p, p) for p in label.split("+") if p != AS_WRITTEN], none="nothing")
-
-
-def addition(label: str) -> str:
-    """What a variant label (``roll+growing+squarem``) adds to the paper as written."""
-    parts = [p for p in label.split("+") if p != AS_WRITTEN]
-    return join([_ADDITIONS.get(p, p) for p in parts], none="nothing")
-
-
-def _truthy(x: Any) -> bool:
-    return str(x).strip().lower() in ("true", "1", "1.0") if not isinstance(x, bool) else x
-
-
-def _rows(t1: pd.DataFrame, label: str) -> pd.DataFrame:
-    return t1[t1["variant"] == label]
-
-
-def _head(t1: pd.DataFrame, label: str) -> pd.Series | None:
-    h = t1[(t1["variant"] == label) & (t1["case_id"] == HEADLINE_CASE)]
-    return h.iloc[0] if len(h) else None
-
-
-def run_label(r) -> str:
-    """The run's label from the data (A-T1 ``label``: converged | stalled | not converged);
-    older tables without it: stalled or converged from the stall flag."""
-    lab = r.get("label") if hasattr(r, "get") else None
-    if isinstance(lab, str) and lab:
-        return lab
-    return "stalled" if _truthy(r["stalled"]) else "converged"
-
-
-def _converged_seeds(r) -> int:
-    c = r.get("converged_seeds") if hasattr(r, "get") else None
-    if c is not None and not pd.isna(c):
-        return int(c)
-    return int(r["n_seeds"]) - int(r["stalled_seeds"])
-
-
-def _label_text(r) -> str:
-    """'converged, 3/3 seeds' / 'stalled, 1/3 seeds converged'."""
-    lab, n = run_label(r), int(r["n_seeds"])
-    c = _converged_seeds(r)
-    return f"{lab}, {c}/{n} seeds" if lab == "converged" else f"{lab}, {c}/{n} seeds converged"
-
-
-def _variants(t1: pd.DataFrame, full_only: bool = False) -> list[str]:
-    """Variant labels in table order; ``full_only``: those with every case of the literal rows."""
-    labels = list(dict.fromkeys(t1["variant"]))
-    if full_only:
-        n = len(_rows(t1, AS_WRITTEN)) or max(len(_rows(t1, v)) for v in labels)
-        labels = [v for v in labels if len(_rows(t1, v)) >= n]
-    return labels
-
-
-def _is_diag(label: str) -> bool:
-    return label.split("+")[0] == DIAGNOSTIC
-
-
-def _is_beyond(label: str) -> bool:
-    return label.split("+")[0] in BEYOND
-
-
-def _outcome(label: str, ok: bool, text: str, score: float, err: float = math.nan, bound: float = math.nan,
-             n: int = 0) -> Outcome:
-    """An outcome with the variant's kind (diagnostic, beyond the paper) set from its label."""
-    return Outcome(label, ok, text, score=score, diagnostic=_is_diag(label), beyond=_is_beyond(label),
-                   err=err, bound=bound, n=n)
-
-
-def _err(r) -> float:
-    """RMS error about the truth over the seeds, the larger axis (arcsec)."""
-    return max(float(r["rmse_x_arcsec"]), float(r["rmse_y_arcsec"]))
-
-
-def _bound(r) -> float:
-    """The bound of the data used, the larger axis (arcsec)."""
-    return max(float(r["crlb_x_arcsec"]), float(r["crlb_y_arcsec"]))
-
-
-def _bound_text(r) -> str:
-    """'CRLB 20.6 arcsec (data used), 20.6 with Q = 0' (the larger axis)."""
-    b = _bound(r)
-    q0 = r.get("crlb_q0_x_arcsec") if hasattr(r, "get") else None
-    q0s = "" if q0 is None or pd.isna(q0) else f", {fmt(float(q0))} with Q = 0"
-    return f"CRLB {fmt(b)} arcsec (data used){q0s}"
-
-
-def _worst_vs_bound(g: pd.DataFrame) -> tuple[float, float, int]:
-    """(err, bound, seeds) of the row of ``g`` whose error is furthest below its bound
-    (the row the bound guard judges)."""
-    best = max(g.iterrows(), key=lambda ir: _bound(ir[1]) / max(_err(ir[1]), 1e-300))[1]
-    return _err(best), _bound(best), int(best["n_seeds"])
 
 
 def _bound_rule(plan: Plan, claim_id: str, blocks: str) -> str:
@@ -146,7 +49,7 @@ def _bound_rule(plan: Plan, claim_id: str, blocks: str) -> str:
 
 
 def _small_sample(t1: pd.DataFrame, plan: Plan) -> list:
-    n = int(_rows(t1, AS_WRITTEN)["n_seeds"].min()) if len(_rows(t1, AS_WRITTEN)) else 0
+    n = int(variant_rows(t1, AS_WRITTEN)["n_seeds"].min()) if len(variant_rows(t1, AS_WRITTEN)) else 0
     return [("sample_too_small", f"{n} seeds")] if n < plan.guard("min_full_seeds") else []
 
 
@@ -190,8 +93,8 @@ def accuracy_outcome(r, target: float, name: str) -> Outcome:
     ex, ey = float(r["rmse_x_arcsec"]), float(r["rmse_y_arcsec"])
     conv = run_label(r) == "converged"
     err = max(ex, ey)
-    text = f"RMS error {fmt(ex)}, {fmt(ey)} arcsec ({_label_text(r)})"
-    return _outcome(name, conv and err <= target, text, score=err, err=err, bound=_bound(r), n=int(r["n_seeds"]))
+    text = f"RMS error {fmt(ex)}, {fmt(ey)} arcsec ({label_text(r)})"
+    return variant_outcome(name, conv and err <= target, text, score=err, err=err, bound=bound_arcsec(r), n=int(r["n_seeds"]))
 
 
 def _accuracy_cause(d: C.Decision, outs, target: float, lit_bound: float, what: str,
@@ -225,9 +128,9 @@ def _claim_headline_accuracy(t1, head_pub, summary, plan: Plan) -> dict:
     target = plan.margin(cid, "target_arcsec")
     truth = head_pub["truth_arcsec"]
     pe = (abs(head_pub["est_x_arcsec"] - truth[0]), abs(head_pub["est_y_arcsec"] - truth[1]))
-    outs = {v: accuracy_outcome(_head(t1, v), target, v) for v in _variants(t1) if _head(t1, v) is not None}
-    lit = _head(t1, AS_WRITTEN)
-    lit_bound = _bound(lit)
+    outs = {v: accuracy_outcome(headline_row(t1, v), target, v) for v in variant_labels(t1) if headline_row(t1, v) is not None}
+    lit = headline_row(t1, AS_WRITTEN)
+    lit_bound = bound_arcsec(lit)
     blocks = (f"CRLB {fmt(lit_bound)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lit_bound > target else "")
     d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
@@ -236,7 +139,7 @@ def _claim_headline_accuracy(t1, head_pub, summary, plan: Plan) -> dict:
     return _result(dict(paper="A", claim_id=cid, claim=f"Accuracy better than {target:g} arcsec (headline case, truth "
                         f"({truth[0]:g}, {truth[1]:g}) arcsec)",
                         published=f"< {target:g} arcsec (errors {fmt(pe[0])}, {fmt(pe[1])} arcsec)"),
-                   d, cause=cause, evidence="A-T1, A-X1, A-F4", bound=_bound_text(lit), would_take=wt,
+                   d, cause=cause, evidence="A-T1, A-X1, A-F4", bound=bound_text(lit), would_take=wt,
                    flags=_small_sample(t1, plan))
 
 
@@ -250,21 +153,21 @@ def _claim_table_accuracy(t1, pub_rows, plan: Plan) -> dict:
         pub_err.append(max(abs(p["est_x_arcsec"] - tr[0]), abs(p["est_y_arcsec"] - tr[1])))
     pmax = max(pub_err)
     outs = {}
-    for v in _variants(t1, full_only=True):
-        g = _rows(t1, v)
-        errs = g.apply(_err, axis=1)
+    for v in variant_labels(t1, full_only=True):
+        g = variant_rows(t1, v)
+        errs = g.apply(rms_err_arcsec, axis=1)
         st = g.apply(run_label, axis=1) != "converged"
         ok_cases = int(((errs <= target) & ~st).sum())
         text = (f"largest RMS error {fmt(errs.max())} arcsec; {ok_cases} of {len(g)} cases within {target:g} arcsec"
                 + (f", {int(st.sum())} not converged" if st.any() else ""))
-        e, b, n = _worst_vs_bound(g)
-        outs[v] = _outcome(v, ok_cases == len(g), text, score=-ok_cases + errs.max() / 1e6, err=e, bound=b, n=n)
-    lit = _rows(t1, AS_WRITTEN)
+        e, b, n = worst_vs_bound(g)
+        outs[v] = variant_outcome(v, ok_cases == len(g), text, score=-ok_cases + errs.max() / 1e6, err=e, bound=b, n=n)
+    lit = variant_rows(t1, AS_WRITTEN)
     lb = float(lit[["crlb_x_arcsec", "crlb_y_arcsec"]].astype(float).min(axis=None))
     blocks = (f"CRLB at least {fmt(lb)} arcsec in every case (data used), above {target:g} arcsec"
               if lb > target else "")
     d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
-    worst = {v: float(_rows(t1, v).apply(_err, axis=1).max()) for v in outs}
+    worst = {v: float(variant_rows(t1, v).apply(rms_err_arcsec, axis=1).max()) for v in outs}
     cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec in every case", lit_err=worst.get(AS_WRITTEN),
                             best_err=worst.get(d.best.label) if d.best is not None else None)
     return _result(dict(paper="A", claim_id=cid, claim="Accuracy unaffected by misalignment size, polarity, EM start "
@@ -281,26 +184,26 @@ def _claim_pixel_accuracy(t1, plan: Plan) -> dict:
     pix = t1[t1["group"] == "pixel"] if "group" in t1.columns else t1.iloc[0:0]
     claim = "Worse pixels do not affect the accuracy (Table 1 pixel cases)"
     outs = {}
-    for v in _variants(t1, full_only=True):
+    for v in variant_labels(t1, full_only=True):
         g = pix[pix["variant"] == v].sort_values("pixel_sigma3_px")
         if len(g) < 2:
             continue
-        errs = g.apply(_err, axis=1)
+        errs = g.apply(rms_err_arcsec, axis=1)
         st = g.apply(run_label, axis=1) != "converged"
         px = ", ".join(f"{p:g}" for p in g["pixel_sigma3_px"].astype(float))
         text = f"RMS error {', '.join(fmt(e) for e in errs)} arcsec at {px} px" + (
             f" ({int(st.sum())} not converged)" if st.any() else "")
-        e, b, n = _worst_vs_bound(g)
-        outs[v] = _outcome(v, bool(((errs <= target) & ~st).all()), text, score=float(errs.max()), err=e, bound=b, n=n)
+        e, b, n = worst_vs_bound(g)
+        outs[v] = variant_outcome(v, bool(((errs <= target) & ~st).all()), text, score=float(errs.max()), err=e, bound=b, n=n)
     if not outs:
         return C.row("A", cid, claim, f"within {target:g} arcsec at 0.1 to 1 px", C.NOT_TESTED,
                      "No pixel cases were run in this profile.", "A-T1", named="no pixel cases in this profile")
     lit = pix[pix["variant"] == AS_WRITTEN]
-    lb = max([_bound(r) for _, r in lit.iterrows()], default=math.nan)
+    lb = max([bound_arcsec(r) for _, r in lit.iterrows()], default=math.nan)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
     d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
-    worst = {v: float(pix[pix["variant"] == v].apply(_err, axis=1).max()) for v in outs}
+    worst = {v: float(pix[pix["variant"] == v].apply(rms_err_arcsec, axis=1).max()) for v in outs}
     cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec at every pixel accuracy",
                             lit_err=worst.get(AS_WRITTEN),
                             best_err=worst.get(d.best.label) if d.best is not None else None)
@@ -322,7 +225,7 @@ def _data_outcome(g: pd.DataFrame, tol: float, target: float, windows: Mapping[s
     """A count is evidence only where the run converged, the data can tell the
     misalignment (bound within the target) and the count is above the first window."""
     st = g.apply(run_label, axis=1) != "converged"
-    blind = g.apply(_bound, axis=1) > target
+    blind = g.apply(bound_arcsec, axis=1) > target
     ours = g["data_to_converge_samples"].astype(float)
     floor = g.apply(lambda r: _first_window(r, windows), axis=1)
     coarse = ours <= floor
@@ -333,14 +236,14 @@ def _data_outcome(g: pd.DataFrame, tol: float, target: float, windows: Mapping[s
            f"{int((coarse & ~st).sum())} at the first window ({fmt(floor.max())} samples)" if (coarse & ~st).any() else ""]
     text = f"{int(ok.sum())} of {len(g)} cases within {tol:g} samples" + (
         f" ({'; '.join(w for w in why if w)})" if any(why) else "")
-    return _outcome(label, bool(ok.all()), text, score=-float(ok.sum()))
+    return variant_outcome(label, bool(ok.all()), text, score=-float(ok.sum()))
 
 
 def _claim_data(t1, windows: Mapping[str, float], plan: Plan) -> dict:
     cid = "A-C3"
     tol, target = plan.margin(cid, "tolerance_samples"), plan.margin(cid, "target_arcsec")
-    lit = _rows(t1, AS_WRITTEN)
-    outs = {v: _data_outcome(_rows(t1, v), tol, target, windows, v) for v in _variants(t1, full_only=True)}
+    lit = variant_rows(t1, AS_WRITTEN)
+    outs = {v: _data_outcome(variant_rows(t1, v), tol, target, windows, v) for v in variant_labels(t1, full_only=True)}
     d = C.decide(outs, AS_WRITTEN, addition)
     pub = lit["pub_data_to_converge_samples"].astype(float)
     if d.verdict == C.REPRODUCED:
@@ -365,20 +268,20 @@ def _claim_little_data(t1, head_pub, summary, plan: Plan) -> dict:
     factor, target = plan.margin(cid, "data_factor"), plan.margin(cid, "target_arcsec")
     pub_n = float(head_pub["data_to_converge_samples"])
     outs = {}
-    for v in _variants(t1):
-        r = _head(t1, v)
+    for v in variant_labels(t1):
+        r = headline_row(t1, v)
         if r is None:
             continue
-        st = int(r["n_seeds"]) - _converged_seeds(r)
+        st = int(r["n_seeds"]) - converged_seeds(r)
         dd = float(r["data_to_converge_samples"]) if not pd.isna(r["data_to_converge_samples"]) else math.nan
-        err = _err(r)
+        err = rms_err_arcsec(r)
         ok = st == 0 and not math.isnan(dd) and dd <= factor * pub_n and err <= target
-        text = (_label_text(r) + (f" after {fmt(dd)} samples" if not math.isnan(dd) else "")
+        text = (label_text(r) + (f" after {fmt(dd)} samples" if not math.isnan(dd) else "")
                 + f", RMS error {fmt(err)} arcsec")
-        outs[v] = _outcome(v, ok, text, score=st * 1e6 + (1e5 if math.isnan(dd) else dd), err=err, bound=_bound(r),
+        outs[v] = variant_outcome(v, ok, text, score=st * 1e6 + (1e5 if math.isnan(dd) else dd), err=err, bound=bound_arcsec(r),
                            n=int(r["n_seeds"]))
-    lit = _head(t1, AS_WRITTEN)
-    lb = _bound(lit)
+    lit = headline_row(t1, AS_WRITTEN)
+    lb = bound_arcsec(lit)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
     d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
@@ -387,7 +290,7 @@ def _claim_little_data(t1, head_pub, summary, plan: Plan) -> dict:
     wt = "" if d.verdict == C.REPRODUCED else _roll_would_take(summary, head_pub, target)
     return _result(dict(paper="A", claim_id=cid, claim="Little data, stable convergence (headline case)",
                         published=f"{fmt(pub_n)} samples, converged"),
-                   d, cause=cause, evidence="A-T1, A-X1, A-F4", bound=_bound_text(lit), would_take=wt,
+                   d, cause=cause, evidence="A-T1, A-X1, A-F4", bound=bound_text(lit), would_take=wt,
                    flags=_small_sample(t1, plan))
 
 
@@ -396,7 +299,7 @@ def _claim_pixels(t1, plan: Plan) -> dict:
     target = plan.margin(cid, "target_arcsec")
     pix = t1[t1["group"] == "pixel"] if "group" in t1.columns else t1.iloc[0:0]
     outs = {}
-    for v in _variants(t1, full_only=True):
+    for v in variant_labels(t1, full_only=True):
         g = pix[pix["variant"] == v].sort_values("pixel_sigma3_px")
         if len(g) < 2:
             continue
@@ -406,14 +309,14 @@ def _claim_pixels(t1, plan: Plan) -> dict:
         # where the bound of the data used exceeds the target, EM converges to an ML the data
         # cannot tell from zero: its sample count says how fast EM contracts, not how much
         # data the misalignment needs
-        bounds = [_bound(r) for _, r in g.iterrows()]
+        bounds = [bound_arcsec(r) for _, r in g.iterrows()]
         blind = [b > target for b in bounds]
         inc = not any(st) and not any(blind) and all(b > a for a, b in zip(dd, dd[1:]))
         px = ", ".join(f"{p:g}" for p in g["pixel_sigma3_px"].astype(float))
         text = (f"{', '.join(lab if s else fmt(x) for lab, s, x in zip(labs, st, dd))} samples at {px} px"
                 + (f" (bound {', '.join(fmt(b) for b in bounds)} arcsec, above {target:g} arcsec: not identifiable)"
                    if any(blind) else ""))
-        outs[v] = _outcome(v, inc, text, score=float(sum(st) + sum(blind)))
+        outs[v] = variant_outcome(v, inc, text, score=float(sum(st) + sum(blind)))
     pub = pix[pix["variant"] == AS_WRITTEN].sort_values("pixel_sigma3_px")
     pub_txt = (", ".join(fmt(x) for x in pub["pub_data_to_converge_samples"].astype(float)) + " samples at "
                + ", ".join(f"{p:g}" for p in pub["pixel_sigma3_px"].astype(float)) + " px")
@@ -422,7 +325,7 @@ def _claim_pixels(t1, plan: Plan) -> dict:
         return C.row("A", cid, claim, pub_txt, C.NOT_TESTED, "No pixel cases were run in this profile.", "A-T1",
                      named="no pixel cases in this profile")
     lit = pix[pix["variant"] == AS_WRITTEN]
-    lb = max([_bound(r) for _, r in lit.iterrows()], default=math.nan)
+    lb = max([bound_arcsec(r) for _, r in lit.iterrows()], default=math.nan)
     blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
               if lb > target else "")
     d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks))
@@ -447,8 +350,8 @@ def _claim_nav_before(t1, head_pub, sim, plan: Plan) -> dict:
     cid = "A-C6"
     rel, k, wide = plan.margin(cid, "rel_tol"), plan.margin(cid, "spread_k"), plan.margin(cid, "max_band_rel")
     outs = {}
-    for v in _variants(t1, full_only=True):
-        g = _rows(t1, v)
+    for v in variant_labels(t1, full_only=True):
+        g = variant_rows(t1, v)
         ok = []
         for _, r in g.iterrows():
             p, o = float(r["pub_nav_err_before_km"]), float(r["nav_err_before_km"])
@@ -456,12 +359,12 @@ def _claim_nav_before(t1, head_pub, sim, plan: Plan) -> dict:
             band = k * sd if math.isfinite(sd) else 0.0
             # inside a band wider than max_band_rel x the published value is not agreement
             ok.append(abs(o - p) <= max(rel * abs(p), band) and band <= wide * abs(p))
-        h = _head(t1, v)
+        h = headline_row(t1, v)
         text = (f"{fmt(float(h['nav_err_before_km']))} km in the headline case; {sum(ok)} of {len(g)} cases "
                 f"within max({k:g} sd, {100 * rel:g} %) of Table 1")
-        outs[v] = _outcome(v, all(ok), text, score=-sum(ok))
+        outs[v] = variant_outcome(v, all(ok), text, score=-sum(ok))
     d = C.decide(outs, AS_WRITTEN, addition)
-    b = float(_head(t1, AS_WRITTEN)["nav_err_before_km"])
+    b = float(headline_row(t1, AS_WRITTEN)["nav_err_before_km"])
     pub = float(head_pub["nav_err_before_km"])
     if d.verdict == C.REPRODUCED:
         cause = (f"The theta = 0 filter ends at {fmt(b)} km against the published {fmt(pub)} km, within "
@@ -487,13 +390,13 @@ def _claim_nav_after(t1, head_pub, summary, plan: Plan) -> dict:
     lim = plan.margin(cid, "limit_km")
     floor = summary.nav_err_true_theta_km
     outs = {}
-    for v in _variants(t1):
-        h = _head(t1, v)
+    for v in variant_labels(t1):
+        h = headline_row(t1, v)
         if h is None:
             continue
         a, b = float(h["nav_err_after_km"]), float(h["nav_err_before_km"])
         ok = a <= lim and run_label(h) == "converged"
-        outs[v] = _outcome(v, ok, f"{fmt(b)} km to {fmt(a)} km ({_label_text(h)})", score=a)
+        outs[v] = variant_outcome(v, ok, f"{fmt(b)} km to {fmt(a)} km ({label_text(h)})", score=a)
     d = C.decide(outs, AS_WRITTEN, addition)
     flags = []
     lt = f"{d.lit.text.split(' (')[0]}" if d.lit else "no value"
@@ -525,12 +428,12 @@ def _claim_order_100km(t1, plan: Plan, head_pub: Mapping[str, Any]) -> dict:
     factor = plan.margin(cid, "order_factor")
     km, arcsec = float(head_pub["intro_nav_err_km"]), float(head_pub["intro_misalignment_arcsec"])
     outs = {}
-    for v in _variants(t1):
-        h = _head(t1, v)
+    for v in variant_labels(t1):
+        h = headline_row(t1, v)
         if h is None:
             continue
         b = float(h["nav_err_before_km"])
-        outs[v] = _outcome(v, km / factor <= b <= km * factor, f"{fmt(b)} km",
+        outs[v] = variant_outcome(v, km / factor <= b <= km * factor, f"{fmt(b)} km",
                            score=abs(math.log(b / km)) if b > 0 else math.inf)
     d = C.decide(outs, AS_WRITTEN, addition)
     lt = d.lit.text if d.lit else "no value"
@@ -548,14 +451,14 @@ def _claim_tz(t1, plan: Plan) -> dict:
     variants beyond the paper that observe it (star images) are named in the cause."""
     cid = "A-C9"
     plan.entry(cid)
-    lit = _rows(t1, AS_WRITTEN)
-    obs = lit["tz_observable"].map(_truthy)
+    lit = variant_rows(t1, AS_WRITTEN)
+    obs = lit["tz_observable"].map(truthy)
     n_obs = int(obs.sum())
     verdict = C.REPRODUCED if n_obs == 0 else C.NOT_REPRODUCED
     text = "unobservable in every case" if n_obs == 0 else f"observable in {n_obs} of {len(lit)} cases"
     cause = (f"A camera that tracks Mars cannot see a roll about its boresight, and the M-step finds tz {text}"
              if n_obs == 0 else f"The M-step finds tz {text} of the as-written rows, which a Mars-tracking camera forbids")
-    beyond = sorted({v.split("+")[0] for v in t1.loc[t1["tz_observable"].map(_truthy), "variant"] if _is_beyond(v)})
+    beyond = sorted({v.split("+")[0] for v in t1.loc[t1["tz_observable"].map(truthy), "variant"] if is_beyond(v)})
     return C.row("A", cid, "Roll about the boresight, tz, not estimable", "not estimable", verdict, cause,
                  "A-T1, A-X1" + (f" (beyond the paper, {join(beyond)} make it observable)" if beyond else ""),
                  ours_as_written=text)
