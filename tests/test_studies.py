@@ -10,7 +10,7 @@ from scipy import stats
 
 from conftest import REPO
 from opnav.studies import captions, planning, tables, values
-from opnav.core.config import SCHEMA_PATH, ConfigError, load_config, validate_config
+from opnav.core.config import ConfigError, load_config
 from opnav.preflight import check_config
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.planner import available_methods

@@ -198,7 +198,7 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
     names = [diag.get(k, f"the {k} variant") for k in below]
     pb = summ["prior_bound_arcsec"]
     lit = base.get("literal", {}).get("crlb_all_x_arcsec")
-    s = (f"With the paper's prior, the bound of tx after all the data is "
+    s = ("With the paper's prior, the bound of tx after all the data is "
          + _join([f"{nice(v.get('crlb_all_x_arcsec'))} arcsec ({k})" for k, v in base.items()])
          + f", against the claimed {target:g} arcsec; "
          + (f"only {_join(names)} {'gets' if len(names) == 1 else 'get'} below it." if below and len(below) < len(base)

@@ -8,9 +8,12 @@ fixed text about a result: every sentence names the claims the table puts in its
 from __future__ import annotations
 
 import re
-from typing import Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
-from opnav.report.manuscript import _col, _sentence, prose_tex
+from opnav.report.manuscript import cell_text, prose_tex, sentence
+
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
 
 
 #: the abstract's length limit (words, LaTeX markup not counted)
@@ -19,9 +22,20 @@ ABSTRACT_MAX_WORDS = 200
 ABSTRACT_FRAMING_WORDS = 40
 #: verdicts a reader counts as "not reproduced" in the broad sense (each group gets its cause)
 #: (in the order the abstract gives them: what an information bound excludes, what needs an addition first)
-_NOT_OK = ("not_reproducible", "reproduced_with_addition", "suspect", "unstable", "not_reproduced",
+NOT_OK = ("not_reproducible", "reproduced_with_addition", "suspect", "unstable", "not_reproduced",
            "depends_on_choice", "not_tested")
 _PAPER_WORDS = {"A": "Paper A", "B": "Paper B"}
+
+
+def verdict_counts_sentence(paper: str, verdicts: Iterable[str]) -> str:
+    """'Paper A: of its 10 claims, 2 reproduced, 3 not reproducible and 5 ...' (the
+    verdicts of one paper's claims, counted in :data:`opnav.report.claims.VERDICTS` order)."""
+    from opnav.report.claims import VERDICT_SHORT, VERDICTS
+
+    verdicts = list(verdicts)
+    parts = [f"{n} {VERDICT_SHORT[v]}" for v in VERDICTS if (n := verdicts.count(v))]
+    return sentence(f"{_PAPER_WORDS.get(paper, 'Paper ' + paper)}: of its {len(verdicts)} claims, "
+                    + ", ".join(parts[:-1]) + (" and " if len(parts) > 1 else "") + parts[-1])
 
 
 def word_count(text: str) -> int:
@@ -55,18 +69,18 @@ def group_sentences(grp: list[Mapping], verdict: str, said: set | None = None) -
     said = set() if said is None else said
     by_named: dict[str, list[Mapping]] = {}
     for r in grp:
-        by_named.setdefault(_col(r, "named"), []).append(r)
+        by_named.setdefault(cell_text(r, "named"), []).append(r)
     out = []
     for named, rows in by_named.items():
         ids = [r["claim_id"] for r in rows]
-        out.append(_sentence(f"{_ids(ids)} {_PREDICATE[verdict][len(ids) == 1]}" + (f": {named}" if named else "")))
-        cause = _col(rows[0], "cause")
+        out.append(sentence(f"{_ids(ids)} {_PREDICATE[verdict][len(ids) == 1]}" + (f": {named}" if named else "")))
+        cause = cell_text(rows[0], "cause")
         if cause and not named and verdict != "reproduced":
-            out.append(_sentence(f"{'Why' if len(ids) == 1 else 'For ' + ids[0]}: {cause}"))
-        take = _col(rows[0], "would_take")
+            out.append(sentence(f"{'Why' if len(ids) == 1 else 'For ' + ids[0]}: {cause}"))
+        take = cell_text(rows[0], "would_take")
         if take and take not in said:
             said.add(take)
-            out.append(_sentence(f"What it would take: {take}"))
+            out.append(sentence(f"What it would take: {take}"))
     return " ".join(out)
 
 
@@ -80,7 +94,7 @@ def conclusion_text(df: "pd.DataFrame") -> str:
     for p in dict.fromkeys(r["paper"] for r in rows):
         g = [r for r in rows if r["paper"] == p]
         said: set = set()
-        for v in ("reproduced", *_NOT_OK):
+        for v in ("reproduced", *NOT_OK):
             grp = [r for r in g if r["verdict"] == v]
             if grp:
                 out.append(group_sentences(grp, v, said))
@@ -99,17 +113,15 @@ def limitations_text(df: "pd.DataFrame") -> str:
                  "our runs cannot make, directly")
     s.append("The published runs' own noise realisations cannot be recovered, so each published value is "
              "compared with the distribution of ours over seeds or runs, never with one run")
-    return " ".join(_sentence(x) for x in s)
+    return " ".join(sentence(x) for x in s)
 
 
 def abstract_findings(df: "pd.DataFrame") -> str:
     """The findings of page 1 in plain sentences (plain text; :func:`prose_tex` makes it LaTeX),
     generated from the claims table: per paper, the verdict counts, then each group of claims
-    not reproduced as written (:func:`group_sentences`, in :data:`_NOT_OK`'s order). Groups are
+    not reproduced as written (:func:`group_sentences`, in :data:`NOT_OK`'s order). Groups are
     dropped from the longer paper's tail until the whole, with the framing sentences of
     ``main.tex``, is at most :data:`ABSTRACT_MAX_WORDS` words."""
-    from opnav.report.claims import VERDICT_SHORT, VERDICTS
-
     rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
     if not rows:
         return "No claim was evaluated in this build."
@@ -117,12 +129,9 @@ def abstract_findings(df: "pd.DataFrame") -> str:
     per_paper: dict[str, list[str]] = {}
     for p in papers:
         g = [r for r in rows if r["paper"] == p]
-        counts = [(v, sum(1 for r in g if r["verdict"] == v)) for v in VERDICTS]
-        parts = [f"{n} {VERDICT_SHORT[v]}" for v, n in counts if n]
-        s = [_sentence(f"{_PAPER_WORDS.get(p, 'Paper ' + p)}: of its {len(g)} claims, " + ", ".join(parts[:-1])
-                       + (" and " if len(parts) > 1 else "") + parts[-1])]
+        s = [verdict_counts_sentence(p, [r["verdict"] for r in g])]
         said: set = set()
-        for v in _NOT_OK:  # the order of _NOT_OK: what an information bound says first
+        for v in NOT_OK:  # the order of NOT_OK: what an information bound says first
             grp = [r for r in g if r["verdict"] == v]
             if grp:
                 s.append(group_sentences(grp, v, said))

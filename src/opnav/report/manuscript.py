@@ -14,9 +14,12 @@ import math
 import numbers
 import re
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Iterable, Mapping
 
 from opnav.core.tables import MISSING, is_missing  # noqa: F401 (re-exported)
+
+if TYPE_CHECKING:  # annotations only: pandas is imported where a frame is made
+    import pandas as pd
 
 _DIGITS = ["Zero", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine"]
 
@@ -351,12 +354,14 @@ def claims_detail_latex(df: "pd.DataFrame") -> str:
 
 # ------------------------------------------------------------ sentences from table cells
 # (also used by opnav.report.claims_prose and opnav.report.readme)
-def _col(r: Mapping, key: str) -> str:
+def cell_text(r: Mapping, key: str) -> str:
+    """A claims-table cell as text: stripped, '' for a missing key, None or NaN."""
     v = r.get(key, "")
     return "" if v is None or (isinstance(v, float) and math.isnan(v)) or str(v) == "nan" else str(v).strip()
 
 
-def _sentence(text: str) -> str:
+def sentence(text: str) -> str:
+    """``text`` as one sentence: white space folded, a capital first letter, one closing period."""
     text = " ".join(text.split()).rstrip(" .;")
     return (text[0].upper() + text[1:] + ".") if text else ""
 
@@ -403,7 +408,7 @@ def _header_tex(text: str, width: int = HEADER_WRAP) -> str:
     lines = textwrap.wrap(str(text), width) or [""]
     if len(lines) == 1:
         return latex_escape(lines[0])
-    return r"\begin{tabular}[b]{@{}l@{}}" + r" \\ ".join(latex_escape(l) for l in lines) + r"\end{tabular}"
+    return r"\begin{tabular}[b]{@{}l@{}}" + r" \\ ".join(latex_escape(line) for line in lines) + r"\end{tabular}"
 
 
 def legible_view(df: "pd.DataFrame") -> "pd.DataFrame":
@@ -475,8 +480,8 @@ def plan_latex(plan: "pd.DataFrame") -> str:
     its reason, the variants and controls, what the verdict depends on."""
     out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
     for r in plan.to_dict("records"):
-        c = {k: latin_text(_col(r, k)) for k in r}
-        s = rf"\item[{latex_escape(c.get('claim_id', ''))}] " + prose_tex(_sentence(c.get("sentence", "")))
+        c = {k: latin_text(cell_text(r, k)) for k in r}
+        s = rf"\item[{latex_escape(c.get('claim_id', ''))}] " + prose_tex(sentence(c.get("sentence", "")))
         if c.get("where"):
             s += " " + prose_tex(f"({c['where']}).")
         parts = [f"Compared: {c.get('quantity', '')}" + (f" ({c['units']})" if c.get("units") else ""),
@@ -495,7 +500,7 @@ def inputs_latex(inputs: "pd.DataFrame") -> str:
     """The inputs we derive (results/paper/inputs.csv) as a description list."""
     out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
     for r in inputs.to_dict("records"):
-        c = {k: latin_text(_col(r, k)) for k in r}
+        c = {k: latin_text(cell_text(r, k)) for k in r}
         out.append(rf"\item[{prose_tex(c.get('input', ''))}] "
                    + prose_tex(f"Ours {c.get('ours', '')}; published {c.get('published', '')}. "
                                f"How we derive it: {c.get('how_derived', '')}. "

@@ -32,20 +32,16 @@ def read_reference(path: str | Path = REFERENCE) -> pd.DataFrame:
 def findings_block(df: pd.DataFrame) -> str:
     """The block (Markdown): per paper its verdict counts and the cause of its largest group
     not reproduced as written (at most four sentences), then id | claim | verdict."""
-    from opnav.report.claims import VERDICT_SHORT, VERDICTS
-    from opnav.report.claims_prose import _NOT_OK, _PAPER_WORDS, group_sentences
-    from opnav.report.manuscript import _sentence
+    from opnav.report.claims import VERDICT_SHORT
+    from opnav.report.claims_prose import NOT_OK, group_sentences, verdict_counts_sentence
     from opnav.report.verdict_plot import short_claim
 
     if "sample" in df.columns and (df["sample"] != "full").any():
         raise ValueError("the README quotes a full build only: the reference table's sample column is not 'full'")
     out = []
     for p, g in df.groupby("paper", sort=False):
-        counts = [(v, int((g["verdict"] == v).sum())) for v in VERDICTS]
-        parts = [f"{n} {VERDICT_SHORT[v]}" for v, n in counts if n]
-        out.append(_sentence(f"{_PAPER_WORDS.get(p, 'Paper ' + p)}: of its {len(g)} claims, "
-                             + (", ".join(parts[:-1]) + " and " if len(parts) > 1 else "") + parts[-1]))
-        first = next((v for v in _NOT_OK if (g["verdict"] == v).any()), None)
+        out.append(verdict_counts_sentence(p, g["verdict"]))
+        first = next((v for v in NOT_OK if (g["verdict"] == v).any()), None)
         if first:  # the paper's first group, as page 1 words it (without what it would take)
             grp = [dict(r) for _, r in g[g["verdict"] == first].iterrows()]
             out.append(group_sentences(grp, first, said={str(grp[0].get("would_take", ""))}))
