@@ -192,6 +192,8 @@ NEW_CONFIGS = [
     ("names", "approach: {growing: {methods: [squarem, squarem]}}", "'approach.growing.methods': duplicated"),
     ("names", "approach: {peers: {variants: [roll, roll]}}", "'approach.peers.variants': duplicated"),
     ("names", "approach: {em: {method: oracle}}", "'approach.em.method'"),
+    ("names", "landing: {extra: {n_runs: {nadir: 5}}}",
+     "'landing.extra.n_runs.nadir': 'nadir' is not one of landing.scenarios"),
     # physical minimum and maximum of every number
     ("ranges", "approach: {roll: {rate_deg_s: 1.0e+300}}", "'approach.roll.rate_deg_s': 1e+300 is greater"),
     ("ranges", "approach: {em: {converge_tol_arcsec: 1.0e+300}}", "'approach.em.converge_tol_arcsec'"),

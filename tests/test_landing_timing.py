@@ -414,3 +414,21 @@ def test_repetitions_keep_the_clock_below_5_pct_of_a_recorded_call(recorded):
     # the closed form and the LAPACK SVD of the same H pick alike
     v = list(a["variant_method"])
     assert np.array_equal(a["pick"][:, v.index("svd")], a["pick"][:, v.index("svd_lapack")])
+
+
+def test_main_and_replication_timing_time_one_list():
+    """The replication's timing times the kinds the main one times (svd_lapack among them),
+    from one list: ``timing.timed_methods`` of B-X1's flown methods, named once (B_TIMED)."""
+    import re
+    from pathlib import Path
+
+    assert timing.timed_methods(["depth", "svd"]) == ["depth", "svd", "svd_lapack"]
+    assert timing.timed_methods(["svd_lapack", "depth"]) == ["svd_lapack", "depth"]
+    rules = Path(__file__).resolve().parents[1] / "workflow" / "rules"
+    text = {p.name: p.read_text() for p in rules.glob("*.smk")}
+    assert "B_TIMED = timed_methods(X1_METHODS)" in text["landing_timing.smk"]
+    for name, rule in (("landing_timing.smk", "landing_timing"), ("replication.smk", "replication_landing_timing")):
+        block = re.search(rf"rule {rule}:\n(.*?)(?=\n\s*rule |\Z)", text[name], re.S).group(1)
+        assert re.search(r"\bmethods=B_TIMED\b", block), (name, rule)
+    # no second copy of the list: the timed-only kinds are named in the package only
+    assert not [n for n, t in text.items() if "svd_lapack" in t]

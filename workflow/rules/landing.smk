@@ -71,7 +71,7 @@ B_SCN_RE = "|".join(B_SCENARIOS)
 
 # B-X1's runs per scenario (landing.extra.n_runs): the methods only B-X1 flies fly runs
 # 0..n-1 (their cost is set by the edge calls' planned posteriors, not by the paper's sample)
-# (its names of no configured scenario do not apply: the default names the default scenarios)
+# (its names are landing.scenarios' own: opnav.core.checks refuses any other)
 _BX1_RUNS = config["landing"]["extra"].get("n_runs", {})
 
 

@@ -3,6 +3,11 @@
 # planning call, one call at a time, interleaved across methods in one process. B-F7,
 # B-T3 and the B-X1 time columns read its output, not the descents' clocks.
 # Included after landing_extra.smk (reuses LANDING, B_SIMS, B_SRC, X1_METHODS, b_mc).
+from opnav.landing.timing import timed_methods
+
+# the methods timed: B-X1's flown ones and a real (LAPACK) SVD of the same H beside svd's
+# closed form (timed only: B-C4's "SVD"); the replication's timing times the same list
+B_TIMED = timed_methods(X1_METHODS)
 
 
 rule landing_timing:
@@ -17,8 +22,7 @@ rule landing_timing:
         bscn=B_SCN_RE,
     params:
         landing=lambda wc: B_SIMS[wc.bscn],
-        # and a real (LAPACK) SVD of the same H beside svd's closed form (timed only: B-C4's "SVD")
-        methods=X1_METHODS + ["svd_lapack"],
+        methods=B_TIMED,
         max_calls=config["landing"]["timing"]["max_calls"],
         max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
     priority: 10        # a long job on the critical path (speed only)

@@ -3,7 +3,7 @@
 # planning-time replay timed a second time. No new science: the same scripts as the main
 # sample with other seeds and sizes; results/replication/ holds it. paper_claims re-judges
 # the claims on it (verdict_replication; 'unstable' where the two verdicts differ).
-# Included after landing_timing.smk (reuses A_*, B_*, X1_METHODS, b_mc) and before paper.smk.
+# Included after landing_timing.smk (reuses A_*, B_*, X1_METHODS, B_TIMED, b_mc) and before paper.smk.
 from opnav.landing.montecarlo import chunk_label as _rep_label, chunk_runs as _rep_runs
 
 REP_CFG = config["replication"]
@@ -104,7 +104,7 @@ if REP_CFG["enabled"]:
             bscn=B_SCN_RE,
         params:
             landing=lambda wc: B_SIMS[wc.bscn],
-            methods=X1_METHODS,
+            methods=B_TIMED,       # the main timing's list (landing_timing.smk)
             max_calls=config["landing"]["timing"]["max_calls"],
             max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
         log:

@@ -12,8 +12,8 @@ fast, no numba), one line per problem naming the keys:
 * names: lists without duplicates; ``table1_variants`` within ``variants``, ``peers``
   within ``table1_variants``; the B-X1 reference and the equivalence reference flown;
   negative controls among the pickers without a metric, apart from the tested methods;
-  ``headline_scenario`` among ``scenarios``; study names that cannot collide with a
-  rule of the workflow (:data:`RESERVED_STUDY_NAMES`);
+  ``headline_scenario`` and the names of ``extra.n_runs`` among ``scenarios``; study
+  names that cannot collide with a rule of the workflow (:data:`RESERVED_STUDY_NAMES`);
 * numbers against each other: seeds of separate streams distinct, brackets ordered,
   a tolerance no larger than the quantity it tolerates, the landing vision cut-off
   (altitude plus margin) below the start altitude, the near-site landmark radius inside
@@ -235,6 +235,11 @@ def landing_rules(c: dict, *, workflow: bool = False) -> list[str]:
     head = c.get("headline_scenario")
     if head is not None and scen and head not in scen:
         out.append(k("headline_scenario") + f"{head!r} is not one of landing.scenarios ({', '.join(scen)})")
+    names = list(scen) or ["default"]
+    for name in c["extra"].get("n_runs") or {}:
+        if name not in names:
+            out.append(k(f"extra.n_runs.{name}") + f"{name!r} is not one of landing.scenarios ({', '.join(names)}): "
+                       "B-X1's runs are sized per camera scenario")
     if c["extra"]["n_boot"] == 1:
         out.append(k("extra.n_boot") + "1 resample gives no interval; use 0 (paired t only) or >= 2")
     return out

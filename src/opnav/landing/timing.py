@@ -90,7 +90,7 @@ from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 __all__ = ["select_calls", "variants", "pass_keys", "paper_limited", "replay", "timed", "save", "load", "times_ns",
            "median_us", "time_reduction", "timed_calls", "method_text", "summary_frame", "median_evals",
            "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us", "clock_cost_ns",
-           "clock_share", "CLOCK_SHARE_INV", "COMPILED_ONLY", "time_reduction_interval", "vs_depth", "VS_DEPTH"]
+           "clock_share", "CLOCK_SHARE_INV", "COMPILED_ONLY", "timed_methods", "time_reduction_interval", "vs_depth", "VS_DEPTH"]
 
 
 # ----------------------------------------------------------------- replay
@@ -110,6 +110,14 @@ def select_calls(n_pool: int, max_calls: int, key: str = "landing.timing.max_cal
 #: methods timed on the compiled path only (their paper path is another method's: svd_lapack's
 #: is svd's, the CasADi H and LAPACK SVD)
 COMPILED_ONLY = ("svd_lapack",)
+
+
+def timed_methods(flown) -> list[str]:
+    """The methods a replay times: the ``flown`` ones (whose Monte Carlo records the calls),
+    then :data:`COMPILED_ONLY` (timed on those calls, no Monte Carlo of their own). The main
+    and the replication timing both take their list from here."""
+    flown = list(flown)
+    return flown + [m for m in COMPILED_ONLY if m not in flown]
 
 
 def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:

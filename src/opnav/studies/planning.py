@@ -218,7 +218,8 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
         checked = merged
         if paper == "landing":  # a study flies the base camera (no scenario overlay): checked so
             checked = {**merged, "landing": {**merged["landing"], "scenarios": {"study": {}},
-                                             "headline_scenario": "study"}}
+                                             "headline_scenario": "study",   # and no B-X1 to size
+                                             "extra": {**merged["landing"]["extra"], "n_runs": {}}}}
         try:
             validate(checked, paper)
         except (ConfigError, ValueError) as exc:
