@@ -43,7 +43,8 @@ from opnav.core import startup
 #: Modules holding kernels, imported by :func:`warm` (each registers its warm-up on import).
 KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
                                     "opnav.approach.em", "opnav.approach.augmented",
-                                    "opnav.core.rotations", "opnav.landing.measurement", "opnav.landing.ekf",
+                                    "opnav.core.rotations", "opnav.landing.measurement", "opnav.landing.linalg",
+                                    "opnav.landing.ekf",
                                     "opnav.landing.kernels",
                                     "opnav.landing.descent", "opnav.landing.imu")
 

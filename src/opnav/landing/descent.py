@@ -88,7 +88,7 @@ from opnav.landing.records import append_call, new_calls, record_plan_inputs, st
 from opnav.landing.scenario import Scenario, build_scenario
 from opnav.landing.trajectory import euler_rpy_deg
 from opnav.core.compiled import kernel, warms
-from opnav.landing.ekf import _cho_solve, _cholesky
+from opnav.landing.linalg import cho_solve, cholesky_in_place
 from opnav.core.rotations import exp_so3, log_so3_into
 
 __all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
@@ -140,8 +140,8 @@ def _record(r_t, v_t, R_t, r, v, R, P, k, err_r, err_v, err_th, sig, sig_yaw, ne
                 x[i] = e[i]
                 for j in range(3):
                     L[i, j] = P[b, 3 * blk + i, 3 * blk + j]
-            _cholesky(L, 3)
-            _cho_solve(L, 3, x)
+            cholesky_in_place(L, 3)
+            cho_solve(L, 3, x)
             s = e[0] * x[0] + e[1] * x[1] + e[2] * x[2]
             if blk == 0:
                 nees_r[b, k] = s
