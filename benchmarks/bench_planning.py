@@ -30,7 +30,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 
 from opnav.core.config import load_config
-from opnav.landing import timing
+from opnav.landing import timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.scenario import camera_scenarios
@@ -60,11 +60,11 @@ def main() -> None:
               f"{tm['wall_ns'].shape[1]} variants in {time.perf_counter() - t0:.2f} s wall, "
               f"{time.process_time() - c0:.2f} s CPU; pick mismatches {int(tm['mismatch'].sum())} "
               f"of {int(tm['checked'].sum())}")
-        print(timing.summary_frame(tm)[["method", "path", "eval_path", "calls", "wall_median_us",
+        print(timing_summary.summary_frame(tm)[["method", "path", "eval_path", "calls", "wall_median_us",
                                         "cpu_median_us", "cpu_p05_us", "cpu_p95_us",
                                         "median_evals"]].to_string(index=False))
         if "svd" in methods:
-            red = timing.time_reduction(tm, "depth", "svd")
+            red = timing_summary.time_reduction(tm, "depth", "svd")
             print(f"[{name}] depth vs svd median reduction (wall): {red[0]:.1f} % +- {red[1]:.1f}")
         ov = timing.call_overhead(scn, rec, "depth", a.calls, reps=a.reps)
         call, ev = ov["call_ns"] / 1e3, ov["evals_ns"] / 1e3

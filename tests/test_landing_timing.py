@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from opnav.core.config import load_config
-from opnav.landing import records, timing
+from opnav.landing import records, timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.report import summary_table
@@ -79,12 +79,12 @@ def test_replay_deterministic_and_order_independent(recorded):
     full = timing.replay(scn, rec, ["svd"], max_calls=0)
     assert a["mismatch"].sum() == 0 and b["mismatch"].sum() == 0
     for m in METHODS:
-        ja = timing._variant(a, m, "main")
-        jb = timing._variant(b, m, "main")
+        ja = timing_summary.variant_index(a, m, "main")
+        jb = timing_summary.variant_index(b, m, "main")
         np.testing.assert_array_equal(a["pick"][:, ja], b["pick"][:, jb], err_msg=m)
     for m in ("depth", "svd"):     # compiled and the paper's definition pick alike here
-        np.testing.assert_array_equal(a["pick"][:, timing._variant(a, m, "alt")],
-                                      a["pick"][:, timing._variant(a, m, "main")])
+        np.testing.assert_array_equal(a["pick"][:, timing_summary.variant_index(a, m, "alt")],
+                                      a["pick"][:, timing_summary.variant_index(a, m, "main")])
     # the subset's calls are the full pool's calls at the selected indices
     sel = timing.select_calls(int(a["n_pool"]), 12)
     pool_src = np.concatenate([np.full(len(rec[m]["plan_index"]), i) for i, m in enumerate(METHODS)])
@@ -93,7 +93,7 @@ def test_replay_deterministic_and_order_independent(recorded):
     # (the full replay's rows are every source's calls in pool order: find svd's)
     row = {(int(s), int(c)): q for q, (s, c) in enumerate(zip(full["source"], full["call"]))}
     src_svd = list(METHODS).index("svd")
-    np.testing.assert_array_equal(a["pick"][svd_calls, timing._variant(a, "svd", "main")],
+    np.testing.assert_array_equal(a["pick"][svd_calls, timing_summary.variant_index(a, "svd", "main")],
                                   full["pick"][[row[(src_svd, int(c))] for c in a["call"][svd_calls]], 0])
     # one pass per (path, compiled or interpreted): a variant's slot is its place among
     # its own pass's variants, and each of them comes first in turn
@@ -115,10 +115,10 @@ def test_time_reduction_known_answer_and_paired_bootstrap():
     b = rng.lognormal(6.0, 0.5, 200)
     runs = np.repeat(np.arange(20), 10)
     tm = _fake_timing({"depth": b / 2, "svd": b}, {"depth": b / 2, "svd": b}, runs)
-    red, sd = timing.time_reduction(tm, "depth", "svd", n_boot=100)
+    red, sd = timing_summary.time_reduction(tm, "depth", "svd", n_boot=100)
     assert red == pytest.approx(50.0, abs=0.01)
     assert sd < 0.01          # paired: every resample halves the median exactly
-    red_cpu, sd_cpu = timing.time_reduction(tm, "svd", "depth", clock="cpu", n_boot=0)
+    red_cpu, sd_cpu = timing_summary.time_reduction(tm, "svd", "depth", clock="cpu", n_boot=0)
     assert red_cpu == pytest.approx(-100.0, abs=0.05) and np.isnan(sd_cpu)
 
 
@@ -231,10 +231,10 @@ def test_replay_times_the_paper_path_on_its_subset_only(recorded):
         firsts = [int(g[np.flatnonzero(a["slot"][q, g] == 0)[0]]) for q in calls]
         assert firsts == [int(g[t % g.size]) for t in range(len(calls))], key
         assert (a["slot"][np.ix_(calls, g)] < g.size).all()
-    s = timing.method_summary(a)
+    s = timing_summary.method_summary(a)
     assert s["timed_calls"] == 12 and s["timed_calls_paper"] == 4 and s["max_calls_paper"] == 4
-    assert "on 4 of them" in timing.method_text(a)
-    assert timing.method_summary(full)["timed_calls_paper"] == 12
+    assert "on 4 of them" in timing_summary.method_text(a)
+    assert timing_summary.method_summary(full)["timed_calls_paper"] == 12
 
 
 def _subset_timing(n=40, every=4):
@@ -273,16 +273,16 @@ def test_consumers_ignore_untimed_entries(recorded):
     from opnav.landing.plots import fig_planning_time
 
     tm, sub = _subset_timing()
-    assert timing.median_us(tm, "svd", "alt") == pytest.approx(5000.0)
-    assert timing.median_us(tm, "depth", "alt", clock="cpu") == pytest.approx(1000.0)
-    assert timing.times_ns(tm, "svd", "alt").size == sub.sum()
-    assert timing.median_evals(tm, "svd", "alt") == 31 and timing.median_evals(tm, "svd") == 7
-    assert timing.timed_calls(tm, "svd", "alt") == 10 and timing.timed_calls(tm, "svd") == 40
-    f = timing.summary_frame(tm).set_index(["method", "path"])
+    assert timing_summary.median_us(tm, "svd", "alt") == pytest.approx(5000.0)
+    assert timing_summary.median_us(tm, "depth", "alt", clock="cpu") == pytest.approx(1000.0)
+    assert timing_summary.times_ns(tm, "svd", "alt").size == sub.sum()
+    assert timing_summary.median_evals(tm, "svd", "alt") == 31 and timing_summary.median_evals(tm, "svd") == 7
+    assert timing_summary.timed_calls(tm, "svd", "alt") == 10 and timing_summary.timed_calls(tm, "svd") == 40
+    f = timing_summary.summary_frame(tm).set_index(["method", "path"])
     assert f.loc[("svd", "alt"), "calls"] == 10 and f.loc[("svd", "alt"), "wall_p05_us"] == pytest.approx(5000)
     assert f.loc[("depth", "alt"), "median_evals"] == 31
-    assert set(timing.per_run_median_us(tm, "svd", path="alt").values()) == {5000.0}
-    assert timing.method_summary(tm)["timed_calls_paper"] == 10
+    assert set(timing_summary.per_run_median_us(tm, "svd", path="alt").values()) == {5000.0}
+    assert timing_summary.method_summary(tm)["timed_calls_paper"] == 10
     _, rec = recorded
     t = summary_table({m: copy.copy(rec[m]) for m in ("depth", "svd")}, tm).set_index("method")
     assert t.loc["svd", "median_plan_time_alt_us"] == pytest.approx(5000.0)
@@ -303,13 +303,13 @@ def test_reductions_across_paths_use_the_common_subset():
     (here 1 us) would move the result if they were used."""
     tm, sub = _subset_timing()
     tm["wall_ns"][~sub, 0] = 1000                                  # 1 us off the subset
-    red, sd = timing.time_reduction(tm, "depth", "svd", path_a="main", path_b="alt", n_boot=50)
+    red, sd = timing_summary.time_reduction(tm, "depth", "svd", path_a="main", path_b="alt", n_boot=50)
     assert red == pytest.approx(100 * (1 - 100 / 5000)) and sd == pytest.approx(0.0, abs=1e-9)
-    assert timing.time_reduction(tm, "depth", "svd", path_a="alt", path_b="alt", n_boot=0)[0] \
+    assert timing_summary.time_reduction(tm, "depth", "svd", path_a="alt", path_b="alt", n_boot=0)[0] \
         == pytest.approx(80.0)
-    assert timing.median_us(tm, "depth") == pytest.approx(1.0)      # its own median: every call
+    assert timing_summary.median_us(tm, "depth") == pytest.approx(1.0)      # its own median: every call
     tm["timed"][:, 3] = False
-    assert np.isnan(timing.time_reduction(tm, "depth", "svd", path_b="alt")[0])
+    assert np.isnan(timing_summary.time_reduction(tm, "depth", "svd", path_b="alt")[0])
 
 
 def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monkeypatch):
@@ -361,7 +361,7 @@ def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monke
 
 def test_less_time_text_says_more_for_a_negative_reduction():
     """B-F7's title and the manuscript's sentence: a negative reduction is more time."""
-    from opnav.landing.timing import less_time_text
+    from opnav.landing.timing_summary import less_time_text
 
     assert less_time_text(34.2) == "34.2 % less"
     assert less_time_text(-137.4) == "137.4 % more"
@@ -404,13 +404,13 @@ def test_repetitions_keep_the_clock_below_5_pct_of_a_recorded_call(recorded):
     bracket) fails."""
     scn, rec = recorded
     a = timing.replay(scn, rec, ["depth", "svd", "svd_lapack"], max_calls=8, alt=False)
-    cs = timing.clock_share(a)
+    cs = timing_summary.clock_share(a)
     assert 0 < a["clock_ns"] < 50_000
     assert cs["share_pct_max"] < 5.0
     ok = a["timed"] & (a["reps"] > 0)
     assert np.all(a["reps"][ok] * a["cpu_ns"][ok] >= 0.95 * timing.CLOCK_SHARE_INV * a["clock_ns"])
     assert cs["reps_max"] > 1                                   # a compiled call needs repeating
-    assert "below 5 %" in timing.method_text(a)
+    assert "below 5 %" in timing_summary.method_text(a)
     # the closed form and the LAPACK SVD of the same H pick alike
     v = list(a["variant_method"])
     assert np.array_equal(a["pick"][:, v.index("svd")], a["pick"][:, v.index("svd_lapack")])

@@ -262,7 +262,7 @@ rule landing_summary:
         tuning=f"{LANDING}/tuning.json",
         plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step
         code=with_kernels("landing", src(
-            "landing/montecarlo.py", "landing/timing.py", "landing/scenario.py", "landing/plots.py",
+            "landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/scenario.py", "landing/plots.py",
             "landing/report.py", "landing/equivalence.py", "landing/ranking.py", "landing/trajectory.py",
             "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),
         kernels=kernels("landing"),

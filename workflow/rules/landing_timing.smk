@@ -14,7 +14,7 @@ rule landing_timing:
     """Planning times of every method on the same recorded planning calls of one scenario."""
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
-        code=B_SRC + src("landing/timing.py"),
+        code=B_SRC + src("landing/timing.py", "landing/timing_summary.py"),
         kernels=kernels("landing"),
     output:
         f"{LANDING}/timing/{{bscn}}.npz",

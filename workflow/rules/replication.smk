@@ -96,7 +96,7 @@ if REP_CFG["enabled"]:
         recorded calls: what varies is the clock)."""
         input:
             mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
-            code=B_SRC + src("landing/timing.py"),
+            code=B_SRC + src("landing/timing.py", "landing/timing_summary.py"),
             kernels=kernels("landing"),
         output:
             f"{REP}/landing/timing/{{bscn}}.npz",
@@ -123,7 +123,7 @@ if REP_CFG["enabled"]:
             single=f"{LANDING}/single/summary_{{bscn}}.json",
             tuning=f"{LANDING}/tuning.json",
             plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step
-            code=src("landing/montecarlo.py", "landing/timing.py", "landing/report.py", "landing/equivalence.py",
+            code=src("landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/report.py", "landing/equivalence.py",
                      "landing/ranking.py", "landing/trajectory.py"),
         output:
             t3=table_outputs(f"{REP}/landing/B-T3_summary_{{bscn}}"),

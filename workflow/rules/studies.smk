@@ -30,7 +30,7 @@ except ConfigError as exc:
     config_exit(exc)
 STUDY_SIMS = {i.digest: i.sim for s in STUDIES.values() for i in s.instances}
 STUDY_JOB_UNITS = _study_job_units(STUDIES)
-STUDY_SRC = {"landing": B_SRC + src("landing/study.py"),
+STUDY_SRC = {"landing": B_SRC + src("landing/study.py", "landing/timing.py", "landing/timing_summary.py"),
              "approach": A_X2_SRC + src("approach/study.py")}
 
 

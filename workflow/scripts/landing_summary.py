@@ -8,7 +8,7 @@ import sys
 import pandas as pd
 
 from opnav.core import figures, published
-from opnav.landing import plots, timing
+from opnav.landing import plots, timing, timing_summary
 from opnav.landing.montecarlo import load
 from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading,
                                   scenario_summary, summary_table)
@@ -41,7 +41,7 @@ with script_context(snakemake) as log:
                          "and its reduction against each other method (bootstrap standard "
                          "deviation over runs); the published 29.03 % (depth vs SVD) is "
                          "labelled published. Converged: final position error below "
-                         f"{snakemake.params.converged_pos_err_m:g} m. " + timing.method_text(tm)))
+                         f"{snakemake.params.converged_pos_err_m:g} m. " + timing_summary.method_text(tm)))
     single = load_json(snakemake.input.single)
     every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
     # B-C1's margin and same-pick threshold, B-C2's smallest difference: the analysis plan's

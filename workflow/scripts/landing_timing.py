@@ -2,7 +2,7 @@
 
 import sys
 
-from opnav.landing import timing
+from opnav.landing import timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import load
 from opnav.core.snakeio import mock_snakemake, script_context
@@ -17,5 +17,5 @@ with script_context(snakemake) as log:
                        int(snakemake.params.max_calls),
                        max_calls_paper=int(snakemake.params.max_calls_paper))
     timing.save(snakemake.output[0], tm)
-    log.info("%s", timing.method_text(tm))
-    log.info("%s", timing.summary_frame(tm).to_string())
+    log.info("%s", timing_summary.method_text(tm))
+    log.info("%s", timing_summary.summary_frame(tm).to_string())

@@ -6,7 +6,7 @@ import json
 import sys
 
 from opnav.core import figures
-from opnav.landing import plots, timing
+from opnav.landing import plots, timing, timing_summary
 from opnav.landing.montecarlo import first_runs, load
 from opnav.landing.ranking import headline, ranking_table
 from opnav.core.snakeio import mock_snakemake, script_context
@@ -38,7 +38,7 @@ with script_context(snakemake) as log:
                          f"{ref} of the per-run position errors (m) at the last landmark update (lastlm), "
                          f"RMS over the landmark phase (lmrms), RMS over the descent and at touchdown (final) with 95 % paired-t "
                          f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
-                         f"error below {conv:g} m. " + timing.method_text(tm)))
+                         f"error below {conv:g} m. " + timing_summary.method_text(tm)))
     t = next(iter(data.values()))["t"]
     figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f)
     out = headline(df, ref)

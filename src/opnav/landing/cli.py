@@ -36,7 +36,8 @@ def _run(args) -> int:
     scn = build_scenario(scenarios[name])
     run = run_descent(scn, args.method, args.seed)
     s = summarize_run(run)
-    from opnav.landing.timing import median_us, replay_own
+    from opnav.landing.timing import replay_own
+    from opnav.landing.timing_summary import median_us
 
     tm = replay_own(scn, run, args.method)       # planning time by replay of the run's calls
     s["median_plan_time_us"] = median_us(tm, args.method)

@@ -198,7 +198,7 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
     import matplotlib
     import matplotlib.pyplot as plt
 
-    from opnav.landing import timing as tmg
+    from opnav.landing import timing_summary as tsum
 
     methods = list(methods)
     paths = {str(p): str(e) for p, e in zip(timing["variant_path"], timing["variant_eval_path"])}
@@ -207,8 +207,8 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
         fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 3.0), constrained_layout=True)
         pos, vals, cols, hatch = [], [], [], []
         for k, m in enumerate(methods, start=1):
-            v = tmg.times_ns(timing, m).astype(float) / 1e3
-            va = tmg.times_ns(timing, m, "alt").astype(float) / 1e3
+            v = tsum.times_ns(timing, m).astype(float) / 1e3
+            va = tsum.times_ns(timing, m, "alt").astype(float) / 1e3
             has_alt = va.size > 0
             pos.append(k - 0.18 if has_alt else k)
             vals.append(v)
@@ -231,7 +231,7 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
         figures.plain_log_labels(ax.yaxis)
         labels = []
         for m in methods:
-            ev = tmg.median_evals(timing, m)
+            ev = tsum.median_evals(timing, m)
             labels.append(f"{_label(m)}\n{ev:.0f} evals")
         ax.set_xticks(range(1, len(methods) + 1), labels, fontsize="small")
         for p_, v in zip(pos, vals):       # the median, above the upper whisker (clear of the box)
@@ -247,17 +247,17 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                                               Patch(facecolor="white", edgecolor="0.3", hatch="///", label=alt_name)],
                                  fontsize="x-small", framealpha=0.9)
         ax.set_ylabel("planning-call time (µs)")
-        n_alt = max((tmg.timed_calls(timing, m, "alt") for m in methods), default=0)
+        n_alt = max((tsum.timed_calls(timing, m, "alt") for m in methods), default=0)
         ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"
                       f"whiskers: 5-95 %; filled: {main_name}"
                       + (f"; hatched: {alt_name} ({n_alt} of the calls)" if alt_name and n_alt else ""),
                       fontsize="x-small")
         if published_reduction_vs_svd is not None and {"depth", "svd"} <= set(methods):
-            ours = tmg.time_reduction(timing, "depth", "svd", n_boot=0)[0]
-            title = f"depth vs SVD: {tmg.less_time_text(ours)} time ({main_name})"
-            if tmg.times_ns(timing, "svd", "alt").size:
-                da = "alt" if tmg.times_ns(timing, "depth", "alt").size else "main"   # both on that path
-                ours_alt = tmg.time_reduction(timing, "depth", "svd", path_a=da, path_b="alt", n_boot=0)[0]
-                title += f", {tmg.less_time_text(ours_alt)} ({alt_name})"
+            ours = tsum.time_reduction(timing, "depth", "svd", n_boot=0)[0]
+            title = f"depth vs SVD: {tsum.less_time_text(ours)} time ({main_name})"
+            if tsum.times_ns(timing, "svd", "alt").size:
+                da = "alt" if tsum.times_ns(timing, "depth", "alt").size else "main"   # both on that path
+                ours_alt = tsum.time_reduction(timing, "depth", "svd", path_a=da, path_b="alt", n_boot=0)[0]
+                title += f", {tsum.less_time_text(ours_alt)} ({alt_name})"
             ax.set_title(f"{title}\npublished {published_reduction_vs_svd:.2f} % less", fontsize="x-small")
         return fig

@@ -201,7 +201,7 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
     whitened baselines sit near it). Time columns (median wall and CPU time of a planning call, us)
     come from ``timing``, the replay of the recorded planning calls
     (``opnav.landing.timing.replay``: every method on the same calls)."""
-    from opnav.landing import timing as tmg
+    from opnav.landing import timing_summary as tsum
 
     if reference not in data:
         raise ValueError(f"landing.extra.reference {reference!r} not among the methods {list(data)}")
@@ -211,7 +211,7 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
         if not s.index.equals(ref_runs):
             raise ValueError(f"method {m!r} flew runs {list(s.index)[:5]}..., reference "
                              f"{reference!r} flew {list(ref_runs)[:5]}...: not paired")
-    ref_cpu = tmg.median_us(timing, reference, clock="cpu")
+    ref_cpu = tsum.median_us(timing, reference, clock="cpu")
     rank_by = _rank_by(st[reference])
     rows = []
     for m, d in data.items():
@@ -233,8 +233,8 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
         row["plan_calls"] = int(len(d["plan_index"]))
         idx = np.asarray(d["plan_index"])
         row["no_pick_pct"] = float(100.0 * np.mean(idx < 0)) if idx.size else math.nan
-        row["median_plan_time_us"] = tmg.median_us(timing, m)
-        row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
+        row["median_plan_time_us"] = tsum.median_us(timing, m)
+        row["median_plan_cpu_us"] = tsum.median_us(timing, m, clock="cpu")
         row["cpu_time_ratio_to_ref"] = row["median_plan_cpu_us"] / ref_cpu
         for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos"),
                           ("lastlm_pos_err_m", "lastlm_pos"), ("lmrms_pos_err_m", "lmrms_pos")):

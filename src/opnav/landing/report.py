@@ -49,19 +49,19 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
     on a subset, ``landing.timing.max_calls_paper``), and each method's time
     reduction against each other ``100 (1 - median_a / median_b)`` (%) on the
     same replayed calls (for ``_alt``: those timed on both variants), with a
-    paired bootstrap standard deviation (``timing.time_reduction``). ``converged_runs_pct`` counts the runs whose
+    paired bootstrap standard deviation (``timing_summary.time_reduction``). ``converged_runs_pct`` counts the runs whose
     final position error is below ``converged_pos_err_m`` (m); the published
     reduction, if given, is a column labelled ``_published`` on the depth row."""
     import pandas as pd
 
     # imported here: the manuscript and scorecard jobs import this module for its
     # page views and need neither scipy (ranking) nor the replay
-    from opnav.landing import timing as tmg
+    from opnav.landing import timing_summary as tsum
     from opnav.landing.montecarlo import per_run_stats, pick_quality, same_pick_pct
     from opnav.landing.ranking import pair_comparison
 
     methods = list(data)
-    missing = [m for m in methods if tmg.times_ns(timing, m).size == 0 and len(timing["source"])]
+    missing = [m for m in methods if tsum.times_ns(timing, m).size == 0 and len(timing["source"])]
     if missing:
         raise ValueError(f"the planning-time replay did not time {missing}")
     rows = []
@@ -89,17 +89,17 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
         row["mean_nees_pos"] = float(st["mean_nees_pos"].mean())
         row["mean_nees_vel"] = float(st["mean_nees_vel"].mean())
         row["landmarks_per_run"] = float(st["n_landmarks"].mean())
-        alt_m = "alt" if tmg.times_ns(timing, m, "alt").size else "main"
-        row["median_plan_time_us"] = tmg.median_us(timing, m)
-        row["median_plan_cpu_us"] = tmg.median_us(timing, m, clock="cpu")
+        alt_m = "alt" if tsum.times_ns(timing, m, "alt").size else "main"
+        row["median_plan_time_us"] = tsum.median_us(timing, m)
+        row["median_plan_cpu_us"] = tsum.median_us(timing, m, clock="cpu")
         # the same replayed calls on the alternative metric path (the configured one
         # for methods without it)
-        row["median_plan_time_alt_us"] = tmg.median_us(timing, m, alt_m)
-        row["median_plan_cpu_alt_us"] = tmg.median_us(timing, m, alt_m, clock="cpu")
+        row["median_plan_time_alt_us"] = tsum.median_us(timing, m, alt_m)
+        row["median_plan_cpu_alt_us"] = tsum.median_us(timing, m, alt_m, clock="cpu")
         row["timed_calls"] = int(len(timing["source"]))
         # the alternative path's medians rest on its own calls (the paper path: a subset,
         # landing.timing.max_calls_paper), its reductions on the calls timed on both
-        row["timed_calls_alt"] = tmg.timed_calls(timing, m, alt_m)
+        row["timed_calls_alt"] = tsum.timed_calls(timing, m, alt_m)
         ev = data[m]["plan_evals"]
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
@@ -116,13 +116,13 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
                 row[f"{k}_vs_{b}_m"] = pc[f"{k}_m"]
                 row[f"{k}_vs_{b}_lo_m"] = pc[f"{k}_lo_m"]
                 row[f"{k}_vs_{b}_hi_m"] = pc[f"{k}_hi_m"]
-            red, sd = tmg.time_reduction(timing, m, b)
+            red, sd = tsum.time_reduction(timing, m, b)
             row[f"time_reduction_vs_{b}_pct"] = red
             row[f"time_reduction_vs_{b}_pct_std"] = sd
-            row[f"cpu_time_reduction_vs_{b}_pct"] = tmg.time_reduction(timing, m, b, clock="cpu",
+            row[f"cpu_time_reduction_vs_{b}_pct"] = tsum.time_reduction(timing, m, b, clock="cpu",
                                                                        n_boot=0)[0]
-            alt_b = "alt" if tmg.times_ns(timing, b, "alt").size else "main"
-            red, sd = tmg.time_reduction(timing, m, b, path_a=alt_m, path_b=alt_b)
+            alt_b = "alt" if tsum.times_ns(timing, b, "alt").size else "main"
+            red, sd = tsum.time_reduction(timing, m, b, path_a=alt_m, path_b=alt_b)
             row[f"time_reduction_vs_{b}_alt_pct"] = red
             row[f"time_reduction_vs_{b}_alt_pct_std"] = sd
         rows.append(row)
@@ -204,7 +204,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
     initial attitude, ``scenario.initial_attitude_report``). Holds per method its
     B-T3 row, per pair of methods ``ranking.pair_comparison``, the depth method's
     time reduction against SVD (%, None unless both were flown) beside the
-    published one, the replay's method (``timing.method_summary``), the
+    published one, the replay's method (``timing_summary.method_summary``), the
     initial attitude (deg) in the paper's convention and as thrust tilt and
     azimuth, the yaw verdict (``montecarlo.yaw_convergence`` of the first
     method: does the 3-sigma envelope fall below ``yaw_ratio`` of its start?),
@@ -212,7 +212,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
     depth (%, the check that an accuracy comparison could fail; nan without one),
     and ``accuracy``: :func:`accuracy_tests` (its keys at the top level).
     """
-    from opnav.landing import timing as tmg
+    from opnav.landing import timing_summary as tsum
     from opnav.landing.montecarlo import yaw_convergence
     from opnav.landing.ranking import pair_table
     from opnav.landing.scenario import initial_attitude_report
@@ -233,11 +233,11 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
                                       if {"svd", "depth"} <= set(t.index) else None),
         "eval_path": eval_path,
         # the reductions in words for the manuscript ("34.2 % less", "137.4 % more")
-        "depth_vs_svd_time_text": {p: tmg.less_time_text(float(t.loc["depth", f"time_reduction_vs_svd{x}_pct"]))
+        "depth_vs_svd_time_text": {p: tsum.less_time_text(float(t.loc["depth", f"time_reduction_vs_svd{x}_pct"]))
                                    for p, x in (("path", ""), ("alt", "_alt"))
                                    if {"svd", "depth"} <= set(t.index)
                                    and f"time_reduction_vs_svd{x}_pct" in t.columns},
-        "timing": tmg.method_summary(timing),
+        "timing": tsum.method_summary(timing),
         "published_time_reduction_vs_svd_pct": published_reduction_vs_svd,
         "initial_attitude_deg": att["paper_convention_deg"],
         "initial_tilt_deg": att["tilt_deg"],
@@ -246,8 +246,8 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
         "yaw_reason": yaw["reason"],
         "n_runs": yaw["n_runs"],
         "min_same_pick_vs_depth_pct": min(same_pick, default=math.nan),
-        "planning_time_vs_depth": (vs := tmg.vs_depth(timing)),
-        "planning_time_text": planning_time_text(vs, tmg.clock_share(timing)),
+        "planning_time_vs_depth": (vs := tsum.vs_depth(timing)),
+        "planning_time_text": planning_time_text(vs, tsum.clock_share(timing)),
         **(accuracy or {}),
     }
 
@@ -509,17 +509,17 @@ def nees_reading(nees: dict) -> dict:
 
 
 def planning_time_text(vs: dict, clock: dict) -> str:
-    """The manuscript's sentence on planning time (CPU, per call) from ``timing.vs_depth`` and
-    ``timing.clock_share``: depth against SVD's closed form, a LAPACK SVD of the same H and the
+    """The manuscript's sentence on planning time (CPU, per call) from ``timing_summary.vs_depth`` and
+    ``timing_summary.clock_share``: depth against SVD's closed form, a LAPACK SVD of the same H and the
     paper's definition, each with its paired 95 % interval, and the clock's measured cost."""
-    from opnav.landing import timing as tmg
+    from opnav.landing import timing_summary as tsum
 
     def part(label, name):
         v = vs.get(label)
         if not v:
             return None
         return (f"{v['depth_median_us']:.2f} against {v['median_us']:.2f} us for {name} (depth "
-                f"{tmg.less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
+                f"{tsum.less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
                 f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %)")
     parts = [p for p in (part("svd_closed_form", "the closed-form SVD"),
                          part("svd_lapack", "a LAPACK SVD of the same H"),

@@ -27,7 +27,7 @@ from opnav.landing.montecarlo import per_run_stats, run_chunk
 def per_run_metrics(data: dict, timing: dict, method: str) -> pd.DataFrame:
     """One row per run of a chunk or gathered Monte-Carlo dict (module docstring);
     ``timing``: the replay of its planning calls (``timing.replay_own``)."""
-    from opnav.landing.timing import per_run_median_us
+    from opnav.landing.timing_summary import per_run_median_us
 
     st = per_run_stats(data).reset_index()
     runs = st["run"].to_numpy()

@@ -19,15 +19,15 @@ a lander's computer would run, and ``planner.alternative_path``, ``paper``: the
 paper's definition interpreted, CasADi H and LAPACK SVD), one
 call at a time in one process. The variants on the paper's definition that are
 not the configured path (``alt`` when ``eval_path`` is ``compiled``; an edge call
-of an H baseline scores every detected landmark through CasADi, 0.4 s per call
-in site-tilt) are timed on a subset of the replayed calls only: at most
+of an H baseline scores every detected landmark through CasADi, a fraction of a second)
+are timed on a subset of the replayed calls only: at most
 ``max_calls_paper`` of them, evenly spaced over the replayed calls by the same
 rule (``select_calls(n_replayed, max_calls_paper)`` over replay positions, so the
 subset spans the descent; 0 or at least the replayed calls: all of them). The
 calls outside it are not run on those variants and marked untimed (``timed``
 false; ``wall_ns`` = ``cpu_ns`` = ``n_evals`` = ``slot`` = -1, ``pick`` = -2);
 every consumer below reads timed entries only, and a comparison of two variants
-(:func:`time_reduction`) uses the calls timed on both. So a median on the
+(``timing_summary.time_reduction``) uses the calls timed on both. So a median on the
 configured path rests on every replayed call, one on the paper's definition
 on the subset (``method_summary``: ``timed_calls``, ``timed_calls_paper``).
 Passes and order rule (:func:`pass_keys`): the variants are timed in separate
@@ -42,19 +42,14 @@ the same inputs (its pick), so that it measures its own work and not the caches 
 before it evicted, and as the mean of back-to-back repetitions: the count doubles (1, 2, 4,
 ...) until the bracket's CPU time reaches :data:`CLOCK_SHARE_INV` (25) times the clock's own
 cost, measured per replay (:func:`clock_cost_ns`: two perf_counter_ns and two thread_time_ns
-readings, ~2 us here against a 3-6 us compiled call, a third of a one-call bracket); so the
-clock is below 5 % of every timed bracket (:func:`clock_share` reports it; the interpreted
-calls, milliseconds, need one). ``svd_lapack`` (a real LAPACK SVD of the same H, compiled)
-is timed beside svd's closed form; :func:`vs_depth` compares depth with each, with paired
-bootstrap intervals over the replayed calls. Measured (interior, 30 calls
-of the quick profile, thread CPU, timed once): in a rotation each variant has the
-same predecessor on every call, and depth placed after svd_w (4-5 ms of compiled
-edge-call work) took 46-52 us a call against SVD's 14-21 us (-141 % and -215 %),
-while without svd_w the four searches took 15-17 us each (-12 % +- 21);
-interleaved with the paper path the compiled calls measured about 4x slower (47
-against 12 us) and the compiled depth-vs-SVD reduction read -45 % and +15 % in
-two builds of the same config. Every method is timed on the same states, so the comparison is paired per
-call. Each call is timed by ``time.perf_counter_ns`` (wall) and
+readings, comparable with a compiled call itself); so the clock is below 5 % of every timed
+bracket (``timing_summary.clock_share`` reports it; the interpreted calls, milliseconds,
+need one). The passes, the rotation and the warm call exist because the order of the
+variants and the cache state left by the call before moved the compiled times more than
+the methods did (docs/performance.md, "Measurements formerly in docstrings (planning
+time)"). ``svd_lapack`` (a real LAPACK SVD of the same H, compiled) is timed beside svd's
+closed form (:data:`COMPILED_ONLY`). Every method is timed on the same states, so the
+comparison is paired per call. Each call is timed by ``time.perf_counter_ns`` (wall) and
 ``time.thread_time_ns`` (CPU time of the calling thread, which other
 processes do not inflate), with the image's detected landmarks given (the
 feature detector's list, computed from the truth pose before the clock starts,
@@ -63,8 +58,8 @@ around the kernel's call itself (``planner.compiled_call``, what a lander's
 computer runs: the whole planning call, numba's argument dispatch included),
 its pick from the untimed call before it; interpreted code around
 ``planner.plan``. The Python wrapper around the compiled call (the
-``PlanResult`` the Monte Carlo keeps) is the harness's, not the planner's: it
-took 2.0 of a 5.0 us depth call (measured, interior). The garbage collector is held during the timed calls
+``PlanResult`` the Monte Carlo keeps) is the harness's, not the planner's, and is
+left out (:func:`call_overhead` measures it). The garbage collector is held during the timed calls
 (collected between calls). One untimed warm-up call per variant precedes the
 timing (imports, caches).
 
@@ -73,7 +68,9 @@ the configured path, must equal the recorded pick; mismatches are counted per
 method (``mismatch``; nonzero means the replay is not the descent's call).
 
 Units: times ns in the arrays, us in the summaries. A replay is written and
-read by ``records.save`` / ``records.load`` (also ``timing.save`` / ``timing.load``).
+read by ``records.save`` / ``records.load`` (also ``timing.save`` / ``timing.load``);
+what is read from it (medians, reductions and their intervals, depth against each SVD, the
+clock's share, the method sentence) is :mod:`opnav.landing.timing_summary`.
 """
 
 from __future__ import annotations
@@ -87,10 +84,8 @@ import numpy as np
 
 from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
 
-__all__ = ["select_calls", "variants", "pass_keys", "paper_limited", "replay", "timed", "save", "load", "times_ns",
-           "median_us", "time_reduction", "timed_calls", "method_text", "summary_frame", "median_evals",
-           "from_times", "method_summary", "call_overhead", "replay_own", "per_run_median_us", "clock_cost_ns",
-           "clock_share", "CLOCK_SHARE_INV", "COMPILED_ONLY", "timed_methods", "time_reduction_interval", "vs_depth", "VS_DEPTH"]
+__all__ = ["select_calls", "COMPILED_ONLY", "timed_methods", "variants", "pass_keys", "paper_limited", "replay",
+           "CLOCK_SHARE_INV", "clock_cost_ns", "replay_own", "from_times", "call_overhead", "save", "load"]
 
 
 # ----------------------------------------------------------------- replay
@@ -335,20 +330,6 @@ def clock_cost_ns(n: int = 2000, repeats: int = 5) -> float:
     return float(best)
 
 
-def clock_share(tm: dict) -> dict:
-    """The clock's measured cost (ns) and its share of the timed brackets (%, ``clock / (reps x
-    call)``): median and maximum over the timed cells, and the repetition counts' range."""
-    reps = np.asarray(tm.get("reps", []))
-    ok = timed(tm) & (reps > 0) if reps.size else np.zeros(0, bool)
-    if not ok.any():
-        return {"clock_ns": float(tm.get("clock_ns", math.nan)), "share_pct_median": None,
-                "share_pct_max": None, "reps_min": None, "reps_max": None}
-    cpu = np.maximum(np.asarray(tm["cpu_ns"])[ok], 1)
-    share = 100.0 * float(tm["clock_ns"]) / (reps[ok] * cpu)
-    return {"clock_ns": float(tm["clock_ns"]), "share_pct_median": float(np.median(share)),
-            "share_pct_max": float(share.max()), "reps_min": int(reps[ok].min()), "reps_max": int(reps[ok].max())}
-
-
 def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
     """Replay a Monte-Carlo dict's (or one ``run_descent`` output's) own calls
     through its own method, configured evaluation path only (parameter
@@ -357,15 +338,6 @@ def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
     if "plan_run" not in d:
         d["plan_run"] = np.zeros(len(d["plan_index"]), np.int64)
     return replay(scn, {method: d}, [method], max_calls, alt=False)
-
-
-def per_run_median_us(tm: dict, method: str, clock: str = "wall", path: str = "main") -> dict[int, float]:
-    """Median replayed planning time (us) per run (the run of the recorded call),
-    over the calls timed on ``path``."""
-    t = times_ns(tm, method, path, clock)
-    j = _variant(tm, method, path)
-    run = np.asarray(tm["run"])[timed(tm)[:, j]] if j is not None else np.zeros(0, np.int64)
-    return {int(r): float(np.median(t[run == r]) / 1e3) for r in np.unique(run)}
 
 
 def from_times(wall_ns: dict, cpu_ns: dict, run, n_evals: int = 0) -> dict:
@@ -385,212 +357,6 @@ def from_times(wall_ns: dict, cpu_ns: dict, run, n_evals: int = 0) -> dict:
             "variant_path": np.array(["main"] * k), "variant_eval_path": np.array(["main"] * k),
             "mismatch": np.zeros(k, np.int64), "checked": np.zeros(k, np.int64),
             "n_pool": np.int64(n), "max_calls": np.int64(0), "max_calls_paper": np.int64(0)}
-
-
-# ----------------------------------------------------------------- consumers
-
-def _variant(tm: dict, method: str, path: str) -> int | None:
-    vm, vp = [str(x) for x in tm["variant_method"]], [str(x) for x in tm["variant_path"]]
-    for j, (m, p) in enumerate(zip(vm, vp)):
-        if m == method and p == path:
-            return j
-    return None
-
-
-def timed(tm: dict) -> np.ndarray:
-    """``(calls, variants)``: whether the replay ran that variant on that call
-    (false for the paper path's calls outside its subset; a replay saved before
-    the flag: every entry with a time >= 0)."""
-    if "timed" in tm:
-        return np.asarray(tm["timed"], bool)
-    return np.asarray(tm["wall_ns"]) >= 0
-
-
-def times_ns(tm: dict, method: str, path: str = "main", clock: str = "wall") -> np.ndarray:
-    """The planning times (ns) of ``method`` on ``path`` (``"main"`` /
-    ``"alt"``) by ``clock`` (``"wall"``: perf_counter, ``"cpu"``: thread CPU),
-    one per replayed call timed on that variant (:func:`timed`), in replay
-    order; empty if that variant was not timed."""
-    if clock not in ("wall", "cpu"):
-        raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
-    j = _variant(tm, method, path)
-    if j is None:
-        return np.zeros(0, np.int64)
-    return np.asarray(tm[f"{clock}_ns"])[timed(tm)[:, j], j]
-
-
-def timed_calls(tm: dict, method: str, path: str = "main") -> int:
-    """Replayed calls timed on ``method``'s ``path`` variant (0 if none)."""
-    j = _variant(tm, method, path)
-    return 0 if j is None else int(np.sum(timed(tm)[:, j]))
-
-
-def median_evals(tm: dict, method: str, path: str = "main") -> float:
-    """Median objective evaluations per timed replayed call (nan if none)."""
-    j = _variant(tm, method, path)
-    if j is None:
-        return math.nan
-    ev = np.asarray(tm["n_evals"])[timed(tm)[:, j], j]
-    return float(np.median(ev)) if ev.size else math.nan
-
-
-def median_us(tm: dict, method: str, path: str = "main", clock: str = "wall") -> float:
-    """Median planning time (us) over the replayed calls (nan if none)."""
-    t = times_ns(tm, method, path, clock)
-    return float(np.median(t) / 1e3) if t.size else math.nan
-
-
-def _reductions(tm: dict, a: str, b: str, clock: str, path_a: str, path_b: str, n_boot: int,
-                seed: int) -> tuple[float, np.ndarray]:
-    """(reduction %, its bootstrap replicates) of :func:`time_reduction`."""
-    if clock not in ("wall", "cpu"):
-        raise ValueError(f"clock must be 'wall' or 'cpu', got {clock!r}")
-    ja, jb = _variant(tm, a, path_a), _variant(tm, b, path_b)
-    if ja is None or jb is None:
-        return math.nan, np.zeros(0)
-    both = timed(tm)[:, ja] & timed(tm)[:, jb]
-    if not both.any():
-        return math.nan, np.zeros(0)
-    t = np.asarray(tm[f"{clock}_ns"])[both]
-    ta, tb = t[:, ja], t[:, jb]
-    red = 100.0 * (1.0 - float(np.median(ta)) / float(np.median(tb)))
-    key = (np.asarray(tm["source"]) * (1 << 32) + np.asarray(tm["run"]))[both]
-    clusters, inv = np.unique(key, return_inverse=True)
-    if len(clusters) < 2 or n_boot < 2:
-        return red, np.zeros(0)
-    rng = np.random.default_rng(seed)
-    members = [np.flatnonzero(inv == c) for c in range(len(clusters))]
-    vals = np.empty(n_boot)
-    for i in range(n_boot):
-        idx = np.concatenate([members[c] for c in rng.integers(len(clusters), size=len(clusters))])
-        vals[i] = 100.0 * (1.0 - np.median(ta[idx]) / np.median(tb[idx]))
-    return red, vals
-
-
-def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str = "main",
-                   path_b: str = "main", n_boot: int = 200, seed: int = 0) -> tuple[float, float]:
-    """``100 (1 - median_a / median_b)`` (%) of the planning times of methods
-    ``a`` (on ``path_a``) and ``b`` (``path_b``) on the same replayed calls (those
-    timed on both variants: the paper path's subset when either is on it), and
-    its bootstrap standard deviation: clusters (source Monte Carlo, run)
-    resampled with replacement, both methods from the same resample (paired).
-    ``nan`` if a variant is missing or no call was timed on both; the spread is
-    ``nan`` below two clusters or two resamples."""
-    red, vals = _reductions(tm, a, b, clock, path_a, path_b, n_boot, seed)
-    return red, (float(np.std(vals, ddof=1)) if vals.size >= 2 else math.nan)
-
-
-def time_reduction_interval(tm: dict, a: str, b: str, *, clock: str = "cpu", path_a: str = "main",
-                            path_b: str = "main", n_boot: int = 1000, seed: int = 0,
-                            level: float = 0.95) -> tuple[float, float, float]:
-    """(reduction %, lo, hi): :func:`time_reduction` with its ``level`` percentile interval over
-    the same paired cluster bootstrap of the replayed calls (nan where it has none)."""
-    red, vals = _reductions(tm, a, b, clock, path_a, path_b, n_boot, seed)
-    if vals.size < 2:
-        return red, math.nan, math.nan
-    q = 100.0 * (1.0 - level) / 2.0
-    lo, hi = np.percentile(vals, [q, 100.0 - q])
-    return red, float(lo), float(hi)
-
-
-#: the planning-time comparisons with depth the summary reports (B-C4): (method, path, label)
-VS_DEPTH = (("svd", "main", "svd_closed_form"), ("svd_lapack", "main", "svd_lapack"),
-            ("svd", "alt", "svd_paper"), ("gdop", "main", "gdop"), ("cond", "main", "cond"))
-
-
-def vs_depth(tm: dict, clock: str = "cpu") -> dict:
-    """Depth's planning time against each of :data:`VS_DEPTH` timed in ``tm``: per label the
-    median call (us) of both on the calls timed on both, and depth's reduction (%) with its
-    95 % paired bootstrap interval over the replayed calls (clusters by run); depth on the
-    same path as the baseline (the paper path against svd's paper path)."""
-    out = {}
-    for m, path, label in VS_DEPTH:
-        if _variant(tm, m, path) is None or _variant(tm, "depth", path) is None:
-            continue
-        red, lo, hi = time_reduction_interval(tm, "depth", m, clock=clock, path_a=path, path_b=path)
-        out[label] = {"method": m, "path": path, "depth_median_us": median_us(tm, "depth", path, clock=clock),
-                      "median_us": median_us(tm, m, path, clock=clock), "depth_reduction_pct": red,
-                      "depth_reduction_lo_pct": lo, "depth_reduction_hi_pct": hi}
-    return out
-
-
-def less_time_text(reduction_pct: float) -> str:
-    """A :func:`time_reduction` in words: ``"34.2 % less"``, a negative one ``"137.4 % more"``
-    (not "-137.4 % less"); ``"n/a"`` if it is nan."""
-    if not math.isfinite(reduction_pct):
-        return "n/a"
-    return f"{reduction_pct:.1f} % less" if reduction_pct >= 0 else f"{-reduction_pct:.1f} % more"
-
-
-def method_summary(tm: dict) -> dict:
-    """The replay's method in numbers (summary JSON, manuscript macros): calls
-    replayed and recorded, ``max_calls``, the calls the paper's definition was
-    timed on (``timed_calls_paper``, 0 if not timed) and ``max_calls_paper``,
-    methods timed, own calls checked and pick mismatches."""
-    return {"method": "replay", "timed_calls": int(len(tm["source"])), "recorded_calls": int(tm["n_pool"]),
-            "max_calls": int(tm["max_calls"]), "all_calls": bool(len(tm["source"]) == int(tm["n_pool"])),
-            "timed_calls_paper": _paper_calls(tm), "max_calls_paper": int(tm.get("max_calls_paper", 0)),
-            "n_methods": int(len(tm["methods"])), "checked_calls": int(np.sum(tm["checked"])),
-            "pick_mismatches": int(np.sum(tm["mismatch"])),
-            "sources_text": ", ".join(str(x) for x in tm["sources"]), "clock": clock_share(tm)}
-
-
-def _paper_calls(tm: dict) -> int:
-    """Replayed calls on which the paper's definition was timed (on whichever
-    path it is; 0 if it was not timed)."""
-    paper = np.asarray(tm["variant_eval_path"]).astype(str) == "paper"
-    return int(np.sum(timed(tm)[:, paper].any(axis=1))) if paper.any() else 0
-
-
-def method_text(tm: dict) -> str:
-    """One sentence stating how the times were measured (captions, paper)."""
-    n, pool = len(tm["source"]), int(tm["n_pool"])
-    srcs = ", ".join(str(x) for x in tm["sources"])
-    subset = (f"all {pool} recorded planning calls" if n == pool else
-              f"{n} of the {pool} recorded planning calls (every {pool / n:.1f}th by index, "
-              f"landing.timing.max_calls = {int(tm['max_calls'])})")
-    mis = int(np.sum(tm["mismatch"]))
-    npaper = _paper_calls(tm)
-    paper = ("" if npaper in (0, n) else
-             f"; the paper's definition (interpreted, CasADi H) on {npaper} of them, evenly spaced "
-             f"(landing.timing.max_calls_paper = {int(tm.get('max_calls_paper', 0))}), its medians "
-             "and its comparisons on those calls")
-    cs = clock_share(tm)
-    clock = ("" if cs["share_pct_max"] is None else
-             f" Each call is timed as the mean of back-to-back repetitions (a doubling count, "
-             f"{cs['reps_min']} to {cs['reps_max']}) until the clock's own cost "
-             f"({cs['clock_ns']:.0f} ns a bracket, measured) is below 5 % of the bracket: "
-             f"{cs['share_pct_median']:.2f} % median, {cs['share_pct_max']:.2f} % at most.")
-    return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
-            "every method's planning call, one call at a time, interleaved across methods in one "
-            f"process (order rotated per call), the same states for every method{paper}; wall clock "
-            "perf_counter_ns, CPU clock thread_time_ns; replayed picks equal to the recorded ones "
-            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + clock)
-
-
-def summary_frame(tm: dict):
-    """One row per timed variant: method, path, evaluation path, calls timed on
-    it (:func:`timed`), median and 5-95 % quantiles of the wall and CPU times
-    (us) and median evaluations over those calls; the method's own-call check
-    (checked, mismatch) on its main row."""
-    import pandas as pd
-
-    methods = [str(m) for m in tm["methods"]]
-    ok = timed(tm)
-    rows = []
-    for j, (m, p, e) in enumerate(zip(tm["variant_method"], tm["variant_path"], tm["variant_eval_path"])):
-        w, c = np.asarray(tm["wall_ns"])[ok[:, j], j] / 1e3, np.asarray(tm["cpu_ns"])[ok[:, j], j] / 1e3
-        row = {"method": str(m), "path": str(p), "eval_path": str(e), "calls": int(len(w))}
-        for name, x in (("wall", w), ("cpu", c)):
-            q = np.quantile(x, [0.05, 0.5, 0.95]) if len(x) else [math.nan] * 3
-            row.update({f"{name}_median_us": float(q[1]), f"{name}_p05_us": float(q[0]),
-                        f"{name}_p95_us": float(q[2])})
-        row["median_evals"] = median_evals(tm, str(m), str(p))
-        if str(p) == "main":
-            i = methods.index(str(m))
-            row["checked"], row["mismatch"] = int(tm["checked"][i]), int(tm["mismatch"][i])
-        rows.append(row)
-    return pd.DataFrame(rows)
 
 
 def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0,
