@@ -97,7 +97,7 @@ def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalle
                              rate=0.999 if roll_stalled else 0.2),
     }}
     pub = published.paper_a()["headline"]
-    txt = approach_text.findings(cfg, summ, pub)
+    txt = approach_text.findings(cfg, summaries.HeadlineSummary.from_json(summ), pub)
     assert ("no variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
     assert ("add almost nothing to the prior" in txt["bound"]) is bool(lit_bound > 0.8 * summ["prior_bound_arcsec"])
     assert ("stalled (4/4)" in txt["headline_roll"]) is roll_stalled

@@ -49,6 +49,7 @@ def test_score_rows_keeps_prejudged_claims():
 def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
     import pandas as pd
 
+    from opnav.approach.summaries import HeadlineSummary
     from opnav.report.approach_scorecard import rows_paper_a
 
     t1 = pd.DataFrame([{
@@ -58,7 +59,7 @@ def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
         "tz_observable": False,
         "pub_est_x_mean": 11.43, "pub_est_y_mean": 21.21, "pub_nav_err_after_km": 18.43,
     }])
-    df = score_rows(rows_paper_a(t1, {}, {"headline": {"tz_estimable": False}}))
+    df = score_rows(rows_paper_a(t1, HeadlineSummary.from_json({}), {"headline": {"tz_estimable": False}}))
     v = dict(zip(df["item"], df["verdict"]))
     assert v["T1 literal T1-01: est_x"] == NOT_REPRODUCIBLE   # 1.43" published error < CRLB 20"
     assert v["T1 literal T1-01: est_y"] == REPRODUCED         # |19 - 21.21| = 2.21 <= 2 * 1.5
@@ -130,6 +131,7 @@ def test_a_stalled_em_row_says_so_in_the_reason_and_never_converged():
     import pandas as pd
 
     from opnav.approach.labels import reading_text
+    from opnav.approach.summaries import HeadlineSummary
     from opnav.report.approach_scorecard import rows_paper_a
 
     base = {"variant": "roll", "case_id": "T1-01", "truth_x_arcsec": 10.0, "truth_y_arcsec": 20.0,
@@ -139,7 +141,7 @@ def test_a_stalled_em_row_says_so_in_the_reason_and_never_converged():
     for label in ("stalled", "converged"):
         reading = reading_text(label, {label: 20}, 20, 8.2, 2.0, 16.6 if label == "stalled" else 0.0, 0.999)
         t1 = pd.DataFrame([{**base, "label": label, "stalled": label == "stalled", "reading": reading}])
-        df = score_rows(rows_paper_a(t1, {}, {}))
+        df = score_rows(rows_paper_a(t1, HeadlineSummary.from_json({}), {}))
         reasons = dict(zip(df["item"], df["reason"]))
         stalled = label == "stalled"
         assert ("stalled (20/20)" in reasons["T1 roll T1-01: est_x"]) is stalled

@@ -37,7 +37,7 @@ rule approach_x2_tables:
         x2=list(A_X2.values()),
         mc=[A_MC[(v, g, m)] for v in A_X2_VARIANTS for g in a_groups(v) for m in A_METHODS],
         code=src("approach/alternatives_summary.py", "approach/labels.py", "approach/summaries.py", "approach/setup.py",
-                 "core/tables.py"),
+                 "core/tables.py", "report/approach_views.py"),
     output:
         table=report_table(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
         long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",

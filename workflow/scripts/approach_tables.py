@@ -38,7 +38,7 @@ with script_context(snakemake) as log:
     if snakemake.input.stars:  # the stars variant (beyond the paper)
         summ["stars"] = summaries.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
     summ["profile"] = snakemake.params.profile
-    summ["text"] = approach_text.findings(setup, summ, pub["headline"])  # the manuscript's finding sentences
+    summ["text"] = approach_text.findings(setup, summaries.HeadlineSummary.from_json(summ), pub["headline"])  # the manuscript's finding sentences
     if "readings" in curves:  # the installation rows and the sample time (opnav.approach.readings)
         summ["installation"] = curves["readings"]["installation"]
         summ["sample_time"] = curves["readings"]["sample_time"]

@@ -6,6 +6,7 @@ from opnav.approach import alternatives_summary
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
+from opnav.report import approach_views
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_x2_tables", argv=sys.argv[1:])
@@ -24,12 +25,13 @@ with script_context(snakemake) as log:
         em_res.extend(r for r in load_pickle(p) if r["variant"] in variants)
     long = alternatives_summary.long_frame(alt_res, em_res, em_times)
     long.to_csv(snakemake.output.long, index=False)
-    table = alternatives_summary.summary_frame(long)
+    rows = alternatives_summary.method_summaries(long)
+    table = approach_views.x2_table(rows)
     write_table(table, snakemake.output.table,
                 caption="A-X2: EM-EKF against the augmented EKF and batch ML (IPOPT) on the Table-1 cases; "
                         "errors in arcsec (estimate minus truth), CRLB = Cramer-Rao bound, nav error in km, "
                         "data needed in samples, run time in s per Monte-Carlo seed.")
-    summ = alternatives_summary.summary_json(long, table, setup)
+    summ = alternatives_summary.summary_json(long, rows, setup)
     summ["profile"] = snakemake.params.profile
     write_json(snakemake.output.summary, summ)
     log.info("A-X2: %d long rows, %d table rows", len(long), len(table))

@@ -7,6 +7,7 @@ import sys
 from opnav.core import published
 from opnav.report import scorecard
 from opnav.report.claims import load_plan
+from opnav.approach.summaries import HeadlineSummary
 from opnav.report.approach_scorecard import rows_paper_a
 from opnav.landing.report import rows_paper_b
 from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
@@ -20,7 +21,7 @@ with script_context(snakemake) as log:
     rows = []
     if "a_table1" in inp.keys():
         summary_a = load_json(inp["summary_A"]) if "summary_A" in inp.keys() else {}
-        rows += rows_paper_a(load_table(inp["a_table1"]), summary_a, published.paper_a())
+        rows += rows_paper_a(load_table(inp["a_table1"]), HeadlineSummary.from_json(summary_a), published.paper_a())
     if "b_summary_table" in inp.keys():
         summary_b = load_json(inp["summary_B"]) if "summary_B" in inp.keys() else {}
         # B-C4's band (the analysis plan's numbers, as the claims table judges it)

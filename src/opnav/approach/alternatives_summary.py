@@ -8,6 +8,8 @@ Monte Carlo (:func:`opnav.approach.pipeline.run_group`). Units: arcsec, km, samp
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -16,7 +18,6 @@ from . import scenario as sc
 from .labels import row_label
 from .setup import Setup
 from .summaries import seed_sd
-
 
 METHOD_LABELS = {
     "em_plain": "EM-EKF (plain)",
@@ -95,51 +96,86 @@ def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) 
     return df.sort_values(["_v", "_m", "case_id"], kind="stable").drop(columns=["_v", "_m"]).reset_index(drop=True)
 
 
-def summary_frame(long: pd.DataFrame) -> pd.DataFrame:
-    """A-X2 table: per variant and method, the headline case (T1-01) and all-case aggregates."""
-    rows = []
+@dataclass(frozen=True)
+class MethodSummary:
+    """A-X2 for one variant and method (a key of :data:`METHOD_LABELS`), by meaning (issue 41
+    item 4): the headline case (T1-01; NaN, label '' without it) and the all-case aggregates.
+    The page's column names and method labels are the report's
+    (:func:`opnav.report.approach_views.x2_table`).
+
+    ``head_err_*``: estimate minus truth, seed mean and sd (arcsec); ``head_crlb_x*``: the
+    bound of the data the estimate used, with Q = 0, and of all the data (arcsec);
+    ``rmse_xy_all_arcsec``: RMS error over every case; ``median_sd_all_arcsec`` /
+    ``median_crlb_all_arcsec``: medians over the cases' tx and ty; navigation errors after
+    compensation (km), data to converge (samples), run time (s per Monte-Carlo seed).
+    """
+
+    variant: str
+    method: str
+    n_cases: int
+    n_seeds: int
+    head_err_x_mean_arcsec: float
+    head_err_x_sd_arcsec: float
+    head_err_y_mean_arcsec: float
+    head_err_y_sd_arcsec: float
+    head_crlb_x_arcsec: float
+    head_crlb_q0_x_arcsec: float
+    head_crlb_all_x_arcsec: float
+    head_label: str
+    rmse_xy_all_arcsec: float
+    median_sd_all_arcsec: float
+    median_crlb_all_arcsec: float
+    head_nav_err_after_km: float
+    nav_err_after_all_km: float
+    head_data_to_converge_samples: float
+    median_data_to_converge_samples: float
+    head_runtime_s_per_seed: float
+
+
+def method_summaries(long: pd.DataFrame) -> tuple[MethodSummary, ...]:
+    """A-X2 per variant and method (:class:`MethodSummary`), in the long frame's order."""
+    out = []
     for (v, m), g in long.groupby(["variant", "method"], sort=False):
         h = g[g["case_id"] == "T1-01"]
         h = h.iloc[0] if len(h) else None
-        rows.append({
-            "variant": v, "method": METHOD_LABELS[m],
-            "n_cases": len(g), "n_seeds": int(g["n_seeds"].max()),
-            "T1-01 err_x mean": h["err_x_mean_arcsec"] if h is not None else math.nan,
-            "T1-01 err_x sd": h["err_x_std_arcsec"] if h is not None else math.nan,
-            "T1-01 err_y mean": h["err_y_mean_arcsec"] if h is not None else math.nan,
-            "T1-01 err_y sd": h["err_y_std_arcsec"] if h is not None else math.nan,
-            "T1-01 CRLB_x": h["crlb_x_arcsec"] if h is not None else math.nan,  # of the data used
-            "T1-01 CRLB_x Q=0": h["crlb_q0_x_arcsec"] if h is not None else math.nan,
-            "T1-01 CRLB_x all data": h["crlb_all_x_arcsec"] if h is not None else math.nan,
-            "T1-01 label": (h["label"] if h is not None and isinstance(h.get("label"), str) else ""),
-            "RMSE_xy all cases": float(np.sqrt(np.mean(g["rmse_xy_arcsec"] ** 2))),
-            "median sd all cases": float(np.median(np.r_[g["err_x_std_arcsec"], g["err_y_std_arcsec"]])),
-            "median CRLB all cases": float(np.median(np.r_[g["crlb_x_arcsec"], g["crlb_y_arcsec"]])),
-            "nav err after km (T1-01)": h["nav_err_after_km"] if h is not None else math.nan,
-            "nav err after km (all)": float(g["nav_err_after_km"].mean()),
-            "data needed (T1-01)": h["data_to_converge_samples"] if h is not None else math.nan,
-            "data needed (median)": float(np.nanmedian(g["data_to_converge_samples"]))
+
+        def head(col: str) -> float:
+            return float(h[col]) if h is not None else math.nan
+
+        out.append(MethodSummary(
+            variant=v, method=m, n_cases=len(g), n_seeds=int(g["n_seeds"].max()),
+            head_err_x_mean_arcsec=head("err_x_mean_arcsec"), head_err_x_sd_arcsec=head("err_x_std_arcsec"),
+            head_err_y_mean_arcsec=head("err_y_mean_arcsec"), head_err_y_sd_arcsec=head("err_y_std_arcsec"),
+            head_crlb_x_arcsec=head("crlb_x_arcsec"), head_crlb_q0_x_arcsec=head("crlb_q0_x_arcsec"),
+            head_crlb_all_x_arcsec=head("crlb_all_x_arcsec"),
+            head_label=(h["label"] if h is not None and isinstance(h.get("label"), str) else ""),
+            rmse_xy_all_arcsec=float(np.sqrt(np.mean(g["rmse_xy_arcsec"] ** 2))),
+            median_sd_all_arcsec=float(np.median(np.r_[g["err_x_std_arcsec"], g["err_y_std_arcsec"]])),
+            median_crlb_all_arcsec=float(np.median(np.r_[g["crlb_x_arcsec"], g["crlb_y_arcsec"]])),
+            head_nav_err_after_km=head("nav_err_after_km"),
+            nav_err_after_all_km=float(g["nav_err_after_km"].mean()),
+            head_data_to_converge_samples=head("data_to_converge_samples"),
+            median_data_to_converge_samples=float(np.nanmedian(g["data_to_converge_samples"]))
             if g["data_to_converge_samples"].notna().any() else math.nan,
-            "run time s/seed (T1-01)": h["runtime_s_per_seed"] if h is not None else math.nan,
-        })
-    return pd.DataFrame(rows)
+            head_runtime_s_per_seed=head("runtime_s_per_seed")))
+    return tuple(out)
 
 
-def summary_json(long: pd.DataFrame, table: pd.DataFrame, setup: Setup | dict) -> dict:
-    """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json)."""
+def summary_json(long: pd.DataFrame, rows: Sequence[MethodSummary], setup: Setup | dict) -> dict:
+    """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json);
+    ``rows``: :func:`method_summaries` of ``long``."""
     setup = Setup.of(setup)
     out = {"segments": setup.segments.as_dict(), "alternatives": setup.alternatives.as_dict(), "variants": {}}
-    for _, r in table.iterrows():
-        key = [k for k, lab in METHOD_LABELS.items() if lab == r["method"]][0]
-        out["variants"].setdefault(r["variant"], {})[key] = {
-            "err_x_mean_arcsec": r["T1-01 err_x mean"], "err_x_sd_arcsec": r["T1-01 err_x sd"],
-            "err_y_mean_arcsec": r["T1-01 err_y mean"], "err_y_sd_arcsec": r["T1-01 err_y sd"],
-            "crlb_x_arcsec": r["T1-01 CRLB_x"], "crlb_q0_x_arcsec": r["T1-01 CRLB_x Q=0"],
-            "crlb_all_x_arcsec": r["T1-01 CRLB_x all data"], "label": r["T1-01 label"],
-            "rmse_xy_all_cases_arcsec": r["RMSE_xy all cases"],
-            "nav_err_after_km": r["nav err after km (T1-01)"],
-            "data_to_converge_samples": r["data needed (T1-01)"],
-            "runtime_s_per_seed": r["run time s/seed (T1-01)"],
+    for r in rows:
+        out["variants"].setdefault(r.variant, {})[r.method] = {
+            "err_x_mean_arcsec": r.head_err_x_mean_arcsec, "err_x_sd_arcsec": r.head_err_x_sd_arcsec,
+            "err_y_mean_arcsec": r.head_err_y_mean_arcsec, "err_y_sd_arcsec": r.head_err_y_sd_arcsec,
+            "crlb_x_arcsec": r.head_crlb_x_arcsec, "crlb_q0_x_arcsec": r.head_crlb_q0_x_arcsec,
+            "crlb_all_x_arcsec": r.head_crlb_all_x_arcsec, "label": r.head_label,
+            "rmse_xy_all_cases_arcsec": r.rmse_xy_all_arcsec,
+            "nav_err_after_km": r.head_nav_err_after_km,
+            "data_to_converge_samples": r.head_data_to_converge_samples,
+            "runtime_s_per_seed": r.head_runtime_s_per_seed,
         }
     if "nav_err_before_km" in long:
         nb = long[long["case_id"] == "T1-01"].dropna(subset=["nav_err_before_km"])

@@ -383,3 +383,98 @@ class ClaimsSummary:
                    roll_rate_to_target_deg_s=_float_or_none(rr.get("rate_to_target_deg_s")),
                    roll_rate_config_deg_s=_float_or_none(rr.get("config_rate_deg_s")),
                    nav_err_true_theta_km=_float_or_none(row.get("nav_err_true_theta_km")))
+
+
+def _opt(v: Mapping[str, Any], key: str) -> float | None:
+    """``v[key]`` as a float, None when absent or None (NaN kept: the text says n/a)."""
+    x = v.get(key)
+    return None if x is None else float(x)
+
+
+@dataclass(frozen=True)
+class HeadlineRow:
+    """One headline-case (T1-01) row of A-summary.json ``variants``: one scenario and EM
+    scheme, read by meaning (issue 41 item 4); the sentences and their words are made in
+    the report layer (:mod:`opnav.report.approach_text`, :mod:`opnav.report.approach_scorecard`).
+
+    ``key`` is the row's identifier in A-T1 (``variant`` column) and A-summary.json
+    (:func:`opnav.approach.labels.variant_label` of scenario, method, mode); ``method`` is the
+    EM scheme (``plain`` | ``squarem``), ``mode`` the windows (``sliding`` | ``growing``).
+    Estimates and bounds in arcsec (``est_*_std`` NaN below two seeds; a ``None`` is a value
+    the summary does not hold); ``label`` the convergence label (None: an older summary
+    without it, see ``stalled``); ``reading`` the label's reading; navigation errors in km;
+    ``iterations_*``: EM maps of the convergence study (None without it).
+    """
+
+    key: str
+    scenario: str
+    method: str
+    mode: str
+    est_x_mean: float
+    est_x_std: float | None
+    est_y_mean: float
+    est_y_std: float | None
+    crlb_x_arcsec: float
+    crlb_y_arcsec: float
+    crlb_q0_x_arcsec: float | None = None
+    crlb_all_x_arcsec: float | None = None
+    label: str | None = None
+    stalled: bool = False
+    reading: str = ""
+    data_to_converge_samples: float | None = None
+    nav_err_before_km: float | None = None
+    nav_err_after_km: float | None = None
+    nav_note: str = ""
+    iterations_plain_median: float | None = None
+    iterations_plain_extrapolated_median: float | None = None
+    iterations_squarem_median: float | None = None
+
+    @property
+    def as_written_scheme(self) -> bool:
+        """Plain EM on sliding windows: the paper's scheme (the scenario may still add something)."""
+        return self.method == "plain" and self.mode == "sliding"
+
+    @classmethod
+    def from_json(cls, key: str, v: Mapping[str, Any]) -> "HeadlineRow":
+        return cls(key=key, scenario=v["scenario"], method=v.get("method", "plain"), mode=v.get("mode", "sliding"),
+                   est_x_mean=float(v["est_x_mean"]), est_x_std=_opt(v, "est_x_std"),
+                   est_y_mean=float(v["est_y_mean"]), est_y_std=_opt(v, "est_y_std"),
+                   crlb_x_arcsec=float(v.get("crlb_x_arcsec", math.nan)),
+                   crlb_y_arcsec=float(v.get("crlb_y_arcsec", math.nan)),
+                   crlb_q0_x_arcsec=_opt(v, "crlb_q0_x_arcsec"), crlb_all_x_arcsec=_opt(v, "crlb_all_x_arcsec"),
+                   label=v.get("label"), stalled=bool(v.get("stalled", False)), reading=v.get("reading") or "",
+                   data_to_converge_samples=_opt(v, "data_to_converge_samples"),
+                   nav_err_before_km=_opt(v, "nav_err_before_km"), nav_err_after_km=_opt(v, "nav_err_after_km"),
+                   nav_note=v.get("nav_note") or "",
+                   iterations_plain_median=_opt(v, "iterations_plain_median"),
+                   iterations_plain_extrapolated_median=_opt(v, "iterations_plain_extrapolated_median"),
+                   iterations_squarem_median=_opt(v, "iterations_squarem_median"))
+
+
+@dataclass(frozen=True)
+class HeadlineSummary:
+    """What the report layer reads of A-summary.json (:func:`summary`) for the manuscript's
+    finding sentences and the scorecard's headline rows, by meaning (issue 41 item 4).
+
+    ``rows``                  the headline rows in the summary's order (:class:`HeadlineRow`);
+    ``prior_bound_arcsec``    what the prior alone bounds theta to (:func:`prior_bound_arcsec`);
+    ``convergence_max_maps``  the EM maps the convergence study runs (None: not stated);
+    ``roll_rate``             :func:`roll_rate_summary` (None: no roll-rate study);
+    ``stars``                 :func:`stars_summary` (None: no stars study).
+    """
+
+    rows: tuple[HeadlineRow, ...]
+    prior_bound_arcsec: float = math.nan
+    convergence_max_maps: int | None = None
+    roll_rate: Mapping[str, Any] | None = None
+    stars: Mapping[str, Any] | None = None
+
+    @classmethod
+    def from_json(cls, summ: Mapping[str, Any]) -> "HeadlineSummary":
+        """From the dict :func:`summary` returns (or A-summary.json as read back); a row
+        without estimates (``est_x_mean``) is not a headline row and is left out."""
+        rows = tuple(HeadlineRow.from_json(k, v) for k, v in (summ.get("variants") or {}).items()
+                     if isinstance(v, Mapping) and "est_x_mean" in v)
+        return cls(rows=rows, prior_bound_arcsec=float(summ.get("prior_bound_arcsec", math.nan)),
+                   convergence_max_maps=summ.get("convergence_max_maps"),
+                   roll_rate=summ.get("roll_rate"), stars=summ.get("stars"))

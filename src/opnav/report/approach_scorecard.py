@@ -11,7 +11,7 @@ import math
 
 import pandas as pd
 
-from opnav.approach.summaries import nav_note
+from opnav.approach.summaries import HeadlineSummary, nav_note
 from opnav.core.verdicts import NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED
 
 
@@ -29,14 +29,18 @@ def _unit_of(col: str) -> str:
     return ""
 
 
-def rows_paper_a(table1: pd.DataFrame, summary: dict, pub: dict) -> list[dict]:
+def rows_paper_a(table1: pd.DataFrame, summary: HeadlineSummary, pub: dict) -> list[dict]:
     """Scorecard rows for paper A, cell by cell from A-T1's ``pub_*`` columns.
 
     For a published column ``pub_<name>``, our value is ``<name>_mean`` (or
     ``<name>``) and our spread ``<name>_std`` where present. Bias estimates
     (``est_x``/``est_y``) carry the truth and the CRLB of the row's variant so
-    the verdict can say when the published accuracy is below the bound.
+    the verdict can say when the published accuracy is below the bound. ``summary``: the
+    headline rows of A-summary.json (:meth:`HeadlineSummary.from_json`).
     """
+    if not isinstance(summary, HeadlineSummary):
+        raise TypeError(f"approach_scorecard.rows_paper_a: summary must be a HeadlineSummary "
+                        f"(HeadlineSummary.from_json(<A-summary.json>)), got {type(summary).__name__}")
     rows: list[dict] = []
     pub_cols = [c for c in table1.columns if c.startswith("pub_")]
     for _, r in table1.iterrows():
@@ -82,22 +86,23 @@ def _reading_note(r) -> str:
     """Reason suffix of a scorecard row: the run's reading (A-T1 ``reading``: its convergence
     label from the ML estimate of the data it used and, when converged, whether that data's
     bound lets the estimate mean anything); '' for a row without one."""
-    reading = r.get("reading")
+    return _reading_text(r.get("reading"))
+
+
+def _reading_text(reading) -> str:
     return f"; EM {reading}" if isinstance(reading, str) and reading else ""
 
 
-def _rows_paper_a_headline(summary: dict, head: dict) -> list[dict]:
-    """Paper A's headline claims (sec. 3, abstract) against each variant's summary."""
+def _rows_paper_a_headline(summary: HeadlineSummary, head: dict) -> list[dict]:
+    """Paper A's headline claims (sec. 3, abstract) against each headline row of the summary."""
     rows: list[dict] = []
-    variants = (summary or {}).get("variants", {})
     truth = head.get("truth_arcsec", [float("nan")] * 3)
     target = float(head.get("accuracy_claim_arcsec", 2.0))
-    for name, v in variants.items():
-        if not isinstance(v, dict) or "est_x_mean" not in v:
-            continue
-        err = math.hypot(v["est_x_mean"] - truth[0], v["est_y_mean"] - truth[1]) / math.sqrt(2)
-        crlb = max(v.get("crlb_x_arcsec", float("nan")), v.get("crlb_y_arcsec", float("nan")))
-        ok = abs(v["est_x_mean"] - truth[0]) <= target and abs(v["est_y_mean"] - truth[1]) <= target
+    for v in summary.rows:
+        name = v.key
+        err = math.hypot(v.est_x_mean - truth[0], v.est_y_mean - truth[1]) / math.sqrt(2)
+        crlb = max(v.crlb_x_arcsec, v.crlb_y_arcsec)
+        ok = abs(v.est_x_mean - truth[0]) <= target and abs(v.est_y_mean - truth[1]) <= target
         if ok:
             verdict, reason = REPRODUCED, f"both axes within {target:g} arcsec of the truth"
         elif crlb > target:
@@ -106,17 +111,18 @@ def _rows_paper_a_headline(summary: dict, head: dict) -> list[dict]:
             verdict, reason = NOT_REPRODUCED, f"RMS axis error {err:.3g} arcsec although the CRLB is {crlb:.3g}"
         rows.append({"paper": "A", "item": f"claim [{name}]: bias accuracy better than {target:g} arcsec",
                      "published": target, "ours": err, "unit": "arcsec", "verdict": verdict, "reason": reason,
-                     "reason_note": _reading_note(v)})
-        if "nav_err_before_km_text" in head and "nav_err_before_km" in v:
+                     "reason_note": _reading_text(v.reading)})
+        if "nav_err_before_km_text" in head and v.nav_err_before_km is not None:
+            # the summary holds no spread of the headline row's navigation error
             rows.append({"paper": "A", "item": f"claim [{name}]: nav. error before compensation (sec. 3 text)",
-                         "published": float(head["nav_err_before_km_text"]), "ours": float(v["nav_err_before_km"]),
-                         "spread": float(v.get("nav_err_before_km_std", float("nan"))), "unit": "km"})
-        if "abstract_claim_km" in head and "nav_err_after_km" in v:
+                         "published": float(head["nav_err_before_km_text"]), "ours": v.nav_err_before_km,
+                         "spread": float("nan"), "unit": "km"})
+        if "abstract_claim_km" in head and v.nav_err_after_km is not None:
             lim = float(head["abstract_claim_km"][1])
-            after = float(v["nav_err_after_km"])
+            after = v.nav_err_after_km
             rows.append({"paper": "A", "item": f"claim [{name}]: nav. error after compensation within {lim:g} km (abstract)",
                          "published": lim, "ours": after, "unit": "km",
                          "verdict": REPRODUCED if after <= lim else NOT_REPRODUCED,
                          "reason": f"ours {after:.3g} km {'<=' if after <= lim else '>'} {lim:g} km",
-                         "reason_note": (f"; {v['nav_note']}" if v.get("nav_note") else "")})
+                         "reason_note": (f"; {v.nav_note}" if v.nav_note else "")})
     return rows

@@ -12,7 +12,7 @@ import math
 import pandas as pd
 
 from opnav.approach.setup import Setup
-from opnav.approach.summaries import prior_bound_arcsec
+from opnav.approach.summaries import HeadlineRow, HeadlineSummary, prior_bound_arcsec
 
 
 def _fmt(x, nd=2):
@@ -171,9 +171,17 @@ def _join(items: list[str], none: str = "none") -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
+def scheme_text(row: HeadlineRow) -> str:
+    """The EM scheme of a headline row in words: 'plain EM, sliding windows' (the paper's),
+    else what it adds ('growing', 'squarem', 'growing squarem')."""
+    parts = (["growing"] if row.mode == "growing" else []) + ([row.method] if row.method != "plain" else [])
+    return " ".join(parts) or "plain EM, sliding windows"
+
+
+def findings(setup: Setup | dict, summ: HeadlineSummary, pub_headline: dict) -> dict:
     """Every sentence of the manuscript's paper-A results that states a finding, generated
-    from the summary's flags and numbers (plain text; the macros escape it). Keys:
+    from the summary's flags and numbers (plain text; the macros escape it). ``summ``:
+    :meth:`opnav.approach.summaries.HeadlineSummary.from_json` of the summary. Keys:
 
     ``bound``    which variants' all-data bound supports the claimed accuracy, and how the
                  literal bound compares with what the prior alone gives (sigma_r / rho);
@@ -182,98 +190,100 @@ def findings(setup: Setup | dict, summ: dict, pub_headline: dict) -> dict:
     ``reading``  where the published error is below the bound of the data the estimator
                  used (not reproducible there), which schemes reach their bound, and which
                  of our rows lies closest to the published estimates.
-    ``headline_<label>`` one sentence per Table-1 headline row.
+    ``headline_<key>`` one sentence per Table-1 headline row (its A-T1 ``variant``).
     """
+    if not isinstance(summ, HeadlineSummary):
+        raise TypeError(f"approach_text.findings: summ must be a HeadlineSummary "
+                        f"(HeadlineSummary.from_json(<summary>)), got {type(summ).__name__}")
     setup = Setup.of(setup)
     target = setup.accuracy_target_arcsec
-    var = summ["variants"]
-    base = {k: v for k, v in var.items() if k == v["scenario"]}  # plain EM, sliding: the paper's scheme
+    rows = summ.rows
+    base = {r.scenario: r for r in rows if r.as_written_scheme}  # plain EM, sliding: the paper's scheme
     out = {}
 
     def nice(x, nd=3):
         return "n/a" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{nd}g}"
 
-    below = [k for k, v in base.items() if (v.get("crlb_all_x_arcsec") or math.inf) <= target]
+    def label_or(r: HeadlineRow, default: str) -> str:
+        return r.label if r.label is not None else default
+
+    below = [k for k, r in base.items() if (r.crlb_all_x_arcsec or math.inf) <= target]
     diag = {"reference-start": "the reference-start diagnostic"}
     names = [diag.get(k, f"the {k} variant") for k in below]
-    pb = summ["prior_bound_arcsec"]
-    lit = base.get("literal", {}).get("crlb_all_x_arcsec")
+    pb = summ.prior_bound_arcsec
+    lit = base["literal"].crlb_all_x_arcsec if "literal" in base else None
     s = ("With the paper's prior, the bound of tx after all the data is "
-         + _join([f"{nice(v.get('crlb_all_x_arcsec'))} arcsec ({k})" for k, v in base.items()])
+         + _join([f"{nice(r.crlb_all_x_arcsec)} arcsec ({k})" for k, r in base.items()])
          + f", against the claimed {target:g} arcsec; "
          + (f"only {_join(names)} {'gets' if len(names) == 1 else 'get'} below it." if below and len(below) < len(base)
             else "every variant gets below it." if below else "no variant gets below it."))
     if lit is not None:
-        r = lit / pb
+        ratio = lit / pb
         s += (f" The prior alone bounds theta to sigma_r / rho = {nice(pb)} arcsec "
               f"({setup.prior_sigma.r_km:g} km seen from {setup.geometry.range_km:.3g} km); the literal "
-              f"bound is {r:.2f} times that, so in the literal geometry the measurements "
-              + ("add almost nothing to the prior." if r > 0.8 else "add information beyond the prior."))
+              f"bound is {ratio:.2f} times that, so in the literal geometry the measurements "
+              + ("add almost nothing to the prior." if ratio > 0.8 else "add information beyond the prior."))
     out["bound"] = s
 
-    by_scheme = {}
-    for k, v in var.items():
-        lab = k[len(v["scenario"]):].lstrip("+") or "plain EM, sliding windows"
-        by_scheme.setdefault(lab, []).append((v["scenario"], v.get("label", "stalled" if v.get("stalled") else "")))
+    by_scheme: dict[str, list[tuple[str, str]]] = {}
+    for r in rows:
+        by_scheme.setdefault(scheme_text(r), []).append((r.scenario, label_or(r, "stalled" if r.stalled else "")))
     parts = []
     for lab, lst in by_scheme.items():
-        groups = {}
+        groups: dict[str, list[str]] = {}
         for scen, l_ in lst:
             groups.setdefault(l_ or "unlabelled", []).append(scen)
-        parts.append(f"{lab.replace('+', ' ')}: " + "; ".join(f"{l_} in {_join(sc_)}" for l_, sc_ in groups.items()))
+        parts.append(f"{lab}: " + "; ".join(f"{l_} in {_join(sc_)}" for l_, sc_ in groups.items()))
     out["stall"] = ("An EM run is labelled converged when it ends within "
                     f"{setup.em.converge_frac_of_bound:g} times the 1-sigma bound of the data it used (in tx and ty) "
                     "of the maximum-likelihood estimate of that data, stalled when it does not and its contraction per map toward that estimate is about 1 "
                     f"(at least {setup.em.stall_rate:g}), whatever its start; whether a converged estimate means "
                     "anything is read from the bound of that data. Headline rows: " + " | ".join(parts) + ".")
 
-    for k, v in var.items():
-        reading = v.get("reading") or ""
-        conv = (f"; data to converge {nice(v.get('data_to_converge_samples'), 4)} samples"
-                if v.get("label") == "converged" else "")
-        q0 = v.get("crlb_q0_x_arcsec")
-        out[f"headline_{k}"] = (f"{k}: tx = {nice(v['est_x_mean'], 4)} +- {nice(v['est_x_std'], 2)}, "
-                                f"ty = {nice(v['est_y_mean'], 4)} +- {nice(v['est_y_std'], 2)} arcsec, "
-                                f"bound of the data it used {nice(v['crlb_x_arcsec'])} arcsec "
-                                f"({nice(q0)} with Q = 0); {reading}{conv}")
+    for r in rows:
+        conv = (f"; data to converge {nice(r.data_to_converge_samples, 4)} samples"
+                if r.label == "converged" else "")
+        out[f"headline_{r.key}"] = (f"{r.key}: tx = {nice(r.est_x_mean, 4)} +- {nice(r.est_x_std, 2)}, "
+                                    f"ty = {nice(r.est_y_mean, 4)} +- {nice(r.est_y_std, 2)} arcsec, "
+                                    f"bound of the data it used {nice(r.crlb_x_arcsec)} arcsec "
+                                    f"({nice(r.crlb_q0_x_arcsec)} with Q = 0); {r.reading}{conv}")
 
     truth = pub_headline.get("truth_arcsec", [math.nan] * 3)
     pe = max(abs(pub_headline.get("est_x_arcsec", math.nan) - truth[0]),
              abs(pub_headline.get("est_y_arcsec", math.nan) - truth[1]))
-    nr = [k for k, v in var.items() if max(v["crlb_x_arcsec"], v["crlb_y_arcsec"]) > pe]
-    reach = [k for k, v in var.items() if v.get("label", "converged") == "converged" and not v.get("stalled")
-             and max(v["crlb_x_arcsec"], v["crlb_y_arcsec"]) <= target
-             and abs(v["est_x_mean"] - truth[0]) <= 3 * v["crlb_x_arcsec"] + 0.1
-             and abs(v["est_y_mean"] - truth[1]) <= 3 * v["crlb_y_arcsec"] + 0.1]
-    dist = {k: math.hypot(v["est_x_mean"] - pub_headline.get("est_x_arcsec", math.nan),
-                          v["est_y_mean"] - pub_headline.get("est_y_arcsec", math.nan)) for k, v in var.items()}
+    nr = [r.key for r in rows if max(r.crlb_x_arcsec, r.crlb_y_arcsec) > pe]
+    reach = [r.key for r in rows if label_or(r, "converged") == "converged" and not r.stalled
+             and max(r.crlb_x_arcsec, r.crlb_y_arcsec) <= target
+             and abs(r.est_x_mean - truth[0]) <= 3 * r.crlb_x_arcsec + 0.1
+             and abs(r.est_y_mean - truth[1]) <= 3 * r.crlb_y_arcsec + 0.1]
+    dist = {r.key: math.hypot(r.est_x_mean - pub_headline.get("est_x_arcsec", math.nan),
+                              r.est_y_mean - pub_headline.get("est_y_arcsec", math.nan)) for r in rows}
     closest = min(dist, key=lambda k: (dist[k], k)) if dist else None
     s = (f"The published error ({nice(pe)} arcsec) is below the bound of the data the estimator used in "
-         f"{len(nr)} of {len(var)} headline rows ({_join(nr)}): there no unbiased estimator with the stated "
+         f"{len(nr)} of {len(rows)} headline rows ({_join(nr)}): there no unbiased estimator with the stated "
          "measurements and prior can know the misalignment that well, and we mark them not reproducible "
          "under stated assumptions. ")
     s += (f"Estimates converged, identifiable (bound at most {target:g} arcsec) and within 3 bound-sigma of "
           f"the truth: {_join(reach)}. " if reach
           else "No row is converged, identifiable and within 3 bound-sigma of the truth. ")
     if closest is not None:
-        c = var[closest]
+        c = next(r for r in rows if r.key == closest)
         s += (f"The row closest to the published estimates is {closest} ({nice(dist[closest])} arcsec away"
-              + ("; a diagnostic that needs the true state" if c["scenario"] == "reference-start" else "")
-              + (f"; it is {c['label']}" if c.get("label", "converged") != "converged" else "") + ").")
+              + ("; a diagnostic that needs the true state" if c.scenario == "reference-start" else "")
+              + (f"; it is {c.label}" if label_or(c, "converged") != "converged" else "") + ").")
     out["reading"] = s
-    out["roll_rate"] = roll_rate_text(summ["roll_rate"]) if "roll_rate" in summ else ""
-    out["stars"] = stars_text(summ["stars"], target) if "stars" in summ else ""
+    out["roll_rate"] = roll_rate_text(summ.roll_rate) if summ.roll_rate is not None else ""
+    out["stars"] = stars_text(summ.stars, target) if summ.stars is not None else ""
 
-    parts = [f"{diag.get(k, k)}: {v['nav_note']}" for k, v in base.items() if v.get("nav_note")]
+    parts = [f"{diag.get(k, k)}: {r.nav_note}" for k, r in base.items() if r.nav_note]
     out["nav"] = ("Navigation error (RMS over the last part of the arc) after compensation, split across and "
                   "along the line of sight, beside the filter given the true theta (a diagnostic floor): "
                   + "; ".join(parts) + "." if parts else "")
 
     parts = []
-    mx = summ.get("convergence_max_maps")
-    for k, v in base.items():
-        mp, ex, sq = (v.get("iterations_plain_median"), v.get("iterations_plain_extrapolated_median"),
-                      v.get("iterations_squarem_median"))
+    mx = summ.convergence_max_maps
+    for k, r in base.items():
+        mp, ex, sq = r.iterations_plain_median, r.iterations_plain_extrapolated_median, r.iterations_squarem_median
         if mp is None:
             continue
         plain = (f"more than the {mx} maps run (about {nice(ex)} extrapolated from its measured contraction rate)"

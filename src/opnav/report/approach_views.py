@@ -5,10 +5,12 @@ page, with display labels; the CSVs keep every column. :data:`COMPACT_VIEWS` is 
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import pandas as pd
 
+from opnav.approach.alternatives_summary import METHOD_LABELS, MethodSummary
 from opnav.core.tables import cell_num, cell_pm
-
 
 COMPACT_COLUMNS = {
     "variant": "variant", "case_id": "case", "truth_x_arcsec": "truth x", "truth_y_arcsec": "truth y",
@@ -25,6 +27,29 @@ COMPACT_COLUMNS = {
 def table1_compact(t1: pd.DataFrame) -> pd.DataFrame:
     """The Table-1 columns that fit a page (LaTeX/Markdown); the CSV keeps them all."""
     return t1[list(COMPACT_COLUMNS)].rename(columns=COMPACT_COLUMNS)
+
+
+def x2_table(rows: Iterable[MethodSummary]) -> pd.DataFrame:
+    """A-X2 table: per variant and method (:func:`opnav.approach.alternatives_summary.method_summaries`),
+    the headline case (T1-01) and all-case aggregates, with the page's column names."""
+    return pd.DataFrame([{
+        "variant": r.variant, "method": METHOD_LABELS[r.method],
+        "n_cases": r.n_cases, "n_seeds": r.n_seeds,
+        "T1-01 err_x mean": r.head_err_x_mean_arcsec, "T1-01 err_x sd": r.head_err_x_sd_arcsec,
+        "T1-01 err_y mean": r.head_err_y_mean_arcsec, "T1-01 err_y sd": r.head_err_y_sd_arcsec,
+        "T1-01 CRLB_x": r.head_crlb_x_arcsec,  # of the data used
+        "T1-01 CRLB_x Q=0": r.head_crlb_q0_x_arcsec,
+        "T1-01 CRLB_x all data": r.head_crlb_all_x_arcsec,
+        "T1-01 label": r.head_label,
+        "RMSE_xy all cases": r.rmse_xy_all_arcsec,
+        "median sd all cases": r.median_sd_all_arcsec,
+        "median CRLB all cases": r.median_crlb_all_arcsec,
+        "nav err after km (T1-01)": r.head_nav_err_after_km,
+        "nav err after km (all)": r.nav_err_after_all_km,
+        "data needed (T1-01)": r.head_data_to_converge_samples,
+        "data needed (median)": r.median_data_to_converge_samples,
+        "run time s/seed (T1-01)": r.head_runtime_s_per_seed,
+    } for r in rows])
 
 
 def _label_or(r, text: str) -> str:
