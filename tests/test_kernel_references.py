@@ -346,7 +346,7 @@ def test_landing_cholesky_kernels_equal_numpy(seed, n, extra, scale):
     """``ekf._cholesky`` (on the leading n x n block of a larger buffer, as the update
     uses it) is numpy's lower factor and ``_cho_solve`` numpy's solve. Mutation tried:
     ``L[i, k]`` for ``L[k, i]`` in the back substitution -> fails."""
-    from opnav.landing.ekf import _cho_solve, _cholesky
+    from opnav.landing.linalg import cho_solve as _cho_solve, cholesky_in_place as _cholesky
 
     rng = np.random.default_rng(seed)
     S = _spd(rng, n, scale)

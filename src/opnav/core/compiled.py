@@ -44,7 +44,7 @@ from opnav.core import startup
 KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
                                     "opnav.approach.em", "opnav.approach.augmented",
                                     "opnav.core.rotations", "opnav.landing.measurement", "opnav.landing.linalg",
-                                    "opnav.landing.ekf",
+                                    "opnav.landing.ekf", "opnav.landing.ekf_update",
                                     "opnav.landing.kernels",
                                     "opnav.landing.descent", "opnav.landing.imu")
 

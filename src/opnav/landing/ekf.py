@@ -35,22 +35,21 @@ flies the runs of a chunk as one batch (``opnav.landing.descent``); a single
 run is the batch of shape ().
 
 Compiled: each step is written once as plain loops over one run's 3-vectors
-and 12 x 12 matrices (``opnav.core.compiled.kernel``: ``_transition`` eq. 6-10,
-``_oc``, ``_propagate``, ``_linearise``/``_update`` eq. 11-18, ``_init``,
-``_inject``, ``_nullspace``), and a ``*_batch`` kernel loops over the runs; the
-Python functions below flatten the leading dimensions and call them. The
-bearing and its Jacobian blocks are the kernels of ``opnav.landing.measurement``,
-Exp is ``opnav.core.rotations.exp_so3_into``. The pre-kernel numpy EKF
+and 12 x 12 matrices (``opnav.core.compiled.kernel``: here ``_transition`` eq. 6-10,
+``_oc``, ``_propagate``, ``_init``, ``_nullspace``; the update's ``_linearise``,
+``_update`` eq. 11-18 and ``_inject`` in ``opnav.landing.ekf_update``), and a
+``*_batch`` kernel loops over the runs; the Python functions below flatten the
+leading dimensions and call them. The bearing and its Jacobian blocks are the
+kernels of ``opnav.landing.measurement``, Exp is
+``opnav.core.rotations.exp_so3_into``. The pre-kernel numpy EKF
 (tests/descent_reference.py) is the reference the tests compare against.
-Measured per run and filter step (3 update iterations, site + landmark; one
-loaded 2-core machine): update 1090 -> 145 us in a batch of 4 runs, 55 -> 16 us
-in a batch of 300; propagation 160 -> 90 and 5.6 -> 3.7 us.
+Compiling per run and looping over the batch inside the kernel is what makes a
+Monte-Carlo chunk cheap (measured: docs/performance.md).
 
-Update: the stacked unit bearings of the known landmark and the unknown one
-(eq. 11-18: ``measurement.line_of_sight`` and ``measurement.blocks``, their
-one home), isotropic noise ``sigma_b`` rad per component, gain by a Cholesky
-solve, Joseph form. The attitude correction ``Exp`` is
-``opnav.core.rotations.exp_so3_into``.
+Update (``opnav.landing.ekf_update``): the stacked unit bearings of the known
+landmark and the unknown one (eq. 11-18: ``measurement.line_of_sight`` and
+``measurement.blocks``, their one home), isotropic noise ``sigma_b`` rad per
+component, gain by a Cholesky solve (``opnav.landing.linalg``), Joseph form.
 
 Landmark initialisation (Fig. 3 strategy): from its first bearing ``b`` and a
 depth guess ``d`` (the estimated line of sight cut with the ground plane),
@@ -67,16 +66,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from opnav.core.compiled import kernel, warms
-from opnav.landing.linalg import cho_solve, cholesky_in_place
-# the names tests/test_kernel_references.py imports from here (its owner moves it to linalg)
-from opnav.landing.linalg import cho_solve as _cho_solve, cholesky_in_place as _cholesky  # noqa: F401
-from opnav.landing.measurement import blocks, line_of_sight
-from opnav.core.rotations import exp_so3_into
+from opnav.landing.ekf_update import N_X, _inject_batch, _linearise_batch, _update_batch
+from opnav.landing.linalg import matmul, symmetrize
 
 __all__ = ["NavState", "transition_matrix", "oc_transition", "process_noise", "propagate",
            "update", "linearise", "init_landmark", "inject", "nullspace", "init_jacobian", "Bearing"]
-
-N_X = 12
 
 
 @dataclass
@@ -164,9 +158,18 @@ def _oc(Phi, N_i, N_j, C_i_prior, C_j, Dt) -> None:
 
 
 @kernel
-def _propagate(r, v, C_i, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
-               r_j, v_j, C_j, P_j, Phi, N_j, T) -> None:
-    """One run's :func:`propagate` (``Phi``, ``N_j`` (12,), ``T`` (12, 12) scratch)."""
+def _propagate(x, inc, model, ocp, out, work) -> None:
+    """One run's :func:`propagate`: ``x = (r, v, C_i, p, P)`` the state at i, ``inc = (dR, dv,
+    dp)`` the IMU increments (``imu.apply_increment``), ``model = (Dt, g, Q)`` (s, m/s^2, the
+    interval's process noise), ``ocp = (oc, N_i, C_i_prior)`` the observability constraint
+    (:func:`oc_transition`, if ``oc``), ``out = (r_j, v_j, C_j, P_j)``, ``work = (Phi, N_j,
+    T)`` scratch (12, 12), (12,), (12, 12)."""
+    r, v, C_i, p, P = x
+    dR, dv, dp = inc
+    Dt, g, Q = model
+    oc, N_i, C_i_prior = ocp
+    r_j, v_j, C_j, P_j = out
+    Phi, N_j, T = work
     h = 0.5 * Dt * Dt
     for a in range(3):        # R_BtoL = C_i^T
         r_j[a] = (r[a] + v[a] * Dt + (C_i[0, a] * dp[0] + C_i[1, a] * dp[1] + C_i[2, a] * dp[2])
@@ -179,174 +182,14 @@ def _propagate(r, v, C_i, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
     if oc:
         _nullspace(r_j, v_j, C_j, p, N_j)
         _oc(Phi, N_i, N_j, C_i_prior, C_j, Dt)
-    _matmul(Phi, P, T)
+    matmul(Phi, P, T)
     for a in range(N_X):      # P_j = T Phi^T + Q
         for b in range(N_X):
             s = 0.0
             for c in range(N_X):
                 s += T[a, c] * Phi[b, c]
             P_j[a, b] = s + Q[a, b]
-    _symmetrize(P_j)
-
-
-@kernel
-def _matmul(A, B, C) -> None:
-    """``C = A B`` (plain loops, sums in index order)."""
-    for a in range(A.shape[0]):
-        for b in range(B.shape[1]):
-            s = 0.0
-            for c in range(A.shape[1]):
-                s += A[a, c] * B[c, b]
-            C[a, b] = s
-
-
-@kernel
-def _symmetrize(P) -> None:
-    n = P.shape[0]
-    for a in range(n):
-        for b in range(a + 1, n):
-            m = 0.5 * (P[a, b] + P[b, a])
-            P[a, b] = m
-            P[b, a] = m
-
-
-@kernel
-def _inject(r, v, R, p, dx, r_o, v_o, R_o, p_o, E) -> None:
-    """``(r_o, v_o, R_o, p_o)`` <- the state corrected by ``dx`` (12,) (:func:`inject`;
-    ``E`` (3, 3) scratch)."""
-    for a in range(3):
-        r_o[a] = r[a] + dx[a]
-        v_o[a] = v[a] + dx[3 + a]
-        p_o[a] = p[a] + dx[9 + a]
-    exp_so3_into(-dx[6:9], E)
-    for a in range(3):
-        for b in range(3):
-            R_o[a, b] = E[a, 0] * R[0, b] + E[a, 1] * R[1, b] + E[a, 2] * R[2, b]
-
-
-@kernel
-def _linearise(r, R, p, bs, pk, known, N, use_N, H, res, u, bb, HC) -> bool:
-    """Stacked Jacobian ``H`` (3m, 12) and residual ``res`` (3m,) of the ``m``
-    bearings ``bs`` (m, 3) at ``(r, R, p)`` (eq. 12, 15-18 by the measurement
-    kernels): landmark ``pk[i]`` if ``known[i]``, else the state's ``p``. ``H``
-    projected on the complement of ``N`` (12,) if ``use_N``. False at zero range
-    or a non-finite position (``H``, ``res`` then meaningless)."""
-    m = bs.shape[0]
-    for i in range(m):
-        inv = line_of_sight(r, pk[i] if known[i] else p, u)
-        if not inv > 0.0:
-            return False
-        blocks(R, u, inv, bb, HC)
-        for a in range(3):
-            k = 3 * i + a
-            res[k] = bs[i, a] - bb[a]                                       # eq. 12
-            for c in range(N_X):
-                H[k, c] = 0.0
-            for c in range(3):
-                H[k, c] = -HC[a, c]                                         # eq. 15
-                if not known[i]:
-                    H[k, 9 + c] = HC[a, c]                                  # eq. 17
-        # eq. 16: [b x]
-        H[3 * i, 7], H[3 * i, 8] = -bb[2], bb[1]
-        H[3 * i + 1, 6], H[3 * i + 1, 8] = bb[2], -bb[0]
-        H[3 * i + 2, 6], H[3 * i + 2, 7] = -bb[1], bb[0]
-    if use_N:
-        nn = 0.0
-        for c in range(N_X):
-            nn += N[c] * N[c]
-        for k in range(3 * m):
-            hn = 0.0
-            for c in range(N_X):
-                hn += H[k, c] * N[c]
-            f = hn / nn
-            for c in range(N_X):
-                H[k, c] -= f * N[c]
-    return True
-
-
-@kernel
-def _update(r, v, R, p, P, bs, pk, known, sigma_b, N, use_N, iterations,
-            r_o, v_o, R_o, p_o, P_o, H, K, res, S, col, delta, PHt, A, T, u, bb, HC, E) -> float:
-    """One run's iterated bearing update (:func:`update`), scratch arrays passed
-    in; returns the NIS at the prior (NaN if a bearing is undefined: the state
-    is then returned unchanged)."""
-    m3 = 3 * bs.shape[0]
-    for a in range(3):
-        r_o[a], v_o[a], p_o[a] = r[a], v[a], p[a]
-        for b in range(3):
-            R_o[a, b] = R[a, b]
-    for c in range(N_X):
-        delta[c] = 0.0
-    nis = 0.0
-    s2 = sigma_b * sigma_b
-    for it in range(max(1, iterations)):
-        if not _linearise(r_o, R_o, p_o, bs, pk, known, N, use_N, H, res, u, bb, HC):
-            for a in range(3):
-                r_o[a], v_o[a], p_o[a] = r[a], v[a], p[a]
-                for b in range(3):
-                    R_o[a, b] = R[a, b]
-            for a in range(N_X):
-                for b in range(N_X):
-                    P_o[a, b] = P[a, b]
-            return np.nan
-        for a in range(N_X):                      # PHt = P H^T
-            for k in range(m3):
-                s = 0.0
-                for c in range(N_X):
-                    s += P[a, c] * H[k, c]
-                PHt[a, k] = s
-        for k in range(m3):                       # S = H P H^T + sigma_b^2 I
-            for l in range(k + 1):
-                s = 0.0
-                for c in range(N_X):
-                    s += H[k, c] * PHt[c, l]
-                S[k, l] = s + (s2 if k == l else 0.0)
-        cholesky_in_place(S, m3)
-        for a in range(N_X):                      # K = P H^T S^-1 (row a: S^-1 (P H^T)[a])
-            for k in range(m3):
-                col[k] = PHt[a, k]
-            cho_solve(S, m3, col)
-            for k in range(m3):
-                K[a, k] = col[k]
-        if it == 0:                               # NIS = res^T S^-1 res
-            for k in range(m3):
-                col[k] = res[k]
-            cho_solve(S, m3, col)
-            for k in range(m3):
-                nis += res[k] * col[k]
-        for k in range(m3):                       # y = res + H delta
-            s = res[k]
-            for c in range(N_X):
-                s += H[k, c] * delta[c]
-            col[k] = s
-        change = 0.0
-        for a in range(N_X):                      # delta_new = K y
-            s = 0.0
-            for k in range(m3):
-                s += K[a, k] * col[k]
-            change = max(change, abs(s - delta[a]))
-            delta[a] = s
-        _inject(r, v, R, p, delta, r_o, v_o, R_o, p_o, E)
-        if change < 1e-9:
-            break
-    for a in range(N_X):                          # A = I - K H
-        for b in range(N_X):
-            s = 1.0 if a == b else 0.0
-            for k in range(m3):
-                s -= K[a, k] * H[k, b]
-            A[a, b] = s
-    _matmul(A, P, T)
-    for a in range(N_X):                          # P_o = T A^T + sigma_b^2 K K^T (Joseph)
-        for b in range(N_X):
-            s = 0.0
-            for c in range(N_X):
-                s += T[a, c] * A[b, c]
-            q = 0.0
-            for k in range(m3):
-                q += K[a, k] * K[b, k]
-            P_o[a, b] = s + s2 * q
-    _symmetrize(P_o)
-    return nis
+    symmetrize(P_j)
 
 
 @kernel
@@ -398,7 +241,7 @@ def _init(r, R, P, b, depth_sigma_frac, sigma_b, p_o, P_o, J, JP) -> bool:
                 s += JP[a, k] * J[c, k]
             uu = u[a] * u[c]
             P_o[9 + a, 9 + c] = s + fd2 * uu + bd2 * ((1.0 if a == c else 0.0) - uu)
-    _symmetrize(P_o)
+    symmetrize(P_o)
     return True
 
 
@@ -423,49 +266,17 @@ def _nullspace_batch(r, v, R, p, N) -> None:
 
 
 @kernel
-def _propagate_batch(r, v, R, p, P, dR, dv, dp, Dt, g, Q, oc, N_i, C_i_prior,
-                     r_j, v_j, R_j, P_j) -> None:
-    Phi = np.empty((N_X, N_X))
-    T = np.empty((N_X, N_X))
-    N_j = np.empty(N_X)
+def _propagate_batch(x, inc, model, ocp, out) -> None:
+    """:func:`_propagate` of every run (the tuples' arrays with a leading run axis; ``model``
+    and the flag ``oc`` shared)."""
+    r, v, R, p, P = x
+    dR, dv, dp = inc
+    oc, N_i, C_i_prior = ocp
+    r_j, v_j, R_j, P_j = out
+    work = (np.empty((N_X, N_X)), np.empty(N_X), np.empty((N_X, N_X)))
     for k in range(r.shape[0]):
-        _propagate(r[k], v[k], R[k], p[k], P[k], dR[k], dv[k], dp[k], Dt, g, Q, oc, N_i[k],
-                   C_i_prior[k], r_j[k], v_j[k], R_j[k], P_j[k], Phi, N_j, T)
-
-
-@kernel
-def _update_batch(r, v, R, p, P, bs, pk, known, sigma_b, N, use_N, iterations,
-                  r_o, v_o, R_o, p_o, P_o, nis) -> None:
-    m3 = 3 * bs.shape[1]
-    H = np.empty((m3, N_X))
-    K = np.empty((N_X, m3))
-    res = np.empty(m3)
-    S = np.empty((m3, m3))
-    col = np.empty(m3)
-    delta = np.empty(N_X)
-    PHt = np.empty((N_X, m3))
-    A = np.empty((N_X, N_X))
-    T = np.empty((N_X, N_X))
-    u = np.empty(3)
-    bb = np.empty(3)
-    HC = np.empty((3, 3))
-    E = np.empty((3, 3))
-    for k in range(r.shape[0]):
-        nis[k] = _update(r[k], v[k], R[k], p[k], P[k], bs[k], pk[k], known, sigma_b, N[k], use_N,
-                         iterations, r_o[k], v_o[k], R_o[k], p_o[k], P_o[k], H, K, res, S, col,
-                         delta, PHt, A, T, u, bb, HC, E)
-
-
-@kernel
-def _linearise_batch(r, R, p, bs, pk, known, N, use_N, H, res) -> bool:
-    u = np.empty(3)
-    bb = np.empty(3)
-    HC = np.empty((3, 3))
-    for k in range(r.shape[0]):
-        if not _linearise(r[k], R[k], p[k], bs[k], pk[k], known, N[k], use_N, H[k], res[k],
-                          u, bb, HC):
-            return False
-    return True
+        _propagate((r[k], v[k], R[k], p[k], P[k]), (dR[k], dv[k], dp[k]), model, (oc, N_i[k], C_i_prior[k]),
+                   (r_j[k], v_j[k], R_j[k], P_j[k]), work)
 
 
 @kernel
@@ -473,13 +284,6 @@ def _init_batch(r, R, P, b, depth_sigma_frac, sigma_b, p_o, P_o, J, ok) -> None:
     JP = np.empty((3, 9))
     for k in range(r.shape[0]):
         ok[k] = _init(r[k], R[k], P[k], b[k], depth_sigma_frac, sigma_b, p_o[k], P_o[k], J[k], JP)
-
-
-@kernel
-def _inject_batch(r, v, R, p, dx, r_o, v_o, R_o, p_o) -> None:
-    E = np.empty((3, 3))
-    for k in range(r.shape[0]):
-        _inject(r[k], v[k], R[k], p[k], dx[k], r_o[k], v_o[k], R_o[k], p_o[k], E)
 
 
 @warms
@@ -492,12 +296,7 @@ def _warm() -> None:
                     np.eye(N_X), (N, st.R))
     oc_transition(transition_matrix(st.r, st.v, st.R, st2.r, st2.v, st2.R, 1.0, g), N, N, st.R,
                   st2.R, 1.0)
-    b = np.array([[0.0, 0.0, -1.0]])
-    new, _ = init_landmark(st2, b, 0.1, 1e-3)
-    meas = [Bearing(b, np.zeros(3)), Bearing(b)]
-    update(new, meas, 1e-3, N, 3)
-    linearise(new, meas, N)
-    inject(new, np.zeros((1, N_X)))
+    init_landmark(st2, np.array([[0.0, 0.0, -1.0]]), 0.1, 1e-3)
 
 
 # ---------------------------------------------------------------- the Python API (batches)
@@ -582,9 +381,9 @@ def propagate(st: NavState, dR, dv, dp, Dt: float, g, Q: np.ndarray,
     N_i, C_p = (np.zeros((n, N_X)), R) if oc is None else (_rows(oc[0], (N_X,), lead),
                                                            _rows(oc[1], (3, 3), lead))
     r_j, v_j, R_j, P_j = np.empty_like(r), np.empty_like(v), np.empty_like(R), np.empty_like(P)
-    _propagate_batch(r, v, R, p, P, _rows(dR, (3, 3), lead), _rows(dv, (3,), lead),
-                     _rows(dp, (3,), lead), float(Dt), _rows(g, (3,), ())[0],
-                     _rows(Q, (N_X, N_X), ())[0], oc is not None, N_i, C_p, r_j, v_j, R_j, P_j)
+    _propagate_batch((r, v, R, p, P), (_rows(dR, (3, 3), lead), _rows(dv, (3,), lead), _rows(dp, (3,), lead)),
+                     (float(Dt), _rows(g, (3,), ())[0], _rows(Q, (N_X, N_X), ())[0]),
+                     (oc is not None, N_i, C_p), (r_j, v_j, R_j, P_j))
     return _state(lead, r_j, v_j, R_j, p.copy(), P_j)
 
 
@@ -650,7 +449,7 @@ def linearise(st: NavState, meas: list[Bearing], N=None) -> tuple[np.ndarray, np
     Nf, use = _direction(N, lead)
     H = np.empty((r.shape[0], 3 * len(meas), N_X))
     res = np.empty((r.shape[0], 3 * len(meas)))
-    if not _linearise_batch(r, R, p, bs, pk, known, Nf, use, H, res):
+    if not _linearise_batch(r, R, p, (bs, pk, known), (Nf, use), H, res):
         raise ValueError("bearing undefined: a landmark at the lander or a non-finite state")
     return H.reshape(lead + H.shape[1:]), res.reshape(lead + res.shape[1:])
 
@@ -680,7 +479,8 @@ def update(st: NavState, meas: list[Bearing], sigma_b: float,
     Nf, use = _direction(N, lead)
     out = [np.empty_like(a) for a in (r, v, R, p, P)]
     nis = np.empty(r.shape[0])
-    _update_batch(r, v, R, p, P, bs, pk, known, float(sigma_b), Nf, use, int(iterations), *out, nis)
+    _update_batch((r, v, R, p, P), (bs, pk, known), (Nf, use), (float(sigma_b), int(iterations)),
+                  tuple(out), nis)
     if np.isnan(nis).any():
         raise ValueError("bearing undefined: a landmark at the lander or a non-finite state")
     return _state(lead, *out), nis.reshape(lead)

@@ -1,4 +1,4 @@
-"""Cholesky algebra of paper B's compiled kernels: the factor, its solve, the log-det.
+"""Linear algebra of paper B's compiled kernels: the Cholesky factor, its solve, the log-det.
 
 One home for the lower Cholesky factor that the landing filter's gain (``opnav.landing.ekf``,
 ``K = P H^T S^-1`` with ``S = H P H^T + sigma_b^2 I``, eq. 11-18) and the planned-information
@@ -18,7 +18,7 @@ import numpy as np
 
 from opnav.core.compiled import kernel, warms
 
-__all__ = ["cholesky_shifted", "cholesky_in_place", "cho_solve", "logdet_spd"]
+__all__ = ["cholesky_shifted", "cholesky_in_place", "cho_solve", "logdet_spd", "matmul", "symmetrize"]
 
 
 @kernel
@@ -102,6 +102,29 @@ def logdet_spd(A, n, C) -> float:
     return -math.inf
 
 
+@kernel
+def matmul(A, B, C) -> None:
+    """``C = A B`` (plain loops, sums in index order)."""
+    for a in range(A.shape[0]):
+        for b in range(B.shape[1]):
+            s = 0.0
+            for c in range(A.shape[1]):
+                s += A[a, c] * B[c, b]
+            C[a, b] = s
+
+
+@kernel
+def symmetrize(P) -> None:
+    """``P <- (P + P^T) / 2`` in place (a covariance after a product that is symmetric only to
+    round-off)."""
+    n = P.shape[0]
+    for a in range(n):
+        for b in range(a + 1, n):
+            m = 0.5 * (P[a, b] + P[b, a])
+            P[a, b] = m
+            P[b, a] = m
+
+
 @warms
 def _warm() -> None:
     A = np.eye(3) * 2.0
@@ -110,3 +133,5 @@ def _warm() -> None:
     cholesky_in_place(A.copy(), 3)
     cho_solve(C, 3, np.ones(3))
     logdet_spd(A, 3, C)
+    matmul(A, A, C)
+    symmetrize(C)
