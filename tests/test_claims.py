@@ -14,6 +14,7 @@ from opnav.approach.summaries import ClaimsSummary
 from opnav.core import published
 from opnav.report import claims as C
 from opnav.report.approach_claims import claim_rows as _rows_a
+from opnav.landing.claims_summary import LandingSummary
 from opnav.report.landing_claims import claim_rows as _rows_b
 
 PUB = published.load()
@@ -27,7 +28,7 @@ def rows_a(summary, t1, pub, plan=None):
 
 
 def rows_b(summary, pub, plan=None):
-    return _rows_b(summary, pub, plan or C.load_plan())
+    return _rows_b(LandingSummary.from_json(summary), pub, plan or C.load_plan())
 
 
 def _row(variant, case, group, px, err=1.0, bound=1.0, label="converged", data=None, before=80.0, after=18.0,

@@ -189,6 +189,7 @@ def test_faster_reading_agrees_with_the_claims_table(shift):
     from opnav.core.verdicts import REPRODUCED
     from opnav.landing.report import rows_paper_b
     from opnav.report.claims import load_plan
+    from opnav.landing.claims_summary import ScenarioClaims
     from opnav.report.landing_claims import _claim_faster
 
     rng = np.random.default_rng(4)
@@ -196,7 +197,7 @@ def test_faster_reading_agrees_with_the_claims_table(shift):
     cf = eqv.converges_faster(tb + shift * _step() + 0.05 * rng.standard_normal(300), tb, "depth", "svd", 100.0,
                               min_difference_s=_step())
     summary = {"converges_faster": {"depth": cf}}
-    claim = _claim_faster("interior", {"interior": summary}, load_plan())["verdict"]
+    claim = _claim_faster("interior", {"interior": ScenarioClaims.from_json("interior", summary)}, load_plan())["verdict"]
     eq = {"reference": "svd", "margin_rel": 0.1, "metrics": {q: {"margin": 1.0} for q in eqv.PRIMARY_METRICS},
           "methods": {"depth": {"equivalent": True, "verdict": "equivalent", "same_pick_pct": 10.0, "text": "",
                                 "lastlm_pos_err_m": {"mean": 0.0}}}}
@@ -303,6 +304,7 @@ def test_scorecard_reading_agrees_with_the_claims_table(case):
     from opnav.landing.report import same_accuracy_verdict
     from opnav.report import claims as C
     from opnav.report.claims import load_plan
+    from opnav.landing.claims_summary import ScenarioClaims
     from opnav.report.landing_claims import _accuracy_claim
 
     st = _runs()
@@ -315,7 +317,8 @@ def test_scorecard_reading_agrees_with_the_claims_table(case):
     plan = load_plan()
     acc = _accuracy(st, plan.margin("B-C1", "same_pick_max_pct"), 95.0 if case == "same_picks" else 40.0)
     ours = same_accuracy_verdict(acc, "depth")
-    row = _accuracy_claim("B-C1", "interior", {"interior": acc}, plan, superior=False)
+    row = _accuracy_claim("B-C1", "interior", {"interior": ScenarioClaims.from_json("interior", acc)}, plan,
+                          superior=False)
     if case == "same_picks":
         assert row["verdict"] == C.NOT_TESTED and "not tested" in ours.reason
     else:

@@ -49,7 +49,7 @@ rule paper_claims:
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
         code=src("report/claims.py", "report/approach_claims.py", "report/approach_rows.py", "report/landing_claims.py",
-                 "report/manuscript.py", "core/published.py"),
+                 "report/manuscript.py", "core/published.py", "landing/claims_summary.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
         md=f"{PAPER}/claims.md",

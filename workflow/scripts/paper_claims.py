@@ -14,6 +14,7 @@ from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_con
 from opnav.core.tables import atomic_write_text, write_table
 from opnav.report import claims
 from opnav.approach.summaries import ClaimsSummary
+from opnav.landing.claims_summary import LandingSummary
 from opnav.report.approach_claims import HEADLINE_IDS as A_HEAD, claim_rows as rows_a, input_rows as inputs_a
 from opnav.report.landing_claims import HEADLINE_IDS as B_HEAD, claim_rows as rows_b, input_rows as inputs_b
 from opnav.report.manuscript import claims_detail_latex, claims_glance_latex
@@ -28,7 +29,7 @@ def score(inp, prefix, pub, plan, windows):
     summ = {k: load_json(inp[f"{prefix}summary_{k}"]) for k in ("A", "B") if f"{prefix}summary_{k}" in keys}
     t1 = load_table(inp[f"{prefix}a_table1"]) if f"{prefix}a_table1" in keys else None
     rows = rows_a(ClaimsSummary.from_json(summ["A"]), t1, pub["paper_a"], plan, windows) if "A" in summ and t1 is not None else []
-    rows += rows_b(summ["B"], pub["paper_b"], plan) if "B" in summ else []
+    rows += rows_b(LandingSummary.from_json(summ["B"]), pub["paper_b"], plan) if "B" in summ else []
     return summ, rows
 
 
@@ -51,7 +52,7 @@ with script_context(snakemake) as log:
     df.to_csv(snakemake.output.csv, index=False)
     plan.table().to_csv(snakemake.output.plan, index=False)
     ins = (inputs_a(pub["paper_a"], plan, float(par.dt_s)) if "A" in summ else []) + (
-        inputs_b(summ["B"], pub["paper_b"], plan, dict(par.landing)) if "B" in summ else [])
+        inputs_b(LandingSummary.from_json(summ["B"]), pub["paper_b"], plan, dict(par.landing)) if "B" in summ else [])
     claims.inputs_frame(ins).to_csv(snakemake.output.inputs, index=False)
     write_table(claims.glance(df), [snakemake.output.md],
                 caption="Claims at a glance: each published claim, ours as written, the verdict.")

@@ -1,7 +1,7 @@
 """Paper B's claims (depth-error landmark selection), each scored over our camera scenarios.
 
-Input: the B-summary.json dict (every camera scenario under ``scenarios``, the headline
-scenario's name under ``headline_scenario``), the published values
+Input: what the claims read of B-summary.json (:class:`opnav.landing.claims_summary.LandingSummary`:
+every camera scenario, the headline one first), the published values
 (``published.paper_b()``) and the analysis plan (:func:`opnav.report.claims.load_plan`),
 which holds every margin the verdicts use. Output: claims-table rows
 (:func:`opnav.report.claims.row`) and derived-input rows (:func:`input_rows`).
@@ -18,23 +18,13 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
+from opnav.landing.claims_summary import ENVELOPES, Interval, LandingSummary, ScenarioClaims
 from opnav.report import claims as C
 from opnav.report.claims import Plan, fmt, join
 
-#: the per-run errors the paired equivalence intervals cover (landing.equivalence.PRIMARY_METRICS)
-PRIMARY = ("lastlm_pos_err_m", "lmrms_pos_err_m")
-#: where only B-T3's pair table pairs two methods: descent RMS and touchdown error (95 % intervals)
-PAIR_METRICS = ("rms_pos", "final_pos")
 NAMES = {"svd": "SVD", "gdop": "GDOP", "cond": "condition number", "depth": "depth", "random": "random",
          "center": "image centre", "closest": "closest"}
 CAMERA = "the camera, which the paper does not give"
-
-
-def _scenarios(summary: Mapping[str, Any]) -> tuple[str, dict]:
-    scen = summary.get("scenarios") or {summary.get("scenario", "headline"): summary}
-    head = summary.get("headline_scenario") or next(iter(scen))
-    order = [head] + [k for k in scen if k != head]
-    return head, {k: scen[k] for k in order}
 
 
 def _across(per: dict[str, str], head: str, why_not_tested: dict[str, str]) -> tuple[str, str]:
@@ -51,64 +41,30 @@ def _name(m: str) -> str:
 
 
 # ------------------------------------------------------------ paired intervals
-def paired(s: Mapping[str, Any], method: str, reference: str) -> dict | None:
-    """The paired intervals of ``method`` minus ``reference`` in one scenario summary:
-    {metric: (mean, lo, hi, reference mean)} (m), or None if the summary pairs them nowhere.
-    The equivalence section (90 % intervals of the landmark-phase errors) where it holds
-    the pair, else B-T3's pair table (95 % intervals of the descent RMS and touchdown errors)."""
-    eq = s.get("equivalence") or {}
-    if eq.get("reference") == reference or (reference == "svd" and "reference" not in eq and eq):
-        res = (eq.get("methods") or {}).get(method) or {}
-        means = {q: ((eq.get("metrics") or {}).get(q) or {}).get("means", {}) for q in PRIMARY}
-        if all(q in res for q in PRIMARY):
-            return {q: (float(res[q]["mean"]), float(res[q]["lo"]), float(res[q]["hi"]),
-                        float(means[q].get(reference, math.nan))) for q in PRIMARY}
-    pairs = s.get("pairs") or {}
-    meth = s.get("methods") or {}
-    for a, b, sign in ((method, reference, 1.0), (reference, method, -1.0)):
-        p = pairs.get(f"{a}_vs_{b}")
-        if p is None:
-            continue
-        out = {}
-        for q in PAIR_METRICS:
-            m, lo, hi = (float(p[f"d_{q}_m"]), float(p[f"d_{q}_lo_m"]), float(p[f"d_{q}_hi_m"]))
-            if sign < 0:
-                m, lo, hi = -m, -hi, -lo
-            out[f"{q}_err_m"] = (m, lo, hi, float((meth.get(reference) or {}).get(f"{q}_err_m_mean", math.nan)))
-        return out
-    return None
-
-
-def _within(iv: dict, rel: float) -> bool:
+def _within(iv: dict[str, Interval], rel: float) -> bool:
     """Every metric's interval inside +-rel x the reference's mean (equivalence)."""
     return all(math.isfinite(r) and -rel * r < lo and hi < rel * r for _, lo, hi, r in iv.values())
 
 
-def _below(iv: dict, margin: float) -> bool:
+def _below(iv: dict[str, Interval], margin: float) -> bool:
     """Every metric's interval below -margin (superiority: the method's error smaller)."""
     return all(hi < -margin for _, _, hi, _ in iv.values())
 
 
-def _iv_text(iv: dict, what: str) -> str:
+def _iv_text(iv: dict[str, Interval], what: str) -> str:
     q, (m, lo, hi, r) = next(iter(iv.items()))
     return f"{m:+.2g} m [{lo:+.2g}, {hi:+.2g}] against {what} {fmt(r)} m"
 
 
-def _same_pick(s: Mapping[str, Any], method: str) -> float:
-    eq = (s.get("equivalence") or {}).get("methods") or {}
-    v = (eq.get(method) or {}).get("same_pick_pct")
-    return float(v) if v is not None else math.nan
-
-
-def _compare(s, compared, controls, test) -> tuple[dict, list, list]:
+def _compare(s: ScenarioClaims, compared, controls, test) -> tuple[dict, list, list]:
     """(per baseline: intervals or None, baselines that fail, controls that pass) in one scenario."""
-    ivs = {b: paired(s, "depth", b) for b in compared}
+    ivs = {b: s.paired("depth", b) for b in compared}
     fail = [b for b, iv in ivs.items() if iv is not None and not test(iv)]
-    met = [c for c in controls if (iv := paired(s, c, "svd")) is not None and test(iv)]
+    met = [c for c in controls if (iv := s.paired(c, "svd")) is not None and test(iv)]
     return ivs, fail, met
 
 
-def _accuracy_claim(cid: str, head: str, scen: dict, plan: Plan, superior: bool) -> dict:
+def _accuracy_claim(cid: str, head: str, scen: dict[str, ScenarioClaims], plan: Plan, superior: bool) -> dict:
     v = plan.variants(cid)
     compared, controls = list(v.get("compared") or ["svd"]), list(v.get("controls") or [])
     if superior:
@@ -122,7 +78,7 @@ def _accuracy_claim(cid: str, head: str, scen: dict, plan: Plan, superior: bool)
     for name, s in scen.items():
         ivs, fail, met = _compare(s, compared, controls, test)
         missing = [b for b, iv in ivs.items() if iv is None]
-        pick = _same_pick(s, "depth")
+        pick = s.same_pick_pct("depth")
         if ivs.get("svd") is None:
             per[name], why[name] = C.NOT_TESTED, "no paired comparison with SVD in this summary"
         elif math.isfinite(pick) and pick >= pick_max:
@@ -172,15 +128,15 @@ def _claim_faster(head: str, scen: dict, plan: Plan) -> dict:
     step = plan.margin(cid, "min_difference_s")
     per, why, texts = {}, {}, {}
     for name, s in scen.items():
-        cf = (s.get("converges_faster") or {}).get("depth")
-        if not cf:
+        cf = s.depth_faster
+        if cf is None:
             per[name], why[name], texts[name] = C.NOT_TESTED, "no paired time to converge in this summary", "not evaluated"
             continue
-        m, lo, hi = float(cf.get("mean_s", math.nan)), float(cf.get("lo_s", math.nan)), float(cf.get("hi_s", math.nan))
+        m, lo, hi = cf.mean_s, cf.lo_s, cf.hi_s
         faster = math.isfinite(hi) and hi < 0 and m <= -step
         per[name] = C.REPRODUCED if faster else C.NOT_REPRODUCED
-        texts[name] = (f"depth minus SVD {fmt(m)} s [{fmt(lo)}, {fmt(hi)}] over {cf.get('n_runs')} runs, "
-                       f"below {fmt(cf.get('threshold_m'))} m")
+        texts[name] = (f"depth minus SVD {fmt(m)} s [{fmt(lo)}, {fmt(hi)}] over {cf.n_runs} runs, "
+                       f"below {fmt(cf.threshold_m)} m")
     verdict, named = _across(per, head, why)
     if verdict == C.DEPENDS:
         cause = (f"Depth converges faster than SVD by at least one filter step ({step:g} s) in "
@@ -203,7 +159,7 @@ def _claim_yaw(head: str, scen: dict, plan: Plan) -> dict:
     plan.entry(cid)
     per, why, texts = {}, {}, {}
     for name, s in scen.items():
-        y = s.get("yaw_converges")
+        y = s.yaw_converges
         if y is None:
             per[name], why[name], texts[name] = C.NOT_TESTED, "no yaw envelope in this summary", "not evaluated"
         else:
@@ -233,15 +189,13 @@ def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any], plan: Plan) -> 
     wide_max = plan.margin(cid, "max_band_rel") * abs(p)
     outs, wide = {}, {}
     for name, s in scen.items():
-        d = (s.get("methods") or {}).get("depth") or {}
-        path = PATH_NAMES.get(s.get("eval_path", ""), s.get("eval_path", "the configured path"))
-        alt = PATH_NAMES.get(OTHER_PATH.get(s.get("eval_path", ""), ""), "the alternative path")
-        for key, lab in (("time_reduction_vs_svd_pct", path), ("time_reduction_vs_svd_alt_pct", alt)):
-            if d.get(key) is None:
-                continue
-            sd = d.get(f"{key}_std")
+        ep = s.eval_path or ""
+        path = PATH_NAMES.get(ep, s.eval_path if s.eval_path is not None else "the configured path")
+        alt = PATH_NAMES.get(OTHER_PATH.get(ep, ""), "the alternative path")
+        for which, value, sd in s.method("depth").reductions():
+            lab = path if which == "path" else alt
             sd = float(sd) if sd is not None and math.isfinite(float(sd)) else 0.0
-            v = float(d[key])
+            v = float(value)
             # a spread wider than max_band_rel x the published value tells 29 % from no saving no better
             # than chance: such a reading never meets the claim, and the claim is then not tested
             wide[(name, lab)] = k * sd > wide_max
@@ -292,7 +246,7 @@ def _claim_optimum(head: str, scen: dict, plan: Plan) -> dict:
     plan.entry(cid)
     per, why, texts = {}, {}, {}
     for name, s in scen.items():
-        n = s.get("multi_optimum_pct")
+        n = s.multi_optimum_pct
         if n is None:
             per[name] = C.NOT_TESTED
             why[name] = "the pipeline does not count the depth error's local optima per planning call"
@@ -312,8 +266,7 @@ def _claim_fastest(head: str, scen: dict, plan: Plan) -> dict:
     plan.entry(cid)
     per, why, texts = {}, {}, {}
     for name, s in scen.items():
-        meth = s.get("methods") or {}
-        t = {m: (meth.get(m) or {}).get("median_plan_time_us") for m in ("depth", "svd", "gdop", "cond")}
+        t = {m: s.method(m).median_plan_time_us for m in ("depth", "svd", "gdop", "cond")}
         t = {m: float(v) for m, v in t.items() if v is not None and math.isfinite(float(v))}
         if "depth" not in t or "svd" not in t:
             per[name], why[name], texts[name] = C.NOT_TESTED, "depth or SVD was not timed", "not timed"
@@ -338,14 +291,13 @@ def _claim_envelopes(head: str, scen: dict, plan: Plan) -> dict:
     cid = "B-C10"
     rel = plan.margin(cid, "envelope_rel")
     compared = list(plan.variants(cid).get("compared") or ["svd"])
-    cols = ("rms_vel_err_mps_3sigma", "rms_att_err_deg_3sigma")
+    cols = ENVELOPES
     per, why, texts = {}, {}, {}
     for name, s in scen.items():
-        meth = s.get("methods") or {}
-        d = meth.get("depth") or {}
+        d = s.method("depth").envelopes
         ratios = {}
         for b in compared:
-            mb = meth.get(b) or {}
+            mb = s.method(b).envelopes
             for c in cols:
                 if d.get(c) is not None and mb.get(c) not in (None, 0):
                     ratios[(b, c)] = float(d[c]) / float(mb[c])
@@ -367,16 +319,18 @@ def _claim_envelopes(head: str, scen: dict, plan: Plan) -> dict:
                  verdict, cause, "B-T3, B-F6", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
 
 
-def _small_sample(summary: Mapping[str, Any], plan: Plan) -> list:
-    n = summary.get("n_runs")
+def _small_sample(s: ScenarioClaims, plan: Plan) -> list:
+    n = s.n_runs
     if n is None:
         return []
     return [("sample_too_small", f"{int(n)} runs")] if int(n) < plan.guard("min_full_seeds") else []
 
 
-def claim_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan) -> list[dict]:
-    """Paper B's claims-table rows (ids B-C1 ... B-C4, B-C7 ... B-C10, stable)."""
-    head, scen = _scenarios(summary)
+def claim_rows(summary: LandingSummary, pub: Mapping[str, Any], plan: Plan) -> list[dict]:
+    """Paper B's claims-table rows (ids B-C1 ... B-C4, B-C7 ... B-C10, stable). ``summary``:
+    B-summary.json as :meth:`opnav.landing.claims_summary.LandingSummary.from_json` reads it."""
+    _typed(summary, "claim_rows")
+    head, scen = summary.headline, summary.by_name()
     rows = [_accuracy_claim("B-C1", head, scen, plan, superior=False), _claim_faster(head, scen, plan),
             _claim_yaw(head, scen, plan), _claim_timing(head, scen, pub, plan),
             _accuracy_claim("B-C7", head, scen, plan, superior=True), _claim_optimum(head, scen, plan),
@@ -406,15 +360,16 @@ def terminal_accel_to_match(landing_cfg: Mapping[str, Any], tilt_deg: float, azi
     return [float(sol.x[0]), float(sol.x[1])]
 
 
-def input_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan,
+def input_rows(summary: LandingSummary, pub: Mapping[str, Any], plan: Plan,
                landing_cfg: Mapping[str, Any] | None = None) -> list[dict]:
     """Paper B's derived inputs (inputs.csv): Table 1's initial pitch and yaw, how we derive
     them and what would match the published values."""
-    if "initial_tilt_deg" not in summary:
+    _typed(summary, "input_rows")
+    if summary.initial_tilt_deg is None:
         return []
     att = pub["table1_initial_state"]["att_deg"]
     tilt_pub, az_pub = -float(att[1]), -float(att[0])
-    tilt, az = float(summary["initial_tilt_deg"]), float(summary["initial_azimuth_deg"])
+    tilt, az = summary.initial_tilt_deg, summary.initial_azimuth_deg
     ins = plan.raw.get("inputs", {})
     match = ""
     if landing_cfg is not None:
@@ -432,6 +387,12 @@ def input_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan,
          "how_derived": ins.get("initial_yaw", {}).get("how_derived", ""),
          "what_would_match": match},
     ]
+
+
+def _typed(summary, where: str) -> None:
+    if not isinstance(summary, LandingSummary):
+        raise TypeError(f"landing_claims.{where}: summary must be a LandingSummary "
+                        f"(LandingSummary.from_json(<B-summary.json>)), got {type(summary).__name__}")
 
 
 def _tilt_az(cfg):
