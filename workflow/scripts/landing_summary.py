@@ -10,7 +10,7 @@ import pandas as pd
 from opnav.core import figures, published
 from opnav.landing import plots, timing, timing_summary
 from opnav.landing.montecarlo import load
-from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading,
+from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading, nees_retuned_text,
                                   scenario_summary, summary_table)
 from opnav.landing.trajectory import truth_states
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
@@ -60,6 +60,9 @@ with script_context(snakemake) as log:
     # NEES read as it is (held out): consistent, under- or overconfident
     out["nees_reading"] = {m: nees_reading(v) for m, v in out["nees"].items()}
     out["nees_text"] = out["nees_reading"].get("depth", {}).get("text", "")
+    if snakemake.input.get("retuned"):      # the main sample: the retuned filter beside the paper's
+        out["nees_retuned"] = load_json(snakemake.input.retuned)
+        out["nees_retuned_text"] = nees_retuned_text(out["nees_retuned"])
     # the descent's end from the per-step records against the true altitude
     c, cut = snakemake.params.landing, snakemake.params.cutoff
     t = next(iter(data.values()))["t"]

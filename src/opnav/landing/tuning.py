@@ -23,6 +23,18 @@ meets the best tier in every scenario. :func:`tuning_report` flies and
 chooses; ``config_matches`` says whether the configured ``landing.filter`` is
 the choice (the pipeline checks and reports it; it does not change the config:
 the Monte Carlo is flown with the config).
+
+Retuned variant (:func:`retune`, :func:`heldout`): the paper tuning above is the flown
+default; beside it, per camera scenario and on the tuning runs alone, the bearing-noise
+scale whose mean position and velocity NEES lie closest to the band's centre (the larger
+of the two log distances, :func:`distance_to_centre`): the candidates at the chosen
+iterations, then ``landing.tuning.retune_points`` log-spaced scales between the best
+candidate's neighbours. :func:`heldout` flies that scale on the Monte Carlo's own runs (the
+held-out evidence) and reads its NEES beside the paper tuning's; nothing else is flown
+with it. One scale multiplies the filter's bearing noise only, so it moves the position
+and velocity NEES together, and a mean over runs follows its largest runs: the tuning
+rows keep the median and the largest run's NEES to show how far the errors are from the
+Gaussian the filter assumes.
 """
 
 from __future__ import annotations
@@ -30,7 +42,10 @@ from __future__ import annotations
 import copy
 import math
 
-__all__ = ["tuning_report", "tuning_rows", "choose"]
+import numpy as np
+
+__all__ = ["tuning_report", "tuning_rows", "choose", "tuning_row", "distance_to_centre", "retune", "heldout", "errors",
+           "retuned_record"]
 
 
 def _tiers(rows_by_scn: dict[str, list[dict]]) -> dict:
@@ -55,49 +70,146 @@ def choose(rows: list[dict]) -> dict:
 
 def tuning_rows(landing_cfg: dict, tuning_cfg: dict) -> list[dict]:
     """Fly the tuning runs of one scenario (``landing_cfg``: its ``landing``
-    config) for every candidate of ``tuning_cfg`` (``landing.tuning``); per
-    candidate the mean position and velocity NEES, whether both lie in the band
-    (``consistent``) or at least not above it (``not_overconfident``), and the
-    median touchdown and last-landmark position errors (m)."""
-    from opnav.landing.montecarlo import nees_band, per_run_stats, run_chunk
-
+    config) for every candidate of ``tuning_cfg`` (``landing.tuning``): one
+    :func:`tuning_row` each."""
     if int(tuning_cfg["base_seed"]) == int(landing_cfg["mc"]["base_seed"]):
         raise ValueError("landing.tuning.base_seed must differ from landing.mc.base_seed "
                          "(the tuning runs must not be the reported runs)")
+    return [tuning_row(landing_cfg, tuning_cfg, scale, iters) for scale, iters in tuning_cfg["candidates"]]
+
+
+def tuning_row(landing_cfg: dict, tuning_cfg: dict, scale: float, iters: int) -> dict:
+    """The tuning runs (``landing.tuning``'s stream, ``n_runs``, ``method``) flown with the
+    filter's bearing-noise scale ``scale`` and ``iters`` update iterations: the mean position
+    and velocity NEES, whether both lie in the band (``consistent``) or at least not above it
+    (``not_overconfident``), the median and largest run's position NEES, and the median
+    touchdown and last-landmark position errors (m)."""
+    from opnav.landing.montecarlo import nees_band, per_run_stats, run_chunk
+
     n = int(tuning_cfg["n_runs"])
     lo, hi = nees_band(n, 3, 0.95)
-    rows = []
-    for scale, iters in tuning_cfg["candidates"]:
-        cfg = copy.deepcopy(landing_cfg)
-        cfg["filter"].update(meas_noise_scale=float(scale), iterations=int(iters))
-        cfg["mc"] = {**cfg["mc"], "base_seed": int(tuning_cfg["base_seed"])}
-        st = per_run_stats(run_chunk(cfg, tuning_cfg["method"], range(n), pick_ratio=False))
-        npos, nvel = float(st["mean_nees_pos"].mean()), float(st["mean_nees_vel"].mean())
-        rows.append({"meas_noise_scale": float(scale), "iterations": int(iters),
-                     "nees_pos": npos, "nees_vel": nvel,
-                     "consistent": bool(lo <= npos <= hi and lo <= nvel <= hi),
-                     "not_overconfident": bool(npos <= hi and nvel <= hi),
-                     "final_pos_err_m_median": float(st["final_pos_err_m"].median()),
-                     "lastlm_pos_err_m_median": (float(st["lastlm_pos_err_m"].median())
-                                                 if "lastlm_pos_err_m" in st else math.nan)})
-    return rows
+    cfg = copy.deepcopy(landing_cfg)
+    cfg["filter"].update(meas_noise_scale=float(scale), iterations=int(iters))
+    cfg["mc"] = {**cfg["mc"], "base_seed": int(tuning_cfg["base_seed"])}
+    st = per_run_stats(run_chunk(cfg, tuning_cfg["method"], range(n), pick_ratio=False))
+    npos, nvel = float(st["mean_nees_pos"].mean()), float(st["mean_nees_vel"].mean())
+    return {"meas_noise_scale": float(scale), "iterations": int(iters), "nees_pos": npos, "nees_vel": nvel,
+            "nees_pos_run_median": float(st["mean_nees_pos"].median()),
+            "nees_pos_run_max": float(st["mean_nees_pos"].max()),
+            "consistent": bool(lo <= npos <= hi and lo <= nvel <= hi),
+            "not_overconfident": bool(npos <= hi and nvel <= hi),
+            "final_pos_err_m_median": float(st["final_pos_err_m"].median()),
+            "lastlm_pos_err_m_median": (float(st["lastlm_pos_err_m"].median())
+                                        if "lastlm_pos_err_m" in st else math.nan)}
+
+
+def distance_to_centre(row: dict, centre: float) -> float:
+    """How far a tuning row's NEES is from ``centre`` (the band's centre): the larger of
+    ``|ln(nees_pos / centre)|`` and ``|ln(nees_vel / centre)|`` (a factor, either way, on
+    either state)."""
+    return max(abs(math.log(row["nees_pos"] / centre)), abs(math.log(row["nees_vel"] / centre)))
+
+
+def retune(landing_cfg: dict, tuning_cfg: dict, rows: list[dict], iterations: int) -> dict:
+    """The retuned bearing-noise scale of one scenario, on its tuning runs only (module
+    docstring): among ``rows`` (:func:`tuning_rows`) at ``iterations``, the candidate
+    closest to the band's centre (:func:`distance_to_centre`; ties: the smaller scale), then
+    ``tuning_cfg["retune_points"]`` scales log-spaced strictly between its neighbouring
+    candidates (or the candidate and 1/2 or 2 times it at the ends), flown; the closest of
+    all. Returns that row, its ``distance``, the ``centre``, ``in_band`` (both NEES in the
+    tuning runs' band) and every row ``evaluated`` in scale order."""
+    from opnav.landing.montecarlo import nees_band
+
+    lo, hi = nees_band(int(tuning_cfg["n_runs"]), 3, 0.95)
+    centre = 0.5 * (lo + hi)
+    rows = sorted((r for r in rows if int(r["iterations"]) == int(iterations)), key=lambda r: r["meas_noise_scale"])
+    if not rows:
+        raise ValueError(f"landing.tuning.candidates: no candidate with {iterations} iterations to retune from")
+
+    def best(rs):
+        return min(rs, key=lambda r: (distance_to_centre(r, centre), r["meas_noise_scale"]))
+
+    b = best(rows)
+    scales = [r["meas_noise_scale"] for r in rows]
+    i = scales.index(b["meas_noise_scale"])
+    left = scales[i - 1] if i > 0 else b["meas_noise_scale"] / 2.0
+    right = scales[i + 1] if i + 1 < len(scales) else b["meas_noise_scale"] * 2.0
+    k = int(tuning_cfg.get("retune_points", 0))
+    new = [float(x) for x in np.geomspace(max(left, 1.0), right, k + 2)[1:-1]] if k > 0 else []
+    rows = rows + [tuning_row(landing_cfg, tuning_cfg, x, iterations) for x in new if x not in scales]
+    rows.sort(key=lambda r: r["meas_noise_scale"])
+    b = best(rows)
+    return {**b, "distance": distance_to_centre(b, centre), "centre": centre, "band": [lo, hi],
+            "in_band": bool(lo <= b["nees_pos"] <= hi and lo <= b["nees_vel"] <= hi),
+            "evaluated": [{k_: r[k_] for k_ in ("meas_noise_scale", "nees_pos", "nees_vel")} for r in rows]}
+
+
+def heldout(landing_cfg: dict, method: str, n_runs: int, meas_noise_scale: float, iterations: int) -> dict:
+    """``method`` flown on the Monte Carlo's own runs ``0..n_runs-1`` (``landing_cfg``'s
+    ``mc.base_seed``: never the tuning runs) with the filter's bearing-noise scale and
+    iterations set to the given ones: ``montecarlo.nees_consistency`` of those runs and their
+    median last-landmark and touchdown position errors (m)."""
+    from opnav.landing.montecarlo import nees_consistency, run_chunk
+
+    cfg = copy.deepcopy(landing_cfg)
+    cfg["filter"].update(meas_noise_scale=float(meas_noise_scale), iterations=int(iterations))
+    d = run_chunk(cfg, method, range(int(n_runs)), pick_ratio=False)
+    return {**nees_consistency(d), **errors(d)}
+
+
+def errors(data: dict) -> dict:
+    """Median last-landmark and touchdown position errors (m) of a Monte Carlo."""
+    from opnav.landing.montecarlo import per_run_stats
+
+    st = per_run_stats(data)
+    return {"lastlm_pos_err_m_median": (float(st["lastlm_pos_err_m"].median())
+                                        if "lastlm_pos_err_m" in st else math.nan),
+            "final_pos_err_m_median": float(st["final_pos_err_m"].median())}
 
 
 def tuning_report(scenario_cfgs: dict[str, dict], tuning_cfg: dict) -> dict:
     """:func:`tuning_rows` of every camera scenario (name -> its ``landing``
     config), the choice per scenario and the one tuning for all (:func:`_tiers`:
-    the smallest scale meeting the best tier in every scenario), and whether the
-    configured ``landing.filter`` (the same in every scenario) is that choice."""
+    the smallest scale meeting the best tier in every scenario), whether the
+    configured ``landing.filter`` (the same in every scenario) is that choice, and per
+    scenario the retuned scale (:func:`retune`, at the chosen iterations; ``retuned``)."""
     from opnav.landing.montecarlo import nees_band
 
     rows = {s: tuning_rows(c, tuning_cfg) for s, c in scenario_cfgs.items()}
     joint = _tiers(rows)
+    retuned = {s: retune(c, tuning_cfg, rows[s], joint["iterations"]) for s, c in scenario_cfgs.items()}
     f = next(iter(scenario_cfgs.values()))["filter"]
     n = int(tuning_cfg["n_runs"])
     return {"base_seed": int(tuning_cfg["base_seed"]), "n_runs": n, "method": tuning_cfg["method"],
             "band": list(nees_band(n, 3, 0.95)), "scenarios": {s: {"candidates": r, "chosen": choose(r)}
                                                               for s, r in rows.items()},
-            "chosen": joint,
+            "chosen": joint, "retuned": retuned,
             "configured": {"meas_noise_scale": float(f["meas_noise_scale"]), "iterations": int(f["iterations"])},
             "config_matches": (float(f["meas_noise_scale"]) == joint["meas_noise_scale"]
                                and int(f["iterations"]) == joint["iterations"])}
+
+
+def retuned_record(tuning: dict, scenario: str, landing_cfg: dict, method: str, n_runs: int,
+                   paper_heldout: dict) -> dict:
+    """The paper tuning and the retuned scale of ``scenario`` side by side on the held-out
+    runs: ``tuning`` is :func:`tuning_report`'s output, ``paper_heldout`` the Monte Carlo's own
+    ``nees_consistency`` and :func:`errors` of ``method`` (flown with the configured filter);
+    the retuned scale is flown by :func:`heldout` on the same ``n_runs`` runs. Each side holds
+    its scale, iterations, the tuning runs' NEES (mean, median and largest run in position;
+    NaN where the configured filter is not a candidate) and the held-out numbers."""
+    def tuning_side(row):
+        keys = ("nees_pos", "nees_vel", "nees_pos_run_median", "nees_pos_run_max")
+        return {f"tuning_{k}": (float(row[k]) if row else math.nan) for k in keys}
+
+    conf = tuning["configured"]
+    cands = tuning["scenarios"][scenario]["candidates"]
+    row = next((c for c in cands if c["meas_noise_scale"] == conf["meas_noise_scale"]
+                and c["iterations"] == conf["iterations"]), None)
+    r = tuning["retuned"][scenario]
+    return {"scenario": scenario, "method": method, "n_runs": int(n_runs), "tuning_n_runs": int(tuning["n_runs"]),
+            "tuning_band": list(tuning["band"]),
+            "paper": {"meas_noise_scale": float(conf["meas_noise_scale"]), "iterations": int(conf["iterations"]),
+                      **tuning_side(row), **paper_heldout},
+            "retuned": {"meas_noise_scale": float(r["meas_noise_scale"]), "iterations": int(r["iterations"]),
+                        **tuning_side(r), "tuning_in_band": bool(r["in_band"]),
+                        **heldout(landing_cfg, method, n_runs, r["meas_noise_scale"], r["iterations"])}}
