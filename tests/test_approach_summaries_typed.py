@@ -7,14 +7,18 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+from test_approach_pipeline import _summary_row, approach_cfg
 
-from opnav.approach.alternatives_summary import METHOD_LABELS, method_summaries, summary_json
+from opnav.approach.alternatives_summary import (
+    METHOD_LABELS,
+    method_summaries,
+    summary_json,
+)
 from opnav.approach.summaries import HeadlineSummary
 from opnav.core import published
 from opnav.report import approach_text
 from opnav.report.approach_scorecard import rows_paper_a
 from opnav.report.approach_views import x2_table
-from test_approach_pipeline import _summary_row, approach_cfg
 
 
 def _row(scenario, method="plain", mode="sliding", label="converged"):
@@ -36,7 +40,7 @@ def test_headline_rows_are_read_by_scenario_method_and_mode_not_by_their_key():
     assert "plain EM, sliding windows: converged in literal | growing squarem: stalled in literal | " \
            "squarem: converged in roll." in txt["stall"]
     assert "3 arcsec (literal), against" in txt["bound"]  # the paper's scheme only
-    assert set(k for k in txt if k.startswith("headline_")) == {"headline_row-a", "headline_row-b", "headline_row-c"}
+    assert {k for k in txt if k.startswith("headline_")} == {"headline_row-a", "headline_row-b", "headline_row-c"}
 
 
 def test_the_report_refuses_an_untyped_summary():

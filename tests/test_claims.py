@@ -12,9 +12,9 @@ import yaml
 
 from opnav.approach.summaries import ClaimsSummary
 from opnav.core import published
+from opnav.landing.claims_summary import LandingSummary
 from opnav.report import claims as C
 from opnav.report.approach_claims import claim_rows as _rows_a
-from opnav.landing.claims_summary import LandingSummary
 from opnav.report.landing_claims import claim_rows as _rows_b
 
 PUB = published.load()

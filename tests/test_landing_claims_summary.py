@@ -4,11 +4,11 @@ B-summary.json through LandingSummary / ScenarioClaims, by meaning."""
 import math
 
 import pytest
+from test_claims import PUB, summary_b
 
 from opnav.landing.claims_summary import Interval, LandingSummary, ScenarioClaims
 from opnav.report import claims as C
 from opnav.report.landing_claims import claim_rows, input_rows
-from test_claims import PUB, summary_b
 
 
 def test_the_headline_scenario_comes_first_and_an_older_summary_is_one_scenario():

@@ -6,8 +6,8 @@ import re
 
 import pandas as pd
 import pytest
-
 from conftest import REPO
+
 from opnav.core import published
 from opnav.core.config import load_config
 from opnav.report import claims_prose, differences, manuscript

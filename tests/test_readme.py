@@ -4,8 +4,8 @@ committed reference claims table of the last full build, so the two cannot diffe
 import re
 
 import pytest
-
 from conftest import REPO
+
 from opnav.report import readme
 
 

@@ -4,7 +4,6 @@ import io
 from pathlib import Path
 
 import pytest
-
 from conftest import REPO
 
 docutils_core = pytest.importorskip("docutils.core")
@@ -19,8 +18,9 @@ def test_there_are_captions():
 def _rendered(path: Path, tmp: Path, profile: str = "full") -> str:
     """A caption as Snakemake's report renders it: Jinja with ``snakemake.config`` and the
     report's files (the landing page reads the claims at a glance from the results)."""
-    import jinja2
     from types import SimpleNamespace
+
+    import jinja2
 
     (tmp / "paper").mkdir(parents=True, exist_ok=True)
     (tmp / "paper" / "claims_glance.csv").write_text(
@@ -46,7 +46,7 @@ def test_caption_renders_without_messages(path: Path, tmp_path):
 
 
 # ------------------------------------------------------------ captions fit to print
-import re  # noqa: E402
+import re
 
 #: abbreviations a sentence does not end on
 _ABBREV = re.compile(r"\b(Fig|Figs|Eq|eq|e\.g|i\.e|vs|cf|Sec|sec|Tab|No)\.$")
@@ -84,10 +84,11 @@ def test_caption_is_three_sentences_without_config_keys(path: Path):
 
 def test_study_captions_are_three_sentences_without_config_keys():
     """Every configured study's generated caption (the float under its figure)."""
+    from test_studies import _shapes
+
     from opnav.core.config import SCHEMA_PATH, load_config, validate_config
     from opnav.landing.planner import available_methods
     from opnav.studies import captions, planning
-    from test_studies import _shapes
 
     for overlays in ((), (REPO / "config" / "quick.yaml",)):
         cfg = load_config(overlays=overlays)

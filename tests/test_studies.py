@@ -6,14 +6,14 @@ import copy
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import REPO
 from scipy import stats
 
-from conftest import REPO
-from opnav.studies import captions, planning, tables, values
 from opnav.core.config import ConfigError, load_config
-from opnav.preflight import check_config
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.planner import available_methods
+from opnav.preflight import check_config
+from opnav.studies import captions, planning, tables, values
 
 QUICK = [REPO / "config" / "quick.yaml"]
 # the simulations' views of the config (as the rules pass them: studies.smk)

@@ -2,9 +2,9 @@
 
 import sys
 
-from opnav.core import published
 from opnav.approach import readings, summaries
 from opnav.approach.setup import Setup
+from opnav.core import published
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_json, write_table
 from opnav.report import approach_text, approach_views

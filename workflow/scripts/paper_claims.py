@@ -8,15 +8,18 @@ and the sample sentence for the manuscript's macros."""
 import json
 import sys
 
-
+from opnav.approach.summaries import ClaimsSummary
 from opnav.core import published
 from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
-from opnav.report import claims
-from opnav.approach.summaries import ClaimsSummary
 from opnav.landing.claims_summary import LandingSummary
-from opnav.report.approach_claims import HEADLINE_IDS as A_HEAD, claim_rows as rows_a, input_rows as inputs_a
-from opnav.report.landing_claims import HEADLINE_IDS as B_HEAD, claim_rows as rows_b, input_rows as inputs_b
+from opnav.report import claims
+from opnav.report.approach_claims import HEADLINE_IDS as A_HEAD
+from opnav.report.approach_claims import claim_rows as rows_a
+from opnav.report.approach_claims import input_rows as inputs_a
+from opnav.report.landing_claims import HEADLINE_IDS as B_HEAD
+from opnav.report.landing_claims import claim_rows as rows_b
+from opnav.report.landing_claims import input_rows as inputs_b
 from opnav.report.manuscript import claims_detail_latex, claims_glance_latex
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -59,7 +62,7 @@ with script_context(snakemake) as log:
     atomic_write_text(snakemake.output.tex, claims_glance_latex(df))
     atomic_write_text(snakemake.output.detail, claims_detail_latex(df))
     atomic_write_text(snakemake.output.json, json.dumps({
-        "n_claims": int(len(df)), "by_paper": claims.counts(df), "sample": str(df["sample"].iloc[0]) if len(df) else "",
+        "n_claims": len(df), "by_paper": claims.counts(df), "sample": str(df["sample"].iloc[0]) if len(df) else "",
         "text": {"abstract": claims.abstract(df, A_HEAD + B_HEAD), "conclusion": claims.conclusion(df),
                  "limitations": claims.limitations(df), "sample": claims.sample_sentence(df)}},
         indent=2, sort_keys=True) + "\n")

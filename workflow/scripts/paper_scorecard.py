@@ -3,15 +3,14 @@
 import json
 import sys
 
-
-from opnav.core import published
-from opnav.report import scorecard
-from opnav.report.claims import load_plan
 from opnav.approach.summaries import HeadlineSummary
-from opnav.report.approach_scorecard import rows_paper_a
-from opnav.landing.report import rows_paper_b
+from opnav.core import published
 from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
+from opnav.landing.report import rows_paper_b
+from opnav.report import scorecard
+from opnav.report.approach_scorecard import rows_paper_a
+from opnav.report.claims import load_plan
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_scorecard", argv=sys.argv[1:])
@@ -36,7 +35,7 @@ with script_context(snakemake) as log:
     write_table(scorecard.headline(df), [snakemake.output.headline])
     counts = df["verdict"].value_counts().to_dict() if len(df) else {}
     atomic_write_text(snakemake.output.json, json.dumps(
-        {"n_items": int(len(df)), "verdicts": {k: int(v) for k, v in sorted(counts.items())},
+        {"n_items": len(df), "verdicts": {k: int(v) for k, v in sorted(counts.items())},
          "by_paper": {p: {k: int(v) for k, v in sorted(g["verdict"].value_counts().items())}
                       for p, g in df.groupby("paper")}},
         indent=2, sort_keys=True) + "\n")

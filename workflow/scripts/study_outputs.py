@@ -8,10 +8,10 @@ import sys
 import pandas as pd
 
 from opnav.core import figures
-from opnav.studies.tables import gather_runs, loglog_slopes, tidy_table, wide_table
 from opnav.core.snakeio import load_csv, mock_snakemake, script_context
-from opnav.report.study_plots import fig_study
 from opnav.core.tables import atomic_write_text, write_table
+from opnav.report.study_plots import fig_study
+from opnav.studies.tables import gather_runs, loglog_slopes, tidy_table, wide_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("study_fov_outputs", argv=sys.argv[1:])

@@ -7,6 +7,7 @@ Monte Carlo (:func:`opnav.approach.pipeline.run_group`). Units: arcsec, km, samp
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -132,16 +133,18 @@ class MethodSummary:
     head_runtime_s_per_seed: float
 
 
+def _headline_value(h: pd.Series | None, col: str) -> float:
+    """``col`` of the headline-case row ``h`` (NaN without one)."""
+    return float(h[col]) if h is not None else math.nan
+
+
 def method_summaries(long: pd.DataFrame) -> tuple[MethodSummary, ...]:
     """A-X2 per variant and method (:class:`MethodSummary`), in the long frame's order."""
     out = []
     for (v, m), g in long.groupby(["variant", "method"], sort=False):
         h = g[g["case_id"] == "T1-01"]
         h = h.iloc[0] if len(h) else None
-
-        def head(col: str) -> float:
-            return float(h[col]) if h is not None else math.nan
-
+        head = functools.partial(_headline_value, h)
         out.append(MethodSummary(
             variant=v, method=m, n_cases=len(g), n_seeds=int(g["n_seeds"].max()),
             head_err_x_mean_arcsec=head("err_x_mean_arcsec"), head_err_x_sd_arcsec=head("err_x_std_arcsec"),

@@ -10,8 +10,9 @@ the Monte Carlo. The sentences the manuscript makes from these numbers are in
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -372,7 +373,7 @@ class ClaimsSummary:
     nav_err_true_theta_km: float | None = None
 
     @classmethod
-    def from_json(cls, summ: Mapping[str, Any]) -> "ClaimsSummary":
+    def from_json(cls, summ: Mapping[str, Any]) -> ClaimsSummary:
         """From the dict :func:`summary` writes (A-summary.json); the as-written row is the
         one whose ``scenario``, ``method`` and ``mode`` say so, whatever its key."""
         rr = summ.get("roll_rate") or {}
@@ -435,7 +436,7 @@ class HeadlineRow:
         return self.method == "plain" and self.mode == "sliding"
 
     @classmethod
-    def from_json(cls, key: str, v: Mapping[str, Any]) -> "HeadlineRow":
+    def from_json(cls, key: str, v: Mapping[str, Any]) -> HeadlineRow:
         return cls(key=key, scenario=v["scenario"], method=v.get("method", "plain"), mode=v.get("mode", "sliding"),
                    est_x_mean=float(v["est_x_mean"]), est_x_std=_opt(v, "est_x_std"),
                    est_y_mean=float(v["est_y_mean"]), est_y_std=_opt(v, "est_y_std"),
@@ -470,7 +471,7 @@ class HeadlineSummary:
     stars: Mapping[str, Any] | None = None
 
     @classmethod
-    def from_json(cls, summ: Mapping[str, Any]) -> "HeadlineSummary":
+    def from_json(cls, summ: Mapping[str, Any]) -> HeadlineSummary:
         """From the dict :func:`summary` returns (or A-summary.json as read back); a row
         without estimates (``est_x_mean``) is not a headline row and is left out."""
         rows = tuple(HeadlineRow.from_json(k, v) for k, v in (summ.get("variants") or {}).items()

@@ -15,8 +15,10 @@ Units: arcsec, km, samples.
 
 from __future__ import annotations
 
+import itertools
 import math
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import pandas as pd
 
@@ -311,7 +313,7 @@ def _claim_pixels(t1, plan: Plan) -> dict:
         # data the misalignment needs
         bounds = [bound_arcsec(r) for _, r in g.iterrows()]
         blind = [b > target for b in bounds]
-        inc = not any(st) and not any(blind) and all(b > a for a, b in zip(dd, dd[1:]))
+        inc = not any(st) and not any(blind) and all(b > a for a, b in itertools.pairwise(dd))
         px = ", ".join(f"{p:g}" for p in g["pixel_sigma3_px"].astype(float))
         text = (f"{', '.join(lab if s else fmt(x) for lab, s, x in zip(labs, st, dd))} samples at {px} px"
                 + (f" (bound {', '.join(fmt(b) for b in bounds)} arcsec, above {target:g} arcsec: not identifiable)"

@@ -14,7 +14,6 @@ import pandas as pd
 from opnav.approach.summaries import HeadlineSummary, nav_note
 from opnav.core.verdicts import NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED
 
-
 #: floors for values published with few digits (module docstring)
 ABS_TOL_A = {"arcsec": 0.5, "samples": 0.0, "km": 0.0}
 
@@ -49,7 +48,7 @@ def rows_paper_a(table1: pd.DataFrame, summary: HeadlineSummary, pub: dict) -> l
             if pd.isna(pv) or not isinstance(pv, (int, float)):
                 continue
             name = pc[len("pub_"):]
-            base = name[: -len("_mean")] if name.endswith("_mean") else name
+            base = name.removesuffix("_mean")
             ours_col = next((c for c in (f"{base}_mean", base) if c in table1.columns), None)
             if ours_col is None:
                 continue

@@ -25,8 +25,8 @@ def identifiability_text(setup: Setup | dict, x1: pd.DataFrame) -> str:
     target = setup.accuracy_target_arcsec
     s = setup.segments
     lines = ["# A-X1: what the data can tell about the camera misalignment", "",
-             f"Profile segments: N0 = {s.N0}, N = {s.N}, M = {s.M}, L = {s.L} ({s.mode}); "
-             f"the paper claims an accuracy better than {target:g} arcsec (published).", ""]
+             (f"Profile segments: N0 = {s.N0}, N = {s.N}, M = {s.M}, L = {s.L} ({s.mode}); "
+             f"the paper claims an accuracy better than {target:g} arcsec (published)."), ""]
     for _, r in x1.iterrows():
         v = r["variant"]
         diag = " (DIAGNOSTIC: the E-step reference is the true state, which the measurements do not provide)" \
@@ -83,8 +83,8 @@ def identifiability_text(setup: Setup | dict, x1: pd.DataFrame) -> str:
             lines.append("  " + "; ".join(extra) + ".")
         if not r["tz_observable"]:
             lines.append("  tz (roll about the boresight) is unobservable: its bound stays at the diffuse prior.")
-    lines += ["", "Any published accuracy finer than a variant's CRLB cannot come from an unbiased estimator "
-              "using that variant's measurements and prior; a match there would be luck or extra information."]
+    lines += ["", ("Any published accuracy finer than a variant's CRLB cannot come from an unbiased estimator "
+              "using that variant's measurements and prior; a match there would be luck or extra information.")]
     return "\n".join(lines) + "\n"
 
 

@@ -61,7 +61,7 @@ def _label_or(r, text: str) -> str:
     return text
 
 
-def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+def compact_a_t1(df: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
     """A-T1 for the page: one table per scenario variant, ours beside published.
 
     Estimates are mean ± standard deviation over the noise seeds (arcsec);
@@ -93,7 +93,7 @@ def compact_a_t1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return out
 
 
-def compact_a_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+def compact_a_x1(df: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
     """A-X1 for the page: CRLB per variant beside the EM and ML estimates' RMS error."""
     rows = []
     for _, r in df.iterrows():
@@ -112,7 +112,7 @@ def compact_a_x1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return [("", pd.DataFrame(rows))]
 
 
-def compact_a_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+def compact_a_x2(df: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
     """A-X2 for the page: EM-EKF vs augmented EKF vs batch ML, headline case and all cases."""
     rows = []
     for _, r in df.iterrows():
@@ -131,7 +131,7 @@ def compact_a_x2(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
     return [("", pd.DataFrame(rows))]
 
 
-def compact_a_p1(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
+def compact_a_p1(df: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
     """A-P1 for the page: the peer UKF beside the paper's estimators, estimate, own 3-sigma, bound."""
     rows = []
     for _, r in df.iterrows():

@@ -49,9 +49,10 @@ noise realisation". Every ``cause`` is one sentence generated from the numbers.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any
 
 import pandas as pd
 import yaml
@@ -477,7 +478,7 @@ def counts(df: pd.DataFrame) -> dict:
     out: dict = {}
     for p, g in df.groupby("paper"):
         c = g["verdict"].value_counts().to_dict()
-        out[p] = {"n_claims": int(len(g)), **{v: int(c.get(v, 0)) for v in VERDICTS}}
+        out[p] = {"n_claims": len(g), **{v: int(c.get(v, 0)) for v in VERDICTS}}
     return out
 
 
@@ -573,9 +574,9 @@ def limitations(df: pd.DataFrame) -> str:
     choice = d[d["verdict"].isin([DEPENDS, NOT_TESTED])]
     easy = d[d["verdict"] == REPRODUCED]
     hard = d[d["verdict"].isin([NOT_REPRODUCED, NOT_REPRODUCIBLE])]
-    s = ["Both papers leave the camera, the geometry and (paper A) the segment sizes unstated, so every "
+    s = [("Both papers leave the camera, the geometry and (paper A) the segment sizes unstated, so every "
          "verdict is conditional on the readings listed in docs/modelling-choices.md; a different reading "
-         "could change a verdict, and the published runs' own noise realisations cannot be recovered."]
+         "could change a verdict, and the published runs' own noise realisations cannot be recovered.")]
     if len(choice):
         s.append(f"Of the {len(d)} claims, {len(choice)} hinge on such a reading or cannot be tested by our runs ("
                  + join([r.claim_id for r in choice.itertuples()]) + ").")

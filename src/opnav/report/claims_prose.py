@@ -8,7 +8,8 @@ fixed text about a result: every sentence names the claims the table puts in its
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING, Iterable, Mapping
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING
 
 from opnav.report.manuscript import cell_text, prose_tex, sentence
 
@@ -84,7 +85,7 @@ def group_sentences(grp: list[Mapping], verdict: str, said: set | None = None) -
     return " ".join(out)
 
 
-def conclusion_text(df: "pd.DataFrame") -> str:
+def conclusion_text(df: pd.DataFrame) -> str:
     """The conclusion (plain text), each finding once: per paper, what reproduced as written,
     then every other group as page 1 words it (:func:`group_sentences`), nothing dropped."""
     rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
@@ -101,13 +102,13 @@ def conclusion_text(df: "pd.DataFrame") -> str:
     return " ".join(out)
 
 
-def limitations_text(df: "pd.DataFrame") -> str:
+def limitations_text(df: pd.DataFrame) -> str:
     """The limitations (plain text), from the claims table: what every verdict is conditional
     on, which claims hinge on an open choice directly, and what cannot be recovered."""
     rows = [dict(r) for _, r in df.iterrows()] if len(df) else []
     hinge = [r["claim_id"] for r in rows if r["verdict"] in ("depends_on_choice", "not_tested", "unstable")]
-    s = ["Every verdict is conditional on our readings of what the papers leave open, listed in the "
-         "table of what we did differently beside the papers' own values; a different reading could change a verdict"]
+    s = [("Every verdict is conditional on our readings of what the papers leave open, listed in the "
+         "table of what we did differently beside the papers' own values; a different reading could change a verdict")]
     if hinge:
         s.append(f"{_ids(hinge)} {'hinge' if len(hinge) > 1 else 'hinges'} on such a reading, or on a test "
                  "our runs cannot make, directly")
@@ -116,7 +117,7 @@ def limitations_text(df: "pd.DataFrame") -> str:
     return " ".join(sentence(x) for x in s)
 
 
-def abstract_findings(df: "pd.DataFrame") -> str:
+def abstract_findings(df: pd.DataFrame) -> str:
     """The findings of page 1 in plain sentences (plain text; :func:`prose_tex` makes it LaTeX),
     generated from the claims table: per paper, the verdict counts, then each group of claims
     not reproduced as written (:func:`group_sentences`, in :data:`NOT_OK`'s order). Groups are
@@ -145,14 +146,14 @@ def abstract_findings(df: "pd.DataFrame") -> str:
     return " ".join(" ".join(s) for s in per_paper.values())
 
 
-def page_one_abstract_tex(df: "pd.DataFrame", sample_sentence: str = "") -> str:
+def page_one_abstract_tex(df: pd.DataFrame, sample_sentence: str = "") -> str:
     """The generated part of page 1's abstract as LaTeX: the findings and, for a quick-profile
     table, the sentence that its sample is too small for verdicts (first)."""
     text = abstract_findings(df)
     return prose_tex(" ".join(t for t in (sample_sentence, text) if t)) + "\n"
 
 
-def sample_sentence_of(df: "pd.DataFrame") -> str:
+def sample_sentence_of(df: pd.DataFrame) -> str:
     """The claims table's own sentence on its sample (quick profile: too small for verdicts);
     empty for a full build or a table without the ``sample`` column."""
     if "sample" not in df.columns:

@@ -9,8 +9,9 @@ there or here, so the table follows the configuration a build ran with.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import yaml
 
@@ -84,8 +85,8 @@ def latex(table: list[dict]) -> str:
     """The choices as a LaTeX tabular (wrapping text columns; ``where`` as a reference)."""
     from opnav.report.manuscript import prose_tex
 
-    lines = [r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.22\linewidth}"
-             r">{\raggedright\arraybackslash}p{0.4\linewidth}>{\raggedright\arraybackslash}p{0.17\linewidth}l@{}}",
+    lines = [(r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.22\linewidth}"
+             r">{\raggedright\arraybackslash}p{0.4\linewidth}>{\raggedright\arraybackslash}p{0.17\linewidth}l@{}}"),
              r"\toprule", r"paper & choice & ours & paper & shown in \\", r"\midrule"]
     for i, r in enumerate(table):
         if i and r["paper"] != table[i - 1]["paper"]:

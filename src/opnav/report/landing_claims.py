@@ -16,9 +16,15 @@ converge); the margins they are judged against are the plan's. Units: m, s, %, d
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
-from opnav.landing.claims_summary import ENVELOPES, Interval, LandingSummary, ScenarioClaims
+from opnav.landing.claims_summary import (
+    ENVELOPES,
+    Interval,
+    LandingSummary,
+    ScenarioClaims,
+)
 from opnav.report import claims as C
 from opnav.report.claims import Plan, fmt, join
 
@@ -52,7 +58,7 @@ def _below(iv: dict[str, Interval], margin: float) -> bool:
 
 
 def _iv_text(iv: dict[str, Interval], what: str) -> str:
-    q, (m, lo, hi, r) = next(iter(iv.items()))
+    m, lo, hi, r = next(iter(iv.values()))
     return f"{m:+.2g} m [{lo:+.2g}, {hi:+.2g}] against {what} {fmt(r)} m"
 
 
@@ -69,10 +75,10 @@ def _accuracy_claim(cid: str, head: str, scen: dict[str, ScenarioClaims], plan: 
     compared, controls = list(v.get("compared") or ["svd"]), list(v.get("controls") or [])
     if superior:
         margin = plan.margin(cid, "superiority_margin_m")
-        test = lambda iv: _below(iv, margin)  # noqa: E731
+        test = lambda iv: _below(iv, margin)
     else:
         rel = plan.margin(cid, "margin_rel")
-        test = lambda iv: _within(iv, rel)  # noqa: E731
+        test = lambda iv: _within(iv, rel)
     pick_max = plan.margin(cid, "same_pick_max_pct")
     per, why, texts, flags = {}, {}, {}, []
     for name, s in scen.items():

@@ -13,10 +13,11 @@ from __future__ import annotations
 import math
 import numbers
 import re
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Mapping
+from typing import TYPE_CHECKING, Any
 
-from opnav.core.tables import MISSING, is_missing  # noqa: F401 (re-exported)
+from opnav.core.tables import MISSING, is_missing
 
 if TYPE_CHECKING:  # annotations only: pandas is imported where a frame is made
     import pandas as pd
@@ -249,7 +250,7 @@ def prose_tex(text: str) -> str:
 TABLE1_GROUPS = ("literal", "roll", "roll+squarem", "roll+growing+squarem")
 
 
-def table1_grouped_latex(t1: "pd.DataFrame", groups: Iterable[str] = TABLE1_GROUPS) -> str:
+def table1_grouped_latex(t1: pd.DataFrame, groups: Iterable[str] = TABLE1_GROUPS) -> str:
     """Paper A's Table 1 as one LaTeX table: a row per case, the published values and each
     variant as a column group (t_x, t_y in arcsec, navigation error after compensation in
     km); a variant's cell is marked where its run did not converge (the A-T1 label)."""
@@ -315,13 +316,13 @@ def format_sci(x: float) -> str:
 
 # ------------------------------------------------------------ the claims table in LaTeX
 
-def claims_glance_latex(df: "pd.DataFrame") -> str:
+def claims_glance_latex(df: pd.DataFrame) -> str:
     """The at-a-glance table as a LaTeX tabular (wrapping text columns, one row per claim)."""
     from opnav.report.claims import VERDICT_SHORT
 
-    lines = [r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.38\linewidth}"
+    lines = [(r"\begin{tabular}{@{}l>{\raggedright\arraybackslash}p{0.38\linewidth}"
              r">{\raggedright\arraybackslash}p{0.16\linewidth}>{\raggedright\arraybackslash}p{0.25\linewidth}"
-             r">{\raggedright\arraybackslash}p{0.1\linewidth}@{}}", r"\toprule",
+             r">{\raggedright\arraybackslash}p{0.1\linewidth}@{}}"), r"\toprule",
              r"id & claim & published & ours, as written & verdict \\", r"\midrule"]
     for i, r in enumerate(df.itertuples()):
         if i and r.paper != df.iloc[i - 1]["paper"]:
@@ -332,7 +333,7 @@ def claims_glance_latex(df: "pd.DataFrame") -> str:
     return "\n".join(lines) + "\n"
 
 
-def claims_detail_latex(df: "pd.DataFrame") -> str:
+def claims_detail_latex(df: pd.DataFrame) -> str:
     """Every claim with all its columns, as a LaTeX description list (the claims table in full)."""
     from opnav.report.claims import VERDICT_TEXT
 
@@ -367,7 +368,7 @@ def sentence(text: str) -> str:
 
 
 # ------------------------------------------------------------ page 1: the run's cost
-def run_info_tex(bench_tables: Iterable["pd.DataFrame"], cpus: int | None, machine: str) -> str:
+def run_info_tex(bench_tables: Iterable[pd.DataFrame], cpus: int | None, machine: str) -> str:
     r"""``\RunInfo``: the measured cost of the build's heavy jobs (the sum of their Snakemake
     benchmark files: wall seconds ``s`` and ``cpu_time``) and the machine, one sentence."""
     wall = cpu = 0.0
@@ -411,7 +412,7 @@ def _header_tex(text: str, width: int = HEADER_WRAP) -> str:
     return r"\begin{tabular}[b]{@{}l@{}}" + r" \\ ".join(latex_escape(line) for line in lines) + r"\end{tabular}"
 
 
-def legible_view(df: "pd.DataFrame") -> "pd.DataFrame":
+def legible_view(df: pd.DataFrame) -> pd.DataFrame:
     """The table as printed: transposed (first column as the header row, a row per
     quantity) when it is much wider than long, else as it is."""
     if df.shape[1] > TRANSPOSE_COLS and len(df) * 2 < df.shape[1] and len(df):
@@ -422,7 +423,7 @@ def legible_view(df: "pd.DataFrame") -> "pd.DataFrame":
     return df
 
 
-def _key_columns(df: "pd.DataFrame") -> int:
+def _key_columns(df: pd.DataFrame) -> int:
     """How many leading columns name a row (text columns, at most two): repeated in every part."""
     n = 0
     for c in df.columns[:2]:
@@ -433,7 +434,7 @@ def _key_columns(df: "pd.DataFrame") -> int:
     return max(n, 1)
 
 
-def _tabular(v: "pd.DataFrame") -> str:
+def _tabular(v: pd.DataFrame) -> str:
     lines = [r"\begin{tabular}{@{}" + "l" * v.shape[1] + "@{}}", r"\toprule",
              " & ".join(_header_tex(c) for c in v.columns) + r" \\", r"\midrule"]
     for row in v.itertuples(index=False):
@@ -442,7 +443,7 @@ def _tabular(v: "pd.DataFrame") -> str:
     return "\n".join(lines)
 
 
-def legible_latex(df: "pd.DataFrame", max_cols: int = 7) -> str:
+def legible_latex(df: pd.DataFrame, max_cols: int = 7) -> str:
     """A booktabs tabular for the manuscript that stays legible at print size: headers wrapped
     onto short lines, wide-and-short tables transposed (:func:`legible_view`), and a table
     still wider than ``max_cols`` columns split into stacked parts that repeat the columns
@@ -474,7 +475,7 @@ def latin_text(text: str) -> str:
     return head + (f", {rest}" if rest and _CJK.search(rest) is None else "")
 
 
-def plan_latex(plan: "pd.DataFrame") -> str:
+def plan_latex(plan: pd.DataFrame) -> str:
     """The analysis plan (results/paper/analysis_plan.csv) as a LaTeX description list, one
     item per claim: the paper's sentence and where, what is compared and how, the margin with
     its reason, the variants and controls, what the verdict depends on."""
@@ -496,7 +497,7 @@ def plan_latex(plan: "pd.DataFrame") -> str:
     return "\n".join(out) + "\n"
 
 
-def inputs_latex(inputs: "pd.DataFrame") -> str:
+def inputs_latex(inputs: pd.DataFrame) -> str:
     """The inputs we derive (results/paper/inputs.csv) as a description list."""
     out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
     for r in inputs.to_dict("records"):

@@ -33,7 +33,11 @@ def findings_block(df: pd.DataFrame) -> str:
     """The block (Markdown): per paper its verdict counts and the cause of its largest group
     not reproduced as written (at most four sentences), then id | claim | verdict."""
     from opnav.report.claims import VERDICT_SHORT
-    from opnav.report.claims_prose import NOT_OK, group_sentences, verdict_counts_sentence
+    from opnav.report.claims_prose import (
+        NOT_OK,
+        group_sentences,
+        verdict_counts_sentence,
+    )
     from opnav.report.verdict_plot import short_claim
 
     if "sample" in df.columns and (df["sample"] != "full").any():

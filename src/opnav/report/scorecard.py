@@ -8,8 +8,17 @@ from __future__ import annotations
 
 import pandas as pd
 
-from opnav.core.verdicts import (K_SPREAD, MAX_BAND_REL, NOT_REPRODUCED, NOT_REPRODUCIBLE,  # noqa: F401
-                            REL_TOL, REPRODUCED, Verdict, judge, tolerance)
+from opnav.core.verdicts import (  # noqa: F401
+    K_SPREAD,
+    MAX_BAND_REL,
+    NOT_REPRODUCED,
+    NOT_REPRODUCIBLE,
+    REL_TOL,
+    REPRODUCED,
+    Verdict,
+    judge,
+    tolerance,
+)
 
 
 def score_rows(rows: list[dict]) -> pd.DataFrame:

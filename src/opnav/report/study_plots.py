@@ -14,7 +14,7 @@ a decade or more); otherwise the values are categories, in the study's order.
 from __future__ import annotations
 
 import math
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
@@ -22,7 +22,6 @@ import pandas as pd
 from opnav.core import figures
 from opnav.studies.metrics import METRICS, shown_statistic
 from opnav.studies.values import slug
-
 
 _LINESTYLES = ("-", "--", "-.", ":")
 
