@@ -410,7 +410,7 @@ def test_descent_record_equals_numpy_and_scipy(seed, B, att):
     err_r, err_v, err_th = (np.full((B, K, 3), np.nan) for _ in range(3))
     sig = np.full((B, K, 9), np.nan)
     sig_yaw, nees_r, nees_v = (np.full((B, K), np.nan) for _ in range(3))
-    _record(r_t, v_t, R_t, s.r, s.v, s.R, s.P, k, err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v)
+    _record((r_t, v_t, R_t), (s.r, s.v, s.R, s.P), k, (err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v))
     assert np.isnan(err_r[:, [0, 2]]).all()                      # only column k written
     for b in range(B):
         er, ev = r_t - s.r[b], v_t - s.v[b]

@@ -87,7 +87,7 @@ def _jacobian_batch(A, C, U, H):
 
 
 @kernel
-def _augmented_samples(k0, k1, z, Phi, C, u_ref, Rvar, Qa, linear, A_lin, U_lin, y, P, th_out, Pth_out, xf, ptr, ll):
+def _augmented_samples(k0, k1, z, model, lin, state, out):
     """The augmented EKF (module docstring) over samples ``k0..k1-1`` for every seed, in place
     on ``y`` (S, 9) and ``P`` (S, 9, 9): time update with ``F = diag(Phi_k, I)`` and ``Qa``
     (:func:`opnav.approach.kalman._predict_mean1`, ``_predict_cov1``), then the Mars update
@@ -95,7 +95,13 @@ def _augmented_samples(k0, k1, z, Phi, C, u_ref, Rvar, Qa, linear, A_lin, U_lin,
     filter's own estimate (``linear``: ``H`` with ``A_lin`` and ``U_lin[k]`` fixed and
     ``z_hat = u_ref + H y``); ``ll`` (S,) gathers the innovation log-likelihood, and
     ``th_out, Pth_out, xf, ptr`` (S, n+1, ...) the outputs of every sample (theta in arcsec).
-    Rvar (n+1, S, 3)."""
+
+    ``model = (Phi, C, u_ref, Rvar, Qa)`` the window (Rvar (n+1, S, 3)), ``lin = (linear,
+    A_lin, U_lin)``, ``state = (y, P)``, ``out = (th_out, Pth_out, xf, ptr, ll)``."""
+    Phi, C, u_ref, Rvar, Qa = model
+    linear, A_lin, U_lin = lin
+    y, P = state
+    th_out, Pth_out, xf, ptr, ll = out
     S = y.shape[0]
     F = np.zeros((9, 9))
     for i in range(6, 9):
@@ -144,7 +150,7 @@ def _augmented_samples(k0, k1, z, Phi, C, u_ref, Rvar, Qa, linear, A_lin, U_lin,
                 _jacobian1(A, C[k], U, H)
                 for i in range(3):
                     nu[i] = z[s, k, i] - (A[i, 0] * u[0] + A[i, 1] * u[1] + A[i, 2] * u[2])
-            det = _condition1(True, y[s], P[s], H, 0, Rvar[k, s], nu, True, K, Sinv, PHt, Sm, T1, T2)
+            det = _condition1(True, y[s], P[s], (H, 0, Rvar[k, s], nu), True, (K, Sinv), (PHt, Sm, T1, T2))
             ll[s] += _loglik1(nu, Sinv, det)
             for i in range(3):
                 th_out[s, k, i] = y[s, 6 + i]
@@ -196,13 +202,14 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
     U_lin = skew(np.asarray(u_lin, float)) * ARCSEC if linear else np.zeros((n + 1, 3, 3))
     Rvar = win.Rvar if win.Rvar.ndim == 3 else win.Rvar[:, None, :]
     c = carray
-    args = (c(z), c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))), c(Qa), linear,
-            c(A_lin), c(U_lin))
+    model = (c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))), c(Qa))
+    lin = (linear, c(A_lin), c(U_lin))
+    zc = c(z)
     # star images (a linear measurement of theta alone, opnav.approach.stars) between compiled stretches
     stars = [] if win.stars is None or win.star_y is None else [(int(k), i) for i, k in enumerate(win.stars.idx)]
     k0 = 1
     for k, i in [*stars, (n, None)]:
-        _augmented_samples(k0, k + 1, *args, y, P, th_out, Pth_out, xf, ptr, ll)
+        _augmented_samples(k0, k + 1, zc, model, lin, (y, P), (th_out, Pth_out, xf, ptr, ll))
         k0 = k + 1
         if i is None:
             continue

@@ -110,12 +110,19 @@ def measurement_jacobian(theta: np.ndarray, C: np.ndarray) -> np.ndarray:
 
 
 @kernel(inline="always")
-def ekf_step(xprev, Pprev, Phi, Q, A, C, u_ref, z, rvar, x, P, K, Sinv, nu, Hr, FP, PHt, Sm, T):
+def ekf_step(prev, dyn, obs, post, work):
     """One sample of the EM-EKF (eq. 6): ``H_r = -A_m C_k`` into ``Hr``, the time update of
-    ``(xprev, Pprev)`` into ``(x, P)`` (``_predict_mean1``, ``_predict_cov1``), the innovation
-    ``nu = z - A_m u_ref - H_r x`` (the model is linear in the state) and the update in place
-    (``_condition1``, K, Sinv). Scratch: FP (6, 6), PHt (6, 3), Sm (3, 3), T (6, 6).
-    Returns det S."""
+    ``prev = (xprev, Pprev)`` with ``dyn = (Phi, Q)`` into ``(x, P)`` (``_predict_mean1``,
+    ``_predict_cov1``), the innovation ``nu = z - A_m u_ref - H_r x`` (the model is linear in
+    the state) of ``obs = (A, C, u_ref, z, rvar)`` (A = A_m(theta), C = A_c^i,k, km, km^2) and
+    the update in place (``_condition1``). ``post = (x, P, K, Sinv, nu, Hr)`` receives the
+    sample's filter quantities; ``work = (FP, PHt, Sm, T)`` scratch (6, 6), (6, 3), (3, 3),
+    (6, 6). Returns det S."""
+    xprev, Pprev = prev
+    Phi, Q = dyn
+    A, C, u_ref, z, rvar = obs
+    x, P, K, Sinv, nu, Hr = post
+    FP, PHt, Sm, T = work
     for i in range(3):
         for j in range(3):
             Hr[i, j] = -(A[i, 0] * C[0, j] + A[i, 1] * C[1, j] + A[i, 2] * C[2, j])
@@ -124,24 +131,26 @@ def ekf_step(xprev, Pprev, Phi, Q, A, C, u_ref, z, rvar, x, P, K, Sinv, nu, Hr, 
     for i in range(3):
         nu[i] = (z[i] - (A[i, 0] * u_ref[0] + A[i, 1] * u_ref[1] + A[i, 2] * u_ref[2])
                  - (Hr[i, 0] * x[0] + Hr[i, 1] * x[1] + Hr[i, 2] * x[2]))
-    return _condition1(True, x, P, Hr, 0, rvar, nu, False, K, Sinv, PHt, Sm, T, T)
+    return _condition1(True, x, P, (Hr, 0, rvar, nu), False, (K, Sinv), (PHt, Sm, T, T))
 
 
 @kernel
-def filter_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, keep_pred, xf, Pf, xp, Pp, K, Sinv, nu, Hr, ll, KH):
+def filter_window(z, A, start, model, keep_pred, out):
     """The EM-EKF (eq. 6, :func:`run_filter`) over one window for every seed, :func:`ekf_step`
     by step.
 
-    z (S, n+1, 3); A (S, 3, 3) = A_m(theta) per seed; x0 (S, 6); P0 (S, 6, 6); Phi (n+1, 6, 6);
-    C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3); Q (6, 6). Fills xf, Pf, (xp, Pp when
-    ``keep_pred``), K (S, n+1, 6, 3), Sinv (S, n+1, 3, 3), nu (S, n+1, 3), Hr (S, n+1, 3, 3)
-    (sample 0: ``-A_m C_0``), the log-likelihood ll (S,) and KH (S, 6, 6) of the last sample.
-    Returns the smallest det S (not positive: the filter broke)."""
+    z (S, n+1, 3); A (S, 3, 3) = A_m(theta) per seed; ``start = (x0 (S, 6), P0 (S, 6, 6))``;
+    the window's ``model = (Phi (n+1, 6, 6), C (n+1, 3, 3), u_ref (n+1, 3), Rvar (n+1, S, 3),
+    Q (6, 6))``. Fills ``out = (xf, Pf, xp, Pp, K, Sinv, nu, Hr, ll, KH)``: xf, Pf, (xp, Pp
+    when ``keep_pred``), K (S, n+1, 6, 3), Sinv (S, n+1, 3, 3), nu (S, n+1, 3), Hr
+    (S, n+1, 3, 3) (sample 0: ``-A_m C_0``), the log-likelihood ll (S,) and KH (S, 6, 6) of
+    the last sample. Returns the smallest det S (not positive: the filter broke)."""
+    x0, P0 = start
+    Phi, C, u_ref, Rvar, Q = model
+    xf, Pf, xp, Pp, K, Sinv, nu, Hr, ll, KH = out
     S, n1 = z.shape[0], z.shape[1]
     FP = np.empty((6, 6))
-    PHt = np.empty((6, 3))
-    Sm = np.empty((3, 3))
-    T = np.empty((6, 6))
+    work = (FP, np.empty((6, 3)), np.empty((3, 3)), np.empty((6, 6)))
     dmin = np.inf
     for s in range(S):
         for i in range(3):
@@ -153,8 +162,8 @@ def filter_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, keep_pred, xf, Pf, xp, P
                 Pf[s, 0, i, j] = P0[s, i, j]
         acc_ll = 0.0
         for k in range(1, n1):
-            det = ekf_step(xf[s, k - 1], Pf[s, k - 1], Phi[k], Q, A[s], C[k], u_ref[k], z[s, k], Rvar[k, s],
-                           xf[s, k], Pf[s, k], K[s, k], Sinv[s, k], nu[s, k], Hr[s, k], FP, PHt, Sm, T)
+            det = ekf_step((xf[s, k - 1], Pf[s, k - 1]), (Phi[k], Q), (A[s], C[k], u_ref[k], z[s, k], Rvar[k, s]),
+                           (xf[s, k], Pf[s, k], K[s, k], Sinv[s, k], nu[s, k], Hr[s, k]), work)
             if keep_pred:  # the predicted moments again (the step updated them in place)
                 _predict_mean1(xf[s, k - 1], Phi[k], xp[s, k])
                 _predict_cov1(Pf[s, k - 1], Phi[k], Q, Pp[s, k], FP)
@@ -195,9 +204,9 @@ def run_filter(z: np.ndarray, theta: np.ndarray, x0: np.ndarray, P0: np.ndarray,
     ll = np.empty(S)
     KH = np.empty((S, 6, 6))
     c = kalman.carray
-    dmin = filter_window(c(z), c(A), c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6))),
-                                c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))),
-                                c(win.Q), predicted, xf, Pf, xp, Pp, Ks, Sinvs, nus, Hrs, ll, KH)
+    dmin = filter_window(c(z), c(A), (c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6)))),
+                         (c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))), c(win.Q)),
+                         predicted, (xf, Pf, xp, Pp, Ks, Sinvs, nus, Hrs, ll, KH))
     if not dmin > 0:
         raise FloatingPointError("innovation covariance not positive definite")
     return FilterResult(xf, Pf, xp if predicted else None, Pp if predicted else None, ll, KH, Ks, Sinvs, nus, Hrs)

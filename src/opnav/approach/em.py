@@ -51,14 +51,19 @@ class EStats:
 
 
 @kernel(inline="always")
-def estep_add(z, xs, Ps, C, u_ref, rvar, N, b, m, M, CP):
-    """Add one sample's E-step terms to ``N`` (3, 3) and ``b`` (3,) (see :func:`estep`).
+def estep_add(obs, sm, stats, work):
+    """Add one sample's E-step terms to ``stats = (N (3, 3), b (3,))`` (see :func:`estep`).
 
-    z (3,); xs (>=3,), Ps (>=3, >=3) smoothed moments (position first); C (3, 3); u_ref (3,);
-    rvar (3,). With the mean ``m = u_ref - C x_r`` and second moment ``M = C P_rr C^T + m m^T``
-    of ``u``, ``w = 1/R`` and ``U = [u x]`` (``U_ik = -eps_ijk u_j``):
+    ``obs = (z, C, u_ref, rvar)``: the measurement (3,), A_c^i (3, 3), the reference vector
+    (3,) km and the noise variances (3,) km^2; ``sm = (xs (>=3,), Ps (>=3, >=3))`` the smoothed
+    moments (position first). With the mean ``m = u_ref - C x_r`` and second moment
+    ``M = C P_rr C^T + m m^T`` of ``u``, ``w = 1/R`` and ``U = [u x]`` (``U_ik = -eps_ijk u_j``):
     ``N_kl += sum_i w_i eps_ijk eps_inl M_jn``, ``b_k += sum_i w_i eps_ijk (m_j z_i - M_ji)``.
-    Scratch: m (3,), M, CP (3, 3)."""
+    ``work = (m (3,), M, CP (3, 3))`` scratch."""
+    z, C, u_ref, rvar = obs
+    xs, Ps = sm
+    N, b = stats
+    m, M, CP = work
     for i in range(3):
         m[i] = u_ref[i] - (C[i, 0] * xs[0] + C[i, 1] * xs[1] + C[i, 2] * xs[2])
     for i in range(3):
@@ -84,26 +89,27 @@ def estep_add(z, xs, Ps, C, u_ref, rvar, N, b, m, M, CP):
 def _estep_window(z, xs, Ps, C, u_ref, Rvar, N, b):
     """:func:`estep_add` over samples 1..n for every seed: z (S, n+1, 3); xs (S, n+1, >=3),
     Ps (S, n+1, >=3, >=3); C (n+1, 3, 3); u_ref (n+1, 3); Rvar (n+1, S, 3); N (S, 3, 3), b (S, 3)."""
-    m = np.empty(3)
-    M = np.empty((3, 3))
-    CP = np.empty((3, 3))
+    work = (np.empty(3), np.empty((3, 3)), np.empty((3, 3)))
     for s in range(z.shape[0]):
         N[s, :, :] = 0.0
         b[s, :] = 0.0
         for t in range(1, z.shape[1]):
-            estep_add(z[s, t], xs[s, t], Ps[s, t], C[t], u_ref[t], Rvar[t, s], N[s], b[s], m, M, CP)
+            estep_add((z[s, t], C[t], u_ref[t], Rvar[t, s]), (xs[s, t], Ps[s, t]), (N[s], b[s]), work)
 
 
 @kernel
-def _em_map_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, N, b, ll, x_last, P_last):
+def _em_map_window(z, A, start, model, out):
     """The E-step statistics of one EM map for every seed, seed by seed in one pass: the EKF
     forward (:func:`opnav.approach.ekf.ekf_step`), the position Bryson-Frazier smoother
     backward (:func:`opnav.approach.smoother.bf_moments`, ``bf_back``) and :func:`estep_add`
     at each sample as its smoothed moments come out (summed n..1), with per-seed buffers
-    of one window (no (seeds x samples) arrays). Arguments as
-    :func:`opnav.approach.ekf.filter_window`; fills N (S, 3, 3), b (S, 3), the log-likelihood
-    ll (S,) and the filtered state at the last sample x_last (S, 6), P_last (S, 6, 6).
-    Returns the smallest det S."""
+    of one window (no (seeds x samples) arrays). ``z, A, start, model`` as
+    :func:`opnav.approach.ekf.filter_window`; fills ``out = (N, b, ll, x_last, P_last)``:
+    N (S, 3, 3), b (S, 3), the log-likelihood ll (S,) and the filtered state at the last sample
+    x_last (S, 6), P_last (S, 6, 6). Returns the smallest det S."""
+    x0, P0 = start
+    Phi, C, u_ref, Rvar, Q = model
+    N, b, ll, x_last, P_last = out
     S, n1 = z.shape[0], z.shape[1]
     xf = np.empty((n1, 6))
     Pf = np.empty((n1, 6, 6))
@@ -111,21 +117,14 @@ def _em_map_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, N, b, ll, x_last, P_las
     Sinv = np.empty((n1, 3, 3))
     nu = np.empty((n1, 3))
     Hr = np.empty((n1, 3, 3))
-    FP = np.empty((6, 6))
-    PHt = np.empty((6, 3))
-    Sm = np.empty((3, 3))
     T = np.empty((6, 6))
+    step_work = (np.empty((6, 6)), np.empty((6, 3)), np.empty((3, 3)), T)      # ekf_step's
     L = np.empty((6, 6))
     lv = np.empty(6)
-    KH = np.empty((6, 3))
-    Lt = np.empty((6, 6))
-    lt = np.empty(6)
-    HS = np.empty((3, 3))
+    back_work = (np.empty((6, 3)), T, np.empty((6, 6)), np.empty(6), np.empty((3, 3)))  # bf_back's
     xs = np.empty(3)
     Ps = np.empty((3, 3))
-    m = np.empty(3)
-    M = np.empty((3, 3))
-    CP = np.empty((3, 3))
+    estep_work = (np.empty(3), np.empty((3, 3)), np.empty((3, 3)))
     dmin = np.inf
     for s in range(S):
         for i in range(6):
@@ -134,8 +133,8 @@ def _em_map_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, N, b, ll, x_last, P_las
                 Pf[0, i, j] = P0[s, i, j]
         acc_ll = 0.0
         for k in range(1, n1):
-            det = ekf_step(xf[k - 1], Pf[k - 1], Phi[k], Q, A[s], C[k], u_ref[k], z[s, k], Rvar[k, s],
-                           xf[k], Pf[k], K[k], Sinv[k], nu[k], Hr[k], FP, PHt, Sm, T)
+            det = ekf_step((xf[k - 1], Pf[k - 1]), (Phi[k], Q), (A[s], C[k], u_ref[k], z[s, k], Rvar[k, s]),
+                           (xf[k], Pf[k], K[k], Sinv[k], nu[k], Hr[k]), step_work)
             dmin = min(dmin, det)
             if det > 0.0:
                 acc_ll += _loglik1(nu[k], Sinv[k], det)
@@ -150,8 +149,8 @@ def _em_map_window(z, A, x0, P0, Phi, C, u_ref, Rvar, Q, N, b, ll, x_last, P_las
         b[s, :] = 0.0
         for k in range(n1 - 1, 0, -1):
             bf_moments(xf[k], Pf[k], L, lv, 0, xs, Ps, T)
-            estep_add(z[s, k], xs, Ps, C[k], u_ref[k], Rvar[k, s], N[s], b[s], m, M, CP)
-            bf_back(K[k], Hr[k], Sinv[k], nu[k], Phi[k], L, lv, KH, T, Lt, lt, HS)
+            estep_add((z[s, k], C[k], u_ref[k], Rvar[k, s]), (xs, Ps), (N[s], b[s]), estep_work)
+            bf_back((K[k], Hr[k], Sinv[k], nu[k]), Phi[k], (L, lv), back_work)
     return dmin
 
 
@@ -222,9 +221,9 @@ def em_map(theta, z, x0, P0, win, tz_tol):
     N, b, ll = np.empty((S, 3, 3)), np.empty((S, 3)), np.empty(S)
     x_last, P_last = np.empty((S, 6)), np.empty((S, 6, 6))
     c = carray
-    dmin = _em_map_window(c(z), c(A), c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6))),
-                          c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))), c(win.Q),
-                          N, b, ll, x_last, P_last)
+    dmin = _em_map_window(c(z), c(A), (c(np.broadcast_to(x0, (S, 6))), c(np.broadcast_to(P0, (S, 6, 6)))),
+                          (c(win.Phi), c(win.C), c(win.u_ref), c(np.broadcast_to(Rvar, (n + 1, S, 3))), c(win.Q)),
+                          (N, b, ll, x_last, P_last))
     if not dmin > 0:
         raise FloatingPointError("innovation covariance not positive definite")
     new, unobs = mstep(_with_stars(N, b, win), theta, tz_tol)

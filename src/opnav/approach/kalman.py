@@ -107,11 +107,16 @@ def _predict_cov1(P, F, Q, Po, FP):
 
 
 @kernel
-def _condition1(has_m, x, P, H, c0, rvar, nu, joseph, K, Sinv, PHt, S, T1, T2):
-    """Measurement update of one member, in place on ``x`` (d,) and ``P`` (d, d) (symmetric:
-    the upper triangle of the result is computed and mirrored); ``H`` (3, c) on the state
-    columns ``c0..c0+c``. Writes the gain ``K`` (d, 3) and ``Sinv`` (3, 3);
-    returns det S. Scratch: ``PHt`` (d, 3), ``S`` (3, 3), ``T1``, ``T2`` (d, d) (Joseph form only)."""
+def _condition1(has_m, x, P, meas, joseph, out, work):
+    """Measurement update of one member, in place on ``x`` (d,) (if ``has_m``) and ``P`` (d, d)
+    (symmetric: the upper triangle of the result is computed and mirrored), Joseph form if
+    ``joseph``. ``meas = (H, c0, rvar, nu)``: ``H`` (3, c) on the state columns ``c0..c0+c``,
+    the noise variances ``rvar`` (3,) and the innovation ``nu`` (3,). ``out = (K, Sinv)``
+    receives the gain (d, 3) and S^-1 (3, 3); returns det S. ``work = (PHt, S, T1, T2)``
+    scratch (d, 3), (3, 3), (d, d), (d, d) (T1, T2 Joseph form only)."""
+    H, c0, rvar, nu = meas
+    K, Sinv = out
+    PHt, S, T1, T2 = work
     d = P.shape[0]
     c = H.shape[1]
     for i in range(d):  # P H^T
@@ -192,16 +197,17 @@ def _predict_batch(m, P, F, Q, mo, Po):
 
 
 @kernel
-def _condition_batch(has_m, m, P, H, c0, rvar, nu, joseph, K, Sinv, det):
+def _condition_batch(has_m, m, P, meas, joseph, out):
+    """:func:`_condition1` of every member: ``meas = (H, c0, rvar, nu)`` with ``H`` and ``rvar``
+    one per member or one row shared; ``out = (K, Sinv, det)``."""
+    H, c0, rvar, nu = meas
+    K, Sinv, det = out
     B, d = P.shape[0], P.shape[1]
-    PHt = np.empty((d, 3))
-    Sm = np.empty((3, 3))
-    T1 = np.empty((d, d))
-    T2 = np.empty((d, d))
+    work = (np.empty((d, 3)), np.empty((3, 3)), np.empty((d, d)), np.empty((d, d)))
     for b in range(B):
         h = b if H.shape[0] > 1 else 0
         r = b if rvar.shape[0] > 1 else 0
-        det[b] = _condition1(has_m, m[b], P[b], H[h], c0, rvar[r], nu[b], joseph, K[b], Sinv[b], PHt, Sm, T1, T2)
+        det[b] = _condition1(has_m, m[b], P[b], (H[h], c0, rvar[r], nu[b]), joseph, (K[b], Sinv[b]), work)
 
 
 @kernel
@@ -326,8 +332,8 @@ def condition_on(m: np.ndarray | None, P: np.ndarray, H: np.ndarray, rvar: np.nd
     else:
         mf, nuf = _flat(m, lead, 1, shared_ok=False).copy(), _flat(nu, lead, 1, shared_ok=False)
     K, Sinv, det = np.empty((B, d, 3)), np.empty((B, 3, 3)), np.empty(B)
-    _condition_batch(m is not None, mf, Pf, _flat(H, lead, 2), c0, _flat(rvar, lead, 1), nuf, joseph,
-                     K, Sinv, det)
+    _condition_batch(m is not None, mf, Pf, (_flat(H, lead, 2), c0, _flat(rvar, lead, 1), nuf), joseph,
+                     (K, Sinv, det))
     return Update(None if m is None else mf.reshape(lead + (d,)), Pf.reshape(lead + (d, d)),
                   K.reshape(lead + (d, 3)), Sinv.reshape(lead + (3, 3)), det.reshape(lead))
 

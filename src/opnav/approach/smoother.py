@@ -68,12 +68,15 @@ def bf_moments(x, P, L, lv, c0, xs, Ps, T):
 
 
 @kernel(inline="always")
-def bf_back(K, Hr, Sinv, nu, Phi, L, lv, KH, T, Lt, lt, HS):
-    """The adjoint from sample k to k-1, in place on ``L`` (Lh) and ``lv`` (lh), with the gain
-    ``K`` (6, 3), ``Hr`` (3, 3, position columns), ``Sinv``, ``nu`` of sample k and
-    ``Phi = Phi_k``: ``Lt = H^T S^-1 H + Ct^T Lh Ct``, ``lt = -H^T S^-1 nu + Ct^T lh``,
-    ``Lh <- Phi^T Lt Phi``, ``lh <- Phi^T lt`` with ``Ct = I - K H``. Scratch: KH (6, 3),
-    T, Lt (6, 6), lt (6,), HS (3, 3)."""
+def bf_back(upd, Phi, adj, work):
+    """The adjoint ``adj = (L, lv)`` (Lh, lh) from sample k to k-1, in place, with the filter's
+    ``upd = (K, Hr, Sinv, nu)`` of sample k (gain (6, 3), H's position columns (3, 3), S^-1,
+    innovation) and ``Phi = Phi_k``: ``Lt = H^T S^-1 H + Ct^T Lh Ct``,
+    ``lt = -H^T S^-1 nu + Ct^T lh``, ``Lh <- Phi^T Lt Phi``, ``lh <- Phi^T lt`` with
+    ``Ct = I - K H``. ``work = (KH, T, Lt, lt, HS)`` scratch (6, 3), (6, 6), (6, 6), (6,), (3, 3)."""
+    K, Hr, Sinv, nu = upd
+    L, lv = adj
+    KH, T, Lt, lt, HS = work
     # Ct differs from I only in its first 3 columns, by -K H_r (6 x 3)
     for i in range(6):
         for j in range(3):
@@ -134,18 +137,15 @@ def _bryson_frazier_window(xf, Pf, K, Hr, Sinv, nu, Phi, c0, xs, Ps):
     S, n1 = xf.shape[0], xf.shape[1]
     L = np.zeros((6, 6))
     lv = np.zeros(6)
-    KH = np.empty((6, 3))
     T = np.empty((6, 6))
-    Lt = np.empty((6, 6))
-    lt = np.empty(6)
-    HS = np.empty((3, 3))
+    work = (np.empty((6, 3)), T, np.empty((6, 6)), np.empty(6), np.empty((3, 3)))
     for s in range(S):
         L[:, :] = 0.0
         lv[:] = 0.0
         for k in range(n1 - 1, -1, -1):
             bf_moments(xf[s, k], Pf[s, k], L, lv, c0, xs[s, k], Ps[s, k], T)
             if k > 0:
-                bf_back(K[s, k], Hr[s, k], Sinv[s, k], nu[s, k], Phi[k], L, lv, KH, T, Lt, lt, HS)
+                bf_back((K[s, k], Hr[s, k], Sinv[s, k], nu[s, k]), Phi[k], (L, lv), work)
 
 
 def bryson_frazier(f: FilterResult, win: Window, cols: slice = slice(None)) -> SmootherResult:

@@ -106,15 +106,19 @@ def _wrap_deg(x):
 
 
 @kernel
-def _record(r_t, v_t, R_t, r, v, R, P, k, err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v) -> None:
-    """Column ``k`` of the per-run tracks from the truth (``r_t``, ``v_t``, ``R_t``
-    at step k) and the estimates of every run (``r`` (B, 3), ``R`` (B, 3, 3), ``P``
-    (B, 12, 12)): errors truth - estimate of position, velocity (m, m/s) and
+def _record(truth, est, k, tracks) -> None:
+    """Column ``k`` of the per-run ``tracks = (err_r, err_v, err_th, sig, sig_yaw, nees_r,
+    nees_v)`` from the ``truth = (r_t, v_t, R_t)`` at step k and the estimates of every run
+    ``est = (r (B, 3), v (B, 3), R (B, 3, 3), P (B, 12, 12))``: errors truth - estimate of
+    position, velocity (m, m/s) and
     attitude (``dtheta`` rad, ``R_true = Exp(-dtheta) R_est``), the filter's
     1-sigma of the 9 navigation states, the 1-sigma (rad) of the heading error
     (the attitude error about the {L} vertical, i.e. along ``R_LtoB e_z`` in our
     body-side ``dtheta``: the attitude part of the unobservable direction,
     ``ekf.nullspace``), and the position and velocity NEES."""
+    r_t, v_t, R_t = truth
+    r, v, R, P = est
+    err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v = tracks
     M = np.empty((3, 3))
     L = np.empty((3, 3))
     x = np.empty(3)
@@ -153,8 +157,8 @@ def _record(r_t, v_t, R_t, r, v, R, P, k, err_r, err_v, err_th, sig, sig_yaw, ne
 def _warm() -> None:
     tracks = [np.zeros((1, 2, 3)), np.zeros((1, 2, 3)), np.zeros((1, 2, 3)), np.zeros((1, 2, 9)),
               np.zeros((1, 2)), np.zeros((1, 2)), np.zeros((1, 2))]
-    _record(np.zeros(3), np.zeros(3), np.eye(3), np.zeros((1, 3)), np.zeros((1, 3)),
-            np.eye(3)[None].copy(), np.eye(12)[None].copy(), 1, *tracks)
+    _record((np.zeros(3), np.zeros(3), np.eye(3)), (np.zeros((1, 3)), np.zeros((1, 3)),
+            np.eye(3)[None].copy(), np.eye(12)[None].copy()), 1, tuple(tracks))
 
 
 def vision_cutoff_altitude(r_est: np.ndarray, margin_m: float) -> np.ndarray:
@@ -267,8 +271,8 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
 
     def record(k):
         c = (lambda a: np.array(a, float, order="C"))      # writable: the warmed signature
-        _record(c(tr.r[k]), c(tr.v[k]), c(tr.R_LtoB[k]), c(st.r), c(st.v), c(st.R), c(st.P), k,
-                err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v)
+        _record((c(tr.r[k]), c(tr.v[k]), c(tr.R_LtoB[k])), (c(st.r), c(st.v), c(st.R), c(st.P)), k,
+                (err_r, err_v, err_th, sig, sig_yaw, nees_r, nees_v))
 
     record(0)
     # the planner's metric contexts skip validation: validate the descent's
