@@ -109,7 +109,7 @@ def _record(pos, vel, tuning_in_band, run_median=2.0, run_max=30.0):
             "n_runs": 300, "pos_mean": pos, "vel_mean": vel, "tuning_nees_pos": 2.7, "tuning_nees_vel": 3.5,
             "tuning_nees_pos_run_median": run_median, "tuning_nees_pos_run_max": run_max,
             "lastlm_pos_err_m_median": 0.5, "final_pos_err_m_median": 2.0}
-    return {"tuning_n_runs": 40, "tuning_band": [2.29, 3.81],
+    return {"scenario": "interior", "tuning_n_runs": 40, "tuning_band": [2.29, 3.81],
             "paper": {**side, "meas_noise_scale": 5.0, "pos_mean": 1.76, "vel_mean": 1.93,
                       "lastlm_pos_err_m_median": 0.3, "final_pos_err_m_median": 0.74},
             "retuned": {**side, "meas_noise_scale": 2.3, "tuning_in_band": tuning_in_band}}
@@ -126,7 +126,7 @@ def test_nees_retuned_text_and_table_read_the_numbers():
     assert t["reading"].tolist() == ["underconfident", "consistent in position, overconfident in velocity"]
     assert t["meas_noise_scale"].tolist() == [5.0, 2.3]
     s = nees_retuned_text(_record(2.85, 4.19, True))
-    assert "2.3 against the paper tuning's 5" in s and "position 2.85 (consistent" in s
+    assert "(interior camera: " in s and "2.3 against the paper tuning's 5" in s and "position 2.85 (consistent" in s
     assert "velocity 4.19 (overconfident" in s and "0.30 to 0.50 m" in s
     assert "does not pin the mean" in s and "heavier-tailed" in s
     assert "velocity NEES is 1.47 times the position's (1.10 with the paper tuning)" in s

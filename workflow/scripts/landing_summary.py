@@ -58,7 +58,7 @@ with script_context(snakemake) as log:
                            accuracy=acc)
     out["tuning"] = load_json(snakemake.input.tuning)        # chosen on a separate seed stream: out["nees"] is held out
     # NEES read as it is (held out): consistent, under- or overconfident
-    out["nees_reading"] = {m: nees_reading(v) for m, v in out["nees"].items()}
+    out["nees_reading"] = {m: nees_reading(v, scn) for m, v in out["nees"].items()}
     out["nees_text"] = out["nees_reading"].get("depth", {}).get("text", "")
     if snakemake.input.get("retuned"):      # the main sample: the retuned filter beside the paper's
         out["nees_retuned"] = load_json(snakemake.input.retuned)

@@ -487,7 +487,7 @@ def end_phase_text(end: dict[str, dict], scenario: str, min_update_alt_m: float,
                 f" for {ms[0]}).")
 
 
-def nees_reading(nees: dict) -> dict:
+def nees_reading(nees: dict, scenario: str | None = None) -> dict:
     """The filter's consistency read from its held-out NEES (``montecarlo.nees_consistency``):
     per state (pos, vel) ``consistent`` if the time-averaged NEES of the run mean lies inside
     the 95 % band of an n-run mean, ``underconfident`` below it (the covariance larger than the
@@ -502,7 +502,8 @@ def nees_reading(nees: dict) -> dict:
              f"of the filter times)" for q in ("pos", "vel")]
     verdict = out["pos"] if out["pos"] == out["vel"] else f"{out['pos']} in position, {out['vel']} in velocity"
     out["verdict"] = verdict
-    out["text"] = (f"On the held-out runs the filter is {verdict}: its mean NEES over {nees['n_runs']} runs is "
+    where = f" of the {scenario} camera" if scenario else ""
+    out["text"] = (f"On the held-out runs{where} the filter is {verdict}: its mean NEES over {nees['n_runs']} runs is "
                    + "; ".join(parts) + f", against the 95 % band [{lo:.2f}, {hi:.2f}] of a "
                    f"{nees['n_runs']}-run mean for 3 degrees of freedom.")
     return out
@@ -541,7 +542,7 @@ def nees_retuned_text(retuned: dict) -> str:
     word = {"pos": "position", "vel": "velocity"}
     parts = "; ".join(f"{word[q]} {r[f'{q}_mean']:.2f} ({rd[q]}, in the band at {r[f'{q}_in_band_pct']:.1f} % "
                       f"of the filter times)" for q in ("pos", "vel"))
-    s = (f"Retuned within the same protocol (per camera, the bearing-noise scale whose NEES on the "
+    s = (f"Retuned within the same protocol ({retuned['scenario']} camera: the bearing-noise scale whose NEES on the "
          f"{retuned['tuning_n_runs']} tuning runs lies closest to the band's centre: {r['meas_noise_scale']:.3g} "
          f"against the paper tuning's {p['meas_noise_scale']:.3g}), the held-out NEES is {parts}, against "
          f"[{lo:.2f}, {hi:.2f}]; the median position error at the last landmark update goes from "
