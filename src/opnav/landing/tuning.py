@@ -115,7 +115,8 @@ def retune(landing_cfg: dict, tuning_cfg: dict, rows: list[dict], iterations: in
     docstring): among ``rows`` (:func:`tuning_rows`) at ``iterations``, the candidate
     closest to the band's centre (:func:`distance_to_centre`; ties: the smaller scale), then
     ``tuning_cfg["retune_points"]`` scales log-spaced strictly between its neighbouring
-    candidates (or the candidate and 1/2 or 2 times it at the ends), flown; the closest of
+    candidates (at the ends half or twice the candidate, never below 1: the filter's noise
+    is not assumed smaller than the true one), flown; the closest of
     all. Returns that row, its ``distance``, the ``centre``, ``in_band`` (both NEES in the
     tuning runs' band) and every row ``evaluated`` in scale order."""
     from opnav.landing.montecarlo import nees_band
