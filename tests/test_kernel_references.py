@@ -14,7 +14,7 @@ _inv_sym3; approach.ekf.filter_window/ekf_step and smoother._bryson_frazier_wind
 approach.ekf.ekf_step and approach.augmented._jacobian1 by finite differences;
 landing.ekf._transition (finite differences), _inject, _nullspace, _cholesky,
 _cho_solve, _linearise (CasADi); landing.measurement.tangent_rows (CasADi) and
-_blocks_batch (the printed eq. 12, 16, 18);
+blocks (the printed eq. 12, 16, 18);
 landing.descent._record; and the warm-up of every kernel module.
 """
 
@@ -214,11 +214,11 @@ def test_approach_measurement_jacobians_match_central_differences(seed, S, n):
 @settings(max_examples=30, deadline=None)
 @given(SEEDS, st.sampled_from([(), (1,), (4,), (2, 3)]), st.floats(1.0, 2e4))
 def test_jacobian_blocks_batch_is_eq_12_16_18_as_printed(seed, lead, dist):
-    """measurement.jacobian_blocks (kernel ``blocks``; over a batch ``_blocks_batch``, which
-    no other test reaches) against the printed forms: ``b = R u`` (eq. 12),
+    """tests/landing_reference.jacobian_blocks (the kernel ``measurement.blocks`` over a
+    batch) against the printed forms: ``b = R u`` (eq. 12),
     ``H_C = R (|rho|^2 I - rho rho^T) / |rho|^3`` (eq. 18) and ``[b x]`` (eq. 16).
-    Mutation tried: the loop of ``_blocks_batch`` passing ``inv[0]`` for ``inv[k]`` -> fails."""
-    from opnav.landing.measurement import jacobian_blocks
+    Mutation tried: its loop passing ``inv[0]`` for ``inv[k]`` -> fails."""
+    from landing_reference import jacobian_blocks
 
     rng = np.random.default_rng(seed)
     m = int(np.prod(lead))

@@ -25,7 +25,7 @@ eq.        function                                                    units
 14         ``measurement.selection_jacobian`` (n_s = n_p = 1, 6 x 12);     1/m (r, p columns),
            the filter stacks ``measurement.bearing_jacobian`` rows         1 (attitude columns)
 15-18      ``measurement.bearing_jacobian`` (H_r, H_theta, H_p),          1/m; H_theta dimensionless
-           ``measurement.jacobian_blocks`` (H_C, [b x]);
+           ``measurement.blocks`` (H_C, [b x], compiled);
            tangent-plane form ``measurement.tangent_jacobian``
            (cross-check: ``casadi_model.jacobian_function``, CasADi)
 19-20      ``kernels.baseline`` (estimated baseline |b|)                   m

@@ -78,7 +78,7 @@ import numpy as np
 from opnav.core.compiled import kernel, warms
 from opnav.core.rotations import skew
 
-__all__ = ["line_of_sight", "blocks", "tangent_rows", "bearing", "bearing_jacobian", "jacobian_blocks", "selection_jacobian",
+__all__ = ["line_of_sight", "blocks", "tangent_rows", "bearing", "bearing_jacobian", "selection_jacobian",
            "tangent_basis", "tangent_jacobian", "tangent_jacobian_scalar", "BehindCameraError",
            "N_STATE", "N_MEAS", "SL_R", "SL_V", "SL_THETA", "SL_P"]
 
@@ -147,12 +147,6 @@ def _bearing_batch(r, R, p, b, HC) -> int:
     return 0
 
 
-@kernel
-def _blocks_batch(R, u, inv, b, HC) -> None:
-    for k in range(u.shape[0]):
-        blocks(R[k], u[k], inv[k], b[k], HC[k])
-
-
 @warms
 def _warm() -> None:
     r = np.zeros((1, 3))
@@ -162,7 +156,6 @@ def _warm() -> None:
     _tangent_batch(np.eye(3)[None].copy(), p, np.ones(1), G)
     tangent_rows(np.eye(3), p[0], 1.0, G[0])
     _basis_batch(p, np.empty((1, 3)), np.empty((1, 3)))
-    _blocks_batch(np.eye(3)[None].copy(), p, np.ones(1), np.empty((1, 3)), np.empty((1, 3, 3)))
     blocks(np.eye(3), p[0], 1.0, np.empty(3), np.empty((3, 3)))
 
 
@@ -207,27 +200,6 @@ def bearing(r_L, R_LtoB, p_L) -> np.ndarray:
     ``opnav.landing.camera``).
     """
     return _evaluate(r_L, R_LtoB, p_L)[0]
-
-
-def jacobian_blocks(R_LtoB, u, inv_rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(b, H_C, [b x])`` from the unit line of sight ``u`` (..., 3) in {L} and
-    the inverse range ``inv_rho`` (...) (1/m): the bearing (eq. 12), ``H_C =
-    (R_LtoB - b u^T) / |rho|`` (eq. 18, 1/m) and the attitude block ``[b x]``
-    (eq. 16), by the kernel :func:`blocks`, broadcast over leading dimensions."""
-    R = np.asarray(R_LtoB, dtype=float)
-    u = np.asarray(u, dtype=float)
-    if u.ndim == 1 and R.ndim == 2:           # one landmark: the kernel itself
-        b, HC = np.empty(3), np.empty((3, 3))
-        blocks(_flat(R, (), (3, 3))[0], _flat(u, (), (3,))[0], float(inv_rho), b, HC)
-        return b, HC, skew(b)
-    inv = np.asarray(inv_rho, dtype=float)
-    shape = np.broadcast_shapes(R.shape[:-2], u.shape[:-1], inv.shape)
-    uf = _flat(u, shape, (3,))
-    b = np.empty(uf.shape)
-    HC = np.empty((b.shape[0], 3, 3))
-    _blocks_batch(_flat(R, shape, (3, 3)), uf, _flat(inv, shape, ()), b, HC)
-    b = b.reshape(shape + (3,))
-    return b, HC.reshape(shape + (3, 3)), skew(b)
 
 
 def bearing_jacobian(r_L, R_LtoB, p_L) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
