@@ -8,7 +8,7 @@ depends on how it is implemented, so this script times both implementations of
 every metric of :mod:`opnav.landing.metrics` on the same inputs:
 
 * ``fast``       ``metric(ctx, cand)``: the compiled closed form (svd, gdop, cond;
-  ``kernels.h_metric``) or the batched tangent update / Gram eigenvalues;
+  ``planning.hmetrics.h_metric``) or the batched tangent update / Gram eigenvalues;
 * ``reference``  ``metric.reference(ctx, cand)``: the paper's definition, H of
   eq. 14-18 from CasADi (``Function.map``), LAPACK SVD / pinv.
 

@@ -45,7 +45,7 @@ def record(a) -> None:
 
 def compare(a) -> None:
     from opnav.core.config import load_config
-    from opnav.landing import kernels as K
+    from opnav.landing.planning import geometry as K
     from opnav.landing import planner as pl
     from opnav.landing.descent import build_scenario
     from opnav.landing.scenario import camera_scenarios

@@ -1,5 +1,5 @@
-"""The planner's nearest-landmark pick (kernels.nearest: a uniform grid of
-buckets, kernels.field_grid) against a brute-force search over every candidate:
+"""The planner's nearest-landmark pick (screens.nearest: a uniform grid of
+buckets, screens.field_grid) against a brute-force search over every candidate:
 the same landmark for any query point, subset of detected landmarks and
 excluded landmark, exact distance ties included (broken by the smaller index)."""
 
@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from opnav.landing.landmarks import make_field, nearest_brute_force
-from opnav.landing import kernels as K
+from opnav.landing.planning import screens
 
 
 def _lattice_field(n_side: int, step: float, seed: int) -> np.ndarray:
@@ -42,7 +42,7 @@ def test_grid_nearest_equals_brute_force(seed, per_cell, frac, lattice):
     xy = (_lattice_field(12, 25.0, seed) if lattice else
           rng.uniform(-1000.0, 1000.0, size=(int(rng.integers(1, 400)), 2)))
     xyz = np.column_stack([xy, np.zeros(len(xy))])
-    grid, cells = K.field_grid(xyz, per_cell)
+    grid, cells = screens.field_grid(xyz, per_cell)
     x0, y0, h, nx, ny = grid
     n = len(xy)
     members = np.flatnonzero(rng.random(n) < frac) if frac < 1.0 else np.arange(n)
@@ -59,7 +59,7 @@ def test_grid_nearest_equals_brute_force(seed, per_cell, frac, lattice):
     for x, y in q.tolist():
         for ex in (-1, int(rng.integers(n))):
             want = nearest_brute_force(xy, x, y, members, {ex} - {-1})
-            assert K.nearest(x, y, xyz, members, np.int64(ex), grid, cells) == want, (x, y, ex)
+            assert screens.nearest(x, y, xyz, members, np.int64(ex), grid, cells) == want, (x, y, ex)
 
 
 def test_grid_nearest_many_rejections_falls_back_exactly():
@@ -68,18 +68,18 @@ def test_grid_nearest_many_rejections_falls_back_exactly():
     f = make_field(1000.0, 2000, seed=4)
     far = np.argsort(np.hypot(*f.xyz[:, :2].T))[-3:]                  # three in a far corner
     members = np.sort(far).astype(np.int64)
-    grid, cells = K.field_grid(f.xyz)
-    assert K.nearest(0.0, 0.0, f.xyz, members, np.int64(-1), grid, cells) == nearest_brute_force(
+    grid, cells = screens.field_grid(f.xyz)
+    assert screens.nearest(0.0, 0.0, f.xyz, members, np.int64(-1), grid, cells) == nearest_brute_force(
         f.xyz[:, :2], 0.0, 0.0, members)
 
 
 def test_compiled_nearest_pick_agrees_with_brute_force_on_ties():
-    """The planner's pick (kernels.nearest: bucket grid, ring search) equals the
+    """The planner's pick (screens.nearest: bucket grid, ring search) equals the
     brute force on a lattice field with exact ties, for many points and excluded
     landmarks, detected lists from most to few landmarks, points far outside."""
     xy = _lattice_field(15, 10.0, 7)
     xyz = np.column_stack([xy, np.zeros(len(xy))])
-    grid, cells = K.field_grid(xyz)
+    grid, cells = screens.field_grid(xyz)
     rng = np.random.default_rng(3)
     for frac in (1.0, 0.5, 0.05):
         det = np.flatnonzero(rng.random(len(xy)) < frac)
@@ -89,4 +89,4 @@ def test_compiled_nearest_pick_agrees_with_brute_force_on_ties():
         for j, (x, y) in enumerate(pts.tolist()):
             e = {int(ex[j])} if ex[j] >= 0 else set()
             want = nearest_brute_force(xy, x, y, det, e)
-            assert K.nearest(x, y, xyz, det, int(ex[j]), grid, cells) == want, (frac, j, x, y)
+            assert screens.nearest(x, y, xyz, det, int(ex[j]), grid, cells) == want, (frac, j, x, y)

@@ -16,11 +16,10 @@ from opnav.landing.metrics import (
     H_METRICS,
     METRIC_NAMES,
     MetricContext,
-    _scores_from_H,
-    chol_logdet,
     make_metric,
 )
-from opnav.landing import kernels as K
+from opnav.landing.planning import hmetrics, layout, search
+from opnav.landing.planning.reference import chol_logdet, h_scores_from_H
 
 
 
@@ -212,9 +211,9 @@ def test_closed_form_singular_values_equal_svd_of_casadi_H(r, R, seed):
     w = d / rho[:, None]
     c, s2 = w @ u, np.sum(np.cross(u, w) ** 2, 1)
     x = 1 / np.linalg.norm(r)
-    want = {K.SVD: s[:, 3], K.COND: s[:, 3] / s[:, 0], K.GDOP: 1 / np.sum(s ** -2.0, axis=1)}
+    want = {layout.SVD: s[:, 3], layout.COND: s[:, 3] / s[:, 0], layout.GDOP: 1 / np.sum(s ** -2.0, axis=1)}
     for kind, ref in want.items():
-        got = [K.h_metric(kind, x, 1 / rh, cc, ss) for rh, cc, ss in zip(rho, c, s2)]
+        got = [hmetrics.h_metric(kind, x, 1 / rh, cc, ss) for rh, cc, ss in zip(rho, c, s2)]
         # LAPACK's s4 carries ~eps * s1 / s4 relative error; the closed form is exact
         np.testing.assert_allclose(got, ref, rtol=1e-9)
 
@@ -223,12 +222,12 @@ def test_known_answer_closed_form_far_field():
     """Landmarks far away (x, y -> 0): s^2 -> {2, 1 + |c|, 1 - |c|, 0} with s4^2 ~
     ((x - c y)^2 + (2 - c^2) y^2) / 2 for the smallest: svd -> 0 like 1/range."""
     c, s2 = 0.3, 1 - 0.09
-    assert K.h_metric(K.SVD, 0.0, 0.0, c, s2) == 0.0
+    assert hmetrics.h_metric(layout.SVD, 0.0, 0.0, c, s2) == 0.0
     for y in (1e-3, 1e-5):
         x = 2 * y
-        s4 = K.h_metric(K.SVD, x, y, c, s2)
+        s4 = hmetrics.h_metric(layout.SVD, x, y, c, s2)
         assert s4 == pytest.approx(np.sqrt(((x - c * y) ** 2 + (2 - c * c) * y * y + s2 * 0) / 2), rel=1e-2)
-        assert K.h_metric(K.COND, x, y, c, s2) == pytest.approx(s4 / np.sqrt(2.0), rel=1e-2)
+        assert hmetrics.h_metric(layout.COND, x, y, c, s2) == pytest.approx(s4 / np.sqrt(2.0), rel=1e-2)
 
 
 # --------------------------------------------------------------------------
@@ -255,17 +254,17 @@ def test_fast_path_equals_the_papers_definition(name, r, R, seed, aniso):
     assert m.n_evals == 2 * 7 and m.n_calls == 2
 
 
-@pytest.mark.parametrize("kind", list(K.KINDS))
+@pytest.mark.parametrize("kind", list(layout.KINDS))
 def test_edge_pick_with_no_candidate_picks_none(kind):
     """An edge call whose image holds no landmark, or only the current one, picks none (-1,
     0 scored) for every compiled kind (the landmark-free end of the descent). It crashed
     for svd_w and cond_w (numba's argmax of an empty array in a since-removed screen)."""
     rng = np.random.default_rng(5)
-    q = np.zeros(K.work_size(3) - 9)
-    q[11] = K.KINDS[kind]
+    q = np.zeros(layout.work_size(3) - layout.NOUT)
+    q[layout.Q_KIND] = layout.KINDS[kind]
     xyz = _ground(rng, 3)
-    assert K.edge_pick(q, xyz, np.zeros(0, np.int64), np.int64(-1)) == (-1, 0)
-    assert K.edge_pick(q, xyz, np.array([1], np.int64), np.int64(1)) == (-1, 0)
+    assert search.edge_pick(q, xyz, np.zeros(0, np.int64), np.int64(-1)) == (-1, 0)
+    assert search.edge_pick(q, xyz, np.array([1], np.int64), np.int64(1)) == (-1, 0)
 
 
 @pytest.mark.parametrize("name", METRIC_NAMES)
@@ -297,13 +296,12 @@ def test_known_answer_singular_values():
     S = np.zeros((6, 12))
     S[np.arange(4), np.arange(4)] = [4.0, 3.0, 2.0, 1.0]
     H = (U @ S @ V.T)[None]
-    ctx = _ctx(with_info=False)
-    assert _scores_from_H("svd", H, ctx)[0] == pytest.approx(1.0, rel=1e-12)
-    assert _scores_from_H("cond", H, ctx)[0] == pytest.approx(0.25, rel=1e-12)
-    assert _scores_from_H("gdop", H, ctx)[0] == pytest.approx(1 / (1 / 16 + 1 / 9 + 1 / 4 + 1), rel=1e-12)
+    assert h_scores_from_H("svd", H)[0] == pytest.approx(1.0, rel=1e-12)
+    assert h_scores_from_H("cond", H)[0] == pytest.approx(0.25, rel=1e-12)
+    assert h_scores_from_H("gdop", H)[0] == pytest.approx(1 / (1 / 16 + 1 / 9 + 1 / 4 + 1), rel=1e-12)
     # pseudo-inverse of the singular 12 x 12 H^T H: trace of its pinv is the same
     assert 1 / np.trace(np.linalg.pinv(H[0].T @ H[0], rcond=1e-10, hermitian=True)) == pytest.approx(
-        _scores_from_H("gdop", H, ctx)[0], rel=1e-10
+        h_scores_from_H("gdop", H)[0], rel=1e-10
     )
 
 
@@ -410,9 +408,9 @@ def test_paper_baselines_rank_identically_in_descent_geometry():
 @settings(max_examples=25, deadline=None)
 @given(r=lander, R=quat, seed=seeds)
 def test_lapack_svd_of_H_equals_the_closed_form(r, R, seed):
-    """svd_lapack (``kernels.h_lapack``: the 6 x 12 H built in place and numba's LAPACK SVD, the
+    """svd_lapack (``hmetrics.h_lapack``: the 6 x 12 H built in place and numba's LAPACK SVD, the
     "real SVD" timed beside the closed form) scores every candidate as svd's closed form
-    (``kernels.h_metric``) to round-off, invalid ones +inf alike. Mutation tried: the [b x]
+    (``hmetrics.h_metric``) to round-off, invalid ones +inf alike. Mutation tried: the [b x]
     block's sign flipped in one row fails."""
     from opnav.landing.camera import Camera  # noqa: F401  (the planner's camera type)
     from opnav.landing.landmarks import LandmarkField

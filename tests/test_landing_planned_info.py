@@ -1,4 +1,4 @@
-"""The planned-information metric logdet_nav (opnav.landing.planned_info): the
+"""The planned-information metric logdet_nav (opnav.landing.planning.reference): the
 candidate's own initialisation, the filter's noise model, obs_per_landmark
 observations, marginalised on the navigation states; against a direct
 information-form computation and with invariants that a mis-specification breaks."""
@@ -13,8 +13,9 @@ from hypothesis import strategies as st
 
 from opnav.landing import ekf
 from opnav.landing.measurement import selection_jacobian
-from opnav.landing.planned_info import (PLANNED_METRICS, planned_metric, planned_nav_logdet, planned_posterior,
-                                       whitened_site_bound)
+from opnav.landing.planning.layout import Estimate
+from opnav.landing.planning.reference import (PLANNED_METRICS, FilterModel, planned_metric, planned_nav_logdet,
+                                              planned_posterior, planned_rows, whitened_site_bound)
 from opnav.core.rotations import exp_so3
 
 
@@ -40,7 +41,8 @@ def test_posterior_is_the_information_form_of_the_planned_updates():
 
     r, v, a, R, P, cand = _state()
     sf, frac, n_obs, dt = 2.5e-3, 0.1, 3, 1.0
-    Sig, ok = planned_posterior(r, v, a, R, P, np.zeros(3), cand, sf, frac, n_obs, dt, G, oc=False)
+    Sig, ok = planned_posterior(Estimate(r, v, a, R, P), np.zeros(3), cand,
+                                FilterModel(sf, frac, n_obs, dt, G, oc=False))
     assert ok.all()
     for c, S in zip(cand, Sig):
         # its own initialisation: the filter's init_landmark for the candidate's bearing
@@ -65,26 +67,28 @@ def test_posterior_is_the_information_form_of_the_planned_updates():
 
 def test_score_is_the_navigation_marginal_and_moves_with_the_model():
     r, v, a, R, P, cand = _state(1)
-    kw = dict(depth_sigma_frac=0.1, oc=True, dt=1.0, g=G)
-    s3 = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=3, **kw)
-    Sig, _ = planned_posterior(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, 0.1, 3, 1.0, G, True)
+    est = Estimate(r, v, a, R, P)
+    nav = lambda sf=2.5e-3, n_obs=3, dt=1.0: planned_nav_logdet(est, np.zeros(3), cand,
+                                                                FilterModel(sf, 0.1, n_obs, dt, G, True))
+    s3 = nav()
+    Sig, _ = planned_posterior(est, np.zeros(3), cand, FilterModel(2.5e-3, 0.1, 3, 1.0, G, True))
     np.testing.assert_allclose(s3, [-np.linalg.slogdet(S[:9, :9])[1] for S in Sig], rtol=1e-9)
     # one observation (the initialising one): no landmark update, so the candidate
     # cannot matter to the navigation states: every candidate scores the same
-    s1 = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=1, **kw)
+    s1 = nav(n_obs=1)
     np.testing.assert_allclose(s1, s1[0], rtol=1e-9)
     # ... nor without motion: seen again from the same point it adds nothing
-    still = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=3, **{**kw, "dt": 0.0})
+    still = nav(dt=0.0)
     np.testing.assert_allclose(still, still[0], rtol=1e-9)
     assert np.ptp(s3) > 1e-3                                # with parallax it does matter
-    assert np.all(planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, n_obs=5, **kw) > s3)
+    assert np.all(nav(n_obs=5) > s3)
     # the filter's (larger) noise model gives less information than the true noise
-    assert np.all(planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, 5 * 2.5e-3, n_obs=3, **kw) < s3)
+    assert np.all(nav(sf=5 * 2.5e-3) < s3)
 
 
 def test_oc_keeps_yaw_unobservable():
     r, v, a, R, P, cand = _state(2)
-    Sig, _ = planned_posterior(r, v, a, R, P, np.zeros(3), cand, 2.5e-3, 0.1, 3, 1.0, G, oc=True)
+    Sig, _ = planned_posterior(Estimate(r, v, a, R, P), np.zeros(3), cand, FilterModel(2.5e-3, 0.1, 3, 1.0, G, oc=True))
     N = ekf.nullspace(r, v, R, cand[0])
     st0 = ekf.NavState(r=r.copy(), v=v.copy(), R=R.copy(), p=np.zeros(3), P=P.copy())
     b = R @ (cand[0] - r)
@@ -107,9 +111,9 @@ def test_planner_objective_uses_the_filter_noise_model_and_strategy():
     field = scn.field.__class__(np.ascontiguousarray(cand))
     _, q = plan_one("logdet_nav", st, scn.camera, field, cfg, -1, np.arange(len(cand)))
     got = candidate_scores("logdet_nav", st, scn.camera, field, cfg, q, np.arange(len(cand)))
-    want = planned_nav_logdet(r, v, a, R, P, np.zeros(3), cand, scn.camera.sigma_b * scn.noise_scale,
-                              scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt, scn.g, scn.oc,
-                              scn.camera.boresight_B)
+    model = FilterModel(scn.camera.sigma_b * scn.noise_scale, scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt,
+                        scn.g, scn.oc)
+    want = planned_nav_logdet(st, np.zeros(3), cand, model, scn.camera.boresight_B)
     np.testing.assert_allclose(-got, want, rtol=1e-12)
 
 
@@ -129,8 +133,8 @@ def _scenario(name):
        st.sampled_from([1.0, 5.0]))
 def test_compiled_baseline_is_its_numpy_definition_and_plans_as_it(name, seed, camera, n_obs, oc, frac, dt,
                                                                     scale):
-    """Each B-X1 information baseline compiled (``kernels.planned`` through ``plan_one``, the
-    Monte Carlo's path) equals its numpy definition (``planned_info.planned_metric``: the
+    """Each B-X1 information baseline compiled (``information.planned`` through ``plan_one``, the
+    Monte Carlo's path) equals its numpy definition (``reference.planned_metric``: the
     information form P0^-1 + A^T A of the candidate's own initialisation, the filter's noise
     sigma_b x scale, n_obs planned observations; the paper path's objective) to round-off for
     hypothesis-drawn states, strategies, noise scales and OC flags, +inf exactly where the
@@ -154,8 +158,8 @@ def test_compiled_baseline_is_its_numpy_definition_and_plans_as_it(name, seed, c
     det = np.arange(len(cand))
     res, q = plan_one(name, st_, scn.camera, field, cfg, -1, det)
     got = candidate_scores(name, st_, scn.camera, field, cfg, q, det)
-    want = -planned_metric(name, r, v, a, R, P, np.asarray(cfg.p_known), cand, scn.camera.sigma_b * scale, frac,
-                           n_obs, dt, cfg.g, oc, scn.camera.boresight_B)
+    want = -planned_metric(name, st_, np.asarray(cfg.p_known), cand,
+                           FilterModel(scn.camera.sigma_b * scale, frac, n_obs, dt, cfg.g, oc), scn.camera.boresight_B)
     fin = np.isfinite(want)
     assert not fin[-1] and np.array_equal(np.isfinite(got), fin) and np.array_equal(got[~fin], want[~fin])
     np.testing.assert_allclose(got[fin], want[fin], rtol=1e-9, atol=1e-9 * np.abs(want[fin]).max())
@@ -173,13 +177,11 @@ def test_information_form_definitions_by_hand():
     P0^1/2 a symmetric root (rank min(4 n_obs - 2, 11)), logdet_nav = -log det Sigma[:9, :9]."""
     from scipy.linalg import sqrtm
 
-    from opnav.landing.planned_info import planned_rows
-
     r, v, a, R, P, cand = _state(4)
-    kw = (np.zeros(3), cand, 5 * 2.5e-3, 0.1, 3, 1.0, G, True)
-    Sig, _ = planned_posterior(r, v, a, R, P, *kw)
-    A, P0, _ = planned_rows(r, v, a, R, P, *kw)
-    got = {n: planned_metric(n, r, v, a, R, P, *kw) for n in PLANNED_METRICS}
+    kw = (Estimate(r, v, a, R, P), np.zeros(3), cand, FilterModel(5 * 2.5e-3, 0.1, 3, 1.0, G, True))
+    Sig, _ = planned_posterior(*kw)
+    A, P0, _ = planned_rows(*kw)
+    got = {n: planned_metric(n, *kw) for n in PLANNED_METRICS}
     for i in range(len(cand)):
         s = np.linalg.svd(A[i] @ np.real(sqrtm(P0[i])), compute_uv=False)[:10]
         want = {"logdet": -np.linalg.slogdet(Sig[i])[1], "mineig": 1 / np.linalg.eigvalsh(Sig[i])[-1],
@@ -193,7 +195,7 @@ def test_information_form_definitions_by_hand():
 @given(st.integers(0, 2**31), st.sampled_from([2, 3, 5]), st.booleans(), st.sampled_from([0.02, 0.1, 0.5]),
        st.sampled_from([1e-3, 5e-3]))
 def test_whitened_baselines_are_capped_by_the_site_alone(seed, n_obs, oc, frac, sf):
-    """Why svd_w / gdop_w cannot reward a candidate (planned_info's module docstring): deleting
+    """Why svd_w / gdop_w cannot reward a candidate (planning.reference's module docstring): deleting
     the candidate's rows interlaces the singular values, so svd_w <= sigma_min of the site's
     whitened rows alone (whitened_site_bound) and gdop_w <= its square, and that bound is the
     same for every candidate (the site's rows see the navigation prior only; OC's projection
@@ -203,7 +205,7 @@ def test_whitened_baselines_are_capped_by_the_site_alone(seed, n_obs, oc, frac, 
     rng = np.random.default_rng(seed)
     cand = np.column_stack([r[0] + rng.uniform(-1500, 1500, 12), r[1] + rng.uniform(-1500, 1500, 12),
                             np.zeros(12)])
-    args = (r, v, a, R, P, np.zeros(3), cand, sf, frac, n_obs, 1.0, G, oc)
+    args = (Estimate(r, v, a, R, P), np.zeros(3), cand, FilterModel(sf, frac, n_obs, 1.0, G, oc))
     bound = whitened_site_bound(*args)
     ok = np.isfinite(bound)
     assert ok.sum() >= 6

@@ -1,6 +1,7 @@
 """Paper B planner: visible interval, method dispatch, one planning call."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -8,16 +9,16 @@ from scipy.spatial.transform import Rotation
 
 from opnav.core.config import load_config
 from opnav.landing.camera import camera_from_config
-from opnav.landing.depth_error import plane_geometry
 from opnav.landing.descent import build_scenario
-from opnav.landing import kernels as K
+from opnav.landing.planning import screens
+from opnav.landing.planning.geometry import plane_geometry
 from opnav.landing.planner import (OBJECTIVE_METHODS, PlanState, available_methods, golden_section, plan,
                                    plan_one, visible_intervals)
 
 
 def _nearest(field, x, y, det, exclude=-1):
-    grid, cells = K.field_grid(field.xyz)
-    return K.nearest(float(x), float(y), np.ascontiguousarray(field.xyz), np.asarray(det, np.int64),
+    grid, cells = screens.field_grid(field.xyz)
+    return screens.nearest(float(x), float(y), np.ascontiguousarray(field.xyz), np.asarray(det, np.int64),
                      exclude, grid, cells)
 
 
@@ -231,22 +232,22 @@ def _reference_objective(method, st, scn, pts):
     """Each landmark scored independently of the planner's code: the depth error
     of eq. 23-25 at the landmark, or the metric by one CasADi Jacobian and an
     explicit SVD / information per landmark (minimised: negated)."""
-    from opnav.landing.depth_error import depth_error_at_landmarks, error_radius
     from opnav.landing.metrics import MetricContext, make_metric
+    from opnav.landing.planning.depth import error_radius
+    from opnav.landing.planning.reference import (PAPER_OF, PLANNED_METRICS, FilterModel, depth_error_at_landmarks,
+                                                  planned_metric)
 
     if method == "depth":
         r_e = error_radius(st.P[3:6, 3:6], scn.planner.t_s, scn.planner.n_sigma_v)
         return depth_error_at_landmarks(st.r, st.v, st.a, pts, scn.planner.t_s, r_e)
-    from opnav.landing.planned_info import PLANNED_METRICS, planned_metric
-    from opnav.landing.planner import PAPER_OF
 
     method = PAPER_OF.get(method, method)      # svd_lapack's definition is svd's
 
     if method in PLANNED_METRICS:       # one landmark at a time (tested in test_landing_planned_info)
-        return np.array([-planned_metric(
-            method, st.r, st.v, st.a, st.R_LtoB, st.P, np.zeros(3), p[None], scn.camera.sigma_b * scn.noise_scale,
-            scn.depth_sigma_frac, scn.obs_per_landmark, scn.Dt, scn.g, scn.oc, scn.camera.boresight_B)[0]
-            for p in pts])
+        model = FilterModel(scn.camera.sigma_b * scn.noise_scale, scn.depth_sigma_frac, scn.obs_per_landmark,
+                            scn.Dt, scn.g, scn.oc)
+        return np.array([-planned_metric(method, st, np.zeros(3), p[None], model, scn.camera.boresight_B)[0]
+                         for p in pts])
     ctx = MetricContext(r_L=st.r, v_L=st.v, R_LtoB=st.R_LtoB, p_known_L=np.zeros(3), P=st.P,
                         R_meas=scn.camera.sigma_b**2 * np.eye(6),
                         boresight_B=scn.camera.boresight_B)
@@ -304,7 +305,8 @@ def _unconstrained_inside(state, camera, cfg):
     """Is the in-plane depth-error optimum over the whole ground arc strictly
     inside the visible interval (estimated state, planning margin)? (The paper's
     law-of-sines formula, searched by the interpreted golden section.)"""
-    from opnav.landing.depth_error import baseline, error_radius, signed_depth_error
+    from opnav.landing.planning.depth import baseline, error_radius
+    from opnav.landing.planning.reference import signed_depth_error
 
     geom = plane_geometry(state.r, state.v)
     b = baseline(state.v, state.a, cfg.t_s)
@@ -357,13 +359,46 @@ def test_unknown_headline_scenario_is_refused():
 
 
 def test_tie_rule_lowest_index_within_the_stated_tolerance():
-    """kernels.best_index: scores within TIE_RTOL (1e-9) relative of the best are
+    """screens.best_index: scores within TIE_RTOL (1e-9) relative of the best are
     tied and the first (lowest landmark index) wins; beyond it the strict best;
     none finite: -1."""
-    assert K.TIE_RTOL == 1e-9
-    assert K.best_index(np.array([3.0, 1.0 + 5e-10, 1.0, 2.0])) == 1
-    assert K.best_index(np.array([3.0, 1.0 + 5e-9, 1.0, 2.0])) == 2
-    assert K.best_index(np.array([-5.0 * (1 - 5e-10), -5.0, 0.0])) == 0
-    assert K.best_index(np.array([-5.0 * (1 - 5e-9), -5.0, 0.0])) == 1
-    assert K.best_index(np.array([np.inf, np.inf])) == -1
-    assert K.best_index(np.zeros(0)) == -1
+    assert screens.TIE_RTOL == 1e-9
+    assert screens.best_index(np.array([3.0, 1.0 + 5e-10, 1.0, 2.0])) == 1
+    assert screens.best_index(np.array([3.0, 1.0 + 5e-9, 1.0, 2.0])) == 2
+    assert screens.best_index(np.array([-5.0 * (1 - 5e-10), -5.0, 0.0])) == 0
+    assert screens.best_index(np.array([-5.0 * (1 - 5e-9), -5.0, 0.0])) == 1
+    assert screens.best_index(np.array([np.inf, np.inf])) == -1
+    assert screens.best_index(np.zeros(0)) == -1
+
+
+def test_slot_layouts_name_every_slot_once():
+    """The planning call's float vectors (planning.layout): every slot of q (before the
+    per-image tables), of the per-field constants c and of the result out lies in exactly one
+    named block, and the tables' two parts tile each image's NT slots. Mutation tried:
+    Q_NA = 179 (overlapping Q_NV) -> fails."""
+    from opnav.landing.planning import layout as L
+
+    for blocks, size in ((L.Q_BLOCKS, L.NQ), (L.C_BLOCKS, L.NC), (L.O_BLOCKS, L.NOUT)):
+        used = np.zeros(size, int)
+        for first, n in blocks.values():
+            used[first:first + n] += 1
+        assert used.tolist() == [1] * size, blocks
+    assert (L.T_PHI, L.T_SITE, L.NT) == (0, 81, 81 + 2 * 12) and L.Q_TAB == L.NQ
+    assert L.work_size(3) == L.Q_TAB + 3 * L.NT + L.NOUT
+
+
+def test_planning_kernels_take_at_most_ten_positional_arguments():
+    """Every compiled kernel of the planning package takes at most ten arguments (issue 41:
+    the call's state travels as one ``layout.Estimate``). Mutation tried: plan_run's estimate
+    split back into r, v, a, R_LtoB, P -> fails."""
+    import ast
+
+    from opnav.landing import planning
+
+    wide = []
+    for f in sorted(Path(planning.__file__).parent.glob("*.py")):
+        for node in ast.walk(ast.parse(f.read_text())):
+            if (isinstance(node, ast.FunctionDef) and any(getattr(d, "id", None) == "kernel" for d in node.decorator_list)
+                    and len(node.args.args) > 10):
+                wide.append(f"{f.stem}.{node.name}")
+    assert wide == []

@@ -373,7 +373,7 @@ def test_the_timed_compiled_call_is_the_planning_call(recorded):
     """What the replay times for a compiled method (planner.compiled_call) computes the pick,
     optimum and evaluations planner.plan returns, on every recorded call of depth and svd
     (the kernel's out vector after the timed call); None for interpreted variants."""
-    from opnav.landing import kernels as K
+    from opnav.landing.planning import layout
     from opnav.landing import planner
 
     scn, rec = recorded
@@ -389,8 +389,8 @@ def test_the_timed_compiled_call_is_the_planning_call(recorded):
                                diagnose=False)
             call = planner.compiled_call(m, st, cam, field_, scn.planner, ex, det)
             call()
-            out = call.args[-1][-9:]
-            if out[8] == K.OK:
+            out = call.args[-1][-layout.NOUT:]
+            if out[layout.O_STATUS] == layout.OK:
                 assert (int(out[0]), int(out[3])) == (res.index, res.n_evals)
                 assert out[1] == res.beta
         assert planner.compiled_call(m, st, cam, field_, planner.alternative_path(scn.planner), ex, det) is None

@@ -63,7 +63,7 @@ B_SIM = canonical({**{k: config["landing"][k] for k in _B_SIM_KEYS},
                    "mc": {k: config["landing"]["mc"][k] for k in ("base_seed", "bounds")}})
 B_SRC = with_kernels("landing", src(
     "landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
-    "landing/measurement.py", "landing/ekf.py", "landing/depth_error.py",
+    "landing/measurement.py", "landing/ekf.py", "landing/planning/reference.py",
     "landing/planner.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
     "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "core/rotations.py"))
 B_SCN_RE = "|".join(B_SCENARIOS)

@@ -45,7 +45,11 @@ KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf"
                                     "opnav.approach.em", "opnav.approach.augmented",
                                     "opnav.core.rotations", "opnav.landing.measurement", "opnav.landing.linalg",
                                     "opnav.landing.ekf", "opnav.landing.ekf_update",
-                                    "opnav.landing.kernels",
+                                    "opnav.landing.planning.layout", "opnav.landing.planning.geometry",
+                                    "opnav.landing.planning.depth",
+                                    "opnav.landing.planning.screens", "opnav.landing.planning.hmetrics",
+                                    "opnav.landing.planning.information", "opnav.landing.planning.search",
+                                    "opnav.landing.planning.warmup",
                                     "opnav.landing.descent", "opnav.landing.imu")
 
 _WARMUPS: dict[str, Callable[[], None]] = {}
@@ -226,7 +230,7 @@ def warms(fn: Callable[[], None]) -> Callable[[], None]:
 COMPILE_CPU_S: dict[str, float] = {
     "opnav.approach.kalman": 3.2, "opnav.approach.ekf": 4.4, "opnav.approach.smoother": 4.2,
     "opnav.approach.em": 5.7, "opnav.approach.augmented": 2.0, "opnav.core.rotations": 0.3,
-    "opnav.landing.measurement": 0.7, "opnav.landing.ekf": 12.2, "opnav.landing.kernels": 47.4,
+    "opnav.landing.measurement": 0.7, "opnav.landing.ekf": 12.2, "opnav.landing.planning.warmup": 47.4,
     "opnav.landing.descent": 1.8, "opnav.landing.imu": 0.5}
 
 

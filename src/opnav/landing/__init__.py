@@ -28,17 +28,19 @@ eq.        function                                                    units
            ``measurement.blocks`` (H_C, [b x], compiled);
            tangent-plane form ``measurement.tangent_jacobian``
            (cross-check: ``casadi_model.jacobian_function``, CasADi)
-19-20      ``kernels.baseline`` (estimated baseline |b|)                   m
-21-22      ``kernels.error_radius`` (r = eps_v t_s)                        m
-23-25      ``kernels.depth_error`` (compiled, the planner's);              m
-           the paper's formula ``depth_error.depth_error`` /
-           ``signed_depth_error`` (law of sines ``depth_error.depth``),
-           arbitrary landmarks ``depth_error.depth_error_at_landmarks``
-26         ``kernels.ground_point`` (law of sines ``kernels.plane_depth``); rad (beta), m (ground point)
-           the call ``kernels.plan_core`` (``planner.plan_batch``): plane,
-           visible interval, ``kernels.golden_section``, nearest pick
+19-20      ``planning.depth.baseline`` (estimated baseline |b|)            m
+21-22      ``planning.depth.error_radius`` (r = eps_v t_s)                 m
+23-25      ``planning.depth.depth_error`` (compiled, the planner's);       m
+           the paper's formula ``planning.reference.depth_error`` /
+           ``signed_depth_error`` (law of sines ``reference.depth``),
+           landmarks ``reference.depth_error_at_landmarks``
+26         ``planning.geometry.ground_point`` (law of sines               rad (beta), m (ground point)
+           ``geometry.plane_depth``); the call ``planning.search.plan_core``
+           (``planner.plan_batch``): plane, visible interval,
+           ``search.golden_section``, nearest pick
 sec. 2.2   ``metrics.make_metric`` (svd, gdop, cond from the 6 x 12 H,     1/m (svd), 1/m^2 (gdop), 1 (cond)
-           closed form ``kernels.h_metric``), ``planner.OBJECTIVE_METHODS``;
-           B-X1 information baselines: ``planned_info.planned_metric``
+           closed form ``planning.hmetrics.h_metric``),
+           ``planner.OBJECTIVE_METHODS``; B-X1 information baselines:
+           ``planning.reference.planned_metric``
 =========  ==========================================================  ===============================
 """

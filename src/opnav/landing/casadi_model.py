@@ -25,8 +25,7 @@ objects:
 
 It is the *cross-check* of the one numpy home of eq. 12-18,
 :mod:`opnav.landing.measurement` (``selection_jacobian``), which the tests
-prove equal to these Functions (tests/test_landing_metrics.py); the metrics'
-``reference`` and ``casadi_map`` paths evaluate H through it.
+prove equal to these Functions (tests/test_landing_metrics.py).
 
 Conventions
 -----------
@@ -44,15 +43,10 @@ Conventions
 * Units: positions m, H position/landmark columns 1/m, attitude columns 1/rad
   (dimensionless), bearings dimensionless.
 
-Speed (``benchmarks/bench_metrics.py``, 50 candidates, median of 60, this
-machine: 2 shared cores under load ~1.4): the Jacobian alone costs ~130 us per
-candidate through one Function call from Python (call + DM -> numpy
-conversion), ~11 us per candidate through ``Function.map(50)`` ("serial";
-"thread" is ~7x slower for this tiny body, "openmp" is not compiled in this
-CasADi build and falls back to serial), and ~1 us per candidate through
-``measurement.selection_jacobian`` (numpy), which is therefore the fastest
-faithful evaluation.  The metrics in :mod:`opnav.landing.metrics` go one step
-further with closed forms.
+The H baselines' reference path (``planning.reference.h_metric_reference``) evaluates
+H through :func:`jacobian_casadi_batch` (``Function.map``, serial: the per-candidate call
+and the threaded map cost more, ``benchmarks/bench_metrics.py``; docs/performance.md);
+the compiled planner uses the closed forms of ``planning.hmetrics``.
 """
 
 from __future__ import annotations

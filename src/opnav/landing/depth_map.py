@@ -17,8 +17,9 @@ import math
 
 import numpy as np
 
-from opnav.landing.depth_error import (baseline, depth_error_at_landmarks, ground_point,
-                                       plane_geometry, signed_depth_error)
+from opnav.landing.planning.depth import baseline
+from opnav.landing.planning.geometry import ground_points, plane_geometry
+from opnav.landing.planning.reference import depth_error_at_landmarks, signed_depth_error
 from opnav.landing.planner import golden_section, visible_intervals
 from opnav.landing.scenario import Scenario
 
@@ -59,7 +60,7 @@ def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
     opt_uv = np.full(2, np.nan)
     opt_xy = np.full(2, np.nan)
     if math.isfinite(best_b):
-        g = ground_point(best_b, geom)[0]
+        g = ground_points(best_b, geom)[0]
         opt_xy = g[:2]
         d = cam.R_BtoC @ (R @ (g - r))
         if d[2] > 0:
@@ -89,7 +90,7 @@ def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
             "field_xy": scn.field.xyz[fin, :2], "field_dr": dr_all[fin],
             "field_best_xy": scn.field.xyz[best_all, :2], "field_best_dr": float(dr_all[best_all]),
             "unconstrained_beta_deg": math.degrees(unc_b), "unconstrained_dr": float(unc_f),
-            "unconstrained_ground_xy": ground_point(unc_b, geom)[0, :2],
+            "unconstrained_ground_xy": ground_points(unc_b, geom)[0, :2],
             "lander_xy": r[:2].copy(), "footprint_xy": footprint,
             "optimum_inside_image": bool(any(lo < unc_b < hi for lo, hi in
                                              visible_intervals(geom, R, cam, 0.0)))}

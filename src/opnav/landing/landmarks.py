@@ -5,8 +5,8 @@ Landmarks are drawn uniformly on the plane z = 0 of {L} over the square
 whose density grows as the inverse square of the distance to it
 (:func:`near_site_xy`, config ``landing.landmarks.near_site``), from their own
 seed (the same field for every Monte-Carlo run and every method). The
-planner's nearest-landmark pick is ``kernels.nearest`` (a bucket grid built
-once per field, ``kernels.field_grid``); :func:`nearest_brute_force` is its
+planner's nearest-landmark pick is ``planning.screens.nearest`` (a bucket grid built
+once per field, ``planning.screens.field_grid``); :func:`nearest_brute_force` is its
 reference (every candidate scored, exact ties to the smaller index).
 """
 
@@ -22,7 +22,7 @@ __all__ = ["LandmarkField", "make_field", "near_site_xy", "nearest_brute_force"]
 
 def nearest_brute_force(xy: np.ndarray, x: float, y: float, members: np.ndarray | None = None,
                         exclude=()) -> int:
-    """Reference for ``kernels.nearest``: every candidate scored, the
+    """Reference for ``planning.screens.nearest``: every candidate scored, the
     smallest ``dx*dx + dy*dy`` (float64), ties by the smaller index; -1 if none."""
     idx = np.arange(len(xy)) if members is None else np.asarray(members, np.int64)
     if len(exclude):

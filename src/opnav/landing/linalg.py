@@ -2,7 +2,7 @@
 
 One home for the lower Cholesky factor that the landing filter's gain (``opnav.landing.ekf``,
 ``K = P H^T S^-1`` with ``S = H P H^T + sigma_b^2 I``, eq. 11-18) and the planned-information
-metrics (``opnav.landing.kernels``: ``S = I + A P0 A^T``, log det) both need. Plain loops over
+metrics (``opnav.landing.planning.information``: ``S = I + A P0 A^T``, log det) both need. Plain loops over
 the leading ``n x n`` block of a square float64 array, so one scratch array of the largest size
 serves every call; sums run in index order, so a result does not depend on the batch it is in.
 
@@ -75,7 +75,7 @@ def cho_solve(L, n, x) -> None:
 
 @kernel
 def logdet_spd(A, n, C) -> float:
-    """log det A[:n, :n] (symmetric) as ``metrics.chol_logdet`` defines it: 2 sum log diag of the
+    """log det A[:n, :n] (symmetric) as ``planning.reference.chol_logdet`` defines it: 2 sum log diag of the
     Cholesky factor of the Jacobi-equilibrated D^-1/2 A D^-1/2 + j I, plus sum log D; j from n eps,
     x 1e3 while the Cholesky fails, up to 1e-8; -inf if it still fails or a diagonal entry is not
     positive (C: (n, n) scratch, receives the factor). The equilibration keeps the jitter relative

@@ -3,23 +3,23 @@ nearest detected landmark (paper B sec. 2.2, eq. 26; SPEC B.3).
 
 Description
 -----------
-Every method runs the SAME call (``kernels.plan_core``); only the objective
+Every method runs the SAME call (``planning.search.plan_core``); only the objective
 (minimised over the signed angle beta between velocity and line of sight, in
 the vertical plane holding the estimated velocity) differs:
 
-1. the plane (``kernels.plane``) and the visible interval: the betas whose line
+1. the plane (``planning.geometry.plane``) and the visible interval: the betas whose line
    of sight meets the ground inside the field of view less the planning margin,
-   under the *estimated* attitude (``kernels.visible_interval``), split at beta
+   under the *estimated* attitude (``planning.geometry.visible_interval``), split at beta
    = 0 (no parallax) into at most two sub-intervals;
-2. a golden-section search (``kernels.golden_section``, tolerance ``tol_rad``)
+2. a golden-section search (``planning.search.golden_section``, tolerance ``tol_rad``)
    on each; the better optimum wins (the first on exact ties);
 3. beta* mapped to its ground point (eq. 26) and the landmark nearest to it
    (horizontal distance, exact ties to the smaller index) among those the image
    holds (``detected``) less the current one, however far;
 4. edge rule: an optimum within ``tol_rad`` of an end of its sub-interval lies
    outside the image, so every detected landmark is scored by the objective and
-   the best is picked by the tie rule (``kernels.best_index``: scores within
-   ``kernels.TIE_RTOL`` = 1e-9 relative of the best are tied, the lowest
+   the best is picked by the tie rule (``planning.screens.best_index``: scores within
+   ``planning.screens.TIE_RTOL`` = 1e-9 relative of the best are tied, the lowest
    landmark index wins); ``edge`` says so and the landmarks scored count as
    evaluations.
 
@@ -27,14 +27,14 @@ Degenerate geometry or no visible interval: the detected landmark nearest to
 the boresight's ground point, ``note`` says why.
 
 Objectives: ``depth`` (eq. 23-25), the H baselines and the B-X1 information
-baselines (``kernels.KINDS``) are compiled (``kernels.objective``);
+baselines (``planning.layout.KINDS``) are compiled (``planning.search.objective``);
 :data:`PICKERS` search nothing.
 
 Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer would
 run) and ``paper`` (the paper's definition through the same call's source run by
-the interpreter, ``kernels.interpreted``: the law-of-sines depth error of
-``depth_error``; H from CasADi and LAPACK's SVD / pseudo-inverse,
-``metrics.Metric.reference``; the information baselines: ``planned_info`` in numpy);
+the interpreter, ``planning.search.interpreted``, with ``planning.reference.paper_objective``:
+the law-of-sines depth error; H from CasADi and LAPACK's SVD / pseudo-inverse; the information
+baselines in numpy);
 timing replays both. One planner:
 :func:`plan_batch` plans run by run with :func:`plan_one`; :func:`plan` is one
 timed call of it.
@@ -51,23 +51,18 @@ from typing import Callable
 
 import numpy as np
 
-from opnav.landing import kernels as K
 from opnav.landing import metrics
 from opnav.landing.camera import Camera
-from opnav.landing.depth_error import (REASONS, PlaneGeometry, baseline, depth_error_at_landmarks,
-                                       error_radius, plane_geometry, signed_depth_error)
 from opnav.landing.landmarks import LandmarkField
-from opnav.landing.planned_info import PLANNED_METRICS, planned_metric
+from opnav.landing.planning import geometry, layout, reference, screens, search
+from opnav.landing.planning.geometry import PlaneGeometry
 
 __all__ = ["golden_section", "visible_intervals", "PlanState", "PlanResult", "PlannerConfig", "plan",
            "plan_one", "plan_batch", "compiled_kind", "compiled_call", "candidate_scores", "PICKERS", "PATHS",
            "available_methods", "alternative_path"]
 
 PATHS = ("compiled", "paper")
-#: compiled kinds whose paper path is another method's definition (svd_lapack: a real SVD of
-#: the 6 x 12 H, compiled; its definition is svd's, CasADi H and LAPACK)
-PAPER_OF = {"svd_lapack": "svd"}
-#: candidates closer than this to the lander are invalid (m; ``kernels.candidate_ok``)
+#: candidates closer than this to the lander are invalid (m; ``planning.screens.candidate_ok``)
 MIN_RANGE_M = 1e-6
 
 
@@ -91,7 +86,7 @@ class PlannerConfig:
     margin_px: float = 40.0          # planning margin inside the detector edge, px
     eval_path: str = "compiled"      # compiled | paper (module docstring)
     p_known: tuple = (0.0, 0.0, 0.0)  # known landmark (landing site), m
-    # the filter's model, for the planned-information metric (logdet_nav, planned_info)
+    # the filter's model, for the planned-information metric (logdet_nav, planning.reference)
     noise_scale: float = 1.0         # filter bearing noise / true pixel noise
     depth_sigma_frac: float = 0.1    # a new landmark's depth guess 1-sigma / depth
     obs_per_landmark: int = 3        # observations of a landmark (Fig. 3 strategy)
@@ -125,13 +120,13 @@ def alternative_path(cfg: PlannerConfig) -> PlannerConfig:
 
 def golden_section(fun: Callable[[float], float], a: float, b: float, tol: float
                    ) -> tuple[float, float, int]:
-    """``kernels.golden_section`` of a Python function ``fun(x)`` on [a, b]:
+    """``planning.search.golden_section`` of a Python function ``fun(x)`` on [a, b]:
     ``(x, f(x), n_evals)``. Raises ``ValueError`` for a bad interval or tolerance."""
     if not (math.isfinite(a) and math.isfinite(b)) or b < a:
         raise ValueError(f"golden_section: bad interval [{a}, {b}]")
     if not tol > 0:
         raise ValueError(f"golden_section: tolerance must be positive, got {tol}")
-    return K.interpreted(K.golden_section, objective=lambda x, q: fun(x))(None, a, b, tol)
+    return search.interpreted(search.golden_section, objective=lambda x, q: fun(x))(None, a, b, tol)
 
 
 def _kfov(camera: Camera, margin_px: float) -> float:
@@ -141,8 +136,8 @@ def _kfov(camera: Camera, margin_px: float) -> float:
 def visible_intervals(geom: PlaneGeometry, R_LtoB: np.ndarray, camera: Camera,
                       margin_px: float) -> list[tuple[float, float]]:
     """Sub-intervals of signed beta (rad) whose lines of sight meet the ground
-    inside the field of view (estimated attitude), split at 0 (``kernels.visible_interval``)."""
-    n, *e = K.visible_interval(geom.q, camera.R_BtoC @ np.asarray(R_LtoB, float),
+    inside the field of view (estimated attitude), split at 0 (``planning.geometry.visible_interval``)."""
+    n, *e = geometry.visible_interval(geom.q, camera.R_BtoC @ np.asarray(R_LtoB, float),
                                _kfov(camera, margin_px))
     return [(e[0], e[1]), (e[2], e[3])][:n]
 
@@ -168,36 +163,9 @@ def _metric_context(state: PlanState, cfg: PlannerConfig, camera: Camera) -> met
                                  min_range_m=MIN_RANGE_M)
 
 
-def _python_objective(method: str, state: PlanState, cfg: PlannerConfig, camera: Camera, q: np.ndarray):
-    """``(f(beta, q), scores(q, xyz, cand), status)`` of a method the interpreter
-    runs on the paper path (``cfg.eval_path == "paper"``): the paper's definitions and
-    ``planned_info.planned_metric`` for the information baselines; minimised, ``+inf`` where the line of sight misses the ground."""
-    if method == "depth":               # the paper's eq. 23-25 (law of sines, numpy)
-        b = baseline(state.v, state.a, cfg.t_s)
-        if not b > 0:
-            return None, None, K.ZERO_BASELINE
-        r_e = error_radius(state.P[3:6, 3:6], cfg.t_s, cfg.n_sigma_v)
-        geom = PlaneGeometry(q[0:3], q[3:6], q[6:9], q[9], q[10])
-        f = lambda beta, q: float(signed_depth_error(beta, geom, b, r_e))
-        scores = lambda q, xyz, cand: depth_error_at_landmarks(state.r, state.v, state.a, xyz[cand],
-                                                               cfg.t_s, r_e)
-        return f, scores, K.OK
-    if method in PLANNED_METRICS:
-        kw = dict(sigma_f=camera.sigma_b * cfg.noise_scale, depth_sigma_frac=cfg.depth_sigma_frac,
-                  n_obs=cfg.obs_per_landmark, dt=cfg.t_s, g=cfg.g, oc=cfg.oc,
-                  boresight_B=camera.boresight_B)
-        p_known = np.asarray(cfg.p_known, float)
-        score = lambda pts: -planned_metric(method, state.r, state.v, state.a, state.R_LtoB, state.P,
-                                            p_known, pts, **kw)
-    else:
-        ctx = _metric_context(state, cfg, camera)
-        score = lambda pts: -metrics.make_metric(PAPER_OF.get(method, method)).reference(ctx, pts)
-
-    def f(beta, q):
-        hit, x, y, z = K.ground_point(beta, q)
-        return float(score(np.array([[x, y, z]]))[0]) if hit else math.inf
-
-    return f, lambda q, xyz, cand: score(xyz[cand]), K.OK
+def _paper_objective(method: str, state: PlanState, cfg: PlannerConfig, camera: Camera, q: np.ndarray):
+    """``reference.paper_objective`` of this state (the H baselines' context made on demand)."""
+    return reference.paper_objective(method, state, cfg, camera, q, lambda: _metric_context(state, cfg, camera))
 
 
 # ----------------------------------------------------------------- planning
@@ -207,12 +175,12 @@ _CACHE: dict = {}
 
 def _setup(field_: LandmarkField, cfg: PlannerConfig, camera: Camera):
     """Per (field, config, camera), built once: the field's landmarks, the
-    compiled call's constant vector (``kernels.plan_run``, with the field's bucket
-    grid) and the grid's buckets (``kernels.field_grid``)."""
+    compiled call's constant vector (``planning.search.plan_run``, with the field's bucket
+    grid) and the grid's buckets (``planning.screens.field_grid``)."""
     key = (id(field_), id(cfg), id(camera))
     if key not in _CACHE:
         xyz = np.ascontiguousarray(field_.xyz, float)
-        grid, cells = K.field_grid(xyz)
+        grid, cells = screens.field_grid(xyz)
         c = np.concatenate([[cfg.t_s, cfg.n_sigma_v, cfg.tol_rad, _kfov(camera, cfg.margin_px), MIN_RANGE_M],
                             camera.R_BtoC.ravel(), camera.boresight_B, cfg.p_known, grid, [camera.sigma_b],
                             [cfg.noise_scale, cfg.depth_sigma_frac, cfg.obs_per_landmark, float(cfg.oc)], cfg.g])
@@ -224,7 +192,7 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
              exclude: int, detected: np.ndarray, rng: np.random.Generator | None = None
              ) -> tuple[PlanResult, np.ndarray]:
     """One planning call (module docstring): ``(PlanResult, q)`` with ``q`` the
-    call's per-run constants (``kernels.NQ``). ``detected``: sorted int64 field
+    call's per-run constants (``planning.layout.NQ``). ``detected``: sorted int64 field
     indices of the landmarks the image holds; ``exclude``: the current landmark
     (-1: none)."""
     kind = compiled_kind(method, cfg)
@@ -238,49 +206,54 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     xyz, c, cells = setup = _setup(field_, cfg, camera)
     if kind >= 0:
         args = _kernel_args(kind, state, setup, exclude, detected)
-        K.plan_run(*args)
+        search.plan_run(*args)
         work = args[-1]
     else:
-        work = np.empty(K.NQ + 9)
-    q, out = work[:-9], work[-9:]
+        work = np.empty(layout.NQ + layout.NOUT)
+    q, out = work[:-layout.NOUT], work[-layout.NOUT:]
     if kind < 0:
-        st = K.plane(state.r, state.v, q)
-        if st == K.OK:
-            f, scores, st = _python_objective(method, state, cfg, camera, q)
-        if st == K.OK:
-            core = K.interpreted(K.plan_core, golden_section=K.interpreted(K.golden_section, objective=f),
-                                 edge_pick=K.interpreted(K.edge_pick, score_points=lambda q, xyz, cand: np.asarray(
-                                     scores(q, xyz, cand), float)))
-            core(q, camera.R_BtoC @ state.R_LtoB, c[K.C_KFOV], c[K.C_TOL], xyz, detected, exclude,
-                 c[K.C_GRID:K.C_GRID + 5], cells, out)
+        st = geometry.plane(state.r, state.v, q)
+        if st == layout.OK:
+            f, scores, st = _paper_objective(method, state, cfg, camera, q)
+        if st == layout.OK:
+            pick = search.interpreted(search.edge_pick,
+                                      score_points=lambda q, xyz, cand: np.asarray(scores(q, xyz, cand), float))
+            core = search.interpreted(search.plan_core, edge_pick=pick,
+                                      golden_section=search.interpreted(search.golden_section, objective=f))
+            core(q, camera.R_BtoC @ state.R_LtoB, c[layout.C_KFOV], c[layout.C_TOL], xyz, detected, exclude,
+                 c[layout.C_GRID:layout.C_GRID + layout.NG], cells, out)
         else:
-            out[3], out[8] = 0, st
+            out[layout.O_NEVAL], out[layout.O_STATUS] = 0, st
     o = out.tolist()
-    if o[8] != K.OK:      # documented fallback: the detected landmark nearest the boresight
+    if o[layout.O_STATUS] != layout.OK:      # documented fallback: the detected landmark nearest the boresight
         bs = state.R_LtoB.T @ camera.boresight_B
         point = state.r + bs * max(state.r[2], 1.0) / max(-bs[2], 1e-3)
-        k = K.nearest(point[0], point[1], xyz, detected, exclude, c[K.C_GRID:K.C_GRID + 5], cells)
-        return PlanResult(method, int(k), math.nan, point, math.nan, int(o[3]), 0, REASONS[int(o[8])]), q
-    return PlanResult(method, int(o[0]), o[1], out[5:8], o[2], int(o[3]), 0, "", 0, o[4] > 0), q
+        grid = c[layout.C_GRID:layout.C_GRID + layout.NG]
+        k = screens.nearest(point[0], point[1], xyz, detected, exclude, grid, cells)
+        return PlanResult(method, int(k), math.nan, point, math.nan, int(o[layout.O_NEVAL]), 0,
+                          layout.REASONS[int(o[layout.O_STATUS])]), q
+    L = layout
+    return PlanResult(method, int(o[L.O_PICK]), o[L.O_BETA], out[L.O_XYZ:L.O_XYZ + 3], o[L.O_F],
+                      int(o[L.O_NEVAL]), 0, "", 0, o[L.O_EDGE] > 0), q
 
 
 def compiled_kind(method: str, cfg: PlannerConfig) -> int:
-    """The compiled objective kind of ``method`` on ``cfg``'s path (``kernels.KINDS``); -1: none."""
-    return K.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+    """The compiled objective kind of ``method`` on ``cfg``'s path (``planning.layout.KINDS``); -1: none."""
+    return layout.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
 
 
 def _kernel_args(kind: int, state: PlanState, setup: tuple, exclude: int, detected: np.ndarray) -> tuple:
-    """``kernels.plan_run``'s arguments for one call (``setup``: :func:`_setup`'s; ``work`` last: q,
+    """``planning.search.plan_run``'s arguments for one call (``setup``: :func:`_setup`'s; ``work`` last: q,
     then out)."""
     xyz, c, cells = setup
-    return (kind, state.r, state.v, state.a, state.R_LtoB, state.P, c, xyz, detected, exclude, cells,
-            np.empty(K.work_size(c[K.C_NAV + 2])))
+    return (kind, layout.Estimate(state.r, state.v, state.a, state.R_LtoB, state.P), c, xyz, detected, exclude,
+            cells, np.empty(layout.work_size(c[layout.C_NOBS])))
 
 
 def compiled_call(method: str, state: PlanState, camera: Camera, field_: LandmarkField, cfg: PlannerConfig,
                   exclude: int, detected: np.ndarray) -> Callable[[], None] | None:
     """The compiled planning call as a lander's computer runs it, for timing: a function of no
-    argument that runs ``kernels.plan_run`` on these inputs (the whole call: plane, visible
+    argument that runs ``planning.search.plan_run`` on these inputs (the whole call: plane, visible
     interval, searches, edge rule, nearest landmark; numba's argument dispatch included), without
     the Python wrapper of :func:`plan_one` around it (the per-field constants, the
     ``PlanResult`` the Monte Carlo keeps, the degenerate-geometry fallback). None if ``method``
@@ -288,7 +261,8 @@ def compiled_call(method: str, state: PlanState, camera: Camera, field_: Landmar
     kind = compiled_kind(method, cfg)
     if kind < 0:
         return None
-    return functools.partial(K.plan_run, *_kernel_args(kind, state, _setup(field_, cfg, camera), int(exclude),
+    setup = _setup(field_, cfg, camera)
+    return functools.partial(search.plan_run, *_kernel_args(kind, state, setup, int(exclude),
                                                        np.asarray(detected, np.int64)))
 
 
@@ -298,8 +272,8 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
     with per-run constants ``q`` (:func:`plan_one`): the edge rule's scores."""
     xyz = _setup(field_, cfg, camera)[0]
     if compiled_kind(method, cfg) >= 0:
-        return K.score_points(q, xyz, cand)
-    return _python_objective(method, state, cfg, camera, q)[1](q, xyz, cand)
+        return search.score_points(q, xyz, cand)
+    return _paper_objective(method, state, cfg, camera, q)[1](q, xyz, cand)
 
 
 def _diagnose(res: PlanResult, q, state, camera, field_, cfg, detected, exclude) -> None:
@@ -385,7 +359,7 @@ def _pick_closest(field_, cand, state, camera, rng) -> int:
 PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center,
                                 "closest": _pick_closest}
 #: methods with a search: the compiled kinds, the metrics, the planned information
-OBJECTIVE_METHODS = tuple(K.KINDS)
+OBJECTIVE_METHODS = tuple(layout.KINDS)
 
 
 def available_methods() -> tuple[str, ...]:

@@ -32,7 +32,7 @@ import math
 import numpy as np
 import pandas as pd
 # Student's t by its special functions (what scipy.stats.t calls, same bits, tested):
-# importing scipy.stats costs a job about 0.4 CPU-s more than scipy.special.
+# scipy.stats is a heavier import than scipy.special (docs/performance.md).
 from scipy import special
 
 from opnav.landing.montecarlo import per_run_stats, same_pick_pct
@@ -197,7 +197,7 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
     reference (m; negative = the method is more accurate); ``converged_runs_pct``
     counts runs whose final position error is below ``converged_pos_err_m`` (m),
     as in B-T3; ``median_abs_beta_deg`` is the median over calls of the optimum's |beta| (deg),
-    its in-plane angle to the estimated velocity (0: no parallax; ``planned_info`` says why the
+    its in-plane angle to the estimated velocity (0: no parallax; ``planning.reference`` says why the
     whitened baselines sit near it). Time columns (median wall and CPU time of a planning call, us)
     come from ``timing``, the replay of the recorded planning calls
     (``opnav.landing.timing.replay``: every method on the same calls)."""
@@ -251,7 +251,7 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
                                        else same_pick_pct(d, data[reference]))
         row["median_abs_dbeta_vs_ref_deg"] = (0.0 if m == reference
                                               else median_abs_dbeta_deg(d, data[reference]))
-        # the optimum's in-plane angle to the estimated velocity (0: no parallax; planned_info)
+        # the optimum's in-plane angle to the estimated velocity (0: no parallax; planning.reference)
         beta = np.abs(np.asarray(d.get("plan_beta", []), float))
         row["median_abs_beta_deg"] = (float(np.degrees(np.median(beta[np.isfinite(beta)])))
                                       if np.isfinite(beta).any() else math.nan)

@@ -119,7 +119,7 @@ def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
     """The timed (method, path, PlannerConfig): every method on ``cfg``'s path
     (``"main"``), and, unless ``alt`` is false, every method with a search on the
     other path (``"alt"``, ``planner.alternative_path``: compiled <-> the paper's
-    definition; for ``logdet_nav``, ``planned_info`` in numpy)."""
+    definition; for ``logdet_nav``, ``planning.reference`` in numpy)."""
     from opnav.landing.planner import PICKERS, alternative_path
 
     alt_cfg = alternative_path(cfg)
@@ -134,7 +134,7 @@ def variants(methods, cfg, alt: bool = True) -> list[tuple[str, str, object]]:
 def pass_keys(var) -> list[tuple[int, int]]:
     """Per variant of :func:`variants`, the pass that times it (module docstring):
     ``(0, .)`` the configured path, ``(1, .)`` the other one; ``(., 0)`` a compiled
-    search (a method of ``kernels.KINDS`` on the compiled path), ``(., 1)`` interpreted
+    search (a method of ``planning.layout.KINDS`` on the compiled path), ``(., 1)`` interpreted
     code (the paper's definition, the pickers). Passes run in
     ascending key order."""
     from opnav.landing.planner import compiled_kind
@@ -367,7 +367,7 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     on the compiled path: the whole compiled call (``planner.compiled_call``, as :func:`replay`
     times it; ``call_ns``: ``reps`` calls in a row, thread CPU clock, the minimum of
     ``repeats`` averages) and its
-    objective evaluations alone (``evals_ns``: ``kernels.evaluations`` at the betas
+    objective evaluations alone (``evals_ns``: ``planning.search.evaluations`` at the betas
     the call's searches evaluate, recorded by an interpreted pass of the same
     search, plus the detected landmarks an edge call scores; timed inside the
     kernel, ``reps`` times, so no call overhead is counted as evaluations). Returns
@@ -376,7 +376,8 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     hot, as ``call_ns``) and ``overhead_ratio = (call - evals) / evals``."""
     import dataclasses
 
-    from opnav.landing import kernels as K
+    from opnav.landing.planning import search as K
+    from opnav.landing.planning.geometry import plane_geometry
     from opnav.landing import planner as pl
 
     d = recorded[method]
@@ -408,7 +409,7 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
                 return K.objective(b, q)
 
             search = K.interpreted(K.golden_section, objective=spy)
-            for lo, hi in pl.visible_intervals(pl.plane_geometry(st.r, st.v), st.R_LtoB, cam, cfg.margin_px):
+            for lo, hi in pl.visible_intervals(plane_geometry(st.r, st.v), st.R_LtoB, cam, cfg.margin_px):
                 search(q, lo, hi, cfg.tol_rad)
             cand = det[det != ex] if res.edge else np.zeros(0, np.int64)
             xyz = np.ascontiguousarray(field_.xyz)
