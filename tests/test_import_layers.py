@@ -6,7 +6,7 @@
 * the papers (``opnav.approach.*``, ``opnav.landing.*``, their ``cli`` modules aside):
   import the core and their own paper only, never the other paper;
 * the report (``opnav.report.*``: claims, scorecard, manuscript, study plots, each
-  paper's claims) and ``opnav.studies``: import anything below them;
+  paper's claims) and the study package (``opnav.studies.*``): import anything below them;
 * the edge (the CLIs, ``__main__``, ``opnav.preflight``: the config checks that need the
   papers' physics and the study planner, which the Snakefile and the CLIs call): may
   import anything.

@@ -44,7 +44,8 @@ Layers
     ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml``, ``consider`` ->
     ``scenario``, ``labels`` (a run's convergence label and reading), ``cases`` -> ``pipeline``,
     ``alternatives``, ``study``, ``peers``, ``readings`` -> ``summaries``, ``alternatives_summary``
-    (the tables' numbers, A-summary.json), ``plots``, ``peer_plots``, ``star_plots``; ``cli`` at
+    (the tables' numbers, A-summary.json; the frozen ``HeadlineSummary``, ``ClaimsSummary`` and
+    ``MethodSummary`` the report reads), ``plots``, ``peer_plots``, ``star_plots``; ``cli`` at
     the edge. The tables' page views, the scorecard rows and the prose made from the numbers are
     in the report layer (``opnav.report.approach_views``, ``approach_scorecard``, ``approach_text``).
 """
