@@ -115,7 +115,8 @@ for _name, _s in STUDIES.items():
             f"study_{_name}_outputs"
         input:
             runs=[f for f, _ in _files],
-            code=src("studies/tables.py", "studies/metrics.py", "studies/values.py", "landing/study.py", "core/tables.py",
+            code=src("studies/tables.py", "studies/metrics.py", "studies/values.py", "studies/captions.py",
+                     "landing/study.py", "core/tables.py",
                      "report/study_plots.py", "core/figures.py",
                      "opnav.mplstyle"),
         output:

@@ -25,14 +25,12 @@ with script_context(snakemake) as log:
     pub = published.paper_a()
     t1 = summaries.table1_frame(results, pub, snakemake.params.profile)
     csv, tex, md = snakemake.output.t1
-    cap = ("A-T1: paper A Table 1 reproduced; mean and sd over Monte-Carlo seeds; CRLB of the data each "
-           "estimate used (Q = 0 beside); EM label from the ML estimate of the data each run used (converged / "
-           "stalled / not converged), identifiable when that bound is at most the published accuracy; pub_* = published.")
+    cap = approach_views.CAPTIONS["A-T1"]
     write_table(t1, [csv], caption=cap)  # every column
     write_table(approach_views.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
     x1 = summaries.crlb_rows(setup, curves["Q"], conv, t1, curves["Q0"])
     write_table(x1, snakemake.output.x1,
-                caption="A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.")
+                caption=approach_views.CAPTIONS["A-X1"])
     atomic_write_text(snakemake.output.verdict, approach_text.identifiability_text(setup, x1))
     summ = summaries.summary(setup, t1, x1, curves.get("roll_rate"))
     if snakemake.input.stars:  # the stars variant (beyond the paper)

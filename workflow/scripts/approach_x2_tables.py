@@ -28,9 +28,7 @@ with script_context(snakemake) as log:
     rows = alternatives_summary.method_summaries(long)
     table = approach_views.x2_table(rows)
     write_table(table, snakemake.output.table,
-                caption="A-X2: EM-EKF against the augmented EKF and batch ML (IPOPT) on the Table-1 cases; "
-                        "errors in arcsec (estimate minus truth), CRLB = Cramer-Rao bound, nav error in km, "
-                        "data needed in samples, run time in s per Monte-Carlo seed.")
+                caption=approach_views.CAPTIONS["A-X2"])
     summ = alternatives_summary.summary_json(long, rows, setup)
     summ["profile"] = snakemake.params.profile
     write_json(snakemake.output.summary, summ)

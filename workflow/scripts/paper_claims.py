@@ -58,7 +58,7 @@ with script_context(snakemake) as log:
         inputs_b(LandingSummary.from_json(summ["B"]), pub["paper_b"], plan, dict(par.landing)) if "B" in summ else [])
     claims.inputs_frame(ins).to_csv(snakemake.output.inputs, index=False)
     write_table(claims.glance(df), [snakemake.output.md],
-                caption="Claims at a glance: each published claim, ours as written, the verdict.")
+                caption=claims.GLANCE_CAPTION)
     atomic_write_text(snakemake.output.tex, claims_glance_latex(df))
     atomic_write_text(snakemake.output.detail, claims_detail_latex(df))
     atomic_write_text(snakemake.output.json, json.dumps({

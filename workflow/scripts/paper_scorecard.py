@@ -29,7 +29,7 @@ with script_context(snakemake) as log:
                 "max_band_rel": plan.margin("B-C4", "max_band_rel")}
         rows += rows_paper_b(load_table(inp["b_summary_table"]), summary_b, published.paper_b(), band)
     df = scorecard.score_rows(rows)
-    write_table(df, snakemake.output.table, caption="Scorecard: published values beside ours.")
+    write_table(df, snakemake.output.table, caption=scorecard.CAPTION)
     atomic_write_text(snakemake.output.longtable, scorecard.to_longtable(df))
     write_table(scorecard.verdict_counts(df), [snakemake.output.counts], float_format="{:.0f}")
     write_table(scorecard.headline(df), [snakemake.output.headline])

@@ -11,6 +11,7 @@ from opnav.core import figures
 from opnav.core.snakeio import load_csv, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
 from opnav.report.study_plots import fig_study
+from opnav.studies.captions import slopes_caption
 from opnav.studies.tables import gather_runs, loglog_slopes, tidy_table, wide_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -27,7 +28,7 @@ with script_context(snakemake) as log:
     write_table(runs, [snakemake.output.runs])
     if study["slopes"]:
         write_table(loglog_slopes(tidy, study), snakemake.output.slopes,
-                    caption=f"{study['id']} {study['name']}: log-log slopes against {study['keys'][0]}.")
+                    caption=slopes_caption(study))
     atomic_write_text(snakemake.output.caption, cap + "\n")
     log.info("study %s: %d runs, %d summary rows", study["name"], len(runs), len(tidy))
     # the figure reads the summary back from its CSV, as a user of the table would

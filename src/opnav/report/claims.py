@@ -586,6 +586,10 @@ def limitations(df: pd.DataFrame) -> str:
     return " ".join(s)
 
 
+#: the caption of the claims-at-a-glance table (claims.md)
+GLANCE_CAPTION = "Claims at a glance: each published claim, ours as written, the verdict."
+
+
 def glance(df: pd.DataFrame) -> pd.DataFrame:
     """The at-a-glance table: id, claim, published, ours (as written), verdict."""
     show = df[["claim_id", "claim", "published", "ours_as_written", "verdict"]].copy()

@@ -20,6 +20,9 @@ from opnav.core.verdicts import (  # noqa: F401
     tolerance,
 )
 
+#: the caption of the scorecard table
+CAPTION = "Scorecard: published values beside ours."
+
 
 def score_rows(rows: list[dict]) -> pd.DataFrame:
     """Score a list of dicts with keys paper, item, published, ours, spread, unit

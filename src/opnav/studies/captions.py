@@ -8,7 +8,7 @@ from collections.abc import Mapping
 from opnav.studies.metrics import METRICS, TIMING_METRICS
 from opnav.studies.values import slug
 
-__all__ = ["caption"]
+__all__ = ["caption", "slopes_caption"]
 
 
 def caption(study: Mapping) -> str:
@@ -44,6 +44,11 @@ def caption(study: Mapping) -> str:
             + (f", and the log-log slopes against {swept}" if study.get("slopes") else "")
             + _timing_text(study) + "."
             + (f" {note}" if note else ""))
+
+
+def slopes_caption(study: Mapping) -> str:
+    """The caption of a study's log-log slopes table."""
+    return f"{study['id']} {study['name']}: log-log slopes against {study['keys'][0]}."
 
 
 def _timing_text(study: Mapping) -> str:
