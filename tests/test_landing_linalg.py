@@ -3,7 +3,8 @@ hypothesis-drawn symmetric positive-definite matrices: the factor, the solve, th
 in-place factorisation the filter uses, and the failure flag."""
 
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from opnav.landing import linalg
 

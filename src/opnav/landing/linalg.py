@@ -18,7 +18,7 @@ import numpy as np
 
 from opnav.core.compiled import kernel, warms
 
-__all__ = ["cholesky_shifted", "cholesky_in_place", "cho_solve", "logdet_spd", "matmul", "symmetrize"]
+__all__ = ["cho_solve", "cholesky_in_place", "cholesky_shifted", "logdet_spd", "matmul", "symmetrize"]
 
 
 @kernel
