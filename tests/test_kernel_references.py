@@ -12,9 +12,9 @@ Kernels covered here: approach.kalman._propagate, _loglik1/_loglik_batch,
 _inv_sym3; approach.ekf.filter_window/ekf_step and smoother._bryson_frazier_window
 (bf_moments, bf_back) against the dense posterior; the measurement Jacobians of
 approach.ekf.ekf_step and approach.augmented._jacobian1 by finite differences;
-landing.ekf._transition (finite differences), _inject, _nullspace, _cholesky,
-_cho_solve, _linearise (CasADi); landing.measurement.tangent_rows (CasADi) and
-blocks (the printed eq. 12, 16, 18);
+landing.ekf._transition (finite differences), _nullspace; landing.ekf_update._inject,
+_linearise (CasADi); landing.linalg.cholesky_in_place, cho_solve;
+landing.measurement.tangent_rows (CasADi) and blocks (the printed eq. 12, 16, 18);
 landing.descent._record; and the warm-up of every kernel module.
 """
 
@@ -343,8 +343,8 @@ def test_landing_nullspace_is_the_derivative_of_a_yaw_rotation_of_the_world(seed
 @settings(max_examples=30, deadline=None)
 @given(SEEDS, st.integers(1, 9), st.integers(0, 3), st.sampled_from([1e-6, 1.0, 1e6]))
 def test_landing_cholesky_kernels_equal_numpy(seed, n, extra, scale):
-    """``ekf._cholesky`` (on the leading n x n block of a larger buffer, as the update
-    uses it) is numpy's lower factor and ``_cho_solve`` numpy's solve. Mutation tried:
+    """``linalg.cholesky_in_place`` (on the leading n x n block of a larger buffer, as the
+    filter's update uses it) is numpy's lower factor and ``cho_solve`` numpy's solve. Mutation tried:
     ``L[i, k]`` for ``L[k, i]`` in the back substitution -> fails."""
     from opnav.landing.linalg import cho_solve as _cho_solve, cholesky_in_place as _cholesky
 
