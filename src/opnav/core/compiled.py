@@ -225,15 +225,15 @@ def warms(fn: Callable[[], None]) -> Callable[[], None]:
 
 
 #: CPU seconds each kernel module's warm-up took to compile on an empty cache (the
-#: progress lines' estimate; 2026-12-04, the project's 2-core VM at load 2-4, numba 0.68.1,
-#: main at 7026688; landing.linalg, .ekf, .ekf_update from a quick build of ee36cb0 with the
-#: filters regrouped). A module that is not listed is estimated at 2 CPU-s.
+#: progress lines' estimate): the compile_kernels logs of bench_pipeline's empty-cache quick
+#: build of ee36cb0 (2026-12-04 08:25, the project's 2-core VM at load 3-5, numba 0.68.1;
+#: docs/performance.md). A module that is not listed is estimated at 2 CPU-s.
 COMPILE_CPU_S: dict[str, float] = {
-    "opnav.approach.kalman": 3.2, "opnav.approach.ekf": 4.4, "opnav.approach.smoother": 4.2,
-    "opnav.approach.em": 5.7, "opnav.approach.augmented": 2.0, "opnav.core.rotations": 0.3,
-    "opnav.landing.measurement": 0.7, "opnav.landing.linalg": 1.1, "opnav.landing.ekf": 3.8,
-    "opnav.landing.ekf_update": 4.6, "opnav.landing.planning.warmup": 47.4,
-    "opnav.landing.descent": 1.8, "opnav.landing.imu": 0.5}
+    "opnav.approach.kalman": 3.3, "opnav.approach.ekf": 2.6, "opnav.approach.smoother": 2.2,
+    "opnav.approach.em": 4.1, "opnav.approach.augmented": 2.8, "opnav.core.rotations": 0.8,
+    "opnav.landing.measurement": 1.1, "opnav.landing.linalg": 1.1, "opnav.landing.ekf": 4.5,
+    "opnav.landing.ekf_update": 4.8, "opnav.landing.planning.warmup": 21.4,
+    "opnav.landing.descent": 1.2, "opnav.landing.imu": 0.4}
 
 
 def warm(modules: tuple[str, ...] | None = None,
