@@ -15,18 +15,24 @@ def test_there_are_captions():
     assert len(CAPTIONS) >= 10
 
 
-def _rendered(path: Path, tmp: Path, profile: str = "full") -> str:
-    """A caption as Snakemake's report renders it: Jinja with ``snakemake.config`` and the
-    report's files (the landing page reads the claims at a glance from the results)."""
+def _rendered(path: Path, tmp: Path, profile: str = "full", wildcards: dict | None = None) -> str:
+    """A caption as Snakemake's report renders it: Jinja with ``snakemake.config`` (the
+    profile's), the job's wildcards and the report's files (the landing page reads the claims
+    at a glance from the results)."""
     from types import SimpleNamespace
 
     import jinja2
 
+    from opnav.core.config import load_config
+
     (tmp / "paper").mkdir(parents=True, exist_ok=True)
     (tmp / "paper" / "claims_glance.csv").write_text(
         "claim_id,claim,published,ours_as_written,verdict\nA-C1,accuracy,2 arcsec,20 arcsec,not_reproducible\n")
-    snakemake = SimpleNamespace(config={"profile": profile, "results_dir": str(tmp)},
-                                params=SimpleNamespace(caption="a caption"))
+    cfg = load_config(overlays=(REPO / "config" / "quick.yaml",) if profile == "quick" else ())
+    cfg.update(profile=profile, results_dir=str(tmp))
+    wildcards = wildcards or {"bscn": next(iter(cfg["landing"]["scenarios"]))}
+    snakemake = SimpleNamespace(config=cfg, params=SimpleNamespace(caption="a caption"),
+                                wildcards=SimpleNamespace(**wildcards))
     files = [SimpleNamespace(target="main.pdf")]
     return jinja2.Environment().from_string(path.read_text()).render(snakemake=snakemake, files=files)
 
@@ -43,6 +49,21 @@ def test_caption_renders_without_messages(path: Path, tmp_path):
         text, source_path=str(path),
         settings_overrides={"report_level": 1, "halt_level": 5, "warning_stream": warnings})
     assert warnings.getvalue() == "", warnings.getvalue()
+
+
+def test_bx1_caption_states_each_cameras_runs(tmp_path):
+    """B-X1 compares every method on the first n runs of each camera (landing.extra.n_runs,
+    fewer than the paper's methods fly where set): its caption says how many, per camera."""
+    from opnav.core.config import load_config
+
+    path = REPO / "workflow" / "report" / "B-X1.rst"
+    cfg = load_config()
+    n_mc = cfg["landing"]["mc"]["n_runs"]
+    for scn in cfg["landing"]["scenarios"]:
+        n = min(n_mc, cfg["landing"]["extra"].get("n_runs", {}).get(scn, n_mc))
+        text = " ".join(_rendered(path, tmp_path, wildcards={"bscn": scn}).split())
+        assert f"runs 0 to {n - 1} ({n} runs" in text, (scn, text)
+        assert (f"of the {n_mc} the paper's methods fly" in text) == (n < n_mc), (scn, text)
 
 
 # ------------------------------------------------------------ captions fit to print
