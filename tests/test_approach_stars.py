@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from opnav.approach import alternatives, cases, crlb, pipeline, stars
+from opnav.approach import alternatives, cases, pipeline, stars
 from opnav.approach import scenario as sc
 from opnav.approach.camera import misalignment_exact
 from opnav.approach.setup import Setup

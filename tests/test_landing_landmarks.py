@@ -6,7 +6,6 @@ excluded landmark, exact distance ties included (broken by the smaller index).""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from hypothesis import given, settings, strategies as st
 
 from opnav.landing.landmarks import make_field, nearest_brute_force

@@ -414,7 +414,7 @@ def test_lapack_svd_of_H_equals_the_closed_form(r, R, seed):
     block's sign flipped in one row fails."""
     from opnav.landing.camera import Camera  # noqa: F401  (the planner's camera type)
     from opnav.landing.landmarks import LandmarkField
-    from opnav.landing.planner import PlannerConfig, PlanState, candidate_scores, plan_one
+    from opnav.landing.planner import PlanState, candidate_scores, plan_one
     from opnav.landing.scenario import build_scenario, camera_scenarios
     from opnav.core.config import load_config
 

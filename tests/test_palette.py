@@ -4,7 +4,6 @@ ablation figure used to colour the roll variant differently)."""
 
 import numpy as np
 import pandas as pd
-import pytest
 from matplotlib.colors import to_rgba
 
 from opnav.core import figures

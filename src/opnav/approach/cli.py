@@ -45,7 +45,7 @@ FLAG_KEYS = {"bias": "approach.truth_bias_arcsec", "init": "approach.theta_init_
 
 def run(args) -> int:
     from opnav.cli import load_cli_config, print_json, with_flags
-    from opnav.core.config import ConfigError, load_config
+    from opnav.core.config import ConfigError
     from . import scenario as sc
     from .cases import Case, run_case
     from .pipeline import bound_curve, bound_data, segment_bounds

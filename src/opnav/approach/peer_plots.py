@@ -5,7 +5,6 @@ Plotting only (numbers from :mod:`opnav.approach.peers` runs and the A-P1 table)
 
 from __future__ import annotations
 
-import numpy as np
 
 from opnav.core import figures
 
