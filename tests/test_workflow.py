@@ -165,9 +165,10 @@ def test_slurm_workflow_profile_dry_run_account_and_measured_resources(workdir):
     profile = yaml.safe_load((workdir / "profiles" / "slurm" / "config.yaml").read_text())
     assert "slurm_account" not in str(profile.get("default-resources", ""))
     set_res = profile["set-resources"]
-    # one Monte-Carlo job per method, as the full profile and a cluster fly it (the quick
-    # profile's landing.mc.methods_per_job packs them into rules landing_mc_pack*)
-    (workdir / "per-method.yaml").write_text("landing: {mc: {methods_per_job: 1}}\n")
+    # one Monte-Carlo job per method (paper A: per variant and group), as the full profile and
+    # a cluster fly them (the quick profile's landing.mc.methods_per_job and
+    # jobs.approach_mc_per_job pack them into rules landing_mc_pack*, approach_mc_pack*)
+    (workdir / "per-method.yaml").write_text("landing: {mc: {methods_per_job: 1}}\njobs: {approach_mc_per_job: 1}\n")
     proc = run_snakemake(workdir, "-n", "--workflow-profile", "profiles/slurm",
                          "--default-resources", "slurm_account=acct42", "slurm_partition=part7",
                          "--configfile", "config/quick.yaml", "per-method.yaml")

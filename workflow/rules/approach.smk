@@ -40,6 +40,18 @@ wildcard_constraints:
     method="plain|squarem|growing-plain|growing-squarem",
 
 
+# jobs.approach_mc_per_job > 1 (tiny profiles): the Monte Carlo's (variant, case group)
+# units, in the order A_VARIANTS and a_groups list them, in packs of that many, one job per
+# pack (rules approach_mc_pack1, ...) writing each unit's files as approach_mc does. Every
+# unit's job gets the same params (A_EM, growing) and code, so an approach key or code edit
+# reruns every unit either way; only adding a variant or group re-flies its pack-mates.
+_A_K = config["jobs"]["approach_mc_per_job"]
+A_MC_UNITS = [(v, g) for v in A_VARIANTS for g in a_groups(v)]
+A_MC_PACKS = [A_MC_UNITS[i:i + _A_K] for i in range(0, len(A_MC_UNITS), _A_K)] if _A_K > 1 else []
+# approach_mc's pattern refuses the packed units (a lookahead over "variant__group__")
+_A_NOT_PACKED = "".join(f"(?!{v}__{g}__)" for p in A_MC_PACKS for v, g in p)
+
+
 rule approach_mc:
     """Monte Carlo of one case group and scenario variant under every EM scheme (A_SCHEMES: sliding
     plain / SQUAREM, growing-<method>; seeds batched). One job for all schemes: they share the
@@ -49,6 +61,8 @@ rule approach_mc:
         kernels=kernels("approach"),
     output:
         [f"{A_WORK}/mc/{{variant}}__{{group}}__{s}.pkl" for s in A_SCHEMES],
+    wildcard_constraints:
+        variant=_A_NOT_PACKED + "(literal|prior|roll|reference-start|stars)",
     params:
         # the growing schemes also read approach.growing
         approach=cfg("approach", *A_EM, *(("growing",) if config["approach"]["growing"]["methods"] else ())),
@@ -59,6 +73,33 @@ rule approach_mc:
         f"{APPROACH}/benchmarks/mc_{{variant}}__{{group}}.tsv"
     script:
         "../scripts/approach_mc.py"
+
+
+for _i, _pack in enumerate(A_MC_PACKS, 1):
+
+    rule:
+        """Several (variant, case group) Monte Carlos in one job (jobs.approach_mc_per_job):
+        each unit's schemes in turn, written as rule approach_mc writes them."""
+        name:
+            f"approach_mc_pack{_i}"
+        input:
+            A_SRC,
+            kernels=kernels("approach"),
+        output:
+            [f"{A_WORK}/mc/{v}__{g}__{s}.pkl" for v, g in _pack for s in A_SCHEMES],
+        params:
+            approach=cfg("approach", *A_EM, *(("growing",) if config["approach"]["growing"]["methods"] else ())),
+            schemes=A_SCHEMES,
+            units=[[v, g] for v, g in _pack],
+        resources:  # SLURM: a dynamic rule has no profiles/slurm entry; approach_mc's per unit
+            runtime=10 * len(_pack),
+            mem_mb=1500,
+        log:
+            f"{APPROACH}/logs/mc_pack{_i}.log",
+        benchmark:
+            f"{APPROACH}/benchmarks/mc_pack{_i}.tsv"
+        script:
+            "../scripts/approach_mc.py"
 
 
 rule approach_convergence:

@@ -1,4 +1,5 @@
-"""Monte Carlo of one Table-1 case group under one scenario variant, every EM scheme of the job."""
+"""Monte Carlo of one Table-1 case group under one scenario variant, every EM scheme of the job;
+or, in a pack (rules approach_mc_pack*, jobs.approach_mc_per_job), several such units in turn."""
 
 import sys
 from pathlib import Path
@@ -11,11 +12,16 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
     snakemake = mock_snakemake("approach_mc", argv=sys.argv[1:], variant="literal", group="size")
 
 with script_context(snakemake) as log:
-    w = snakemake.wildcards
-    setup = Setup.from_config(snakemake.params.approach)
-    shared = {}  # the schemes share the simulation, the theta = 0 filter and a mode's bounds
-    for scheme, out in zip(snakemake.params.schemes, snakemake.output):
-        mode, _, method = scheme.rpartition("-")  # "growing-squarem" -> growing windows, SQUAREM
-        res = run_group(setup, w.variant, w.group, method, mode or "sliding", log=log, shared=shared)
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        save_pickle(out, res)
+    p = snakemake.params
+    setup = Setup.from_config(p.approach)
+    # a pack (rules approach_mc_pack*): its units in turn; otherwise the job's own unit
+    units = [tuple(u) for u in p.units] if hasattr(p, "units") else [(snakemake.wildcards.variant,
+                                                                      snakemake.wildcards.group)]
+    outs = iter(snakemake.output)
+    for variant, group in units:
+        shared = {}  # the schemes share the simulation, the theta = 0 filter and a mode's bounds
+        for scheme, out in zip(p.schemes, outs):
+            mode, _, method = scheme.rpartition("-")  # "growing-squarem" -> growing windows, SQUAREM
+            res = run_group(setup, variant, group, method, mode or "sliding", log=log, shared=shared)
+            Path(out).parent.mkdir(parents=True, exist_ok=True)
+            save_pickle(out, res)
