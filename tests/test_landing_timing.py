@@ -417,8 +417,10 @@ def test_repetitions_keep_the_clock_below_5_pct_of_a_recorded_call(recorded):
 
 
 def test_main_and_replication_timing_time_one_list():
-    """The replication's timing times the kinds the main one times (svd_lapack among them),
-    from one list: ``timing.timed_methods`` of B-X1's flown methods, named once (B_TIMED)."""
+    """Each timing replay times what its Monte Carlo flies plus the timed-only kinds (svd_lapack),
+    by one rule (``timing.timed_methods``): the main replay B-X1's methods (B_TIMED), the
+    replication's the methods it flies (the timing claims' and the controls: REP_B_TIMED), each on
+    the recorded calls of the same methods, never a second copy of the list."""
     import re
     from pathlib import Path
 
@@ -427,8 +429,15 @@ def test_main_and_replication_timing_time_one_list():
     rules = Path(__file__).resolve().parents[1] / "workflow" / "rules"
     text = {p.name: p.read_text() for p in rules.glob("*.smk")}
     assert "B_TIMED = timed_methods(X1_METHODS)" in text["landing_timing.smk"]
-    for name, rule in (("landing_timing.smk", "landing_timing"), ("replication.smk", "replication_landing_timing")):
+    assert "REP_B_TIMED = timed_methods(REP_B_FLOWN)" in text["replication.smk"]
+    for name, rule, flown, timed in (("landing_timing.smk", "landing_timing", "X1_METHODS", "B_TIMED"),
+                                     ("replication.smk", "replication_landing_timing", "REP_B_FLOWN", "REP_B_TIMED")):
         block = re.search(rf"rule {rule}:\n(.*?)(?=\n\s*rule |\Z)", text[name], re.S).group(1)
-        assert re.search(r"\bmethods=B_TIMED\b", block), (name, rule)
+        assert re.search(rf"\bmethods={timed}\b", block), (name, rule)
+        assert re.search(rf"mc=lambda wc: b_mc\(wc.bscn, {flown}\)", block), (name, rule)
+    # the replication flies B_METHODS and B_EQ_METHODS (its Monte Carlo rules), so it times those
+    rep = text["replication.smk"]
+    assert "REP_B_FLOWN = list(dict.fromkeys([*B_METHODS, *B_EQ_METHODS]))" in rep
+    assert re.search(r"for m in B_METHODS\]", rep) and re.search(r"for m in B_EQ_METHODS\]", rep)
     # no second copy of the list: the timed-only kinds are named in the package only
     assert not [n for n, t in text.items() if "svd_lapack" in t]

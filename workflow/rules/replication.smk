@@ -3,7 +3,7 @@
 # planning-time replay timed a second time. No new science: the same scripts as the main
 # sample with other seeds and sizes; results/replication/ holds it. paper_claims re-judges
 # the claims on it (verdict_replication; 'unstable' where the two verdicts differ).
-# Included after landing_timing.smk (reuses A_*, B_*, X1_METHODS, B_TIMED, b_mc) and before paper.smk.
+# Included after landing_timing.smk (reuses A_*, B_*, timed_methods, b_mc) and before paper.smk.
 from opnav.landing.montecarlo import chunk_label as _rep_label, chunk_runs as _rep_runs
 
 REP_CFG = config["replication"]
@@ -16,6 +16,10 @@ if REP_CFG["enabled"]:
     _REP_A_KEYS = A_EM + (("growing",) if config["approach"]["growing"]["methods"] else ())
     REP_A_MC = [f"{REP}/approach/mc/{v}__headline__{s}.pkl" for v in A_VARIANTS for s in A_SCHEMES]
     REP_B_CHUNK = _rep_label(range(REP_CFG["landing_n_runs"]))
+    # what the replication flies (its Monte Carlo rules below) and so what its timing times:
+    # the timing claims' methods and the controls, the timed-only kinds (timing.timed_methods)
+    REP_B_FLOWN = list(dict.fromkeys([*B_METHODS, *B_EQ_METHODS]))
+    REP_B_TIMED = timed_methods(REP_B_FLOWN)
     REP_B_SIMS = {s: canonical({**c, "mc": {**c["mc"], "base_seed": c["mc"]["base_seed"] + REP_CFG["seed_offset"]}})
                   for s, c in B_SIMS.items()}
 
@@ -92,10 +96,12 @@ if REP_CFG["enabled"]:
             "../scripts/landing_mc_chunk.py"
 
     rule replication_landing_timing:
-        """The planning-time replay of one scenario timed a second time (the main sample's
-        recorded calls: what varies is the clock)."""
+        """The planning-time replay of one scenario timed a second time, on the main sample's
+        recorded calls of the methods the replication flies (what varies is the clock and the
+        calls drawn), through those methods and the timed-only kinds: the replicated timing
+        claims read these; B-X1's extra methods are timed once, in the main replay."""
         input:
-            mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
+            mc=lambda wc: b_mc(wc.bscn, REP_B_FLOWN),
             code=B_SRC + src("landing/timing.py", "landing/timing_summary.py"),
             kernels=kernels("landing"),
         output:
@@ -104,7 +110,7 @@ if REP_CFG["enabled"]:
             bscn=B_SCN_RE,
         params:
             landing=lambda wc: B_SIMS[wc.bscn],
-            methods=B_TIMED,       # the main timing's list (landing_timing.smk)
+            methods=REP_B_TIMED,
             max_calls=config["landing"]["timing"]["max_calls"],
             max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
         log:
