@@ -67,3 +67,56 @@ def test_kernel_sources_are_the_registered_modules_files():
     for name, path in zip(compiled.KERNEL_MODULES, files[1:]):
         assert path.is_file(), name
         assert path.relative_to(REPO / "src").with_suffix("").parts == tuple(name.split("."))
+
+
+DIGEST = "import opnav.core.compiled as c; print(c.kernel_set_digest())"
+
+
+def _digest(src):
+    env = dict(os.environ, PYTHONPATH=str(src))
+    return subprocess.run([sys.executable, "-c", DIGEST], env=env, capture_output=True, text=True,
+                          check=True).stdout.strip()
+
+
+def test_compile_estimates_outside_the_kernel_set_digest(tmp_path):
+    """A new compile estimate (the progress lines') recompiles nothing; a kernel edit recompiles."""
+    import shutil
+    src = tmp_path / "src"
+    shutil.copytree(REPO / "src" / "opnav", src / "opnav",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.npz", "*.nbi", "*.nbc"))
+    estimates = src / "opnav" / compiled.COMPILE_ESTIMATES.relative_to(REPO / "src" / "opnav")
+    assert compiled.COMPILE_ESTIMATES not in compiled.kernel_sources() and estimates.is_file()
+    first = _digest(src)
+    data = json.loads(estimates.read_text())
+    data["cpu_s"]["opnav.landing.linalg"] = 99.0
+    estimates.write_text(json.dumps(data))
+    assert _digest(src) == first
+    linalg = src / "opnav" / "landing" / "linalg.py"
+    linalg.write_text(linalg.read_text() + "\n# edited\n")
+    assert _digest(src) != first
+
+
+def test_compile_estimates_name_registered_modules():
+    estimate = compiled.compile_cpu_s()
+    assert set(estimate) <= set(compiled.KERNEL_MODULES) and all(v > 0 for v in estimate.values())
+
+
+ONE_SIGNATURE = textwrap.dedent("""\
+    import json, opnav.core.compiled as c
+    c.warm(("opnav.landing.linalg", "opnav.landing.descent"))
+    print(json.dumps({f"{k.py_func.__module__}.{k.__name__}": [str(s) for s in k._dispatcher.signatures]
+                      for k in c._KERNELS if k._dispatcher is not None}))
+""")
+
+
+@pytest.mark.slow  # a process that compiles linalg and descent: 5-6 CPU-s
+def test_one_signature_per_kernel_when_kernels_pass_constants(tmp_path):
+    """descent calls ``cholesky_in_place(L, 3)`` and ``cho_solve(L, 3, x)``, linalg's warm-up
+    calls them with an int64: one compiled signature each, not a second one for the literal 3
+    (each a full compile; compiled._unliteral_calls)."""
+    env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", ONE_SIGNATURE], env=env, capture_output=True, text=True,
+                         check=True)
+    sigs = json.loads(out.stdout.splitlines()[-1])
+    assert "opnav.landing.linalg.cholesky_in_place" in sigs
+    assert {k: v for k, v in sigs.items() if len(v) != 1} == {}

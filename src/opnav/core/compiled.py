@@ -33,6 +33,7 @@ import functools
 import hashlib
 import importlib
 import importlib.util
+import json
 import sys
 import time
 from pathlib import Path
@@ -198,7 +199,27 @@ def _dispatcher(f, settings: dict):
     if settings["cache"]:
         d._cache = _kernel_cache_type()(d.py_func)  # keyed by the kernel set too
     d._compile_for_args = _timed_dispatch(d._compile_for_args)
+    d.get_call_template = _unliteral_calls(d.get_call_template)
     return d
+
+
+def _unliteral_calls(get_call_template):
+    """numba's typing of a call to this kernel from another kernel, with the argument types
+    made non-literal: numba would otherwise compile the callee once more for every constant
+    a caller passes (``cholesky_shifted(S, 12, ...)``: ``Literal[int](12)``, a tuple holding a
+    ``0``, a ``True`` flag), each such copy a full compile, and with ``n`` a constant LLVM
+    unrolls the callee's loops completely (``cholesky_shifted`` for n = 12: most of the
+    landing kernels' compile, docs/performance.md). One signature per argument type; the
+    arithmetic is the same IEEE operations in the same order (no fastmath), so the results
+    are the same bits."""
+    from numba.core import types
+
+    @functools.wraps(get_call_template)
+    def typed(args, kws):
+        return get_call_template(tuple(types.unliteral(a) for a in args),
+                                 {k: types.unliteral(v) for k, v in kws.items()})
+
+    return typed
 
 
 def kernel(fn=None, **options):
@@ -224,16 +245,15 @@ def warms(fn: Callable[[], None]) -> Callable[[], None]:
     return fn
 
 
-#: CPU seconds each kernel module's warm-up took to compile on an empty cache (the
-#: progress lines' estimate): the compile_kernels logs of bench_pipeline's empty-cache quick
-#: build of ee36cb0 (2026-12-04 08:25, the project's 2-core VM at load 3-5, numba 0.68.1;
-#: docs/performance.md). A module that is not listed is estimated at 2 CPU-s.
-COMPILE_CPU_S: dict[str, float] = {
-    "opnav.approach.kalman": 3.3, "opnav.approach.ekf": 2.6, "opnav.approach.smoother": 2.2,
-    "opnav.approach.em": 4.1, "opnav.approach.augmented": 2.8, "opnav.core.rotations": 0.8,
-    "opnav.landing.measurement": 1.1, "opnav.landing.linalg": 1.1, "opnav.landing.ekf": 4.5,
-    "opnav.landing.ekf_update": 4.8, "opnav.landing.planning.warmup": 21.4,
-    "opnav.landing.descent": 1.2, "opnav.landing.imu": 0.4}
+#: The progress lines' estimates (CPU-s each kernel module's warm-up takes to compile on an
+#: empty cache, and their source): a data file, not one of :func:`kernel_sources`, so a new
+#: measurement changes no cache key and recompiles nothing. A module not listed: 2 CPU-s.
+COMPILE_ESTIMATES = Path(__file__).resolve().parents[1] / "data" / "compile_cpu_s.json"
+
+
+def compile_cpu_s() -> dict[str, float]:
+    """Estimated compile CPU-s per kernel module (:data:`COMPILE_ESTIMATES`)."""
+    return {name: float(v) for name, v in json.loads(COMPILE_ESTIMATES.read_text())["cpu_s"].items()}
 
 
 def warm(modules: tuple[str, ...] | None = None,
@@ -241,18 +261,19 @@ def warm(modules: tuple[str, ...] | None = None,
     """Import the kernel modules ``modules`` (default ``KERNEL_MODULES``) and run their
     warm-ups, in that order; return wall seconds per module (compile time on an empty
     cache, load time on a filled one). ``progress`` (``log.info``, say) gets a line as each
-    module starts, with its estimate (:data:`COMPILE_CPU_S`), and one as it ends, with
+    module starts, with its estimate (:func:`compile_cpu_s`), and one as it ends, with
     the CPU it took and the signatures it compiled and loaded."""
     names = list(KERNEL_MODULES if modules is None else modules)
     for name in names:
         importlib.import_module(name)
     todo = [n for n in names if n in _WARMUPS]
     say = progress or (lambda text: None)
-    total = sum(COMPILE_CPU_S.get(n, 2.0) for n in todo)
+    estimate = compile_cpu_s()
+    total = sum(estimate.get(n, 2.0) for n in todo)
     say(f"kernels: {len(todo)} modules to warm up, about {total:.0f} CPU-s to compile on an empty cache")
     seconds: dict[str, float] = {}
     for i, name in enumerate(todo, 1):
-        say(f"[{i}/{len(todo)}] {name}: warming up (about {COMPILE_CPU_S.get(name, 2.0):.1f} CPU-s "
+        say(f"[{i}/{len(todo)}] {name}: warming up (about {estimate.get(name, 2.0):.1f} CPU-s "
             "if nothing is cached)")
         before, c0, t0 = cache_stats(), time.process_time(), time.perf_counter()
         _WARMUPS[name]()
