@@ -9,8 +9,8 @@ import runpy
 
 import numpy as np
 import pytest
-
 from conftest import REPO, copy_workflow, dry_run_jobs
+
 from opnav.core.snakeio import mock_snakemake, stand_in
 
 SCRIPT = REPO / "workflow" / "scripts" / "approach_mc.py"
