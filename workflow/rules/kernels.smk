@@ -24,7 +24,7 @@ rule compile_kernels:
         kpaper="|".join(KERNEL_PAPERS),
     message:
         "rule compile_kernels (kpaper={wildcards.kpaper}): compiling this paper's numba kernels into the "
-        "on-disk cache, first build only: about a minute of CPU per paper, a line per module in its log "
+        "on-disk cache, first build only: 15-40 CPU-s per paper (src/opnav/data/compile_cpu_s.json), a line per module in its log "
         "(measured: docs/performance.md)"
     script:
         "../scripts/compile_kernels.py"
