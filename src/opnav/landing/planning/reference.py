@@ -155,7 +155,7 @@ def depth_error(beta, alpha, cd: float, b: float, r_e: float) -> np.ndarray:
     dd = np.where(fin, d, 0.0)
     rks = np.sqrt(np.maximum(b * b + dd * dd - 2 * b * dd * np.cos(beta), 0.0))   # eq. 25
     sin_t = np.where(fin & (rks > 0), b * np.sin(beta) / np.where(rks > 0, rks, 1.0), 0.0)  # eq. 24
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", over="ignore"):    # a vanishing sin(theta): +inf, as eq. 23 gives
         return np.where(fin & (sin_t > 0), 2.0 * r_e / np.where(sin_t > 0, sin_t, 1.0), np.inf)  # eq. 23
 
 
