@@ -180,34 +180,3 @@ def test_place_legend_finds_the_empty_corner_or_goes_outside():
         assert leg.get_bbox_to_anchor() is not None and figures.legend_collisions(fig) == []
         plt.close(fig)
 
-
-def test_place_legend_saves_the_files_of_a_draw_per_corner(tmp_path):
-    """place_legend judges later corners after the layout engine alone, not a whole draw:
-    the corners chosen and the saved PNG are those of the former draw per corner (B-F4 on
-    data whose legends land in the second corner; constrained layout starts from where it
-    last left the axes, so running the engine fewer times would move them by round-off)."""
-    import matplotlib.pyplot as plt
-
-    from opnav.landing import plots
-
-    def place_by_drawing(ax, *args, outside="right", **kw):   # the former place_legend
-        fig = ax.figure
-        for loc in figures.LEGEND_CORNERS:
-            leg = ax.legend(*args, loc=loc, **kw)
-            r = figures._renderer(fig)
-            if figures._clear(leg, fig, r, figures._texts(fig, r)):
-                return leg
-        return ax.legend(*args, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, **kw)
-
-    t = np.linspace(0.0, 100.0, 500)
-    r = np.c_[np.sin(t), np.cos(t), t]
-    out = {}
-    for name, place in (("now", figures.place_legend), ("drawn", place_by_drawing)):
-        import unittest.mock
-        with unittest.mock.patch.object(figures, "place_legend", place):
-            fig = plots.fig_true_states(t, r, r, r)
-        out[name] = [ax.get_legend()._loc for ax in fig.axes]
-        figures.save(fig, tmp_path / f"{name}.png")
-        plt.close("all")
-    assert out["now"] == out["drawn"] == [2, 2, 2]   # upper left: upper right holds the curves
-    assert (tmp_path / "now.png").read_bytes() == (tmp_path / "drawn.png").read_bytes()

@@ -278,46 +278,23 @@ def legend_collisions(fig) -> list[str]:
     return out
 
 
-def _clear(leg, fig, renderer, texts) -> bool:
+def _clear(leg, fig) -> bool:
+    renderer = _renderer(fig)
     box = leg.get_window_extent(renderer)
-    if any(bb.overlaps(box.padded(-1.0)) for _, bb in texts):
+    if any(bb.overlaps(box.padded(-1.0)) for _, bb in _texts(fig, renderer)):
         return False
     return not any(_data_hits(ax, box, renderer) for ax in fig.axes if ax.get_visible() and ax.axison)
-
-
-def _inside(box, frame) -> bool:
-    """Whether a legend box lies within its axes' frame (display coordinates)."""
-    return box.x0 >= frame.x0 and box.x1 <= frame.x1 and box.y0 >= frame.y0 and box.y1 <= frame.y1
 
 
 def place_legend(ax, *args, outside: str = "right", **kw):
     """The legend of ``ax`` in the first inside corner (:data:`LEGEND_CORNERS`) where it
     covers no data and no text of the figure as drawn now, else outside the axes
     (``outside``: "right" or "below"). Call it after the figure's content is drawn; a
-    figure with constrained layout makes room for an outside legend itself.
-
-    The figure is drawn for the first corner. A later corner is judged after the layout
-    engine alone is run again (what a draw does first), not a whole draw, while that
-    corner's legend and the drawn one lie inside the frame of ``ax``: a legend inside its
-    axes adds nothing to their tight box, and nothing else a draw does moves a text box
-    or a data artist. The engine still runs once per corner as the draws did: constrained
-    layout starts from the positions it left, so the saved layout depends on how often it
-    ran (the saved files are those of a draw per corner)."""
+    figure with constrained layout makes room for an outside legend itself."""
     fig = ax.figure
-    renderer = None
     for loc in LEGEND_CORNERS:
         leg = ax.legend(*args, loc=loc, **kw)
-        if renderer is not None and drawn_inside and _inside(leg.get_window_extent(renderer), ax.bbox):
-            engine = fig.get_layout_engine()
-            if engine is not None and fig.axes:
-                try:  # as Figure.draw does first; the renderer is the canvas's, as the draw's
-                    engine.execute(fig)
-                except ValueError:
-                    pass
-        else:
-            renderer = _renderer(fig)  # the layout with this legend in place
-            drawn_inside = _inside(leg.get_window_extent(renderer), ax.bbox)
-        if _clear(leg, fig, renderer, _texts(fig, renderer)):
+        if _clear(leg, fig):
             return leg
     if outside == "below":
         return ax.legend(*args, loc="upper center", bbox_to_anchor=(0.5, -0.18), **kw)
