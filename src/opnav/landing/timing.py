@@ -78,6 +78,7 @@ from __future__ import annotations
 import functools
 import gc
 import math
+import os
 import time
 
 import numpy as np
@@ -232,6 +233,7 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
 
     perf, thread = time.perf_counter_ns, time.thread_time_ns
     clock_ns = clock_cost_ns()
+    load_start = os.getloadavg()[0]         # other processes on the cores: stated with the times
     reps = np.full((nc, nv), -1, np.int64)
     if nc:
         _, _, _, state, visible, exclude, det, words = inputs(0)
@@ -302,6 +304,7 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
             "variant_path": np.array([v[1] for v in var]),
             "variant_eval_path": np.array([v[2].eval_path for v in var]),
             "mismatch": mismatch, "checked": checked, "reps": reps, "clock_ns": np.float64(clock_ns),
+            "load_avg": np.array([load_start, os.getloadavg()[0]]), "n_cpu": np.int64(os.cpu_count() or 0),
             "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls),
             "max_calls_paper": np.int64(max_calls_paper)}
 

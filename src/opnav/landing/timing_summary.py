@@ -190,11 +190,16 @@ def method_text(tm: dict) -> str:
              f"{cs['reps_min']} to {cs['reps_max']}) until the clock's own cost "
              f"({cs['clock_ns']:.0f} ns a bracket, measured) is below 5 % of the bracket: "
              f"{cs['share_pct_median']:.2f} % median, {cs['share_pct_max']:.2f} % at most.")
+    load = ("" if "load_avg" not in tm else
+            " The machine's 1-minute load average was {:.1f} at the start and {:.1f} at the end of the "
+            "replay ({} cores): other processes sharing the cores lengthen microsecond calls and "
+            "narrow their differences, so timing readings compare between builds at a like load."
+            .format(*np.asarray(tm["load_avg"], float)[:2], int(tm.get("n_cpu", 0))))
     return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
             "every method's planning call, one call at a time, interleaved across methods in one "
             f"process (order rotated per call), the same states for every method{paper}; wall clock "
             "perf_counter_ns, CPU clock thread_time_ns; replayed picks equal to the recorded ones "
-            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + clock)
+            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + clock + load)
 
 
 def summary_frame(tm: dict):
