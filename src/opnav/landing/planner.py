@@ -246,7 +246,7 @@ def _kernel_args(kind: int, state: PlanState, setup: tuple, exclude: int, detect
     """``planning.search.plan_run``'s arguments for one call (``setup``: :func:`_setup`'s; ``work`` last: q,
     then out)."""
     xyz, c, cells = setup
-    return (kind, layout.Estimate(state.r, state.v, state.a, state.R_LtoB, state.P), c, xyz, detected, exclude,
+    return (kind, layout.estimate_arg(state.r, state.v, state.a, state.R_LtoB, state.P), c, xyz, detected, exclude,
             cells, np.empty(layout.work_size(c[layout.C_NOBS])))
 
 

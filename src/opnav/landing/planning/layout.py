@@ -101,14 +101,22 @@ O_BLOCKS = dict(PICK=(O_PICK, 1), BETA=(O_BETA, 1), F=(O_F, 1), NEVAL=(O_NEVAL, 
 class Estimate(NamedTuple):
     """The filter's estimate a planning call starts from ({L}, SI): position r (3, m),
     velocity v (3, m/s), acceleration a (3, m/s^2), attitude R_LtoB (3 x 3), covariance P
-    (12 x 12) of [r, v, dtheta, p]. A plain named tuple of float64 arrays, so numba takes it
-    as one argument."""
+    (12 x 12) of [r, v, dtheta, p]. The order of the tuple a kernel takes as one argument
+    (:func:`estimate_arg`)."""
 
     r: np.ndarray
     v: np.ndarray
     a: np.ndarray
     R_LtoB: np.ndarray
     P: np.ndarray
+
+
+def estimate_arg(r, v, a, R_LtoB, P) -> tuple:
+    """:class:`Estimate` as the kernels take it (``plan_run``'s ``est``): its fields, in its order,
+    as a plain tuple. numba types a named-tuple argument on its slow path, a cost every compiled
+    planning call would carry into its timed bracket (the timed call includes numba's argument
+    dispatch; docs/performance.md 2026-12-04, the planning call's dispatch)."""
+    return tuple(Estimate(r, v, a, R_LtoB, P))
 
 
 def work_size(n_obs: int) -> int:

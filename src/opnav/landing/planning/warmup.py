@@ -8,7 +8,7 @@ import numpy as np
 from opnav.core.compiled import warms
 from opnav.landing.planning.hmetrics import sv_metric
 from opnav.landing.planning.layout import (C_BS, C_GRID, C_NOISE, C_RBC, C_SIGMA, KINDS, NC, NOUT, SVD,
-                                           Estimate, work_size)
+                                           estimate_arg, work_size)
 from opnav.landing.planning.screens import field_grid, nearest, valid_points
 from opnav.landing.planning.search import edge_pick, evaluations, plan_run, score_points
 
@@ -20,7 +20,7 @@ def _warm() -> None:
     xyz = make_field(500.0, 200, 1).xyz
     grid, cells = field_grid(xyz)
     det = np.arange(0, 200, 2, dtype=np.int64)
-    est = Estimate(np.array([10.0, 0, 1000.0]), np.array([-5.0, 0, -20.0]), np.zeros(3),
+    est = estimate_arg(np.array([10.0, 0, 1000.0]), np.array([-5.0, 0, -20.0]), np.zeros(3),
                    np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]]), np.eye(12))
     c = np.zeros(NC)
     c[:5], c[C_RBC:C_RBC + 9:4], c[C_BS + 2], c[C_GRID:C_SIGMA], c[C_SIGMA], c[C_NOISE:NC] = (
