@@ -91,7 +91,7 @@ VERDICT_TEXT = {
     NOT_REPRODUCIBLE: "not reproducible under the stated assumptions",
     DEPENDS: "depends on a choice the paper leaves open",
     NOT_TESTED: "not tested",
-    UNSTABLE: "unstable between two independent samples",
+    UNSTABLE: "unstable between two independent runs (the replication: other seeds; for planning times, a second replay)",
     SUSPECT: "suspect: better than its own information bound",
 }
 
@@ -545,7 +545,7 @@ _CONCLUSION = [
     (NOT_REPRODUCED, "Not reproduced: ", "{s} ({i})", "; the claims table gives each cause."),
     (DEPENDS, "Decided by a choice the paper leaves open: ", "{s} ({i}: {n})", "."),
     (NOT_TESTED, "Not tested by our runs: ", "{s} ({i}: {n})", "."),
-    (UNSTABLE, "Different between two independent samples, so not reported either way: ", "{s} ({i}: {n})", "."),
+    (UNSTABLE, "Different between two independent runs, so not reported either way: ", "{s} ({i}: {n})", "."),
     (SUSPECT, "Better than its own information bound, so suspect rather than reproduced: ", "{s} ({i}: {n})", "."),
 ]
 

@@ -53,7 +53,7 @@ _PREDICATE = {
     "not_reproducible": ("are not reproducible", "is not reproducible"),
     "depends_on_choice": ("depend on a choice the paper leaves open", "depends on a choice the paper leaves open"),
     "not_tested": ("are not tested", "is not tested"),
-    "unstable": ("differ between two independent samples", "differs between two independent samples"),
+    "unstable": ("differ between two independent runs", "differs between two independent runs"),
     "suspect": ("are suspect, better than their own information bound", "is suspect, better than its own information bound"),
 }
 
