@@ -444,9 +444,37 @@ def test_main_and_replication_timing_time_one_list():
         block = re.search(rf"rule {rule}:\n(.*?)(?=\n\s*rule |\Z)", text[name], re.S).group(1)
         assert re.search(rf"\bmethods={timed}\b", block), (name, rule)
         assert re.search(rf"mc=lambda wc: b_mc\(wc.bscn, {flown}\)", block), (name, rule)
+        # a replay runs alone (threads: every core), so no other job shares the cores it times on
+        assert re.search(r"^\s*threads: workflow\.cores\b", block, re.M), (name, rule)
     # the replication flies B_METHODS and B_EQ_METHODS (its Monte Carlo rules), so it times those
     rep = text["replication.smk"]
     assert "REP_B_FLOWN = list(dict.fromkeys([*B_METHODS, *B_EQ_METHODS]))" in rep
     assert re.search(r"for m in B_METHODS\]", rep) and re.search(r"for m in B_EQ_METHODS\]", rep)
     # no second copy of the list: the timed-only kinds are named in the package only
     assert not [n for n, t in text.items() if "svd_lapack" in t]
+
+
+@pytest.mark.slow
+def test_replay_keeps_blas_on_its_own_thread(recorded, monkeypatch):
+    """The thread CPU clock sees a call's work only on the calling thread, so the replay runs
+    BLAS/LAPACK single-threaded whatever the caller set (a job given all cores, a run by hand:
+    OpenBLAS starts one thread per core), and restores the caller's setting. Mutation tried:
+    without the limit the planning calls see the caller's 2 threads and it fails."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    from opnav.landing import planner
+
+    seen = []
+    plan = planner.plan
+
+    def spying(*a, **k):
+        seen.append(max((i["num_threads"] for i in threadpool_info()), default=1))
+        return plan(*a, **k)
+
+    monkeypatch.setattr(planner, "plan", spying)
+    scn, rec = recorded
+    with threadpool_limits(limits=2):
+        timing.replay(scn, rec, ["depth"], max_calls=2, alt=False)
+        after = max((i["num_threads"] for i in threadpool_info()), default=1)
+    assert seen and set(seen[1:]) == {1}, seen      # the first: the warm-up, before the limit
+    assert after == 2 or not threadpool_info()

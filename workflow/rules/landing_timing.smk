@@ -26,6 +26,10 @@ rule landing_timing:
         max_calls=config["landing"]["timing"]["max_calls"],
         max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
     priority: 10        # a long job on the critical path (speed only)
+    # the replay times microsecond calls by thread CPU: it runs with no other job beside it
+    # (more busy processes than cores read the interior depth call at 4.5-4.7 us instead of
+    # 3.0-3.2, and its saving against SVD at 17-22 % instead of 27-29 %; docs/performance.md)
+    threads: workflow.cores
     log:
         f"{LANDING}/logs/timing_{{bscn}}.log",
     benchmark:

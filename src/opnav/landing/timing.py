@@ -240,6 +240,12 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
         for m, _, cfg in var:                                     # warm-up, untimed
             plan(m, state, cam, field_, visible, cfg, exclude=exclude, rng=rng_from_words(words),
                  detected=det, diagnose=False)
+    # thread CPU time must see all of a call's work: BLAS and LAPACK (numpy's, the paper path's
+    # SVDs and products) on this thread only, whatever the environment gives (a job with more
+    # threads, or a run by hand: OpenBLAS starts one thread per core)
+    from threadpoolctl import threadpool_limits
+
+    blas = threadpool_limits(limits=1)
     gc_was = gc.isenabled()
     gc.collect()
     gc.disable()
@@ -287,6 +293,7 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt: boo
                 if t % 64 == 63:
                     gc.collect()
     finally:
+        blas.restore_original_limits()
         if gc_was:
             gc.enable()
     for j, m in enumerate(methods):
