@@ -445,7 +445,7 @@ def test_main_and_replication_timing_time_one_list():
         assert re.search(rf"\bmethods={timed}\b", block), (name, rule)
         assert re.search(rf"mc=lambda wc: b_mc\(wc.bscn, {flown}\)", block), (name, rule)
         # a replay runs alone (threads: every core), so no other job shares the cores it times on
-        assert re.search(r"^\s*threads: workflow\.cores\b", block, re.M), (name, rule)
+        assert re.search(r"^\s*threads: all_cores\(\)", block, re.M), (name, rule)
     # the replication flies B_METHODS and B_EQ_METHODS (its Monte Carlo rules), so it times those
     rep = text["replication.smk"]
     assert "REP_B_FLOWN = list(dict.fromkeys([*B_METHODS, *B_EQ_METHODS]))" in rep

@@ -24,6 +24,16 @@ def test_findings_are_a_few_sentences_and_a_table_of_every_claim():
     assert len(re.findall(r"[.!?](?:\s|$)", prose)) <= 5, prose
     for cid in ref["claim_id"]:
         assert f"| {cid} |" in block
+    assert "What it would take" not in prose
+    # a group whose claims name different things it would take: none of them (the first
+    # group as page 1 words it, without what it would take; the reference table has them)
+    two = ref.copy()
+    b = two["paper"] == two["paper"].iloc[-1]
+    idx = two.index[b][:2]
+    two.loc[idx, "verdict"] = "unstable"
+    two.loc[idx, "would_take"] = ["a bigger sample", "a quieter machine"]
+    prose2 = readme.findings_block(two).split("\n\n")[1]
+    assert "What it would take" not in prose2, prose2
     mutated = ref.copy()
     mutated.loc[0, "verdict"] = "suspect" if mutated.loc[0, "verdict"] != "suspect" else "reproduced"
     assert readme.findings_block(mutated) != block  # the block follows the table

@@ -10,6 +10,18 @@ from opnav.landing.timing import timed_methods
 B_TIMED = timed_methods(X1_METHODS)
 
 
+def all_cores() -> int:
+    """Every core this run was given (``--cores``): a timing replay takes them all, so no other
+    job runs beside it; 1 where a run gives none (a script run by hand parses the workflow
+    without ``--cores``, and Snakemake refuses to read ``workflow.cores`` then)."""
+    from snakemake.exceptions import WorkflowError
+
+    try:
+        return int(workflow.cores)
+    except WorkflowError:
+        return 1
+
+
 rule landing_timing:
     """Planning times of every method on the same recorded planning calls of one scenario."""
     input:
@@ -29,7 +41,7 @@ rule landing_timing:
     # the replay times microsecond calls by thread CPU: it runs with no other job beside it
     # (more busy processes than cores read the interior depth call at 4.5-4.7 us instead of
     # 3.0-3.2, and its saving against SVD at 17-22 % instead of 27-29 %; docs/performance.md)
-    threads: workflow.cores
+    threads: all_cores()
     log:
         f"{LANDING}/logs/timing_{{bscn}}.log",
     benchmark:

@@ -113,7 +113,7 @@ if REP_CFG["enabled"]:
             methods=REP_B_TIMED,
             max_calls=config["landing"]["timing"]["max_calls"],
             max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
-        threads: workflow.cores     # alone, as the main replay (landing_timing.smk)
+        threads: all_cores()     # alone, as the main replay (landing_timing.smk)
         log:
             f"{REP}/logs/landing_timing_{{bscn}}.log",
         benchmark:

@@ -48,7 +48,7 @@ def findings_block(df: pd.DataFrame) -> str:
         first = next((v for v in NOT_OK if (g["verdict"] == v).any()), None)
         if first:  # the paper's first group, as page 1 words it (without what it would take)
             grp = [dict(r) for _, r in g[g["verdict"] == first].iterrows()]
-            out.append(group_sentences(grp, first, said={str(grp[0].get("would_take", ""))}))
+            out.append(group_sentences(grp, first, said={str(r.get("would_take", "")) for r in grp}))
     lines = [START, "", " ".join(out), "", "| claim | | verdict |", "|---|---|---|"]
     for r in df.itertuples():
         lines.append(f"| {r.claim_id} | {short_claim(r.claim).replace('|', '/')} | "
