@@ -33,9 +33,12 @@ A_MC_GROWING = {(v, g, m): f"{A_WORK}/mc/{v}__{g}__growing-{m}.pkl"
 # every EM scheme of a Monte-Carlo job (rule approach_mc), in this order
 A_SCHEMES = list(A_METHODS) + [f"growing-{m}" for m in config["approach"]["growing"]["methods"]]
 
+# every scenario variant's name (one pattern, also approach_mc's when it refuses packed units)
+_A_VARIANT_RE = "literal|prior|roll|reference-start|stars"
+
 
 wildcard_constraints:
-    variant="literal|prior|roll|reference-start|stars",
+    variant=_A_VARIANT_RE,
     group="size|polarity|initial|pixel|install|headline|all",
     method="plain|squarem|growing-plain|growing-squarem",
 
@@ -46,6 +49,9 @@ wildcard_constraints:
 # unit's job gets the same params (A_EM, growing) and code, so an approach key or code edit
 # reruns every unit either way; only adding a variant or group re-flies its pack-mates.
 _A_K = config["jobs"]["approach_mc_per_job"]
+# the keys a Monte-Carlo unit reads, alike in rule approach_mc and the packs (the growing schemes
+# also read approach.growing)
+_A_MC_APPROACH = cfg("approach", *A_EM, *(("growing",) if config["approach"]["growing"]["methods"] else ()))
 A_MC_UNITS = [(v, g) for v in A_VARIANTS for g in a_groups(v)]
 A_MC_PACKS = [A_MC_UNITS[i:i + _A_K] for i in range(0, len(A_MC_UNITS), _A_K)] if _A_K > 1 else []
 # approach_mc's pattern refuses the packed units (a lookahead over "variant__group__")
@@ -62,10 +68,10 @@ rule approach_mc:
     output:
         [f"{A_WORK}/mc/{{variant}}__{{group}}__{s}.pkl" for s in A_SCHEMES],
     wildcard_constraints:
-        variant=_A_NOT_PACKED + "(literal|prior|roll|reference-start|stars)",
+        variant=f"{_A_NOT_PACKED}({_A_VARIANT_RE})",
     params:
         # the growing schemes also read approach.growing
-        approach=cfg("approach", *A_EM, *(("growing",) if config["approach"]["growing"]["methods"] else ())),
+        approach=_A_MC_APPROACH,
         schemes=A_SCHEMES,
     log:
         f"{APPROACH}/logs/mc_{{variant}}__{{group}}.log",
@@ -88,7 +94,7 @@ for _i, _pack in enumerate(A_MC_PACKS, 1):
         output:
             [f"{A_WORK}/mc/{v}__{g}__{s}.pkl" for v, g in _pack for s in A_SCHEMES],
         params:
-            approach=cfg("approach", *A_EM, *(("growing",) if config["approach"]["growing"]["methods"] else ())),
+            approach=_A_MC_APPROACH,
             schemes=A_SCHEMES,
             units=[[v, g] for v, g in _pack],
         resources:  # SLURM: a dynamic rule has no profiles/slurm entry; approach_mc's per unit
