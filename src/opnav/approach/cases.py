@@ -385,13 +385,15 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
 
 def label_bounds(setup: Setup, geo: sc.Geometry, case_list: list[Case], variant: str) -> list[np.ndarray]:
     """Per case, the 1-sigma bound (3,), arcsec, of the data its last segment's estimate used
-    (:func:`opnav.approach.pipeline.segment_bounds`), evaluated at the case's configured start
-    theta, not its truth: the convergence label's scale (the bound changes with theta by a
-    relative O(theta), about 1e-4 here)."""
+    (:func:`opnav.approach.pipeline.segment_bounds`), evaluated at what the estimator knows: the
+    case's configured start theta and the reference trajectory (``Geometry.along_reference``),
+    not the truth: the convergence label's scale and the consider filter's covariance (the bound
+    changes with theta and the trajectory by a relative O(theta) and O(|dr| / rho), about 1e-4
+    here)."""
     from .bounds import segment_bounds_many
 
     items = [(geo.measurement_variance(c.sigma3_px), c.init_arcsec, False) for c in case_list]
-    return [b[-1] for b in segment_bounds_many(setup, geo, items, variant)]
+    return [b[-1] for b in segment_bounds_many(setup, geo.along_reference(), items, variant)]
 
 
 def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indices, data_samples: int,

@@ -92,6 +92,13 @@ class Geometry:
                 for i in seed_indices]
         return stars.simulate(self.stars, theta_true_rad, rngs)
 
+    def along_reference(self) -> "Geometry":
+        """The same geometry with the truth's Mars vector ``u_true`` replaced by the reference's
+        ``u_ref``: what an estimator may evaluate a bound at (the truth is not known to it)."""
+        from dataclasses import replace
+
+        return replace(self, u_true=self.u_ref)
+
     def measurement_variance(self, sigma3_px) -> np.ndarray:
         """Rvar (n+1, 3), km^2, from the pinhole camera at the reference range (paper eq. 3-4)."""
         return camera.noise_sigma_km(self.rho_ref, self.ifov_arcsec, sigma3_px) ** 2
