@@ -295,7 +295,7 @@ def _claim_fastest(head: str, scen: dict, plan: Plan) -> dict:
 
 def _claim_envelopes(head: str, scen: dict, plan: Plan) -> dict:
     cid = "B-C10"
-    rel = plan.margin(cid, "envelope_rel")
+    rel = plan.margin(cid, "ratio_high") - 1.0
     compared = list(plan.variants(cid).get("compared") or ["svd"])
     cols = ENVELOPES
     per, why, texts = {}, {}, {}
