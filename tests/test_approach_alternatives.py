@@ -281,7 +281,7 @@ def _augmented_reference(z, x0, P0, theta0, sig, win, q_theta=0.0, u_lin=None):
             G = win.stars.G[i] * ARCSEC
             Wd = win.stars.w[i]
             P = theta_information_update(P, np.broadcast_to(np.einsum("ak,a,al->kl", G, Wd, G), (S, 3, 3)))
-            y = y + np.einsum("sij,sj->si", P[:, :, 6:], np.einsum("ak,a,sa->sk", G, Wd, win.star_y[:, i] - y[:, 6:] @ G.T))
+            y = y + np.einsum("sij,sj->si", P[:, :, 6:], np.einsum("ak,a,sa->sk", G, Wd, win.star_yw[:, i] - y[:, 6:] @ G.T))
         for o, v in zip(out, (y[:, 6:], P[:, 6:, 6:], y[:, :6], np.trace(P[:, :3, :3], axis1=1, axis2=2))):
             o.append(v)
     th, Pth, xf, ptr = (np.stack(o, 1) for o in out)

@@ -184,3 +184,72 @@ def test_attitude_knowledge_sets_a_floor_that_more_stars_cannot_pass():
     # the drift adds a floor of its own that more images cannot average down
     bd, _ = _floor_bound(30, 0.0, drift_arcsec=2.0, images=20)
     assert np.all(bd >= 0.98 * 2.0)
+
+
+def _dense_window_bound(cfg, geo, Rvar, theta_arcsec, a, b):
+    """Independent bound of one sliding window (a, b): the dense joint information of the
+    window's states and theta (Mars rows of samples a+1..b, the prior propagated to a without
+    data) plus its own star rows, G^T R^-1 G with R the joint covariance of just those images
+    (centroid noise, per-image attitude error, drift), written out here."""
+    from opnav.approach import crlb, kalman
+    from opnav.approach.camera import misalignment_small
+
+    setup = Setup.of(cfg)
+    win = geo.window(Rvar).slice(a, b)
+    P_a = kalman.propagate(None, geo.P0, geo.Phi[:a + 1], geo.Q)[1][-1]
+    A = misalignment_small(sc.rad(theta_arcsec))
+    Hx = np.stack([-A @ C for C in win.C])
+    J, _ = crlb.dense_information(win, P_a, Hx, crlb.theta_sensitivity(geo.u_true[a:b + 1]),
+                                  setup.crlb_prior_sigma_rad)
+    f = geo.stars
+    k = (f.idx > a) & (f.idx <= b)
+    Gr, sig = f.G_raw[k], f.sigma[k]
+    Gf = Gr.reshape(-1, 3)
+    R = np.diag(sig.reshape(-1) ** 2) + f.drift_sigma_rad ** 2 * Gf @ Gf.T
+    m2 = Gr.shape[1]
+    for i in range(Gr.shape[0]):
+        blk = slice(i * m2, (i + 1) * m2)
+        R[blk, blk] += f.attitude_sigma_rad ** 2 * Gr[i] @ Gr[i].T
+    J[-3:, -3:] += Gf.T @ np.linalg.solve(R, Gf)
+    return sc.arcsec(np.sqrt(np.diag(np.linalg.inv(J))[-3:]))
+
+
+def test_sliding_window_star_bound_is_the_windows_own_data_marginalised_exactly():
+    """Issue 54, item 2: the bound of a sliding window of the stars variant is that of its own
+    Mars and star data, the star rows marginalised exactly over drift and attitude errors (a
+    dense joint-information computation, independent of the recursion and of the whitening).
+    Mutation tried: the window reading the arc's whitened rows (conditioned on the images before
+    it, as before issue 54) fails on every window after the first image (it was 6.66 against 5.09
+    arcsec on the last window of the full profile)."""
+    cfg = approach_cfg(N0=100, N=60, M=3, L=4)
+    cfg["stars"].update(every_K=30, per_image=3, attitude_sigma_arcsec=5.0, mode_drift_arcsec=3.0)
+    geo = sc.build_geometry(cfg, "stars")
+    case = cases.headline_case(cfg)
+    Rvar = geo.measurement_variance(case.sigma3_px)
+    seg = pipeline.segment_bounds(cfg, geo, Rvar, case.truth_arcsec, "stars")
+    for l, (a, b) in enumerate(Setup.of(cfg).segments.windows()):
+        np.testing.assert_allclose(seg[l], _dense_window_bound(cfg, geo, Rvar, case.truth_arcsec, a, b), rtol=2e-4)
+    # the label reads the same exact bound (along the reference trajectory, at the start theta)
+    lab = cases.label_bounds(Setup.of(cfg), geo, [case], "stars")[0]
+    np.testing.assert_allclose(lab[:2], seg[-1][:2], rtol=1e-3)
+
+
+def test_a_window_whitens_its_own_star_rows():
+    """Window.slice re-whitens the window's images: its whitened rows reproduce the window's joint
+    covariance information, and growing windows (from the first image) keep the arc's rows."""
+    cfg = approach_cfg(N0=100, N=60, M=3, L=4)
+    cfg["stars"].update(every_K=30, per_image=3, attitude_sigma_arcsec=5.0, mode_drift_arcsec=3.0)
+    geo = sc.build_geometry(cfg, "stars")
+    y = geo.simulate_stars(sc.rad((10.0, 20.0, 10.0)), 7, 1, range(2))
+    win = geo.window(geo.measurement_variance((0.1, 0.1, 0.2)), y)
+    w = win.slice(220, 280)
+    f = w.stars
+    assert np.all(f.idx == [30, 60])  # images at samples 250 and 280
+    np.testing.assert_allclose(f.L @ f.L.T, stars.joint_covariance(f.G_raw, f.sigma, f.attitude_sigma_rad,
+                                                                   f.drift_sigma_rad), rtol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,sj->si", f.L, w.star_yw.reshape(2, -1)), w.star_y.reshape(2, -1),
+                               rtol=1e-10, atol=1e-18)
+    g = win.slice(100, 280)
+    keep = (geo.stars.idx > 100) & (geo.stars.idx <= 280)
+    np.testing.assert_allclose(g.stars.G, geo.stars.G[keep], rtol=1e-10, atol=1e-3 * np.abs(geo.stars.G).max())
+    np.testing.assert_allclose(g.star_yw, win.star_yw[:, keep], rtol=1e-8, atol=1e-10)

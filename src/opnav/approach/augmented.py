@@ -207,6 +207,7 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
     zc = c(z)
     # star images (a linear measurement of theta alone, opnav.approach.stars) between compiled stretches
     stars = [] if win.stars is None or win.star_y is None else [(int(k), i) for i, k in enumerate(win.stars.idx)]
+    star_yw = win.star_yw
     k0 = 1
     for k, i in [*stars, (n, None)]:
         _augmented_samples(k0, k + 1, zc, model, lin, (y, P), (th_out, Pth_out, xf, ptr, ll))
@@ -217,7 +218,7 @@ def run_augmented(z: np.ndarray, x0: np.ndarray, P0: np.ndarray, theta0: np.ndar
         Wd = win.stars.w[i]
         J = np.einsum("ak,a,al->kl", G, Wd, G)
         P = carray(theta_information_update(P, np.broadcast_to(J, (S, 3, 3))))
-        g = np.einsum("ak,a,sa->sk", G, Wd, win.star_y[:, i] - y[:, 6:] @ G.T)
+        g = np.einsum("ak,a,sa->sk", G, Wd, star_yw[:, i] - y[:, 6:] @ G.T)
         y = carray(y + np.einsum("sij,sj->si", P[:, :, 6:], g))
         th_out[:, k], Pth_out[:, k], xf[:, k] = y[:, 6:], P[:, 6:, 6:], y[:, :6]
         ptr[:, k] = np.trace(P[:, :3, :3], axis1=1, axis2=2)

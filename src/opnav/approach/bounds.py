@@ -136,5 +136,14 @@ def segment_bounds_many(setup: Setup | dict, geo: sc.Geometry, items, variant: s
                            np.concatenate(Pa), np.repeat(np.stack([sc.rad(th) for _, th, _ in items]), L, axis=0),
                            setup.crlb_prior_sigma_rad,
                            None if geo.stars is None else
-                           _star_info(geo, idx, len(items)).reshape(B, n1, 3, 3))[:, -1]
+                           np.broadcast_to(_window_star_info(geo, windows), (len(items), L, n1, 3, 3)
+                                           ).reshape(B, n1, 3, 3))[:, -1]
     return list(sc.arcsec(out).reshape(len(items), L, 3))
+
+
+def _window_star_info(geo: sc.Geometry, windows) -> np.ndarray:
+    """Per sliding window (a, b), the information on theta of each of its samples' star images
+    (L, N+1, 3, 3), rad^-2, from the window's own star rows whitened by their joint covariance
+    (:meth:`opnav.approach.stars.StarField.select`): the window's star data marginalised exactly
+    over the drift and the attitude errors, nothing of the images before it."""
+    return np.stack([geo.stars.select(a, b).info_per_sample(b - a) for a, b in windows])

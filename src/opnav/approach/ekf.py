@@ -27,6 +27,7 @@ Units: km, km/s, rad.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,16 +51,25 @@ class Window:
     Rvar: np.ndarray  # (n+1, 3) or per seed (n+1, S, 3) measurement variances, km^2
     Q: np.ndarray  # (6, 6) process noise per step
     stars: object = None  # stars.StarField of the window's star images (``stars`` variant), or None
-    star_y: np.ndarray | None = None  # (S, I, 2m) star measurements, rad
+    star_y: np.ndarray | None = None  # (S, I, 2m) raw star measurements, rad
 
     def slice(self, a: int, b: int) -> "Window":
-        """Samples a..b (inclusive; a becomes the start sample 0; star images a+1..b)."""
+        """Samples a..b (inclusive; a becomes the start sample 0; star images a+1..b, whitened by
+        their own joint covariance: :meth:`opnav.approach.stars.StarField.select`)."""
         st, y = self.stars, self.star_y
         if st is not None:
             keep = (st.idx > a) & (st.idx <= b)
             st, y = st.select(a, b), (None if y is None else y[:, keep])
         return Window(self.Phi[a:b + 1], self.C[a:b + 1], self.u_ref[a:b + 1],
                       self.Rvar[a:b + 1], self.Q, st, y)
+
+    @functools.cached_property
+    def star_yw(self) -> np.ndarray | None:
+        """The star measurements whitened by this window's field (S, I, 2m), rad: what the
+        M-step, the likelihood and the augmented EKF read (None without star data)."""
+        if self.stars is None or self.star_y is None:
+            return None
+        return self.stars.whiten(self.star_y)
 
     def rows(self, idx: np.ndarray) -> "Window":
         """The window of the seeds ``idx`` (per-seed variances and star data have a seed axis)."""

@@ -173,7 +173,7 @@ def _with_stars(N: np.ndarray, b: np.ndarray, win: Window) -> EStats:
     if win.stars is not None and win.star_y is not None:
         from .stars import normal_equations
 
-        J, h = normal_equations(win.stars, win.star_y)
+        J, h = normal_equations(win.stars, win.star_yw)
         return EStats(N + J, b + h, J)
     return EStats(N, b)
 
@@ -230,7 +230,7 @@ def em_map(theta, z, x0, P0, win, tz_tol):
     if win.stars is not None and win.star_y is not None:
         from .stars import loglik
 
-        ll = ll + loglik(win.stars, win.star_y, theta)
+        ll = ll + loglik(win.stars, win.star_yw, theta)
     return new, ll, unobs, (x_last, P_last)
 
 
