@@ -53,7 +53,9 @@ def _star_row(sweep, value, bound, per_image=10, att=5.0):
     th = np.array([[10.0, 20.0, 10.0], [10.5, 19.5, 12.0]])
     return {"sweep": sweep, "value": value, "per_image": per_image, "every_K": 200, "images": 10,
             "attitude_sigma_arcsec": att, "mode_drift_arcsec": 1.0, "mag_limit": 8.0,
-            "stars_per_image": {"min": 3, "median": 3.0, "max": 3}, "floor_arcsec": 1.87,
+            "stars_per_image": ({"min": per_image, "median": float(per_image), "max": per_image}
+                                if sweep == "per_image" else {"min": 10, "median": 10.0, "max": 10}),
+            "field_deg": 2.84 if per_image < 10 else 6.0, "camera_field_deg": 2.84, "floor_arcsec": 1.87,
             "crlb_stars_only_arcsec": np.full(3, bound), "truth_arcsec": np.array([10.0, 20.0, 10.0]),
             "total_samples": 10, "crlb_all_arcsec": np.full(3, bound), "crlb_all_q0_arcsec": np.full(3, bound),
             "crlb_curve_arcsec": curve,
@@ -73,7 +75,9 @@ def test_stars_text_reads_the_objection_from_the_numbers():
     st = summaries.stars_summary(rows, 2.0)
     assert set(st) == {"m3", "m30", "att0", "att20", "objection"}
     txt = approach_text.stars_text(st, 2.0)
-    assert "better than 5.38 arcsec" in txt and "(0 % lower)" in txt
+    assert "better than 5.38 arcsec" in txt and "(unchanged)" in txt and "From 3 to 30 stars per image" in txt
+    assert "3 stars in every image (to magnitude 8 in a 2.84 deg field)" in txt
+    assert "30 stars in every image (to magnitude 8 in a 6 deg field, widened from the camera's 2.84 deg)" in txt
     rows[1] = _star_row("per_image", 30, 0.95, per_image=30)
     assert "(50 % lower)" in approach_text.stars_text(summaries.stars_summary(rows, 2.0), 2.0)
     for r in rows:

@@ -253,3 +253,69 @@ def test_a_window_whitens_its_own_star_rows():
     keep = (geo.stars.idx > 100) & (geo.stars.idx <= 280)
     np.testing.assert_allclose(g.stars.G, geo.stars.G[keep], rtol=1e-10, atol=1e-3 * np.abs(geo.stars.G).max())
     np.testing.assert_allclose(g.star_yw, win.star_yw[:, keep], rtol=1e-8, atol=1e-10)
+
+
+@pytest.mark.parametrize("counts", [(1, 3, 10, 30)])
+def test_the_count_sweep_puts_that_many_stars_in_every_image(counts):
+    """Issue 54, item 4: each count of the stars sweep is real: with the magnitude limit and field
+    of stars.count_settings every image holds exactly that many stars; the limit is the brightest
+    that does it in the camera's field (one step brighter leaves an image short), the field is
+    widened only where the catalogue's limit is not enough, and the bound falls as the count grows."""
+    from dataclasses import replace
+
+    cfg = approach_cfg(N0=100, N=100, M=3, L=4)
+    cfg["stars"].update(every_K=100)
+    setup = Setup.of(cfg)
+    geo = sc.build_geometry(cfg, "stars")
+    cam = sc.camera_half_fov_rad(setup)
+    case = cases.headline_case(cfg)
+    Rvar = geo.measurement_variance(case.sigma3_px)
+    bounds = []
+    for c in counts:
+        cs = stars.count_settings(geo.C, 100, 100, c, 8.0, setup.stars.slew_deg, cam, stars.catalogue())
+        s_c = setup.replace(stars=replace(setup.stars, per_image=c, mag_limit=cs["mag_limit"]))
+        g = sc.with_stars(geo, s_c, cs["half_fov_rad"])
+        assert np.all(g.stars.n_stars == c), (c, g.stars.n_stars)
+        assert cs["widened"] == (cs["half_fov_rad"] > cam)
+        if not cs["widened"]:  # the brightest limit: a hair brighter, some image is short
+            s_b = setup.replace(stars=replace(setup.stars, per_image=c, mag_limit=cs["mag_limit"] - 1e-3))
+            try:
+                short = sc.with_stars(geo, s_b).stars.n_stars.min() < c
+            except ValueError:  # an image with no star at all
+                short = True
+            assert short
+        else:
+            assert cs["mag_limit"] == 8.0
+        bounds.append(pipeline.bound_curve(s_c, g, Rvar, case.truth_arcsec, "stars")[-1][:2].max())
+    assert all(b1 < b0 for b0, b1 in zip(bounds, bounds[1:])), bounds
+
+
+def test_the_stars_label_reads_tz(monkeypatch):
+    """Issue 54, item 4: star images observe tz, so the stars variant's convergence label reads
+    tz too: a run whose tx, ty sit on the ML estimate of its data but whose tz is 5 bounds from it
+    is not converged with stars, and converged where tz is unobservable (prior). The distance
+    the label reads is over (tx, ty, tz) with stars, (tx, ty) otherwise. Mutation tried: tx, ty
+    only for stars (``cases.label_axes`` := 2) fails."""
+    ml = cases.ml_estimate
+
+    def off_in_tz(z, theta, *a, **k):  # the ML estimate: the run's own tx, ty; tz 5 bounds away
+        th, done, tr = ml(z, theta, *a, **k)
+        th = theta.copy()
+        th[:, 2] += 5.0 * sc.rad(BOUND_TZ[0])
+        return th, done, tr
+
+    monkeypatch.setattr(cases, "ml_estimate", off_in_tz)
+    cfg = _stars_cfg(3)
+    cfg["stars"].update(attitude_sigma_arcsec=5.0, mode_drift_arcsec=1.0)
+    case = cases.headline_case(cfg)
+    setup = Setup.of(cfg).scheme("growing")
+    for variant, nax in (("stars", 3), ("prior", 2)):
+        geo = sc.build_geometry(cfg, variant)
+        BOUND_TZ[0] = cases.label_bounds(setup, geo, [case], variant)[0][2]
+        r = cases.run_case(setup, variant, case, range(2), geo=geo, method="squarem")
+        rel = np.abs(r["theta_final_arcsec"] - r["theta_ml_arcsec"]) / r["label_bound_arcsec"]
+        np.testing.assert_allclose(r["dist_to_ml_over_bound"], rel[:, :nax].max(1), rtol=1e-9)
+        assert np.all((r["label"] == "converged") == (variant != "stars")), (variant, r["label"])
+
+
+BOUND_TZ = [1.0]

@@ -210,30 +210,44 @@ def time_em(setup: Setup | dict, variant: str, case: cases.Case, seed_indices, g
 
 def stars_study(setup: Setup | dict, log=None) -> list[dict]:
     """The ``stars`` variant (beyond the paper), headline case, ``n_seeds`` seeds, one row per
-    swept value (``sweep``): stars per image (``stars.study_per_image``: the bound of (tx, ty, tz)
-    after all the data with Q and Q = 0 and its curve against the data, beside the EM-EKF with
-    growing windows and SQUAREM, the paper's sliding plain EM and the augmented EKF), the
-    per-image attitude knowledge (``stars.study_attitude_sigma_arcsec``) and the magnitude limit
-    (``stars.study_mag_limit``) (the bound and the growing-window SQUAREM EM-EKF). Every row also
-    holds the stars-only bound (the star images' information alone) and the stars per image
-    along the arc."""
+    swept value (``sweep``):
+
+    * ``per_image``: stars per image, each value of ``stars.study_count`` made real (issue 54,
+      item 4): ``per_image`` = the count, with the magnitude limit and field at which every image
+      holds that many stars (:func:`opnav.approach.stars.count_settings`: the camera's field and
+      the brightest limit that gives every image the count; the catalogue's limit and a widened
+      field where the camera's field holds too few). The bound of (tx, ty, tz) after all the data
+      with Q and Q = 0 and its curve against the data, beside the EM-EKF with growing windows and
+      SQUAREM, the paper's sliding plain EM and the augmented EKF;
+    * ``attitude_sigma_arcsec``: the per-image attitude knowledge
+      (``stars.study_attitude_sigma_arcsec``) at the configured stars (the bound and the
+      growing-window SQUAREM EM-EKF).
+
+    Every row also holds the stars-only bound (the star images' information alone), the stars
+    per image along the arc, the magnitude limit and the field (deg, full width)."""
     from dataclasses import replace
 
+    from . import stars as stars_mod
     from .pipeline import bound_curves
 
     setup = Setup.of(setup)
     case = cases.headline_case(setup)
     seeds = range(setup.n_seeds)
     st0 = setup.stars
-    plan = ([("per_image", float(m), replace(st0, per_image=int(m)), True) for m in st0.study_per_image]
-            + [("attitude_sigma_arcsec", float(a), replace(st0, attitude_sigma_arcsec=float(a)), False)
-               for a in st0.study_attitude_sigma_arcsec]
-            + [("mag_limit", float(g), replace(st0, mag_limit=float(g)), False) for g in st0.study_mag_limit])
-    out = []
     geo0 = sc.build_geometry(setup, "stars")
-    for sweep, value, st, full in plan:
+    cam_half = sc.camera_half_fov_rad(setup)
+    plan = []
+    for m in st0.study_count:
+        cs = stars_mod.count_settings(geo0.C, setup.segments.N0, st0.every_K, int(m), st0.mag_limit, st0.slew_deg,
+                                      cam_half, stars_mod.catalogue())
+        plan.append(("per_image", float(m), replace(st0, per_image=int(m), mag_limit=cs["mag_limit"]),
+                     cs["half_fov_rad"], True))
+    plan += [("attitude_sigma_arcsec", float(a), replace(st0, attitude_sigma_arcsec=float(a)), cam_half, False)
+             for a in st0.study_attitude_sigma_arcsec]
+    out = []
+    for sweep, value, st, half_fov, full in plan:
         s_m = setup.replace(stars=st)
-        geo = sc.with_stars(geo0, s_m)  # the same arc, these stars
+        geo = sc.with_stars(geo0, s_m, half_fov)  # the same arc, these stars
         Rvar = geo.measurement_variance(case.sigma3_px)
         c, c0 = bound_curves(s_m, geo, [(Rvar, case.truth_arcsec, False), (Rvar, case.truth_arcsec, True)], "stars")
         d = min(s_m.segments.data_samples, len(c) - 1)
@@ -242,7 +256,8 @@ def stars_study(setup: Setup | dict, log=None) -> list[dict]:
         ns = geo.stars.n_stars
         row = {"sweep": sweep, "value": value, "per_image": int(st.per_image), "every_K": st.every_K,
                "attitude_sigma_arcsec": st.attitude_sigma_arcsec, "mode_drift_arcsec": st.mode_drift_arcsec,
-               "mag_limit": st.mag_limit, "images": n_img,
+               "mag_limit": st.mag_limit, "field_deg": float(2.0 * np.degrees(half_fov)),
+               "camera_field_deg": float(2.0 * np.degrees(cam_half)), "images": n_img,
                "stars_per_image": {"min": int(ns.min()), "median": float(np.median(ns)), "max": int(ns.max())},
                "floor_arcsec": float(np.hypot(st.attitude_sigma_arcsec / np.sqrt(n_img), st.mode_drift_arcsec)),
                "crlb_stars_only_arcsec": sc.arcsec(np.sqrt(np.diag(np.linalg.pinv(J)))),

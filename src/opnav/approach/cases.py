@@ -29,7 +29,8 @@ Written rules (Table 1 columns)
     ``em.converge_tol_arcsec``; the table reports the median over seeds. Only a
     run labelled *converged* has one (:func:`opnav.approach.em.convergence_labels`:
     within ``em.converge_frac_of_bound`` times the 1-sigma bound of its last segment's
-    data (tx and ty each, :func:`label_bounds`) of that data's ML estimate;
+    data (tx and ty each, and tz where star images observe it: :func:`label_axes`,
+    :func:`label_bounds`) of that data's ML estimate;
     *stalled* when not and its contraction per map toward it is ``em.stall_rate`` or
     more; else *not converged*). The label reads the data, not the start.
     *Navigation error before / after compensation* (km): for each seed, the
@@ -297,16 +298,18 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
 
     # the convergence label (SPEC A.3c) from the last segment's data (one window when sliding,
     # the cumulative data when growing): its ML estimate, reached from the final estimate by
-    # SQUAREM, the distance to it and the measured contraction factor per map toward it
+    # SQUAREM, the distance to it and the measured contraction factor per map toward it, over
+    # the axes the data observe (tx, ty; tz too with star images, issue 54)
+    nax = label_axes(geo)
     theta_ml, ml_done, _ = ml_estimate(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), tz_tol,
-                                       em_set.ml_max_maps)
-    rate = contraction_per_map(theta_seg_start, theta, theta_ml, maps_per_segment(method, M))
-    dist_ml = np.abs(sc.arcsec(theta - theta_ml))[:, :2].max(1)
-    moved = np.abs(sc.arcsec(theta - theta_init))[:, :2].max(1)
+                                       em_set.ml_max_maps, axes=nax)
+    rate = contraction_per_map(theta_seg_start, theta, theta_ml, maps_per_segment(method, M), axes=nax)
+    dist_ml = np.abs(sc.arcsec(theta - theta_ml))[:, :nax].max(1)
+    moved = np.abs(sc.arcsec(theta - theta_init))[:, :nax].max(1)
     if seg_bounds is None:
         seg_bounds = label_bounds(setup, geo, case_list, variant)
-    bnd = np.repeat(np.stack([np.asarray(b, float)[:2] for b in seg_bounds]), ns, axis=0)  # (S, 2)
-    dist_rel = (np.abs(sc.arcsec(theta - theta_ml))[:, :2] / bnd).max(1)  # in bounds of the data used
+    bnd = np.repeat(np.stack([np.asarray(b, float)[:nax] for b in seg_bounds]), ns, axis=0)  # (S, nax)
+    dist_rel = (np.abs(sc.arcsec(theta - theta_ml))[:, :nax] / bnd).max(1)  # in bounds of the data used
     label = convergence_labels(dist_rel, rate, em_set.converge_frac_of_bound, em_set.stall_rate)
 
     f1 = run_filter(z, theta, dx0, geo.P0, win, predicted=False)
@@ -381,6 +384,12 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
             "t_s": geo.t,
         })
     return out
+
+
+def label_axes(geo: sc.Geometry) -> int:
+    """The components of theta a run's convergence label reads: tx and ty (2), and tz as well (3)
+    where the data observe it (star images, which see the roll about the boresight)."""
+    return 3 if geo.stars is not None else 2
 
 
 def label_bounds(setup: Setup, geo: sc.Geometry, case_list: list[Case], variant: str) -> list[np.ndarray]:

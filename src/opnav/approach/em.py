@@ -271,9 +271,10 @@ def maps_per_segment(method: str, iterations: int) -> int:
 
 def ml_estimate(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarray, win: Window,
                 tz_tol: float = 1e-6, max_maps: int = 60, step_tol_rad: float = 1e-4 * np.pi / 648000.0,
-                per_seed: bool = True) -> tuple[np.ndarray, np.ndarray, EMTrace]:
+                per_seed: bool = True, axes: int = 2) -> tuple[np.ndarray, np.ndarray, EMTrace]:
     """Maximum-likelihood theta of one window's data: SQUAREM cycles from ``theta0`` until
-    the cycle step in (tx, ty) is below ``step_tol_rad``, or ``max_maps`` maps.
+    the cycle step in the first ``axes`` components (2: tx, ty; 3: tz too, where the data
+    observe it) is below ``step_tol_rad``, or ``max_maps`` maps.
 
     ``per_seed`` (default): each seed stops at its own first cycle that meets the step
     criterion and only the seeds still moving are iterated, so the other seeds of the batch
@@ -308,7 +309,7 @@ def ml_estimate(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarra
             tr.unobservable = np.zeros((S, 3), bool)
         tr.unobservable[act] = t.unobservable
         new = t.theta[-1]
-        step_ok = np.abs(new - th[act])[:, :2].max(1) < step_tol_rad
+        step_ok = np.abs(new - th[act])[:, :axes].max(1) < step_tol_rad
         th[act] = new
         if per_seed:
             done[act] = step_ok
@@ -321,15 +322,16 @@ def ml_estimate(z: np.ndarray, theta0: np.ndarray, x0: np.ndarray, P0: np.ndarra
 
 
 def contraction_per_map(theta_start: np.ndarray, theta_end: np.ndarray, theta_ml: np.ndarray,
-                        maps: int, floor_rad: float = 1e-6 * np.pi / 648000.0) -> np.ndarray:
+                        maps: int, floor_rad: float = 1e-6 * np.pi / 648000.0, axes: int = 2) -> np.ndarray:
     """Measured contraction factor per EM map toward the ML estimate of the same data (S,).
 
-    ``(d_end / d_start) ** (1 / maps)`` with ``d = max(|tx - tx_ML|, |ty - ty_ML|)``:
-    about 1 means the iteration does not approach its fixed point (stalled), 0 means
-    it got there at once. NaN where the start is already within ``floor_rad`` of it.
+    ``(d_end / d_start) ** (1 / maps)`` with ``d = max(|tx - tx_ML|, |ty - ty_ML|)`` (and
+    ``|tz - tz_ML|`` when ``axes`` is 3): about 1 means the iteration does not approach its fixed
+    point (stalled), 0 means it got there at once. NaN where the start is already within
+    ``floor_rad`` of it.
     """
-    d0 = np.abs(theta_start - theta_ml)[:, :2].max(1)
-    d1 = np.abs(theta_end - theta_ml)[:, :2].max(1)
+    d0 = np.abs(theta_start - theta_ml)[:, :axes].max(1)
+    d1 = np.abs(theta_end - theta_ml)[:, :axes].max(1)
     with np.errstate(divide="ignore", invalid="ignore"):
         rate = (np.maximum(d1, 1e-300) / d0) ** (1.0 / max(maps, 1))
     return np.where(d0 > floor_rad, rate, np.nan)

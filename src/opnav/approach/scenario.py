@@ -160,10 +160,11 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
                     cam.ifov_arcsec, field, sig)
 
 
-def star_field_of(setup: Setup | dict, C: np.ndarray):
+def star_field_of(setup: Setup | dict, C: np.ndarray, half_fov_rad: float | None = None):
     """The ``stars`` variant's star images along the Mars-tracking attitude ``C`` (n+1, 3, 3)
     with the setup's ``stars`` and ``camera`` (:func:`opnav.approach.stars.star_field`), and the
-    centroid 1-sigma at ``stars.sigma_ref_mag`` (rad)."""
+    centroid 1-sigma at ``stars.sigma_ref_mag`` (rad). ``half_fov_rad``: the star images' field
+    half-width (default the camera's, ``pixels * ifov / 2``; the stars sweep widens it)."""
     from . import stars
 
     setup = Setup.of(setup)
@@ -174,16 +175,24 @@ def star_field_of(setup: Setup | dict, C: np.ndarray):
                                cam.ifov_arcsec)
 
     field = stars.star_field(C, setup.segments.N0, st.every_K, st.per_image, st.mag_limit, st.slew_deg,
-                             0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC, sigma_of_mag, stars.catalogue(),
+                             camera_half_fov_rad(setup) if half_fov_rad is None else half_fov_rad,
+                             sigma_of_mag, stars.catalogue(),
                              st.attitude_sigma_arcsec * ARCSEC, st.mode_drift_arcsec * ARCSEC)
     return field, float(stars.sigma_rad(st.sigma_px, cam.ifov_arcsec))
 
 
-def with_stars(geo: Geometry, setup: Setup | dict) -> Geometry:
-    """The same ``stars`` arc with the star images of ``setup.stars`` (no orbit propagated again)."""
+def camera_half_fov_rad(setup: Setup | dict) -> float:
+    """Half-width of the camera's square field, ``pixels * ifov / 2``, rad."""
+    cam = Setup.of(setup).camera
+    return 0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC
+
+
+def with_stars(geo: Geometry, setup: Setup | dict, half_fov_rad: float | None = None) -> Geometry:
+    """The same ``stars`` arc with the star images of ``setup.stars`` (no orbit propagated again),
+    in a field of half-width ``half_fov_rad`` (default the camera's)."""
     from dataclasses import replace
 
-    field, sig = star_field_of(setup, geo.C)
+    field, sig = star_field_of(setup, geo.C, half_fov_rad)
     return replace(geo, stars=field, star_sigma_rad=sig)
 
 

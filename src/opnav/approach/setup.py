@@ -154,7 +154,8 @@ class Stars(_Section):
     """``stars``: star images every ``every_K`` samples, up to ``per_image`` brightest Hipparcos
     stars to ``mag_limit``, the star-mode slew (deg), the centroid 1-sigma (px) at
     ``sigma_ref_mag`` and its floor (px), the per-image attitude-knowledge 1-sigma and the
-    star-mode / Mars-mode drift 1-sigma (arcsec per axis), and the stars study's sweeps."""
+    star-mode / Mars-mode drift 1-sigma (arcsec per axis), and the stars study's sweeps (stars
+    per image, each made real by its magnitude limit and field; per-image attitude knowledge)."""
 
     every_K: int
     per_image: int
@@ -165,9 +166,8 @@ class Stars(_Section):
     sigma_floor_px: float
     attitude_sigma_arcsec: float
     mode_drift_arcsec: float
-    study_per_image: tuple
+    study_count: tuple
     study_attitude_sigma_arcsec: tuple
-    study_mag_limit: tuple
 
 
 @dataclass(frozen=True)

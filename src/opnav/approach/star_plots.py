@@ -1,11 +1,9 @@
-"""A-X6 figure: the stars study (beyond the paper) against attitude knowledge and magnitude limit.
+"""A-X6 figure: the stars study (beyond the paper) against attitude knowledge and stars per image.
 
 Plotting only (numbers from :func:`opnav.approach.summaries.stars_frame`).
 """
 
 from __future__ import annotations
-
-import numpy as np
 
 from opnav.core import figures
 
@@ -13,20 +11,20 @@ from opnav.core import figures
 def stars_figure(frame, target_arcsec: float):
     """Left: the 1-sigma bound of tx (all data, and the star images alone), the floor
     ``hypot(sigma_a / sqrt(images), drift)`` and the RMS error of the EM-EKF (growing windows,
-    SQUAREM) against the per-image attitude knowledge; right: the same against the magnitude
-    limit, with the stars per image (median along the arc) on a second axis. Dashed: the
+    SQUAREM) against the per-image attitude knowledge; right: the same against the stars in
+    every image (each count made real by its magnitude limit and field, annotated). Dashed: the
     claimed accuracy."""
     import matplotlib.pyplot as plt
 
     with figures.style():
         fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 2.8), layout="constrained")
         for ax, sweep, xlabel in ((axes[0], "attitude_sigma_arcsec", "attitude knowledge per star image, 1-sigma (arcsec)"),
-                                  (axes[1], "mag_limit", "magnitude limit")):
+                                  (axes[1], "per_image", "stars in every image")):
             d = frame[frame["sweep"] == sweep].sort_values("value")
             if not len(d):
                 ax.set_visible(False)
                 continue
-            x = d["value"].to_numpy(float)
+            x = (d["stars_per_image_median"] if sweep == "per_image" else d["value"]).to_numpy(float)
             ax.plot(x, d["crlb_x_arcsec"], "o-", color="k", lw=1.0, ms=3, label="bound, all data")
             ax.plot(x, d["crlb_stars_only_x_arcsec"], "s--", color="0.5", lw=0.8, ms=3, label="bound, stars alone")
             ax.plot(x, d["floor_arcsec"], ":", color="C1", lw=1.0, label="attitude floor")
@@ -36,11 +34,11 @@ def stars_figure(frame, target_arcsec: float):
             ax.set_yscale("log")
             ax.set_xlabel(xlabel)
             ax.set_ylabel("arcsec")
-            if sweep == "mag_limit":
-                ax2 = ax.twinx()
-                ax2.step(x, d["stars_per_image_median"], where="mid", color="C0", lw=0.8)
-                ax2.set_ylabel("stars per image", color="C0")
-                ax2.set_ylim(0, max(1.0, float(np.nanmax(d["stars_per_image_median"]))) * 1.3)
+            if sweep == "per_image":
+                ax.set_xscale("log")
+                for xi, (_, r) in zip(x, d.iterrows()):
+                    ax.annotate(f"mag {r['mag_limit']:.3g}\n{r['field_deg']:.2g} deg", (xi, r["crlb_x_arcsec"]),
+                                textcoords="offset points", xytext=(0, 6), ha="center", fontsize="x-small")
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside lower center", ncol=3, frameon=False, fontsize="small")
     return fig

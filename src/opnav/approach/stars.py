@@ -225,6 +225,46 @@ def star_field(C: np.ndarray, N0: int, every_K: int, per_image: int, mag_limit: 
                      float(attitude_sigma_rad), float(drift_sigma_rad))
 
 
+def count_settings(C: np.ndarray, N0: int, every_K: int, count: int, mag_cap: float, slew_deg: float,
+                   half_fov_rad: float, cat) -> dict:
+    """The magnitude limit and field at which *every* star image of the arc (:func:`star_field`'s
+    images of the Mars-tracking attitude ``C``) holds at least ``count`` stars, so that with
+    ``per_image = count`` each image holds exactly ``count`` (issue 54, item 4: the stars sweep
+    changes what it says it changes). The camera's field (half-width ``half_fov_rad``) with the
+    brightest magnitude limit that gives every image ``count`` stars (the largest, over the
+    images, of the ``count``-th brightest magnitude in the field); where even ``mag_cap`` (the
+    catalogue's limit) leaves an image short, ``mag_cap`` and the field widened (a square field,
+    the camera's pixel scale: more pixels) just enough for every image. Returns ``mag_limit``,
+    ``half_fov_rad`` and ``widened`` (bool)."""
+    dirs, mag, _ = cat
+    keep = mag <= mag_cap
+    dirs, mag = dirs[keep], mag[keep]
+    n = C.shape[0] - 1
+    idx = np.arange(N0 + every_K, n + 1, every_K)
+    if idx.size == 0:
+        raise ValueError(f"approach.stars.every_K: the first star image (sample N0 + every_K = {N0 + every_K}) "
+                         f"lies beyond the arc's last sample {n}; lower every_K or lengthen the arc")
+    R = rot_x(np.deg2rad(slew_deg))
+    need_mag, need_tan = -np.inf, 0.0
+    for k in idx:
+        vk = dirs @ (R @ C[k]).T
+        front = vk[:, 2] > 0
+        cheb = np.full(vk.shape[0], np.inf)  # the square field's half-width (tan) that contains a star
+        cheb[front] = np.abs(vk[front, :2] / vk[front, 2:3]).max(1)
+        inside = cheb <= np.tan(half_fov_rad)
+        if inside.sum() >= count:
+            need_mag = max(need_mag, float(np.sort(mag[inside])[count - 1]))
+        else:
+            need_mag = np.inf
+        need_tan = max(need_tan, float(np.sort(cheb)[count - 1]))
+    if np.isfinite(need_mag):
+        return {"mag_limit": need_mag, "half_fov_rad": float(half_fov_rad), "widened": False}
+    if not np.isfinite(need_tan):
+        raise ValueError(f"approach.stars.study_count: {count} stars per image are not in the sky in front of the "
+                         f"camera to magnitude {mag_cap:g}")
+    return {"mag_limit": float(mag_cap), "half_fov_rad": float(np.arctan(need_tan * (1.0 + 1e-9))), "widened": True}
+
+
 def joint_covariance(G_raw: np.ndarray, sigma: np.ndarray, attitude_sigma_rad: float,
                      drift_sigma_rad: float) -> np.ndarray:
     """The joint covariance (D, D), D = I 2m, rad^2, of the star rows of I images (module

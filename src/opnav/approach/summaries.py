@@ -218,11 +218,11 @@ def roll_rate_summary(study: dict) -> dict:
 
 
 def _stars_key(row: dict) -> str:
-    """Summary key of a stars-study row: ``m<k>`` (stars per image), ``att<v>`` (attitude
-    knowledge, arcsec) or ``mag<v>`` (magnitude limit); '.' written 'p', '-' written 'n'."""
+    """Summary key of a stars-study row: ``m<k>`` (k stars in every image) or ``att<v>``
+    (attitude knowledge, arcsec); '.' written 'p', '-' written 'n'."""
     if row.get("sweep", "per_image") == "per_image":
         return f"m{row['per_image']}"
-    tag = {"attitude_sigma_arcsec": "att", "mag_limit": "mag"}[row["sweep"]]
+    tag = {"attitude_sigma_arcsec": "att"}[row["sweep"]]
     return tag + f"{row['value']:g}".replace(".", "p").replace("-", "n")
 
 
@@ -254,8 +254,8 @@ def stars_summary(study: list[dict], target_arcsec: float) -> dict:
         out[_stars_key(row)] = {
             "sweep": row.get("sweep", "per_image"), "per_image": row["per_image"], "every_K": row["every_K"],
             "images": row["images"], "total_samples": row["total_samples"],
-            **{k: row[k] for k in ("attitude_sigma_arcsec", "mode_drift_arcsec", "mag_limit", "stars_per_image",
-                                   "floor_arcsec") if k in row},
+            **{k: row[k] for k in ("attitude_sigma_arcsec", "mode_drift_arcsec", "mag_limit", "field_deg",
+                                   "camera_field_deg", "stars_per_image", "floor_arcsec") if k in row},
             "crlb_arcsec": [float(x) for x in row["crlb_all_arcsec"]],
             "crlb_q0_arcsec": [float(x) for x in row["crlb_all_q0_arcsec"]],
             **({"crlb_stars_only_arcsec": [float(x) for x in row["crlb_stars_only_arcsec"]]}
@@ -281,6 +281,7 @@ def stars_frame(study: list[dict]) -> pd.DataFrame:
             "sweep": r.get("sweep", "per_image"), "value": float(r.get("value", r["per_image"])),
             "per_image": int(r["per_image"]), "attitude_sigma_arcsec": r.get("attitude_sigma_arcsec", math.nan),
             "mode_drift_arcsec": r.get("mode_drift_arcsec", math.nan), "mag_limit": r.get("mag_limit", math.nan),
+            "field_deg": r.get("field_deg", math.nan),
             "images": int(r["images"]),
             **{f"stars_per_image_{k}": float(v) for k, v in r.get("stars_per_image", {}).items()},
             "crlb_x_arcsec": float(r["crlb_all_arcsec"][0]), "crlb_y_arcsec": float(r["crlb_all_arcsec"][1]),

@@ -114,9 +114,17 @@ def stars_text(st: dict, target: float) -> str:
         b, g, a = v["crlb_arcsec"], v["estimators"].get("em_growing_squarem"), v["estimators"].get("augmented")
         need = v["samples_to_target"]
         spi = v.get("stars_per_image")
-        txt = (f"up to {v['per_image']} stars per image"
-               + (f" ({spi['min']}-{spi['max']} in the field along the arc)" if spi else "")
-               + f", {v['images']} images one every {v['every_K']} samples: bound "
+        count = (f"{spi['min']}" if spi['min'] == spi['max'] else f"{spi['min']}-{spi['max']}") if spi else None
+        field = v.get("field_deg")
+        where = ""
+        if field is not None and v.get("mag_limit") is not None:
+            wide = v.get("camera_field_deg")
+            where = (f" (to magnitude {v['mag_limit']:.3g} in a {field:.3g} deg field"
+                     + (f", widened from the camera's {wide:.3g} deg" if wide is not None and field > wide + 1e-9 else "")
+                     + ")")
+        txt = ((f"{count} star{'s' if v['per_image'] > 1 else ''} in every image" if count == str(v['per_image'])
+                else f"up to {v['per_image']} stars per image" + (f" ({count} in the field along the arc)" if spi else ""))
+               + where + f", {v['images']} images one every {v['every_K']} samples: bound "
                f"(tx, ty, tz) = ({b[0]:.3g}, {b[1]:.3g}, {b[2]:.3g}) arcsec, "
                + (f"{target:g} arcsec reached after {need:.0f} samples" if need is not None else
                   f"{target:g} arcsec not reached"))
@@ -138,11 +146,6 @@ def stars_text(st: dict, target: float) -> str:
                     f"{v['attitude_sigma_arcsec']:g} arcsec: bound {max(v['crlb_arcsec'][:2]):.3g} "
                     f"(stars alone {max(v['crlb_stars_only_arcsec'][:2]):.3g}, floor {v['floor_arcsec']:.3g}), "
                     f"EM RMS {v['estimators']['em_growing_squarem']['rmse_xy_arcsec']:.3g}" for v in att) + ".")
-    mags = sorted((v for v in rows.values() if v.get("sweep") == "mag_limit"), key=lambda v: v["mag_limit"])
-    if mags:
-        out += (" Against the magnitude limit: " + "; ".join(
-            f"{v['mag_limit']:g}: {v['stars_per_image']['median']:.3g} stars per image, bound "
-            f"{max(v['crlb_arcsec'][:2]):.3g}" for v in mags) + ".")
     obj = st.get("objection")
     if obj:
         thr = obj["attitude_threshold_arcsec"]
@@ -157,10 +160,15 @@ def stars_text(st: dict, target: float) -> str:
         mrows = sorted((v for v in rows.values() if v.get("sweep", "per_image") == "per_image"),
                        key=lambda v: v["per_image"])
         if len(mrows) > 1:
+            n0 = mrows[0].get("stars_per_image", {}).get("median", mrows[0]["per_image"])
+            n1 = mrows[-1].get("stars_per_image", {}).get("median", mrows[-1]["per_image"])
             b0, b1 = max(mrows[0]["crlb_arcsec"][:2]), max(mrows[-1]["crlb_arcsec"][:2])
-            out += (f" From {mrows[0]['per_image']} to {mrows[-1]['per_image']} stars per image the bound goes from "
-                    f"{b0:.3g} to {b1:.3g} arcsec ({100 * (1 - b1 / b0):.0f} % lower) at the configured attitude "
-                    f"knowledge ({mrows[-1].get('attitude_sigma_arcsec', float('nan')):g} arcsec).")
+            change = 100 * (1 - b1 / b0)
+            how = (f"{change:.0f} % lower" if change >= 0.5 else f"{-change:.0f} % higher" if change <= -0.5
+                   else "unchanged")
+            out += (f" From {n0:g} to {n1:g} stars per image the bound goes from {b0:.3g} to {b1:.3g} arcsec "
+                    f"({how}) at the configured attitude knowledge "
+                    f"({mrows[-1].get('attitude_sigma_arcsec', float('nan')):g} arcsec).")
     return out
 
 
