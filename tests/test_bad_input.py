@@ -292,6 +292,50 @@ NEW_CONFIGS = [
 ]
 
 
+# Round four (issue 57): (class, overlay, text the one error line must contain)
+ROUND_FOUR_CONFIGS = [
+    ("unchecked", "landing: {tuning: {candidates: [[5.0, 3], [3.0, 3], [5.0, 3]]}}",
+     "'landing.tuning.candidates': duplicated [5.0, 3]"),
+    ("unchecked", "landing: {tuning: {candidates: [[5.0, 3], [5, 3]]}}", "'landing.tuning.candidates': duplicated"),
+    ("unchecked", "profile: full", "'profile': 'full' claims the full profile's samples"),
+    ("unchecked", "studies: {s: {paper: landing, id: B-T1, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "'studies.s.id' (study 's'): B-T1 is an output id of the workflow"),
+    ("unchecked", "studies: {s: {paper: approach, id: A-F4, vary: {approach.camera.ifov_arcsec: [10.0]}}}",
+     "'studies.s.id' (study 's'): A-F4 is an output id"),
+    ("unchecked", "studies: {s: {paper: approach, id: B-X9, vary: {approach.camera.ifov_arcsec: [10.0]}}}",
+     "'studies.s.id' (study 's'): B-X9 names paper B"),
+    ("unchecked", "results_dir: 'my results'", "'results_dir': 'my results' holds ' '"),
+    ("unchecked", "results_dir: 'res*'", "'results_dir': 'res*' holds '*'"),
+    ("unchecked", "results_dir: 'res?'", "'results_dir': 'res?' holds '?'"),
+    ("unchecked", "results_dir: results/quick/report", "'results_dir': 'results/quick/report' is inside the results "
+                                                        "folder results/quick/"),
+    ("unchecked", "results_dir: results/mine", "'results_dir': 'results/mine' is inside the results folder results/"),
+    ("framed", "studies: {runs_pack1: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}\n"
+               "jobs: {study_values_per_job: 2}", "'studies.runs_pack1': the name makes the rule study_runs_pack1"),
+    ("framed", "studies: {runs_pack7: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}",
+     "'studies.runs_pack7': the name makes the rule study_runs_pack7"),
+    ("framed", "results_dir: 'results/{x}'", "'results_dir': 'results/{x}' holds '{'"),
+    ("framed", "results_dir: 'results/{{x}}'", "'results_dir': 'results/{{x}}' holds '{'"),
+    ("framed", "results_dir: 'results/x}'", "'results_dir': 'results/x}' holds '}'"),
+    ("noisy", "landing: {mc: {n_runs: 1.0e+300}}", "'landing.mc.n_runs': 1e+300 is not an integer (and far beyond"),
+    ("noisy", "approach: {n_seeds: 1.0e+20}", "'approach.n_seeds': 1e+20 is not an integer (and far beyond"),
+]
+
+# (overlay, the one line the whole refusal must be: a broken top-level key said once,
+# not once per study value)
+ONCE = [
+    ("profile: fast", "'profile'"),
+    ("results_dir: 7", "'results_dir'"),
+    ("jobs: 7", "'jobs'"),
+    ("jobs: {study_values_per_job: 0}", "'jobs.study_values_per_job'"),
+    ("replication: 5", "'replication'"),
+    ("replication: {enabled: 3}", "'replication.enabled'"),
+    ("paper: {build_pdf: 3}", "'paper.build_pdf'"),
+    ("paper: []", "'paper'"),
+    ("limits: {max_jobs: -1}", "'limits.max_jobs'"),
+]
+
+
 def _overlaid(overlay: str) -> dict:
     cfg = copy.deepcopy(_BASE)
     _merge(cfg, yaml.safe_load(overlay))
@@ -317,6 +361,68 @@ def test_round_three_config_refused_naming_key(cls, overlay, key):
     text = str(err.value)
     assert key in text, text
     assert all(line.startswith("invalid config key") for line in text.splitlines()), text
+
+
+@pytest.mark.parametrize("cls,overlay,key", ROUND_FOUR_CONFIGS, ids=[f"{c}:{o[:60]}" for c, o, _ in ROUND_FOUR_CONFIGS])
+def test_round_four_config_refused_in_one_line(cls, overlay, key):
+    """Issue 57: garbage accepted, accepted unchecked, framed after validation, noisy: each
+    refused in one line naming the key, before any job. Mutations (tried): dropping the
+    tuning.candidates duplicate check, the output-id check, the workflow's pack patterns
+    (workflow_names made=()), or the path characters each fail their cases."""
+    with pytest.raises(ConfigError) as err:
+        validate_config(_overlaid(overlay), root=REPO, workflow=True)
+    lines = str(err.value).splitlines()
+    assert len(lines) == 1 and key in lines[0], lines
+
+
+@pytest.mark.parametrize("overlay,key", ONCE, ids=[o for o, _ in ONCE])
+def test_a_broken_top_level_key_is_said_once(overlay, key):
+    """The quick profile plans 8 studies of 2 values: a broken key was repeated once per
+    value (17-34 lines blaming studies.<x>.vary). Mutations (tried): planning the studies
+    whatever else is broken fails 8 cases; keeping a study value's lines about other
+    sections fails results_dir: 7."""
+    with pytest.raises(ConfigError) as err:
+        validate_config(_overlaid(overlay), root=REPO, workflow=True)
+    lines = str(err.value).splitlines()
+    assert len(lines) == 1 and key in lines[0], lines
+
+
+def test_study_rule_names_are_read_from_the_workflow(tmp_path):
+    """The names a study may not take come from the workflow's own rules (rule NAME:, and the
+    patterns of rules made in loops), not a hand list: a checkout whose workflow has a rule
+    study_extra refuses a study named 'extra'; two studies whose rules collide are refused;
+    a name ending in _outputs is fine where no study makes that rule."""
+    from opnav.core.checks import workflow_names
+
+    names = workflow_names(REPO)
+    assert "study_runs" in names.rules and any(r.fullmatch("approach_mc_pack3") for r in names.made)
+    assert not any(r.fullmatch("study_fov") for r in names.made)       # a study's own rules are not reserved
+    (tmp_path / "workflow" / "rules").mkdir(parents=True)
+    (tmp_path / "workflow" / "report").mkdir()
+    (tmp_path / "Snakefile").write_text("rule all:\n    input: []\n")
+    (tmp_path / "workflow" / "rules" / "x.smk").write_text(
+        "rule study_extra:\n    input: []\nfor i in range(3):\n    rule:\n        name:\n            f\"study_big{i}_x\"\n")
+    (tmp_path / "config").mkdir()
+    study = "{paper: landing, vary: {landing.camera.fov_deg: [45.0]}}"
+    for name, bad in (("extra", "study_extra"), ("big2_x", "study_big2_x"), ("big", None), ("solo_outputs", None)):
+        cfg = _overlaid(f"studies: {{{name}: {study}}}\nresults_dir: {tmp_path / 'out'}")
+        from opnav.preflight import problems
+
+        lines = problems(cfg, root=tmp_path, workflow=True)
+        assert (bad is None) == (not lines) and (bad is None or bad in lines[0]), (name, lines)
+    cfg = _overlaid(f"studies: {{a_outputs: {study}, a: {study}}}\nresults_dir: {tmp_path / 'out'}")
+    from opnav.preflight import problems
+
+    lines = problems(cfg, root=tmp_path, workflow=True)
+    assert len(lines) == 1 and "'studies.a_outputs'" in lines[0] and "study 'a' makes too" in lines[0], lines
+
+
+def test_full_label_on_full_sizes_passes_and_quick_label_on_any():
+    """The label is checked against the sizes it claims, from the schema's defaults (the full
+    profile's): full on quick sizes refused (above); full on full sizes, quick on either, pass."""
+    validate_config(yaml.safe_load((REPO / "config" / "config.yaml").read_text()), root=REPO, workflow=True)
+    validate_config(_overlaid("{}"), root=REPO, workflow=True)
+    validate_config(_overlaid("approach: {n_seeds: 20}\nlanding: {mc: {n_runs: 300}}"), root=REPO)
 
 
 @pytest.mark.parametrize("where", ["studies", "landing.scenarios", "approach.camera", "", "landing.mc.methods[0]"])

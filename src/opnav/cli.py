@@ -18,172 +18,45 @@ config (:func:`with_flags`), so the errors name the flag and the limit.
 from __future__ import annotations
 
 import argparse
-import importlib
-import json
-import math
 import re
 import sys
-from typing import Any
 
 from opnav import __version__
+from opnav.core.cliargs import (EXIT_NUMERICAL, EXIT_USER, Parser, RunConfig, add_config_arguments,  # noqa: F401
+                                finite_float, integer, parse_set, print_json, set_key)
 from opnav.core.errors import ConfigError
 
-#: Exit code of every user error (argparse's own code for a bad flag).
-EXIT_USER = 2
-#: Exit code of a numerical failure on inputs that passed every check.
-EXIT_NUMERICAL = 3
 
+def run_config() -> RunConfig:
+    """The checks every subcommand's config goes through (:func:`opnav.preflight.problems`)."""
+    from opnav.preflight import problems
 
-class Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line (no usage block) naming the flag: an
-    extra value after a flag of fixed arity (``--bias 1 2 3 4``) is reported against that
-    flag, not as an unrecognised argument."""
-
-    def parse_known_args(self, args=None, namespace=None):  # noqa: D102
-        self._argv = list(sys.argv[1:] if args is None else args)
-        return super().parse_known_args(args, namespace)
-
-    def _arity(self) -> dict[str, int]:
-        """``{option string: fixed number of values}`` of this parser and its subparsers."""
-        out: dict[str, int] = {}
-        stack = [self]
-        while stack:
-            p = stack.pop()
-            for a in p._actions:
-                if isinstance(a, argparse._SubParsersAction):
-                    stack += list(a.choices.values())
-                elif a.option_strings:
-                    single = a.nargs is None and isinstance(a, (argparse._StoreAction, argparse._AppendAction))
-                    n = a.nargs if isinstance(a.nargs, int) else (1 if single else None)
-                    if n:
-                        out.update(dict.fromkeys(a.option_strings, n))
-        return out
-
-    def error(self, message: str):  # noqa: D102
-        m = re.match(r"unrecognized arguments: (\S+)", message)
-        argv = getattr(self, "_argv", [])
-        if m and m.group(1) in argv:
-            i = argv.index(m.group(1))
-            j = i - 1
-            while j >= 0 and not (argv[j].startswith("-") and not _is_number(argv[j])):
-                j -= 1
-            arity = self._arity()
-            if j >= 0 and argv[j] in arity:
-                end = next((k for k in range(i, len(argv)) if argv[k].startswith("-") and not _is_number(argv[k])),
-                           len(argv))
-                given = end - j - 1
-                message = (f"argument {argv[j]}: takes {arity[argv[j]]} value(s), got {given} "
-                           f"({' '.join(argv[j + 1:j + 1 + given])})")
-        self.exit(EXIT_USER, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def finite_float(text: str) -> float:
-    """argparse type: a finite number (``nan``, ``inf`` refused)."""
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(x):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
-    return x
-
-
-def integer(text: str) -> int:
-    """argparse type: an integer written as one (``3.0`` refused, as in the config)."""
-    try:
-        return int(text, 10)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-
-
-def _set(config: dict, dotted: str, value: Any) -> None:
-    *parents, last = dotted.split(".")
-    node = config
-    for p in parents:
-        node = node.setdefault(p, {})
-    node[last] = value
-
-
-_KEY_RE = re.compile(r"config key '([^'\[]+)")
-
-
-def _shown(value: Any) -> str:
-    """A flag's value as the user typed it (lists space-separated, as nargs flags take them)."""
-    if isinstance(value, (list, tuple)):
-        return " ".join(_shown(v) for v in value)
-    return "null" if value is None else str(value).lower() if isinstance(value, bool) else str(value)
+    return RunConfig(problems)
 
 
 def with_flags(config: dict, flags: dict[str, tuple], *, workflow: bool = False) -> dict:
-    """Set config keys from command-line flags and validate the result.
-
-    ``flags`` maps a dotted config key to ``(flag, value)`` or ``(flag, value, shown)``
-    (``shown``: the user's value where the flag sets a derived one, e.g. ``--pixel-sigma``
-    sets three 3-sigma values); ``None`` values are skipped. The whole config is checked
-    again (:func:`opnav.preflight.check_config`: schema, core checks, the papers' physics
-    checks). Each error line about a flag's key (or a parent or child of it) is prefixed
-    with the flag and the user's value; a line the flags caused that names another key
-    (``--set landing.duration_s=1`` moving the B-F5 instant out of the descent) is prefixed
-    with every flag given, so no line blames a key the user did not touch without naming
-    the one they did. Raises :class:`~opnav.core.errors.ConfigError`.
-    """
-    import copy
-
-    from opnav.preflight import check_config, problems
-
-    given = {k: fv for k, fv in flags.items() if fv[1] is not None}
-    before = copy.deepcopy(config) if given else None
-    for key, (_, value, *_rest) in given.items():
-        _set(config, key, value)
-    try:
-        return check_config(config, workflow=workflow)
-    except ConfigError as exc:
-        old = set(problems(before, workflow=workflow)) if before is not None else set()
-        lines = []
-        for line in str(exc).splitlines():
-            m = _KEY_RE.search(line)
-            bad = m.group(1) if m else ""
-            # the flag of the key the line names (or a parent or child of it), else of a
-            # key the line mentions (approach.table1_variants ... not in approach.variants)
-            names = [key for key in given
-                     if bad and (bad == key or key.startswith(bad + ".") or bad.startswith(key + "."))]
-            names = names or [key for key in given if re.search(rf"(?<![\w.]){re.escape(key)}(?![\w])", line)]
-            if not names and line not in old:
-                names = list(given)                # caused by the flags, about another key
-            shown = [f"{given[k][0]} {_shown(given[k][2] if len(given[k]) > 2 else given[k][1])}"
-                     if not given[k][0].startswith("--set ") else
-                     f"{given[k][0]}={_shown(given[k][2] if len(given[k]) > 2 else given[k][1])}"
-                     for k in names]
-            lines.append(f"{', '.join(dict.fromkeys(shown))}: {line}" if shown else line)
-        raise ConfigError("\n".join(lines)) from None
+    """:meth:`opnav.core.cliargs.RunConfig.with_flags` with the workflow's checks."""
+    return run_config().with_flags(config, flags, workflow=workflow)
 
 
-def print_json(obj: Any, **kw) -> None:
-    """Print ``obj`` as strict JSON (NaN and infinities written as ``null``)."""
-    from opnav.core.tables import json_ready
-
-    print(json.dumps(json_ready(obj), allow_nan=False, **kw))
-
-#: Subpackages that may contribute a subcommand, in help order.
-PARTS = ("approach", "landing")
+def load_cli_config(args, *, workflow: bool = False) -> dict:
+    """:meth:`opnav.core.cliargs.RunConfig.load` with the workflow's checks: the defaults, the
+    ``--config`` overlays and the ``--set`` keys, checked once."""
+    return run_config().load(args, workflow=workflow)
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from opnav.approach import cli as approach_cli
+    from opnav.landing import cli as landing_cli
+
     parser = Parser(
         prog="opnav",
         description=(
             "Reproducible Mars optical navigation: EM-EKF camera-misalignment "
             "estimation on approach (paper A) and depth-error landmark selection "
             "for powered descent (paper B). The full pipeline runs with "
-            "`snakemake --cores 2`; these subcommands run single cases."
+            "`snakemake --cores 2`; these subcommands run single cases. Check a new "
+            "config file with `opnav check FILE` before `snakemake --configfile FILE`."
         ),
         epilog=f"Exit codes: 0 ok, {EXIT_USER} bad input (flag, config value or file), "
                f"{EXIT_NUMERICAL} numerical failure.",
@@ -192,87 +65,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--config", default=None,
                         help="config overlay on config/config.yaml of the checkout (e.g. config/quick.yaml)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for part in PARTS:
-        try:
-            mod = importlib.import_module(f"opnav.{part}.cli")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"opnav.{part}.cli":
-                raise
-            continue
-        mod.register(sub)
+    for part in (approach_cli, landing_cli):    # the papers' subcommands, in help order
+        part.register(sub)
     _register_study(sub)
     for p in sub.choices.values():
         add_config_arguments(p)
+    _register_check(sub)                        # files only: no overlays, no --set
     return parser
-
-
-def add_config_arguments(p: argparse.ArgumentParser) -> None:
-    """``--config FILE`` (overlay) and ``--set KEY.PATH=VALUE`` on a subcommand."""
-    g = p.add_argument_group("configuration (applied in this order, then validated once)")
-    g.add_argument("--config", dest="overlays", action="append", default=[], metavar="FILE",
-                   help="config overlay merged on the defaults (config/config.yaml), after the "
-                        "top-level `opnav --config`; repeatable")
-    g.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY.PATH=VALUE",
-                   help="set one config key, the value parsed as YAML (e.g. --set landing.camera.fov_deg=75, "
-                        "--set approach.camera.sigma3_px=[0.2,0.2,0.4]); repeatable; the subcommand's own "
-                        "flags are applied after it")
-
-
-#: A --set key: dotted names, each as the schema's names are (scenario names hold "-").
-_SET_KEY_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_-]*(\.[A-Za-z0-9_][A-Za-z0-9_-]*)*")
-
-
-def parse_set(text: str) -> tuple[str, Any, str]:
-    """``KEY.PATH=VALUE`` -> (dotted key, value, the value's text): the value read by the
-    config files' strict reader (:func:`opnav.core.yamlfile.read_value`: YAML 1.1 traps,
-    duplicate keys, control characters refused); an empty or null value is refused (a
-    config key cannot be unset). Raises :class:`ConfigError` naming the flag and key."""
-    from opnav.core.yamlfile import read_value
-
-    key, sep, raw = text.partition("=")
-    key = key.strip()
-    if not sep or not _SET_KEY_RE.fullmatch(key):
-        raise ConfigError(f"--set {text!r}: expected KEY.PATH=VALUE, e.g. --set landing.camera.fov_deg=75")
-    return key, read_value(raw, f"--set {key}"), raw.strip()
-
-
-def load_cli_config(args, *, workflow: bool = False) -> dict:
-    """The config of one subcommand run: the defaults (``config/config.yaml``), the top-level
-    ``opnav --config`` overlay, the subcommand's ``--config`` overlays, then its ``--set``
-    keys, checked once by the workflow's own pre-flight (:func:`opnav.preflight.check_config`:
-    schema, core checks, the papers' physics checks; with ``workflow``, also the studies,
-    growing windows and job bounds). A ``--set`` key must exist, or be a key the schema
-    allows under an existing map (a camera scenario's ``fov_deg``); its errors name the flag,
-    the key and the value given."""
-    from opnav.core.config import load_config
-
-    overlays = [*([args.config] if getattr(args, "config", None) else []), *getattr(args, "overlays", [])]
-    config = load_config(overlays=overlays, validate=False)
-    flags, new = {}, {}
-    for text in getattr(args, "sets", []):
-        key, value, raw = parse_set(text)
-        node, parts = config, key.split(".")
-        for i, part in enumerate(parts):
-            if isinstance(node, dict) and part not in node and i == len(parts) - 1:
-                new[key] = sorted(node)      # a new key of an existing map: the schema decides
-                break
-            if not isinstance(node, dict) or part not in node:
-                where = ".".join(parts[:i]) or "the top level"
-                have = ", ".join(sorted(node)) if isinstance(node, dict) else "no sub-keys"
-                raise ConfigError(f"--set {key}: no config key '{key}' ({where} has: {have})")
-            node = node[part]
-        flags[key] = (f"--set {key}", value, raw)
-    try:
-        return with_flags(config, flags, workflow=workflow)
-    except ConfigError as exc:
-        lines = str(exc).splitlines()
-        for key, have in new.items():      # the schema's "'x' was unexpected", said as above
-            parent, _, last = key.rpartition(".")
-            unexpected = f"invalid config key '{parent}': Additional properties are not allowed ('{last}' was"
-            if any(unexpected in ln for ln in lines):
-                raise ConfigError(f"--set {key}: no config key '{key}' ({parent} has: "
-                                  f"{', '.join(have) or 'no keys'})") from None
-        raise
 
 
 def _register_study(sub) -> None:
@@ -287,6 +86,124 @@ def _register_study(sub) -> None:
     p.set_defaults(func=run_study)
 
 
+def _register_check(sub) -> None:
+    p = sub.add_parser("check", help="check config files before `snakemake --configfile FILE ...`",
+                       description="Read each config FILE as the workflow will (size, file type, encoding, "
+                                   "YAML 1.2 rules, no YTE template), merge them on config/config.yaml in "
+                                   "order as `snakemake --configfile FILE ...` does, and run every check the "
+                                   "workflow runs before any job. One line per problem naming the file and "
+                                   "the key, exit 2; a JSON summary and exit 0 when every file passes. It "
+                                   "never hangs: a FIFO or device is not opened, and the check runs under a "
+                                   "time and a memory limit.")
+    p.add_argument("files", nargs="+", metavar="CONFIG", help="config files, in the order given to --configfile")
+    p.add_argument("--timeout", type=integer, default=60, help="seconds before the check is stopped (default 60)")
+    p.set_defaults(func=run_check)
+    p.epilog = ("Snakemake reads a --configfile itself before any of the project's code runs: a FIFO, "
+                "/dev/zero or a 10 MB file given to it hangs or fills memory, a UTF-16 file or deep "
+                "nesting ends in a traceback. Run this first on a new config.")
+
+
+def run_check(args, rc=None) -> int:
+    """``opnav check``: print each problem line (``opnav: error: ...``) and exit 2, or a
+    JSON summary and exit 0. Runs :func:`check_files` under a time and memory limit."""
+    import time
+
+    if args.timeout < 1:
+        raise ConfigError("--timeout: must be at least 1 (seconds)")
+    t0 = time.perf_counter()
+    lines = _limited(args.files, args.timeout)
+    if lines:
+        for line in lines:
+            print(f"opnav: error: {line}", file=sys.stderr)
+        return EXIT_USER
+    print_json({"ok": True, "files": list(args.files), "merged_on": "config/config.yaml",
+                "seconds": round(time.perf_counter() - t0, 2)})
+    return 0
+
+
+def _limited(files: list[str], timeout: float) -> list[str]:
+    """:func:`check_files` in a forked child with a memory limit, stopped after ``timeout`` s."""
+    import json
+    import os
+    import select
+    import signal
+    import time
+
+    from opnav.preflight import check_files
+
+    if not hasattr(os, "fork"):
+        return check_files(files)
+    import opnav.approach.preflight  # noqa: F401  (imported before the limit: the child only checks)
+    import opnav.landing.preflight  # noqa: F401
+    import opnav.studies.planning  # noqa: F401
+
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:                                      # the child: limited, reports through the pipe
+        os.close(r)
+        code = 0
+        try:
+            _limit_memory(CHECK_MEMORY_MB)
+            out = check_files(files)
+        except MemoryError:
+            out = [f"config files {', '.join(files)}: the check ran out of memory ({CHECK_MEMORY_MB} MB)"]
+        except BaseException as exc:                  # noqa: BLE001 - one line, never a traceback
+            out = [f"config files {', '.join(files)}: the check failed ({type(exc).__name__}: "
+                   f"{' '.join(str(exc).split())[:200]})"]
+            code = 1
+        try:
+            os.write(w, json.dumps(out).encode())
+        finally:
+            os._exit(code)
+    os.close(w)
+    data, deadline = b"", time.monotonic() + timeout
+    try:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                return [f"config files {', '.join(files)}: the check did not finish in {timeout:g} s (stopped)"]
+            ready, _, _ = select.select([r], [], [], left)
+            if ready:
+                chunk = os.read(r, 1 << 16)
+                if not chunk:
+                    break
+                data += chunk
+    finally:
+        os.close(r)
+    _, status = os.waitpid(pid, 0)
+    if not data:
+        sig = -os.waitstatus_to_exitcode(status)
+        why = "ran out of memory" if sig == signal.SIGKILL else f"ended by signal {sig}" if sig > 0 else "failed"
+        return [f"config files {', '.join(files)}: the check {why}"]
+    return json.loads(data)
+
+
+def _limit_memory(mb: int) -> None:
+    """RLIMIT_AS: what the process maps now plus ``mb`` (where the platform has it)."""
+    import os
+
+    try:
+        import resource
+    except ImportError:                               # pragma: no cover - not POSIX
+        return
+    try:
+        with open("/proc/self/statm") as f:
+            now = int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError):
+        now = 0
+    limit = now + mb * 1024 * 1024
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+
+
+#: Memory ``opnav check`` may take beyond what the process maps when it starts (MB).
+CHECK_MEMORY_MB = 1024
+
+
 def study_command(name: str, overlays, cores: int = 2, dry_run: bool = False) -> list[str]:
     """The Snakemake command line that runs study ``name`` with the config ``overlays``
     (files; the target after ``--``, since ``--configfile`` takes every word after it)."""
@@ -298,7 +215,7 @@ def study_command(name: str, overlays, cores: int = 2, dry_run: bool = False) ->
     return cmd + ["--", f"study_{name}"]
 
 
-def run_study(args) -> int:
+def run_study(args, rc: RunConfig) -> int:
     """``opnav study NAME``: validate the merged config and every study (the checks the
     Snakefile runs, before any job), then run the study's Snakemake target in the
     checkout. Snakemake's output goes to stderr (stdout holds the JSON summary only); if
@@ -315,7 +232,7 @@ def run_study(args) -> int:
 
     if args.cores < 1:
         raise ConfigError("--cores: must be at least 1")
-    config = load_cli_config(args, workflow=True)  # every overlay and --set, every study: errors name the key
+    config = rc.load(args, workflow=True)  # every overlay and --set, every study: errors name the key
     studies = config.get("studies") or {}
     if args.name not in studies:
         raise ConfigError(f"no study '{args.name}' in the config (studies: {', '.join(sorted(studies)) or 'none'}); "
@@ -328,7 +245,7 @@ def run_study(args) -> int:
             sets = {}
             for text in args.sets:
                 key, value, _ = parse_set(text)
-                _set(sets, key, value)
+                set_key(sets, key, value)
             extra = Path(tmp, "set.yaml")
             extra.write_text(yaml.safe_dump(sets))
             overlays.append(extra)
@@ -379,7 +296,7 @@ def main(argv: list[str] | None = None) -> int:
     import numpy as np
 
     try:
-        return int(args.func(args) or 0)
+        return int(args.func(args, run_config()) or 0)
     except ConfigError as exc:
         for line in str(exc).splitlines():
             print(f"opnav: error: {line}", file=sys.stderr)

@@ -13,7 +13,7 @@ import numpy as np
 
 
 def register(sub) -> None:
-    from opnav.cli import finite_float, integer
+    from opnav.core.cliargs import finite_float, integer
 
     from .scenario import VARIANTS
 
@@ -25,7 +25,9 @@ def register(sub) -> None:
                    help="EM initial value, arcsec (default: config theta_init_arcsec)")
     p.add_argument("--pixel-sigma", type=finite_float, default=None,
                    help="3-sigma centroid error in pixels (radius: x config ratio); default: config")
-    p.add_argument("--seed", type=integer, default=0, help="first Monte-Carlo seed index (>= 0)")
+    p.add_argument("--seed", type=integer, default=0,
+                   help="first Monte-Carlo seed index (>= 0; the last seed index at most that of "
+                        "landing.single.run_index's maximum, 1e9)")
     p.add_argument("--seeds", type=integer, default=1,
                    help="number of seeds (batched; limit: the schema's approach.n_seeds)")
     p.add_argument("--variant", default="literal", choices=list(VARIANTS))
@@ -43,8 +45,10 @@ FLAG_KEYS = {"bias": "approach.truth_bias_arcsec", "init": "approach.theta_init_
              **{k: f"approach.segments.{k}" for k in ("N0", "N", "M", "L")}}
 
 
-def run(args) -> int:
-    from opnav.cli import load_cli_config, print_json, with_flags
+def run(args, rc) -> int:
+    """``rc``: the run's config and its checks (:class:`opnav.core.cliargs.RunConfig`)."""
+    from opnav.core.checks import schema_node
+    from opnav.core.cliargs import print_json
     from opnav.core.config import ConfigError
     from . import scenario as sc
     from .cases import Case, run_case
@@ -52,9 +56,14 @@ def run(args) -> int:
     from .labels import bound_cause, reading_text, row_label
     from .setup import Setup
 
-    config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
+    config = rc.load(args)  # defaults + --config overlays + --set keys, validated
+    # seed indices as paper B's run indices: SeedSequence([base_seed, index]), the same bound
+    top = schema_node("landing.single.run_index")["maximum"]
     if args.seed < 0:
         raise ConfigError(f"--seed: must be >= 0, got {args.seed}")
+    if args.seed + max(args.seeds, 1) - 1 > top:
+        raise ConfigError(f"--seed {args.seed}: the seed indices {args.seed}..{args.seed + args.seeds - 1} exceed "
+                          f"{top} (the largest seed index, as landing.single.run_index's)")
     px = None
     if args.pixel_sigma is not None:
         r = config["approach"]["camera"]["radius_to_centroid_ratio"]
@@ -65,7 +74,7 @@ def run(args) -> int:
     flags = {key: ("--" + name.replace("_", "-"), values[name]) for name, key in FLAG_KEYS.items()}
     if px is not None:  # errors state the user's value, not the derived radius 3-sigma
         flags[FLAG_KEYS["pixel_sigma"]] = ("--pixel-sigma", px, args.pixel_sigma)
-    checked = with_flags(config, flags)["approach"]
+    checked = rc.with_flags(config, flags)["approach"]
     if args.variant == "stars":          # the arc the flags make must hold a star image
         from opnav.core.checks import stars_arc_problems
 

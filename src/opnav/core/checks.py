@@ -13,7 +13,10 @@ fast, no numba), one line per problem naming the keys:
   within ``table1_variants``; the B-X1 reference and the equivalence reference flown;
   negative controls among the pickers without a metric, apart from the tested methods;
   ``headline_scenario`` and the names of ``extra.n_runs`` among ``scenarios``; study
-  names that cannot collide with a rule of the workflow (:data:`RESERVED_STUDY_NAMES`);
+  names whose rules cannot collide with a rule the workflow has or makes, nor with another
+  study's, and study ids that are no output id of the workflow (both read from the
+  checkout's workflow: :func:`workflow_names`); tuning candidates without duplicates;
+* the ``profile`` label against the sizes it claims (:func:`profile_problems`);
 * numbers against each other: seeds of separate streams distinct, brackets ordered,
   a tolerance no larger than the quantity it tolerates, the landing vision cut-off
   (altitude plus margin) below the start altitude, the near-site landmark radius inside
@@ -34,12 +37,12 @@ import functools
 import math
 import re
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, NamedTuple
 
 __all__ = ["config_problems", "approach_rules", "landing_rules", "results_dir_problems", "job_problems",
            "growing_problems", "study_size_problem", "study_spec_defaults", "TRACKED_DIRS",
            "MAX_APPROACH_SAMPLES", "MAX_APPROACH_SEED_SAMPLES", "MAX_LANDING_IMU_SAMPLES",
-           "MAX_LANDING_RUN_STEPS", "RESERVED_STUDY_NAMES", "PICKERS"]
+           "MAX_LANDING_RUN_STEPS", "STUDY_RULES", "PICKERS", "workflow_names", "profile_problems"]
 
 #: Memory bounds. An approach arc of n samples keeps n one-step STMs (6x6) per
 #: geometry and (seeds x n) filter states and covariances per batch.
@@ -55,11 +58,8 @@ MAX_LANDING_RUN_STEPS = 5_000_000
 TRACKED_DIRS = ("paper", "src", "config", "workflow", "profiles", "tests", "benchmarks", ".git",
                 ".snakemake")
 
-#: Study names whose rules (``study_<name>``, ``study_<name>_outputs``, studies.smk) would
-#: collide with a rule the workflow has: ``runs`` (rule study_runs); a name ending in
-#: ``_outputs`` is refused too (``pixel_outputs`` would make study_pixel_outputs, study
-#: pixel's table rule).
-RESERVED_STUDY_NAMES = ("runs",)
+#: The rules a parameter study makes (studies.smk): ``study_<name>`` and ``study_<name>_outputs``.
+STUDY_RULES = ("study_{}", "study_{}_outputs")
 
 #: The planning "methods" without a metric (opnav.landing.planner's pickers): the negative
 #: controls of the equivalence test. tests/test_bad_input.py keeps it equal to the planner's.
@@ -76,11 +76,25 @@ def multiple(value: float, step: float, tol: float = 1e-9) -> bool:
     return k >= 1 and abs(k * step - value) <= tol * max(1.0, abs(value))
 
 
+def _shown(x) -> str:
+    """A list item as YAML shows it: [5.0, 3], a name bare."""
+    return "[" + ", ".join(map(_shown, x)) + "]" if isinstance(x, (list, tuple)) else str(x)
+
+
+def _numbers_as_floats(x):
+    """``x`` with every number a float: [5, 3] and [5.0, 3] are one candidate."""
+    if isinstance(x, (list, tuple)):
+        return [_numbers_as_floats(v) for v in x]
+    if isinstance(x, dict):
+        return {k: _numbers_as_floats(v) for k, v in x.items()}
+    return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) else x
+
+
 def duplicates(items) -> list:
     """The items given more than once, in order of their second appearance."""
     seen, dup = set(), []
     for x in items:
-        key = repr(x) if isinstance(x, (list, dict)) else x
+        key = repr(_numbers_as_floats(x)) if isinstance(x, (list, dict)) else x
         if key in seen and x not in dup:
             dup.append(x)
         seen.add(key)
@@ -97,7 +111,7 @@ def config_problems(config: dict, root: str | Path | None = None,
     checks to those sections; ``workflow`` adds what only the workflow reads (growing
     windows, job-graph bounds, study names and sizes)."""
     want = set(sections) if sections is not None else {"results_dir", "approach", "landing", "studies",
-                                                        "limits"}
+                                                        "limits", "profile"}
     todo = want - set(skip)
     out: list[str] = []
     if "results_dir" in todo:
@@ -109,13 +123,70 @@ def config_problems(config: dict, root: str | Path | None = None,
         out += seed_rules(config)
     if not workflow:
         return out
+    if "profile" in todo and not set(skip) & {"profile", "approach", "landing"}:
+        out += profile_problems(config)     # the label the workflow's outputs carry
     if "approach" in todo and "approach" not in set(skip):
         out += growing_problems(config["approach"])
     if "studies" in todo and "landing" not in set(skip):
-        out += study_rules(config)
+        out += study_rules(config, root)
     if "limits" in todo and not set(skip) & {"landing", "studies", "limits"}:
         out += job_problems(config)
     return out
+
+
+#: The sample sizes the label ``profile: full`` claims (the Monte Carlos the verdicts are
+#: judged on): at least the full profile's, which are the schema's defaults.
+FULL_SIZES = ("approach.n_seeds", "landing.mc.n_runs")
+
+
+def profile_problems(config: dict) -> list[str]:
+    """``profile: full`` only on the full profile's sample sizes (:data:`FULL_SIZES`): the
+    label decides whether the report, the claims table and the manuscript call the samples
+    too small for verdicts. (``quick`` on larger samples is accepted: it only under-claims.)"""
+    if config.get("profile") != "full":
+        return []
+    small = []
+    for key in FULL_SIZES:
+        section, *rest = key.split(".")
+        node = config.get(section, {})
+        for part in rest:
+            node = node.get(part) if isinstance(node, dict) else None
+        full = schema_default(key)
+        if isinstance(node, int) and isinstance(full, int) and node < full:
+            small.append(f"{key} = {node} < {full}")
+    if not small:
+        return []
+    return [f"invalid config key 'profile': 'full' claims the full profile's samples, but {'; '.join(small)}: "
+            "the report and the manuscript would judge verdicts on a sample the full profile does not have; "
+            "set profile: quick (its outputs say the sample is too small for verdicts) or the full sizes"]
+
+
+def schema_default(key: str):
+    """The schema's default of the dotted ``key`` (``approach.n_seeds``); None where it has none."""
+    return (schema_node(key) or {}).get("default")
+
+
+@functools.lru_cache(maxsize=16)
+def schema_node(key: str) -> dict | None:
+    """The schema of the dotted config ``key`` (``landing.single.run_index``), following the
+    section files; None where the schema has no such key."""
+    here = Path(__file__).resolve().parents[1] / "schemas"
+    load = functools.partial(_read_schema, here)
+    node = load("config.schema.yaml")
+    for part in key.split("."):
+        node = (node.get("properties") or {}).get(part)
+        if not isinstance(node, dict):
+            return None
+        if "$ref" in node and not node["$ref"].startswith("#"):
+            node = {**load(node["$ref"]), **{k: v for k, v in node.items() if k != "$ref"}}
+    return node
+
+
+@functools.lru_cache(maxsize=8)
+def _read_schema(here: Path, name: str) -> dict:
+    import yaml
+
+    return yaml.load((here / name).read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
 
 
 def _k(section: str, key: str) -> str:
@@ -213,12 +284,13 @@ def landing_rules(c: dict, *, workflow: bool = False) -> list[str]:
         if runs * n_steps > MAX_LANDING_RUN_STEPS:
             out.append(k(key) + f"{runs} runs x {n_steps} filter steps exceeds the limit {MAX_LANDING_RUN_STEPS} "
                        "(memory)")
-    lists = {"mc.methods": c["mc"]["methods"], "extra.methods": c["extra"]["methods"],
+    lists = {"tuning.candidates": c["tuning"]["candidates"],
+             "mc.methods": c["mc"]["methods"], "extra.methods": c["extra"]["methods"],
              "equivalence.methods": c["equivalence"]["methods"], "equivalence.controls": c["equivalence"]["controls"]}
     for key, names in lists.items():
         dup = duplicates(names)
         if dup:
-            out.append(k(key) + f"duplicated {', '.join(dup)}")
+            out.append(k(key) + f"duplicated {', '.join(map(_shown, dup))}")
     flown = list(c["mc"]["methods"]) + list(c["extra"]["methods"])
     if c["extra"]["reference"] not in flown:
         out.append(k("extra.reference") + f"{c['extra']['reference']!r} is not flown (not in landing.mc.methods or "
@@ -264,24 +336,100 @@ def seed_rules(config: dict) -> list[str]:
     return out
 
 
-def study_rules(config: dict) -> list[str]:
-    """Study names that cannot collide with a rule; a paper-B study within the Monte
-    Carlo's memory bound (runs x filter steps)."""
+def study_rules(config: dict, root: str | Path | None = None) -> list[str]:
+    """Study names whose rules (:data:`STUDY_RULES`) collide with no rule the workflow has or
+    makes (:func:`workflow_names`) nor with another study's; study ids that are no output
+    id of the workflow and whose letter is the study's paper's; a paper-B study within the
+    Monte Carlo's memory bound (runs x filter steps)."""
     out = []
     c = config["landing"]
     n_steps = max(1, round(c["duration_s"] / c["filter"]["dt_s"]))
-    for name, spec in (config.get("studies") or {}).items():
+    names = workflow_names(root)
+    studies = config.get("studies") or {}
+    made: dict[str, str] = {}       # rule name -> the study that makes it; a study's derived rules
+    for pattern in STUDY_RULES[::-1]:   # (study_<x>_outputs) first: 'x_outputs' is the name to blame
+        for name in studies:
+            if isinstance(name, str):
+                made.setdefault(pattern.format(name), name)
+    for name, spec in studies.items():
         if not isinstance(name, str):                   # a YAML 1.1 key (on:, 1:) given in process
             out.append(f"invalid config key 'studies': the study name {name!r} is not a string")
             continue
-        if name in RESERVED_STUDY_NAMES or name.endswith("_outputs"):
-            out.append(f"invalid config key 'studies.{name}': the name makes the rule study_{name}, which the "
-                       "workflow has already (choose another name)")
+        for rule in (pattern.format(name) for pattern in STUDY_RULES):
+            owner = made.get(rule)
+            if names is not None and (rule in names.rules or any(r.fullmatch(rule) for r in names.made)):
+                out.append(f"invalid config key 'studies.{name}': the name makes the rule {rule}, which the "
+                           "workflow has already (choose another name)")
+                break
+            if owner != name:
+                out.append(f"invalid config key 'studies.{name}': the name makes the rule {rule}, which study "
+                           f"'{owner}' makes too (choose another name)")
+                break
+        sid, paper = spec.get("id"), spec.get("paper")
+        if isinstance(sid, str) and names is not None and sid in names.outputs:
+            out.append(f"invalid config key 'studies.{name}.id' (study '{name}'): {sid} is an output id of the "
+                       f"workflow (workflow/report/{sid}.rst); a study's id names its own outputs: choose another, "
+                       f"e.g. {next(f'{sid[0]}-X{k}' for k in range(1, 999) if f'{sid[0]}-X{k}' not in names.outputs)}")
+        elif isinstance(sid, str) and paper in PAPER_LETTER and not sid.startswith(PAPER_LETTER[paper] + "-"):
+            out.append(f"invalid config key 'studies.{name}.id' (study '{name}'): {sid} names paper "
+                       f"{sid[0]}, the study flies paper {PAPER_LETTER[paper]} ({paper}); an id starts with its "
+                       f"paper's letter ({PAPER_LETTER[paper]}-...)")
         runs = spec.get("runs", study_spec_defaults()["runs"])
         if spec.get("paper") == "landing" and runs * n_steps > MAX_LANDING_RUN_STEPS:
             out.append(f"invalid config key 'studies.{name}.runs' (study '{name}'): {runs} runs x {n_steps} filter "
                        f"steps exceeds the limit {MAX_LANDING_RUN_STEPS} (memory, as landing.mc.n_runs)")
     return out
+
+
+#: The letter of each paper in output ids (A-T1, B-X2; a study's default id is A-S or B-S).
+PAPER_LETTER = {"approach": "A", "landing": "B"}
+
+
+class WorkflowNames(NamedTuple):
+    """What the checkout's workflow names: its rules (``rule NAME:``), the patterns of the
+    rules it makes in loops (``name: f"approach_mc_pack{_i}"`` -> ``approach_mc_pack.+``; a
+    study's own rules left out) and its output ids (``workflow/report/<id>.rst``)."""
+    rules: frozenset
+    made: tuple
+    outputs: frozenset
+
+
+_RULE_RE = re.compile(r"^\s*(?:rule\s+(\w+)\s*:|use\s+rule\s+.*?\bas\s+(\w+))", re.M)
+_MADE_RE = re.compile(r"^\s*name:\s*(?:\n\s*)?f?([\"'])(.+?)\1", re.M)
+_OUTPUT_ID_RE = re.compile(r"[A-Z]-[A-Z]+[0-9]+")
+
+
+def workflow_names(root: str | Path | None = None) -> WorkflowNames | None:
+    """:class:`WorkflowNames` of the checkout ``root`` (default: the one holding the working
+    directory, else the package's), read from ``workflow/rules/*.smk`` and
+    ``workflow/report/``; None where there is no workflow (an installed package)."""
+    base = _checkout(root)
+    return None if base is None else _workflow_names(str(base))
+
+
+def _checkout(root) -> Path | None:
+    cands = [Path(root)] if root is not None else [Path.cwd(), *Path.cwd().parents,
+                                                    Path(__file__).resolve().parents[3]]
+    for c in cands:
+        if (c / "workflow" / "rules").is_dir() and (c / "Snakefile").is_file():
+            return c.resolve()
+    return None
+
+
+@functools.lru_cache(maxsize=4)
+def _workflow_names(root: str) -> WorkflowNames:
+    rules, made = set(), []
+    probe = "zz0probe"                                    # a study's own rules match any name
+    for f in [Path(root, "Snakefile"), *sorted(Path(root, "workflow", "rules").glob("*.smk"))]:
+        text = f.read_text(errors="replace")
+        rules |= {a or b for a, b in _RULE_RE.findall(text)}
+        for _, name in _MADE_RE.findall(text):
+            parts = re.split(r"\{[^{}]*\}", name)
+            rx = re.compile(".+".join(map(re.escape, parts)))
+            if not any(rx.fullmatch(p.format(probe)) for p in STUDY_RULES):
+                made.append(rx)
+    outputs = {f.name.split(".")[0] for f in Path(root, "workflow", "report").glob("*.rst")}
+    return WorkflowNames(frozenset(rules), tuple(made), frozenset(o for o in outputs if _OUTPUT_ID_RE.fullmatch(o)))
 
 
 #: Default upper bound on a study's value sets (config ``limits.max_study_values``).
@@ -394,6 +542,10 @@ def results_dir_problems(config_or_dir, root: str | Path | None = None,
     if env:
         return [k + f"{results_dir[:60]!r} holds {env.group(0)}, which is not expanded (a folder literally named "
                 f"{env.group(0)!r} would be made); write the path itself"]
+    bad = next((ch for ch in results_dir if ch in _PATH_SPECIAL or ch.isspace()), None)
+    if bad is not None:
+        why = _PATH_SPECIAL.get(bad, "a space splits the path in the commands and LaTeX inputs that name it")
+        return [k + f"{results_dir[:60]!r} holds {bad!r}: {why}; use letters, digits and . _ - / only"]
     if len(results_dir) > MAX_PATH_CHARS or any(len(x) > 255 for x in Path(results_dir).parts):
         return [k + f"{len(results_dir)} characters (at most {MAX_PATH_CHARS}, and 255 per folder name)"]
     if results_dir.startswith("~"):
@@ -435,9 +587,62 @@ def results_dir_problems(config_or_dir, root: str | Path | None = None,
         return [k + f"{shown}: {q} is a file, so the folder cannot be made"]
     if not os.access(q, os.W_OK | os.X_OK):
         return [k + f"{shown}: {q} is not writable"]
+    nested = nested_problems(p, base, shown)
+    if nested:
+        return nested
     if cfg is not None and root is not None and p.is_dir():
         return owner_problems(p, root, str(cfg.get("profile", "full")))
     return []
+
+
+#: Characters results_dir may not hold, and why (Snakemake reads every output path as a
+#: pattern: a path that names it is expanded before any job).
+_PATH_SPECIAL = {"{": "Snakemake reads {...} in an output path as a wildcard", "}": "Snakemake reads {...} in an "
+                 "output path as a wildcard", "*": "a glob character ('*' matches any name)",
+                 "?": "a glob character ('?' matches any character)", "[": "a glob character ('[...]')",
+                 "]": "a glob character ('[...]')", "\\": "a backslash is no folder separator here",
+                 '"': "a quote", "'": "a quote", "`": "a backquote", ";": "a shell separator",
+                 "&": "a shell operator", "|": "a shell operator", "<": "a shell redirection",
+                 ">": "a shell redirection"}
+
+
+def nested_problems(p: Path, base: Path, shown_dir: str | None = None) -> list[str]:
+    """``p`` (a resolved results_dir) strictly inside another build's results folder: one
+    holding an :data:`OWNER_MARKER`, or the ``results_dir`` of a profile in the checkout
+    ``base``'s ``config/`` (results, results/quick), unless ``p`` is itself one of those
+    (the quick profile's results/quick inside results/ is the project's own layout). Two
+    builds would write one tree, and one's outputs would stand where the other has its own."""
+    known = _profile_dirs(str(base))
+    if p in known or (p / OWNER_MARKER).is_file():
+        return []
+    owners = {a for a in p.parents if (a / OWNER_MARKER).is_file()} | {d for d in known if d in p.parents}
+    if not owners:
+        return []
+    outer = max(owners, key=lambda a: len(a.parts))           # the nearest one
+    try:
+        shown = outer.relative_to(base).as_posix()
+    except ValueError:
+        shown = str(outer)
+    return [f"invalid config key 'results_dir': {shown_dir or repr(str(p))} is inside the results folder {shown}/ of another build "
+            f"(its outputs and this config's would mix); choose a folder beside it, e.g. '{shown}-mine'"]
+
+
+@functools.lru_cache(maxsize=4)
+def _profile_dirs(base: str) -> frozenset:
+    """The resolved results_dir of each config file in ``base``/config (the checkout's
+    profiles), read with the strict reader; a file it refuses names none."""
+    from opnav.core.yamlfile import read_config_file
+    from opnav.core.errors import ConfigError
+
+    out = set()
+    for f in sorted(Path(base, "config").glob("*.yaml")):
+        try:
+            d = read_config_file(f).get("results_dir", "results")
+        except ConfigError:
+            continue
+        if isinstance(d, str) and d.strip():
+            out.add((Path(base) / d).resolve())
+    return frozenset(out)
 
 
 #: results_dir's length limit (characters).

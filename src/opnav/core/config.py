@@ -139,7 +139,9 @@ def _validator(schema_path: Path):
                 yield ValidationError(f"{instance} is not a finite number (NaN and infinity are refused)")
                 return
             if "integer" in wanted and instance.is_integer():
-                yield ValidationError(f"{instance!r} is not an integer (write {int(instance)})")
+                # a float holds every integer exactly only up to 2**53: beyond, no digits to suggest
+                hint = f"write {int(instance)}" if abs(instance) < 2 ** 53 else "and far beyond any count here"
+                yield ValidationError(f"{instance!r} is not an integer ({hint})")
                 return
         yield from errors
 
@@ -199,9 +201,12 @@ def schema_problems(config: dict, schema_path: Path = SCHEMA_PATH) -> list[str]:
     lines = [f"invalid config key '{k}': {v} is not a finite number "
              "(NaN and infinity are refused)" for k, v in bad.items()]
     validator = _validator(schema_path)
+    # one line per key, its first problem: that 1e300 for a count is also over the maximum is noise
+    seen = set(bad)
     for err in sorted(validator.iter_errors(config), key=lambda e: [str(p) for p in e.absolute_path]):
         key = _dotted(err.absolute_path)
-        if key not in bad:
+        if key not in seen:
+            seen.add(key)
             where = f"config key '{key}'" if key else "config (top level)"
             lines.append(f"invalid {where}: {_message(err)}")
     return lines

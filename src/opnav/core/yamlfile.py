@@ -361,27 +361,44 @@ def _top(data, where: _Where, mark) -> dict:
 
 def read_config_file(path: str | Path) -> dict:
     """The config mapping in the user's file ``path`` (:func:`read_config_text`), or
-    :class:`ConfigError` naming the file: missing, not a regular file, unreadable, over
-    :data:`MAX_BYTES`, not UTF-8 text, or any refusal of this module."""
+    :class:`ConfigError` naming the file: missing, not a regular file (a FIFO or a device is
+    never opened: reading one would wait, or never end), unreadable, over :data:`MAX_BYTES`
+    (checked before reading, and at most that many bytes are read), not UTF-8 text, or any
+    refusal of this module."""
+    import stat
+
     f = Path(path)
     source = f"config file {f}"
-    if not f.exists():
-        raise ConfigError(f"{source}: not found")
-    if not f.is_file():
-        raise ConfigError(f"{source}: not a regular file")
     try:
-        size = f.stat().st_size
-        if size > MAX_BYTES:
-            raise ConfigError(f"{source}: {size} bytes, over the {MAX_BYTES} a config may have")
-        raw = f.read_bytes()
+        st = f.stat()
+    except FileNotFoundError:
+        raise ConfigError(f"{source}: not found") from None
     except OSError as exc:
         raise ConfigError(f"{source}: cannot be read ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode)
+                else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
+                else "a socket" if stat.S_ISSOCK(st.st_mode) else "not a file")
+        raise ConfigError(f"{source}: {kind}, not a regular file; give a YAML file")
+    if st.st_size > MAX_BYTES:
+        raise ConfigError(f"{source}: {st.st_size} bytes, over the {MAX_BYTES} a config may have")
+    try:
+        with open(f, "rb") as fh:
+            raw = fh.read(MAX_BYTES + 1)
+    except OSError as exc:
+        raise ConfigError(f"{source}: cannot be read ({exc.strerror or exc})") from None
+    if len(raw) > MAX_BYTES:                        # grew after the size check
+        raise ConfigError(f"{source}: over the {MAX_BYTES} bytes a config may have")
+    for bom, name in ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+                      (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16")):
+        if raw.startswith(bom):
+            raise ConfigError(f"{source}, line 1: {name} text (byte-order mark); save it as UTF-8")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = raw[:exc.start].count(b"\n") + 1
-        raise ConfigError(f"{source}, line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); "
-                          "a YAML config is expected") from None
+        raise ConfigError(f"{source}, line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); save it as "
+                          "UTF-8 (a YAML config is expected)") from None
     return read_config_text(text, source)
 
 

@@ -15,18 +15,19 @@ of the Monte Carlo for that method exactly.
 from __future__ import annotations
 
 
-def _run(args) -> int:
-    from opnav.cli import load_cli_config, print_json, with_flags
+def _run(args, rc) -> int:
+    """``rc``: the run's config and its checks (:class:`opnav.core.cliargs.RunConfig`)."""
+    from opnav.core.cliargs import print_json
     from opnav.landing.descent import build_scenario, run_descent
     from opnav.landing.montecarlo import summarize_run
 
-    config = load_cli_config(args)  # defaults + --config overlays + --set keys, validated
+    config = rc.load(args)  # defaults + --config overlays + --set keys, validated
     # the planner's registry and the seed's limits are checked as the config's
     # landing.single.method / run_index (opnav.core.checks), naming the flag
     from opnav.core.config import ConfigError
     from opnav.landing.scenario import camera_scenarios, headline_scenario
 
-    landing = with_flags(config, {"landing.single.method": ("--method", args.method),
+    landing = rc.with_flags(config, {"landing.single.method": ("--method", args.method),
                                   "landing.single.run_index": ("--seed", args.seed)})["landing"]
     scenarios = camera_scenarios(landing)
     name = headline_scenario(landing) if args.scenario is None else args.scenario
@@ -50,7 +51,7 @@ def _run(args) -> int:
 
 
 def register(subparsers) -> None:
-    from opnav.cli import integer
+    from opnav.core.cliargs import integer
 
     p = subparsers.add_parser("landing", help="fly one Mars powered descent (paper B)",
                               description=__doc__.split("\n\n")[0])
