@@ -124,6 +124,25 @@ def test_table1_grouped_has_one_column_group_per_variant_and_marks_unconverged()
     assert "-0.0" not in tex and "11.43" in tex
 
 
+def test_table1_stacks_groups_in_panels_that_repeat_the_case_columns():
+    """Issue 55 item 2: paper A's Table 1 with four variants beside the published values (15
+    number columns, printed at 4.2 pt when shrunk to the page) is set as panels of at most
+    three groups, each repeating the case and truth: it prints at its own size."""
+    import pandas as pd
+
+    from opnav.report.manuscript import TABLE1_GROUPS, table1_grouped_latex
+
+    rows = [{"variant": v, "case_id": c, "truth_x_arcsec": 10, "truth_y_arcsec": 20, "pub_est_x_mean": 11.43,
+             "pub_est_y_mean": 21.21, "pub_nav_err_after_km": 18.43, "est_x_mean": 1.0, "est_y_mean": 2.0,
+             "nav_err_after_km": 100.0, "label": "converged"} for v in TABLE1_GROUPS for c in ("T1-01", "T1-02")]
+    tex = table1_grouped_latex(pd.DataFrame(rows))
+    panels = tex.split(r"\begin{tabular}")[1:]
+    assert len(panels) == 2
+    for p in panels:
+        assert p.count(r"\multicolumn{3}") <= 3 and "case & truth" in p and "T1-02 & 10, 20" in p
+    assert all(rf"\multicolumn{{3}}{{c}}{{{g}}}" in tex for g in ("published", *TABLE1_GROUPS))
+
+
 def test_pdf_selection_drops_variants_not_studies():
     from opnav.report.manuscript import in_pdf
 
@@ -152,4 +171,30 @@ def test_tables_are_printed_legibly():
     tex = legible_latex(long, max_cols=7)
     parts = tex.split(r"\toprule")[1:]
     assert len(parts) == 2 and all("variant & method" in p for p in parts)  # key columns in each part
-    assert r"\begin{tabular}[b]{@{}l@{}}a rather long \\ header 0\end{tabular}" in tex  # a wrapped header
+    assert r"\begin{tabular}[b]{@{}l@{}}a rather long \\ {}header 0\end{tabular}" in tex  # a wrapped header
+
+
+def test_wide_text_tables_wrap_their_words_then_split_by_width():
+    """Issue 55 item 2: a table whose text cells are long wraps them (never a number, interval
+    or mean +- spread) and, still wider than the line, splits into parts that each fit it."""
+    import re
+
+    import pandas as pd
+
+    from opnav.report import manuscript as M
+
+    df = pd.DataFrame({"variant": ["literal", "roll"],
+                       "estimator": ["Basilisk pixelLineBiasUKF square-root filter", "augmented EKF"],
+                       "run": ["prior mean at the truth (diagnostic)", "headline case"],
+                       **{f"quantity {i} (arcsec)": ["0.000364 ± 0.00497", "0.0268 [-0.00848, 0.0551]"]
+                          for i in range(4)}})
+    tex = M.legible_latex(df)
+    assert r"Basilisk \\ {}" in tex or r"Basilisk pixelLineBiasUKF \\ {}" in tex  # words wrapped
+    assert "0.0268 [-0.00848, 0.0551]" in tex and "0.000364 ± 0.00497" in tex      # numbers whole
+    parts = tex.split(r"\toprule")[1:]
+    assert len(parts) >= 2
+    fitted = M.fit_text_columns(M.legible_view(df))
+    for p in parts:  # each part fits the line
+        heads = re.findall(r"quantity \d", p.split(r"\midrule")[0])
+        cols = ["variant", "estimator", "run"] + [c for c in df.columns if c[:10] in heads]
+        assert M._width_chars(fitted[[c for c in cols if c in fitted.columns]]) <= M.LINE_CHARS, cols

@@ -78,6 +78,44 @@ PDF_DROP = [v for v in A_VARIANTS if v not in ("literal", "roll")] + [s for s in
 PDF_FLOATS = {part: [p for p in _floats(part) if manuscript.in_pdf(p, PDF_DROP)] for part in ("approach", "landing")}
 
 
+def _producing_job(path):
+    """The rule, wildcards and plain params of the job that writes `path`: what Snakemake's
+    report gives that output's caption template."""
+    import json
+    from snakemake.io import apply_wildcards
+
+    for r in workflow.rules:
+        if r.is_producer(path):
+            wc = {k: str(v) for k, v in r.get_wildcards(path).items()}
+            params = {}
+            for k, v in r.params.items():
+                if isinstance(v, str):
+                    v = apply_wildcards(v, wc)
+                try:
+                    json.dumps(v)
+                except TypeError:  # a function of the job: known only when it runs
+                    continue
+                params[k] = v
+            return {"rule": r.name, "wildcards": wc, "params": params}
+    return {}
+
+
+def _float_captions():
+    """Each float's caption from workflow/report/, rendered as Snakemake's HTML report renders
+    it (the run's config, the producing job's wildcards and params), by path: the PDF prints
+    the report's words, and a caption whose rendered text changes reruns the floats. A
+    parameter study's caption is written by its rule (opnav.studies.captions), not here."""
+    out = {}
+    for p in PDF_FLOATS["approach"] + PDF_FLOATS["landing"]:
+        cap = CAPTIONS / f"{manuscript.output_id(p)}.rst"
+        if p.endswith(".tex") and (CAPTIONS / f"{manuscript.output_id(p)}.table.rst").is_file():
+            cap = CAPTIONS / f"{manuscript.output_id(p)}.table.rst"
+        if cap.is_file():
+            ctx = manuscript.CaptionContext(config, **_producing_job(p))
+            out[p] = manuscript.render_caption(cap.read_text(), ctx, source=str(cap.relative_to(workflow.basedir)))
+    return out
+
+
 rule paper_floats:
     """Figure and table floats for the manuscript (headline variants only, opnav.report.manuscript.in_pdf),
     captions from workflow/report/; paper A's Table 1 as one grouped table."""
@@ -97,6 +135,8 @@ rule paper_floats:
     params:
         paper_dir=str(PAPER_DIR),
         captions_dir=lambda wildcards, input: str(Path(input.captions[0]).parent),
+        # each float's caption rendered with its job's context (the report's words)
+        captions=_float_captions(),
     log:
         f"{PAPER}/logs/paper_floats.log",
     localrule: True
@@ -217,6 +257,7 @@ rule paper_pdf:
         tex=sorted(str(p) for p in PAPER_DIR.rglob("*.tex")),
         generated=PAPER_INPUTS,
         results=[t for t in _targets if t.endswith((".pdf", ".tex"))],
+        code=src("report/print_size.py"),
     output:
         report(f"{PAPER}/main.pdf", caption=_caption("manuscript"), category="Claims", subcategory="manuscript"),
     params:

@@ -20,8 +20,13 @@ with script_context(snakemake) as log:
     compact_dir = Path(snakemake.output.compact)
     compact_dir.mkdir(parents=True, exist_ok=True)
     for part in ("approach", "landing"):
-        paths = []
+        paths, captions = [], {}
         for p in map(Path, snakemake.input[part]):
+            # the caption rendered for this output's job (keyed by its workflow path; a run by
+            # hand gives absolute paths)
+            cap = next((c for k, c in snakemake.params.captions.items() if p == Path(k) or p.match(k)), None)
+            if cap is not None:
+                captions[str(p)] = cap
             if p.suffix != ".tex" or not p.with_suffix(".csv").is_file():
                 paths.append(p)
                 continue
@@ -32,7 +37,10 @@ with script_context(snakemake) as log:
                 out = compact_dir / f"{stem}.tex"
                 atomic_write_text(out, legible_latex(df))
                 paths.append(out)
-        text = float_block(paths, snakemake.params.captions_dir, relative_to=snakemake.params.paper_dir)
+                if str(p) in captions:  # the table's caption, rendered for its job
+                    captions[str(out)] = captions[str(p)]
+        text = float_block(paths, snakemake.params.captions_dir, relative_to=snakemake.params.paper_dir,
+                           captions=captions)
         atomic_write_text(snakemake.output[part], text or "% no outputs yet\n")
         log.info("%s: %d floats", part, len(paths))
     a_t1 = list(snakemake.input.a_table1) if "a_table1" in snakemake.input.keys() else []

@@ -123,6 +123,37 @@ def render_macros(macros: Mapping[str, str], header: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
+class CaptionContext:
+    """The ``snakemake`` object a caption template sees, as Snakemake's HTML report builds it
+    for an output (``snakemake.report.FileRecord.render``): the run's config, the producing
+    job's rule name, wildcards and (plain-valued) params. Input, output, threads, resources
+    and log are not known when the manuscript is written: a caption that uses them stops
+    with the template error (:func:`render_caption`)."""
+
+    def __init__(self, config: Mapping[str, Any], wildcards: Mapping[str, Any] | None = None,
+                 rule: str | None = None, params: Mapping[str, Any] | None = None):
+        from types import SimpleNamespace
+
+        self.config = config
+        self.rule = rule
+        self.wildcards = SimpleNamespace(**dict(wildcards or {}))
+        self.params = SimpleNamespace(**dict(params or {}))
+
+
+def render_caption(text: str, snakemake: CaptionContext, source: str = "caption") -> str:
+    """A caption's reStructuredText with its Jinja template code rendered, as Snakemake's
+    report renders it (same environment options: ``trim_blocks``, ``lstrip_blocks``), so the
+    PDF and the HTML report print the same words. An undefined name stops with a one-line
+    error naming the caption file (the HTML report would print it as empty text)."""
+    import jinja2
+
+    env = jinja2.Environment(trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
+    try:
+        return env.from_string(text).render(snakemake=snakemake)
+    except jinja2.TemplateError as exc:
+        raise ValueError(f"{source}: cannot render its template code: {exc}") from None
+
+
 def rst_to_latex(text: str) -> str:
     """Caption text from an ``.rst`` caption file as LaTeX (plain prose subset)."""
     text = " ".join(text.split())
@@ -152,9 +183,31 @@ def output_variant(path: str | Path) -> str:
     return stem.split("_", 1)[1].replace("_", " ") if "_" in stem else ""
 
 
+def caption_file(path: str | Path, captions_dir: str | Path) -> Path:
+    """The caption of an output: ``<captions_dir>/<ID>.rst`` (a table's own ``<ID>.table.rst``
+    where a figure shares its id), else a caption generated beside the output (a parameter
+    study's ``<ID>.rst``)."""
+    p, captions_dir = Path(path), Path(captions_dir)
+    cid = output_id(p)
+    cap = captions_dir / f"{cid}.rst"
+    if p.suffix == ".tex" and (captions_dir / f"{cid}.table.rst").is_file():
+        cap = captions_dir / f"{cid}.table.rst"
+    if not cap.is_file():
+        cap = p.parent / f"{cid}.rst"
+    if not cap.is_file():
+        raise FileNotFoundError(f"no caption file {captions_dir / f'{cid}.rst'} for {p}")
+    return cap
+
+
 def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_to: str | Path,
-                width: str | None = None) -> str:
+                width: str | None = None, captions: Mapping[str, str] | None = None) -> str:
     """Figure floats for PDFs and table floats for ``.tex`` tables, in the given order.
+
+    Every caption is rendered before it becomes LaTeX (:func:`render_caption`): ``captions``
+    holds, by path as given, the caption rendered with its job's context (rule paper_floats
+    renders them when the workflow is parsed, from the run's config and each output's
+    wildcards); any other caption file is rendered here with an empty context, so one whose
+    template code needs the config stops with its error instead of printing as code.
 
     Figures keep their natural size (the shared style draws them at column
     or page width, so fonts read at 8 pt), shrunk only if wider than the text;
@@ -166,17 +219,13 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
     import os
 
     blocks = []
-    captions_dir = Path(captions_dir)
     for p in map(Path, paths):
         cid = output_id(p)
-        cap_file = captions_dir / f"{cid}.rst"
-        if p.suffix == ".tex" and (captions_dir / f"{cid}.table.rst").is_file():  # a table's own caption
-            cap_file = captions_dir / f"{cid}.table.rst"
-        if not cap_file.is_file():  # a generated caption beside the output (parameter studies)
-            cap_file = p.parent / f"{cid}.rst"
-        if not cap_file.is_file():
-            raise FileNotFoundError(f"no caption file {captions_dir / f'{cid}.rst'} for {p}")
-        caption = rst_to_latex(cap_file.read_text())
+        rendered = (captions or {}).get(str(p))
+        if rendered is None:
+            cap_file = caption_file(p, captions_dir)
+            rendered = render_caption(cap_file.read_text(), CaptionContext({}), source=str(cap_file))
+        caption = rst_to_latex(rendered)
         variant = output_variant(p)
         rel = Path(os.path.relpath(p, relative_to)).as_posix()
         label = re.sub(r"[^A-Za-z0-9:-]", "-", p.stem)
@@ -191,12 +240,15 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
                 f"  \\label{{fig:{label}}}\n\\end{{figure}}\n"
             )
         elif p.suffix == ".tex":
+            # set at \footnotesize (legible_latex fits its tables to that line); shrunk only if
+            # still wider, which paper/print-size.tex measures and rule paper_pdf reports
             blocks.append(
                 "\\begin{table}[htbp]\n  \\centering\n"
                 f"  \\caption[{short}]{{\\textbf{{{short}.}} {caption}}}\n"
                 f"  \\label{{tab:{label}}}\n"
-                "  \\resizebox{\\ifdim\\width>\\linewidth\\linewidth\\else\\width\\fi}{!}{%\n"
-                f"    \\input{{{rel}}}}}\n\\end{{table}}\n"
+                "  {\\footnotesize\\setlength{\\tabcolsep}{4pt}"
+                "\\resizebox{\\ifdim\\width>\\linewidth\\linewidth\\else\\width\\fi}{!}"
+                f"{{\\input{{{rel}}}}}\\par}}\n\\end{{table}}\n"
             )
         else:
             raise ValueError(f"{p}: only .pdf figures and .tex tables go into the manuscript")
@@ -250,10 +302,18 @@ def prose_tex(text: str) -> str:
 TABLE1_GROUPS = ("literal", "roll", "roll+squarem", "roll+growing+squarem")
 
 
-def table1_grouped_latex(t1: pd.DataFrame, groups: Iterable[str] = TABLE1_GROUPS) -> str:
-    """Paper A's Table 1 as one LaTeX table: a row per case, the published values and each
-    variant as a column group (t_x, t_y in arcsec, navigation error after compensation in
-    km); a variant's cell is marked where its run did not converge (the A-T1 label)."""
+#: at most this many column groups (published and each variant: t_x, t_y, error after) side by
+#: side; more are stacked in a second panel below, so the table prints at its own size
+TABLE1_GROUPS_PER_PANEL = 3
+
+
+def table1_grouped_latex(t1: pd.DataFrame, groups: Iterable[str] = TABLE1_GROUPS,
+                         per_panel: int = TABLE1_GROUPS_PER_PANEL) -> str:
+    """Paper A's Table 1 as LaTeX: a row per case, the published values and each variant as a
+    column group (t_x, t_y in arcsec, navigation error after compensation in km); a variant's
+    cell is marked where its run did not converge (the A-T1 label). Groups beyond
+    ``per_panel`` go into further panels stacked below, each repeating the case and truth
+    columns, so the table keeps its font size instead of being shrunk to the page."""
     import pandas as pd
 
     groups = [g for g in groups if (t1["variant"] == g).any()]
@@ -266,26 +326,38 @@ def table1_grouped_latex(t1: pd.DataFrame, groups: Iterable[str] = TABLE1_GROUPS
         t = f.format(float(x))
         return t[1:] if t.startswith("-") and float(t) == 0 else t  # no "-0.0"
 
-    cols = "ll" + "rrr" * (len(groups) + 1)
-    head1 = ["", "", r"\multicolumn{3}{c}{published}"] + [rf"\multicolumn{{3}}{{c}}{{{latex_escape(g)}}}" for g in groups]
-    rules = "".join(rf"\cmidrule(lr){{{3 + 3 * i}-{5 + 3 * i}}}" for i in range(len(groups) + 1))
-    head2 = ["case", r"truth ($''$)"] + [r"$t_x$ ($''$)", r"$t_y$ ($''$)", "after (km)"] * (len(groups) + 1)
-    lines = [rf"\begin{{tabular}}{{@{{}}{cols}@{{}}}}", r"\toprule", " & ".join(head1) + r" \\", rules,
-             " & ".join(head2) + r" \\", r"\midrule"]
-    for c in cases:
-        p = by[(groups[0], c)]
-        cells = [c, f"{num(p['truth_x_arcsec'], '{:g}')}, {num(p['truth_y_arcsec'], '{:g}')}", num(p["pub_est_x_mean"], "{:g}"), num(p["pub_est_y_mean"], "{:g}"), num(p["pub_nav_err_after_km"], "{:g}")]
-        for g in groups:
-            r = by.get((g, c))
-            if r is None:
-                cells += [MISSING] * 3
-                continue
-            lab = str(r.get("label", "converged" if str(r.get("stalled")).lower() != "true" else "stalled"))
-            mark = "" if lab == "converged" else r"$^\dagger$"
-            cells += [num(r["est_x_mean"]) + mark, num(r["est_y_mean"]) + mark, num(r["nav_err_after_km"])]
-        lines.append(" & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}"]
-    return "\n".join(lines) + "\n"
+    def cells(group, c):
+        if group is None:  # published
+            p = by[(groups[0], c)]
+            return [num(p["pub_est_x_mean"], "{:g}"), num(p["pub_est_y_mean"], "{:g}"),
+                    num(p["pub_nav_err_after_km"], "{:g}")]
+        r = by.get((group, c))
+        if r is None:
+            return [MISSING] * 3
+        lab = str(r.get("label", "converged" if str(r.get("stalled")).lower() != "true" else "stalled"))
+        mark = "" if lab == "converged" else r"$^\dagger$"
+        return [num(r["est_x_mean"]) + mark, num(r["est_y_mean"]) + mark, num(r["nav_err_after_km"])]
+
+    blocks = [None, *groups]
+    panels = [blocks[i:i + per_panel] for i in range(0, len(blocks), per_panel)] or [[None]]
+    out = []
+    for panel in panels:
+        cols = "ll" + "rrr" * len(panel)
+        names = ["published" if g is None else latex_escape(g) for g in panel]
+        head1 = ["", ""] + [rf"\multicolumn{{3}}{{c}}{{{n}}}" for n in names]
+        rules = "".join(rf"\cmidrule(lr){{{3 + 3 * i}-{5 + 3 * i}}}" for i in range(len(panel)))
+        head2 = ["case", "truth"] + [r"$t_x$", r"$t_y$", "after"] * len(panel)
+        lines = [rf"\begin{{tabular}}{{@{{}}{cols}@{{}}}}", r"\toprule", " & ".join(head1) + r" \\", rules,
+                 " & ".join(head2) + r" \\", r"\midrule"]
+        for c in cases:
+            p = by[(groups[0], c)]
+            row = [c, f"{num(p['truth_x_arcsec'], '{:g}')}, {num(p['truth_y_arcsec'], '{:g}')}"]
+            for g in panel:
+                row += cells(g, c)
+            lines.append(" & ".join(row) + r" \\")
+        lines += [r"\bottomrule", r"\end{tabular}"]
+        out.append("\n".join(lines))
+    return "\n\n\\medskip\n".join(out) + "\n"
 
 
 def in_pdf(path: str | Path, drop_variants: Iterable[str]) -> bool:
@@ -409,7 +481,7 @@ def _header_tex(text: str, width: int = HEADER_WRAP) -> str:
     lines = textwrap.wrap(str(text), width) or [""]
     if len(lines) == 1:
         return latex_escape(lines[0])
-    return r"\begin{tabular}[b]{@{}l@{}}" + r" \\ ".join(latex_escape(line) for line in lines) + r"\end{tabular}"
+    return r"\begin{tabular}[b]{@{}l@{}}" + r" \\ {}".join(latex_escape(line) for line in lines) + r"\end{tabular}"
 
 
 def legible_view(df: pd.DataFrame) -> pd.DataFrame:
@@ -434,28 +506,105 @@ def _key_columns(df: pd.DataFrame) -> int:
     return max(n, 1)
 
 
+#: the text width a table may take, in characters of the table font (the manuscript's tables
+#: are set in \\footnotesize, 8 pt: about 4.1 pt a character, on a 484 pt line) and the
+#: space a column adds (\\tabcolsep both sides), in characters
+LINE_CHARS = 112
+COLUMN_GAP_CHARS = 2
+
+
+def _cell_lines(x: Any) -> list[str]:
+    return _cell_tex(x).split("\x00")
+
+
+def _wrapped_cell(x: Any, width: int) -> Any:
+    """A text cell cut onto lines of at most ``width`` characters (words kept whole), the
+    lines joined by a marker :func:`_tabular` sets as stacked lines."""
+    import textwrap
+
+    if not isinstance(x, str) or len(x) <= width or " " not in x:
+        return x
+    return "\x00".join(textwrap.wrap(x, width, break_long_words=False))
+
+
+def _col_chars(v: pd.DataFrame, c: Any) -> int:
+    """A column's printed width in characters: its widest header line or cell line."""
+    import textwrap
+
+    def plain(x):  # the cell as printed, before LaTeX escapes
+        if isinstance(x, float):
+            return MISSING if not math.isfinite(x) else f"{x:.4g}"
+        return MISSING if is_missing(x) else str(x)
+
+    head = max((len(line) for line in textwrap.wrap(str(c), HEADER_WRAP)), default=0)
+    cells = max((len(line) for x in v[c] for line in plain(x).split("\x00")), default=0)
+    return max(head, cells, 1)
+
+
+def _width_chars(v: pd.DataFrame) -> int:
+    return sum(_col_chars(v, c) for c in v.columns) + COLUMN_GAP_CHARS * v.shape[1]
+
+
+def _prose_cell(x: Any) -> bool:
+    """A cell of words (which may wrap), not a number, interval or mean +- spread (which may not)."""
+    return isinstance(x, str) and " " in x.strip() and re.search(r"[A-Za-z]{3}", x) is not None
+
+
+def fit_text_columns(v: pd.DataFrame, line_chars: int = LINE_CHARS, min_wrap: int = 12) -> pd.DataFrame:
+    """The table with its widest text columns wrapped onto more lines, widest first, until it
+    fits ``line_chars`` or no text column can narrow further (numbers are never wrapped)."""
+    v = v.copy()
+    while _width_chars(v) > line_chars:
+        text = [c for c in v.columns if v[c].map(_prose_cell).any()]
+        widths = {c: _col_chars(v, c) for c in text}
+        wide = [c for c in text if widths[c] > min_wrap]
+        if not wide:
+            break
+        c = max(wide, key=lambda k: widths[k])
+        target = max(min_wrap, widths[c] - (_width_chars(v) - line_chars), (widths[c] * 2) // 3)
+        trial = v.copy()
+        trial[c] = v[c].map(lambda x: _wrapped_cell(x.replace("\x00", " "), target) if isinstance(x, str) else x)
+        if _col_chars(trial, c) >= widths[c]:
+            break  # a word as long as the column: it cannot narrow
+        v = trial
+    return v
+
+
 def _tabular(v: pd.DataFrame) -> str:
+    def cell(x):
+        lines = _cell_lines(x)
+        if len(lines) == 1:
+            return lines[0]
+        return r"\begin{tabular}[t]{@{}l@{}}" + r" \\ {}".join(lines) + r"\end{tabular}"  # {}: a line may open with [
+
     lines = [r"\begin{tabular}{@{}" + "l" * v.shape[1] + "@{}}", r"\toprule",
              " & ".join(_header_tex(c) for c in v.columns) + r" \\", r"\midrule"]
     for row in v.itertuples(index=False):
-        lines.append(" & ".join(_cell_tex(x) for x in row) + r" \\")
+        lines.append(" & ".join(cell(x) for x in row) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}"]
     return "\n".join(lines)
 
 
-def legible_latex(df: pd.DataFrame, max_cols: int = 7) -> str:
+def legible_latex(df: pd.DataFrame, max_cols: int = 7, line_chars: int = LINE_CHARS) -> str:
     """A booktabs tabular for the manuscript that stays legible at print size: headers wrapped
-    onto short lines, wide-and-short tables transposed (:func:`legible_view`), and a table
-    still wider than ``max_cols`` columns split into stacked parts that repeat the columns
-    naming a row."""
-    v = legible_view(df)
-    if v.shape[1] <= max_cols:
+    onto short lines, wide-and-short tables transposed (:func:`legible_view`), long text cells
+    wrapped until the table fits the line (:func:`fit_text_columns`), and a table still wider
+    than ``max_cols`` columns or than the line split into stacked parts that repeat the
+    columns naming a row."""
+    v = fit_text_columns(legible_view(df), line_chars)
+    if v.shape[1] <= max_cols and _width_chars(v) <= line_chars:
         return _tabular(v) + "\n"
     k = _key_columns(v)
-    rest = list(v.columns[k:])
-    step = max_cols - k
-    parts = [_tabular(v[list(v.columns[:k]) + rest[i:i + step]]) for i in range(0, len(rest), step)]
-    return (r"\begin{tabular}{@{}l@{}}" + "\n" + "\\\\[6pt]\n".join(parts) + "\n" + r"\end{tabular}" + "\n")
+    key, rest = list(v.columns[:k]), list(v.columns[k:])
+    parts, cur = [], []
+    for c in rest:  # greedy: as many columns a part as fit the line and max_cols
+        if cur and (len(key) + len(cur) + 1 > max_cols or _width_chars(v[key + cur + [c]]) > line_chars):
+            parts.append(cur)
+            cur = []
+        cur.append(c)
+    parts.append(cur)
+    tabs = [_tabular(v[key + p]) for p in parts if p]
+    return (r"\begin{tabular}{@{}l@{}}" + "\n" + "\\\\[6pt]\n".join(tabs) + "\n" + r"\end{tabular}" + "\n")
 
 
 # ------------------------------------------------------------ appendix: the analysis plan and the inputs
