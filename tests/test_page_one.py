@@ -60,21 +60,74 @@ def test_abstract_of_a_quick_table_says_its_sample_is_too_small():
     assert claims_prose.sample_sentence_of(_table(3, 3).drop(columns="sample")) == ""  # an older table
 
 
-def test_verdict_figure_has_a_row_per_claim_and_tolerates_older_tables():
+def _figure_texts(fig):
+    """Every non-empty text of a drawn figure with its box on the page (display units)."""
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    return [(t.get_text(), t.get_window_extent(r)) for t in fig.findobj(lambda a: hasattr(a, "get_text")
+                                                                          and hasattr(a, "get_window_extent"))
+            if getattr(t, "get_text", None) and isinstance(t.get_text(), str) and t.get_text().strip()
+            and t.get_visible()]
+
+
+def _markers(fig, marker):
+    return [ln for ln in fig.axes[0].get_lines() if ln.get_marker() == marker]
+
+
+@pytest.mark.parametrize("n_a, n_b, replication", [(9, 10, True), (10, 8, False), (3, 3, True)])
+def test_verdict_figure_is_a_grid_of_claims_by_verdict_without_cut_or_overlapping_text(n_a, n_b, replication):
+    """Issue 55 item 3: page 1's figure marks each claim's verdict in its verdict's column (a
+    dot for the main sample, a diamond for the replication), every text whole (no ellipsis)
+    and clear of every other, inside the figure; no published value or ours (Table 1 has them)."""
     import matplotlib.pyplot as plt
 
     from opnav.report import verdict_plot
 
-    df = _table(9, 10)
+    df = _table(n_a, n_b)
+    df["claim"] = df["claim"] + " and a long tail that a narrow column must wrap onto a second line"
+    if replication:
+        df["verdict_replication"] = ["not_reproduced" if i % 3 else v for i, v in enumerate(df["verdict"])]
     fig = verdict_plot.fig_verdicts(df)
-    cells = [p for p in fig.axes[0].patches]
-    assert len(cells) == len(df)  # one coloured verdict cell per claim
-    assert {tuple(round(c, 3) for c in p.get_facecolor()[:3]) for p in cells} >= {(0.0, 0.62, 0.451)}  # reproduced
+    assert len(_markers(fig, "o")) == len(df) + 1               # a dot per claim, one in the key
+    assert len(_markers(fig, "D")) == (len(df) + 1 if replication else 0)
+    verdicts = list(dict.fromkeys([*df["verdict"], *(df["verdict_replication"] if replication else [])]))
+    heads = {t for t, _ in _figure_texts(fig)}
+    assert all(any(verdict_plot.verdict_word(v).split()[-1] in h for h in heads) for v in verdicts)
+    texts = _figure_texts(fig)
+    page = fig.bbox
+    for text, box in texts:
+        assert "…" not in text and "..." not in text, text
+        assert box.x0 >= page.x0 - 0.5 and box.x1 <= page.x1 + 0.5 and box.y0 >= page.y0 - 0.5 \
+            and box.y1 <= page.y1 + 0.5, (text, box, page)
+        assert "20.6 arcsec" not in text and "2 arcsec" != text.strip(), text   # Table 1's values
+    for i, (t1, b1) in enumerate(texts):
+        for t2, b2 in texts[i + 1:]:
+            assert not b1.overlaps(b2), (t1, t2)
+    # the dot of each claim lies in its verdict's column, under that column's head
+    for ln, v in zip(_markers(fig, "o"), df["verdict"]):
+        x = fig.axes[0].transData.transform((ln.get_xdata()[0], ln.get_ydata()[0]))[0]
+        head = [b for t, b in texts if t.replace("\n", " ") == verdict_plot.verdict_word(v)]
+        assert head and head[0].x0 - 30 <= x <= head[0].x1 + 30, v
     plt.close(fig)
+
+
+def test_verdict_figure_tolerates_older_tables():
+    import matplotlib.pyplot as plt
+
+    from opnav.report import verdict_plot
+
     old = _table(3, 3, columns=["paper", "claim_id", "claim", "published", "ours_as_written", "verdict", "cause"])
     fig = verdict_plot.fig_verdicts(old)
-    assert len(fig.axes[0].patches) == 6
+    assert len(_markers(fig, "o")) == 7 and not _markers(fig, "D")
     plt.close(fig)
+
+
+def test_wrap_to_width_never_cuts_a_word():
+    from opnav.report import verdict_plot
+
+    lines = verdict_plot.wrap_to_width("a b c extraordinarilylongword d", 0.2, 7.0)
+    assert "extraordinarilylongword" in lines and " ".join(lines) == "a b c extraordinarilylongword d"
+    assert all(verdict_plot._width_in(ln, 7.0) <= 0.2 for ln in lines if " " in ln)
 
 
 def test_differences_read_ours_from_the_configuration():

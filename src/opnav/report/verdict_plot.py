@@ -1,6 +1,6 @@
-"""The verdict figure of page 1: one row per claim of either paper, the published value
-beside ours (as written, best faithful variant) and the verdict as a coloured cell (and
-the replication sample's verdict, where the claims table has one).
+"""The verdict figure of page 1: a grid of the claims of both papers (rows, by paper) by
+verdict (columns), a dot for the main sample's verdict and a diamond for the
+replication sample's, with a count per paper and verdict. The published values and ours are Table 1's.
 
 Plotting only: every text comes from the claims table (``results/paper/claims.csv``).
 """
@@ -30,81 +30,150 @@ VERDICT_WORDS = {
 }
 
 
-def _cell(text: object, width: int, lines: int = 2) -> str:
-    """``text`` wrapped to ``width`` characters, at most ``lines`` lines (an ellipsis marks a cut)."""
-    s = " ".join(str(text if text is not None else "").split())
-    if s in ("nan", "None"):
-        s = ""
-    w = textwrap.wrap(s, width) or [""]
-    if len(w) > lines:
-        w = w[:lines]
-        w[-1] = w[-1][: max(0, width - 1)].rstrip() + "…"
-    return "\n".join(w)
-
-
 def short_claim(claim: str) -> str:
     """The claim up to its first parenthesis (where the table's claim names its source)."""
     return str(claim).split(" (")[0].strip()
 
 
+def _verdict_order(df) -> list[str]:
+    """The verdicts the table uses (main or replication), in the claims engine's order."""
+    try:
+        from opnav.report.claims import VERDICTS
+    except ImportError:  # pragma: no cover - an older claims module
+        VERDICTS = list(VERDICT_COLORS)
+    used = [str(v) for c in ("verdict", "verdict_replication") if c in df.columns for v in df[c]]
+    used = [v for v in dict.fromkeys(used) if v.strip() and v != "nan"]
+    return [v for v in VERDICTS if v in used] + [v for v in used if v not in VERDICTS]
+
+
+def verdict_word(code: str) -> str:
+    """A verdict as the PDF says it in short (the claims engine's words where it has them)."""
+    try:
+        from opnav.report.claims import VERDICT_SHORT
+    except ImportError:  # pragma: no cover
+        VERDICT_SHORT = {}
+    return VERDICT_SHORT.get(code, VERDICT_WORDS.get(code, str(code).replace("_", " ")))
+
+
+def _present(x) -> bool:
+    return str(x if x is not None else "").strip() not in ("", "nan", "None")
+
+
+#: figure layout, inches and points: the text width of the manuscript's page (A4, 2 cm margins),
+#: so the figure prints at its own size; the fonts; a column's padding either side of its text
+FIG_WIDTH_IN = 6.7
+LABEL_PT = 7.0
+HEAD_PT = 6.5
+PAD_IN = 0.025
+LINE_IN = 0.135       # one text line of a row at LABEL_PT
+ROW_PAD_IN = 0.05
+#: the claim column is never narrower than this (the verdict columns' heads give way first)
+MIN_LABEL_IN = 2.4
+#: the mark of each sample's verdict: a dot for the main sample, a diamond for the replication
+MARKERS = {"verdict": {"marker": "o", "ms": 6.5}, "verdict_replication": {"marker": "D", "ms": 5.5}}
+
+
+def _width_in(text: str, pt: float, weight: str = "normal") -> float:
+    """The printed width of one line of ``text`` at ``pt`` in the current style's font, inches."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    prop = FontProperties(size=pt, weight=weight)
+    return TextToPath().get_text_width_height_descent(text, prop, ismath=False)[0] / 72.0
+
+
+def wrap_to_width(text: str, width_in: float, pt: float) -> list[str]:
+    """``text`` wrapped onto lines no wider than ``width_in`` at ``pt`` (measured, not counted);
+    a word wider than the line keeps a line of its own: nothing is cut."""
+    lines: list[str] = []
+    for word in str(text).split():
+        if lines and _width_in(f"{lines[-1]} {word}", pt) <= width_in:
+            lines[-1] += f" {word}"
+        else:
+            lines.append(word)
+    return lines or [""]
+
+
 def fig_verdicts(df):
-    """One row per claim: id, claim, published, ours as written, ours best (variant), verdict
-    (coloured) and, where present, the replication's verdict. Missing columns are left out."""
+    """The verdicts at a glance: a grid of claims (rows, by paper) by verdict (columns, in the
+    verdict's colour), a dot for the main sample's verdict and a diamond for the
+    replication sample's where it was flown; a count per paper and verdict closes each block.
+    The claims carry their id and short name only (wrapped, never cut): the published values
+    and ours are Table 1's (Section 1)."""
     import matplotlib.pyplot as plt
     from matplotlib.patches import Rectangle
 
-    cols = [("claim_id", "id", 0.06, 8), ("claim", "claim", 0.27, 40), ("published", "published", 0.16, 22),
-            ("ours_as_written", "ours, as written", 0.18, 26), ("ours_best", "ours, best variant", 0.18, 26)]
-    cols = [c for c in cols if c[0] in df.columns]
-    verdict_cols = [c for c in ("verdict", "verdict_replication") if c in df.columns
-                    and df[c].astype(str).str.strip().replace("nan", "").ne("").any()]
-    vw = 0.13
-    total = sum(c[2] for c in cols) + vw * len(verdict_cols)
-    scale = 1.0 / total
-    n = len(df)
-    row_h = 0.26  # inches
+    verdicts = _verdict_order(df)
+    has_rep = "verdict_replication" in df.columns and df["verdict_replication"].map(_present).any()
+    width = FIG_WIDTH_IN
     with figures.style():
-        fig = plt.figure(figsize=(figures.PAGE_WIDTH_IN, row_h * (n + 1.6)))
+        # each verdict column as wide as its head (the verdict's words, at most two lines)
+        head_pt = HEAD_PT
+        heads = [textwrap.wrap(verdict_word(v), 11, break_long_words=False) or [""] for v in verdicts]
+        while True:
+            col_w = max([max(_width_in(line, head_pt) for line in h) + 2 * PAD_IN for h in heads] + [0.45])
+            if width - col_w * len(verdicts) >= MIN_LABEL_IN or head_pt <= 5.0:
+                break
+            head_pt -= 0.25
+        label_w = width - col_w * len(verdicts)
+        ids = [str(r.get("claim_id", "")) for r in df.to_dict("records")]
+        id_w = max([_width_in(i, LABEL_PT, "bold") for i in ids] + [0.0]) + 3 * PAD_IN
+        rows = []  # (kind, paper, record or block, claim name lines)
+        papers = list(dict.fromkeys(df["paper"])) if "paper" in df.columns else [None]
+        for paper in papers:
+            sub = df[df["paper"] == paper] if paper is not None else df
+            for r in sub.to_dict("records"):
+                name = short_claim(r.get("claim", ""))
+                rows.append(("claim", paper, r, wrap_to_width(name, label_w - id_w - PAD_IN, LABEL_PT)))
+            rows.append(("count", paper, sub, [""]))
+        heights = [len(lines) * LINE_IN + ROW_PAD_IN for _, _, _, lines in rows]
+        head_h = max(len(h) for h in heads + [[""]]) * 0.11 + 0.14
+        legend_h = 0.25
+        total_h = head_h + sum(heights) + legend_h
+        fig = plt.figure(figsize=(width, total_h))
         ax = fig.add_axes((0, 0, 1, 1))
-        ax.set_xlim(0, 1)
-        ax.set_ylim(n + 1.6, 0)
+        ax.set_xlim(0, width)
+        ax.set_ylim(total_h, 0)
         ax.axis("off")
-        x = 0.0
-        heads = [(c[1], c[2] * scale) for c in cols] + \
-                [("verdict" if v == "verdict" else "replication", vw * scale) for v in verdict_cols]
-        for name, w in heads:
-            ax.text(x + 0.005, 0.5, name, ha="left", va="center", fontsize=7, fontweight="bold")
-            x += w
-        ax.axhline(1.0, color="k", lw=0.6)
-        prev_paper = None
-        for i, r in enumerate(df.itertuples(index=False)):
-            y = i + 1.0
-            rd = r._asdict()
-            if prev_paper is not None and rd.get("paper") != prev_paper:
-                ax.axhline(y, color="k", lw=0.4)
-            prev_paper = rd.get("paper")
-            x = 0.0
-            for key, _, w, chars in cols:
-                text = rd.get(key, "")
-                if key == "claim":
-                    text = short_claim(text)
-                if key == "ours_best" and rd.get("best_variant") not in (None, "", "nan") and str(text) not in ("", "nan"):
-                    text = f"{text} ({rd['best_variant']})"
-                ax.text(x + 0.005, y + 0.5, _cell(text, chars), ha="left", va="center", fontsize=5.6,
-                        linespacing=1.0)
-                x += w * scale
-            for v in verdict_cols:
-                val = str(rd.get(v, "") or "")
-                face, ink = VERDICT_COLORS.get(val, ("white", "black"))
-                ax.add_patch(Rectangle((x + 0.003, y + 0.08), vw * scale - 0.006, 0.84, facecolor=face,
-                                       edgecolor="0.3", lw=0.3))
-                ax.text(x + vw * scale / 2, y + 0.5, VERDICT_WORDS.get(val, val.replace("_", " ")),
-                        ha="center", va="center", fontsize=5.6, color=ink)
-                x += vw * scale
-        ax.axhline(n + 1.0, color="k", lw=0.6)
-        flags = [f"{r.claim_id}: {r.flags}" for r in df.itertuples()
-                 if "flags" in df.columns and str(getattr(r, "flags", "") or "").strip() not in ("", "nan")]
-        note = "flags: " + "; ".join(flags) if flags else ""
-        if note:
-            ax.text(0.005, n + 1.3, _cell(note, 170, 1), ha="left", va="center", fontsize=5.2, color="0.3")
+        x0 = label_w
+        # column heads: the verdict's words on its colour
+        for j, (v, head) in enumerate(zip(verdicts, heads)):
+            face, ink = VERDICT_COLORS.get(v, ("white", "black"))
+            ax.add_patch(Rectangle((x0 + j * col_w + 0.012, 0.02), col_w - 0.024, head_h - 0.06, facecolor=face,
+                                   edgecolor="0.3", lw=0.3))
+            ax.text(x0 + (j + 0.5) * col_w, head_h / 2 - 0.01, "\n".join(head),
+                    ha="center", va="center", fontsize=head_pt, color=ink, linespacing=1.0)
+        ax.text(PAD_IN, head_h / 2, "claim", ha="left", va="center", fontsize=LABEL_PT, fontweight="bold")
+        y = head_h
+        for (kind, paper, r, lines), h in zip(rows, heights):
+            if kind == "claim":
+                ax.text(PAD_IN, y + h / 2, str(r.get("claim_id", "")), ha="left", va="center", fontsize=LABEL_PT,
+                        fontweight="bold")
+                ax.text(id_w, y + h / 2, "\n".join(lines), ha="left", va="center", fontsize=LABEL_PT,
+                        linespacing=1.05)
+                ax.plot([0, width], [y + h, y + h], color="0.85", lw=0.3)
+                for key, dx in (("verdict", -0.09 if has_rep else 0.0), ("verdict_replication", 0.09)):
+                    v = str(r.get(key, "") or "")
+                    if v in verdicts:
+                        cx = x0 + (verdicts.index(v) + 0.5) * col_w + dx
+                        face = VERDICT_COLORS.get(v, ("0.5", "black"))[0]
+                        ax.plot([cx], [y + h / 2], ls="none", mfc=face, mec="0.15", mew=0.6, **MARKERS[key])
+            else:
+                counts = r["verdict"].value_counts() if "verdict" in r.columns else {}
+                ax.text(PAD_IN, y + h / 2, f"paper {paper}: claims per verdict (main sample)" if paper else "claims per verdict (main sample)",
+                        ha="left", va="center", fontsize=LABEL_PT - 0.5, style="italic", color="0.25")
+                for j, v in enumerate(verdicts):
+                    n = int(counts.get(v, 0))
+                    ax.text(x0 + (j + 0.5) * col_w, y + h / 2, str(n) if n else "", ha="center", va="center",
+                            fontsize=LABEL_PT, fontweight="bold")
+                ax.plot([0, width], [y + h, y + h], color="k", lw=0.6)
+            y += h
+        ax.plot([0, width], [head_h, head_h], color="k", lw=0.6)
+        # the key
+        ky = y + legend_h / 2 + 0.02
+        ax.plot([0.1], [ky], ls="none", mfc="0.6", mec="0.15", mew=0.6, **MARKERS["verdict"])
+        ax.text(0.18, ky, "main sample (the verdict)", ha="left", va="center", fontsize=LABEL_PT)
+        if has_rep:
+            ax.plot([2.0], [ky], ls="none", mfc="0.6", mec="0.15", mew=0.6, **MARKERS["verdict_replication"])
+            ax.text(2.08, ky, "replication sample (independent seeds)", ha="left", va="center", fontsize=LABEL_PT)
     return fig
