@@ -26,6 +26,11 @@ sys.path.insert(0, str(Path(workflow.basedir) / "src"))
 from opnav.core.errors import ConfigError  # noqa: E402
 from opnav.core.yamlfile import read_config_file  # noqa: E402
 from opnav.core.snakeio import config_exit  # noqa: E402
+from opnav.core.console import quiet_job_headers  # noqa: E402
+
+# Job headers on the console list no source files (a count instead) and cut a reason's
+# file lists to three names (opnav.core.console): what reruns a job is unchanged.
+quiet_job_headers([Path(workflow.basedir, d) for d in ("src", "workflow", "paper", "config")])
 
 _config_files = [Path(workflow.basedir, "config", "config.yaml")]
 _config_files += list(getattr(getattr(workflow, "config_settings", None), "configfiles", None) or [])
