@@ -83,6 +83,7 @@ import numpy as np
 
 from opnav.landing import ekf, imu
 from opnav.landing.metrics import MetricContext
+from opnav.landing.methods import MethodError
 from opnav.landing.planner import PlanState, plan_batch
 from opnav.landing.records import append_call, new_calls, record_plan_inputs, stack_calls
 from opnav.landing.scenario import Scenario, build_scenario
@@ -323,8 +324,13 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
                     record_plan_inputs(calls[b], k, st.r[b], st.v[b], a_est[b], st.R[b], st.P[b],
                                        cur[b], rng_pick[b])
                 states = PlanState(st.r[ip], st.v[ip], a_est[ip], st.R[ip], st.P[ip])
-                res = plan_batch(method, states, cam, scn.field, visible, scn.planner, cur[ip],
-                                 [rng_pick[b] for b in ip], np.flatnonzero(det), diagnose=pick_ratio)
+                try:
+                    res = plan_batch(method, states, cam, scn.field, visible, scn.planner, cur[ip],
+                                     [rng_pick[b] for b in ip], np.flatnonzero(det), diagnose=pick_ratio)
+                except MethodError as exc:     # a user's method failed: name the run and the call
+                    b = ip[getattr(exc, "batch_position", 0)]
+                    raise MethodError(f"{exc} in run {runs[b]}, planning call {len(calls[b]['plan_step'])} "
+                                      f"(t = {k * scn.Dt:g} s; method {method!r})") from exc
                 for b, rs in zip(ip, res):
                     append_call(calls[b], k * scn.Dt, rs)
                 cur[ip] = [rs.index for rs in res]

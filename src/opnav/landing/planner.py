@@ -26,9 +26,11 @@ the vertical plane holding the estimated velocity) differs:
 Degenerate geometry or no visible interval: the detected landmark nearest to
 the boresight's ground point, ``note`` says why.
 
-Objectives: ``depth`` (eq. 23-25), the H baselines and the B-X1 information
-baselines (``planning.layout.KINDS``) are compiled (``planning.search.objective``);
-:data:`PICKERS` search nothing.
+Methods (``opnav.landing.methods``, the registry): ``depth`` (eq. 23-25), the H baselines and
+the B-X1 information baselines (``planning.layout.KINDS``) are compiled
+(``planning.search.objective``); :data:`PICKERS` search nothing; a user's own metric
+(``landing.custom_methods``, ``PlannerConfig.custom``) runs the same call's source through the
+interpreter with its score as the objective (``methods.objective``), on either path.
 
 Paths (``PlannerConfig.eval_path``): ``compiled`` (what a lander's computer would
 run) and ``paper`` (the paper's definition through the same call's source run by
@@ -51,7 +53,7 @@ from typing import Callable
 
 import numpy as np
 
-from opnav.landing import metrics
+from opnav.landing import methods as registry, metrics
 from opnav.landing.camera import Camera
 from opnav.landing.landmarks import LandmarkField
 from opnav.landing.planning import geometry, layout, reference, screens, search
@@ -92,6 +94,7 @@ class PlannerConfig:
     obs_per_landmark: int = 3        # observations of a landmark (Fig. 3 strategy)
     oc: bool = True                  # observability-constrained updates
     g: tuple = (0.0, 0.0, -3.711)    # gravity in {L}, m/s^2 (the filter's transition)
+    custom: tuple = ()               # the user's own methods: (name, import path) pairs (methods.spec_items)
 
     def __post_init__(self):
         if self.eval_path not in PATHS:
@@ -150,6 +153,8 @@ def _ratio(method: str) -> Callable[[float, float], float]:
     exp(f_pick - f_best) for a log metric."""
     if method == "depth":
         return lambda fp, fb: fp / fb
+    if method not in registry.BUILTIN:        # a user's score has no scale: no ratio
+        return lambda fp, fb: math.nan
     if method in ("logdet", "logdet_nav"):
         return lambda fp, fb: math.exp(fp - fb)
     return lambda fp, fb: fb / fp
@@ -196,13 +201,12 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     indices of the landmarks the image holds; ``exclude``: the current landmark
     (-1: none)."""
     kind = compiled_kind(method, cfg)
-    if kind < 0 and method in PICKERS:
+    entry = registry.BUILTIN.get(method) if kind >= 0 else registry.get(method, cfg.custom)
+    if entry.family == "picker":
         cand = detected[detected != exclude]
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
                           math.nan, 0, 0), None
-    if kind < 0 and method not in OBJECTIVE_METHODS:
-        raise ValueError(f"unknown planning method {method!r}; available: {available_methods()}")
     xyz, c, cells = setup = _setup(field_, cfg, camera)
     if kind >= 0:
         args = _kernel_args(kind, state, setup, exclude, detected)
@@ -213,7 +217,9 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     q, out = work[:-layout.NOUT], work[-layout.NOUT:]
     if kind < 0:
         st = geometry.plane(state.r, state.v, q)
-        if st == layout.OK:
+        if st == layout.OK and entry.family == "custom":
+            f, scores = registry.objective(entry, state, cfg, camera)
+        elif st == layout.OK:
             f, scores, st = _paper_objective(method, state, cfg, camera, q)
         if st == layout.OK:
             pick = search.interpreted(search.edge_pick,
@@ -273,6 +279,9 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
     xyz = _setup(field_, cfg, camera)[0]
     if compiled_kind(method, cfg) >= 0:
         return search.score_points(q, xyz, cand)
+    entry = registry.get(method, cfg.custom)
+    if entry.family == "custom":
+        return registry.objective(entry, state, cfg, camera)[1](q, xyz, cand)
     return _paper_objective(method, state, cfg, camera, q)[1](q, xyz, cand)
 
 
@@ -325,9 +334,13 @@ def plan_batch(method: str, states: PlanState, camera: Camera, field_: LandmarkF
     out = []
     for j in range(exclude.size):
         st = PlanState(states.r[j], states.v[j], states.a[j], states.R_LtoB[j], states.P[j])
-        res, q = plan_one(method, st, camera, field_, cfg, int(exclude[j]), det, rngs[j])
-        if diagnose and q is not None:
-            _diagnose(res, q, st, camera, field_, cfg, det, int(exclude[j]))
+        try:
+            res, q = plan_one(method, st, camera, field_, cfg, int(exclude[j]), det, rngs[j])
+            if diagnose and q is not None:
+                _diagnose(res, q, st, camera, field_, cfg, det, int(exclude[j]))
+        except registry.MethodError as exc:
+            exc.batch_position = j        # which run of the batch: the descent names it
+            raise
         out.append(res)
     return out
 
@@ -360,7 +373,9 @@ PICKERS: dict[str, Callable] = {"random": _pick_random, "center": _pick_center,
                                 "closest": _pick_closest}
 #: methods with a search: the compiled kinds, the metrics, the planned information
 OBJECTIVE_METHODS = tuple(layout.KINDS)
+assert tuple(PICKERS) == registry.PICKER_NAMES and registry.builtin_names() == OBJECTIVE_METHODS + tuple(PICKERS)
 
 
-def available_methods() -> tuple[str, ...]:
-    return OBJECTIVE_METHODS + tuple(PICKERS)
+def available_methods(cfg: PlannerConfig | None = None) -> tuple[str, ...]:
+    """The built-in methods (``methods.BUILTIN``), then ``cfg``'s own (``PlannerConfig.custom``)."""
+    return registry.builtin_names() + tuple(n for n, _ in (cfg.custom if cfg is not None else ()))

@@ -75,6 +75,10 @@ def landing_problems(c: dict) -> list[str]:
     to_site_B = np.einsum("kij,kj->ki", tr.R_LtoB, -tr.r)
     for key, cam in {"camera": c["camera"], **{f"scenarios.{n}": v for n, v in scenarios.items()}}.items():
         out += _view_problems(cam, f"{k}{key}'", t, to_site_B, measuring)
+    if not out:    # the user's own methods: imported, signature, name, a probe on the sound start
+        from opnav.landing.methods import problems as method_problems
+
+        out += method_problems(c)
     return out
 
 

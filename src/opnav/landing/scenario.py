@@ -66,6 +66,7 @@ def _scenario_from_json(text: str) -> Scenario:
     from opnav.landing.camera import camera_from_config
     from opnav.landing.landmarks import make_field
     from opnav.landing.planner import PlannerConfig, alternative_path
+    from opnav.landing.methods import spec_items as methods_spec_items
 
     c = json.loads(text)
     T = float(c["duration_s"])
@@ -96,7 +97,8 @@ def _scenario_from_json(text: str) -> Scenario:
                          depth_sigma_frac=float(c["filter"]["depth_sigma_frac"]),
                          obs_per_landmark=int(c["filter"]["obs_per_landmark"]),
                          oc=bool(c["filter"]["observability_constrained"]),
-                         g=tuple(float(x) for x in g))
+                         g=tuple(float(x) for x in g),
+                         custom=methods_spec_items(c.get("custom_methods")))
     lm = c["landmarks"]
     b = c["mc"]["bounds"]
     fl = c["filter"]
@@ -117,7 +119,7 @@ def _scenario_from_json(text: str) -> Scenario:
 
 
 _KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu", "camera", "landmarks",
-         "filter", "planner", "mc")
+         "filter", "planner", "mc", "custom_methods")
 
 
 def build_scenario(landing_cfg: dict) -> Scenario:

@@ -1,0 +1,448 @@
+"""The registry of paper B's planning methods: the built-in ones and a user's own selection
+metric (``landing.custom_methods``), flown, timed, scored and plotted beside them.
+
+Description
+-----------
+Every planning method has one :class:`Method` entry. Its ``family`` says how the planner
+(``opnav.landing.planner.plan_one``) runs it:
+
+* ``compiled``: a built-in objective with a compiled kind (``planning.layout.KINDS``: the
+  depth error, the H baselines, B-X1's information baselines); the kernels are its fast path,
+  ``planning.reference`` its paper path;
+* ``picker``: a built-in direct pick without a search (``random``, ``center``, ``closest``:
+  ``planner.PICKERS``);
+* ``custom``: a user's score function, registered in the config by its import path. The
+  planner runs the same call as for every method (plane, visible interval, golden-section
+  search, edge rule, nearest detected landmark: ``planning.search.plan_core``'s source, run by
+  the interpreter) with the user's function as the objective, at the ground points the search
+  tries and, on the edge rule, at every detected landmark.
+
+A user's metric
+---------------
+``landing.custom_methods`` maps a method name to its function::
+
+    landing:
+      custom_methods:
+        parallax:
+          path: examples/parallax.py:parallax_score   # or an importable module: mypkg.metrics:parallax_score
+          label: max. parallax                          # legend and table name (default: the name)
+          color: "#117733"                             # any matplotlib colour (default: from the name)
+
+``path`` is ``module:function`` (a module on ``sys.path`` or under the checkout) or
+``file.py:function`` (relative to the checkout's root, or absolute). The function takes ONE
+argument, a :class:`Candidate`, and returns one real number, the score of that candidate:
+LOWER IS BETTER (return ``-metric`` for a metric where larger is better); ``+inf`` marks a
+candidate the metric refuses; NaN is an error. It may be a plain Python function or a
+numba-compiled one (``numba.njit``; a :class:`Candidate` is a named tuple of float64 arrays
+and floats, which numba takes as it is), in which case each evaluation runs compiled and the
+planning-time replay names its path so (:func:`eval_path`).
+
+Checked before any work (:func:`problems`, the workflow's preflight), one line naming the
+method: the path imports and names a callable, the callable takes exactly one positional
+argument, the name is no built-in method's, and a probe call on candidates of the scenario's
+start (:func:`probe_candidates`: the estimate equal to the truth at t = 0, the prior
+covariance of the Monte Carlo, the landing site and the boresight's ground point) returns a
+finite real number without raising. A function that raises or returns NaN during the Monte
+Carlo stops its job with a :class:`MethodError` naming the method, the run and the call
+(``opnav.landing.descent``).
+
+Units and frames: SI (m, m/s, m/s^2, rad); {L} the landing frame (the landing site at its
+origin, z up, the ground z = 0), {B} the lander's body frame, {C} the camera frame (z the
+boresight).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import importlib.util
+import inspect
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Mapping, NamedTuple
+
+import numpy as np
+
+from opnav.landing.planning import layout
+
+__all__ = ["Candidate", "Method", "MethodError", "CustomSpec", "BUILTIN", "PICKER_NAMES", "builtin_names",
+           "specs", "spec_items", "load", "resolve", "get", "probe", "probe_candidates", "problems",
+           "objective", "eval_path", "display", "labels", "colors", "source_files", "CHECKOUT"]
+
+#: the checkout's root: a relative ``file.py:function`` path is read from here
+CHECKOUT = Path(__file__).resolve().parents[3]
+#: the built-in pickers (their functions are ``opnav.landing.planner.PICKERS``)
+PICKER_NAMES = ("random", "center", "closest")
+
+
+class Candidate(NamedTuple):
+    """What a selection metric receives for one candidate ground point: the candidate's
+    geometry and the filter's estimate at the planning instant (what the paper's metrics read:
+    the depth error reads r, v, a, P's velocity block and t_s; the H baselines r, R_LtoB, the
+    site and the candidate; the information baselines all of it). Units SI, frames as named.
+    Read-only: do not modify the arrays."""
+
+    p_L: np.ndarray          #: (3,) the candidate landmark / ground point, {L}, m
+    r_L: np.ndarray          #: (3,) estimated lander position, {L}, m
+    v_L: np.ndarray          #: (3,) estimated velocity, {L}, m/s
+    a_L: np.ndarray          #: (3,) estimated acceleration over the last filter step (gravity included), {L}, m/s^2
+    R_LtoB: np.ndarray       #: (3, 3) estimated attitude: v_B = R_LtoB v_L
+    P: np.ndarray            #: (12, 12) filter covariance of [r (m), v (m/s), dtheta (rad), p (m)] (p: the current landmark)
+    p_site_L: np.ndarray     #: (3,) the known landmark (landing site), {L}, m
+    R_BtoC: np.ndarray       #: (3, 3) camera mounting: v_C = R_BtoC v_B (boresight = row 2)
+    sigma_b_rad: float       #: true bearing noise, 1-sigma per component, rad (pixel noise / focal length)
+    noise_scale: float       #: the filter's bearing-noise model / sigma_b_rad
+    t_s: float               #: observation interval (the filter step), s
+    n_obs: int               #: observations of a landmark before the next is planned (Fig. 3)
+
+
+class MethodError(ValueError):
+    """A registered method that cannot be used (preflight) or failed during a run: the message
+    is one line naming the method (``landing.custom_methods.<name>``)."""
+
+
+@dataclass(frozen=True)
+class CustomSpec:
+    """One entry of ``landing.custom_methods``."""
+
+    name: str
+    path: str
+    label: str = ""
+    color: str = ""
+
+    @property
+    def key(self) -> str:
+        return f"landing.custom_methods.{self.name}"
+
+
+@dataclass(frozen=True)
+class Method:
+    """A planning method: its name, how the planner runs it (``family``: compiled | picker |
+    custom), its legend name and colour (empty: the palette's, ``opnav.core.figures``), and for
+    a custom method its import path and function (``compiled``: a numba dispatcher)."""
+
+    name: str
+    family: str
+    label: str = ""
+    color: str = ""
+    path: str = ""
+    fn: Callable | None = None
+    compiled: bool = False
+
+    @property
+    def kind(self) -> int:
+        """The compiled objective kind (``planning.layout.KINDS``); -1 for none."""
+        return layout.KINDS.get(self.name, -1) if self.family == "compiled" else -1
+
+
+#: the built-in methods: the compiled kinds, then the pickers
+BUILTIN: dict[str, Method] = {**{m: Method(m, "compiled") for m in layout.KINDS},
+                              **{m: Method(m, "picker") for m in PICKER_NAMES}}
+
+
+def builtin_names() -> tuple[str, ...]:
+    return tuple(BUILTIN)
+
+
+# ---------------------------------------------------------------- the config's entries
+
+def specs(custom_methods: Mapping | None) -> dict[str, CustomSpec]:
+    """``landing.custom_methods`` (a mapping name -> ``{path, label, color}`` or name -> path)
+    as :class:`CustomSpec` entries, in the config's order."""
+    out = {}
+    for name, v in dict(custom_methods or {}).items():
+        v = {"path": v} if isinstance(v, str) else dict(v)
+        out[str(name)] = CustomSpec(str(name), str(v.get("path", "")), str(v.get("label", "") or ""),
+                                    str(v.get("color", "") or ""))
+    return out
+
+
+def spec_items(custom_methods: Mapping | None) -> tuple[tuple[str, str], ...]:
+    """``(name, path)`` of every registered method: the planner's hashable form of the registry
+    (``planner.PlannerConfig.custom``)."""
+    return tuple((s.name, s.path) for s in specs(custom_methods).values())
+
+
+def _split(path: str, key: str) -> tuple[str, str]:
+    target, sep, attr = str(path).rpartition(":")
+    if not sep or not target or not attr.isidentifier():
+        raise MethodError(f"{key}: path {path!r} is not 'module:function' or 'file.py:function'")
+    return target, attr
+
+
+def _import(target: str, key: str):
+    """The module of ``target``: a ``.py`` file (relative to :data:`CHECKOUT` or absolute) or a
+    dotted module name (``sys.path``, then the checkout)."""
+    if target.endswith(".py"):
+        file = Path(target)
+        file = file if file.is_absolute() else CHECKOUT / file
+        if not file.is_file():
+            raise MethodError(f"{key}: file {target} not found (relative paths start at {CHECKOUT})")
+        name = "opnav_custom_" + "".join(c if c.isalnum() else "_" for c in str(file.resolve()))
+        if name in sys.modules:
+            return sys.modules[name]
+        spec = importlib.util.spec_from_file_location(name, file)
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        try:
+            spec.loader.exec_module(mod)
+        except (Exception, SystemExit) as exc:
+            del sys.modules[name]
+            raise MethodError(f"{key}: importing {target} raised {_what(exc)}") from exc
+        return mod
+    try:
+        return importlib.import_module(target)
+    except ModuleNotFoundError as exc:
+        first = exc
+    except (Exception, SystemExit) as exc:
+        raise MethodError(f"{key}: module {target!r} does not import: {_what(exc)}") from exc
+    if str(CHECKOUT) in sys.path:          # not under the checkout either
+        raise MethodError(f"{key}: module {target!r} does not import: {_what(first)}") from first
+    sys.path.append(str(CHECKOUT))
+    try:
+        return importlib.import_module(target)
+    except (Exception, SystemExit) as exc:
+        raise MethodError(f"{key}: module {target!r} does not import: {_what(exc)}") from exc
+    finally:
+        sys.path.remove(str(CHECKOUT))
+
+
+def _what(exc: BaseException) -> str:
+    return " ".join(f"{type(exc).__name__}: {exc}".split())
+
+
+def _is_numba(fn) -> bool:
+    return type(fn).__module__.startswith("numba") and hasattr(fn, "py_func")
+
+
+def _check_signature(fn, key: str) -> None:
+    """One positional parameter (the :class:`Candidate`); anything else is refused."""
+    py = fn.py_func if _is_numba(fn) else fn
+    try:
+        sig = inspect.signature(py)
+    except (TypeError, ValueError) as exc:
+        raise MethodError(f"{key}: its signature cannot be read ({_what(exc)})") from exc
+    pos = [p for p in sig.parameters.values()
+           if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty]
+    other = [p for p in sig.parameters.values() if p not in pos and p.default is p.empty
+             and p.kind is not p.VAR_KEYWORD and p.kind is not p.VAR_POSITIONAL]
+    if len(pos) != 1 or other:
+        raise MethodError(f"{key}: the function must take exactly one argument (a "
+                          f"opnav.landing.methods.Candidate), it takes {sig}")
+
+
+def load(spec: CustomSpec) -> Method:
+    """The :class:`Method` of a registered metric: imported and its signature checked
+    (:class:`MethodError`, one line naming the method)."""
+    key = spec.key
+    if spec.name in BUILTIN:
+        raise MethodError(f"{key}: the name {spec.name!r} is a built-in method's; choose another")
+    target, attr = _split(spec.path, key)
+    mod = _import(target, key)
+    fn = getattr(mod, attr, None)
+    if fn is None:
+        raise MethodError(f"{key}: {target} has no attribute {attr!r}")
+    if not callable(fn):
+        raise MethodError(f"{key}: {spec.path} is not a function")
+    _check_signature(fn, key)
+    return Method(spec.name, "custom", spec.label, spec.color, spec.path, fn, _is_numba(fn))
+
+
+@functools.lru_cache(maxsize=64)
+def _loaded(name: str, path: str) -> Method:
+    return load(CustomSpec(name, path))
+
+
+def resolve(name: str, custom: tuple = ()) -> Method | None:
+    """The :class:`Method` called ``name``: a built-in one, or one of ``custom`` (``(name, path)``
+    pairs, :func:`spec_items`), imported once per process; None if neither."""
+    if name in BUILTIN:
+        return BUILTIN[name]
+    for n, path in custom:
+        if n == name:
+            return _loaded(n, path)
+    return None
+
+
+def get(name: str, custom: tuple = ()) -> Method:
+    """:func:`resolve`, or ``ValueError`` naming the methods available."""
+    m = resolve(name, custom)
+    if m is None:
+        raise ValueError(f"unknown planning method {name!r}; available: "
+                         f"{builtin_names() + tuple(n for n, _ in custom)}")
+    return m
+
+
+# ---------------------------------------------------------------- scoring
+
+def _score(method: Method, rec: Candidate) -> float:
+    """The user's score of one candidate as a float (+inf allowed); :class:`MethodError` for an
+    exception, NaN, -inf or a value that is not one real number."""
+    key = f"landing.custom_methods.{method.name}"
+    try:
+        s = method.fn(rec)
+    except Exception as exc:
+        raise MethodError(f"{key}: {method.path} raised {_what(exc)}") from exc
+    if isinstance(s, (bool, np.bool_)) or not isinstance(s, (int, float, np.integer, np.floating)):
+        arr = np.asarray(s) if isinstance(s, np.ndarray) else None
+        if arr is None or arr.shape != () or arr.dtype.kind not in "iuf":
+            raise MethodError(f"{key}: {method.path} returned {type(s).__name__} {s!r:.60}, "
+                              "not one real number")
+    s = float(s)
+    if math.isnan(s) or s == -math.inf:
+        raise MethodError(f"{key}: {method.path} returned {s} (scores are finite, or +inf for a refused candidate)")
+    return s
+
+
+def candidate_record(state, cfg, camera) -> Candidate:
+    """The :class:`Candidate` of a planning call (``planner.PlanState``, ``PlannerConfig``,
+    ``Camera``) with ``p_L`` unset (NaN): :func:`objective` fills it per candidate."""
+    f = lambda x: np.ascontiguousarray(x, np.float64)   # noqa: E731
+    return Candidate(np.full(3, np.nan), f(state.r), f(state.v), f(state.a), f(state.R_LtoB),
+                     f(0.5 * (np.asarray(state.P) + np.asarray(state.P).T)), f(cfg.p_known), f(camera.R_BtoC),
+                     float(camera.sigma_b), float(cfg.noise_scale), float(cfg.t_s), int(cfg.obs_per_landmark))
+
+
+def objective(method: Method, state, cfg, camera) -> tuple[Callable, Callable]:
+    """``(f(beta, q), scores(q, xyz, cand))`` of a custom method for one planning call, as the
+    interpreted search takes them (``planning.search.interpreted``): the user's score at the
+    ground point of the line of sight at signed beta (eq. 26; +inf where it misses the ground)
+    and at the landmarks ``xyz[cand]`` (the edge rule)."""
+    from opnav.landing.planning.geometry import ground_point
+
+    base = candidate_record(state, cfg, camera)
+
+    def at(p) -> float:
+        return _score(method, base._replace(p_L=np.array(p, np.float64)))
+
+    def f(beta, q):
+        hit, x, y, z = ground_point(beta, q)
+        return at((x, y, z)) if hit else math.inf
+
+    def scores(q, xyz, cand):
+        return np.array([at(xyz[i]) for i in cand], float)
+
+    return f, scores
+
+
+def eval_path(name: str, cfg) -> str:
+    """The path a method's planning call runs on under ``cfg`` (a ``PlannerConfig``), as the
+    planning-time replay names it: ``cfg.eval_path`` for a built-in; for a custom method
+    ``custom:<path>`` with the search interpreted and the score ``compiled`` (numba) or
+    ``interpreted``: e.g. ``custom (interpreted search, compiled score: examples/x.py:f)``."""
+    m = resolve(name, getattr(cfg, "custom", ()))
+    if m is None or m.family != "custom":
+        return cfg.eval_path
+    return f"custom (interpreted search, {'compiled' if m.compiled else 'interpreted'} score: {m.path})"
+
+
+# ---------------------------------------------------------------- preflight
+
+def probe_candidates(landing_cfg: Mapping) -> list[Candidate]:
+    """Candidates of the scenario's start for the probe call: the estimate equal to the truth at
+    t = 0 (acceleration the truth's), the Monte Carlo's prior covariance (``mc.bounds``: uniform
+    errors, variance bound^2 / 3; the landmark block dormant, 1e8 m^2), the base camera; the
+    candidates the landing site and the ground point of the boresight (both in view at the start:
+    ``landing.preflight``)."""
+    from opnav.landing.camera import camera_from_config
+    from opnav.landing.trajectory import truth_states
+
+    c = landing_cfg
+    s0 = c["initial_state"]
+    tr = truth_states(np.array([0.0]), s0["r_m"], s0["v_mps"], float(c["duration_s"]), c["gravity_mps2"],
+                      float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2"))
+    cam = camera_from_config(c["camera"])
+    b = c["mc"]["bounds"]
+    P = np.zeros((12, 12))
+    P[:9, :9] = np.diag(np.repeat([b["r_m"] ** 2 / 3, b["v_mps"] ** 2 / 3, math.radians(b["att_deg"]) ** 2 / 3], 3))
+    P[9:, 9:] = np.eye(3) * 1e8
+    r, R = tr.r[0], tr.R_LtoB[0]
+    bs_L = R.T @ cam.boresight_B
+    ground = r + bs_L * (r[2] / -bs_L[2]) if bs_L[2] < 0 else np.array([0.0, 0.0, 0.0])
+    ground[2] = 0.0
+    fl = c["filter"]
+    base = Candidate(np.zeros(3), r.copy(), tr.v[0].copy(), tr.a[0].copy(), R.copy(), P, np.zeros(3),
+                     cam.R_BtoC.copy(), float(cam.sigma_b), float(fl["meas_noise_scale"]), float(fl["dt_s"]),
+                     int(fl["obs_per_landmark"]))
+    return [base._replace(p_L=np.zeros(3)), base._replace(p_L=ground)]
+
+
+def probe(method: Method, landing_cfg: Mapping) -> None:
+    """The probe call (module docstring): :class:`MethodError` if the function raises or a score
+    is not finite."""
+    key = f"landing.custom_methods.{method.name}"
+    for rec in probe_candidates(landing_cfg):
+        try:
+            s = _score(method, rec)
+        except MethodError as exc:
+            raise MethodError(f"{exc} on the probe call (the start's estimate, candidate "
+                              f"p_L = [{', '.join(f'{x:.6g}' for x in rec.p_L)}] m)") from exc
+        if not math.isfinite(s):
+            raise MethodError(f"{key}: {method.path} returned {s} on the probe call (candidate "
+                              f"p_L = [{', '.join(f'{x:.6g}' for x in rec.p_L)}] m, in view at the start): "
+                              "a probe score must be finite")
+
+
+def problems(landing_cfg: Mapping) -> list[str]:
+    """One line per registered method that cannot be used (module docstring); [] if none is
+    registered."""
+    out = []
+    for spec in specs(landing_cfg.get("custom_methods")).values():
+        try:
+            m = load(spec)
+            probe(m, landing_cfg)
+        except MethodError as exc:
+            msg = str(exc)
+            msg = msg[len(spec.key):].lstrip(": ") if msg.startswith(spec.key) else msg
+            out.append(f"invalid config key '{spec.key}': {msg}")
+    return out
+
+
+# ---------------------------------------------------------------- display
+
+def display(name: str, custom_methods: Mapping | None = None) -> tuple[str, str]:
+    """``(legend name, colour)`` of a method: a custom method's ``label`` / ``color`` from the
+    config (empty: the name, the palette's colour from the name); a built-in's empty strings
+    (the plots' own names and the palette)."""
+    s = specs(custom_methods).get(name)
+    return (s.label or s.name, s.color) if s else ("", "")
+
+
+def labels(custom_methods: Mapping | None) -> dict[str, str]:
+    """name -> legend name of every registered method."""
+    return {n: s.label or n for n, s in specs(custom_methods).items()}
+
+
+def colors(custom_methods: Mapping | None) -> dict[str, str]:
+    """name -> colour of every registered method that gives one."""
+    return {n: s.color for n, s in specs(custom_methods).items() if s.color}
+
+
+def source_files(custom_methods: Mapping | None) -> list[str]:
+    """The files the registered methods' functions live in (for the workflow's inputs, so an
+    edit of one re-flies its Monte Carlo): a ``file.py`` path as given, resolved; a module's
+    file where it can be found without importing it (else nothing)."""
+    out = []
+    for s in specs(custom_methods).values():
+        target = s.path.rpartition(":")[0]
+        if target.endswith(".py"):
+            f = Path(target)
+            out.append(str(f if f.is_absolute() else CHECKOUT / f))
+            continue
+        try:
+            found = importlib.util.find_spec(target.split(".")[0]) and importlib.util.find_spec(target)
+        except (ImportError, ValueError):
+            found = None
+        if found is None:
+            sys.path.append(str(CHECKOUT))
+            try:
+                found = importlib.util.find_spec(target)
+            except (ImportError, ValueError):
+                found = None
+            finally:
+                sys.path.remove(str(CHECKOUT))
+        if found is not None and found.origin and Path(found.origin).is_file():
+            out.append(found.origin)
+    return out
