@@ -55,17 +55,24 @@ def main() -> None:
         rec = {m: run_chunk(scns[name], m, range(a.runs)) for m in methods}
         t0 = time.perf_counter()
         c0 = time.process_time()
-        tm = timing.replay(scn, rec, methods, a.calls)
+        tm = timing.replay(scn, rec, methods, a.calls, decompose=True)
         print(f"[{name}] replay: {len(tm['source'])} of {int(tm['n_pool'])} calls x "
               f"{tm['wall_ns'].shape[1]} variants in {time.perf_counter() - t0:.2f} s wall, "
               f"{time.process_time() - c0:.2f} s CPU; pick mismatches {int(tm['mismatch'].sum())} "
               f"of {int(tm['checked'].sum())}")
-        print(timing_summary.summary_frame(tm)[["method", "path", "eval_path", "calls", "wall_median_us",
+        print(timing_summary.summary_frame(tm)[["method", "path", "eval_path", "calls",
                                         "cpu_median_us", "cpu_p05_us", "cpu_p95_us",
                                         "median_evals"]].to_string(index=False))
+        for m in methods:                  # the call's two parts (timing_summary.decomposition)
+            d = timing_summary.decomposition(tm, m)
+            if d["n_calls"]:
+                print(f"[{name}] {m:10s} shared {d['shared_us']:6.2f} us + {d['evals_per_call']:.0f} evaluations x "
+                      f"{1e3 * d['per_eval_us']:5.0f} ns = {d['eval_us']:6.2f} us (least squares: shared "
+                      f"{d['fit_shared_us']:.2f} us, {1e3 * d['fit_per_eval_us']:.0f} ns an evaluation)")
         if "svd" in methods:
             red = timing_summary.time_reduction(tm, "depth", "svd")
-            print(f"[{name}] depth vs svd median reduction (wall): {red[0]:.1f} % +- {red[1]:.1f}")
+            print(f"[{name}] depth vs svd median reduction ({timing_summary.CLOCK_WORDS}): {red[0]:.1f} % "
+                  f"+- {red[1]:.1f} (one replay's bootstrap; the claims read the spread between replays)")
         ov = timing.call_overhead(scn, rec, "depth", a.calls, reps=a.reps)
         call, ev = ov["call_ns"] / 1e3, ov["evals_ns"] / 1e3
         r = float(np.median(ov["overhead_ratio"]))

@@ -3,7 +3,8 @@
 # planning-time replay timed a second time. No new science: the same scripts as the main
 # sample with other seeds and sizes; results/replication/ holds it. paper_claims re-judges
 # the claims on it (verdict_replication; 'unstable' where the two verdicts differ).
-# Included after landing_timing.smk (reuses A_*, B_*, timed_methods, b_mc) and before paper.smk.
+# Included after landing_timing.smk (reuses A_*, B_*, B_REPLAYED, TIMING_CODE, _BT, all_cores, b_mc)
+# and before paper.smk.
 from opnav.landing.montecarlo import chunk_label as _rep_label, chunk_runs as _rep_runs
 
 REP_CFG = config["replication"]
@@ -16,10 +17,9 @@ if REP_CFG["enabled"]:
     _REP_A_KEYS = A_EM + (("growing",) if config["approach"]["growing"]["methods"] else ())
     REP_A_MC = [f"{REP}/approach/mc/{v}__headline__{s}.pkl" for v in A_VARIANTS for s in A_SCHEMES]
     REP_B_CHUNK = _rep_label(range(REP_CFG["landing_n_runs"]))
-    # what the replication flies (its Monte Carlo rules below) and so what its timing times:
-    # the timing claims' methods and the controls, the timed-only kinds (timing.timed_methods)
+    # what the replication flies (its Monte Carlo rules below): the timing claims' methods and
+    # the controls; its timing replays the recorded calls of those and times the claims' methods
     REP_B_FLOWN = list(dict.fromkeys([*B_METHODS, *B_EQ_METHODS]))
-    REP_B_TIMED = timed_methods(REP_B_FLOWN)
     REP_B_SIMS = {s: canonical({**c, "mc": {**c["mc"], "base_seed": c["mc"]["base_seed"] + REP_CFG["seed_offset"]}})
                   for s, c in B_SIMS.items()}
 
@@ -95,25 +95,52 @@ if REP_CFG["enabled"]:
         script:
             "../scripts/landing_mc_chunk.py"
 
-    rule replication_landing_timing:
-        """The planning-time replay of one scenario timed a second time, on the main sample's
-        recorded calls of the methods the replication flies (what varies is the clock and the
-        calls drawn), through those methods and the timed-only kinds: the replicated timing
-        claims read these; B-X1's extra methods are timed once, in the main replay."""
+    rule replication_landing_timing_replays:
+        """The replication's independent replays (separate processes, alone on the machine) of the
+        compiled calls its timing claims read (B-C4, B-C9: landing.mc.methods), on the main
+        sample's recorded calls of the methods the replication flies (what varies is the clock)."""
         input:
             mc=lambda wc: b_mc(wc.bscn, REP_B_FLOWN),
-            code=B_SRC + src("landing/timing.py", "landing/timing_summary.py"),
+            code=TIMING_CODE,
             kernels=kernels("landing"),
         output:
-            f"{REP}/landing/timing/{{bscn}}.npz",
+            [f"{REP}/landing/timing/{{bscn}}/replay{r}.npz" for r in range(_BT["n_replays"])],
         wildcard_constraints:
             bscn=B_SCN_RE,
         params:
             landing=lambda wc: B_SIMS[wc.bscn],
-            methods=REP_B_TIMED,
-            max_calls=config["landing"]["timing"]["max_calls"],
-            max_calls_paper=config["landing"]["timing"]["max_calls_paper"],
-        threads: all_cores()     # alone, as the main replay (landing_timing.smk)
+            flown=REP_B_FLOWN,
+            replayed=B_REPLAYED,
+            max_calls=_BT["max_calls"],
+        threads: all_cores()     # alone, as the main replays (landing_timing.smk)
+        log:
+            f"{REP}/logs/landing_timing_replays_{{bscn}}.log",
+        benchmark:
+            f"{REP}/benchmarks/landing_timing_replays_{{bscn}}.tsv"
+        script:
+            "../scripts/landing_timing.py"
+
+    rule replication_landing_timing:
+        """The replication's replays merged with the paper's definition of the same methods on its
+        subset of the calls (B-C4's other path), timed once beside other jobs: only what the
+        replicated timing claims read (B-X1's methods and the LAPACK SVD are the main replay's)."""
+        input:
+            mc=lambda wc: b_mc(wc.bscn, REP_B_FLOWN),
+            replays=rules.replication_landing_timing_replays.output,
+            code=TIMING_CODE,
+            kernels=kernels("landing"),
+        output:
+            timing=f"{REP}/landing/timing/{{bscn}}.npz",
+        wildcard_constraints:
+            bscn=B_SCN_RE,
+        params:
+            landing=lambda wc: B_SIMS[wc.bscn],
+            flown=REP_B_FLOWN,
+            methods=B_REPLAYED,
+            main=[],
+            alt=B_REPLAYED,
+            max_calls=_BT["max_calls"],
+            max_calls_paper=_BT["max_calls_paper"],
         log:
             f"{REP}/logs/landing_timing_{{bscn}}.log",
         benchmark:

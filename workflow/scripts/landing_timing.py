@@ -1,21 +1,48 @@
-"""Planning time by replay of one camera scenario (opnav.landing.timing.replay)."""
+"""Planning time by replay of one camera scenario (opnav.landing.timing).
+
+Rule ``landing_timing_replays`` (alone on the machine): ``landing.timing.n_replays`` independent
+replays of the compiled calls the timing claims read, each in a fresh process
+(``timing.replays_in_processes``), with each call's evaluations timed alone (the decomposition).
+Rule ``landing_timing`` (an ordinary job, beside others): the other variants (calls of
+milliseconds: the information baselines, the LAPACK SVD, the pickers, the paper's definition on
+its subset) once, on the same calls, merged with the replays (``timing.merge``) into the one
+file every consumer reads, and B-F7's overhead curve (main sample only).
+"""
 
 import sys
+import tempfile
 
 from opnav.landing import timing, timing_summary
-from opnav.landing.descent import build_scenario
-from opnav.landing.montecarlo import load
 from opnav.core.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
-    snakemake = mock_snakemake("landing_timing", argv=sys.argv[1:], bscn="site-tilt")
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md); rule=NAME picks
+    _rule = next((a.split("=", 1)[1] for a in sys.argv[1:] if a.startswith("rule=")), "landing_timing")
+    snakemake = mock_snakemake(_rule, argv=[a for a in sys.argv[1:] if not a.startswith("rule=")], bscn="site-tilt")
 
 with script_context(snakemake) as log:
-    methods = list(snakemake.params.methods)
-    recorded = {m: load(p) for m, p in zip(methods, snakemake.input.mc)}
-    tm = timing.replay(build_scenario(snakemake.params.landing), recorded, methods,
-                       int(snakemake.params.max_calls),
-                       max_calls_paper=int(snakemake.params.max_calls_paper))
-    timing.save(snakemake.output[0], tm)
-    log.info("%s", timing_summary.method_text(tm))
-    log.info("%s", timing_summary.summary_frame(tm).to_string())
+    p = snakemake.params
+    mc = dict(zip(p.flown, snakemake.input.mc))
+    if snakemake.rule.endswith("_replays"):
+        spec = timing.replay_spec(p.landing, mc, p.replayed, int(p.max_calls), alt=False, decompose=True,
+                                  best_of=timing.REPLAY_BEST_OF)
+        with tempfile.TemporaryDirectory() as tmp:
+            reps = timing.replays_in_processes(spec, len(snakemake.output), tmp, log)
+        for r, path in zip(reps, snakemake.output):
+            timing.save(path, r)
+    else:
+        reps = [timing.load(f) for f in snakemake.input.replays]
+        spec = timing.replay_spec(p.landing, mc, p.methods, int(p.max_calls), alt=list(p.alt), main=list(p.main),
+                                  max_calls_paper=int(p.max_calls_paper))
+        tm = timing.merge(reps, timing.run_spec(spec))
+        timing.save(snakemake.output.timing, tm)
+        log.info("%s", timing_summary.method_text(tm))
+        log.info("%s", timing_summary.summary_frame(tm).to_string())
+        if "f7o" in snakemake.output.keys():
+            from opnav.core import figures, published
+            from opnav.landing import timing_plots
+
+            ev = timing_summary.planning_time_evidence(
+                tm, published.load()["paper_b"]["depth_time_reduction_vs_svd_pct"])
+            log.info("shared part at the published reduction: %.3f us; reductions: %s",
+                     ev["shared_us_at_published"], {k: round(v["mean"], 2) for k, v in ev["reduction_pct"].items()})
+            figures.save(timing_plots.fig_overhead_curve(ev, snakemake.wildcards.bscn), snakemake.output.f7o)

@@ -187,7 +187,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
 
 
 def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float | None = None):
-    """B-F7: planning-call wall time (us) per method on the replayed planning
+    """B-F7: planning-call thread CPU time (us, ``timing_summary.CLOCK``) per method on the replayed planning
     calls (``timing``: ``opnav.landing.timing.replay``, the same calls for every
     method), box = quartiles, whiskers = 5th and 95th percentiles (the paper's
     Fig. 7 draws min/max; a replay's extremes are machine noise),
@@ -246,9 +246,11 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             figures.place_legend(ax, handles=[Patch(facecolor=(0.5, 0.5, 0.5, 0.5), edgecolor="k", label=main_name),
                                               Patch(facecolor="white", edgecolor="0.3", hatch="///", label=alt_name)],
                                  fontsize="x-small", framealpha=0.9)
-        ax.set_ylabel("planning-call time (µs)")
+        ax.set_ylabel("planning-call time (µs, thread CPU)")
         n_alt = max((tsum.timed_calls(timing, m, "alt") for m in methods), default=0)
-        ax.set_xlabel(f"replay of {len(timing['source'])} recorded calls; box: quartiles,\n"
+        nr = tsum.n_replays(timing)
+        ax.set_xlabel(f"replay of {tsum.replay_calls(timing)} recorded calls"
+                      + (f" ({nr} replays pooled)" if nr > 1 else "") + "; box: quartiles,\n"
                       f"whiskers: 5-95 %; filled: {main_name}"
                       + (f"; hatched: {alt_name} ({n_alt} of the calls)" if alt_name and n_alt else ""),
                       fontsize="x-small")

@@ -15,7 +15,18 @@ import math
 
 import numpy as np
 
-__all__ = ["clock_share", "per_run_median_us", "variant_index", "timed", "times_ns", "timed_calls", "median_evals", "median_us", "time_reduction", "time_reduction_interval", "VS_DEPTH", "vs_depth", "less_time_text", "method_summary", "method_text", "summary_frame"]
+#: The one clock of every planning time the pipeline reports (verdict inputs, tables, macros,
+#: figures and text): the calling thread's CPU time (``time.thread_time_ns``; ``cpu_ns`` in a
+#: replay), which other processes' work does not add to. The replay also records the wall clock
+#: (``wall_ns``, perf_counter_ns) for diagnosis; nothing reported reads it unless asked by name.
+CLOCK = "cpu"
+#: :data:`CLOCK` as the evidence names it (``planning_time_evidence``'s ``clock``) and in words
+CLOCK_NAME, CLOCK_WORDS = "thread_cpu", "thread CPU time"
+
+__all__ = ["clock_share", "per_run_median_us", "variant_index", "timed", "times_ns", "timed_calls", "median_evals", "median_us", "time_reduction", "time_reduction_interval", "VS_DEPTH", "vs_depth", "less_time_text", "method_summary", "method_text", "summary_frame",
+           "CLOCK", "CLOCK_NAME", "CLOCK_WORDS", "n_replays", "replay_calls", "replay_ids", "one_replay",
+           "replayed_methods", "BETWEEN_LEVEL", "between", "median_interval", "decomposition", "reduction_at", "shared_at",
+           "planning_time_evidence"]
 
 
 def variant_index(tm: dict, method: str, path: str) -> int | None:
@@ -35,9 +46,9 @@ def timed(tm: dict) -> np.ndarray:
     return np.asarray(tm["wall_ns"]) >= 0
 
 
-def times_ns(tm: dict, method: str, path: str = "main", clock: str = "wall") -> np.ndarray:
+def times_ns(tm: dict, method: str, path: str = "main", clock: str = CLOCK) -> np.ndarray:
     """The planning times (ns) of ``method`` on ``path`` (``"main"`` /
-    ``"alt"``) by ``clock`` (``"wall"``: perf_counter, ``"cpu"``: thread CPU),
+    ``"alt"``) by ``clock`` (:data:`CLOCK`, thread CPU; ``"wall"``: perf_counter, diagnosis only),
     one per replayed call timed on that variant (:func:`timed`), in replay
     order; empty if that variant was not timed."""
     if clock not in ("wall", "cpu"):
@@ -63,7 +74,7 @@ def median_evals(tm: dict, method: str, path: str = "main") -> float:
     return float(np.median(ev)) if ev.size else math.nan
 
 
-def median_us(tm: dict, method: str, path: str = "main", clock: str = "wall") -> float:
+def median_us(tm: dict, method: str, path: str = "main", clock: str = CLOCK) -> float:
     """Median planning time (us) over the replayed calls (nan if none)."""
     t = times_ns(tm, method, path, clock)
     return float(np.median(t) / 1e3) if t.size else math.nan
@@ -96,7 +107,7 @@ def _reductions(tm: dict, a: str, b: str, clock: str, path_a: str, path_b: str, 
     return red, vals
 
 
-def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str = "main",
+def time_reduction(tm: dict, a: str, b: str, *, clock: str = CLOCK, path_a: str = "main",
                    path_b: str = "main", n_boot: int = 200, seed: int = 0) -> tuple[float, float]:
     """``100 (1 - median_a / median_b)`` (%) of the planning times of methods
     ``a`` (on ``path_a``) and ``b`` (``path_b``) on the same replayed calls (those
@@ -109,7 +120,7 @@ def time_reduction(tm: dict, a: str, b: str, *, clock: str = "wall", path_a: str
     return red, (float(np.std(vals, ddof=1)) if vals.size >= 2 else math.nan)
 
 
-def time_reduction_interval(tm: dict, a: str, b: str, *, clock: str = "cpu", path_a: str = "main",
+def time_reduction_interval(tm: dict, a: str, b: str, *, clock: str = CLOCK, path_a: str = "main",
                             path_b: str = "main", n_boot: int = 1000, seed: int = 0,
                             level: float = 0.95) -> tuple[float, float, float]:
     """(reduction %, lo, hi): :func:`time_reduction` with its ``level`` percentile interval over
@@ -127,7 +138,7 @@ VS_DEPTH = (("svd", "main", "svd_closed_form"), ("svd_lapack", "main", "svd_lapa
             ("svd", "alt", "svd_paper"), ("gdop", "main", "gdop"), ("cond", "main", "cond"))
 
 
-def vs_depth(tm: dict, clock: str = "cpu") -> dict:
+def vs_depth(tm: dict, clock: str = CLOCK) -> dict:
     """Depth's planning time against each of :data:`VS_DEPTH` timed in ``tm``: per label the
     median call (us) of both on the calls timed on both, and depth's reduction (%) with its
     95 % paired bootstrap interval over the replayed calls (clusters by run); depth on the
@@ -151,16 +162,30 @@ def less_time_text(reduction_pct: float) -> str:
     return f"{reduction_pct:.1f} % less" if reduction_pct >= 0 else f"{-reduction_pct:.1f} % more"
 
 
+def n_replays(tm: dict) -> int:
+    """Independent replays (separate processes) merged in ``tm`` (``timing.merge``; 1 for one
+    replay)."""
+    return int(tm.get("n_replays", 1))
+
+
+def replay_calls(tm: dict) -> int:
+    """Distinct replayed calls (each replay times the same ones)."""
+    return int(len(tm["source"])) // max(n_replays(tm), 1)
+
+
 def method_summary(tm: dict) -> dict:
     """The replay's method in numbers (summary JSON, manuscript macros): calls
     replayed and recorded, ``max_calls``, the calls the paper's definition was
     timed on (``timed_calls_paper``, 0 if not timed) and ``max_calls_paper``,
-    methods timed, own calls checked and pick mismatches."""
-    return {"method": "replay", "timed_calls": int(len(tm["source"])), "recorded_calls": int(tm["n_pool"]),
-            "max_calls": int(tm["max_calls"]), "all_calls": bool(len(tm["source"]) == int(tm["n_pool"])),
+    methods timed, own calls checked and pick mismatches, the independent replays
+    (``n_replays``) and the clock (:data:`CLOCK_NAME`)."""
+    n = replay_calls(tm)
+    return {"method": "replay", "timed_calls": n, "recorded_calls": int(tm["n_pool"]),
+            "max_calls": int(tm["max_calls"]), "all_calls": bool(n == int(tm["n_pool"])),
             "timed_calls_paper": _paper_calls(tm), "max_calls_paper": int(tm.get("max_calls_paper", 0)),
             "n_methods": int(len(tm["methods"])), "checked_calls": int(np.sum(tm["checked"])),
-            "pick_mismatches": int(np.sum(tm["mismatch"])),
+            "pick_mismatches": int(np.sum(tm["mismatch"])), "n_replays": n_replays(tm),
+            "clock_name": CLOCK_NAME,
             "sources_text": ", ".join(str(x) for x in tm["sources"]), "clock": clock_share(tm)}
 
 
@@ -173,7 +198,7 @@ def _paper_calls(tm: dict) -> int:
 
 def method_text(tm: dict) -> str:
     """One sentence stating how the times were measured (captions, paper)."""
-    n, pool = len(tm["source"]), int(tm["n_pool"])
+    n, pool = replay_calls(tm), int(tm["n_pool"])
     srcs = ", ".join(str(x) for x in tm["sources"])
     subset = (f"all {pool} recorded planning calls" if n == pool else
               f"{n} of the {pool} recorded planning calls (every {pool / n:.1f}th by index, "
@@ -184,27 +209,42 @@ def method_text(tm: dict) -> str:
              f"; the paper's definition (interpreted, CasADi H) on {npaper} of them, evenly spaced "
              f"(landing.timing.max_calls_paper = {int(tm.get('max_calls_paper', 0))}), its medians "
              "and its comparisons on those calls")
+    nr = n_replays(tm)
+    reps = ("" if nr < 2 else
+            f" The compiled calls of {', '.join(replayed_methods(tm))} were replayed {nr} times, each replay a "
+            "separate process run alone on the machine (the between-replay spread is what the timing claims "
+            "are judged on); the other variants once, in a job that runs beside others (calls of "
+            "milliseconds).")
     cs = clock_share(tm)
     clock = ("" if cs["share_pct_max"] is None else
              f" Each call is timed as the mean of back-to-back repetitions (a doubling count, "
              f"{cs['reps_min']} to {cs['reps_max']}) until the clock's own cost "
              f"({cs['clock_ns']:.0f} ns a bracket, measured) is below 5 % of the bracket: "
              f"{cs['share_pct_median']:.2f} % median, {cs['share_pct_max']:.2f} % at most.")
-    load = ("" if "load_avg" not in tm else
-            " The machine's 1-minute load average was {:.1f} at the start and {:.1f} at the end of the "
-            "replay ({} cores): other processes sharing the cores lengthen microsecond calls and "
-            "narrow their differences, so timing readings compare between builds at a like load."
-            .format(*np.asarray(tm["load_avg"], float)[:2], int(tm.get("n_cpu", 0))))
+    load = ""
+    if "replay_load_avg" in tm:
+        la = np.asarray(tm["replay_load_avg"], float)
+        load = (" The machine's 1-minute load average was " + ", ".join(f"{a:.1f}-{b:.1f}" for a, b in la)
+                + f" over the replays ({int(tm.get('n_cpu', 0))} cores)")
+        if "extra_load_avg" in tm:
+            load += " and {:.1f}-{:.1f} over the other variants' job".format(*np.asarray(tm["extra_load_avg"], float))
+        load += ("; other processes sharing the cores lengthen microsecond calls, mostly their shared part, "
+                 "and narrow their differences.")
+    elif "load_avg" in tm:
+        load = (" The machine's 1-minute load average was {:.1f} at the start and {:.1f} at the end of the "
+                "replay ({} cores): other processes sharing the cores lengthen microsecond calls and "
+                "narrow their differences, so timing readings compare between builds at a like load."
+                .format(*np.asarray(tm["load_avg"], float)[:2], int(tm.get("n_cpu", 0))))
     return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
             "every method's planning call, one call at a time, interleaved across methods in one "
-            f"process (order rotated per call), the same states for every method{paper}; wall clock "
-            "perf_counter_ns, CPU clock thread_time_ns; replayed picks equal to the recorded ones "
-            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + clock + load)
+            f"process (order rotated per call), the same states for every method{paper}; clock: "
+            f"{CLOCK_WORDS} (thread_time_ns); replayed picks equal to the recorded ones "
+            f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + reps + clock + load)
 
 
 def summary_frame(tm: dict):
     """One row per timed variant: method, path, evaluation path, calls timed on
-    it (:func:`timed`), median and 5-95 % quantiles of the wall and CPU times
+    it (:func:`timed`, every replay's), median and 5-95 % quantiles of the :data:`CLOCK` time
     (us) and median evaluations over those calls; the method's own-call check
     (checked, mismatch) on its main row."""
     import pandas as pd
@@ -213,12 +253,11 @@ def summary_frame(tm: dict):
     ok = timed(tm)
     rows = []
     for j, (m, p, e) in enumerate(zip(tm["variant_method"], tm["variant_path"], tm["variant_eval_path"])):
-        w, c = np.asarray(tm["wall_ns"])[ok[:, j], j] / 1e3, np.asarray(tm["cpu_ns"])[ok[:, j], j] / 1e3
-        row = {"method": str(m), "path": str(p), "eval_path": str(e), "calls": int(len(w))}
-        for name, x in (("wall", w), ("cpu", c)):
-            q = np.quantile(x, [0.05, 0.5, 0.95]) if len(x) else [math.nan] * 3
-            row.update({f"{name}_median_us": float(q[1]), f"{name}_p05_us": float(q[0]),
-                        f"{name}_p95_us": float(q[2])})
+        c = np.asarray(tm[f"{CLOCK}_ns"])[ok[:, j], j] / 1e3
+        row = {"method": str(m), "path": str(p), "eval_path": str(e), "calls": int(len(c))}
+        q = np.quantile(c, [0.05, 0.5, 0.95]) if len(c) else [math.nan] * 3
+        row.update({f"{CLOCK}_median_us": float(q[1]), f"{CLOCK}_p05_us": float(q[0]),
+                    f"{CLOCK}_p95_us": float(q[2])})
         row["median_evals"] = median_evals(tm, str(m), str(p))
         if str(p) == "main":
             i = methods.index(str(m))
@@ -228,23 +267,234 @@ def summary_frame(tm: dict):
 
 
 def clock_share(tm: dict) -> dict:
-    """The clock's measured cost (ns) and its share of the timed brackets (%, ``clock / (reps x
-    call)``): median and maximum over the timed cells, and the repetition counts' range."""
+    """The clock's measured cost (ns; the largest over the merged replays) and its share of the
+    timed brackets (%, ``clock / (reps x call)``, each bracket's own replay's clock): median and
+    maximum over the timed cells, and the repetition counts' range."""
     reps = np.asarray(tm.get("reps", []))
     ok = timed(tm) & (reps > 0) if reps.size else np.zeros(0, bool)
     if not ok.any():
         return {"clock_ns": float(tm.get("clock_ns", math.nan)), "share_pct_median": None,
                 "share_pct_max": None, "reps_min": None, "reps_max": None}
-    cpu = np.maximum(np.asarray(tm["cpu_ns"])[ok], 1)
-    share = 100.0 * float(tm["clock_ns"]) / (reps[ok] * cpu)
+    cpu = np.maximum(np.asarray(tm["cpu_ns"]), 1)
+    row_clock = np.asarray(tm.get("row_clock_ns", np.full(len(cpu), float(tm["clock_ns"]))), float)
+    share = 100.0 * (row_clock[:, None] / (reps * cpu))[ok]
     return {"clock_ns": float(tm["clock_ns"]), "share_pct_median": float(np.median(share)),
             "share_pct_max": float(share.max()), "reps_min": int(reps[ok].min()), "reps_max": int(reps[ok].max())}
 
 
-def per_run_median_us(tm: dict, method: str, clock: str = "wall", path: str = "main") -> dict[int, float]:
+def per_run_median_us(tm: dict, method: str, clock: str = CLOCK, path: str = "main") -> dict[int, float]:
     """Median replayed planning time (us) per run (the run of the recorded call),
     over the calls timed on ``path``."""
     t = times_ns(tm, method, path, clock)
     j = variant_index(tm, method, path)
     run = np.asarray(tm["run"])[timed(tm)[:, j]] if j is not None else np.zeros(0, np.int64)
     return {int(r): float(np.median(t[run == r]) / 1e3) for r in np.unique(run)}
+
+
+# ------------------------------------------------------------ independent replays (issue 53)
+
+def replay_ids(tm: dict) -> list[int]:
+    """The replays merged in ``tm`` (``timing.merge``: ``replay`` per row; [0] for one replay)."""
+    return sorted(int(r) for r in np.unique(tm["replay"])) if "replay" in tm else [0]
+
+
+def one_replay(tm: dict, r: int) -> dict:
+    """The replay-shaped dict of replay ``r``'s rows of a merged ``tm`` (every variant; those
+    timed on replay 0's rows only are untimed in the others)."""
+    if "replay" not in tm:
+        return tm
+    rows = np.asarray(tm["replay"]) == r
+    out = dict(tm)
+    for k, v in tm.items():
+        a = np.asarray(v)
+        if a.ndim >= 1 and a.shape[0] == rows.size and k not in ("methods", "sources", "mismatch", "checked") \
+                and not k.startswith("variant_") and not k.startswith("replay_"):
+            out[k] = a[rows]
+    out["n_replays"] = 1
+    out["clock_ns"] = float(np.asarray(tm.get("replay_clock_ns", [tm["clock_ns"]]))[r])
+    return out
+
+
+def replayed_methods(tm: dict, path: str = "main") -> list[str]:
+    """Methods whose ``path`` variant is timed in every replay of ``tm`` (the ones a timing claim
+    can be judged on between replays), in variant order."""
+    ok = timed(tm)
+    rid = np.asarray(tm["replay"]) if "replay" in tm else np.zeros(len(ok), np.int64)
+    out = []
+    for j, (m, p) in enumerate(zip(tm["variant_method"], tm["variant_path"])):
+        if str(p) == path and all(ok[rid == r, j].any() for r in replay_ids(tm)):
+            out.append(str(m))
+    return out
+
+
+#: interval level of the between-replay intervals (mean +- t sd / sqrt(n))
+BETWEEN_LEVEL = 0.95
+
+
+def between(values, level: float = BETWEEN_LEVEL) -> dict:
+    """``{per_replay, mean, sd_between, lo, hi, level}`` of per-replay readings: their mean, sample
+    standard deviation (ddof 1) and the Student-t interval of the mean at ``level`` over the
+    replays (nan below two finite readings)."""
+    from scipy import stats
+
+    v = [float(x) for x in values]
+    f = np.array([x for x in v if math.isfinite(x)])
+    mean = float(f.mean()) if f.size else math.nan
+    if f.size >= 2:
+        sd = float(f.std(ddof=1))
+        h = float(stats.t.ppf(0.5 + level / 2.0, f.size - 1)) * sd / math.sqrt(f.size)
+        lo, hi = mean - h, mean + h
+    else:
+        sd = lo = hi = math.nan
+    return {"per_replay": v, "mean": mean, "sd_between": sd, "lo": lo, "hi": hi, "level": float(level)}
+
+
+def median_interval(x, level: float = BETWEEN_LEVEL) -> tuple[float, float]:
+    """Distribution-free interval of a median (the order statistics ``k`` and ``n + 1 - k`` with
+    ``k`` the largest count a Binomial(n, 1/2) stays below with probability ``(1 - level) / 2``:
+    covers the median with at least ``level``); (nan, nan) below 6 values."""
+    from scipy import stats
+
+    v = np.sort(np.asarray(x, float))
+    n = v.size
+    k = int(stats.binom.ppf((1.0 - level) / 2.0, n, 0.5)) if n else 0
+    if n < 6 or k < 1:
+        return math.nan, math.nan
+    return float(v[k - 1]), float(v[n - k])
+
+
+def decomposition(tm: dict, method: str, path: str = "main") -> dict:
+    """A compiled planning call = its shared part + evaluations x cost of one (one replay's calls
+    of ``method`` whose evaluations were timed alone, ``timing.replay(decompose=True)``):
+    ``shared_us`` the median over calls of call minus its evaluations (numba's dispatch, argument
+    unpacking, the plane, the visible interval, the searches' and the edge rule's own steps),
+    ``eval_us`` the median call's evaluations, ``per_eval_us`` one evaluation (all calls'
+    evaluation time over their evaluations), ``evals_per_call`` (median), ``n_calls``; and, as a
+    check by another route, the least-squares line of call time on evaluation count over the
+    same calls (``fit_shared_us``, ``fit_per_eval_us``: nan below 10 calls or a count sd below 1).
+    Times in us, :data:`CLOCK`."""
+    j = variant_index(tm, method, path)
+    nan = {"shared_us": math.nan, "eval_us": math.nan, "per_eval_us": math.nan, "evals_per_call": math.nan,
+           "n_calls": 0, "fit_shared_us": math.nan, "fit_per_eval_us": math.nan}
+    if j is None or "eval_ns" not in tm:
+        return nan
+    ev = np.asarray(tm["eval_ns"])[:, j]
+    ok = timed(tm)[:, j] & (ev >= 0)
+    if not ok.any():
+        return nan
+    call = np.asarray(tm[f"{CLOCK}_ns"])[ok, j].astype(float) / 1e3
+    e = ev[ok].astype(float) / 1e3
+    n = np.asarray(tm["n_evals"])[ok, j].astype(float)
+    fit_s = fit_e = math.nan
+    if n.size >= 10 and np.std(n) >= 1.0:      # counts that vary: the line is defined
+        fit_e, fit_s = (float(x) for x in np.polyfit(n, call, 1))
+    return {"shared_us": float(np.median(call - e)), "eval_us": float(np.median(e)),
+            "per_eval_us": float(e.sum() / n.sum()) if n.sum() > 0 else math.nan,
+            "evals_per_call": float(np.median(n)), "n_calls": int(ok.sum()),
+            "fit_shared_us": fit_s, "fit_per_eval_us": fit_e}
+
+
+def reduction_at(shared_us, eval_a_us: float, eval_b_us: float):
+    """Method a's time reduction against b (%) when both calls share ``shared_us`` (us, scalar
+    or array) beside their own evaluations ``eval_a_us``, ``eval_b_us``: ``100 (1 - (S + E_a) /
+    (S + E_b))``."""
+    s = np.asarray(shared_us, float)
+    return 100.0 * (1.0 - (s + eval_a_us) / (s + eval_b_us))
+
+
+def shared_at(reduction_pct: float, eval_a_us: float, eval_b_us: float) -> float:
+    """The shared part (us) at which :func:`reduction_at` equals ``reduction_pct``:
+    ``S = ((1 - p) E_b - E_a) / p``; nan where no shared part >= 0 gives it (the evaluations
+    alone give less, or ``p`` <= 0)."""
+    p = float(reduction_pct) / 100.0
+    if not (p > 0 and math.isfinite(eval_a_us) and math.isfinite(eval_b_us)):
+        return math.nan
+    s = ((1.0 - p) * eval_b_us - eval_a_us) / p
+    return float(s) if s >= 0 else math.nan
+
+
+def planning_time_evidence(tm: dict, published_pct: float, *, a: str = "depth", b: str = "svd",
+                           path: str = "main", level: float = BETWEEN_LEVEL, n_curve: int = 21) -> dict:
+    """The planning-time evidence of one camera scenario (B-summary ``scenarios.<cam>.planning_time``;
+    the timing claims B-C4 and B-C9 read it), from a merged replay (``timing.merge``) on
+    :data:`CLOCK`: per independent replay of ``path`` (``replays``: each method's median call,
+    calls, the load average, numba's dispatch alone), per pair of replayed methods ``x_vs_y``
+    (``x`` before ``y`` in variant order) the reduction ``100 (1 - median_x / median_y)`` per
+    replay with its mean, between-replay sd and t interval (:func:`between`), per method its
+    median call likewise, per method the call's shared part and evaluations (:func:`decomposition`,
+    averaged over the replays, each replay's shared part kept), and for ``a`` against ``b`` the
+    reduction as a function of the shared part (``overhead_curve``): each median call is its
+    method's unshared part (the median call, mean over replays, less the mean of the two methods'
+    shared parts, ``unshared_a_us``, ``unshared_b_us``) plus a shared part ``S`` common to both
+    (:func:`reduction_at`; a common added cost shifts a median by itself, so the curve passes
+    through the measured mean reduction at the measured shared part), each replay's reading at its
+    own shared part beside it, and the ``S`` at which the reduction would equal ``published_pct``
+    (``shared_us_at_published``, :func:`shared_at`; nan if none would, not even ``S = 0``)."""
+    ids = replay_ids(tm)
+    parts = [one_replay(tm, r) for r in ids]
+    methods = replayed_methods(tm, path)
+    replays = []
+    for r, t in zip(ids, parts):
+        ok = timed(t)
+        j0 = variant_index(t, methods[0], path) if methods else None
+        la = (np.asarray(tm["replay_load_avg"], float)[r] if "replay_load_avg" in tm
+              else np.asarray(tm.get("load_avg", [math.nan] * 2), float)[:2])
+        disp = (float(np.asarray(tm["replay_dispatch_ns"])[r]) if "replay_dispatch_ns" in tm
+                else float(tm.get("dispatch_ns", math.nan)))
+        replays.append({"median_us": {m: median_us(t, m, path) for m in methods},
+                        "median_interval_us": {m: [x / 1e3 for x in median_interval(times_ns(t, m, path), level)]
+                                               for m in methods},
+                        "n_calls": int(ok[:, j0].sum()) if j0 is not None else 0,
+                        "load_avg": [float(x) for x in la], "dispatch_us": disp / 1e3})
+    reduction = {}
+    for i, x in enumerate(methods):
+        for y in methods[i + 1:]:
+            reduction[f"{x}_vs_{y}"] = between([time_reduction(t, x, y, path_a=path, path_b=path, n_boot=0)[0]
+                                                for t in parts], level)
+    for r in reduction.values():
+        r["interval"] = "between_replays"
+    # depth against the baselines timed once (the LAPACK SVD, the paper's definition: the job beside
+    # others): one reading, its interval a paired bootstrap over that replay's calls (by run)
+    for m, p_, label in VS_DEPTH:
+        key = f"{a}_vs_{label}" if label != "svd_closed_form" else None
+        pa = p_ if variant_index(tm, a, p_) is not None else path
+        if key is None or key in reduction or variant_index(tm, m, p_) is None or variant_index(tm, a, pa) is None:
+            continue
+        if m in methods and p_ == path:
+            continue
+        red, lo, hi = time_reduction_interval(tm, a, m, path_a=pa, path_b=p_, level=level)
+        reduction[key] = {"per_replay": [red], "mean": red, "sd_between": math.nan, "lo": lo, "hi": hi,
+                          "level": float(level), "interval": "bootstrap", "path": p_,
+                          "n_calls": int(np.sum(timed(tm)[:, variant_index(tm, m, p_)] & timed(tm)[:, variant_index(tm, a, pa)]))}
+    med = {m: between([rp["median_us"][m] for rp in replays], level) for m in methods}
+    dec = {}
+    for m in methods:
+        per = [decomposition(t, m, path) for t in parts]
+        dec[m] = {k: float(np.nanmean([d[k] for d in per])) if any(math.isfinite(d[k]) for d in per) else math.nan
+                  for k in ("shared_us", "eval_us", "per_eval_us", "evals_per_call", "fit_shared_us",
+                            "fit_per_eval_us")}
+        dec[m]["shared_us_per_replay"] = [d["shared_us"] for d in per]
+        dec[m]["n_calls"] = int(sum(d["n_calls"] for d in per))
+    curve: dict = {"a": a, "b": b, "shared_us": [], "reduction_pct": [], "replay_shared_us": [],
+                   "replay_reduction_pct": []}
+    at_pub = math.nan
+    rs = ([0.5 * (x + y) for x, y in zip(dec[a]["shared_us_per_replay"], dec[b]["shared_us_per_replay"])]
+          if a in dec and b in dec else [])
+    sbar = float(np.nanmean(rs)) if rs and any(math.isfinite(x) for x in rs) else math.nan
+    # the part of the median calls that is not shared (the median call less the mean shared part):
+    # medians shift with a common added cost, so the curve passes through the measured reduction
+    ea = med[a]["mean"] - sbar if a in med else math.nan
+    eb = med[b]["mean"] - sbar if b in med else math.nan
+    if math.isfinite(ea) and math.isfinite(eb) and ea > 0 and eb > 0:
+        at_pub = shared_at(published_pct, ea, eb)
+        top = max([1.0] + [2.0 * x for x in rs if math.isfinite(x)] + ([1.5 * at_pub] if math.isfinite(at_pub) else []))
+        grid = np.linspace(0.0, top, int(n_curve))
+        curve.update(shared_us=[float(x) for x in grid], reduction_pct=[float(x) for x in reduction_at(grid, ea, eb)],
+                     replay_shared_us=rs,
+                     replay_reduction_pct=list(reduction.get(f"{a}_vs_{b}", {}).get("per_replay", [])),
+                     mean_shared_us=sbar, unshared_a_us=ea, unshared_b_us=eb,
+                     no_shared_reduction_pct=float(reduction_at(0.0, ea, eb)))
+    ep = [str(e) for m, p, e in zip(tm["variant_method"], tm["variant_path"], tm["variant_eval_path"]) if str(p) == path]
+    return {"clock": CLOCK_NAME, "path": path, "eval_path": ep[0] if ep else "", "n_replays": len(ids), "methods": methods, "replays": replays,
+            "reduction_pct": reduction, "median_us": med, "decomposition": dec, "overhead_curve": curve,
+            "shared_us_at_published": at_pub, "published_pct": float(published_pct)}
