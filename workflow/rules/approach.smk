@@ -191,6 +191,7 @@ rule approach_tables:
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         crlb=f"{A_WORK}/crlb.pkl",
         stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
+        nav_arc=f"{A_WORK}/nav_arc.pkl",
         code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
                  "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:
@@ -200,13 +201,49 @@ rule approach_tables:
         summary=f"{APPROACH}/A-summary.json",
     params:
         approach=cfg("approach", "segments", "accuracy_target_arcsec", "convergence_study", "crlb",
-                     "prior_sigma", "geometry", "em"),
+                     "prior_sigma", "geometry", "em", "camera"),
         profile=config["profile"],
     log:
         f"{APPROACH}/logs/tables.log",
     localrule: True
     script:
         "../scripts/approach_tables.py"
+
+
+rule approach_nav_arc:
+    """The navigation error after compensation against arc length (nav_floor: variant, scheme, arcs;
+    A-C7's would_take) and with the tz bias on and off (paper A: tz does not affect navigation)."""
+    input:
+        A_SRC + src("approach/navfloor.py", "approach/labels.py"),
+        kernels=kernels("approach"),
+    output:
+        f"{A_WORK}/nav_arc.pkl",
+    params:
+        approach=cfg("approach", *A_EM, "growing", "nav_floor"),
+    log:
+        f"{APPROACH}/logs/nav_arc.log",
+    benchmark:
+        f"{APPROACH}/benchmarks/nav_arc.tsv"
+    script:
+        "../scripts/approach_nav_arc.py"
+
+
+rule approach_nav_arc_outputs:
+    """A-X7: the table and figure of the navigation error against arc length, the paper's limit
+    drawn from the analysis plan (A-C7)."""
+    input:
+        nav_arc=f"{A_WORK}/nav_arc.pkl",
+        plan=src("data/analysis_plan.yaml")[0],
+        code=src("approach/summaries.py", "approach/plots.py", "core/figures.py", "core/tables.py", "opnav.mplstyle",
+                 "report/plan.py"),
+    output:
+        table=report_table(f"{APPROACH}/A-X7_nav_floor", "A-X7", "Paper A"),
+        fig=report_figure(f"{APPROACH}/A-X7_nav_floor", "A-X7", "Paper A"),
+    log:
+        f"{APPROACH}/logs/nav_arc_outputs.log",
+    localrule: True
+    script:
+        "../scripts/approach_nav_arc_outputs.py"
 
 
 A_FIGURES = {"f4": ("A-F4", "bias_estimate"), "f5": ("A-F5", "nav_accuracy"),

@@ -142,6 +142,7 @@ def result_outputs():
          *rules.approach_x2_figure.output]
     if "stars" in config["approach"]["variants"]:
         a += [*rules.approach_stars_outputs.output.table, *rules.approach_stars_outputs.output.fig]
+    a += [*rules.approach_nav_arc_outputs.output.table, *rules.approach_nav_arc_outputs.output.fig]
     if HAVE_BSK:
         a += [*rules.approach_peer_tables.output.table, rules.approach_peer_tables.output.summary,
               *rules.approach_peer_figure.output]

@@ -8,7 +8,7 @@ from opnav.core import published
 from opnav.approach import scenario as sc
 from opnav.approach import readings
 from opnav.approach.cases import headline_case, table1_cases
-from opnav.approach.pipeline import bound_curve, roll_rate_study
+from opnav.approach.pipeline import bound_curve, mars_attitude_bounds, roll_rate_study
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
 
@@ -25,6 +25,9 @@ with script_context(snakemake) as log:
         curves["Q"][v] = bound_curve(setup, geo, Rvar, case.truth_arcsec, v)
         curves["Q0"][v] = bound_curve(setup, geo, Rvar, case.truth_arcsec, v, zero_q=True)
         log.info("%s: CRLB at end %s arcsec (Q = 0: %s)", v, curves["Q"][v][-1], curves["Q0"][v][-1])
+        # the bound with the Mars images' attitude knowledge of camera.attitude_study_arcsec (issue 54)
+        curves.setdefault("mars_attitude", {})[v] = mars_attitude_bounds(
+            setup, geo, lambda g: g.measurement_variance(case.sigma3_px), case.truth_arcsec, v)
     if "roll" in setup.variants:  # the roll rows depend on the roll rate: the bound against it
         samples = int(published.paper_a()["headline"]["data_to_converge_samples"])
         curves["roll_rate"] = roll_rate_study(setup, samples, setup.accuracy_target_arcsec)

@@ -1,5 +1,5 @@
 """A-X6: the stars study (beyond the paper) as a table and a figure against attitude knowledge
-and magnitude limit."""
+and stars per image."""
 
 import sys
 
@@ -14,9 +14,10 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     frame = summaries.stars_frame(load_pickle(snakemake.input.stars))
     write_table(frame, snakemake.output.table,
-                caption="A-X6: star calibration on Hipparcos stars against stars per image, attitude knowledge "
-                        "per star image and magnitude limit: bound of tx, ty (all data; stars alone), the "
-                        "attitude floor and the EM-EKF (growing windows, SQUAREM) over the seeds, arcsec.")
+                caption="A-X6: star calibration on Hipparcos stars against the stars in every image (each count "
+                        "with the magnitude limit and field that make it real) and the attitude knowledge per star "
+                        "image: bound of tx, ty (all data; stars alone), the attitude floor and the EM-EKF (growing "
+                        "windows, SQUAREM) over the seeds, arcsec.")
     with figures.style():
         fig = star_plots.stars_figure(frame, snakemake.params.target)
         figures.save(fig, snakemake.output.fig)

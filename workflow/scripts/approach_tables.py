@@ -35,12 +35,22 @@ with script_context(snakemake) as log:
     summ = summaries.summary(setup, t1, x1, curves.get("roll_rate"))
     if snakemake.input.stars:  # the stars variant (beyond the paper)
         summ["stars"] = summaries.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
+    summ["nees"] = summaries.nees_summary(t1)  # each compensated filter against the true-theta filter
+    summ["mars_attitude"] = summaries.mars_attitude_summary(setup, curves.get("mars_attitude"), curves["Q"])
+    if "roll_rate" in curves:  # the bound against the roll rate (A-C1's would_take, scored from the plan)
+        summ["roll_rate_bound"] = summaries.roll_rate_bound_summary(curves["roll_rate"])
+    if snakemake.input.nav_arc:  # navigation error against arc length (A-C7's would_take); tz on and off
+        nav_arc = load_pickle(snakemake.input.nav_arc)
+        summ["nav_floor_by_arc"] = summaries.nav_floor_summary(nav_arc["nav_floor_by_arc"])
+        summ["tz_nav_effect"] = nav_arc["tz_nav_effect"]
+    summ["figures_5_6"] = summaries.figures_5_6(results)
     summ["profile"] = snakemake.params.profile
     summ["text"] = approach_text.findings(setup, summaries.HeadlineSummary.from_json(summ), pub["headline"])  # the manuscript's finding sentences
     if "readings" in curves:  # the installation rows and the sample time (opnav.approach.readings)
-        summ["installation"] = curves["readings"]["installation"]
+        chk = curves["readings"]["installation"]
+        summ["installation"] = {**chk, **summaries.installation_summary(chk)}
         summ["sample_time"] = curves["readings"]["sample_time"]
-        summ["text"]["installation"] = readings.installation_text(summ["installation"])
+        summ["text"]["installation"] = readings.installation_text(chk)
         summ["text"]["sample_time"] = readings.sample_time_text(summ["sample_time"])
     write_json(snakemake.output.summary, summ)
     log.info("wrote %d Table-1 rows", len(t1))

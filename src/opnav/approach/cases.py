@@ -147,14 +147,15 @@ def consistency(f, dx_true: np.ndarray) -> dict:
 
 def simulate_case(setup: Setup, geo: sc.Geometry, case: Case, seed_indices, init_mode: str | None = None,
                   truth_arcsec=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Measurement variances (n+1, 3), measurements z (S, n+1, 3) and the prior mean
+    """Measurement variances (n+1, 3) the estimators use (pixel noise and the Mars images'
+    attitude knowledge), measurements z (S, n+1, 3) and the prior mean
     deviations dx0 (S, 6) of ``case`` for the given seeds (streams
     ``SeedSequence([base_seed, case_index, seed_index])``; ``truth_arcsec`` overrides the
     case's truth, ``init_mode`` the initial-error mode of the case and the setup)."""
     Rvar = geo.measurement_variance(case.sigma3_px)
     rngs = sc.seed_streams(setup.base_seed, case.case_index, seed_indices)
     truth = case.truth_arcsec if truth_arcsec is None else truth_arcsec
-    z, e0 = sc.simulate(geo, Rvar, sc.rad(truth), rngs)
+    z, e0 = sc.simulate(geo, geo.pixel_variance(case.sigma3_px), sc.rad(truth), rngs)
     return Rvar, z, sc.prior_mean_deviation(geo, e0, init_mode or case.init_mode or setup.initial_error.mode)
 
 
@@ -268,20 +269,13 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     dx_true = geo.dx_true
     tz_tol = em_set.tz_tol
 
-    start = sc.START_OF[variant]
     windows = setup.segments.windows()
     M = setup.segments.M
     theta_init = theta.copy()
     seg_theta, it_theta, it_ll, it_data = [], [], [], []
     seg_lat, seg_rng, seg_lat3, seg_rng3 = [], [], [], []
     unobs = None
-    key = (start, tuple(a for (a, _) in windows))
-    if key not in data.starts:
-        data.starts[key] = start_states(start, list(key[1]), f0, dx_true, dx0, geo.P0, win)
-    starts = data.starts[key]
-    for (a, b), (x0, P0) in zip(windows, starts):
-        theta_seg_start = theta
-        tr = em_window(z[:, a:b + 1], theta, x0, P0, win.slice(a, b), M, method, tz_tol)
+    for a, b, x0, P0, theta_seg_start, tr in em_segments(setup, variant, data, method, theta):
         theta = tr.theta[-1]
         unobs = tr.unobservable
         used = b - windows[0][0]
@@ -384,6 +378,25 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
             "t_s": geo.t,
         })
     return out
+
+
+def em_segments(setup: Setup, variant: str, data: CaseData, method: str, theta: np.ndarray, windows=None):
+    """The segment-wise EM-EKF (paper A sec. 2.3) over ``data``: for each window (a, b) of
+    ``setup.segments`` (sliding or growing; or of ``windows`` when given), M maps of ``method``
+    from the variant's start state at a, seeded with the previous window's estimate (``theta``
+    (S, 3) rad for the first). Yields ``(a, b, x0, P0, theta_start, trace)`` per window
+    (:func:`opnav.approach.em.em_window`'s trace; its last iterate seeds the next window). The
+    variant's start states are computed once per window list and kept in ``data.starts``."""
+    windows = setup.segments.windows() if windows is None else list(windows)
+    key = (sc.START_OF[variant], tuple(a for (a, _) in windows))
+    if key not in data.starts:
+        data.starts[key] = start_states(key[0], list(key[1]), data.f0, data.geo.dx_true, data.dx0, data.geo.P0,
+                                        data.win)
+    for (a, b), (x0, P0) in zip(windows, data.starts[key]):
+        tr = em_window(data.z[:, a:b + 1], theta, x0, P0, data.win.slice(a, b), setup.segments.M, method,
+                       setup.em.tz_tol)
+        yield a, b, x0, P0, theta, tr
+        theta = tr.theta[-1]
 
 
 def label_axes(geo: sc.Geometry) -> int:

@@ -140,6 +140,18 @@ def total_bound(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, 
     return _at_total(setup, bound_curve(setup, geo, Rvar, theta_arcsec, variant))
 
 
+def mars_attitude_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar_of, theta_arcsec, variant: str) -> dict:
+    """The bound of all the data (tx, ty, tz; arcsec, 1-sigma, with Q) of ``variant`` at each Mars-image
+    attitude knowledge of ``camera.attitude_study_arcsec`` (issue 54, item 3): the same arc with the
+    estimators' variances for that knowledge (``Rvar_of(geo)``: the case's variances of a geometry)."""
+    setup = Setup.of(setup)
+    out = {}
+    for a in setup.camera.attitude_study_arcsec:
+        g = replace(geo, attitude_sigma_rad=float(sc.rad(a)))
+        out[float(a)] = total_bound(setup, g, Rvar_of(g), theta_arcsec, variant)
+    return out
+
+
 # ------------------------------------------------------------ the roll rate (issue 28, item 4)
 def _head(geo: sc.Geometry, n: int) -> sc.Geometry:
     """The first ``n`` samples of a geometry (arrays cut to n + 1 rows)."""
@@ -192,11 +204,17 @@ def rate_to_target(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, thet
     return hi
 
 
+#: points of the roll-rate grid (log-spaced over roll_rate_study.search_deg_s): 8 per decade over 0.001-20 deg/s
+ROLL_GRID_POINTS = 36
+
+
 def roll_rate_study(setup: Setup | dict, samples: int, target_arcsec: float) -> dict:
     """The roll rows' dependence on the roll rate (headline case): the bound of tx, ty after
     ``samples`` samples and after all the data, with and without process noise, at each rate
     of ``roll_rate_study.rates_deg_s``; the log-log slope of the all-data bound against the
-    rate; and the rate that brings the bound to ``target_arcsec`` within ``samples`` samples."""
+    rate; the rate that brings the bound to ``target_arcsec`` within ``samples`` samples; and the
+    bound after ``samples`` on a log grid of :data:`ROLL_GRID_POINTS` rates over the searched
+    bracket (``grid_rates_deg_s``, ``bound_grid_arcsec``)."""
     setup = Setup.of(setup)
     case = cases.headline_case(setup)
     total = setup.segments.data_samples
@@ -209,7 +227,12 @@ def roll_rate_study(setup: Setup | dict, samples: int, target_arcsec: float) -> 
     slope = float(np.polyfit(np.log(rates), np.log(at_all[:, :2].max(1)), 1)[0])
     rate = rate_to_target(setup, geo, Rvar, case.truth_arcsec, samples, target_arcsec,
                           setup.roll_rate_study.search_deg_s)
+    # the bound after ``samples`` on a log grid over the searched bracket (issue 54: the claims
+    # scorer reads the rate at which it reaches the plan's target from these points)
+    grid = np.geomspace(*setup.roll_rate_study.search_deg_s, ROLL_GRID_POINTS)
+    at_grid = roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, grid, samples)
     return {"rates_deg_s": rates, "samples": samples, "total_samples": total,
+            "grid_rates_deg_s": grid, "bound_grid_arcsec": at_grid,
             "bound_at_samples_arcsec": at_n, "bound_all_arcsec": at_all, "bound_all_q0_arcsec": at_all0,
             "slope_all": slope, "rate_to_target_deg_s": rate, "target_arcsec": target_arcsec,
             "config_rate_deg_s": setup.roll.rate_deg_s}

@@ -1,7 +1,8 @@
 """Paper A's config checks that need its physics, run before any job (the workflow's
 validation step, :func:`opnav.preflight.check_config`, and the CLI call them).
 
-The arc and roll-step durations versus ``approach.dt_s``; the approach direction
+The arc and roll-step durations versus ``approach.dt_s``; the navigation-floor arcs
+(``nav_floor.arcs_s``: past N0, within the memory limit, not reaching Mars); the approach direction
 non-zero and not along the ecliptic pole (the aim-offset direction is ``v_inf_dir x z``);
 the arc starting outside Mars and not hitting it (two-body Mars-centred hyperbola);
 Mars at its closest fitting the detector; the truth misalignment keeping Mars on the
@@ -106,6 +107,21 @@ def _integrated_min_range_km(r0, v0, T: float, mu: float, r_surface: float) -> f
     return r_surface if rmin <= r_surface else rmin
 
 
+def _nav_floor_problem(a: dict) -> str | None:
+    """What is wrong with ``approach.nav_floor.arcs_s`` (an arc ending before N0, or longer than
+    the memory limit), or None."""
+    from opnav.approach import navfloor
+    from opnav.approach.setup import Setup
+
+    try:
+        nmax = max(navfloor.arcs_samples_of(Setup.from_config(a)))
+    except ValueError as exc:
+        return str(exc).split(": ", 1)[1]
+    if nmax > MAX_APPROACH_SAMPLES:
+        return f"the longest arc's {nmax} samples exceed the limit {MAX_APPROACH_SAMPLES} (memory)"
+    return None
+
+
 def approach_problems(a: dict) -> list[str]:
     """Cross-key problems of the ``approach`` section (see module docstring)."""
     from opnav.approach import dynamics, scenario
@@ -130,6 +146,10 @@ def approach_problems(a: dict) -> list[str]:
                    f"{MAX_APPROACH_SAMPLES} (memory)")
     if out:
         return out
+    nf = a.get("nav_floor")
+    nf_problem = _nav_floor_problem(a) if nf else None
+    if nf_problem:
+        out.append(f"{k}nav_floor.arcs_s': {nf_problem}")
     roll = a["roll"]
     if roll["steps_deg"] and not _multiple(roll["step_interval_s"], dt):
         out.append(f"{k}roll.step_interval_s': {roll['step_interval_s']} s is not a multiple of "
@@ -147,6 +167,8 @@ def approach_problems(a: dict) -> list[str]:
     if g["range_km"] <= dynamics.R_MARS_KM:          # refused by opnav.core.checks.approach_rules
         return out
     T = dt * max(n, s["N0"] + a["convergence_study"]["data_samples"])
+    if nf and not nf_problem:
+        T = max(T, max(nf["arcs_s"]))
     rmin = _approach_min_range_km(a, T)
     if rmin <= dynamics.R_MARS_KM:
         out.append(f"{k}geometry': the arc reaches Mars' surface within its {T:g} s "

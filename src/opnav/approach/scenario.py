@@ -65,6 +65,7 @@ class Geometry:
     ifov_arcsec: float = 10.0  # pixel size of the camera the variances are made for
     stars: object = None  # stars.StarField (``stars`` variant), else None
     star_sigma_rad: float = 0.0  # star centroid 1-sigma at stars.sigma_ref_mag, rad
+    attitude_sigma_rad: float = 0.0  # attitude knowledge of each Mars image, 1-sigma per axis, rad
 
     @property
     def dx_true(self) -> np.ndarray:
@@ -100,7 +101,19 @@ class Geometry:
         return replace(self, u_true=self.u_ref)
 
     def measurement_variance(self, sigma3_px) -> np.ndarray:
-        """Rvar (n+1, 3), km^2, from the pinhole camera at the reference range (paper eq. 3-4)."""
+        """Rvar (n+1, 3), km^2, that the filters, EM and the bounds use: the pinhole camera's at
+        the reference range (paper eq. 3-4, :meth:`pixel_variance`) plus, across the line of
+        sight, what the Mars image's attitude error makes, ``(rho sigma_a)^2`` (to first order
+        ``[u x] delta`` with ``u`` along the boresight: lateral only)."""
+        R = self.pixel_variance(sigma3_px)
+        if self.attitude_sigma_rad > 0.0:
+            R = R.copy()
+            R[:, :2] += (self.rho_ref[:, None] * self.attitude_sigma_rad) ** 2
+        return R
+
+    def pixel_variance(self, sigma3_px) -> np.ndarray:
+        """The pixel noise alone (n+1, 3), km^2 (paper eq. 3-4): what the simulation draws;
+        the attitude error is drawn as a rotation (:func:`simulate`)."""
         return camera.noise_sigma_km(self.rho_ref, self.ifov_arcsec, sigma3_px) ** 2
 
 
@@ -157,7 +170,7 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
     field, sig = (star_field_of(setup, C) if variant == "stars" else (None, 0.0))
     return Geometry(t, X_true, X_ref, X_mars, Phi, C, u_ref, u_true,
                     np.linalg.norm(u_ref, axis=1), setup.Q, setup.prior_sigma.P0, e_fixed, variant,
-                    cam.ifov_arcsec, field, sig)
+                    cam.ifov_arcsec, field, sig, cam.attitude_sigma_arcsec * ARCSEC)
 
 
 def star_field_of(setup: Setup | dict, C: np.ndarray, half_fov_rad: float | None = None):
@@ -233,8 +246,13 @@ def simulate(geo: Geometry, Rvar: np.ndarray, theta_true_rad: np.ndarray,
              rngs: list[np.random.Generator]) -> tuple[np.ndarray, np.ndarray]:
     """Measurements z (S, n+1, 3) with the exact misalignment, and initial-error draws (S, 6).
 
-    ``z_k = A_m_exact(theta) A_c^i (X_M - r_true) + v_k``; the draws are
-    ``N(0, P_X0)`` samples used only in the ``sampled`` initial-error mode.
+    ``z_k = A_m_exact(theta) A(delta_k) A_c^i (X_M - r_true) + v_k`` with ``v_k ~ N(0, Rvar)``
+    (``Rvar``: the pixel noise, :meth:`Geometry.pixel_variance`) and ``delta_k`` the Mars image's
+    attitude-knowledge error (``geo.attitude_sigma_rad`` per axis, independent per sample; the
+    true camera attitude is the known ``A_c^i`` turned by it, exactly); the initial-error draws
+    are ``N(0, P_X0)`` samples used only in the ``sampled`` initial-error mode. Per run: the
+    pixel noise, then the initial error, then the attitude errors from its stream (no attitude
+    error: the same draws as without it).
     """
     A = camera.misalignment_exact(theta_true_rad)
     clean = geo.u_true @ A.T
@@ -244,8 +262,12 @@ def simulate(geo: Geometry, Rvar: np.ndarray, theta_true_rad: np.ndarray,
     z, e0 = [], []
     for g in rngs:
         noise = g.standard_normal((n1, 3)) * sd
-        z.append(clean + noise)
         e0.append(L0 @ g.standard_normal(6))
+        if geo.attitude_sigma_rad > 0.0:
+            rot = camera.misalignment_exact(geo.attitude_sigma_rad * g.standard_normal((n1, 3)))  # (n1, 3, 3)
+            z.append(np.einsum("ij,kjl,kl->ki", A, rot, geo.u_true) + noise)
+        else:
+            z.append(clean + noise)
     z = np.stack(z)
     z[:, 0] = np.nan
     return z, np.stack(e0)

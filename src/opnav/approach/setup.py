@@ -128,12 +128,16 @@ class PriorSigma(_Section):
 @dataclass(frozen=True)
 class Camera(_Section):
     """``camera``: pixel size (arcsec), detector size (px), 3-sigma pixel errors of
-    (centroid x, centroid y, radius) and the radius/centroid error ratio of the pixel sweep."""
+    (centroid x, centroid y, radius), the radius/centroid error ratio of the pixel sweep, the
+    attitude knowledge of each Mars image (1-sigma per axis, arcsec, independent per image; 0:
+    known exactly, paper A's eq. 3) and the values of its bound study (arcsec)."""
 
     ifov_arcsec: float
     pixels: int
     sigma3_px: tuple
     radius_to_centroid_ratio: float
+    attitude_sigma_arcsec: float
+    attitude_study_arcsec: tuple
 
     def pixel_errors(self, centroid_px: float) -> tuple:
         """3-sigma (x, y, radius) errors for a centroid error, with the configured ratio."""
@@ -168,6 +172,16 @@ class Stars(_Section):
     mode_drift_arcsec: float
     study_count: tuple
     study_attitude_sigma_arcsec: tuple
+
+
+@dataclass(frozen=True)
+class NavFloor(_Section):
+    """``nav_floor``: the navigation error against arc length (A-C7's would_take): the variant and
+    EM scheme (``growing-squarem``, ``plain``, ...) it is measured for, and the arc lengths, s."""
+
+    variant: str
+    scheme: str
+    arcs_s: tuple
 
 
 @dataclass(frozen=True)
@@ -315,6 +329,7 @@ _FIELDS: dict[str, tuple[str, Any]] = {
     "variants": ("variants", tuple),
     "table1_variants": ("table1_variants", tuple),
     "nav_last_fraction": ("nav_error", lambda c: float(c["last_fraction"])),
+    "nav_floor": ("nav_floor", NavFloor.from_config),
     "crlb_prior_sigma_rad": ("crlb", lambda c: float(c["theta_prior_sigma_rad"])),
     "accuracy_target_arcsec": ("accuracy_target_arcsec", float),
     "alternatives": ("alternatives", Alternatives.from_config),
@@ -354,6 +369,7 @@ class Setup:
     variants: tuple
     table1_variants: tuple
     nav_last_fraction: float
+    nav_floor: NavFloor
     crlb_prior_sigma_rad: float
     accuracy_target_arcsec: float
     alternatives: Alternatives
