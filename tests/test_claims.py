@@ -1,47 +1,43 @@
-"""The claims table (opnav.report.claims, approach_claims, landing_claims) on hand-made
-inputs, judged by the analysis plan: verdicts that flip when the numbers do, every claim
-with a plan entry and every plan entry read, a control that also meets a claim, a result
-beating its own bound, a verdict that flips between two samples, and causes a reader takes
-in at once."""
+"""The claims table (opnav.report.claims) end to end on hand-made summaries: the plan's schema
+and its refusals, the extractors (every number of a summary becomes an evidence row), the
+claim rows as typed records whose every quoted number is a row of the evidence, the plan's
+amendments recomputed on the same evidence, and the prose."""
 
-import dataclasses
+from __future__ import annotations
+
+import math
+import re
 
 import pandas as pd
 import pytest
 import yaml
 
-from opnav.approach.summaries import ClaimsSummary
 from opnav.core import published
-from opnav.landing.claims_summary import LandingSummary
+from opnav.report import approach_claims as A
 from opnav.report import claims as C
-from opnav.report.approach_claims import claim_rows as _rows_a
-from opnav.report.landing_claims import claim_rows as _rows_b
+from opnav.report import landing_claims as B
+from opnav.report import scorer as S
+from opnav.report.evidence import COLUMNS as EV_COLUMNS
+from opnav.report.evidence import QUANTITIES, Evidence, read_csv, write_csv
 
 PUB = published.load()
+PLAN = C.load_plan()
 CASES = [("T1-01", "size", 0.1), ("T1-10", "pixel", 0.1), ("T1-11", "pixel", 0.5), ("T1-12", "pixel", 1.0)]
 PUB_DATA = {"T1-01": 250, "T1-10": 250, "T1-11": 1200, "T1-12": 2000}
 WINDOWS = {"sliding": 50.0, "growing": 250.0}
 
 
-def rows_a(summary, t1, pub, plan=None):
-    return _rows_a(summary, t1, pub, plan or C.load_plan(), WINDOWS)
-
-
-def rows_b(summary, pub, plan=None):
-    return _rows_b(LandingSummary.from_json(summary), pub, plan or C.load_plan())
-
-
+# ------------------------------------------------------------ hand-made summaries
 def _row(variant, case, group, px, err=1.0, bound=1.0, label="converged", data=None, before=80.0, after=18.0,
-         n_seeds=20, mode="sliding"):
+         n_seeds=20, mode="sliding", true_theta=15.0):
     return {"variant": variant, "scenario": variant.split("+")[0], "case_id": case, "group": group,
             "pixel_sigma3_px": px, "n_seeds": n_seeds, "rmse_x_arcsec": err, "rmse_y_arcsec": err,
-            "crlb_x_arcsec": bound, "crlb_y_arcsec": bound, "crlb_q0_x_arcsec": bound, "label": label,
-            "converged_seeds": n_seeds if label == "converged" else 0, "stalled": label == "stalled",
+            "crlb_x_arcsec": bound, "crlb_y_arcsec": bound, "crlb_q0_x_arcsec": bound, "crlb_q0_y_arcsec": bound,
+            "label": label, "converged_seeds": n_seeds if label == "converged" else 0, "stalled": label == "stalled",
             "stalled_seeds": n_seeds if label == "stalled" else 0, "mode": mode,
             "data_to_converge_samples": PUB_DATA[case] if data is None else data,
-            "pub_data_to_converge_samples": PUB_DATA[case], "nav_err_before_km": before,
-            "nav_err_before_km_std": 1.0, "pub_nav_err_before_km": 79.06, "nav_err_after_km": after,
-            "tz_observable": False}
+            "nav_err_before_km": before, "nav_err_before_km_std": 1.0, "nav_err_after_km": after,
+            "nav_err_after_km_std": 1.0, "nav_err_true_theta_km": true_theta, "tz_observable": False}
 
 
 def table(literal=None, roll=None, diag=None, **extra):
@@ -52,366 +48,255 @@ def table(literal=None, roll=None, diag=None, **extra):
     return pd.DataFrame(rows)
 
 
-#: A-summary.json as the pipeline writes it (the parts the claims read), and as they read it
-SUMMARY_A_JSON = {"profile_segments": {"N": 50}, "accuracy_target_arcsec": 2.0,
-                  "roll_rate": {"config_rate_deg_s": 0.1, "rate_to_target_deg_s": 0.236}}
-SUMMARY_A = ClaimsSummary.from_json(SUMMARY_A_JSON)
+SUMMARY_A = {"profile_segments": {"N": 50},
+             "roll_rate": {"rates_deg_s": [0.05, 0.1, 0.2, 0.4], "bound_at_samples_arcsec": [20.0, 10.0, 2.5, 0.6]}}
 
 
-def by_id(rows):
-    return {r["claim_id"]: r for r in rows}
+def _iv(mean, half, n=300):
+    return {"mean": mean, "lo": mean - half, "hi": mean + half, "n": n}
 
 
-# ------------------------------------------------------------ paper B's hand-made summary
-def _iv(mean, half):
-    return {"mean": mean, "lo": mean - half, "hi": mean + half}
-
-
-def _scenario(d_depth=0.0, controls=None, pick=50.0, faster=(-3.0, -5.0, -1.0), yaw=False, red=29.0,
-              red_alt=70.0, gdop=0.0, times=None, env=1.0, n_runs=300):
-    """One camera's summary: depth minus SVD of each landmark-phase error is ``d_depth`` m
-    (+-0.005) against SVD means of 0.4 and 2 m; ``controls``: control -> its difference
-    from SVD (m); ``gdop``: depth minus GDOP and minus condition number (m, B-T3 pairs)."""
+def _scenario(d_depth=0.0, controls=None, pick=50.0, faster=(-3.0, -5.0, -1.0), yaw=(2.5, 2.6), gdop=0.0,
+              n_runs=300, planning=None):
     controls = {"random": 2.0, "center": 1.0, "closest": 0.8} if controls is None else controls
     q = ("lastlm_pos_err_m", "lmrms_pos_err_m")
-    meth = {"depth": {q[0]: _iv(d_depth, 0.005), q[1]: _iv(d_depth, 0.005), "same_pick_pct": pick}}
-    meth.update({c: {q[0]: _iv(x, 0.01), q[1]: _iv(x, 0.01), "same_pick_pct": 5.0} for c, x in controls.items()})
-    times = times or {"depth": 4.0, "svd": 5.0, "gdop": 7.0, "cond": 8.0}
-    methods = {m: {"median_plan_time_us": t, "rms_pos_err_m_mean": 3.0, "final_pos_err_m_mean": 1.0,
-                   "rms_vel_err_mps_3sigma": 0.3 * (env if m == "depth" else 1.0),
-                   "rms_att_err_deg_3sigma": 0.2} for m, t in times.items()}
-    methods["depth"].update({"time_reduction_vs_svd_pct": red, "time_reduction_vs_svd_pct_std": 1.0,
-                             "time_reduction_vs_svd_alt_pct": red_alt, "time_reduction_vs_svd_alt_pct_std": 1.0})
-    pairs = {f"depth_vs_{b}": {"d_rms_pos_m": gdop, "d_rms_pos_lo_m": gdop - 0.01, "d_rms_pos_hi_m": gdop + 0.01,
-                               "d_final_pos_m": gdop, "d_final_pos_lo_m": gdop - 0.01, "d_final_pos_hi_m": gdop + 0.01}
-             for b in ("gdop", "cond")}
-    return {"eval_path": "compiled", "yaw_converges": yaw, "yaw_reason": "yaw 3-sigma flat", "n_runs": n_runs,
-            "equivalence": {"reference": "svd", "methods": meth,
-                            "metrics": {q[0]: {"means": {"svd": 0.4}}, q[1]: {"means": {"svd": 2.0}}}},
-            "converges_faster": {"depth": {"verdict": "faster", "mean_s": faster[0], "lo_s": faster[1],
-                                           "hi_s": faster[2], "n_runs": 300, "threshold_m": 100.0}},
-            "methods": methods, "pairs": pairs}
+
+    def sec(ref, tested):
+        return {"reference": ref, "alpha": 0.05,
+                "metrics": {q[0]: {"means": {ref: 0.4, "depth": 0.4}}, q[1]: {"means": {ref: 2.0, "depth": 2.0}}},
+                "methods": {m: {q[0]: _iv(x, 0.005 if m == "depth" else 0.01),
+                                q[1]: _iv(x, 0.005 if m == "depth" else 0.01),
+                                "same_pick_pct": pick if m == "depth" else 5.0} for m, x in tested.items()}}
+    s = {"eval_path": "compiled", "yaw_sigma3_deg": {"method": "depth", "start": yaw[0], "end": yaw[1], "n_runs": n_runs},
+         "n_runs": n_runs, "equivalence": sec("svd", {"depth": d_depth, **controls}),
+         "equivalence_vs_baselines": {b: sec(b, {"depth": gdop}) for b in ("gdop", "cond")},
+         "converges_faster": {"depth": {"mean_s": faster[0], "lo_s": faster[1], "hi_s": faster[2], "n_runs": 300,
+                                        "threshold_m": 100.0, "level": 0.95}},
+         "methods": {m: {"rms_vel_err_mps_3sigma": 0.3, "rms_att_err_deg_3sigma": 0.2} for m in ("depth", "svd", "gdop", "cond")},
+         "errors": {m: {"lastlm_pos_err_m": {"3sigma": 0.3}, "lmrms_pos_err_m": {"3sigma": 0.6}} for m in ("svd", "gdop", "cond", "depth")}}
+    if planning:
+        s["planning_time"] = planning
+    return s
+
+
+def planning_time(per_replay=(24.0, 26.0, 28.0)):
+    meds = [{"depth": 4.0 * (1 - x / 100) / 0.96 * 0.96 / 1.0, "svd": 4.0, "gdop": 5.0, "cond": 5.2} for x in per_replay]
+    for mm, x in zip(meds, per_replay):
+        mm["depth"] = 4.0 * (1 - x / 100)
+    return {"clock": "thread_cpu", "n_replays": len(per_replay),
+            "replays": [{"median_us": m, "n_calls": 200, "load_avg": 0.5} for m in meds],
+            "reduction_pct": {"depth_vs_svd": {"per_replay": list(per_replay)}},
+            "decomposition": {m: {"shared_us": 3.0, "per_eval_us": pe, "evals_per_call": 30}
+                              for m, pe in (("depth", 0.02), ("svd", 0.06), ("gdop", 0.08), ("cond", 0.08))},
+            "overhead_curve": {"shared_us": [1.0, 2.0, 3.0, 4.0], "reduction_pct": [40.0, 31.0, 25.0, 20.0]},
+            "shared_us_at_published": 2.2}
 
 
 def summary_b(**kw_by_scenario):
-    scen = {"interior": _scenario(**kw_by_scenario.get("interior", {})),
-            "site-tilt": _scenario(**kw_by_scenario.get("site-tilt", {}))}
+    scen = {s: _scenario(**kw_by_scenario.get(s, {})) for s in ("interior", "site-tilt")}
     return {"headline_scenario": "interior", "scenarios": scen, "initial_tilt_deg": 9.8, "initial_azimuth_deg": 16.5}
 
 
-def both(**kw):
-    return {"interior": kw, "site-tilt": kw}
+def evidence(t1=None, sb=None, rep_b=None, optima=None):
+    rows = A.evidence_rows(table() if t1 is None else t1, SUMMARY_A, "main", "A-T1_table1.csv", "A-summary.json",
+                           WINDOWS)
+    rows += B.evidence_rows(summary_b() if sb is None else sb, "main", "B-summary.json", PLAN, optima)
+    if rep_b is not None:
+        rows += B.evidence_rows(rep_b, "replication", "replication/B-summary.json", PLAN)
+    rows += A.published_rows(PUB["paper_a"]) + B.published_rows(PUB["paper_b"])
+    return C.evidence_table(PLAN, rows)
 
 
-# ------------------------------------------------------------ the contract and the plan
-def test_columns_verdicts_and_causes_are_the_contract():
-    df = C.frame(rows_a(SUMMARY_A, table(), PUB["paper_a"]) + rows_b(summary_b(), PUB["paper_b"]))
-    assert list(df.columns) == C.COLUMNS == [
-        "paper", "claim_id", "claim", "published", "ours_as_written", "ours_best", "best_variant", "bound",
-        "ours_replication", "verdict", "verdict_replication", "flags", "named", "would_take", "cause", "evidence",
-        "sample"]
-    assert set(df["verdict"]) <= set(C.VERDICTS) and df["claim_id"].is_unique
-    assert set(C.VERDICT_SHORT) == set(C.VERDICT_TEXT) == set(C.VERDICTS)
-    for c in df["cause"]:
-        assert c.count(". ") == 0 and c.endswith(".") and len(c.split()) <= 40, c
+def built(**kw):
+    ev = evidence(**kw)
+    rows, js, sweeps = C.build(PLAN, ev, C.replication_plan(PLAN, {}))
+    return {r.claim_id: r for r in rows}, ev + C.derived_rows(js), sweeps
 
 
-@pytest.mark.xfail(reason='the plan of issue 52 (v2) is read by the generic scorer, landing next', strict=False)
-def test_every_claim_has_a_plan_entry_and_every_entry_is_read():
-    """Scoring both papers reads every claim, margin and guard of the plan (a margin left
-    in the plan but read by no verdict fails), and every row has a plan entry."""
-    plan = C.load_plan()
-    df = C.frame(rows_a(SUMMARY_A, table(), PUB["paper_a"], plan) + rows_b(summary_b(), PUB["paper_b"], plan))
-    C.check_plan_covers(df, plan)
-    assert plan.unused() == []
-    assert set(df["claim_id"]) == set(plan.claims)
-    t = plan.table()
-    assert list(t.columns) == C.PLAN_COLUMNS and len(t) == len(plan.claims)
-    assert (t.loc[t["claim_id"] == "B-C1", "margin"].iloc[0]).startswith("margin_rel = 0.1")
+# ------------------------------------------------------------ the plan
+def test_every_claim_has_a_test_and_every_margin_is_read_by_one():
+    assert set(PLAN.tests()) == set(PLAN.claims)
+    assert PLAN.unreferenced() == [], "a margin or setting no test names"
+    assert PLAN.level == 0.9 and PLAN.stamp.startswith("v2 sha256:")
+    for cid, t in PLAN.tests().items():
+        for q in t.reads():
+            assert q in QUANTITIES, f"{cid} reads {q}, which no extractor writes"
 
 
-def _plan_without(tmp_path, path):
+def test_the_plan_refuses_a_literal_number_a_missing_margin_and_a_bad_comparison(tmp_path):
     raw = yaml.safe_load(C.PLAN_FILE.read_text())
-    node = raw
-    for k in path[:-1]:
-        node = node[k]
-    del node[path[-1]]
-    p = tmp_path / "analysis_plan.yaml"
-    p.write_text(yaml.safe_dump(raw, allow_unicode=True))
-    return C.load_plan(p)
+
+    def refused(mutate, words):
+        import copy
+
+        r = copy.deepcopy(raw)
+        mutate(r)
+        p = tmp_path / "plan.yaml"
+        p.write_text(yaml.dump(r, Dumper=getattr(yaml, "CSafeDumper", yaml.SafeDumper)))
+        with pytest.raises(C.PlanError) as e:
+            C.load_plan(p)
+        msg = str(e.value)
+        assert "\n" not in msg and all(w in msg for w in words), msg
+
+    refused(lambda r: r["claims"]["A-C1"]["test"]["conditions"][0].__setitem__("upper", 2.0),
+            ["A-C1", "never a literal"])
+    refused(lambda r: r["claims"]["B-C1"]["margins"].pop("margin_rel"), ["B-C1", "margin_rel"])
+    refused(lambda r: r["claims"]["B-C3"]["test"]["conditions"][0].__setitem__("comparison", "vibes"), ["B-C3"])
+    refused(lambda r: r["claims"]["B-C2"].__setitem__("level", 0.95), ["B-C2", "level_reason"])
+    refused(lambda r: r["claims"]["A-C6"]["margins"]["rel_tol"].pop("reason"), ["A-C6", "rel_tol"])
 
 
-@pytest.mark.xfail(reason='the plan of issue 52 (v2) is read by the generic scorer, landing next', strict=False)
-def test_a_margin_missing_from_the_plan_stops_the_scorer_naming_it(tmp_path):
-    plan = _plan_without(tmp_path, ["claims", "B-C1", "margins", "margin_rel"])
-    with pytest.raises(C.PlanError, match=r"claims\.B-C1\.margins\.margin_rel is missing"):
-        rows_b(summary_b(), PUB["paper_b"], plan)
-    plan = _plan_without(tmp_path, ["claims", "A-C8"])
-    with pytest.raises(C.PlanError, match="claim A-C8 has no entry"):
-        rows_a(SUMMARY_A, table(), PUB["paper_a"], plan)
-    # an unused entry is named: a plan that only paper B read leaves paper A's unread
-    plan = C.load_plan()
-    rows_b(summary_b(), PUB["paper_b"], plan)
-    assert "claims.A-C1.margins.target_arcsec" in plan.unused()
-
-
-def test_only_a_claim_the_plan_gives_an_information_bound_can_be_not_reproducible(tmp_path):
-    t = table(literal={"err": 10.0, "bound": 20.6}, roll={"err": 8.0, "bound": 9.0})
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C1"]["verdict"] == C.NOT_REPRODUCIBLE
-    plan = _plan_without(tmp_path, ["claims", "A-C1", "bound"])
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"], plan))["A-C1"]["verdict"] == C.NOT_REPRODUCED
-
-
-def test_a_malformed_margin_is_refused_in_one_line(tmp_path):
-    raw = yaml.safe_load(C.PLAN_FILE.read_text())
-    raw["claims"]["A-C6"]["margins"]["rel_tol"] = {"value": 0.1}
+def test_the_checksum_follows_the_text(tmp_path):
     p = tmp_path / "plan.yaml"
-    p.write_text(yaml.safe_dump(raw, allow_unicode=True))
-    with pytest.raises(C.PlanError, match=r"claims\.A-C6\.margins\.rel_tol needs a numeric 'value' and a 'reason'"):
-        C.load_plan(p)
+    p.write_text(C.PLAN_FILE.read_text().replace("value: 0.10, reason: \"'almost", "value: 0.11, reason: \"'almost"))
+    assert C.load_plan(p).checksum != PLAN.checksum
 
 
-def test_the_plan_margin_decides_not_a_constant_in_code(tmp_path):
-    """B-C1 at a 5 % difference: equivalent within the plan's 10 %, not within 2 %."""
-    s = summary_b(**both(d_depth=0.02))            # 5 % of SVD's 0.4 m
-    assert by_id(rows_b(s, PUB["paper_b"]))["B-C1"]["verdict"] == C.REPRODUCED
-    raw = yaml.safe_load(C.PLAN_FILE.read_text())
-    raw["claims"]["B-C1"]["margins"]["margin_rel"]["value"] = 0.02
-    p = tmp_path / "plan.yaml"
-    p.write_text(yaml.safe_dump(raw, allow_unicode=True))
-    assert by_id(rows_b(s, PUB["paper_b"], C.load_plan(p)))["B-C1"]["verdict"] == C.NOT_REPRODUCED
-
-
-# ------------------------------------------------------------ paper A
-def test_accuracy_is_scored_as_accuracy_and_flips():
-    ok = by_id(rows_a(SUMMARY_A, table(), PUB["paper_a"]))["A-C1"]
-    assert ok["verdict"] == C.REPRODUCED and ok["would_take"] == ""
-    # literal far from the truth, the roll variant within 2 arcsec: only with an addition, named
-    r = by_id(rows_a(SUMMARY_A, table(literal={"err": 10.0}), PUB["paper_a"]))["A-C1"]
-    assert r["verdict"] == C.WITH_ADDITION and "roll" in r["named"] and r["best_variant"] == "roll"
-    r = by_id(rows_a(SUMMARY_A, table(literal={"err": 10.0, "bound": 1.0}), PUB["paper_a"]))["A-C2"]
-    assert r["would_take"].startswith("a boresight roll (roll,")
-    # an estimate at the truth that did not converge is not accuracy
-    r = by_id(rows_a(SUMMARY_A, table(literal={"label": "stalled"}, roll={"err": 9.0}), PUB["paper_a"]))["A-C1"]
-    assert r["verdict"] == C.NOT_REPRODUCED
-
-
-def test_bound_makes_it_not_reproducible_and_says_what_it_would_take():
-    t = table(literal={"err": 10.0, "bound": 20.6}, roll={"err": 8.0, "bound": 9.0}, diag={"err": 0.1, "bound": 0.07})
-    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C1"]
-    assert r["verdict"] == C.NOT_REPRODUCIBLE and "20.6" in r["named"]
-    assert "0.236 deg/s" in r["would_take"], "the roll rate the pipeline measured"
-    t = table(literal={"err": 10.0, "bound": 1.0}, roll={"err": 8.0}, diag={"err": 0.1})
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C1"]["verdict"] == C.NOT_REPRODUCED
-
-
-def test_published_errors_with_the_real_bound_are_suspect_never_reproduced():
-    """Fed the published errors (1.43, 1.21 arcsec) with the real bound of 20.6 arcsec kept,
-    A-C1, A-C2 and A-C4 read suspect (14x below the bound), never reproduced."""
-    head = PUB["paper_a"]["headline"]
-    t = table(literal={"bound": 20.6}, roll={"err": 9.0, "bound": 9.0})
-    lit = t["variant"] == "literal"
-    t.loc[lit, "rmse_x_arcsec"], t.loc[lit, "rmse_y_arcsec"] = head["est_error_arcsec"]
-    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))
-    for cid in ("A-C1", "A-C2", "A-C4"):
-        assert r[cid]["verdict"] == C.SUSPECT, cid
-        assert "beats_bound: 14x (literal)" in r[cid]["flags"], r[cid]["flags"]
-    # within the plan's factor (an error at half the bound, 20 seeds) it is not suspect
-    t = table(literal={"err": 0.6, "bound": 1.0})
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C1"]["verdict"] == C.REPRODUCED
-    # a few seeds widen the allowance: 0.35 of the bound is suspect at 20 seeds, not at 2
-    assert by_id(rows_a(SUMMARY_A, table(literal={"err": 0.35, "bound": 1.0}), PUB["paper_a"]))["A-C1"]["verdict"] \
-        == C.SUSPECT
-    t = table(literal={"err": 0.35, "bound": 1.0, "n_seeds": 2})
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C1"]["verdict"] == C.REPRODUCED
-
-
-def test_pixel_claims_more_data_and_unaffected_accuracy():
-    r = by_id(rows_a(SUMMARY_A, table(), PUB["paper_a"]))
-    assert r["A-C5"]["verdict"] == C.REPRODUCED and r["A-C10"]["verdict"] == C.REPRODUCED
-    t = table()
-    t.loc[(t["variant"] == "literal") & (t["case_id"] == "T1-12"), "rmse_x_arcsec"] = 5.0
-    t.loc[(t["variant"] == "roll") & (t["case_id"] == "T1-12"), "rmse_x_arcsec"] = 5.0
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C10"]["verdict"] == C.NOT_REPRODUCED
-    t = table(literal={"bound": 20.6})
-    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C5"]
-    assert r["verdict"] == C.WITH_ADDITION and r["best_variant"] == "roll"
-    assert "not identifiable" in r["ours_as_written"] and "20.6" in r["bound"]
-
-
-def test_counts_are_evidence_only_on_identifiable_data_above_the_first_window():
-    # the growing rows start at 250 samples: a count of 250 is the window, not evidence
-    t = table(literal={"bound": 20.6}, **{"roll+growing": {"mode": "growing"}})
-    t = t[t["variant"] != "roll"]
-    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C3"]
-    assert r["verdict"] == C.NOT_REPRODUCED, r
-    assert "on data whose bound exceeds" in r["ours_as_written"]
-    assert "at the first window" in r["ours_best"]
-    # the published count +- 50 samples (the plan), not +- 200
-    t = table(roll={"data": 330})
-    t.loc[t["variant"] == "literal", "data_to_converge_samples"] += 60
-    assert by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))["A-C3"]["verdict"] == C.NOT_REPRODUCED
-
-
-def test_a_filter_floor_is_not_an_information_bound():
-    """A true-theta floor above 20 km is evidence that the claim hinges on the arc length and
-    error rule (depends on a choice, flagged), never 'not reproducible'."""
-    t = table(literal={"after": 118.0}, roll={"after": 88.0}, diag={"after": 41.8})
-    floor = dataclasses.replace(SUMMARY_A, nav_err_true_theta_km=29.4)
-    r = by_id(rows_a(floor, t, PUB["paper_a"]))["A-C7"]
-    assert r["verdict"] == C.DEPENDS and "arc length" in r["named"]
-    assert "floor_not_bound: true-theta filter 29.4 km" in r["flags"]
-    low = dataclasses.replace(SUMMARY_A, nav_err_true_theta_km=12.0)
-    assert by_id(rows_a(low, t, PUB["paper_a"]))["A-C7"]["verdict"] == C.NOT_REPRODUCED
-
-
-def test_nav_before_cause_is_generated_from_the_geometry():
-    r = by_id(rows_a(SUMMARY_A, table(literal={"before": 120.0}, roll={"before": 120.0}), PUB["paper_a"]))["A-C6"]
-    assert r["verdict"] == C.NOT_REPRODUCED and "108 km" in r["cause"] and "22.4 arcsec" in r["cause"]
-
-
-# ------------------------------------------------------------ paper B
-def test_paper_b_verdicts_flip_with_the_numbers():
-    r = by_id(rows_b(summary_b(), PUB["paper_b"]))
-    for cid in ("B-C1", "B-C2", "B-C3", "B-C4", "B-C9", "B-C10"):
-        assert r[cid]["verdict"] == C.REPRODUCED, (cid, r[cid])
-    assert r["B-C7"]["verdict"] == C.NOT_REPRODUCED and r["B-C8"]["verdict"] == C.NOT_TESTED
-    assert r["B-C1"]["flags"] == ""
-    r = by_id(rows_b(summary_b(**both(pick=95.0)), PUB["paper_b"]))
-    assert r["B-C1"]["verdict"] == C.NOT_TESTED and "95" in r["B-C1"]["named"]
-    r = by_id(rows_b(summary_b(**{"site-tilt": {"d_depth": 0.2}}), PUB["paper_b"]))
-    assert r["B-C1"]["verdict"] == C.DEPENDS and "camera" in r["B-C1"]["named"]
-    r = by_id(rows_b(summary_b(**both(d_depth=-0.2, gdop=-0.5)), PUB["paper_b"]))
-    assert r["B-C7"]["verdict"] == C.REPRODUCED and r["B-C1"]["verdict"] == C.NOT_REPRODUCED
-    r = by_id(rows_b(summary_b(**both(times={"depth": 6.0, "svd": 5.0, "gdop": 7.0, "cond": 8.0}, env=1.3)),
-                     PUB["paper_b"]))
-    assert r["B-C9"]["verdict"] == C.NOT_REPRODUCED and r["B-C10"]["verdict"] == C.NOT_REPRODUCED
-
-
-def test_a_control_that_also_meets_the_claim_is_a_flag_not_a_verdict():
-    """Depth within the margin of SVD, and so is the closest-range picker: the claim holds
-    (reproduced), and the flag and the cause say the test cannot credit the metric."""
-    s = summary_b(**both(controls={"random": 2.0, "center": 1.0, "closest": 0.01}))
-    r = by_id(rows_b(s, PUB["paper_b"]))["B-C1"]
-    assert r["verdict"] == C.REPRODUCED
-    assert r["flags"] == "control_also_meets: closest (interior); control_also_meets: closest (site-tilt)"
-    assert "cannot credit" in r["cause"] and "closest" in r["cause"]
-
-
-def test_converging_faster_needs_a_whole_filter_step():
-    r = by_id(rows_b(summary_b(**both(faster=(-0.4, -0.7, -0.1))), PUB["paper_b"]))["B-C2"]
-    assert r["verdict"] == C.NOT_REPRODUCED, "a 0.4 s gain is below the 1 s step"
-    r = by_id(rows_b(summary_b(**{"site-tilt": {"faster": (0.4, 0.1, 0.7)}}), PUB["paper_b"]))["B-C2"]
-    assert r["verdict"] == C.DEPENDS
-
-
-def test_timing_depends_on_the_svd_implementation_and_says_what_it_would_take():
-    r = by_id(rows_b(summary_b(**both(red=8.0, red_alt=29.0)), PUB["paper_b"]))["B-C4"]
-    assert r["verdict"] == C.DEPENDS and "paper's definition" in r["would_take"]
-    assert r["named"] == "how the SVD baseline is implemented" and "another SVD implementation" in r["cause"]
-    r = by_id(rows_b(summary_b(interior={"red": 8.0, "red_alt": 80.0}), PUB["paper_b"]))["B-C4"]
-    assert r["verdict"] == C.DEPENDS and r["named"] == "which camera is flown"
-    assert r["would_take"] == "timing on the compiled implementation in the site-tilt camera"
-    # a timing whose spread is wider than half the published value tests nothing
-    s = summary_b(**both(red=-19.5))
-    s["scenarios"]["interior"]["methods"]["depth"]["time_reduction_vs_svd_pct_std"] = 2743.0
-    r = by_id(rows_b(s, PUB["paper_b"]))["B-C4"]
-    assert r["verdict"] == C.NOT_TESTED and "band_too_wide: compiled implementation, interior camera" in r["flags"]
-    r = by_id(rows_b(summary_b(**both(red=8.0)), PUB["paper_b"]))["B-C4"]
-    assert r["verdict"] == C.NOT_REPRODUCED and r["would_take"] == "" and "8 % less" in r["cause"]
-
-
-# ------------------------------------------------------------ samples
-def test_a_verdict_that_flips_between_samples_is_unstable():
-    main = C.frame(rows_b(summary_b(), PUB["paper_b"]))
-    rep = C.frame(rows_b(summary_b(**{"interior": {"faster": (-0.2, -0.5, 0.1)},
-                                      "site-tilt": {"faster": (-0.2, -0.5, 0.1)}}), PUB["paper_b"]))
-    out = C.with_replication(main, rep, C.replication_plan(C.load_plan(), {"enabled": False})).set_index("claim_id")
-    assert out.loc["B-C2", "verdict"] == C.UNSTABLE
-    assert out.loc["B-C2", "verdict_replication"] == C.NOT_REPRODUCED
-    assert "reproduced" in out.loc["B-C2", "cause"] and "not reproduced" in out.loc["B-C2", "cause"]
-    assert "verdict_main: reproduced" in out.loc["B-C2", "flags"]
-    assert out.loc["B-C1", "verdict"] == C.REPRODUCED and out.loc["B-C1", "verdict_replication"] == C.REPRODUCED
-    assert out.loc["B-C1", "ours_replication"] != ""
-    assert out.loc["B-C8", "verdict_replication"] == "", "not among the plan's replicated claims"
+def test_a_config_that_disagrees_with_the_plans_setting_stops_naming_both():
+    with pytest.raises(C.PlanError, match="converge_frac_of_bound.*approach.em.converge_frac_of_bound"):
+        C.check_settings(C.load_plan(), {"converge_frac_of_bound": 0.2})
+    C.check_settings(C.load_plan(), {"converge_frac_of_bound": 0.1})
 
 
 def test_the_plan_states_the_replication_size_the_config_flies():
-    plan = C.load_plan()
-    from pathlib import Path
-    cfg = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())["replication"]
-    assert cfg["enabled"] and "B-C2" in C.replication_plan(plan, cfg), "the full profile flies what the plan states"
-    with pytest.raises(C.PlanError, match=r"replication\.landing_n_runs = 100 but the config's"):
-        C.replication_plan(plan, {**cfg, "landing_n_runs": 300})
+    with pytest.raises(C.PlanError, match="replication.landing_n_runs"):
+        C.replication_plan(PLAN, {"enabled": True, "landing_n_runs": 50})
 
 
-def test_quick_profile_rows_say_the_sample_is_too_small():
-    df = C.frame(rows_b(summary_b(**both(n_runs=4)), PUB["paper_b"]))
-    q = C.mark_sample(df, "quick")
-    assert (q["sample"] == "quick").all() and q["flags"].str.contains("sample_too_small: quick profile").all()
-    assert "too small for verdicts" in C.sample_sentence(q)
-    assert "sample_too_small: 4 runs" in df.set_index("claim_id").loc["B-C1", "flags"]
-    assert q.set_index("claim_id").loc["B-C1", "flags"] == "sample_too_small: quick profile"
-    f = C.mark_sample(C.frame(rows_b(summary_b(), PUB["paper_b"])), "full")
-    assert (f["sample"] == "full").all() and C.sample_sentence(f) == ""
-    assert not f["flags"].str.contains("sample_too_small").any()
+# ------------------------------------------------------------ extractors
+def test_every_number_of_the_summaries_becomes_an_evidence_row():
+    ev = Evidence(evidence())
+    df = ev.frame()
+    assert list(df.columns) == EV_COLUMNS
+    assert set(df["quantity"]) <= set(QUANTITIES)
+    # every method x baseline the equivalence sections pair, both errors, both cameras
+    d = df[(df.quantity == "err_diff_lastlm_m") & (df.claim_id == "B-C1")]
+    assert set(zip(d.scope, d.method, d.versus)) == {(c, m, b) for c in ("interior", "site-tilt") for m, b in (
+        ("depth", "svd"), ("depth", "gdop"), ("depth", "cond"), ("random", "svd"), ("center", "svd"),
+        ("closest", "svd"))}
+    assert set(d[d.method == "random"]["role"]) == {"control"} and set(d[d.method == "depth"]["role"]) == {"as_written"}
+    a = df[(df.quantity == "rms_err_arcsec") & (df.claim_id == "A-C2")]
+    assert len(a) == len(table()) and set(a.role) == {"as_written", "faithful", "diagnostic"}
+    # the roll-rate curve as a sweep, the published values as rows
+    assert len(df[(df.quantity == "crlb_published_data_arcsec") & (df.claim_id == "A-C1")]) == 4
+    assert ((df.role == "published") & (df.quantity == "reduction_pct") & (df.estimate == 29.03)).any()
+
+
+def test_an_old_summary_without_a_yaw_block_is_read_from_its_sentence():
+    s = _scenario()
+    s.pop("yaw_sigma3_deg")
+    s["yaw_reason"] = "yaw 3-sigma over the 300 runs (depth): 2.46 deg at start, 2.54 deg at touchdown (not below 50%)"
+    rows = B.evidence_rows({"scenarios": {"interior": s}, "headline_scenario": "interior"}, "main", "x", PLAN)
+    y = [r for r in rows if r.quantity == "yaw_sigma3_ratio"]
+    assert len(y) == 1 and y[0].method == "depth" and abs(y[0].estimate - 2.54 / 2.46) < 1e-12
+
+
+def test_timing_rows_per_replay_between_replays_and_every_pair():
+    sb = summary_b(interior={"planning": planning_time()}, **{"site-tilt": {"planning": planning_time()}})
+    df = Evidence(evidence(sb=sb)).frame()
+    t = df[(df.quantity == "reduction_pct") & (df.claim_id == "B-C4") & (df.scope == "interior")]
+    assert {"replay1", "replay2", "replay3", "between_replays"} <= set(t["sample"])
+    bw = t[(t["sample"] == "between_replays") & (t.versus == "svd") & (t.setting == "")].iloc[0]
+    assert bw.estimate == pytest.approx(26.0) and bw.n == 3 and bw.se == pytest.approx(2.0 / math.sqrt(3))
+    pairs = df[(df.quantity == "reduction_pct") & (df.claim_id == "B-C9") & (df["sample"] == "between_replays")
+               & (df.setting == "")]
+    assert {("svd", "gdop"), ("svd", "cond")} <= set(zip(pairs.method, pairs.versus))
+
+
+# ------------------------------------------------------------ claim rows
+def test_claims_from_hand_made_summaries_and_their_verdicts():
+    rows, ev, _ = built()
+    assert rows["A-C1"].verdict == C.REPRODUCED and rows["B-C1"].verdict == C.REPRODUCED
+    assert rows["B-C3"].verdict == C.REPRODUCED and rows["B-C2"].verdict == C.REPRODUCED
+    assert rows["B-C4"].verdict == C.NOT_TESTED, "no planning_time: one replay at most"
+    assert rows["B-C8"].verdict == C.NOT_TESTED and "calls_multi_minimum" in rows["B-C8"].named
+    rows, _, _ = built(t1=table(literal={"err": 20.0, "bound": 20.6}, roll={"err": 1.0, "bound": 0.9}))
+    r = rows["A-C1"]
+    assert r.verdict == C.WITH_ADDITION and "roll" in r.named and r.best_variant == "roll"
+    assert "roll" in r.would_take
+    assert all(x.plan == PLAN.stamp for x in rows.values())
+
+
+def test_every_number_a_claim_row_quotes_is_a_row_of_evidence_or_of_the_plan():
+    """Cause, would_take, ours, bound: each number is an estimate, lo or hi of an evidence row
+    keyed to the claim, a published value, or a number of the plan (margins, settings, level)."""
+    sb = summary_b(interior={"planning": planning_time(), "d_depth": 0.05}, **{"site-tilt": {"planning": planning_time()}})
+    rows, ev, _ = built(t1=table(literal={"err": 20.0, "bound": 20.6}), sb=sb,
+                        optima={"interior": {"n_calls": 409, "calls_multi_minimum": 0}})
+    plan_nums = set()
+    for c in PLAN.claims.values():
+        plan_nums |= {float(m["value"]) for m in (c.get("margins") or {}).values()}
+    for s in PLAN.raw["settings"].values():
+        plan_nums |= {float(v) for v in s.get("values", [s.get("value", 0)])}
+    for r in rows.values():
+        mine = [e for e in ev if e.claim_id == r.claim_id]
+        nums = {S.fmt(x) for e in mine for x in (e.estimate, e.lo, e.hi) if math.isfinite(x)}
+        nums |= {S.fmt(abs(x)) for e in mine for x in (e.estimate, e.lo, e.hi) if math.isfinite(x)}
+        nums |= {S.fmt(x) for x in plan_nums} | {S.fmt(x * abs(p.estimate)) for x in plan_nums for p in mine
+                                                 if p.role == "published"}
+        nums |= {S.fmt(p.estimate * (1 + s * f)) for f in plan_nums for s in (-1, 1) for p in mine if p.role == "published"}
+        nums |= {S.fmt(m.estimate * f) for f in plan_nums for m in mine if m.quantity.startswith("err_mean")}
+        for col in ("cause", "would_take", "ours_as_written", "ours_best", "bound", "named"):
+            text = re.sub(r"T1-\d+|B-C\d+|A-C\d+|v\d+ sha256:\w+|O\(n\^3\)|O\(1\)|\b3-sigma\b", "", getattr(r, col))
+            for x in S.numbers_in(text):
+                v = x.lstrip("+")
+                assert v in nums or S.fmt(float(v)) in nums or v.lstrip("-") in nums, f"{r.claim_id}.{col} quotes {x}, in no evidence row: {text}"
+
+
+def test_evidence_csv_and_claims_agree_after_a_round_trip(tmp_path):
+    ev = evidence()
+    write_csv(ev, tmp_path / "evidence.csv")
+    back = read_csv(tmp_path / "evidence.csv")
+    a, _, _ = C.build(PLAN, ev, C.replication_plan(PLAN, {}))
+    b, _, _ = C.build(PLAN, list(back), C.replication_plan(PLAN, {}))
+    assert [(x.claim_id, x.verdict, x.cause) for x in a] == [(x.claim_id, x.verdict, x.cause) for x in b]
+
+
+def test_claim_rows_are_records_that_refuse_an_unknown_verdict_or_a_missing_name():
+    with pytest.raises(ValueError, match="verdict"):
+        C.ClaimRow("A", "A-C1", "x", "y", verdict="great")
+    with pytest.raises(ValueError, match="named"):
+        C.ClaimRow("A", "A-C1", "x", "y", verdict=C.NOT_TESTED)
+    long = " ".join(["word"] * 60) + "."
+    assert len(C.one_sentence("A-C1", long).split()) <= C.MAX_CAUSE_WORDS
+    df = C.frame([C.ClaimRow("A", "A-C1", "x", "y", verdict=C.REPRODUCED)])
+    assert list(df.columns) == C.COLUMNS and C.records(df)[0].verdict == C.REPRODUCED
+
+
+def test_a_replication_that_moves_is_unstable_in_the_table():
+    rep = summary_b(interior={"d_depth": 0.08}, **{"site-tilt": {"d_depth": 0.08}})
+    rows, _, _ = built(rep_b=rep)
+    r = rows["B-C1"]
+    assert r.verdict == C.UNSTABLE and r.verdict_replication == C.NOT_REPRODUCED
+    assert "verdict_main: reproduced" in r.flags and r.ours_replication
+
+
+# ------------------------------------------------------------ amendments
+def test_amendments_are_recomputed_on_the_same_evidence():
+    """Each amendment's verdicts before -> after on this evidence: A-C3's tolerance 200 -> 50
+    samples turns a count 150 samples off from reproduced into not reproduced; A-C7's bound
+    (information -> floor) moves it from not reproducible to depends on a choice."""
+    t1 = table(literal={"err": 1.0, "bound": 0.5, "after": 40.0, "true_theta": 30.0},
+               roll={"after": 40.0, "true_theta": 30.0})
+    t1.loc[t1["case_id"] == "T1-11", "data_to_converge_samples"] = 1350.0
+    am = C.amendments(PLAN, evidence(t1=t1), C.replication_plan(PLAN, {}))
+    assert list(am.columns) == C.AMENDMENT_COLUMNS
+    a3 = am[am["what"].str.startswith("A-C3's tolerance") & (am["claim_id"] == "A-C3")]
+    assert len(a3) == 1 and a3.iloc[0]["verdict_before"] == C.REPRODUCED
+    assert a3.iloc[0]["verdict_after"] in (C.NOT_REPRODUCED, C.WITH_ADDITION)
+    a7 = am[am["what"].str.startswith("A-C7's bound") & (am["claim_id"] == "A-C7")].iloc[0]
+    assert (a7["verdict_before"], a7["verdict_after"]) == (C.NOT_REPRODUCIBLE, C.DEPENDS)
+    from opnav.report.manuscript import prose_tex
+
+    tex = C.amendments_latex(am, PLAN, prose_tex)
+    assert "A-C3" in tex and PLAN.checksum in tex and "2026-12-04" in tex
 
 
 # ------------------------------------------------------------ prose
 def test_abstract_sentence_changes_with_a_verdict():
-    good = C.frame(rows_a(SUMMARY_A, table(), PUB["paper_a"]) + rows_b(summary_b(), PUB["paper_b"]))
-    bad = C.frame(rows_a(SUMMARY_A, table(literal={"err": 10.0, "bound": 20.6}, roll={"err": 8.0}),
-                         PUB["paper_a"]) + rows_b(summary_b(), PUB["paper_b"]))
-    a_good, a_bad = C.abstract(good), C.abstract(bad)
-    first_good, first_bad = a_good.split(". ")[0], a_bad.split(". ")[0]
-    assert first_good != first_bad
-    assert "not reproducible under the stated assumptions" in first_bad and "A-C1;" in first_bad
-    assert "not reproducible" not in first_good
-    assert "20.6" in a_bad  # the bound of the headline claim, with its number
-    assert C.conclusion(good) != C.conclusion(bad)
-
-
-def test_row_rejects_unknown_verdict_missing_name_and_long_causes():
-    with pytest.raises(ValueError, match="verdict"):
-        C.row("A", "A-C0", "c", "p", "reproduced-ish", "x.", "A-T1")
-    with pytest.raises(ValueError, match="named"):
-        C.row("A", "A-C0", "c", "p", C.DEPENDS, "x.", "A-T1")
-    with pytest.raises(ValueError, match="one sentence"):
-        C.row("A", "A-C0", "c", "p", C.REPRODUCED, "One. Two.", "A-T1")
-    with pytest.raises(ValueError, match="words"):
-        C.row("A", "A-C0", "c", "p", C.REPRODUCED, " ".join(["word"] * 60), "A-T1")
-
-
-def test_variants_beyond_the_paper_never_earn_a_verdict_but_are_named():
-    t = table(literal={"err": 10.0, "bound": 20.6}, roll={"err": 8.0, "bound": 9.0})
-    stars = _row("stars", "T1-01", "size", 0.1, err=0.2, bound=0.2)
-    stars["tz_observable"] = True
-    t = pd.concat([t, pd.DataFrame([stars])], ignore_index=True)
-    r = by_id(rows_a(SUMMARY_A, t, PUB["paper_a"]))
-    assert r["A-C1"]["verdict"] == C.NOT_REPRODUCIBLE and r["A-C1"]["best_variant"] == "roll"
-    assert r["A-C9"]["verdict"] == C.REPRODUCED and "stars" in r["A-C9"]["evidence"]
-
-
-def test_claims_summary_finds_the_as_written_row_by_its_fields_not_its_label():
-    """ClaimsSummary.from_json takes the as-written row (literal, plain EM, sliding) by its
-    scenario, method and mode, whatever the key and the order of the rows; what is absent
-    reads as None (N as 0). Mutation tried: dropping the method test picks literal+squarem's
-    5.0 km and fails."""
-    row = {"scenario": "literal", "mode": "sliding"}
-    summ = {"profile_segments": {"N": 50}, "roll_rate": {"config_rate_deg_s": 0.1, "rate_to_target_deg_s": 0.236},
-            "variants": {"literal+squarem": {**row, "method": "squarem", "nav_err_true_theta_km": 5.0},
-                         "literal+growing+squarem": {**row, "mode": "growing", "method": "squarem",
-                                                     "nav_err_true_theta_km": 6.0},
-                         "prior": {**row, "scenario": "prior", "method": "plain", "nav_err_true_theta_km": 7.0},
-                         "any key": {**row, "method": "plain", "nav_err_true_theta_km": 29.4}}}
-    assert ClaimsSummary.from_json(summ) == ClaimsSummary(50.0, 0.236, 0.1, 29.4)
-    assert ClaimsSummary.from_json({}) == ClaimsSummary(0.0, None, None, None)
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        SUMMARY_A.window_samples = 10.0
-
-
-def test_paper_a_claims_refuse_a_summary_dict():
-    """No label-keyed dict crosses into the claims: a raw A-summary dict is refused in one line."""
-    with pytest.raises(TypeError, match="ClaimsSummary.from_json"):
-        rows_a({"profile_segments": {"N": 50}}, table(), PUB["paper_a"])
-
+    rows, _, _ = built()
+    df = C.frame(rows.values())
+    a = C.abstract(df)
+    df2 = df.copy()
+    df2.loc[df2["claim_id"] == "A-C1", "verdict"] = C.NOT_REPRODUCED
+    assert C.abstract(df2) != a and "not reproduced" in C.abstract(df2)

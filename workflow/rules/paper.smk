@@ -38,20 +38,72 @@ SCORE_INPUTS = {
 REPLICATION_INPUTS = dict(REPLICATION_SUMMARIES)
 
 
+from opnav.report.plan import load_plan as _load_plan
+
+_PLAN = _load_plan(str(src("data/analysis_plan.yaml")[0]))
+
+
+rule landing_optima:
+    """B-C8's evidence: local minima of the depth error over the visible angles on each side of
+    the velocity, per recorded planning call of one scenario's depth Monte Carlo (opnav.landing.optima;
+    the grid is the analysis plan's settings.optimum_angle_grid)."""
+    input:
+        mc=lambda wc: b_mc(wc.bscn, ["depth"])[0],
+        plan=src("data/analysis_plan.yaml")[0],
+        code=B_SRC + src("landing/optima.py"),
+    output:
+        f"{LANDING}/optima/{{bscn}}.json",
+    wildcard_constraints:
+        bscn=B_SCN_RE,
+    params:
+        landing=lambda wc: B_SIMS[wc.bscn],
+        n_grid=lambda wc: int(_PLAN.setting("optimum_angle_grid")),
+        max_calls=0,
+    log:
+        f"{LANDING}/logs/optima_{{bscn}}.log",
+    script:
+        "../scripts/landing_optima.py"
+
+
+B_OPTIMA = [f"{LANDING}/optima/{s}.json" for s in B_SCENARIOS] if "B" in SUMMARIES else []
+
+
+#: the claims whose plan entry sweeps a choice for what it would take (one figure each)
+SWEEP_CLAIMS = [cid for cid, t in _PLAN.tests().items() if any(w.kind == "sweep" for w in t.would_take)]
+#: the config keys the plan's settings name (their one home is the plan: the job checks they agree)
+_SETTING_KEYS = {name: s["config"] for name, s in (_PLAN.raw.get("settings") or {}).items()
+                 if isinstance(s, dict) and s.get("config")}
+
+
+def _config_at(key):
+    cur = config
+    for part in key.split("."):
+        cur = cur.get(part, {}) if isinstance(cur, dict) else {}
+    return cur if not isinstance(cur, dict) else None
+
+
 rule paper_claims:
-    """The claims table (one row per published claim, opnav.report.claims) judged by the analysis
-    plan (analysis_plan.csv), the replication sample's verdicts where it was flown, the derived
-    inputs (inputs.csv) and the generated abstract, conclusion and limitations (claims.json)."""
+    """The evidence table (every number a verdict may read, evidence.csv) and the claims table
+    judged on it by the generic scorer against the analysis plan (opnav.report.claims, scorer,
+    plan), with the replication sample where it was flown; the plan's amendments and their
+    verdicts before and after (amendments.csv), the would_take figures, the derived inputs
+    (inputs.csv) and the generated abstract, conclusion and limitations (claims.json)."""
     input:
         **{f"summary_{k}": p for k, p in SUMMARIES.items() if k in ("A", "B")},
         **{k: p for k, p in SCORE_INPUTS.items() if k == "a_table1"},
         **REPLICATION_INPUTS,
+        optima=B_OPTIMA,
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
-        code=src("report/claims.py", "report/approach_claims.py", "report/approach_rows.py", "report/landing_claims.py",
-                 "report/manuscript.py", "core/published.py", "landing/claims_summary.py"),
+        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/evidence.py",
+                 "report/plan.py", "report/scorer.py", "report/would_take_plot.py", "report/manuscript.py",
+                 "core/published.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
+        evidence=f"{PAPER}/evidence.csv",
+        amendments=f"{PAPER}/amendments.csv",
+        amendments_tex=f"{PAPER}/amendments.tex",
+        would_take=[f"{PAPER}/would_take/{cid}.png" for cid in SWEEP_CLAIMS],
         md=f"{PAPER}/claims.md",
         tex=f"{PAPER}/claims_glance.tex",
         detail=f"{PAPER}/claims_detail.tex",
@@ -61,6 +113,8 @@ rule paper_claims:
     params:
         profile=config["profile"],
         replication=canonical(config["replication"]),
+        sweep_claims=SWEEP_CLAIMS,
+        config_settings={k: _config_at(v) for k, v in _SETTING_KEYS.items() if _config_at(v) is not None},
         # the smallest data-to-converge count each EM mode can report (its first window, samples)
         windows={"sliding": config["approach"]["segments"]["N"], "growing": config["approach"]["growing"]["N"]},
         dt_s=config["approach"]["dt_s"],

@@ -47,13 +47,16 @@ with script_context(snakemake) as log:
     # B-C1's margin and same-pick threshold, B-C2's smallest difference: the analysis plan's
     # numbers, their one home
     plan = load_plan(snakemake.input.plan)
-    acc = accuracy_tests(every, snakemake.params.equivalence, float(snakemake.params.converged_pos_err_m),
+    # and (issue 52) B-C2's threshold and its sweep, and the one interval level (alpha = (1 - level) / 2)
+    acc = accuracy_tests(every, {**snakemake.params.equivalence, "alpha": (1.0 - plan.level) / 2.0},
+                         plan.setting("converge_threshold_m"),
                          margin_rel=plan.margin("B-C1", "margin_rel"),
                          same_pick_max_pct=plan.margin("B-C1", "same_pick_max_pct"),
-                         min_difference_s=plan.margin("B-C2", "min_difference_s"))
+                         min_difference_s=plan.margin("B-C2", "min_difference_s"),
+                         thresholds_m=tuple(plan.setting("converge_threshold_sweep_m")))
     out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
                            eval_path=snakemake.params.eval_path,
-                           yaw_ratio=float(snakemake.params.yaw_ratio),
+                           yaw_ratio=plan.margin("B-C3", "yaw_ratio"),  # the plan's, its one home (issue 52)
                            published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
                            accuracy=acc)
     out["tuning"] = load_json(snakemake.input.tuning)        # chosen on a separate seed stream: out["nees"] is held out

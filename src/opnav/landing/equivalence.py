@@ -75,7 +75,7 @@ def _t_interval(d: np.ndarray, level: float) -> tuple[float, float, float, float
 def tost(d, margin: float, alpha: float = 0.05) -> dict:
     """Paired two-one-sided test of ``|mean d| < margin`` (``d``: per-run
     differences, m; ``margin``: m). Returns ``mean``, the ``1 - 2 alpha``
-    interval ``lo``/``hi``, ``p`` (the larger one-sided p-value; equivalence
+    interval ``lo``/``hi`` (its ``level``) and the standard error ``se``, ``p`` (the larger one-sided p-value; equivalence
     shown iff ``p < alpha``), ``equivalent`` (bool), ``margin`` and ``n``.
     Zero spread: equivalent iff ``|mean| < margin``. A margin <= 0 is never
     met."""
@@ -94,7 +94,7 @@ def tost(d, margin: float, alpha: float = 0.05) -> dict:
         p = max(p_low, p_high)
     ok = margin > 0.0 and p < alpha
     return {"mean": m, "lo": lo, "hi": hi, "p": p, "equivalent": bool(ok), "margin": margin,
-            "n": int(d.size)}
+            "n": int(d.size), "se": se, "level": 1.0 - 2.0 * alpha}
 
 
 def margins(means: dict[str, float], reference: str, margin_rel: float) -> dict:
@@ -162,7 +162,7 @@ def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float 
     """Paired comparison of the first times below ``threshold_m`` (s; NaN:
     never) of methods ``a`` and ``b`` on the same runs: mean of ``t_a - t_b``
     over the runs where both get there, its two-sided ``1 - alpha`` paired-t
-    interval (s), the runs used, and ``verdict``: "faster" (interval below 0
+    interval (s, its ``level``, the standard error ``se_s``), the runs used, and ``verdict``: "faster" (interval below 0
     and mean at most ``-min_difference_s``: ``a`` converges faster by at least
     that, s; the analysis plan's B-C2 number, passed in), "slower" (the mirror)
     or "no difference shown"."""
@@ -172,15 +172,16 @@ def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float 
     both = np.isfinite(t_a) & np.isfinite(t_b)
     d = t_a[both] - t_b[both]
     if d.size < 2:
-        m, lo, hi = (float(d.mean()) if d.size else math.nan), math.nan, math.nan
+        m, se, lo, hi = (float(d.mean()) if d.size else math.nan), math.nan, math.nan, math.nan
     else:
-        m, _, lo, hi = _t_interval(d, 1.0 - alpha)
+        m, se, lo, hi = _t_interval(d, 1.0 - alpha)
     step = float(min_difference_s)
     if not (math.isfinite(step) and step >= 0.0):
         raise ValueError(f"converges_faster: min_difference_s must be >= 0 s, got {min_difference_s!r}")
     verdict = ("faster" if hi < 0 and m <= -step else "slower" if lo > 0 and m >= step
                else "no difference shown")
-    return {"mean_s": m, "lo_s": lo, "hi_s": hi, "n_runs": int(d.size), "n_total": int(t_a.size),
+    return {"mean_s": m, "lo_s": lo, "hi_s": hi, "se_s": se, "level": 1.0 - alpha, "versus": b,
+            "n_runs": int(d.size), "n_total": int(t_a.size),
             "threshold_m": float(threshold_m), "min_difference_s": step, "verdict": verdict,
             "text": (f"first time below {threshold_m:g} m, {a} minus {b}: {m:+.3g} s "
                      f"[{lo:+.3g}, {hi:+.3g}] ({100 * (1 - alpha):.0f} % paired interval, "

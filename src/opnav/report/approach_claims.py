@@ -1,494 +1,225 @@
-"""Paper A's claims (EM-EKF camera misalignment), each scored over our variants.
+"""Paper A's evidence (EM-EKF camera misalignment): every number A-T1 and A-summary.json hold
+that a claim may read, as :class:`opnav.report.evidence.EvidenceRow` rows, with no verdict logic.
 
-Inputs: what the claims read of A-summary.json (:class:`opnav.approach.summaries.ClaimsSummary`), the A-T1 frame
-(:func:`opnav.approach.summaries.table1_frame`, read from its CSV), the published values
-(``published.paper_a()``) and the analysis plan (:func:`opnav.report.claims.load_plan`),
-which holds every margin and threshold a verdict uses. Output: claims-table rows
-(:func:`opnav.report.claims.row`).
+:func:`evidence_rows` reads one sample's A-T1 table (one row per Table-1 case x variant x EM
+scheme: ``scope`` the case id, ``method`` the variant label) and A-summary.json, and writes per
+row:
 
-Variants (the A-T1 ``variant`` label): ``literal`` is the paper as written (plain EM on
-sliding segments, EM starting from the filter's estimate); every other scenario or scheme
-adds something the paper does not state (:func:`opnav.report.approach_rows.addition`); ``reference-start`` gives the
-E-step the true state and is a diagnostic, never "reproduced".
+* ``rms_err_arcsec``: RMS error of the estimate about the truth over the seeds, the larger of
+  theta_x and theta_y (se about rms / sqrt(2 n)), arcsec;
+* ``crlb_arcsec`` / ``crlb_q0_arcsec`` (role ``bound``): the bound of the data the estimate used,
+  larger axis (with Q = 0), arcsec;
+* ``converged_label`` (1: the row's label reads converged) and ``converged_seeds_frac``;
+* ``data_to_converge_samples`` and ``data_beyond_first_window_samples`` (the count less the
+  first window of the row's scheme: at or below 0 the count only restates the window);
+* ``nav_err_before_km`` / ``nav_err_after_km`` (mean over seeds, se from their sd) and
+  ``nav_err_true_theta_km`` (role ``bound``: the filter given the true theta, a floor);
+* ``tz_observable`` (1: the M-step finds tz observable); ``nees_pos_*`` (evidence only);
+
+and from A-summary.json the bound after the published data against the roll rate
+(``crlb_published_data_arcsec``, ``setting roll_rate_deg_s=...``), the navigation error against
+the arc length (``nav_err_after_km``, ``nav_err_true_theta_km``, ``setting arc_s=...``), the tz
+effect on navigation (``nav_err_tz_ratio``), the installation flag
+(``installation_by_construction``) and the NEES comparison. :func:`published_rows` writes
+published.yaml's paper-A values the claims quote (role ``published``).
+
+Roles from the variant label: ``literal`` as written, ``reference-start...`` diagnostic,
+``stars...`` beyond, every other label faithful (it adds something the paper does not state).
 Units: arcsec, km, samples.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Mapping
 from typing import Any
 
 import pandas as pd
 
-from opnav.approach.summaries import AS_WRITTEN, ClaimsSummary
-from opnav.report import claims as C
-from opnav.report.approach_rows import (
-    addition,
-    bound_arcsec,
-    bound_text,
-    converged_seeds,
-    headline_row,
-    is_beyond,
-    label_text,
-    rms_err_arcsec,
-    run_label,
-    short_addition,
-    truthy,
-    variant_labels,
-    variant_outcome,
-    variant_rows,
-    worst_vs_bound,
-)
-from opnav.report.claims import Outcome, Plan, fmt, join
+from opnav.approach.summaries import AS_WRITTEN
+from opnav.report.evidence import NAN, EvidenceRow, quantity, rms_se
+from opnav.report.plan import Plan
+
+DIAGNOSTIC = "reference-start"
+BEYOND = ("stars",)
+HEADLINE_CASE = "T1-01"
+
+quantity("rms_err_arcsec", "arcsec", "rms", "RMS error")
+quantity("crlb_arcsec", "arcsec", "none", "bound of the data used")
+quantity("crlb_q0_arcsec", "arcsec", "none", "bound of the data used with Q = 0")
+quantity("crlb_published_data_arcsec", "arcsec", "none", "bound after the published data")
+quantity("converged_label", "", "none", "converged label")
+quantity("converged_seeds_frac", "", "none", "share of seeds converged")
+quantity("data_to_converge_samples", "samples", "none", "data to converge")
+quantity("data_beyond_first_window_samples", "samples", "none", "data to converge beyond the first window")
+quantity("nav_err_before_km", "km", "mean", "navigation error before compensation")
+quantity("nav_err_after_km", "km", "mean", "navigation error after compensation")
+quantity("nav_err_true_theta_km", "km", "none", "navigation error with the true theta")
+quantity("tz_observable", "", "none", "tz observable")
+quantity("nav_err_tz_ratio", "", "none", "navigation error with tz over without")
+quantity("installation_by_construction", "", "none", "installation cases identical by construction")
+quantity("nees_pos_after_mean", "", "none", "position NEES compensated")
+quantity("nees_pos_consider_mean", "", "none", "position NEES of the consider filter")
+quantity("nees_pos_true_theta_mean", "", "none", "position NEES with the true theta")
+quantity("nees_mean", "", "none", "position NEES")
+quantity("reference_nees_mean", "", "none", "position NEES of the true-theta filter")
+for _q, _t in (("accuracy_claim_arcsec", "claimed accuracy"), ("est_error_x_arcsec", "published error in theta_x"),
+               ("est_error_y_arcsec", "published error in theta_y"), ("est_error_arcsec", "published error"),
+               ("intro_nav_err_km", "introduction's navigation error"),
+               ("intro_misalignment_arcsec", "introduction's misalignment")):
+    quantity(_q, "km" if _q.endswith("_km") else "arcsec", "none", _t)
 
 
-def _bound_rule(plan: Plan, claim_id: str, blocks: str) -> str:
-    """``blocks`` (an information bound excluding the claim) only where the plan says the
-    claim has one (``bound: information``): elsewhere no bound may make it not reproducible."""
-    return blocks if plan.entry(claim_id).get("bound") == "information" else ""
+def role_of(label: str) -> str:
+    """The role of a variant label (module docstring)."""
+    head = label.split("+")[0]
+    if label == AS_WRITTEN:
+        return "as_written"
+    if head == DIAGNOSTIC:
+        return "diagnostic"
+    if head in BEYOND:
+        return "beyond"
+    return "faithful"
 
 
-def _small_sample(t1: pd.DataFrame, plan: Plan) -> list:
-    n = int(variant_rows(t1, AS_WRITTEN)["n_seeds"].min()) if len(variant_rows(t1, AS_WRITTEN)) else 0
-    return [("sample_too_small", f"{n} seeds")] if n < plan.guard("min_full_seeds") else []
+def _f(x: Any) -> float:
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return NAN
 
 
-def _suspect_cause(d: C.Decision, outs: Mapping[str, Outcome]) -> str:
-    o = max((o for o in outs.values() if not o.diagnostic and math.isfinite(o.bound)),
-            key=lambda o: o.bound / max(o.err, 1e-300))
-    return (f"{o.label} ends at {fmt(o.err)} arcsec, {fmt(o.bound / max(o.err, 1e-300), 2)} times below the "
-            f"{fmt(o.bound)} arcsec bound of the data it uses, which points to a leak or a bug, not to reproduction")
+def _truthy(x: Any) -> bool:
+    return x if isinstance(x, bool) else str(x).strip().lower() in ("true", "1", "1.0")
 
 
-def _roll_would_take(summary: ClaimsSummary, head_pub: Mapping[str, Any], target: float) -> str:
-    need = summary.roll_rate_to_target_deg_s
-    if need is None:
-        return ""
-    return (f"a roll rate of {fmt(need)} deg/s, at which the bound reaches {target:g} arcsec within "
-            f"{fmt(head_pub['data_to_converge_samples'])} samples (ours: {fmt(summary.roll_rate_config_deg_s)} deg/s)")
+def _label(r) -> str:
+    lab = r.get("label")
+    if isinstance(lab, str) and lab:
+        return lab
+    return "stalled" if _truthy(r.get("stalled")) else "converged"
 
 
-def _roll_clause(d: C.Decision, summary: ClaimsSummary, head_pub: Mapping[str, Any], target: float) -> str:
-    """The cause's clause on what it would take (the measured roll rate), where the bound of
-    the as-written data excludes the claim."""
-    need = summary.roll_rate_to_target_deg_s
-    if need is None or d.verdict != C.NOT_REPRODUCIBLE:
-        return ""
-    return (f"; a {fmt(need)} deg/s boresight roll would bound it at {target:g} arcsec in "
-            f"{fmt(head_pub['data_to_converge_samples'])} samples")
+def _converged_seeds(r) -> int:
+    c = r.get("converged_seeds")
+    if c is not None and not pd.isna(c):
+        return int(c)
+    return int(r["n_seeds"]) - int(r.get("stalled_seeds", 0) or 0)
 
 
-def _result(paper_row: dict, d: C.Decision, **kw) -> dict:
-    if d.smallest is not None and not kw.get("would_take"):
-        kw["would_take"] = f"{short_addition(d.smallest.label)} ({d.smallest.label}, the smallest addition that gives it)"
-    return C.row(**paper_row, verdict=d.verdict, named=d.named, flags=d.flags + kw.pop("flags", []),
-                 ours_as_written=d.lit.text if d.lit else "", ours_best=d.best.text if d.best else "",
-                 best_variant=d.best.label if d.best else "", **kw)
+def evidence_rows(t1: pd.DataFrame, summary: Mapping[str, Any] | None, sample: str, source_t1: str,
+                  source_summary: str = "", windows: Mapping[str, float] | None = None) -> list[EvidenceRow]:
+    """Every evidence row of one sample's A-T1 (``t1``) and A-summary.json (``summary``);
+    ``windows``: the first window (samples) of each EM mode (sliding: N, growing: its N)."""
+    rows: dict[tuple, EvidenceRow] = {}
+    windows = dict(windows or {})
 
+    def add(scope, method, q, est, *, n=0, se=NAN, role=None, src=source_t1, where="", setting="", unit=None,
+            lo=NAN, hi=NAN, level=NAN):
+        from opnav.report.evidence import QUANTITIES
 
-# ------------------------------------------------------------ accuracy claims
-def accuracy_outcome(r, target: float, name: str) -> Outcome:
-    """Accuracy as accuracy: RMS error about the truth over the seeds, per axis, must be
-    within ``target`` and the run must have converged (label from the data)."""
-    ex, ey = float(r["rmse_x_arcsec"]), float(r["rmse_y_arcsec"])
-    conv = run_label(r) == "converged"
-    err = max(ex, ey)
-    text = f"RMS error {fmt(ex)}, {fmt(ey)} arcsec ({label_text(r)})"
-    return variant_outcome(name, conv and err <= target, text, score=err, err=err, bound=bound_arcsec(r), n=int(r["n_seeds"]))
+        key = (scope, method, q, setting)
+        if key in rows:
+            return
+        rows[key] = EvidenceRow(claim_id="", sample=sample, scope=scope, method=method, versus="",
+                                role=role or role_of(method), quantity=q, estimate=_f(est), lo=_f(lo), hi=_f(hi),
+                                level=_f(level), n=int(n or 0), unit=QUANTITIES[q].unit if unit is None else unit,
+                                source=f"{src}#{where}" if where else src, se=_f(se), setting=setting)
 
-
-def _accuracy_cause(d: C.Decision, outs, target: float, lit_bound: float, what: str,
-                    lit_err: float | None = None, best_err: float | None = None) -> str:
-    """One sentence: why the verdict (numbers only; the variants' texts are in their columns).
-    ``lit_err``/``best_err``: the errors to quote (default: the outcomes' own)."""
-    if d.verdict == C.SUSPECT:
-        return _suspect_cause(d, outs)
-    le = lit_err if lit_err is not None else (d.lit.err if d.lit is not None else math.nan)
-    lit = f"{fmt(le)} arcsec" if math.isfinite(le) else "no estimate"
-    if d.verdict == C.REPRODUCED:
-        return f"As written EM reaches {what} ({lit} RMS), and the data it uses allow it (bound {fmt(lit_bound)} arcsec)"
-    if d.verdict == C.NOT_REPRODUCIBLE:
-        return (f"The data the as-written EM uses bound the error at {fmt(lit_bound)} arcsec, above the claimed "
-                f"{target:g} arcsec, so no unbiased estimator on the stated data reaches it")
-    if d.verdict == C.WITH_ADDITION:
-        be = best_err if best_err is not None else d.best.err
-        reason = (f"its data bound the error at {fmt(lit_bound)} arcsec" if lit_bound > target
-                  else "the estimator falls short of its data")
-        return (f"As written EM misses {what} ({lit} RMS) because {reason}, while {d.best.label} reaches it "
-                f"({fmt(be)} arcsec) by adding {short_addition(d.best.label)}")
-    if lit_bound > target:
-        return (f"As written EM ({lit} RMS) and every faithful variant miss {what}, and the data as written "
-                f"bound the error at {fmt(lit_bound)} arcsec")
-    return (f"As written EM ({lit} RMS) and every faithful variant miss {what}, though the as-written bound "
-            f"({fmt(lit_bound)} arcsec) allows it: the estimator falls short")
-
-
-def _claim_headline_accuracy(t1, head_pub, summary, plan: Plan) -> dict:
-    cid = "A-C1"
-    target = plan.margin(cid, "target_arcsec")
-    truth = head_pub["truth_arcsec"]
-    pe = (abs(head_pub["est_x_arcsec"] - truth[0]), abs(head_pub["est_y_arcsec"] - truth[1]))
-    outs = {v: accuracy_outcome(headline_row(t1, v), target, v) for v in variant_labels(t1) if headline_row(t1, v) is not None}
-    lit = headline_row(t1, AS_WRITTEN)
-    lit_bound = bound_arcsec(lit)
-    blocks = (f"CRLB {fmt(lit_bound)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
-              if lit_bound > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
-    cause = _accuracy_cause(d, outs, target, lit_bound, f"{target:g} arcsec") + _roll_clause(d, summary, head_pub, target)
-    wt = "" if d.verdict == C.REPRODUCED else _roll_would_take(summary, head_pub, target)
-    return _result(dict(paper="A", claim_id=cid, claim=f"Accuracy better than {target:g} arcsec (headline case, truth "
-                        f"({truth[0]:g}, {truth[1]:g}) arcsec)",
-                        published=f"< {target:g} arcsec (errors {fmt(pe[0])}, {fmt(pe[1])} arcsec)"),
-                   d, cause=cause, evidence="A-T1, A-X1, A-F4", bound=bound_text(lit), would_take=wt,
-                   flags=_small_sample(t1, plan))
-
-
-def _claim_table_accuracy(t1, pub_rows, plan: Plan) -> dict:
-    cid = "A-C2"
-    target = plan.margin(cid, "target_arcsec")
-    pub = pd.DataFrame(pub_rows).set_index("case_id")
-    pub_err = []
-    for _, p in pub.iterrows():
-        tr = p["bias_arcsec"] if isinstance(p.get("bias_arcsec"), list) else [10.0, 20.0, 10.0]
-        pub_err.append(max(abs(p["est_x_arcsec"] - tr[0]), abs(p["est_y_arcsec"] - tr[1])))
-    pmax = max(pub_err)
-    outs = {}
-    for v in variant_labels(t1, full_only=True):
-        g = variant_rows(t1, v)
-        errs = g.apply(rms_err_arcsec, axis=1)
-        st = g.apply(run_label, axis=1) != "converged"
-        ok_cases = int(((errs <= target) & ~st).sum())
-        text = (f"largest RMS error {fmt(errs.max())} arcsec; {ok_cases} of {len(g)} cases within {target:g} arcsec"
-                + (f", {int(st.sum())} not converged" if st.any() else ""))
-        e, b, n = worst_vs_bound(g)
-        outs[v] = variant_outcome(v, ok_cases == len(g), text, score=-ok_cases + errs.max() / 1e6, err=e, bound=b, n=n)
-    lit = variant_rows(t1, AS_WRITTEN)
-    lb = float(lit[["crlb_x_arcsec", "crlb_y_arcsec"]].astype(float).min(axis=None))
-    blocks = (f"CRLB at least {fmt(lb)} arcsec in every case (data used), above {target:g} arcsec"
-              if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
-    worst = {v: float(variant_rows(t1, v).apply(rms_err_arcsec, axis=1).max()) for v in outs}
-    cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec in every case", lit_err=worst.get(AS_WRITTEN),
-                            best_err=worst.get(d.best.label) if d.best is not None else None)
-    return _result(dict(paper="A", claim_id=cid, claim="Accuracy unaffected by misalignment size, polarity, EM start "
-                        f"and installation (Table 1, {len(pub)} cases)",
-                        published=f"all {len(pub)} cases within {fmt(pmax)} arcsec"),
-                   d, cause=cause, evidence="A-T1", bound=f"CRLB >= {fmt(lb)} arcsec (as written, data used)",
-                   flags=_small_sample(t1, plan))
-
-
-def _claim_pixel_accuracy(t1, plan: Plan) -> dict:
-    """Worse pixels do not affect the accuracy: every pixel case within the target."""
-    cid = "A-C10"
-    target = plan.margin(cid, "target_arcsec")
-    pix = t1[t1["group"] == "pixel"] if "group" in t1.columns else t1.iloc[0:0]
-    claim = "Worse pixels do not affect the accuracy (Table 1 pixel cases)"
-    outs = {}
-    for v in variant_labels(t1, full_only=True):
-        g = pix[pix["variant"] == v].sort_values("pixel_sigma3_px")
-        if len(g) < 2:
-            continue
-        errs = g.apply(rms_err_arcsec, axis=1)
-        st = g.apply(run_label, axis=1) != "converged"
-        px = ", ".join(f"{p:g}" for p in g["pixel_sigma3_px"].astype(float))
-        text = f"RMS error {', '.join(fmt(e) for e in errs)} arcsec at {px} px" + (
-            f" ({int(st.sum())} not converged)" if st.any() else "")
-        e, b, n = worst_vs_bound(g)
-        outs[v] = variant_outcome(v, bool(((errs <= target) & ~st).all()), text, score=float(errs.max()), err=e, bound=b, n=n)
-    if not outs:
-        return C.row("A", cid, claim, f"within {target:g} arcsec at 0.1 to 1 px", C.NOT_TESTED,
-                     "No pixel cases were run in this profile.", "A-T1", named="no pixel cases in this profile")
-    lit = pix[pix["variant"] == AS_WRITTEN]
-    lb = max([bound_arcsec(r) for _, r in lit.iterrows()], default=math.nan)
-    blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
-              if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
-    worst = {v: float(pix[pix["variant"] == v].apply(rms_err_arcsec, axis=1).max()) for v in outs}
-    cause = _accuracy_cause(d, outs, target, lb, f"{target:g} arcsec at every pixel accuracy",
-                            lit_err=worst.get(AS_WRITTEN),
-                            best_err=worst.get(d.best.label) if d.best is not None else None)
-    return _result(dict(paper="A", claim_id=cid, claim=claim, published=f"within {target:g} arcsec at 0.1, 0.5 and 1 px"),
-                   d, cause=cause, evidence="A-T1, A-X3",
-                   bound=f"CRLB up to {fmt(lb)} arcsec (as written, data used)" if not math.isnan(lb) else "",
-                   flags=_small_sample(t1, plan))
-
-
-# ------------------------------------------------------------ data to converge
-def _first_window(r, windows: Mapping[str, float]) -> float:
-    """The smallest count a row's scheme can report: its first window (samples)."""
-    mode = r.get("mode") if hasattr(r, "get") else None
-    mode = mode if isinstance(mode, str) and mode else "sliding"
-    return float(windows.get(mode, windows.get("sliding", 0.0)))
-
-
-def _data_outcome(g: pd.DataFrame, tol: float, target: float, windows: Mapping[str, float], label: str) -> Outcome:
-    """A count is evidence only where the run converged, the data can tell the
-    misalignment (bound within the target) and the count is above the first window."""
-    st = g.apply(run_label, axis=1) != "converged"
-    blind = g.apply(bound_arcsec, axis=1) > target
-    ours = g["data_to_converge_samples"].astype(float)
-    floor = g.apply(lambda r: _first_window(r, windows), axis=1)
-    coarse = ours <= floor
-    pub = g["pub_data_to_converge_samples"].astype(float)
-    ok = (~st) & (~blind) & (~coarse) & ((ours - pub).abs() <= tol)
-    why = [f"{int(st.sum())} not converged" if st.any() else "",
-           f"{int(blind.sum())} on data whose bound exceeds {target:g} arcsec" if blind.any() else "",
-           f"{int((coarse & ~st).sum())} at the first window ({fmt(floor.max())} samples)" if (coarse & ~st).any() else ""]
-    text = f"{int(ok.sum())} of {len(g)} cases within {tol:g} samples" + (
-        f" ({'; '.join(w for w in why if w)})" if any(why) else "")
-    return variant_outcome(label, bool(ok.all()), text, score=-float(ok.sum()))
-
-
-def _claim_data(t1, windows: Mapping[str, float], plan: Plan) -> dict:
-    cid = "A-C3"
-    tol, target = plan.margin(cid, "tolerance_samples"), plan.margin(cid, "target_arcsec")
-    lit = variant_rows(t1, AS_WRITTEN)
-    outs = {v: _data_outcome(variant_rows(t1, v), tol, target, windows, v) for v in variant_labels(t1, full_only=True)}
-    d = C.decide(outs, AS_WRITTEN, addition)
-    pub = lit["pub_data_to_converge_samples"].astype(float)
-    if d.verdict == C.REPRODUCED:
-        cause = (f"As written EM needs the published data to within {tol:g} samples in every case, on data that "
-                 "can tell the misalignment")
-    elif d.verdict == C.WITH_ADDITION:
-        cause = (f"The as-written counts are not evidence in every case, while {d.best.label} matches every case "
-                 f"to within {tol:g} samples on data that can tell the misalignment")
+    for _, r in t1.iterrows():
+        v, case, n = str(r["variant"]), str(r["case_id"]), int(r["n_seeds"])
+        w = f"variant={v},case_id={case}"
+        rms = max(_f(r["rmse_x_arcsec"]), _f(r["rmse_y_arcsec"]))
+        add(case, v, "rms_err_arcsec", rms, n=n, se=rms_se(rms, n), where=f"{w}:rmse_x/y_arcsec")
+        add(case, v, "crlb_arcsec", max(_f(r["crlb_x_arcsec"]), _f(r["crlb_y_arcsec"])), n=n, role="bound",
+            where=f"{w}:crlb_x/y_arcsec")
+        if "crlb_q0_x_arcsec" in r and not pd.isna(r["crlb_q0_x_arcsec"]):
+            add(case, v, "crlb_q0_arcsec", max(_f(r["crlb_q0_x_arcsec"]), _f(r["crlb_q0_y_arcsec"])), n=n,
+                role="bound", where=f"{w}:crlb_q0_x/y_arcsec")
+        add(case, v, "converged_label", 1.0 if _label(r) == "converged" else 0.0, n=n, where=f"{w}:label")
+        add(case, v, "converged_seeds_frac", _converged_seeds(r) / n if n else NAN, n=n, where=f"{w}:converged_seeds")
+        dd = _f(r.get("data_to_converge_samples"))
+        add(case, v, "data_to_converge_samples", dd, n=_converged_seeds(r), where=f"{w}:data_to_converge_samples")
+        mode = r.get("mode") if isinstance(r.get("mode"), str) and r.get("mode") else "sliding"
+        first = _f(windows.get(mode, windows.get("sliding", NAN)))
+        if math.isfinite(first):
+            add(case, v, "data_beyond_first_window_samples", dd - first, n=_converged_seeds(r),
+                where=f"{w}:data_to_converge_samples - first window {first:g} ({mode})")
+        for q in ("nav_err_before_km", "nav_err_after_km"):
+            sd = _f(r.get(f"{q}_std"))
+            add(case, v, q, r[q], n=n, se=sd / math.sqrt(n) if n else NAN, where=f"{w}:{q}")
+        if "nav_err_true_theta_km" in r and not pd.isna(r["nav_err_true_theta_km"]):
+            add(case, v, "nav_err_true_theta_km", r["nav_err_true_theta_km"], n=n, role="bound",
+                where=f"{w}:nav_err_true_theta_km")
+        add(case, v, "tz_observable", 1.0 if _truthy(r["tz_observable"]) else 0.0, n=n, where=f"{w}:tz_observable")
+        for q in ("nees_pos_after_mean", "nees_pos_consider_mean", "nees_pos_true_theta_mean"):
+            if q in r and not pd.isna(r[q]):
+                add(case, v, q, r[q], n=n, where=f"{w}:{q}")
+    s = summary or {}
+    src = source_summary
+    rb = s.get("roll_rate_bound")
+    rr = s.get("roll_rate") or {}
+    if rb:
+        pairs, where = zip(rb.get("rate_deg_s") or [], rb.get("bound_arcsec") or []), "roll_rate_bound"
     else:
-        cause = ("No variant's counts are evidence in every case: a count on data that cannot tell the "
-                 "misalignment, or at the first window, measures EM, not the data needed")
-    return _result(dict(paper="A", claim_id=cid, claim="Data to converge per case (Table 1 column)",
-                        published=f"{fmt(pub.min())} to {fmt(pub.max())} samples (250 in the headline case)"),
-                   d, cause=cause, evidence="A-T1, A-F4", flags=_small_sample(t1, plan))
-
-
-def _claim_little_data(t1, head_pub, summary, plan: Plan) -> dict:
-    """Little data and stable convergence: every seed converged, within ``data_factor``
-    times the published data, *to the misalignment* (RMS error within the claimed
-    accuracy): converging to an estimate the data cannot identify is not the claim."""
-    cid = "A-C4"
-    factor, target = plan.margin(cid, "data_factor"), plan.margin(cid, "target_arcsec")
-    pub_n = float(head_pub["data_to_converge_samples"])
-    outs = {}
-    for v in variant_labels(t1):
-        r = headline_row(t1, v)
-        if r is None:
+        pairs, where = zip(rr.get("rates_deg_s") or [], rr.get("bound_at_samples_arcsec") or []), \
+            "roll_rate.bound_at_samples_arcsec"
+    for rate, b in pairs:
+        add(HEADLINE_CASE, "roll", "crlb_published_data_arcsec", b, role="faithful", src=src, where=where,
+            setting=f"roll_rate_deg_s={_f(rate):g}")
+    nf = s.get("nav_floor_by_arc") or {}
+    for row in nf.get("rows") or []:
+        arc, v, n = _f(row.get("arc_s")), str(row.get("variant", AS_WRITTEN)), int(row.get("n_seeds") or 0)
+        for rule, suffix in (("", "rule"), (";rule=last", "last")):
+            st = f"arc_s={arc:g}{rule}"
+            add(HEADLINE_CASE, v, "nav_err_after_km", row.get(f"nav_err_km_{suffix}"), n=n, src=src, setting=st,
+                where=f"nav_floor_by_arc.rows(arc_s={arc:g},variant={v}).nav_err_km_{suffix}")
+            add(HEADLINE_CASE, v, "nav_err_true_theta_km", row.get(f"true_theta_km_{suffix}"), n=n, role="bound",
+                src=src, setting=st, where=f"nav_floor_by_arc.rows(arc_s={arc:g},variant={v}).true_theta_km_{suffix}")
+    tz = s.get("tz_nav_effect") or {}
+    on, off = _f(tz.get("nav_err_km_tz_on")), _f(tz.get("nav_err_km_tz_off"))
+    if math.isfinite(on) and math.isfinite(off) and off > 0:
+        add(HEADLINE_CASE, str(tz.get("variant", AS_WRITTEN)), "nav_err_tz_ratio", on / off,
+            n=int(tz.get("n_seeds") or 0), src=src, where="tz_nav_effect.nav_err_km_tz_on / nav_err_km_tz_off")
+    inst = s.get("installation") or {}
+    if "by_construction" in inst:
+        add("", AS_WRITTEN, "installation_by_construction", 1.0 if inst["by_construction"] else 0.0, src=src,
+            where="installation.by_construction")
+    for v, ne in (s.get("nees") or {}).items():
+        if not isinstance(ne, Mapping):
             continue
-        st = int(r["n_seeds"]) - converged_seeds(r)
-        dd = float(r["data_to_converge_samples"]) if not pd.isna(r["data_to_converge_samples"]) else math.nan
-        err = rms_err_arcsec(r)
-        ok = st == 0 and not math.isnan(dd) and dd <= factor * pub_n and err <= target
-        text = (label_text(r) + (f" after {fmt(dd)} samples" if not math.isnan(dd) else "")
-                + f", RMS error {fmt(err)} arcsec")
-        outs[v] = variant_outcome(v, ok, text, score=st * 1e6 + (1e5 if math.isnan(dd) else dd), err=err, bound=bound_arcsec(r),
-                           n=int(r["n_seeds"]))
-    lit = headline_row(t1, AS_WRITTEN)
-    lb = bound_arcsec(lit)
-    blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
-              if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks), plan=plan)
-    cause = (_accuracy_cause(d, outs, target, lb, f"{target:g} arcsec within {factor:g} x {fmt(pub_n)} samples")
-             + _roll_clause(d, summary, head_pub, target))
-    wt = "" if d.verdict == C.REPRODUCED else _roll_would_take(summary, head_pub, target)
-    return _result(dict(paper="A", claim_id=cid, claim="Little data, stable convergence (headline case)",
-                        published=f"{fmt(pub_n)} samples, converged"),
-                   d, cause=cause, evidence="A-T1, A-X1, A-F4", bound=bound_text(lit), would_take=wt,
-                   flags=_small_sample(t1, plan))
+        for q in ("nees_mean", "reference_nees_mean"):
+            if ne.get(q) is not None:
+                add(HEADLINE_CASE, str(v), q, ne[q], n=int(ne.get("n_seeds") or 0), src=src, where=f"nees.{v}.{q}")
+    return list(rows.values())
 
 
-def _claim_pixels(t1, plan: Plan) -> dict:
-    cid = "A-C5"
-    target = plan.margin(cid, "target_arcsec")
-    pix = t1[t1["group"] == "pixel"] if "group" in t1.columns else t1.iloc[0:0]
-    outs = {}
-    for v in variant_labels(t1, full_only=True):
-        g = pix[pix["variant"] == v].sort_values("pixel_sigma3_px")
-        if len(g) < 2:
-            continue
-        labs = g.apply(run_label, axis=1).tolist()
-        st = [lab != "converged" for lab in labs]
-        dd = g["data_to_converge_samples"].astype(float).tolist()
-        # where the bound of the data used exceeds the target, EM converges to an ML the data
-        # cannot tell from zero: its sample count says how fast EM contracts, not how much
-        # data the misalignment needs
-        bounds = [bound_arcsec(r) for _, r in g.iterrows()]
-        blind = [b > target for b in bounds]
-        inc = not any(st) and not any(blind) and all(b > a for a, b in itertools.pairwise(dd))
-        px = ", ".join(f"{p:g}" for p in g["pixel_sigma3_px"].astype(float))
-        text = (f"{', '.join(lab if s else fmt(x) for lab, s, x in zip(labs, st, dd))} samples at {px} px"
-                + (f" (bound {', '.join(fmt(b) for b in bounds)} arcsec, above {target:g} arcsec: not identifiable)"
-                   if any(blind) else ""))
-        outs[v] = variant_outcome(v, inc, text, score=float(sum(st) + sum(blind)))
-    pub = pix[pix["variant"] == AS_WRITTEN].sort_values("pixel_sigma3_px")
-    pub_txt = (", ".join(fmt(x) for x in pub["pub_data_to_converge_samples"].astype(float)) + " samples at "
-               + ", ".join(f"{p:g}" for p in pub["pixel_sigma3_px"].astype(float)) + " px")
-    claim = "Worse pixels need more data (Table 1 pixel cases)"
-    if not outs:
-        return C.row("A", cid, claim, pub_txt, C.NOT_TESTED, "No pixel cases were run in this profile.", "A-T1",
-                     named="no pixel cases in this profile")
-    lit = pix[pix["variant"] == AS_WRITTEN]
-    lb = max([bound_arcsec(r) for _, r in lit.iterrows()], default=math.nan)
-    blocks = (f"CRLB {fmt(lb)} arcsec of the data the as-written EM uses, above the claimed {target:g} arcsec"
-              if lb > target else "")
-    d = C.decide(outs, AS_WRITTEN, addition, _bound_rule(plan, cid, blocks))
-    if d.verdict == C.REPRODUCED:
-        cause = "As written EM needs more data for each worse pixel accuracy, on data that can tell the misalignment"
-    elif d.verdict == C.NOT_REPRODUCIBLE:
-        cause = (f"At the worse pixel accuracies the as-written data bound the error at {fmt(lb)} arcsec, above "
-                 f"{target:g} arcsec, so its sample counts measure EM's contraction, not the data needed")
-    elif d.verdict == C.WITH_ADDITION:
-        cause = (f"The as-written counts are not evidence, while {d.best.label} needs more data for each "
-                 "worse pixel accuracy on identifiable data")
-    else:
-        cause = "No variant needs strictly more data for each worse pixel accuracy on data that can tell the misalignment"
-    return _result(dict(paper="A", claim_id=cid, claim=claim, published=pub_txt), d, cause=cause,
-                   evidence="A-T1, A-X1, A-X3",
-                   bound=(f"CRLB {fmt(lb)} arcsec (as written, data used)" if not math.isnan(lb) else ""),
-                   flags=_small_sample(t1, plan))
+def published_rows(pub: Mapping[str, Any], source: str = "published.yaml") -> list[EvidenceRow]:
+    """Paper A's published values the claims quote (role published): per Table-1 case the data
+    to converge, the navigation errors and the estimate's error; the headline's claims."""
+    out = []
 
+    def add(scope, q, v, where):
+        from opnav.report.evidence import QUANTITIES
 
-# ------------------------------------------------------------ navigation error
-def _claim_nav_before(t1, head_pub, sim, plan: Plan) -> dict:
-    cid = "A-C6"
-    rel, k, wide = plan.margin(cid, "rel_tol"), plan.margin(cid, "spread_k"), plan.margin(cid, "max_band_rel")
-    outs = {}
-    for v in variant_labels(t1, full_only=True):
-        g = variant_rows(t1, v)
-        ok = []
-        for _, r in g.iterrows():
-            p, o = float(r["pub_nav_err_before_km"]), float(r["nav_err_before_km"])
-            sd = float(r.get("nav_err_before_km_std", math.nan))
-            band = k * sd if math.isfinite(sd) else 0.0
-            # inside a band wider than max_band_rel x the published value is not agreement
-            ok.append(abs(o - p) <= max(rel * abs(p), band) and band <= wide * abs(p))
-        h = headline_row(t1, v)
-        text = (f"{fmt(float(h['nav_err_before_km']))} km in the headline case; {sum(ok)} of {len(g)} cases "
-                f"within max({k:g} sd, {100 * rel:g} %) of Table 1")
-        outs[v] = variant_outcome(v, all(ok), text, score=-sum(ok))
-    d = C.decide(outs, AS_WRITTEN, addition)
-    b = float(headline_row(t1, AS_WRITTEN)["nav_err_before_km"])
-    pub = float(head_pub["nav_err_before_km"])
-    if d.verdict == C.REPRODUCED:
-        cause = (f"The theta = 0 filter ends at {fmt(b)} km against the published {fmt(pub)} km, within "
-                 f"{100 * rel:g} % in every case")
-    else:
-        rng, th = float(sim["range_km"]), math.hypot(*head_pub["truth_arcsec"][:2])
-        lat = rng * math.radians(th / 3600.0)
-        cause = (f"Lateral error is about range x misalignment, {rng:.2g}".replace("e+0", "e").replace("e+", "e")
-                 + f" km x {fmt(th)} arcsec = {fmt(lat)} km, and "
-                 f"our theta = 0 filter ends at {fmt(b)} km, so the published {fmt(pub)} km implies another range or "
-                 "error rule")
-    return _result(dict(paper="A", claim_id=cid, claim="Navigation error before compensation (Table 1 column)",
-                        published=f"{fmt(pub)} km (headline case)"),
-                   d, cause=cause, evidence="A-T1, A-F6", flags=_small_sample(t1, plan))
+        out.append(EvidenceRow(claim_id="", sample="main", scope=scope, method="", versus="", role="published",
+                               quantity=q, estimate=float(v), unit=QUANTITIES[q].unit,
+                               source=f"{source}#paper_a.{where}"))
 
-
-def _claim_nav_after(t1, head_pub, summary, plan: Plan) -> dict:
-    """After compensation within the abstract's limit. The filter given the *true* theta
-    (A-summary ``nav_err_true_theta_km``) is one filter's Monte-Carlo floor, not an
-    information bound: above the limit it is evidence (a flag and the cause), and the
-    claim depends on the arc length and error rule the paper does not state."""
-    cid = "A-C7"
-    lim = plan.margin(cid, "limit_km")
-    floor = summary.nav_err_true_theta_km
-    outs = {}
-    for v in variant_labels(t1):
-        h = headline_row(t1, v)
-        if h is None:
-            continue
-        a, b = float(h["nav_err_after_km"]), float(h["nav_err_before_km"])
-        ok = a <= lim and run_label(h) == "converged"
-        outs[v] = variant_outcome(v, ok, f"{fmt(b)} km to {fmt(a)} km ({label_text(h)})", score=a)
-    d = C.decide(outs, AS_WRITTEN, addition)
-    flags = []
-    lt = f"{d.lit.text.split(' (')[0]}" if d.lit else "no value"
-    if d.verdict == C.REPRODUCED:
-        cause = f"Compensated with its own estimate the as-written filter goes from {lt}, within {lim:g} km"
-    elif d.verdict == C.WITH_ADDITION:
-        cause = f"As written the filter goes from {lt}, while {d.best.label} reaches {lim:g} km with its better estimate"
-    elif floor is not None and floor > lim:
-        flags.append(("floor_not_bound", f"true-theta filter {fmt(floor)} km"))
-        d.verdict, d.named = C.DEPENDS, "the arc length and the navigation-error rule, which the paper does not state"
-        cause = (f"Even the true misalignment leaves our filter at {fmt(floor)} km, above {lim:g} km, a floor "
-                 "set by our arc length and error rule rather than by the information, so the claim hinges on them")
-    else:
-        cause = (f"Compensated with its own estimate the as-written filter goes from {lt}, although the true "
-                 f"misalignment would allow {fmt(floor)} km, so the estimate, not the filter, falls short")
-    dn = C.diagnostic_note(outs)
-    return _result(dict(paper="A", claim_id=cid,
-                        claim=f"Compensation brings navigation from about 100 km to within {lim:g} km (abstract, Table 1)",
-                        published=f"{fmt(head_pub['nav_err_before_km'])} km to {fmt(head_pub['nav_err_after_km'])} km"),
-                   d, cause=cause, evidence="A-T1, A-F6" + (f" ({dn})" if dn else ""),
-                   bound=f"true-theta floor {fmt(floor)} km (one filter, not an information bound)"
-                   if floor is not None else "", flags=flags + _small_sample(t1, plan))
-
-
-def _claim_order_100km(t1, plan: Plan, head_pub: Mapping[str, Any]) -> dict:
-    """A-C8: the introduction's order of magnitude (published.yaml: headline.intro_nav_err_km
-    from a misalignment of headline.intro_misalignment_arcsec), against our uncompensated error."""
-    cid = "A-C8"
-    factor = plan.margin(cid, "order_factor")
-    km, arcsec = float(head_pub["intro_nav_err_km"]), float(head_pub["intro_misalignment_arcsec"])
-    outs = {}
-    for v in variant_labels(t1):
-        h = headline_row(t1, v)
-        if h is None:
-            continue
-        b = float(h["nav_err_before_km"])
-        outs[v] = variant_outcome(v, km / factor <= b <= km * factor, f"{fmt(b)} km",
-                           score=abs(math.log(b / km)) if b > 0 else math.inf)
-    d = C.decide(outs, AS_WRITTEN, addition)
-    lt = d.lit.text if d.lit else "no value"
-    truth = ", ".join(fmt(x) for x in head_pub["truth_arcsec"][:2])
-    cause = (f"A ({truth}) arcsec misalignment leaves the uncompensated filter at {lt}, "
-             + (f"within a factor {factor:g} of {fmt(km)} km" if d.verdict == C.REPRODUCED
-                else f"outside a factor {factor:g} of {fmt(km)} km"))
-    return _result(dict(paper="A", claim_id=cid, claim=f"About {fmt(km)} km navigation error from a {fmt(arcsec)} "
-                        "arcsec misalignment (introduction)", published=f"about {fmt(km)} km"),
-                   d, cause=cause, evidence="A-T1, A-F6", flags=_small_sample(t1, plan))
-
-
-def _claim_tz(t1, plan: Plan) -> dict:
-    """tz not estimable, as written: read from the as-written rows of A-T1 (every case);
-    variants beyond the paper that observe it (star images) are named in the cause."""
-    cid = "A-C9"
-    plan.entry(cid)
-    lit = variant_rows(t1, AS_WRITTEN)
-    obs = lit["tz_observable"].map(truthy)
-    n_obs = int(obs.sum())
-    verdict = C.REPRODUCED if n_obs == 0 else C.NOT_REPRODUCED
-    text = "unobservable in every case" if n_obs == 0 else f"observable in {n_obs} of {len(lit)} cases"
-    cause = (f"A camera that tracks Mars cannot see a roll about its boresight, and the M-step finds tz {text}"
-             if n_obs == 0 else f"The M-step finds tz {text} of the as-written rows, which a Mars-tracking camera forbids")
-    beyond = sorted({v.split("+")[0] for v in t1.loc[t1["tz_observable"].map(truthy), "variant"] if is_beyond(v)})
-    return C.row("A", cid, "Roll about the boresight, tz, not estimable", "not estimable", verdict, cause,
-                 "A-T1, A-X1" + (f" (beyond the paper, {join(beyond)} make it observable)" if beyond else ""),
-                 ours_as_written=text)
-
-
-def claim_rows(summary: ClaimsSummary, t1: pd.DataFrame, pub: Mapping[str, Any], plan: Plan,
-               windows: Mapping[str, float] | None = None) -> list[dict]:
-    """Paper A's claims-table rows (ids A-C1 ... A-C10, stable). ``windows``: the first
-    window (samples) of each EM mode (``sliding``: N, ``growing``: the growing N), the
-    smallest data-to-converge count each can report; default the summary's N. ``summary``:
-    A-summary.json as :meth:`opnav.approach.summaries.ClaimsSummary.from_json` reads it."""
-    if not isinstance(summary, ClaimsSummary):
-        raise TypeError(f"approach_claims.claim_rows: summary must be a ClaimsSummary "
-                        f"(ClaimsSummary.from_json(<A-summary.json>)), got {type(summary).__name__}")
     head = pub["headline"]
-    windows = dict(windows or {"sliding": summary.window_samples})
-    return [
-        _claim_headline_accuracy(t1, head, summary, plan),
-        _claim_table_accuracy(t1, pub["table1"], plan),
-        _claim_data(t1, windows, plan),
-        _claim_little_data(t1, head, summary, plan),
-        _claim_pixels(t1, plan),
-        _claim_pixel_accuracy(t1, plan),
-        _claim_nav_before(t1, head, pub["simulation"], plan),
-        _claim_nav_after(t1, head, summary, plan),
-        _claim_order_100km(t1, plan, head),
-        _claim_tz(t1, plan),
-    ]
+    for row in pub["table1"]:
+        cid = row["case_id"]
+        for q in ("data_to_converge_samples", "nav_err_before_km", "nav_err_after_km"):
+            add(cid, q, row[q], f"table1({cid}).{q}")
+        tr = row.get("bias_arcsec") or head["truth_arcsec"]
+        add(cid, "est_error_arcsec", max(abs(row["est_x_arcsec"] - tr[0]), abs(row["est_y_arcsec"] - tr[1])),
+            f"table1({cid}).est_x/y_arcsec - truth")
+    add("", "accuracy_claim_arcsec", head["accuracy_claim_arcsec"], "headline.accuracy_claim_arcsec")
+    add("", "est_error_x_arcsec", head["est_error_arcsec"][0], "headline.est_error_arcsec[0]")
+    add("", "est_error_y_arcsec", head["est_error_arcsec"][1], "headline.est_error_arcsec[1]")
+    add("", "intro_nav_err_km", head["intro_nav_err_km"], "headline.intro_nav_err_km")
+    add("", "intro_misalignment_arcsec", head["intro_misalignment_arcsec"], "headline.intro_misalignment_arcsec")
+    return out
 
 
 def input_rows(pub: Mapping[str, Any], plan: Plan, dt_s: float) -> list[dict]:

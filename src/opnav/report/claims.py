@@ -1,81 +1,68 @@
 """The claims table: one row per distinct published claim of each paper, with a verdict.
 
-The scorecard (:mod:`opnav.report.scorecard`) sets every published *number* beside ours, cell
-by cell; this module answers the reader's question instead: which of the papers'
-*claims* reproduce. Each paper's rows are computed from its summary files by
-:mod:`opnav.report.approach_claims` (paper A) and :mod:`opnav.report.landing_claims` (paper B) and
-assembled here. Columns (:data:`COLUMNS`) and verdicts (:data:`VERDICTS`):
+The scorecard (:mod:`opnav.report.scorecard`) sets every published *number* beside ours; this
+table answers which of the papers' *claims* reproduce. It is built in three steps with one home
+each (docs/claims-engine.md): the evidence rows (:mod:`opnav.report.evidence`, written by the
+extractors :mod:`opnav.report.approach_claims` and :mod:`opnav.report.landing_claims`), the
+analysis plan's declared tests (:mod:`opnav.report.plan`), and the generic scorer
+(:mod:`opnav.report.scorer`). :func:`build` puts them together into :class:`ClaimRow` records;
+CSV and JSON only at the scripts' edge. Verdicts (:data:`VERDICTS`):
 
 ``reproduced``
-    the paper as written (our reading of it, no addition) gives the claim (a
-    negative control that also gives it is flagged, not a reason to withhold it);
+    the paper as written (our reading of it, no addition) meets the claim's test;
 ``reproduced_with_addition``
-    only a variant that adds something the paper does not state gives it; ``named``
-    says what (a variant that uses the true state never counts: it is a diagnostic,
-    reported in the cause as "what it would take");
+    only a variant that adds something the paper does not state meets it; ``named`` says what
+    (a variant given the truth never counts: it is a diagnostic);
 ``not_reproduced``
-    no faithful variant gives it; the cause says what we get instead;
+    neither the method as written nor a faithful variant meets it; the cause quotes the
+    interval on which the test failed;
 ``not_reproducible``
-    not reproduced, and an information bound (Cramér-Rao) of the stated
-    measurements and prior says no unbiased estimator could give it; ``named`` is the
-    bound (only an information bound: a Monte-Carlo floor of one filter is evidence
-    for "not reproduced" or "depends on a choice");
+    not reproduced, and an information bound (Cramér-Rao) of the stated data fails the test
+    itself (only claims whose plan entry has ``bound: information``);
 ``depends_on_choice``
-    whether it reproduces depends on a choice the paper leaves open; ``named`` is that choice;
+    the verdict differs between readings of a choice the paper leaves open (the camera, the
+    SVD implementation, the arc length); ``named`` is that choice;
 ``not_tested``
-    our runs cannot test it (e.g. the compared methods pick the same landmarks, so
-    equal accuracy follows by construction); ``named`` says why;
+    our evidence cannot test it (no evidence, every baseline picking depth's landmark, a band
+    too wide); ``named`` says why;
 ``unstable``
-    the main sample and the replication sample (an independent seed base) give
-    different verdicts; the cause gives both;
+    the main and replication samples give different verdicts *and* an estimate the test reads
+    differs between them (the plan's ``sample_difference`` test); samples that agree in their
+    estimates but not in their verdicts are read pooled (flag ``replication_underpowered``);
 ``suspect``
-    an accuracy beats its own information bound by more than the plan's factor
-    (judged with the seeds' spread): a leak or a bug, never "reproduced".
+    an accuracy beats its own information bound by more than the plan's factor (in either
+    sample: the flag ``suspect`` names which), a leak or a bug until shown otherwise.
 
-``flags`` qualifies a verdict without changing it: ``control_also_meets: closest``
-(the claim holds, but a negative control meets it too, so the test cannot credit the
-method), ``beats_bound: 14x``, ``floor_not_bound`` (a Monte-Carlo floor of one filter,
-evidence but not an information bound), ``sample_too_small: quick profile``.
-
-Every margin, tolerance and threshold of a verdict is a fixed number of the analysis
-plan (``data/analysis_plan.yaml``, :func:`load_plan`), with its reason; the scorer
-reads them from there and :meth:`Plan.unused` names any the verdicts never read.
-
-Accuracy claims are scored as accuracy: our error about the truth against the
-published error and the bound, never "our estimate within 10 % of a published
-noise realisation". Every ``cause`` is one sentence generated from the numbers.
+``flags`` qualify a verdict without changing it (``control_also_meets``, ``beats_bound``,
+``floor_not_bound``, ``not_tested_vs``, ``replication_underpowered``, ``verdict_main``,
+``sample_too_small``...). Every claim row prints the plan's version and checksum (``plan``).
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
-from pathlib import Path
+import re
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import pandas as pd
-import yaml
 
-from opnav.core import published
+from opnav.report import scorer as S
+from opnav.report.evidence import EvidenceRow, for_claims, pooled
 
-COLUMNS = ["paper", "claim_id", "claim", "published", "ours_as_written", "ours_best", "best_variant",
-           "bound", "ours_replication", "verdict", "verdict_replication", "flags", "named", "would_take",
-           "cause", "evidence", "sample"]
-
-REPRODUCED = "reproduced"
-WITH_ADDITION = "reproduced_with_addition"
-NOT_REPRODUCED = "not_reproduced"
-NOT_REPRODUCIBLE = "not_reproducible"
-DEPENDS = "depends_on_choice"
-NOT_TESTED = "not_tested"
-UNSTABLE = "unstable"
-SUSPECT = "suspect"
+REPRODUCED = S.REPRODUCED
+WITH_ADDITION = S.WITH_ADDITION
+NOT_REPRODUCED = S.NOT_REPRODUCED
+NOT_REPRODUCIBLE = S.NOT_REPRODUCIBLE
+DEPENDS = S.DEPENDS
+NOT_TESTED = S.NOT_TESTED
+UNSTABLE = S.UNSTABLE
+SUSPECT = S.SUSPECT
 VERDICTS = (REPRODUCED, WITH_ADDITION, NOT_REPRODUCED, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED, UNSTABLE, SUSPECT)
 #: verdicts that must name something (the addition, the choice, the bound, the reason)
 NEEDS_NAMED = (WITH_ADDITION, NOT_REPRODUCIBLE, DEPENDS, NOT_TESTED, UNSTABLE, SUSPECT)
-#: a cause is one sentence a reader takes in at once (issue 42: about 40 words)
-MAX_CAUSE_WORDS = 45
+#: a cause is one sentence a reader takes in at once
+MAX_CAUSE_WORDS = 40
 
 #: the verdicts as the at-a-glance table prints them
 VERDICT_SHORT = {
@@ -95,7 +82,6 @@ VERDICT_TEXT = {
     SUSPECT: "suspect: better than its own information bound",
 }
 
-
 # ------------------------------------------------------------ the analysis plan
 # the plan's one home is opnav.report.plan; these names stay importable from here
 from opnav.report.plan import PLAN_COLUMNS, PLAN_FILE, Plan, PlanError, load_plan  # noqa: E402,F401
@@ -106,124 +92,55 @@ INPUT_COLUMNS = ["input", "ours", "published", "how_derived", "what_would_match"
 
 def fmt(x: Any, nd: int = 3, unit: str = "") -> str:
     """A number as claim-table text: ``nd`` significant digits, ``"n/a"`` if missing."""
-    if x is None or (isinstance(x, float) and not math.isfinite(x)):
-        return "n/a"
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        return str(x)
-    if not math.isfinite(v):
-        return "n/a"
-    s = f"{v:.{nd}g}" if abs(v) < 10 ** nd else f"{v:.0f}"
-    return f"{s} {unit}".rstrip() if unit else s
+    s = S.fmt(x, nd)
+    return f"{s} {unit}".rstrip() if unit and s != "n/a" else s
 
 
-def join(items: Iterable[str], none: str = "none") -> str:
-    """'a', 'a and b', 'a, b and c'."""
-    items = [i for i in items if i]
-    if not items:
-        return none
-    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+from opnav.report.plan import join  # noqa: E402,F401  ('a, b and c')
 
 
-@dataclass
-class Outcome:
-    """One variant's reading of one claim: does it give the claim, and what it shows.
+# ------------------------------------------------------------ the claim row
+@dataclass(frozen=True)
+class ClaimRow:
+    """One row of results/paper/claims.csv (a typed record; CSV only at the script's edge).
 
-    ``bound``/``n``: for an accuracy, the information bound (1-sigma) of the data the
-    variant used and the number of seeds behind ``err`` (the RMS error), for the bound
-    guard (:func:`beats_bound`)."""
-    label: str
-    ok: bool
-    text: str                 # our value, as text with units
-    score: float = math.inf   # lower is better (to pick the best variant)
-    diagnostic: bool = False  # uses the truth: never earns "reproduced"
-    beyond: bool = False      # beyond the paper (what practitioners do): never earns "reproduced" either
-    err: float = math.nan
-    bound: float = math.nan
-    n: int = 0
-    extra: dict = field(default_factory=dict)
+    ``claim``/``published``: the claim's title and the published value (from published.yaml,
+    through the evidence); ``ours_as_written``, ``ours_best`` (+ ``best_variant``), ``bound``,
+    ``ours_replication``: the evidence rows the verdict read, quoted; ``verdict`` /
+    ``verdict_replication``: the verdict over both samples and the replication's alone;
+    ``flags``: 'name: value' joined by '; '; ``named``: the addition, choice, bound or reason
+    the verdict names; ``would_take``: what the claim would take where it is not reproduced as
+    written; ``cause``: one sentence quoting the interval the test turned on; ``evidence``: the
+    outputs the quoted rows come from; ``sample``: 'full' or 'quick'; ``plan``: the plan's
+    version and checksum."""
 
+    paper: str
+    claim_id: str
+    claim: str
+    published: str
+    ours_as_written: str = ""
+    ours_best: str = ""
+    best_variant: str = ""
+    bound: str = ""
+    ours_replication: str = ""
+    verdict: str = NOT_TESTED
+    verdict_replication: str = ""
+    flags: str = ""
+    named: str = ""
+    would_take: str = ""
+    cause: str = ""
+    evidence: str = ""
+    sample: str = "full"
+    plan: str = ""
 
-def beats_bound(err: float, bound: float, n: int, plan: Plan) -> float | None:
-    """The factor by which an RMS error ``err`` over ``n`` seeds beats its information
-    bound ``bound`` (same units), or None if it does not by more than the plan's
-    ``bound_factor``. The seeds' spread enters as ``spread_k`` standard errors of an
-    RMS over ``n`` seeds (about ``err / sqrt(2 n)``): the error must stay below
-    ``bound / bound_factor`` even at ``err (1 + spread_k / sqrt(2 n))``."""
-    factor, k = plan.guard("bound_factor"), plan.guard("spread_k")
-    if not (math.isfinite(err) and math.isfinite(bound)) or bound <= 0 or n < 1:
-        return None
-    upper = err * (1.0 + k / math.sqrt(2.0 * n))
-    if upper * factor < bound:
-        return math.inf if err <= 0 else bound / err
-    return None
-
-
-@dataclass
-class Decision:
-    verdict: str
-    lit: Outcome | None
-    best: Outcome | None
-    named: str
-    flags: list = field(default_factory=list)
-    #: of the faithful variants that give the claim, the one adding least (fewest '+' parts)
-    smallest: Outcome | None = None
+    def __post_init__(self):
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"{self.claim_id}: verdict {self.verdict!r} is not one of {VERDICTS}")
+        if self.verdict in NEEDS_NAMED and not self.named:
+            raise ValueError(f"{self.claim_id}: verdict {self.verdict} needs 'named'")
 
 
-def decide(outcomes: Mapping[str, Outcome], as_written: str, describe: Callable[[str], str],
-           bound_blocks: str = "", plan: Plan | None = None) -> Decision:
-    """The verdict of a claim from its per-variant outcomes.
-
-    ``as_written``: the label of the paper-as-written variant; ``describe(label)``: the
-    addition a variant makes (for ``named``); ``bound_blocks``: non-empty (the bound, as
-    text) when an *information bound* of the as-written variant excludes the claim (a
-    Monte-Carlo floor of one filter is not one: pass it as evidence, not here);
-    ``plan``: the analysis plan, for the bound guard (any non-diagnostic variant whose
-    error beats its bound by more than the plan's factor makes the claim ``suspect``).
-    Negative controls that also meet a claim are the paper-B scorer's flag
-    (``control_also_meets``), not a verdict."""
-    lit = outcomes.get(as_written)
-    faithful = [o for k, o in outcomes.items() if k != as_written and not o.diagnostic and not o.beyond]
-    best = min(faithful, key=lambda o: (not o.ok, o.score, o.label), default=None)
-    flags: list = []
-    if plan is not None:
-        hits = []
-        for o in outcomes.values():
-            r = None if o.diagnostic else beats_bound(o.err, o.bound, o.n, plan)
-            if r is not None:
-                hits.append((r, o.label))
-        if hits:
-            r, lab = max(hits)
-            flags.append(("beats_bound", f"{fmt(r, 2)}x ({lab})"))
-            return Decision(SUSPECT, lit, best, f"{lab} is {fmt(r, 2)} times below its own bound", flags)
-    if lit is not None and lit.ok:
-        verdict, named = REPRODUCED, ""
-    elif best is not None and best.ok:
-        verdict, named = WITH_ADDITION, describe(best.label)
-        smallest = min((o for o in faithful if o.ok), key=lambda o: (o.label.count("+"), o.score, o.label))
-        return Decision(verdict, lit, best, named, flags, smallest)
-    elif bound_blocks:
-        return Decision(NOT_REPRODUCIBLE, lit, None if best is None else best, bound_blocks, flags)
-    else:
-        return Decision(NOT_REPRODUCED, lit, best, "", flags)
-    return Decision(verdict, lit, None if verdict == REPRODUCED else best, named, flags)
-
-
-def diagnostic_note(outcomes: Mapping[str, Outcome]) -> str:
-    """'what it would take': the best diagnostic (truth-using) variant and the best variant
-    beyond the paper, as clauses (never a verdict)."""
-    out = []
-    beyond = [o for o in outcomes.values() if o.beyond]
-    if beyond:
-        b = min(beyond, key=lambda o: (not o.ok, o.score, o.label))
-        out.append(f"beyond the paper, {b.label} " + ("reaches it" if b.ok else "comes closest") + f" ({b.text})")
-    diag = [o for o in outcomes.values() if o.diagnostic]
-    if diag:
-        d = min(diag, key=lambda o: (not o.ok, o.score, o.label))
-        out.append(f"the {d.label} diagnostic, which is given the true state, "
-                   + ("reaches it" if d.ok else "comes closest") + f" ({d.text})")
-    return "; ".join(out)
+COLUMNS = [f.name for f in fields(ClaimRow)]
 
 
 def flag_text(flags: Iterable) -> str:
@@ -232,57 +149,62 @@ def flag_text(flags: Iterable) -> str:
     for f in flags:
         name, value = (f, "") if isinstance(f, str) else f
         out.append(f"{name}: {value}" if value != "" else str(name))
-    return "; ".join(out)
+    return "; ".join(dict.fromkeys(out))
 
 
-def _one_sentence(claim_id: str, cause: str) -> str:
-    cause = " ".join(cause.split())
-    if not cause.endswith("."):
-        cause += "."
+def one_sentence(claim_id: str, cause: str) -> str:
+    """The cause as one sentence of at most :data:`MAX_CAUSE_WORDS` words: a longer one drops
+    its parentheses, then its clauses after the first semicolon or comma-and (never a number the
+    test turned on: those sit before them), and raises if still too long."""
+    cause = " ".join(cause.split()).rstrip(".")
+    for cut in (lambda c: re.sub(r" \((?:[^()]|\([^()]*\))*\)", "", c), lambda c: c.split("; ")[0],
+                lambda c: re.sub(r", (and|but|while|so) [^0-9]*$", "", c),
+                lambda c: " ".join(c.split()[:MAX_CAUSE_WORDS])):
+        if len(cause.split()) <= MAX_CAUSE_WORDS:
+            break
+        cause = cut(cause)
+    cause += "."
     if ". " in cause.replace("e.g. ", "").replace("i.e. ", "").replace("vs. ", ""):
-        raise ValueError(f"{claim_id}: the cause must be one sentence: {cause!r}")
+        cause = cause.replace(". ", "; ")
     n = len(cause.split())
     if n > MAX_CAUSE_WORDS:
         raise ValueError(f"{claim_id}: the cause has {n} words (at most {MAX_CAUSE_WORDS}): {cause!r}")
     return cause[0].upper() + cause[1:]
 
 
-def row(paper: str, claim_id: str, claim: str, published: str, verdict: str, cause: str,
-        evidence: str, ours_as_written: str = "", ours_best: str = "", best_variant: str = "",
-        bound: str = "", named: str = "", flags: Iterable = (), would_take: str = "",
-        sample: str = "full", ours_replication: str = "", verdict_replication: str = "") -> dict:
-    """One claims-table row, checked: a stated verdict, ``named`` where the verdict needs
-    it, and a cause of one sentence of at most :data:`MAX_CAUSE_WORDS` words."""
-    if verdict not in VERDICTS:
-        raise ValueError(f"{claim_id}: verdict {verdict!r} is not one of {VERDICTS}")
-    if verdict in NEEDS_NAMED and not named:
-        raise ValueError(f"{claim_id}: verdict {verdict} needs 'named'")
-    return {"paper": paper, "claim_id": claim_id, "claim": claim, "published": published,
-            "ours_as_written": ours_as_written, "ours_best": ours_best, "best_variant": best_variant,
-            "bound": bound, "ours_replication": ours_replication, "verdict": verdict,
-            "verdict_replication": verdict_replication, "flags": flag_text(flags), "named": named,
-            "would_take": would_take, "cause": _one_sentence(claim_id, cause), "evidence": evidence,
-            "sample": sample}
-
-
-def frame(rows: Iterable[dict]) -> pd.DataFrame:
+def frame(rows: Iterable[ClaimRow | dict]) -> pd.DataFrame:
     """The claims table, columns in :data:`COLUMNS` order, ids unique."""
-    df = pd.DataFrame(list(rows), columns=COLUMNS)
+    recs = [asdict(r) if isinstance(r, ClaimRow) else dict(r) for r in rows]
+    df = pd.DataFrame(recs, columns=COLUMNS)
     dup = df["claim_id"][df["claim_id"].duplicated()].tolist()
     if dup:
         raise ValueError(f"claim ids defined twice: {dup}")
     return df.fillna("")
 
 
-def check_plan_covers(df: pd.DataFrame, plan: Plan) -> None:
-    """Every claim row has a plan entry (raises :class:`PlanError` naming the first that has none)."""
-    for cid in df["claim_id"]:
-        plan.entry(cid)
+def records(df: pd.DataFrame) -> list[ClaimRow]:
+    """The claims table's rows as records (claims.csv read back)."""
+    return [ClaimRow(**{k: ("" if pd.isna(v) else str(v)) for k, v in r.items() if k in COLUMNS})
+            for r in df.to_dict("records")]
 
 
-def _add_flag(flags: str, name: str, value: str) -> str:
-    new = f"{name}: {value}"
-    return f"{flags}; {new}" if flags else new
+# ------------------------------------------------------------ evidence -> claims
+def evidence_table(plan: Plan, rows: Iterable[EvidenceRow]) -> list[EvidenceRow]:
+    """The evidence table: every row keyed to the claims that read its quantity
+    (:func:`opnav.report.evidence.for_claims`), plus each claim's pooled sample (its two
+    readings' samples pooled, :func:`opnav.report.evidence.pooled`). Intervals are restated at
+    the plan's level wherever a row has a standard error (a summary's 95 % interval becomes the
+    plan's 90 %), so the table holds the intervals the verdicts read."""
+    level = plan.level
+    keyed = [r.at_level(level) for r in for_claims(rows, plan.reads())]
+    out = list(keyed)
+    for cid, t in plan.tests().items():
+        mine = [r for r in keyed if r.claim_id == cid]
+        a = [r for r in mine if r.sample == t.samples["main"]]
+        b = [r for r in mine if r.sample == t.samples["replication"]]
+        if a and b:
+            out += pooled(a, b)
+    return out
 
 
 def replication_plan(plan: Plan, cfg: Mapping[str, Any]) -> list[str]:
@@ -302,33 +224,223 @@ def replication_plan(plan: Plan, cfg: Mapping[str, Any]) -> list[str]:
     return ids
 
 
-def with_replication(main: pd.DataFrame, rep: pd.DataFrame, ids: Iterable[str] | None = None) -> pd.DataFrame:
-    """The main table with the replication sample's reading beside it.
-
-    ``rep``: the claims table of the same claims scored on the replication sample (an
-    independent seed base). Its verdict and as-written value fill ``verdict_replication``
-    and ``ours_replication``; a claim whose two verdicts differ reads ``unstable``, with
-    both verdicts in the cause and the main one kept in ``flags``. Claims the
-    replication does not score (or, given ``ids``, not among them) keep their verdict, with
-    an empty replication."""
-    out = main.copy()
-    r = rep.set_index("claim_id")
-    if ids is not None:
-        r = r[r.index.isin(list(ids))]
-    for i, row_ in out.iterrows():
-        cid = row_["claim_id"]
-        if cid not in r.index:
+def check_settings(plan: Plan, values: Mapping[str, Any]) -> None:
+    """Every plan setting that names a config key (``settings.<name>.config``) equals the
+    value the run used (``values``: setting name -> the config's value): the plan is the
+    number's home (one line naming both when they differ)."""
+    for name, s in (plan.raw.get("settings") or {}).items():
+        key = s.get("config") if isinstance(s, Mapping) else None
+        if not key or name not in values or values[name] is None:
             continue
-        v1, v2 = row_["verdict"], r.loc[cid, "verdict"]
-        out.at[i, "verdict_replication"] = v2
-        out.at[i, "ours_replication"] = r.loc[cid, "ours_as_written"]
-        if v1 != v2 and NOT_TESTED not in (v1, v2):
-            out.at[i, "flags"] = _add_flag(out.at[i, "flags"], "verdict_main", v1)
-            out.at[i, "verdict"] = UNSTABLE
-            out.at[i, "named"] = f"{VERDICT_SHORT[v1]} in the main sample, {VERDICT_SHORT[v2]} in the replication"
-            out.at[i, "cause"] = _one_sentence(cid, (
-                f"The main sample reads {VERDICT_SHORT[v1]} and the replication sample, on an independent seed "
-                f"base, reads {VERDICT_SHORT[v2]}, so this verdict moves with the seeds and neither is reported"))
+        plan.mark_read(f"settings.{name}")
+        if float(values[name]) != float(s["value"]):
+            raise PlanError(f"{plan.source}: settings.{name} = {s['value']:g} but the config's {key} = "
+                            f"{float(values[name]):g}: the plan's number is the one the verdicts read")
+
+
+def _published_text(plan: Plan, cid: str, rows: list[EvidenceRow], scope: str) -> str:
+    pubs = [r for r in rows if r.role == "published"]
+
+    def one(m: re.Match) -> str:
+        key = m.group(1)
+        agg, _, key = key.rpartition(":")
+        q, _, sc = key.partition("@")
+        sel = [r for r in pubs if r.quantity == q]
+        if agg in ("min", "max") and sel:
+            v = (min if agg == "min" else max)(r.estimate for r in sel)
+            return fmt(v)
+        for want in (sc, scope, ""):
+            hit = next((r for r in sel if r.scope == want), None)
+            if hit is not None:
+                return fmt(hit.estimate)
+        return "n/a"
+
+    return re.sub(r"{([^}]+)}", one, str(plan.entry(cid)["published"]))
+
+
+def _first(rd: S.Reading | None) -> S.UnitReading | None:
+    if rd is None:
+        return None
+    if rd.lit is not None:
+        return rd.lit
+    for r in rd.per_scope.values():
+        if isinstance(r, S.Reading) and r.lit is not None:
+            return r.lit
+    return None
+
+
+def _ours(u: S.UnitReading | None, plan: Plan, cited: list | None = None) -> str:
+    if u is None:
+        return ""
+    o = u.first()
+    if o is not None and cited is not None:
+        cited.append(o)
+    return S.quote(o, plan) if o is not None else ""
+
+
+def _small(j: S.Judgement, plan: Plan) -> list[tuple[str, str]]:
+    ns = [r.n for r in j.quoted if r.role in ("as_written", "faithful") and r.sample in ("main", "replication")
+          and r.n > 0]
+    if not ns:
+        return []
+    n = min(ns)
+    return [("sample_too_small", f"{n} seeds or runs")] if n < plan.guard("min_full_seeds") else []
+
+
+def claim_row(plan: Plan, cid: str, ev: list[EvidenceRow], replicated: bool, profile: str = "full") -> tuple[ClaimRow, S.Judgement, list[dict]]:
+    """One claim's row, its judgement and the sweeps behind its would_take."""
+    j = S.judge(plan, cid, ev, replicated=replicated)
+    wt, sweeps = S.would_take(plan, cid, ev, j)
+    c = plan.entry(cid)
+    mine = [r for r in ev if r.claim_id == cid]
+    lit = _first(j.main)
+    best = j.main.best
+    if j.verdict == WITH_ADDITION and best is not None:
+        wt = "; ".join(x for x in (f"{best.method.replace('+', ', ')} added ({plan.addition(best.method)})", wt) if x)
+    scopes = [s for s in (j.main.per_scope or {}) if s != "alternatives"]
+    head_scope = scopes[0].split("+")[0] if scopes else ""
+    bound = ""
+    if j.main.bound is not None:
+        bound = S.quote(j.main.bound, plan)
+    else:
+        t = plan.test(cid)
+        if t.bound and lit is not None:
+            b = next((r for r in mine if r.quantity == t.bound["quantity"] and r.method == lit.method
+                      and r.sample == t.samples["main"] and r.setting == ""
+                      and (not head_scope or r.scope == head_scope)), None)
+            if b is not None:
+                bound = f"{S.QUANTITIES[b.quantity].text if b.quantity in S.QUANTITIES else b.quantity} " \
+                        f"{fmt(b.estimate)}{S._u(b.unit)} ({b.scope or lit.method})"
+                j.quoted.append(b)
+    flags = list(j.flags) + _small(j, plan)
+    if profile != "full":
+        flags = [f for f in flags if f[0] != "sample_too_small"] + [("sample_too_small", f"{profile} profile")]
+    t = plan.test(cid)
+    for fl in t.flags:
+        hit = next((r for r in mine if r.quantity == fl["quantity"] and r.sample == t.samples["main"]), None)
+        if hit is not None and abs(hit.estimate - float(fl["equals"])) < 1e-12:
+            flags.append((fl["flag"], fl.get("text", "")))
+            j.quoted.append(hit)
+    cited = list(j.main.cited) + list(j.replication.cited if j.replication is not None else []) + list(
+        j.pooled.cited if j.pooled is not None else [])
+    if j.main.bound is not None:
+        cited.append(j.main.bound)
+    sources = sorted({r.source.split("#")[0].rsplit("/", 1)[-1] for r in j.quoted if r.source})
+    row = ClaimRow(
+        paper=c["paper"], claim_id=cid, claim=c["title"], published=_published_text(plan, cid, mine, head_scope),
+        ours_as_written=_ours(lit, plan, cited), ours_best=_ours(best, plan, cited) if best is not None and best is not lit else "",
+        best_variant=best.method if best is not None and best is not lit else "",
+        bound=bound,
+        ours_replication=_ours(_first(j.replication), plan, cited) if j.replication is not None else "",
+        verdict=j.verdict, verdict_replication=j.replication.verdict if j.replication is not None else "",
+        flags=flag_text(flags), named=j.named or ("" if j.verdict not in NEEDS_NAMED else j.verdict),
+        would_take=wt, cause=one_sentence(cid, j.cause or j.named or j.verdict),
+        evidence=", ".join(sources), sample="full" if profile == "full" else "quick", plan=plan.stamp)
+    seen = set()
+    for o in cited:
+        for d in S.cited_rows(o, cid):
+            k = (d.sample,) + d.key()
+            if k not in seen:
+                seen.add(k)
+                j.derived.append(d)
+    return row, j, sweeps
+
+
+def build(plan: Plan, evidence: Iterable[EvidenceRow], replicated: Iterable[str] = (),
+          profile: str = "full") -> tuple[list[ClaimRow], list[S.Judgement], list[dict]]:
+    """Every claim of the plan scored on the evidence table (:func:`evidence_table`'s rows):
+    the claim rows, the judgements and the would_take sweeps (for the figures). The numbers
+    the scorer computes (would_take's flips and margins) are each judgement's ``derived`` rows
+    (:func:`derived_rows`), which belong in the evidence table beside the rest."""
+    ev = list(evidence)
+    rep = set(replicated)
+    rows, js, sweeps = [], [], []
+    for cid in plan.claims:
+        r, j, sw = claim_row(plan, cid, ev, cid in rep, profile)
+        rows.append(r)
+        js.append(j)
+        sweeps += sw
+    return rows, js, sweeps
+
+
+def derived_rows(judgements: Iterable[S.Judgement]) -> list[EvidenceRow]:
+    """The rows the scorer computed (role ``derived``), for evidence.csv."""
+    return [r for j in judgements for r in j.derived]
+
+
+# ------------------------------------------------------------ amendments
+AMENDMENT_COLUMNS = ["date", "what", "why", "commit", "claim_id", "verdict_before", "verdict_after", "how"]
+
+
+def amendments(plan: Plan, evidence: Iterable[EvidenceRow], replicated: Iterable[str] = ()) -> pd.DataFrame:
+    """results/paper/amendments.csv: per amendment of the plan (oldest first), each claim whose
+    verdict it changed, before -> after, computed by the scorer on the same evidence (the plan
+    right after the amendment: today's with every later amendment undone; before: that with this
+    one undone too); an amendment that changed no verdict has one row saying so. An amendment
+    whose old rule the schema cannot express carries the verdicts recorded in the build it names."""
+    ev = raw_rows(evidence)
+    rep = set(replicated)
+    ams = plan.amendments()
+    out = []
+    for k, am in enumerate(ams):
+        base = {"date": am.get("date", ""), "what": " ".join(str(am.get("what", "")).split()),
+                "why": " ".join(str(am.get("why", "")).split()), "commit": str(am.get("commit", ""))}
+        if "recorded" in am:
+            rec = dict(am["recorded"])
+            build_name = rec.pop("build", "")
+            for cid, v in rec.items():
+                after = _verdicts(plan, ev, rep, [cid]).get(cid, "")
+                out.append({**base, "claim_id": cid, "verdict_before": v, "verdict_after": after,
+                            "how": f"before: recorded in the {build_name} build; after: this plan on this evidence"})
+            continue
+        later: dict = {}
+        for a in reversed(ams[k + 1:]):
+            later.update(a.get("before") or {})
+        after_plan = plan.amended(later) if later else plan
+        before_plan = plan.amended({**later, **(am.get("before") or {})})
+        va, vb = _verdicts(after_plan, ev, rep), _verdicts(before_plan, ev, rep)
+        changed = [cid for cid in va if va[cid] != vb.get(cid)]
+        if not changed:
+            out.append({**base, "claim_id": "", "verdict_before": "", "verdict_after": "",
+                        "how": "recomputed on this evidence: no verdict changed"})
+        for cid in changed:
+            out.append({**base, "claim_id": cid, "verdict_before": vb.get(cid, ""), "verdict_after": va[cid],
+                        "how": "recomputed on this evidence"})
+    return pd.DataFrame(out, columns=AMENDMENT_COLUMNS)
+
+
+def _verdicts(plan: Plan, raw: list[EvidenceRow], rep: set, ids: Iterable[str] | None = None) -> dict[str, str]:
+    rows = evidence_table(plan, raw)
+    return {cid: S.judge(plan, cid, rows, replicated=cid in rep).verdict for cid in (ids or plan.claims)}
+
+
+def amendments_latex(df: pd.DataFrame, plan: Plan, prose_tex=lambda s: s) -> str:
+    """The report appendix's list of the plan's amendments (a LaTeX description list): per
+    amendment its date, what changed and why, and the verdicts it changed, before -> after.
+    ``prose_tex``: the text-to-LaTeX function (``opnav.report.manuscript.prose_tex``)."""
+    out = [f"The analysis plan is version {plan.version} (sha256 {plan.checksum}); "
+           f"{len(plan.amendments())} amendments after results existed:", r"\begin{description}"]
+    for (date, what), g in df.groupby(["date", "what"], sort=False):
+        r0 = g.iloc[0]
+        ch = [f"{r.claim_id} {VERDICT_SHORT.get(r.verdict_before, r.verdict_before)} $\\to$ "
+              f"{VERDICT_SHORT.get(r.verdict_after, r.verdict_after)}" for r in g.itertuples() if r.claim_id]
+        how = "; ".join(dict.fromkeys(g["how"]))
+        out.append(rf"\item[{prose_tex(date)}] {prose_tex(what)}. {prose_tex(r0['why'])}. "
+                   + (("Verdicts: " + ", ".join(ch) + f" ({prose_tex(how)}).") if ch else prose_tex(how).capitalize() + "."))
+    out.append(r"\end{description}")
+    return "\n".join(out) + "\n"
+
+
+def raw_rows(evidence: Iterable[EvidenceRow]) -> list[EvidenceRow]:
+    """The evidence rows before keying (each once, claim_id empty), from a keyed table."""
+    seen, out = set(), []
+    for r in evidence:
+        if r.sample == "pooled":
+            continue
+        k = (r.sample, r.role) + r.key()
+        if k not in seen:
+            seen.add(k)
+            out.append(EvidenceRow(**{**asdict(r), "claim_id": ""}))
     return out
 
 
@@ -338,9 +450,9 @@ def mark_sample(df: pd.DataFrame, profile: str) -> pd.DataFrame:
     out = df.copy()
     quick = profile != "full"
     out["sample"] = "quick" if quick else "full"
-    if quick:  # one sample flag: the profile's (a row's own seed count says the same)
-        out["flags"] = [_add_flag("; ".join(x for x in f.split("; ") if x and not x.startswith("sample_too_small:")),
-                                  "sample_too_small", f"{profile} profile") for f in out["flags"]]
+    if quick:
+        out["flags"] = ["; ".join([x for x in f.split("; ") if x and not x.startswith("sample_too_small:")]
+                                  + ["sample_too_small: " + f"{profile} profile"]) for f in out["flags"]]
     return out
 
 

@@ -27,7 +27,9 @@ Columns (:data:`COLUMNS`; units in ``unit``):
               ``faithful`` (a variant adding something the paper does not state), ``diagnostic``
               (uses the truth), ``beyond`` (beyond the paper), ``compared`` (a baseline's own
               value), ``control`` (a negative control), ``bound`` (an information bound or a
-              Monte-Carlo floor), ``published`` (a number of published.yaml).
+              Monte-Carlo floor), ``published`` (a number of published.yaml), ``derived``
+              (computed by the scorer from other rows: where a swept choice flips the verdict,
+              the margin at which a condition would pass; ``source`` names the rows).
 ``quantity``  the quantity's name (:data:`QUANTITIES` defines each, with its unit).
 ``estimate``  the point estimate (mean, RMS, ratio, count, median...).
 ``lo, hi``    the interval at ``level`` (NaN: no interval).
@@ -56,7 +58,7 @@ __all__ = ["COLUMNS", "QUANTITIES", "ROLES", "SAMPLES", "Evidence", "EvidenceRow
 
 NAN = math.nan
 
-ROLES = ("as_written", "faithful", "diagnostic", "beyond", "compared", "control", "bound", "published")
+ROLES = ("as_written", "faithful", "diagnostic", "beyond", "compared", "control", "bound", "published", "derived")
 #: the fixed sample names (timing adds replay1 ... replayK)
 SAMPLES = ("main", "replication", "pooled", "between_replays")
 

@@ -1,352 +1,343 @@
-"""Paper B's claims (depth-error landmark selection), each scored over our camera scenarios.
+"""Paper B's evidence (depth-error landmark selection): every number B-summary.json holds that a
+claim may read, as :class:`opnav.report.evidence.EvidenceRow` rows, with no verdict logic.
 
-Input: what the claims read of B-summary.json (:class:`opnav.landing.claims_summary.LandingSummary`:
-every camera scenario, the headline one first), the published values
-(``published.paper_b()``) and the analysis plan (:func:`opnav.report.claims.load_plan`),
-which holds every margin the verdicts use. Output: claims-table rows
-(:func:`opnav.report.claims.row`) and derived-input rows (:func:`input_rows`).
+:func:`evidence_rows` reads one sample's B-summary.json (the dict
+:func:`opnav.landing.report.combine_scenarios` writes; each camera scenario is a ``scope``) and
+writes, for every method and every baseline or control the summary pairs it with:
 
-The paper gives no camera: both our scenarios are readings of it, so a claim that holds in
-one and not the other *depends on a choice the paper leaves open* (the camera), and the
-timing claim likewise depends on how the SVD baseline is implemented. The paired
-statistics are the landing summary's (paired intervals, same-pick rates, times to
-converge); the margins they are judged against are the plan's. Units: m, s, %, deg.
+* ``err_diff_{lastlm,lmrms,final}_m``: the paired mean difference ``method - versus`` of the
+  position error at the last landmark update, its RMS over the landmark phase and at touchdown
+  (the equivalence sections, every reference they hold), m, with its interval and se;
+* ``err_mean_{...}_m``: each method's own mean of the same errors (the margins' scale), m;
+* ``same_pick_pct``: how often ``method`` picks ``versus``'s landmark, %;
+* ``converge_time_diff_s``: ``method - versus`` first time below a position-error threshold,
+  one row per threshold (``setting threshold_m=...``), s;
+* ``yaw_sigma3_ratio``: the yaw 3-sigma at touchdown over the one at the start;
+* ``envelope_ratio_{vel,att}``: 3-sigma of the RMS velocity / attitude error, ``method / versus``;
+* ``reduction_pct`` and ``median_time_us``: planning time (thread CPU) per replay
+  (``replay1``...), between replays (``between_replays``: mean, interval, se of the spread
+  between independent replays), on each SVD implementation (``versus svd_lapack``,
+  ``svd_paper``) and along the overhead curve (``setting shared_us=...``); ``per_eval_us``,
+  ``shared_us``, ``evals_per_call`` (the decomposition of a call) and ``shared_us_at_published``;
+* ``calls_multi_minimum`` (B-C8): planning calls whose depth error has more than one local
+  minimum, from the optima count (:mod:`opnav.landing.optima`);
+* the published values of published.yaml the claims quote (role ``published``).
+
+Roles (the plan's ``variants`` blocks): the paper's method ``as_written``, the baselines it names
+``compared``, the negative controls ``control``, any other method ``beyond`` (never judged).
+Units: m, s, %, us, deg.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from typing import Any
 
-from opnav.landing.claims_summary import (
-    ENVELOPES,
-    Interval,
-    LandingSummary,
-    ScenarioClaims,
-)
-from opnav.report import claims as C
-from opnav.report.claims import Plan, fmt, join
+from opnav.report.evidence import NAN, EvidenceRow, quantity, se_from_interval
+from opnav.report.plan import Plan
 
-NAMES = {"svd": "SVD", "gdop": "GDOP", "cond": "condition number", "depth": "depth", "random": "random",
-         "center": "image centre", "closest": "closest"}
-CAMERA = "the camera, which the paper does not give"
+ERR_KEYS = {"lastlm_pos_err_m": "lastlm", "lmrms_pos_err_m": "lmrms", "final_pos_err_m": "final"}
+for _q, _t in (("lastlm", "last-landmark error"), ("lmrms", "landmark-phase RMS error"), ("final", "touchdown error")):
+    quantity(f"err_diff_{_q}_m", "m", "mean", _t)
+    quantity(f"err_mean_{_q}_m", "m", "mean", f"mean {_t}")
+quantity("same_pick_pct", "%", "none", "same landmark")
+quantity("converge_time_diff_s", "s", "mean", "time to converge")
+quantity("yaw_sigma3_ratio", "", "none", "yaw 3-sigma end over start")
+quantity("envelope_ratio_vel", "", "none", "velocity 3-sigma ratio")
+quantity("envelope_ratio_att", "", "none", "attitude 3-sigma ratio")
+quantity("reduction_pct", "%", "mean", "planning-time reduction")
+quantity("median_time_us", "us", "mean", "median planning call")
+quantity("per_eval_us", "us", "none", "cost of one metric evaluation")
+quantity("shared_us", "us", "none", "per-call time shared by every method")
+quantity("evals_per_call", "", "none", "metric evaluations per call")
+quantity("shared_us_at_published", "us", "none", "shared per-call time at which the published reduction holds")
+quantity("calls_multi_minimum", "calls", "none", "planning calls with more than one local minimum")
+quantity("max_minima_per_call", "", "none", "most local minima in one call")
 
-
-def _across(per: dict[str, str], head: str, why_not_tested: dict[str, str]) -> tuple[str, str]:
-    """Combine per-scenario verdicts: the same everywhere -> that verdict; else depends on the camera."""
-    verdicts = set(per.values())
-    if len(verdicts) == 1:
-        v = verdicts.pop()
-        return v, (why_not_tested.get(head, "") if v == C.NOT_TESTED else "")
-    return C.DEPENDS, CAMERA
-
-
-def _name(m: str) -> str:
-    return NAMES.get(m, m)
-
-
-# ------------------------------------------------------------ paired intervals
-def _within(iv: dict[str, Interval], rel: float) -> bool:
-    """Every metric's interval inside +-rel x the reference's mean (equivalence)."""
-    return all(math.isfinite(r) and -rel * r < lo and hi < rel * r for _, lo, hi, r in iv.values())
-
-
-def _below(iv: dict[str, Interval], margin: float) -> bool:
-    """Every metric's interval below -margin (superiority: the method's error smaller)."""
-    return all(hi < -margin for _, _, hi, _ in iv.values())
-
-
-def _iv_text(iv: dict[str, Interval], what: str) -> str:
-    m, lo, hi, r = next(iter(iv.values()))
-    return f"{m:+.2g} m [{lo:+.2g}, {hi:+.2g}] against {what} {fmt(r)} m"
-
-
-def _compare(s: ScenarioClaims, compared, controls, test) -> tuple[dict, list, list]:
-    """(per baseline: intervals or None, baselines that fail, controls that pass) in one scenario."""
-    ivs = {b: s.paired("depth", b) for b in compared}
-    fail = [b for b, iv in ivs.items() if iv is not None and not test(iv)]
-    met = [c for c in controls if (iv := s.paired(c, "svd")) is not None and test(iv)]
-    return ivs, fail, met
-
-
-def _accuracy_claim(cid: str, head: str, scen: dict[str, ScenarioClaims], plan: Plan, superior: bool) -> dict:
-    v = plan.variants(cid)
-    compared, controls = list(v.get("compared") or ["svd"]), list(v.get("controls") or [])
-    if superior:
-        margin = plan.margin(cid, "superiority_margin_m")
-        test = lambda iv: _below(iv, margin)
-    else:
-        rel = plan.margin(cid, "margin_rel")
-        test = lambda iv: _within(iv, rel)
-    pick_max = plan.margin(cid, "same_pick_max_pct")
-    per, why, texts, flags = {}, {}, {}, []
-    for name, s in scen.items():
-        ivs, fail, met = _compare(s, compared, controls, test)
-        missing = [b for b, iv in ivs.items() if iv is None]
-        pick = s.same_pick_pct("depth")
-        if ivs.get("svd") is None:
-            per[name], why[name] = C.NOT_TESTED, "no paired comparison with SVD in this summary"
-        elif math.isfinite(pick) and pick >= pick_max:
-            per[name] = C.NOT_TESTED
-            why[name] = f"depth and SVD pick the same landmark in {fmt(pick)} % of the planning calls"
-        else:
-            per[name] = C.NOT_REPRODUCED if fail else C.REPRODUCED
-        if met and per[name] == C.REPRODUCED:
-            flags.append(("control_also_meets", f"{', '.join(met)} ({name})"))
-        if missing:
-            flags.append(("not_compared", f"{', '.join(_name(b) for b in missing)} ({name})"))
-        ok = [_name(b) for b in compared if ivs.get(b) is not None and b not in fail]
-        texts[name] = ((f"smaller errors than {join(ok, none='no baseline')}" if superior else
-                        f"within the margin of {join(ok, none='no baseline')}")
-                       + (f", not shown for {join([_name(b) for b in fail])}" if fail else "")
-                       + (f" (depth minus SVD {_iv_text(ivs['svd'], 'SVD')})" if ivs.get("svd") else ""))
-    verdict, named = _across(per, head, why)
-    s = scen[head]
-    ivs, fail, met = _compare(s, compared, controls, test)
-    what = "smaller errors than" if superior else "errors within the margin of"
-    if verdict == C.NOT_TESTED:
-        cause = f"In the {head} camera {why[head]}" + (
-            ", so equal accuracy follows by construction, not from the metric" if "same landmark" in why[head] else "")
-    elif verdict == C.DEPENDS:
-        cause = (f"Depth has {what} the baselines in "
-                 + join([k for k, x in per.items() if x == C.REPRODUCED]) + " but not in "
-                 + join([k for k, x in per.items() if x != C.REPRODUCED]) + ", and the paper gives no camera")
-    elif verdict == C.REPRODUCED:
-        cause = (f"In the {head} camera depth has {what} " + join([_name(b) for b in compared if ivs.get(b)])
-                 + (f", but so does the control {join(met)}, so the test cannot credit the depth-error metric"
-                    if met else " while no control does, so the test credits the metric"))
-    else:
-        cause = (f"In the {head} camera the paired intervals do not show depth with {what} "
-                 + join([_name(b) for b in fail])
-                 + (f" (depth minus SVD {_iv_text(ivs['svd'], 'SVD')})" if ivs.get("svd") else ""))
-    claim = ("Navigation accuracy higher than conventional methods (Highlights)" if superior else
-             "Accuracy almost the same as SVD, GDOP and condition number (Fig. 6)")
-    pub = "higher accuracy" if superior else "almost the same (3-sigma envelopes)"
-    others = [k for k in scen if k != head]
-    return C.row("B", cid, claim, pub, verdict, cause, "B-T3, B-F6, B-X1", ours_as_written=f"{texts[head]} ({head} camera)",
-                 ours_best="; ".join(texts[k] for k in others), best_variant=join(others, none=""),
-                 named=named, flags=flags)
-
-
-def _claim_faster(head: str, scen: dict, plan: Plan) -> dict:
-    cid = "B-C2"
-    step = plan.margin(cid, "min_difference_s")
-    per, why, texts = {}, {}, {}
-    for name, s in scen.items():
-        cf = s.depth_faster
-        if cf is None:
-            per[name], why[name], texts[name] = C.NOT_TESTED, "no paired time to converge in this summary", "not evaluated"
-            continue
-        m, lo, hi = cf.mean_s, cf.lo_s, cf.hi_s
-        faster = math.isfinite(hi) and hi < 0 and m <= -step
-        per[name] = C.REPRODUCED if faster else C.NOT_REPRODUCED
-        texts[name] = (f"depth minus SVD {fmt(m)} s [{fmt(lo)}, {fmt(hi)}] over {cf.n_runs} runs, "
-                       f"below {fmt(cf.threshold_m)} m")
-    verdict, named = _across(per, head, why)
-    if verdict == C.DEPENDS:
-        cause = (f"Depth converges faster than SVD by at least one filter step ({step:g} s) in "
-                 + join([k for k, x in per.items() if x == C.REPRODUCED]) + " only, so it depends on the camera")
-    elif verdict == C.REPRODUCED:
-        cause = f"In every camera depth reaches the threshold sooner than SVD by at least one filter step ({step:g} s)"
-    elif verdict == C.NOT_TESTED:
-        cause = f"In the {head} camera there is {why[head]}"
-    else:
-        cause = (f"In no camera does depth reach the threshold sooner than SVD by one filter step ({step:g} s) "
-                 f"or more ({head}: {texts[head]})")
-    others = [k for k in scen if k != head]
-    return C.row("B", cid, "Position converges slightly faster with depth-error selection (Fig. 6)",
-                 "slightly faster", verdict, cause, "B-F6, B-T3", ours_as_written=f"{texts[head]} ({head} camera)",
-                 ours_best="; ".join(texts[k] for k in others), best_variant=join(others, none=""), named=named)
-
-
-def _claim_yaw(head: str, scen: dict, plan: Plan) -> dict:
-    cid = "B-C3"
-    plan.entry(cid)
-    per, why, texts = {}, {}, {}
-    for name, s in scen.items():
-        y = s.yaw_converges
-        if y is None:
-            per[name], why[name], texts[name] = C.NOT_TESTED, "no yaw envelope in this summary", "not evaluated"
-        else:
-            per[name] = C.REPRODUCED if not y else C.NOT_REPRODUCED
-            texts[name] = "yaw does not converge" if not y else "yaw converges"
-    verdict, named = _across(per, head, why)
-    cause = ("With one known landmark the yaw is unobservable, and in "
-             + join([k for k in scen if per[k] == C.REPRODUCED]) + " its 3-sigma envelope does not shrink"
-             if verdict == C.REPRODUCED else
-             f"In the {head} camera {texts[head]}, "
-             + ("which one known landmark should not allow" if verdict == C.NOT_REPRODUCED else "unlike the other camera"))
-    return C.row("B", cid, "Yaw does not converge (one known landmark)", "does not converge",
-                 verdict, cause, "B-F6", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
-
-
-#: the planner's paths (B-summary ``eval_path``, ``opnav.landing.planner.PATHS``), as the text
-#: names them; the claim is judged on the configured path (compiled: what a lander would run)
-PATH_NAMES = {"compiled": "compiled implementation",
-              "paper": "the paper's definition (CasADi H, LAPACK SVD; interpreted)"}
+#: the paths of the planner (B-summary eval_path) and the other one
 OTHER_PATH = {"compiled": "paper", "paper": "compiled"}
+#: the planning-time comparisons of B-summary ``planning_time_vs_depth`` -> the baseline they time
+VS_LABELS = {"svd_closed_form": "svd", "svd_lapack": "svd_lapack", "svd_paper": "svd_paper", "gdop": "gdop",
+             "cond": "cond"}
 
 
-def _claim_timing(head: str, scen: dict, pub: Mapping[str, Any], plan: Plan) -> dict:
-    cid = "B-C4"
-    p = float(pub["depth_time_reduction_vs_svd_pct"])
-    rel, k = plan.margin(cid, "rel_tol"), plan.margin(cid, "spread_k")
-    wide_max = plan.margin(cid, "max_band_rel") * abs(p)
-    outs, wide = {}, {}
-    for name, s in scen.items():
-        ep = s.eval_path or ""
-        path = PATH_NAMES.get(ep, s.eval_path if s.eval_path is not None else "the configured path")
-        alt = PATH_NAMES.get(OTHER_PATH.get(ep, ""), "the alternative path")
-        for which, value, sd in s.method("depth").reductions():
-            lab = path if which == "path" else alt
-            sd = float(sd) if sd is not None and math.isfinite(float(sd)) else 0.0
-            v = float(value)
-            # a spread wider than max_band_rel x the published value tells 29 % from no saving no better
-            # than chance: such a reading never meets the claim, and the claim is then not tested
-            wide[(name, lab)] = k * sd > wide_max
-            outs[(name, lab)] = (v, abs(v - p) <= max(rel * abs(p), k * sd) and not wide[(name, lab)])
-    claim, pubtxt = f"Median planning time {p:g} % below SVD (Fig. 7)", f"{p:g} % less"
-    if not outs:
-        return C.row("B", cid, claim, pubtxt, C.NOT_TESTED, "No planning call was timed in this build.", "B-F7",
-                     named="no timing in this build")
-    first = next(iter(outs))
-    lit = (head, first[1]) if (head, first[1]) in outs else first
-    txt = {kk: f"{fmt(v, 3)} % less time" if v >= 0 else f"{fmt(-v, 3)} % more time" for kk, (v, _) in outs.items()}
-    meets = [kk for kk, (_, ok) in outs.items() if ok and kk != lit]
-    band = f"{fmt(p - rel * p)} to {fmt(p + rel * p)} %"
-    flags = [("band_too_wide", f"{kk[1]}, {kk[0]} camera") for kk in outs if wide[kk]]
-    if wide[lit] and not meets:
-        return C.row("B", cid, claim, pubtxt, C.NOT_TESTED,
-                     f"Our timing of depth against SVD ({lit[1]}, {lit[0]} camera) spreads by more than "
-                     f"{fmt(wide_max)} percentage points (2 sd), too wide to tell the published {p:g} % from no saving",
-                     "B-F7, B-T3", ours_as_written=f"{txt[lit]} ({lit[1]}, {lit[0]} camera)",
-                     named="a timing spread wider than the plan's band", flags=flags)
-    if outs[lit][1]:
-        verdict, named, wt = C.REPRODUCED, "", ""
-        cause = f"On the same replayed calls depth's median call takes {txt[lit]} than SVD's, inside the band {band}"
-    elif meets:
-        verdict = C.DEPENDS
-        other_path = any(kk[1] != lit[1] for kk in meets)
-        other_cam = any(kk[0] != lit[0] and kk[1] == lit[1] for kk in meets)
-        named = join((["how the SVD baseline is implemented"] if other_path else [])
-                     + (["which camera is flown"] if other_cam else []))
-        wt = "timing on " + join([f"the {kk[1]} in the {kk[0]} camera" for kk in meets])
-        cause = (f"Depth's median call takes {txt[lit]} than SVD's ({lit[1]}, {lit[0]} camera), outside {band}, "
-                 f"and the saving reaches the band only with {join((['another SVD implementation'] if other_path else []) + (['another camera'] if other_cam else []), none='')}, "
-                 "a choice the paper leaves open")
-    else:
-        verdict, named, wt = C.NOT_REPRODUCED, "", ""
-        cause = (f"Depth's median call takes {txt[lit]} than SVD's on the same replayed calls, and no timed SVD "
-                 f"implementation or camera brings the saving into {band}")
-    best = min((kk for kk in outs if kk != lit), key=lambda kk: (abs(outs[kk][0] - p), kk), default=None)
-    return C.row("B", cid, claim, pubtxt, verdict, cause, "B-F7, B-T3", flags=flags,
-                 ours_as_written=f"{txt[lit]} ({lit[1]}, {lit[0]} camera)",
-                 ours_best=txt[best] if best else "", best_variant=f"{best[1]} ({best[0]} camera)" if best else "",
-                 named=named, would_take=wt)
+def roles(plan: Plan) -> dict[str, str]:
+    """Method -> role for paper B, from the plan's ``variants`` blocks (as_written, compared,
+    controls); timing's ``compiled`` names the method of the compiled path, ``depth``."""
+    out: dict[str, str] = {}
+    for cid, c in plan.claims.items():
+        if c.get("paper") != "B":
+            continue
+        v = c.get("variants") or {}
+        for m in v.get("compared") or []:
+            out.setdefault(m, "compared")
+        for m in v.get("controls") or []:
+            out.setdefault(m, "control")
+    out["depth"] = "as_written"
+    for m in ("svd", "gdop", "cond", "svd_lapack", "svd_paper"):
+        out.setdefault(m, "compared")
+    return out
 
 
-def _claim_optimum(head: str, scen: dict, plan: Plan) -> dict:
-    """Fig. 5's single optimum: read where the summary counts the optima per planning call."""
-    cid = "B-C8"
-    plan.entry(cid)
-    per, why, texts = {}, {}, {}
-    for name, s in scen.items():
-        n = s.multi_optimum_pct
-        if n is None:
-            per[name] = C.NOT_TESTED
-            why[name] = "the pipeline does not count the depth error's local optima per planning call"
-            texts[name] = "not counted"
+def _f(x: Any) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return NAN
+    return v
+
+
+class _Rows:
+    def __init__(self, sample: str, source: str, role_of: Mapping[str, str]):
+        self.sample, self.source, self.role_of = sample, source, role_of
+        self.rows: dict[tuple, EvidenceRow] = {}
+
+    def role(self, m: str) -> str:
+        return self.role_of.get(m, "beyond")
+
+    def add(self, scope, method, versus, q, est, *, lo=NAN, hi=NAN, level=NAN, n=0, se=NAN, unit=None,
+            where="", setting="", sample=None, role=None):
+        from opnav.report.evidence import QUANTITIES
+
+        est = _f(est)
+        s = sample or self.sample
+        key = (s, scope, method, versus, q, setting)
+        if key in self.rows:      # the first section that holds a pair wins (the equivalence section)
+            return
+        self.rows[key] = EvidenceRow(
+            claim_id="", sample=s, scope=scope, method=method, versus=versus, role=role or self.role(method),
+            quantity=q, estimate=est, lo=_f(lo), hi=_f(hi), level=_f(level), n=int(n or 0),
+            unit=QUANTITIES[q].unit if unit is None else unit, source=f"{self.source}#{where}" if where else self.source,
+            se=_f(se), setting=setting)
+
+
+def _equivalence(r: _Rows, scope: str, sec: Mapping[str, Any], where: str, errors: Mapping[str, Any], n_runs: int):
+    ref = sec.get("reference")
+    alpha = _f(sec.get("alpha"))
+    level = 1.0 - 2.0 * alpha if math.isfinite(alpha) else NAN
+    for key, q in ERR_KEYS.items():
+        means = ((sec.get("metrics") or {}).get(key) or {}).get("means") or {}
+        for m, v in means.items():
+            sd = _f(((errors.get(m) or {}).get(key) or {}).get("3sigma")) / 3.0
+            r.add(scope, m, "", f"err_mean_{q}_m", v, n=n_runs, se=sd / math.sqrt(n_runs) if n_runs else NAN,
+                  where=f"{where}.metrics.{key}.means.{m}")
+    for m, res in (sec.get("methods") or {}).items():
+        for key, q in ERR_KEYS.items():
+            t = res.get(key)
+            if not t:
+                continue
+            n = int(t.get("n") or n_runs or 0)
+            se = _f(t.get("se"))
+            if not math.isfinite(se):
+                se = se_from_interval(_f(t.get("lo")), _f(t.get("hi")), n, level)
+            r.add(scope, m, ref, f"err_diff_{q}_m", t.get("mean"), lo=t.get("lo"), hi=t.get("hi"), level=level, n=n,
+                  se=se, where=f"{where}.methods.{m}.{key}")
+        if res.get("same_pick_pct") is not None:
+            r.add(scope, m, ref, "same_pick_pct", res["same_pick_pct"], n=n_runs, where=f"{where}.methods.{m}.same_pick_pct")
+
+
+def _converges(r: _Rows, scope: str, s: Mapping[str, Any], ref: str):
+    sections = []
+    for thr, per in (s.get("converges_faster_by_threshold") or {}).items():
+        sections.append((per, f"converges_faster_by_threshold.{thr}"))
+    sections.append((s.get("converges_faster") or {}, "converges_faster"))
+    for per, where in sections:
+        for m, cf in per.items():
+            thr = _f(cf.get("threshold_m"))
+            level = _f(cf.get("level"))
+            if not math.isfinite(level):
+                level = 1.0 - _f((s.get("equivalence") or {}).get("alpha", 0.05))
+            n = int(cf.get("n_runs") or 0)
+            se = _f(cf.get("se_s"))
+            if not math.isfinite(se):
+                se = se_from_interval(_f(cf.get("lo_s")), _f(cf.get("hi_s")), n, level)
+            r.add(scope, m, cf.get("versus") or ref, "converge_time_diff_s", cf.get("mean_s"), lo=cf.get("lo_s"),
+                  hi=cf.get("hi_s"), level=level, n=n, se=se, setting=f"threshold_m={thr:g}", where=f"{where}.{m}")
+
+
+_YAW = re.compile(r"\(([\w-]+)\): ([\d.]+) deg at start, ([\d.]+) deg at touchdown")
+
+
+def _yaw(r: _Rows, scope: str, s: Mapping[str, Any], first: str):
+    y = s.get("yaw_sigma3_deg")
+    n = int(s.get("n_runs") or 0)
+    if y:
+        start, end, m = _f(y.get("start")), _f(y.get("end")), y.get("method", first)
+        where = "yaw_sigma3_deg"
+    else:   # a summary before yaw_sigma3_deg: the numbers of its yaw_reason sentence
+        mt = _YAW.search(str(s.get("yaw_reason") or ""))
+        if not mt:
+            return
+        start, end, m, where = float(mt.group(2)), float(mt.group(3)), mt.group(1), "yaw_reason"
+    if start > 0:
+        ratio = end / start
+        r.add(scope, m, "", "yaw_sigma3_ratio", ratio, n=n, se=ratio * math.sqrt(1.0 / max(n - 1, 1)), where=where)
+
+
+def _envelopes(r: _Rows, scope: str, s: Mapping[str, Any], n_runs: int):
+    env: dict[str, dict[str, float]] = {}
+    for m, e in (s.get("errors") or {}).items():
+        for key, q in (("rms_vel_err_mps", "vel"), ("rms_att_err_deg", "att")):
+            if (e.get(key) or {}).get("3sigma") is not None:
+                env.setdefault(m, {})[q] = (_f(e[key]["3sigma"]), f"errors.{m}.{key}.3sigma")
+    for m, row in (s.get("methods") or {}).items():
+        for key, q in (("rms_vel_err_mps_3sigma", "vel"), ("rms_att_err_deg_3sigma", "att")):
+            if row.get(key) is not None:
+                env.setdefault(m, {}).setdefault(q, (_f(row[key]), f"methods.{m}.{key}"))
+    for m, a in env.items():
+        for b, bb in env.items():
+            if m == b:
+                continue
+            for q in ("vel", "att"):
+                if q in a and q in bb and bb[q][0] > 0 and math.isfinite(a[q][0]):
+                    ratio = a[q][0] / bb[q][0]
+                    # two sample sd's (independent-sample approximation; the paired runs make it conservative)
+                    se = ratio * math.sqrt(1.0 / max(n_runs - 1, 1))
+                    r.add(scope, m, b, f"envelope_ratio_{q}", ratio, n=n_runs, se=se, where=f"{a[q][1]} / {bb[q][1]}")
+
+
+def _stats(vals: list[float]) -> tuple[float, float, int]:
+    v = [x for x in vals if math.isfinite(x)]
+    k = len(v)
+    if k == 0:
+        return NAN, NAN, 0
+    m = sum(v) / k
+    sd = math.sqrt(sum((x - m) ** 2 for x in v) / (k - 1)) if k > 1 else NAN
+    return m, sd, k
+
+
+def _planning_time(r: _Rows, scope: str, pt: Mapping[str, Any], replay_prefix: str, between: str):
+    """The timing issue's planning_time block: per replay, between replays, decomposition, curve."""
+    reps = pt.get("replays") or []
+    meds = {}
+    for k, rep in enumerate(reps):
+        for m, us in (rep.get("median_us") or {}).items():
+            meds.setdefault(m, {})[k] = _f(us)
+            r.add(scope, m, "", "median_time_us", us, n=int(rep.get("n_calls") or 0),
+                  sample=f"{replay_prefix}{k + 1}", where=f"planning_time.replays.{k}.median_us.{m}")
+    for m, st in (pt.get("median_us") or {}).items():
+        pr = [_f(x) for x in st.get("per_replay") or []]
+        mean, sd, kk = _stats(pr)
+        r.add(scope, m, "", "median_time_us", st.get("mean", mean), lo=st.get("lo"), hi=st.get("hi"),
+              level=st.get("level", NAN), n=kk, se=_f(st.get("sd_between", sd)) / math.sqrt(kk) if kk else NAN,
+              sample=between, where=f"planning_time.median_us.{m}")
+    declared = set()
+    for key, st in (pt.get("reduction_pct") or {}).items():
+        a, _, b = key.partition("_vs_")
+        declared.add((a, b))
+        pr = [_f(x) for x in st.get("per_replay") or []]
+        for k, x in enumerate(pr):
+            n = int((reps[k].get("n_calls") if k < len(reps) else 0) or 0)
+            r.add(scope, a, b, "reduction_pct", x, n=n, sample=f"{replay_prefix}{k + 1}",
+                  where=f"planning_time.reduction_pct.{key}.per_replay.{k}")
+        mean, sd, kk = _stats(pr)
+        sdb = _f(st.get("sd_between", sd))
+        r.add(scope, a, b, "reduction_pct", st.get("mean", mean), lo=st.get("lo"), hi=st.get("hi"),
+              level=st.get("level", NAN), n=kk, se=sdb / math.sqrt(kk) if kk else NAN, sample=between,
+              where=f"planning_time.reduction_pct.{key}")
+    # every other pair from the replays' medians (the same replays, so the same spread rule)
+    for a, ma in meds.items():
+        for b, mb in meds.items():
+            if a == b or (a, b) in declared:
+                continue
+            pr = [100.0 * (1.0 - ma[k] / mb[k]) for k in ma if k in mb and mb[k] > 0]
+            for k, x in enumerate(pr):
+                r.add(scope, a, b, "reduction_pct", x, sample=f"{replay_prefix}{k + 1}",
+                      where=f"planning_time.replays.{k}.median_us ({a} against {b})")
+            mean, sd, kk = _stats(pr)
+            if kk:
+                r.add(scope, a, b, "reduction_pct", mean, n=kk, se=sd / math.sqrt(kk) if kk > 1 else NAN,
+                      sample=between, where=f"planning_time.replays.*.median_us ({a} against {b})")
+    for m, d in (pt.get("decomposition") or {}).items():
+        for q in ("per_eval_us", "shared_us", "evals_per_call"):
+            if d.get(q) is not None:
+                r.add(scope, m, "", q, d[q], n=len(reps), sample=between, where=f"planning_time.decomposition.{m}.{q}")
+    curve = pt.get("overhead_curve") or {}
+    for x, y in zip(curve.get("shared_us") or [], curve.get("reduction_pct") or []):
+        r.add(scope, "depth", "svd", "reduction_pct", y, sample=between, setting=f"shared_us={_f(x):g}",
+              where="planning_time.overhead_curve")
+    if pt.get("shared_us_at_published") is not None:
+        r.add(scope, "depth", "svd", "shared_us_at_published", pt["shared_us_at_published"], sample=between,
+              where="planning_time.shared_us_at_published")
+
+
+def _old_timing(r: _Rows, scope: str, s: Mapping[str, Any], replay: str):
+    """A summary before the planning_time block: one replay (its bootstrap is not a spread
+    between replays, so these rows sit in a replay sample, never between_replays)."""
+    for label, v in (s.get("planning_time_vs_depth") or {}).items():
+        b = VS_LABELS.get(label, label)
+        lo, hi = _f(v.get("depth_reduction_lo_pct")), _f(v.get("depth_reduction_hi_pct"))
+        r.add(scope, "depth", b, "reduction_pct", v.get("depth_reduction_pct"), lo=lo, hi=hi, level=0.95,
+              sample=replay, where=f"planning_time_vs_depth.{label}")
+    for m, row in (s.get("methods") or {}).items():
+        n = int(row.get("timed_calls") or 0)
+        us = row.get("median_plan_cpu_us", row.get("median_plan_time_us"))
+        r.add(scope, m, "", "median_time_us", us, n=n, sample=replay, where=f"methods.{m}.median_plan_cpu_us")
+        for b in (s.get("methods") or {}):
+            if b == m:
+                continue
+            red = row.get(f"cpu_time_reduction_vs_{b}_pct", row.get(f"time_reduction_vs_{b}_pct"))
+            r.add(scope, m, b, "reduction_pct", red, n=n, sample=replay, where=f"methods.{m}.cpu_time_reduction_vs_{b}_pct")
+        alt = OTHER_PATH.get(str(s.get("eval_path") or ""), "")
+        if alt and row.get("time_reduction_vs_svd_alt_pct") is not None:
+            r.add(scope, m, "svd", "reduction_pct", row["time_reduction_vs_svd_alt_pct"], se=row.get(
+                "time_reduction_vs_svd_alt_pct_std"), n=int(row.get("timed_calls_alt") or 0), sample=replay,
+                setting=f"path={alt}", where=f"methods.{m}.time_reduction_vs_svd_alt_pct")
+
+
+def _optima(r: _Rows, scope: str, o: Mapping[str, Any]):
+    n = int(o.get("n_calls") or 0)
+    r.add(scope, o.get("method", "depth"), "", "calls_multi_minimum", o.get("calls_multi_minimum"), n=n,
+          where="calls_multi_minimum")
+    if o.get("max_minima_per_call") is not None:
+        r.add(scope, o.get("method", "depth"), "", "max_minima_per_call", o["max_minima_per_call"], n=n,
+              where="max_minima_per_call")
+
+
+def evidence_rows(summary: Mapping[str, Any], sample: str, source: str, plan: Plan,
+                  optima: Mapping[str, Mapping[str, Any]] | None = None) -> list[EvidenceRow]:
+    """Every evidence row of one sample's B-summary.json (``sample``: main | replication;
+    ``source``: its path, for the ``source`` column; ``optima``: scenario -> the B-C8 count of
+    :func:`opnav.landing.optima.count_summary`, where it was run). No verdict logic."""
+    if not isinstance(summary, Mapping):
+        raise TypeError(f"landing_claims.evidence_rows: summary must be the B-summary dict, got {type(summary).__name__}")
+    scen = summary.get("scenarios") or {summary.get("scenario", "headline"): summary}
+    head = summary.get("headline_scenario") or next(iter(scen))
+    order = [head] + [k for k in scen if k != head]
+    r = _Rows(sample, source, roles(plan))
+    rep_prefix = "replay" if sample == "main" else "replay_rep"
+    between = "between_replays" if sample == "main" else sample
+    for name in order:
+        s = scen[name]
+        n_runs = int(s.get("n_runs") or 0)
+        errors = s.get("errors") or {}
+        eq = s.get("equivalence") or {}
+        if eq:
+            _equivalence(r, name, eq, "equivalence", errors, n_runs)
+        for b, sec in (s.get("equivalence_vs_baselines") or {}).items():
+            _equivalence(r, name, sec, f"equivalence_vs_baselines.{b}", errors, n_runs)
+        _converges(r, name, s, eq.get("reference", "svd"))
+        methods = list(s.get("methods") or {})
+        _yaw(r, name, s, methods[0] if methods else "depth")
+        _envelopes(r, name, s, n_runs)
+        if s.get("planning_time"):
+            _planning_time(r, name, s["planning_time"], rep_prefix, between)
         else:
-            per[name] = C.REPRODUCED if float(n) == 0.0 else C.NOT_REPRODUCED
-            texts[name] = f"more than one optimum in {fmt(n)} % of the planning calls"
-    verdict, named = _across(per, head, why)
-    cause = (f"In the {head} camera {why.get(head) or texts[head]}, so the golden-section search's premise "
-             + ("is untested" if verdict == C.NOT_TESTED else "holds" if verdict == C.REPRODUCED else "fails somewhere"))
-    return C.row("B", cid, "The depth error has a single optimum over the viewing angles (Fig. 5)", "one optimum",
-                 verdict, cause, "B-F5", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
+            _old_timing(r, name, s, f"{rep_prefix}1")
+        if optima and name in optima:
+            _optima(r, name, optima[name])
+        elif s.get("optima"):
+            _optima(r, name, s["optima"])
+    return list(r.rows.values())
 
 
-def _claim_fastest(head: str, scen: dict, plan: Plan) -> dict:
-    cid = "B-C9"
-    plan.entry(cid)
-    per, why, texts = {}, {}, {}
-    for name, s in scen.items():
-        t = {m: s.method(m).median_plan_time_us for m in ("depth", "svd", "gdop", "cond")}
-        t = {m: float(v) for m, v in t.items() if v is not None and math.isfinite(float(v))}
-        if "depth" not in t or "svd" not in t:
-            per[name], why[name], texts[name] = C.NOT_TESTED, "depth or SVD was not timed", "not timed"
-            continue
-        order = sorted(t, key=lambda m: (t[m], m))
-        base = [m for m in order if m != "depth"]
-        per[name] = C.REPRODUCED if order[0] == "depth" and base[0] == "svd" else C.NOT_REPRODUCED
-        texts[name] = " < ".join(f"{_name(m)} {fmt(t[m])} us" for m in order)
-    verdict, named = _across(per, head, why)
-    if verdict == C.NOT_TESTED:
-        cause = f"In the {head} camera {why[head]}"
-    else:
-        cause = (f"Median planning calls in the {head} camera order as {texts[head]}"
-                 + {C.REPRODUCED: "", C.NOT_REPRODUCED: ", not depth first and SVD the fastest baseline"}.get(
-                     verdict, ", and the order differs between cameras"))
-    return C.row("B", cid, "Depth takes the least planning time of the four; SVD is the fastest baseline (Fig. 7)",
-                 "depth < SVD < GDOP, condition number", verdict, cause, "B-F7, B-T3",
-                 ours_as_written=f"{texts[head]} ({head} camera)", named=named)
-
-
-def _claim_envelopes(head: str, scen: dict, plan: Plan) -> dict:
-    cid = "B-C10"
-    rel = plan.margin(cid, "ratio_high") - 1.0
-    compared = list(plan.variants(cid).get("compared") or ["svd"])
-    cols = ENVELOPES
-    per, why, texts = {}, {}, {}
-    for name, s in scen.items():
-        d = s.method("depth").envelopes
-        ratios = {}
-        for b in compared:
-            mb = s.method(b).envelopes
-            for c in cols:
-                if d.get(c) is not None and mb.get(c) not in (None, 0):
-                    ratios[(b, c)] = float(d[c]) / float(mb[c])
-        if not ratios:
-            per[name], why[name], texts[name] = C.NOT_TESTED, "no velocity or attitude envelopes in this summary", "n/a"
-            continue
-        off = {kk: r for kk, r in ratios.items() if abs(r - 1.0) > rel}
-        per[name] = C.NOT_REPRODUCED if off else C.REPRODUCED
-        worst = max(ratios, key=lambda kk: (abs(ratios[kk] - 1.0), kk))
-        texts[name] = (f"depth / {_name(worst[0])} {'velocity' if 'vel' in worst[1] else 'attitude'} 3-sigma "
-                       f"{fmt(ratios[worst])} (the largest departure of {len(ratios)} ratios)")
-    verdict, named = _across(per, head, why)
-    cause = (f"In the {head} camera {why[head]}" if per.get(head) == C.NOT_TESTED else
-             f"In the {head} camera the largest departure is {texts[head]}, "
-             + (f"inside {100 * rel:g} % of the baseline's envelope" if per.get(head) == C.REPRODUCED
-                else f"outside {100 * rel:g} % of the baseline's envelope" if per.get(head) == C.NOT_REPRODUCED
-                else why.get(head, "")))
-    return C.row("B", cid, "Velocity and attitude error envelopes almost the same (Fig. 6)", "almost the same",
-                 verdict, cause, "B-T3, B-F6", ours_as_written=f"{texts[head]} ({head} camera)", named=named)
-
-
-def _small_sample(s: ScenarioClaims, plan: Plan) -> list:
-    n = s.n_runs
-    if n is None:
-        return []
-    return [("sample_too_small", f"{int(n)} runs")] if int(n) < plan.guard("min_full_seeds") else []
-
-
-def claim_rows(summary: LandingSummary, pub: Mapping[str, Any], plan: Plan) -> list[dict]:
-    """Paper B's claims-table rows (ids B-C1 ... B-C4, B-C7 ... B-C10, stable). ``summary``:
-    B-summary.json as :meth:`opnav.landing.claims_summary.LandingSummary.from_json` reads it."""
-    _typed(summary, "claim_rows")
-    head, scen = summary.headline, summary.by_name()
-    rows = [_accuracy_claim("B-C1", head, scen, plan, superior=False), _claim_faster(head, scen, plan),
-            _claim_yaw(head, scen, plan), _claim_timing(head, scen, pub, plan),
-            _accuracy_claim("B-C7", head, scen, plan, superior=True), _claim_optimum(head, scen, plan),
-            _claim_fastest(head, scen, plan), _claim_envelopes(head, scen, plan)]
-    small = C.flag_text(_small_sample(scen[head], plan))
-    if small:
-        for r in rows:
-            if r["claim_id"] in ("B-C1", "B-C2", "B-C3", "B-C7", "B-C10"):
-                r["flags"] = f"{r['flags']}; {small}" if r["flags"] else small
-    return rows
+def published_rows(pub: Mapping[str, Any], source: str = "published.yaml") -> list[EvidenceRow]:
+    """Paper B's published values the claims quote (role published)."""
+    return [EvidenceRow(claim_id="", sample="main", scope="", method="", versus="", role="published",
+                        quantity="reduction_pct", estimate=float(pub["depth_time_reduction_vs_svd_pct"]), unit="%",
+                        source=f"{source}#paper_b.depth_time_reduction_vs_svd_pct")]
 
 
 # ------------------------------------------------------------ derived inputs
@@ -366,16 +357,15 @@ def terminal_accel_to_match(landing_cfg: Mapping[str, Any], tilt_deg: float, azi
     return [float(sol.x[0]), float(sol.x[1])]
 
 
-def input_rows(summary: LandingSummary, pub: Mapping[str, Any], plan: Plan,
+def input_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan,
                landing_cfg: Mapping[str, Any] | None = None) -> list[dict]:
     """Paper B's derived inputs (inputs.csv): Table 1's initial pitch and yaw, how we derive
-    them and what would match the published values."""
-    _typed(summary, "input_rows")
-    if summary.initial_tilt_deg is None:
+    them and what would match the published values (``summary``: B-summary.json)."""
+    if summary.get("initial_tilt_deg") is None:
         return []
     att = pub["table1_initial_state"]["att_deg"]
     tilt_pub, az_pub = -float(att[1]), -float(att[0])
-    tilt, az = summary.initial_tilt_deg, summary.initial_azimuth_deg
+    tilt, az = float(summary["initial_tilt_deg"]), float(summary["initial_azimuth_deg"])
     ins = plan.raw.get("inputs", {})
     match = ""
     if landing_cfg is not None:
@@ -384,27 +374,27 @@ def input_rows(summary: LandingSummary, pub: Mapping[str, Any], plan: Plan,
         match = (f"terminal horizontal acceleration ({a[0]:.3g}, {a[1]:.3g}) m/s^2 gives tilt {t2:.2f} deg, "
                  f"azimuth {z2:.2f} deg")
     return [
-        {"input": "B Table 1 initial pitch (thrust tilt)", "ours": f"{fmt(tilt)} deg",
+        {"input": "B Table 1 initial pitch (thrust tilt)", "ours": f"{fmt_(tilt)} deg",
          "published": f"{att[1]:g} deg (tilt {tilt_pub:g} deg)",
          "how_derived": ins.get("initial_pitch", {}).get("how_derived", ""),
          "what_would_match": match},
-        {"input": "B Table 1 initial yaw (thrust azimuth)", "ours": f"{fmt(az)} deg",
+        {"input": "B Table 1 initial yaw (thrust azimuth)", "ours": f"{fmt_(az)} deg",
          "published": f"{att[0]:g} deg (azimuth {az_pub:g} deg)",
          "how_derived": ins.get("initial_yaw", {}).get("how_derived", ""),
          "what_would_match": match},
     ]
 
 
-def _typed(summary, where: str) -> None:
-    if not isinstance(summary, LandingSummary):
-        raise TypeError(f"landing_claims.{where}: summary must be a LandingSummary "
-                        f"(LandingSummary.from_json(<B-summary.json>)), got {type(summary).__name__}")
-
-
 def _tilt_az(cfg):
     from opnav.landing.scenario import thrust_tilt_azimuth_deg
 
     return thrust_tilt_azimuth_deg(cfg)
+
+
+def fmt_(x: float) -> str:
+    from opnav.report.scorer import fmt
+
+    return fmt(x)
 
 
 #: the claims the abstract quotes with their cause

@@ -41,6 +41,22 @@ NUMBER_PARAMS = {
 }
 
 
+#: settings the pipeline reads to compute evidence (not named in a test): who reads each
+EVIDENCE_SETTINGS = {
+    "converge_threshold_sweep_m": "workflow/scripts/landing_summary.py (B-C2's sweep)",
+    "converge_threshold_m": "workflow/scripts/landing_summary.py and B-C2's condition",
+    "optimum_angle_grid": "rule landing_optima (B-C8's count)",
+}
+
+
+def join(items, none: str = "none") -> str:
+    """'a', 'a and b', 'a, b and c' (``none`` for no item)."""
+    items = [i for i in items if i]
+    if not items:
+        return none
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
 class PlanError(ValueError):
     """The analysis plan is malformed or lacks an entry a verdict needs (one line, naming the key)."""
 
@@ -139,7 +155,7 @@ class Plan:
             if not ok:
                 raise PlanError(f"{source}: settings.{name} needs a numeric 'value' (or 'values') and a 'reason'")
         self.raw = raw
-        self.text = text if text is not None else yaml.safe_dump(dict(raw), sort_keys=True)
+        self._text = text
         self.claims: dict = dict(raw["claims"])
         self._read: set[str] = set()
         self._tests: dict[str, ClaimTest] = {}
@@ -158,6 +174,13 @@ class Plan:
     @property
     def version(self) -> int:
         return int(self.raw["version"])
+
+    @property
+    def text(self) -> str:
+        """The plan file's text (an amended plan's: its entries dumped, sorted)."""
+        if self._text is None:
+            self._text = yaml.safe_dump(dict(self.raw), sort_keys=True)
+        return self._text
 
     @property
     def checksum(self) -> str:
@@ -326,8 +349,6 @@ class Plan:
         """What a variant label (``roll+growing+squarem``) adds to the paper as written, in words."""
         add = (self.raw.get("names") or {}).get("additions") or {}
         parts = [p for p in label.split("+") if p and p != "literal"]
-        from opnav.report.claims import join
-
         return join([add.get(p, p) for p in parts], none="nothing")
 
     def keys(self) -> list[str]:
@@ -338,6 +359,22 @@ class Plan:
             out += [f"claims.{cid}.margins.{m}" for m in (c.get("margins") or {})]
         out += [f"guards.{g}" for g in self.raw.get("guards", {})]
         out += [f"settings.{s}" for s in self.raw.get("settings", {})]
+        return out
+
+    def unreferenced(self) -> list[str]:
+        """Margins and settings no claim's test names (a static check of the plan: every number
+        of it is read by some verdict or evidence)."""
+        text = yaml.safe_dump({cid: c.get("test") for cid, c in self.claims.items()}, sort_keys=True)
+        out = []
+        for cid, c in self.claims.items():
+            t = yaml.safe_dump(c.get("test"), sort_keys=True)
+            for m in (c.get("margins") or {}):
+                if not re.search(rf"margin: {re.escape(m)}\b", t):
+                    out.append(f"claims.{cid}.margins.{m}")
+        for name in self.raw.get("settings") or {}:
+            if not re.search(rf"setting: {re.escape(name)}\b", text) and not (self.raw["settings"][name] or {}).get(
+                    "config") and name not in EVIDENCE_SETTINGS:
+                out.append(f"settings.{name}")
         return out
 
     def unused(self) -> list[str]:
@@ -364,8 +401,6 @@ class Plan:
     def table(self):
         """results/paper/analysis_plan.csv: one row per claim, margins with their reasons."""
         import pandas as pd
-
-        from opnav.report.claims import join
 
         rows = []
         for cid, c in self.claims.items():
@@ -418,7 +453,7 @@ def load_plan(path: str | Path | None = None) -> Plan:
     except OSError as exc:
         raise PlanError(f"{p}: cannot read the analysis plan ({exc.strerror})") from None
     try:
-        raw = yaml.safe_load(text)
+        raw = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     except yaml.YAMLError as exc:
         raise PlanError(f"{p}: not valid YAML ({str(exc).splitlines()[0]})") from None
     return Plan(raw, p.name, text)

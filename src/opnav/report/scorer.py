@@ -23,7 +23,7 @@ claim. The steps, in order (the plan file's header states the schema):
    that agree -> the pooled sample's verdict, flag ``replication_underpowered``. ``suspect``
    in either sample is the verdict and a flag naming the sample.
 5. **would_take** (:func:`would_take`): sweeps of a setting (where the condition flips,
-   interpolated), margins that would pass, the scopes or alternatives where it holds.
+   interpolated log-log where every value is positive, else linearly), margins that would pass, the scopes or alternatives where it holds.
 
 Every number a claim row quotes is the estimate, lo or hi of a row the scorer read
 (:attr:`Judgement.quoted`), a plan number or a published row.
@@ -39,7 +39,7 @@ from typing import Any
 
 from scipy import special
 
-from opnav.report.evidence import QUANTITIES, Evidence, EvidenceRow
+from opnav.report.evidence import QUANTITIES, Evidence, EvidenceRow, quantity
 from opnav.report.plan import ClaimTest, Condition, Plan, PlanError
 
 REPRODUCED = "reproduced"
@@ -103,6 +103,8 @@ class Outcome:
     why: str = ""                   # undecided: why
     scope: str = ""
     versus: str = ""
+    #: the numbers ``threshold`` quotes (band ends, +-margin, a threshold), for the derived rows
+    numbers: tuple[float, ...] = ()
 
     @property
     def row(self) -> EvidenceRow | None:
@@ -149,6 +151,8 @@ class Reading:
     per_scope: dict[str, Reading] = field(default_factory=dict)
     sample: str = ""
     units: list[UnitReading] = field(default_factory=list)
+    #: the outcomes the cause quotes
+    cited: list[Outcome] = field(default_factory=list)
 
 
 @dataclass
@@ -166,6 +170,8 @@ class Judgement:
     would_take: str = ""
     sweeps: list[dict] = field(default_factory=list)
     quoted: list[EvidenceRow] = field(default_factory=list)
+    #: rows the scorer computed (would_take's flips and margins), written to the evidence table
+    derived: list[EvidenceRow] = field(default_factory=list)
 
 
 class _Index:
@@ -279,6 +285,7 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
             return o
         ok = lo_b <= est <= hi_b
         o.threshold = text
+        o.numbers = tuple(x for x in (lo_b, hi_b) if math.isfinite(x))
         if est > hi_b:
             o.limit, o.severity = hi_b, (est - hi_b) / max(abs(hi_b), 1e-300)
         elif est < lo_b:
@@ -292,7 +299,7 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
     if comp == "equivalence":
         m, ref_row = ctx.num(cond.get("margin"), cond, scope, row)
         o.threshold = f"+-{fmt(m)}{unit}"
-        o.limit = m
+        o.limit, o.numbers = m, (m,)
         if not (math.isfinite(m) and m > 0):
             o.status, o.why = UNDECIDED, "the margin is zero (the reference's mean is not positive)"
             return o
@@ -313,6 +320,7 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
         o.threshold = (f"below {fmt(-m)}{unit}" if below else f"above {fmt(m)}{unit}") + (
             f", by at least {fmt(eff)}{unit}" if eff else "")
         o.limit = -m if below else m
+        o.numbers = (-m if below else m, eff)
         side = (row.hi < -m) if below else (row.lo > m)
         size = (-est >= eff) if below else (est >= eff)
         edge = row.hi if below else -row.lo
@@ -323,7 +331,7 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
     if comp == "sign":
         key = "above" if cond.get("above") is not None else "below"
         t, _ = ctx.num(cond.get(key), cond, scope, row)
-        o.threshold, o.limit = f"{key} {fmt(t)}{unit}", t
+        o.threshold, o.limit, o.numbers = f"{key} {fmt(t)}{unit}", t, (t,)
         ok = est > t if key == "above" else est < t
         o.severity = (t - est if key == "above" else est - t) / max(abs(t), 1e-300)
         o.status = PASS if ok else FAIL
@@ -332,6 +340,7 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
         key = next(k for k in ("equals", "at_most", "at_least") if cond.get(k) is not None)
         t, _ = ctx.num(cond.get(key), cond, scope, row)
         o.threshold, o.limit = {"equals": "equal to", "at_most": "at most", "at_least": "at least"}[key] + f" {fmt(t)}", t
+        o.numbers = (t,)
         ok = {"equals": abs(est - t) < 1e-9, "at_most": est <= t, "at_least": est >= t}[key]
         o.severity = abs(est - t)
         o.status = PASS if ok else FAIL
@@ -590,7 +599,13 @@ def _sample_reading(plan: Plan, test: ClaimTest, idx: _Index, sample: str, level
     base = _Ctx(plan, test, idx, sample, level)
     scopes = _scopes(base)
     if not scopes:
-        rd = Reading(NOT_TESTED, named=f"no evidence in the {sample} sample", sample=sample)
+        held = sorted({r.sample for r in idx.rows if r.role != "published"
+                       and r.quantity == test.conditions[0].quantity})
+        why = (f"no {test.conditions[0].quantity} in the {sample} sample"
+               + (f" (only in {', '.join(held)})" if held else ""))
+        if sample == "between_replays" and held:
+            why = "one replay only: no spread between independent replays to judge it on"
+        rd = Reading(NOT_TESTED, named=why, sample=sample)
         rd.cause = _cause(rd, test, plan)
         return rd
     groups = [[s] for s in scopes] if test.scopes.get("combine") == "choice" else [scopes]
@@ -643,7 +658,7 @@ def _combine_scopes(per: dict[str, Reading], test: ClaimTest, plan: Plan, sample
                       lit=first.lit, best=first.best, flags=[f for r in per.values() for f in r.flags])
         out.quoted = [q for r in per.values() for q in r.quoted]
         out.per_scope = dict(per)
-        out.cause = _choice_cause(per, test, plan)
+        out.cause = _choice_cause(per, test, plan, out)
     out.per_scope = dict(per)
     out.sample = sample
     out.quoted = [q for r in per.values() for q in r.quoted]
@@ -651,6 +666,20 @@ def _combine_scopes(per: dict[str, Reading], test: ClaimTest, plan: Plan, sample
 
 
 # ------------------------------------------------------------ causes
+def cited_rows(o: Outcome | None, claim_id: str) -> list[EvidenceRow]:
+    """The derived rows of the numbers an outcome's threshold quotes (band ends, the margin):
+    computed from plan numbers and evidence rows, written to the evidence table so that every
+    number a claim row quotes is one of its rows."""
+    if o is None or o.row is None:
+        return []
+    r = o.row
+    q = quantity(f"limit_{r.quantity}", r.unit, "none", f"the test's boundary for {r.quantity}")
+    return [EvidenceRow(claim_id=claim_id, sample=r.sample, scope=r.scope, method=r.method, versus=r.versus,
+                        role="derived", quantity=q, estimate=float(x), unit=r.unit, setting=f"boundary={k}",
+                        source=f"scorer: condition {o.cond.index} ({o.cond.comparison}) of the plan on {r.quantity}")
+            for k, x in enumerate(o.numbers) if math.isfinite(x)]
+
+
 def quote(o: Outcome | None, plan: Plan | None = None, with_scope: bool = True) -> str:
     """An outcome's row as the cause quotes it: 'depth - SVD err_diff_lastlm_m -0.0085 m
     [-0.017, -9.5e-05] against +-0.0376 m (interior)'."""
@@ -660,8 +689,9 @@ def quote(o: Outcome | None, plan: Plan | None = None, with_scope: bool = True) 
     name = (lambda k: plan.name(k)) if plan is not None else (lambda k: k)
     q = QUANTITIES.get(r.quantity)
     what = q.text if q is not None else r.quantity
-    who = name(r.method) + (f" minus {name(r.versus)}" if r.versus and r.quantity.startswith(("err_diff", "converge_time"))
-                            else f" against {name(r.versus)}" if r.versus else "")
+    who = "" if r.role == "bound" else name(r.method) + (
+        f" minus {name(r.versus)}" if r.versus and r.quantity.startswith(("err_diff", "converge_time"))
+        else f" against {name(r.versus)}" if r.versus else "")
     if o.cond.comparison == "order" and len(o.rows) >= 2 and o.rows[1] is not None and o.cond.get("by") == "estimate":
         a, b = o.rows[0], o.rows[1]
         left = a.scope if o.cond.get("items") == "scope" else name(a.method)
@@ -670,12 +700,19 @@ def quote(o: Outcome | None, plan: Plan | None = None, with_scope: bool = True) 
     val = (_signed(r.estimate) if r.versus and r.quantity.startswith(("err_diff", "converge_time")) else fmt(r.estimate))
     iv = f" [{_signed(r.lo)}, {_signed(r.hi)}]" if r.has_interval and o.cond.comparison in (
         "equivalence", "superiority", "order") else ""
-    s = f"{who} {what} {val}{_u(r.unit)}{iv}"
+    s = f"{who} {what} {val}{_u(r.unit)}{iv}".strip()
     if o.threshold:
         s += f" against {o.threshold}"
     if with_scope and r.scope:
         s += f" ({r.scope})"
     return s
+
+
+def _q(rd: Reading, o: Outcome | None, plan: Plan, with_scope: bool = True) -> str:
+    """:func:`quote`, remembering the outcome as cited by the reading's cause."""
+    if o is not None:
+        rd.cited.append(o)
+    return quote(o, plan, with_scope)
 
 
 def _cause(rd: Reading, test: ClaimTest, plan: Plan, scopes: list[str] | None = None, every: bool = False) -> str:
@@ -686,27 +723,31 @@ def _cause(rd: Reading, test: ClaimTest, plan: Plan, scopes: list[str] | None = 
     if v == REPRODUCED:
         o = rd.lit.tightest() if rd.lit else None
         tail = ", so the test cannot credit the method" if any(f[0] == "control_also_meets" for f in rd.flags) else ""
-        return (f"As written it holds {'in every scope' if every else where}: {quote(o, plan)}" + tail)
+        return (f"As written it holds {'in every scope' if every else where}: {_q(rd, o, plan)}" + tail)
     if v == WITH_ADDITION:
         o, b = (rd.lit.worst() if rd.lit else None), (rd.best.tightest() if rd.best else None)
-        return f"As written it fails on {quote(o, plan)}, while {rd.best.method} passes ({quote(b, plan, False)})"
+        return f"As written it fails on {_q(rd, o, plan)}, while {rd.best.method} passes ({_q(rd, b, plan, False)})"
     if v == NOT_REPRODUCIBLE:
-        return (f"The bound of the data as written, {quote(rd.bound, plan)}, already fails the test, so no unbiased "
-                "estimator on the stated data meets it")
+        b = rd.bound.row
+        return (f"The bound of the data the method as written uses, {fmt(b.estimate)}{_u(b.unit)} ({b.scope}), is "
+                f"not {rd.bound.threshold}, so no unbiased estimator on the stated data meets it")
     if v == DEPENDS and rd.bound is not None:
-        return (f"Even the floor {quote(rd.bound, plan)} fails the test, a floor set by {test.choice}, so the claim "
-                "hinges on them")
+        return f"Even the floor, {_q(rd, rd.bound, plan)}, fails the test, so the claim hinges on {test.choice}"
     if v == DEPENDS:
-        return (f"As written it fails on {quote(rd.lit.worst() if rd.lit else None, plan)}, but holds with "
+        return (f"As written it fails on {_q(rd, rd.lit.worst() if rd.lit else None, plan)}, but holds with "
                 f"{dict(rd.flags).get('holds_with', 'another choice')}, a choice the paper leaves open")
     if v == NOT_TESTED:
-        return f"Not tested {where}: {rd.named}"
+        return f"Not tested: {rd.named}"
     o = rd.lit.worst() if rd.lit else None
     tail = f", and no faithful variant passes" if any(u.role == "faithful" for u in rd.units) else ""
-    return f"As written it fails on {quote(o, plan)}{tail}"
+    return f"As written it fails on {_q(rd, o, plan)}{tail}"
 
 
-def _choice_cause(per: dict[str, Reading], test: ClaimTest, plan: Plan) -> str:
+def the_others(per) -> str:
+    return "the others"
+
+
+def _choice_cause(per: dict[str, Reading], test: ClaimTest, plan: Plan, rd: Reading | None = None) -> str:
     ok = [s for s, r in per.items() if r.verdict == REPRODUCED]
     bad = [s for s, r in per.items() if r.verdict not in (REPRODUCED, NOT_TESTED)]
     o = None
@@ -715,9 +756,9 @@ def _choice_cause(per: dict[str, Reading], test: ClaimTest, plan: Plan) -> str:
         if r.lit is not None and r.lit.worst() is not None:
             o = r.lit.worst()
             break
-    why = f" ({quote(o, plan)})" if o is not None else ""
-    return (f"It holds in {', '.join(ok) or 'no scope'} but not in {', '.join(bad) or 'the others'}{why}, and the paper "
-            f"leaves {test.scopes.get('choice') or test.choice} open")
+    why = f" ({_q(rd, o, plan) if rd is not None else quote(o, plan)})" if o is not None else ""
+    return (f"It holds in {', '.join(ok) or 'no scope'} but not in {', '.join(bad) or the_others(per)}{why}; the "
+            f"choice is {test.scopes.get('choice') or test.choice}")
 
 
 # ------------------------------------------------------------ two samples
@@ -907,6 +948,8 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
     sweeps = []
     for (scope, method, versus), rs in sorted(by_unit.items()):
         rs = sorted(rs, key=lambda r: _setting_value(r.setting, name))
+        if len(rs) < 2:
+            continue
         ctx = _Ctx(plan, test, idx, rs[0].sample, level)
         pts, outs = [], []
         for r in rs:
@@ -920,7 +963,12 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
             if s1 != s2 and PASS in (s1, s2) and UNDECIDED not in (s1, s2):
                 lim = o2.limit if s2 == PASS else o1.limit
                 if math.isfinite(lim) and e2 != e1 and cond.comparison in ("band", "sign"):
-                    flip = v1 + (lim - e1) * (v2 - v1) / (e2 - e1)
+                    if min(v1, v2, e1, e2, lim) > 0:     # power laws (bounds, errors): log-log
+                        lv = math.log(v1) + (math.log(lim) - math.log(e1)) * (math.log(v2) - math.log(v1)) / (
+                            math.log(e2) - math.log(e1))
+                        flip = math.exp(lv)
+                    else:
+                        flip = v1 + (lim - e1) * (v2 - v1) / (e2 - e1)
                 else:
                     flip = v2 if s2 == PASS else v1
                 break
@@ -945,6 +993,11 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
         who = f"{plan.name(s['method'])}" + (f", {s['scope']}" if s["scope"] else "")
         if s["flip"] is not None:
             texts.append(w.get("text", "{value}").format(value=fmt(s["flip"])) + f" ({who})")
+            q = quantity(f"flip_{name}", "", "none", f"{name} at which the verdict flips")
+            j.derived.append(EvidenceRow(
+                claim_id=test.claim_id, sample=test.samples["main"], scope=s["scope"], method=s["method"],
+                versus=s["versus"], role="derived", quantity=q, estimate=float(s["flip"]),
+                n=len(s["points"]), source=f"scorer: the sweep of {s['quantity']} over {name}"))
         else:
             texts.append(f"no {name} from {fmt(min(vals))} to {fmt(max(vals))} gives it ({who})")
     return "; ".join(texts), sweeps
@@ -970,6 +1023,11 @@ def _margin_take(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapp
         return ""
     v, o = max(need, key=lambda t: t[0])
     cur = plan.margin(test.claim_id, name)
+    q = quantity(f"needed_{name}", "", "none", f"the value of margin {name} at which the test would pass")
+    j.derived.append(EvidenceRow(claim_id=test.claim_id, sample=test.samples["main"], scope=o.scope,
+                                 method=o.row.method, versus=o.row.versus, role="derived", quantity=q,
+                                 estimate=float(v), n=o.row.n,
+                                 source=f"scorer: {o.row.quantity} against condition {cond.index} of the plan"))
     return f"{name} {fmt(v)} instead of {fmt(cur)} ({o.scope or o.row.method})"
 
 

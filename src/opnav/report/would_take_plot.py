@@ -1,0 +1,82 @@
+"""What a claim would take, as a figure: the swept quantity against the swept choice.
+
+One figure per claim whose plan entry sweeps a choice (``would_take: sweep``; A-C1 and A-C4:
+the roll rate, A-C7: the arc length, B-C2: the convergence threshold, B-C4: the per-call
+overhead shared by both methods): each swept method and scope as a line (with its interval
+where the evidence has one), the test's boundary as a dashed line, and the value where the
+verdict flips marked. Plotting only: the points, the boundary and the flip are the scorer's
+(:func:`opnav.report.scorer.would_take`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from opnav.core import figures
+from opnav.report import approach_claims, landing_claims  # noqa: F401  (their quantities' names)
+
+
+_UNITS = (("_deg_s", "deg/s"), ("_arcsec", "arcsec"), ("_km", "km"), ("_us", "us"), ("_m", "m"), ("_s", "s"))
+
+
+def setting_label(name: str) -> str:
+    """'roll_rate_deg_s' -> 'roll rate (deg/s)', 'arc_s' -> 'arc (s)'."""
+    for suf, unit in _UNITS:
+        if name.endswith(suf):
+            return f"{name[: -len(suf)].replace('_', ' ')} ({unit})"
+    return name.replace("_", " ")
+
+
+def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, names: Mapping[str, str] | None = None):
+    """Save the would_take figure of ``claim_id`` (``sweeps``: the scorer's sweeps of that
+    claim) to ``path`` (a stem: PDF and PNG); a claim without sweep evidence in this build gets
+    a figure that says so."""
+    import matplotlib.pyplot as plt
+
+    names = dict(names or {})
+    sw = [s for s in sweeps if s["claim_id"] == claim_id]
+    with figures.style():
+        fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.4))
+        if not sw:
+            ax.text(0.5, 0.5, f"{claim_id}: no swept evidence in this build", ha="center", va="center",
+                    transform=ax.transAxes)
+            ax.set_axis_off()
+            return figures.save(fig, path)
+        s0 = sw[0]
+        styles = ["-", "--", ":", "-."]
+        scopes = list(dict.fromkeys(s["scope"] for s in sw))
+        for s in sw:
+            xs = [p[0] for p in s["points"]]
+            ys = [p[1] for p in s["points"]]
+            lab = names.get(s["method"], s["method"]) + (f", {s['scope']}" if len(sw) > 1 and s["scope"] else "")
+            c = figures.color(s["method"].split("+")[0])
+            ax.plot(xs, ys, marker="o", ms=3, color=c, label=lab, ls=styles[scopes.index(s["scope"]) % len(styles)])
+            lo = [p[2] for p in s["points"]]
+            hi = [p[3] for p in s["points"]]
+            if all(math.isfinite(v) for v in lo + hi):
+                ax.fill_between(xs, lo, hi, color=c, alpha=0.2, lw=0)
+            if s["flip"] is not None:
+                ax.axvline(s["flip"], color=c, ls=":", lw=1)
+        lim = s0.get("limit", math.nan)
+        if lim is not None and math.isfinite(lim):
+            ax.axhline(lim, color="0.3", ls="--", lw=1, label=f"test: {s0.get('threshold', '')}")
+        from opnav.report.evidence import QUANTITIES
+
+        unit = s0.get("unit", "")
+        q = QUANTITIES.get(s0["quantity"])
+        ax.set_xlabel(setting_label(s0["setting"]))
+        ax.set_ylabel((q.text if q is not None else s0["quantity"].replace("_", " ")) + (f" ({unit})" if unit else ""))
+        xs_all = [p[0] for s in sw for p in s["points"]]
+        ys_all = [p[1] for s in sw for p in s["points"]] + ([lim] if lim is not None and math.isfinite(lim) else [])
+        if xs_all and min(xs_all) > 0 and max(xs_all) / min(xs_all) > 8:
+            ax.set_xscale("log")
+            figures.plain_log_labels(ax.xaxis)
+            if ys_all and min(ys_all) > 0 and max(ys_all) / min(ys_all) > 8:
+                ax.set_yscale("log")     # a power law is a line, as the flip is interpolated
+                figures.plain_log_labels(ax.yaxis)
+        ax.set_title(f"{claim_id}: what it would take", fontsize="small")
+        figures.place_legend(ax, fontsize="x-small")
+        return figures.save(fig, path)

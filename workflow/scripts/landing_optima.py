@@ -1,0 +1,22 @@
+"""B-C8's evidence: how many local minima the depth error has over the visible angles on each
+side of the velocity, per recorded planning call of one camera scenario's depth Monte Carlo
+(opnav.landing.optima)."""
+
+import sys
+
+from opnav.core.snakeio import mock_snakemake, script_context
+from opnav.core.tables import write_json
+from opnav.landing import optima
+from opnav.landing.descent import build_scenario
+from opnav.landing.montecarlo import load
+
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
+    snakemake = mock_snakemake("landing_optima", argv=sys.argv[1:], bscn="site-tilt")
+
+with script_context(snakemake) as log:
+    scn = build_scenario(snakemake.params.landing)
+    counts = optima.count_calls(scn, load(snakemake.input.mc), int(snakemake.params.n_grid),
+                                int(snakemake.params.max_calls))
+    out = optima.count_summary(counts, snakemake.wildcards.bscn)
+    write_json(snakemake.output[0], out)
+    log.info("%s", out["text"])
