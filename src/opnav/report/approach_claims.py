@@ -172,7 +172,9 @@ def evidence_rows(t1: pd.DataFrame, summary: Mapping[str, Any] | None, sample: s
         arc, v, n = _f(row.get("arc_s")), str(row.get("variant", AS_WRITTEN)), int(row.get("n_seeds") or 0)
         for rule, suffix in (("", "rule"), (";rule=last", "last")):
             st = f"arc_s={arc:g}{rule}"
+            sd = _f(row.get(f"nav_err_km_{suffix}_sd"))
             add(HEADLINE_CASE, v, "nav_err_after_km", row.get(f"nav_err_km_{suffix}"), n=n, src=src, setting=st,
+                se=sd / math.sqrt(n) if n else NAN,
                 where=f"nav_floor_by_arc.rows(arc_s={arc:g},variant={v}).nav_err_km_{suffix}")
             add(HEADLINE_CASE, v, "nav_err_true_theta_km", row.get(f"true_theta_km_{suffix}"), n=n, role="bound",
                 src=src, setting=st, where=f"nav_floor_by_arc.rows(arc_s={arc:g},variant={v}).true_theta_km_{suffix}")

@@ -700,7 +700,7 @@ def quote(o: Outcome | None, plan: Plan | None = None, with_scope: bool = True) 
     val = (_signed(r.estimate) if r.versus and r.quantity.startswith(("err_diff", "converge_time")) else fmt(r.estimate))
     iv = f" [{_signed(r.lo)}, {_signed(r.hi)}]" if r.has_interval and o.cond.comparison in (
         "equivalence", "superiority", "order") else ""
-    s = f"{who} {what} {val}{_u(r.unit)}{iv}".strip()
+    s = (f"{what} of {who}" if who else what) + f" {val}{_u(r.unit)}{iv}"
     if o.threshold:
         s += f" against {o.threshold}"
     if with_scope and r.scope:
@@ -726,7 +726,7 @@ def _cause(rd: Reading, test: ClaimTest, plan: Plan, scopes: list[str] | None = 
         return (f"As written it holds {'in every scope' if every else where}: {_q(rd, o, plan)}" + tail)
     if v == WITH_ADDITION:
         o, b = (rd.lit.worst() if rd.lit else None), (rd.best.tightest() if rd.best else None)
-        return f"As written it fails on {_q(rd, o, plan)}, while {rd.best.method} passes ({_q(rd, b, plan, False)})"
+        return f"As written it fails ({_q(rd, o, plan)}), while {rd.best.method} passes ({_q(rd, b, plan, False)})"
     if v == NOT_REPRODUCIBLE:
         b = rd.bound.row
         return (f"The bound of the data the method as written uses, {fmt(b.estimate)}{_u(b.unit)} ({b.scope}), is "
@@ -734,13 +734,13 @@ def _cause(rd: Reading, test: ClaimTest, plan: Plan, scopes: list[str] | None = 
     if v == DEPENDS and rd.bound is not None:
         return f"Even the floor, {_q(rd, rd.bound, plan)}, fails the test, so the claim hinges on {test.choice}"
     if v == DEPENDS:
-        return (f"As written it fails on {_q(rd, rd.lit.worst() if rd.lit else None, plan)}, but holds with "
+        return (f"As written it fails ({_q(rd, rd.lit.worst() if rd.lit else None, plan)}), but holds with "
                 f"{dict(rd.flags).get('holds_with', 'another choice')}, a choice the paper leaves open")
     if v == NOT_TESTED:
         return f"Not tested: {rd.named}"
     o = rd.lit.worst() if rd.lit else None
     tail = f", and no faithful variant passes" if any(u.role == "faithful" for u in rd.units) else ""
-    return f"As written it fails on {_q(rd, o, plan)}{tail}"
+    return f"As written it fails: {_q(rd, o, plan)}{tail}"
 
 
 def the_others(per) -> str:
