@@ -37,13 +37,17 @@ issue 44   star images of Hipparcos stars, attitude knowledge, drift   stars.sta
                                                                        scenario.star_field_of
 issue 44   installation rows and the sample time read against model   readings.installation_check,                    arcsec, s
                                                                        readings.sample_time_reading
+issue 54   Mars images' attitude knowledge (lateral (rho sigma)^2)     scenario.Geometry.measurement_variance,         km^2, rad
+                                                                       scenario.simulate
+issue 54   a window's star rows whitened by their own covariance       stars.StarField.select, stars.joint_covariance  rad
+issue 54   navigation error against arc length; tz on and off          navfloor.nav_floor_by_arc, navfloor.tz_nav_effect km, s
 =========  ==========================================================  ==============================================  ====================
 
 Layers
     ``setup`` (the config parsed once, frozen) -> ``dynamics``, ``camera``, ``kalman`` ->
     ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml``, ``consider`` ->
     ``scenario``, ``labels`` (a run's convergence label and reading), ``cases`` -> ``pipeline``,
-    ``alternatives``, ``study``, ``peers``, ``readings`` -> ``summaries``, ``alternatives_summary``
+    ``alternatives``, ``study``, ``peers``, ``readings``, ``navfloor`` -> ``summaries``, ``alternatives_summary``
     (the tables' numbers, A-summary.json; the frozen ``HeadlineSummary``, ``ClaimsSummary`` and
     ``MethodSummary`` the report reads), ``plots``, ``peer_plots``, ``star_plots``; ``cli`` at
     the edge. The tables' page views, the scorecard rows and the prose made from the numbers are
