@@ -58,6 +58,11 @@ include: "workflow/rules/paper.smk"
 
 
 onstart:
+    # A SLURM run without its status command is refused before any submission, and a
+    # signal stops the build within seconds, saying so (opnav.core.runguard).
+    from opnav.core.runguard import guard
+
+    guard(workflow)
     # results_dir is this checkout's (and this profile's): its marker names them, and a
     # later parse from another checkout is refused (opnav.core.checks.owner_problems).
     # Written here, when jobs are about to run, so a dry run writes nothing.
@@ -83,6 +88,9 @@ onsuccess:
 
 onerror:
     stop_rate_limit_timers()
+    from opnav.core.runguard import interrupted_exit
+
+    interrupted_exit()  # after a signal: "interrupted", not "a job did not complete"
 
 
 rule all:

@@ -94,3 +94,58 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     assert chunk.name in out and "snakemake --cores 2 --force" in out, out
     text = log.read_text()
     assert "Traceback" in text and "CorruptIntermediate" in text and chunk.name in text, text
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGKILL"])
+def test_a_signal_to_the_build_alone_stops_it_and_its_jobs(tmp_path, sig):
+    """Issue 57 item 5: SIGTERM (or SIGKILL) to the snakemake process alone, as a batch system
+    or `kill PID` sends it, while a Monte-Carlo job runs. SIGTERM: the build ends within
+    10 s saying it was interrupted (Snakemake 9.27 alone waited for the jobs, then said "At
+    least one job did not complete successfully"), exit 143; either way no job of it is
+    alive 3 s after it ended (after SIGKILL two jobs ran on ~30 s as orphans). Mutations
+    (tried): no stop_with_parent in script_context fails SIGKILL; no guard() in onstart fails
+    SIGTERM."""
+    import subprocess
+    import sys
+
+    from opnav.core.runguard import _descendants
+
+    wd = tmp_path / "wf"
+    wd.mkdir()
+    copy_workflow(wd)
+    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 12, runs_per_job: 4, methods_per_job: 1}}\n")
+    target = "results/quick/landing/mc/site-tilt/depth.npz"
+    env = dict(os.environ, PYTHONPATH=str(wd / "src"))
+    proc = subprocess.Popen([sys.executable, "-m", "snakemake", target, "--cores", "2", "--configfile",
+                             "config/quick.yaml", "small.yaml"], cwd=wd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    try:
+        deadline = time.time() + 300
+        while time.time() < deadline and proc.poll() is None and not _job_in_flight(proc.pid, "landing_mc_chunk"):
+            time.sleep(0.1)
+        assert proc.poll() is None, "the workflow ended before a job ran:\n" + proc.communicate()[0][-3000:]
+        time.sleep(1.0)                                  # the job past its start-up
+        jobs = _descendants(proc.pid)
+        assert jobs
+        t0 = time.monotonic()
+        os.kill(proc.pid, getattr(signal, sig))
+        out, _ = proc.communicate(timeout=60)
+        took = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    time.sleep(3)
+    alive = []
+    for pid in jobs:
+        try:
+            os.kill(pid, 0)
+            alive.append(pid)
+        except ProcessLookupError:
+            pass
+    assert not alive, f"{len(alive)} job process(es) outlived the build by 3 s"
+    if sig == "SIGTERM":
+        assert took < 10 and proc.returncode == 143, (took, proc.returncode, out[-3000:])
+        assert "interrupted by SIGTERM" in out and "did not complete successfully" not in out, out[-3000:]
+        assert "Error in rule" not in out, out[-3000:]
+        assert not (wd / ".snakemake" / "locks").exists() or not any((wd / ".snakemake" / "locks").iterdir())

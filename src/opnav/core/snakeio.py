@@ -33,6 +33,10 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
     process's CPU seconds and peak memory, start-up and imports included), which
     ``benchmarks/job_costs.py`` sums per rule.
     """
+    if type(snakemake).__module__.startswith("snakemake"):   # a workflow job, not a script run by hand
+        from opnav.core.runguard import stop_with_parent
+
+        stop_with_parent()  # the job ends with Snakemake, even a SIGKILLed one (opnav.core.runguard)
     startup.begin()  # the job's own work starts here (opnav.core.startup)
     log_path = snakemake.log[0] if len(getattr(snakemake, "log", [])) else None
     logger = logging.getLogger("opnav")
