@@ -188,3 +188,59 @@ def test_the_rule_reads_only_the_keys_the_table_shows():
     sub = differences.subset(cfg)
     assert differences.rows(sub, pub) == differences.rows(cfg, pub)
     assert "accuracy_target_arcsec" not in sub["approach"]  # an edit elsewhere reruns nothing of page 1
+
+
+def test_build_wall_time_is_the_union_of_its_jobs_from_snakemakes_records(tmp_path):
+    """Issue 55 item 7: the PDF states the build's wall time and machine beside the heavy jobs'
+    job time. The wall time is the time at least one job ran (side-by-side jobs once, a pause
+    between two invocations not at all), read from .snakemake/metadata."""
+    import base64
+    import json
+
+    meta = tmp_path / "metadata"
+    meta.mkdir()
+
+    def record(path, rule, start, end, job_hash, **kw):
+        b64 = base64.urlsafe_b64encode(path.encode()).decode()
+        parts = [b64[i:i + 60] for i in range(0, len(b64), 60)]  # a long name, cut as Snakemake does
+        f = meta.joinpath(*["@" + p for p in parts[:-1]], parts[-1])
+        f.parent.mkdir(parents=True, exist_ok=True)
+        f.write_text(json.dumps({"rule": rule, "starttime": start, "endtime": end, "job_hash": job_hash,
+                                 "incomplete": False, **kw}))
+
+    record("results/quick/a/x.csv", "mc", 100.0, 160.0, 1)
+    record("results/quick/a/x.png", "mc", 100.000004, 160.0, 1)           # the same job's other output
+    record("results/quick/b/y.csv", "mc", 120.0, 200.0, 2)                  # side by side with it
+    record("results/quick/c/" + "long_folder_name/" * 20 + "z.csv", "tables", 1000.0, 1010.0, 3)  # a later run
+    record("results/full/a/x.csv", "mc", 0.0, 5000.0, 4)                    # another profile's
+    record("results/quick/d/z.csv", "mc", 300.0, 310.0, 5, incomplete=True)
+    (meta / "not-base64!").write_text("{}")
+    for rel in ("results/quick/a/x.csv", "results/quick/a/x.png", "results/quick/b/y.csv",
+                "results/quick/c/" + "long_folder_name/" * 20 + "z.csv", "results/full/a/x.csv", "results/quick/d/z.csv"):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text("")
+    record("results/quick/e/gone.csv", "old", 5000.0, 6000.0, 6)            # no longer made
+    jobs = manuscript.snakemake_jobs(meta, "results/quick", workdir=tmp_path)
+    assert [(r, a, b) for r, a, b in jobs] == [("mc", 100.0, 160.0), ("mc", 120.0, 200.0), ("tables", 1000.0, 1010.0)]
+    assert manuscript.busy_wall_s(jobs) == pytest.approx(110.0)
+    bench = [pd.DataFrame({"s": [600.0], "cpu_time": [540.0]}), pd.DataFrame({"s": [60.0], "cpu_time": [30.0]})]
+    tex = manuscript.run_info_tex(bench, "AMD EPYC (2 logical cores, 24 GB memory)", jobs)
+    assert "AMD EPYC (2 logical cores, 24 GB memory)" in tex and "its 3 jobs" in tex and "1.8 min of wall time" in tex
+    assert "The 2 heavy jobs" in tex and "11.0 min of job time" in tex and "9.5 CPU-min" in tex
+    assert "docs/run-times.md" in tex
+    assert manuscript.snakemake_jobs(tmp_path / "none", "results/quick", workdir=tmp_path) == []
+    assert "This build ran on" in manuscript.run_info_tex([], "x", [])
+    assert "logical cores" in manuscript.machine_text()
+
+
+def test_the_html_reports_claims_use_the_pdfs_words():
+    """Issue 55 item 11: the report's claims table and landing page say 'ours, as written' and
+    'not reproducible', as the PDF does, not ours_as_written and not_reproducible."""
+    df = _table(4, 4).assign(verdict_replication=["", "not_reproduced", "unstable", "", "", "reproduced", "", ""])
+    out = manuscript.claims_for_readers(df)
+    assert "ours, as written" in out.columns and "verdict, replication sample" in out.columns
+    assert not [c for c in out.columns if "_" in c]
+    words = set(out["verdict"]) | set(out["verdict, replication sample"])
+    assert "not reproducible" in words and "depends on a choice" in words and "unstable" in words
+    assert not [w for w in words if "_" in w]
+    assert out["published"].tolist() == df["published"].tolist()   # cells otherwise unchanged

@@ -278,6 +278,9 @@ rule paper_page_one:
         fig_png=report(f"{PAPER}/verdicts.png", caption=_caption("verdicts"), category="Claims",
                        subcategory="verdicts"),
         glance=f"{PAPER}/claims_glance.csv",
+        # the claims table in the PDF's words (claims.csv keeps the codes, for programs)
+        readers=report(f"{PAPER}/claims_table.csv", caption=_caption("claims"), category="Claims",
+                       subcategory="claims table"),
         differences=f"{PAPER}/differences.tex",
         runinfo=f"{PAPER}/runinfo.tex",
         conclusion=f"{PAPER}/conclusion.tex",

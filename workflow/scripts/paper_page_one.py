@@ -3,8 +3,6 @@ abstract (abstract.tex), the verdict figure (one row per claim), the claims at a
 CSV for the HTML report's first page, and the table of what we did differently
 (differences.tex: every open or changed choice, ours from the run's configuration)."""
 
-import os
-import platform
 import sys
 from pathlib import Path
 
@@ -27,17 +25,22 @@ with script_context(snakemake) as log:
     atomic_write_text(out.conclusion, "\\newcommand{\\PageConclusion}{" + manuscript.prose_tex(
         claims_prose.conclusion_text(df)) + "}\n\\newcommand{\\PageLimitations}{" + manuscript.prose_tex(
         claims_prose.limitations_text(df)) + "}\n")
+    # the HTML report's claims in the PDF's words: the landing page's glance and the full table
     glance = df[[c for c in ("claim_id", "claim", "published", "ours_as_written", "verdict") if c in df.columns]]
-    glance.assign(claim=glance["claim"].map(verdict_plot.short_claim)).to_csv(out.glance, index=False)
+    manuscript.claims_for_readers(glance.assign(claim=glance["claim"].map(verdict_plot.short_claim))).to_csv(
+        out.glance, index=False)
+    manuscript.claims_for_readers(df).to_csv(out.readers, index=False)
     # the appendix tables of the claims job: the analysis plan and the inputs we derive
     atomic_write_text(out.plan_tex, manuscript.plan_latex(pd.read_csv(snakemake.input.plan, keep_default_na=False)))
     atomic_write_text(out.inputs_tex, manuscript.inputs_latex(pd.read_csv(snakemake.input.inputs,
                                                                           keep_default_na=False)))
     rows = differences.rows(dict(snakemake.params.config), published.load())
     atomic_write_text(out.differences, differences.latex(rows))
-    # the heavy jobs' benchmark files (read, not inputs: this is a description of the build)
+    # the build's cost: Snakemake's records of its jobs and the heavy jobs' benchmark files
+    # (read, not inputs: this is a description of the build, not a result)
     bench = sorted(Path(snakemake.params.results).glob("*/benchmarks/*.tsv"))
+    jobs = manuscript.snakemake_jobs(Path(".snakemake") / "metadata", snakemake.params.results)
     atomic_write_text(out.runinfo, manuscript.run_info_tex(
-        (pd.read_csv(b, sep="\t") for b in bench), os.cpu_count(), platform.machine()))
+        (pd.read_csv(b, sep="\t") for b in bench), manuscript.machine_text(), jobs))
     log.info("page 1: abstract %d words, %d claims, %d choices", claims_prose.word_count(
         claims_prose.page_one_abstract_tex(df, sample)), len(df), len(rows))

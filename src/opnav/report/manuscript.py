@@ -405,6 +405,31 @@ def claims_glance_latex(df: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: the claims table's columns in the PDF's words (Table 1 and Appendix A), for readers of the
+#: HTML report and of the landing page; a column not named here reads with spaces for "_"
+CLAIM_COLUMN_WORDS = {
+    "paper": "paper", "claim_id": "id", "claim": "claim", "published": "published",
+    "ours_as_written": "ours, as written", "ours_best": "ours, best faithful variant",
+    "best_variant": "best faithful variant", "bound": "bound", "ours_replication": "ours, replication sample",
+    "verdict": "verdict", "verdict_replication": "verdict, replication sample", "flags": "flags",
+    "named": "the addition or choice", "would_take": "what it would take", "cause": "cause",
+    "evidence": "evidence", "sample": "sample",
+}
+
+
+def claims_for_readers(df: pd.DataFrame) -> pd.DataFrame:
+    """The claims table in the PDF's words: its column names as Table 1 and Appendix A say
+    them and every verdict (any column whose name starts with ``verdict``) as Table 1 prints
+    it (``not_reproducible`` -> ``not reproducible``); cells otherwise unchanged."""
+    from opnav.report.claims import VERDICT_SHORT
+
+    out = df.copy()
+    for c in out.columns:
+        if str(c).startswith("verdict"):
+            out[c] = out[c].map(lambda v: VERDICT_SHORT.get(v, v) if isinstance(v, str) else v)
+    return out.rename(columns=lambda c: CLAIM_COLUMN_WORDS.get(str(c), str(c).replace("_", " ")))
+
+
 def claims_detail_latex(df: pd.DataFrame) -> str:
     """Every claim with all its columns, as a LaTeX description list (the claims table in full)."""
     from opnav.report.claims import VERDICT_TEXT
@@ -440,9 +465,92 @@ def sentence(text: str) -> str:
 
 
 # ------------------------------------------------------------ page 1: the run's cost
-def run_info_tex(bench_tables: Iterable[pd.DataFrame], cpus: int | None, machine: str) -> str:
-    r"""``\RunInfo``: the measured cost of the build's heavy jobs (the sum of their Snakemake
-    benchmark files: wall seconds ``s`` and ``cpu_time``) and the machine, one sentence."""
+def snakemake_jobs(metadata_dir: str | Path, results_dir: str | Path,
+                   workdir: str | Path = ".") -> list[tuple[str, float, float]]:
+    """``(rule, start, end)`` (Unix seconds) of every finished job that wrote a file under
+    ``results_dir`` that is still there (paths relative to ``workdir``), from Snakemake's own
+    records (``.snakemake/metadata``: one JSON per output, named by the output's path in URL-safe
+    base64, cut into ``@``-prefixed parts when long). A job with several outputs counts once;
+    unreadable records are skipped."""
+    import base64
+    import json
+
+    root = Path(metadata_dir)
+    prefix = Path(results_dir).as_posix().rstrip("/") + "/"
+    jobs: dict[tuple, tuple[str, float, float]] = {}
+    if not root.is_dir():
+        return []
+    for f in root.rglob("*"):
+        if not f.is_file():
+            continue
+        try:
+            name = "".join(part.lstrip("@") for part in f.relative_to(root).parts)
+            path = base64.urlsafe_b64decode(name.encode()).decode()
+            rec = json.loads(f.read_text())
+        except (ValueError, UnicodeDecodeError, OSError):
+            continue
+        start, end = rec.get("starttime"), rec.get("endtime")
+        if not path.startswith(prefix) or rec.get("incomplete") or start is None or end is None:
+            continue
+        if not (Path(workdir) / path).exists():  # a record of a file this build no longer makes
+            continue
+        # one job's outputs share its hash and end time (their start times differ by microseconds)
+        key = (str(rec.get("rule", "")), rec.get("job_hash"), round(float(end), 3))
+        old = jobs.get(key)
+        jobs[key] = (key[0], min(float(start), old[1]) if old else float(start), float(end))
+    return sorted(jobs.values(), key=lambda j: (j[1], j[0]))
+
+
+def busy_wall_s(jobs: Iterable[tuple[str, float, float]]) -> float:
+    """The wall time during which at least one of ``jobs`` ran: the length of the union of
+    their [start, end] intervals, so a pause between two invocations of a build counts
+    nothing and jobs that ran side by side count once."""
+    total, cur = 0.0, None
+    for _, a, b in sorted(jobs, key=lambda j: j[1]):
+        if cur is None or a > cur[1]:
+            total += (cur[1] - cur[0]) if cur else 0.0
+            cur = [a, b]
+        else:
+            cur[1] = max(cur[1], b)
+    return total + ((cur[1] - cur[0]) if cur else 0.0)
+
+
+def machine_text() -> str:
+    """This machine in a few words: CPU model (Linux's /proc/cpuinfo, else the platform's
+    processor name), logical cores and memory."""
+    import os
+    import platform
+
+    model = ""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.lower().startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    model = " ".join((model or platform.processor() or platform.machine() or "unknown CPU").split())
+    cores = os.cpu_count()
+    try:
+        mem_gb = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30
+    except (ValueError, OSError, AttributeError):
+        mem_gb = float("nan")
+    parts = [f"{cores} logical cores" if cores else "", f"{mem_gb:.0f} GB memory" if math.isfinite(mem_gb) else ""]
+    return f"{model} ({', '.join(p for p in parts if p)})" if any(parts) else model
+
+
+def _minutes(s: float) -> str:
+    return f"{s / 60:.1f} min" if s >= 60 else f"{s:.0f} s"
+
+
+def run_info_tex(bench_tables: Iterable[pd.DataFrame], machine: str,
+                 jobs: Iterable[tuple[str, float, float]] = ()) -> str:
+    r"""``\RunInfo``: where and how long this build ran. The build's wall time is the time at
+    least one of its jobs was running (:func:`busy_wall_s` over Snakemake's records of the
+    jobs up to the manuscript); the heavy jobs' (Monte Carlos, bounds, timing) job time and
+    CPU time are the sums of their Snakemake benchmark files (wall seconds ``s``,
+    ``cpu_time``). Job times add up jobs that ran side by side, so they can exceed the wall time."""
+    jobs = list(jobs)
     wall = cpu = 0.0
     n = 0
     for t in bench_tables:
@@ -450,13 +558,17 @@ def run_info_tex(bench_tables: Iterable[pd.DataFrame], cpus: int | None, machine
             wall += float(t["s"].iloc[-1])
             cpu += float(t["cpu_time"].iloc[-1]) if "cpu_time" in t else 0.0
             n += 1
-    if n:
-        text = (f"The {n} heavy jobs of this build (Monte Carlos, bounds, timing; their Snakemake benchmark "
-                f"files) took {wall / 60:.1f} min of job time and {cpu / 60:.1f} CPU-min on a "
-                f"{cpus or '?'}-core {machine} machine; docs/performance.md holds dated measurements of whole builds.")
+    sentences = []
+    if jobs:
+        sentences.append(f"This build ran on {machine}: its {len(jobs)} jobs up to the manuscript took "
+                         f"{_minutes(busy_wall_s(jobs))} of wall time (Snakemake's records; pauses between runs left out).")
     else:
-        text = "This build recorded no benchmark; docs/performance.md holds dated measurements of whole builds."
-    return "\\newcommand{\\RunInfo}{" + prose_tex(text) + "}\n"
+        sentences.append(f"This build ran on {machine}.")
+    if n:
+        sentences.append(f"The {n} heavy jobs (Monte Carlos, bounds, timing) took {_minutes(wall)} of job time "
+                         f"and {cpu / 60:.1f} CPU-min (their benchmark files; jobs side by side add up).")
+    sentences.append("Measured times per profile and machine: docs/run-times.md.")
+    return "\\newcommand{\\RunInfo}{" + prose_tex(" ".join(sentences)) + "}\n"
 
 
 # ------------------------------------------------------------ tables legible at print size
