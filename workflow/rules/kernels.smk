@@ -25,6 +25,6 @@ rule compile_kernels:
     message:
         "rule compile_kernels (kpaper={wildcards.kpaper}): compiling this paper's numba kernels into the "
         "on-disk cache, first build only: 15-40 CPU-s per paper (src/opnav/data/compile_cpu_s.json), a line per module in its log "
-        "(measured: docs/performance.md)"
+        "(measured: docs/dev/performance-log.md)"
     script:
         "../scripts/compile_kernels.py"

@@ -52,7 +52,7 @@ rule landing_timing_replays:
     priority: 10        # on the critical path (speed only)
     # the replay times microsecond calls by thread CPU: it runs with no other job beside it
     # (more busy processes than cores read the interior depth call at 4.5-4.7 us instead of
-    # 3.0-3.2, and its saving against SVD at 17-22 % instead of 27-29 %; docs/performance.md)
+    # 3.0-3.2, and its saving against SVD at 17-22 % instead of 27-29 %; docs/dev/performance-log.md)
     threads: all_cores()
     log:
         f"{LANDING}/logs/timing_replays_{{bscn}}.log",
