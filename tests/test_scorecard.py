@@ -173,3 +173,22 @@ def test_timing_rows_take_the_plans_band():
     t3w = t3.assign(time_reduction_vs_svd_pct_std=4.0)
     r = score_rows(rows_paper_b(t3w, {}, pub, {**band, "max_band_rel": 0.2})).set_index("item").loc[item]
     assert r["verdict"] == NOT_REPRODUCED and f"{band['k_spread']:g} sd = 8" in r["reason"]
+
+
+def test_the_timing_row_reads_the_spread_between_replays_not_one_replays_bootstrap():
+    """With the summary's planning_time block the scorecard's timing row is the mean of the
+    replays with their sd between them (18, 24, 30 %: sd 6, 2 sd = 12 points holds 29.03 %);
+    B-T3's bootstrap sd of one replay (0.5) would read it not reproduced (mutation tried once)."""
+    import pandas as pd
+
+    from opnav.landing.report import rows_paper_b
+
+    t3 = pd.DataFrame([{"method": "depth", "time_reduction_vs_svd_pct": 24.0, "time_reduction_vs_svd_pct_std": 0.5}])
+    pub = {"depth_time_reduction_vs_svd_pct": 29.03}
+    band = {"rel_tol": 0.1, "k_spread": 2.0, "max_band_rel": 0.5}
+    summ = {"planning_time": {"reduction_pct": {"depth_vs_svd": {"per_replay": [18.0, 24.0, 30.0], "mean": 24.0,
+                                                                "sd_between": 6.0, "interval": "between_replays"}}}}
+    df = score_rows(rows_paper_b(t3, summ, pub, band))
+    row = df[df["item"].str.contains("mean of 3 replays")].iloc[0]
+    assert row["verdict"] == REPRODUCED and row["ours (spread)"] == 6.0
+    assert score_rows(rows_paper_b(t3, {}, pub, band)).iloc[0]["verdict"] == NOT_REPRODUCED

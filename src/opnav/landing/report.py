@@ -371,7 +371,17 @@ def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: st
     rows: list[dict] = []
     tag = f"[{label}] " if label else ""
     t3 = t3.set_index("method")
-    if "depth" in t3.index and "time_reduction_vs_svd_pct" in t3.columns:
+    between = (((summary.get("planning_time") or {}).get("reduction_pct") or {}).get("depth_vs_svd")
+               if isinstance(summary, dict) else None)
+    if between and between.get("interval", "between_replays") == "between_replays":
+        # judged as the claims table judges B-C4: the mean over independent replays, its spread the
+        # sd between them (never one replay's bootstrap over the calls)
+        rows.append({"paper": "B", "item": f"{tag}median planning time, depth vs SVD: reduction "
+                                           f"(mean of {len(between.get('per_replay') or [])} replays)",
+                     "published": float(pub["depth_time_reduction_vs_svd_pct"]), "ours": float(between["mean"]),
+                     "spread": float(between.get("sd_between", float("nan"))), "unit": "%",
+                     "band": dict(timing_band or {})})
+    elif "depth" in t3.index and "time_reduction_vs_svd_pct" in t3.columns:
         # the claim's size depends on how the planning call is implemented: the
         # configured path and the other one (compiled vs the paper's definition
         # interpreted, opnav.landing.planner), each a row
