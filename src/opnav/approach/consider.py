@@ -19,7 +19,14 @@ Description
         H_k = [ -A_m(theta_hat) C_k, 0_3x3, [u_k x] ],   u_k = u_ref,k - C_k dr_k(predicted).
 
     Update with the Schmidt gain ``K_s = [K_x; 0]`` in Joseph form,
-    ``P+ = (I - K_s H) P (I - K_s H)^T + K_s R K_s^T`` (valid for any gain).
+    ``P+ = (I - K_s H) P (I - K_s H)^T + K_s R K_s^T`` (valid for any gain). Its blocks are
+    those of the full Kalman update (gain ``K = [K_x; K_t] = P H^T S^-1``) but for the theta
+    block, which the Schmidt update leaves at its prior: with ``K_x H P = K_x S K^T`` the
+    Schmidt ``xx`` block is ``P_xx - K_x S K_x^T`` and its ``xt`` block ``P_xt - K_x H P_.t =
+    P_xt - K_x S K_t^T``, the full update's (Tapley, Schutz & Born, sec. 6.3). So the update is
+    paper A's one measurement update (:func:`opnav.approach.kalman.condition_on`, Joseph form)
+    on ``[dX; theta]``, the theta mean kept at zero and ``P_tt`` put back: one home of the
+    Kalman update (issue 56 item 3; the former hand-written update agreed to round-off, tested).
     Star images (``stars`` variant) are measurements of theta alone, which the consider
     filter does not update: they are not used here (the estimate already holds them).
 
@@ -39,6 +46,7 @@ import numpy as np
 
 from opnav.core.rotations import skew
 
+from . import kalman
 from .camera import misalignment_small
 from .ekf import Window
 
@@ -87,8 +95,8 @@ def run_consider(z: np.ndarray, theta_hat: np.ndarray, P_theta: np.ndarray, x0: 
             nees[:, k] = np.einsum("si,si->s", e, np.linalg.solve(P[:, :3, :3], e[..., None])[..., 0])
 
     keep(0)
-    I9 = np.eye(9)
     H = np.zeros((S, 3, 9))
+    m = np.zeros((S, 9))  # [dX; theta - theta_hat]: the theta part stays 0 (never updated)
     for k in range(1, n + 1):
         F[:6, :6] = win.Phi[k]
         x = x @ win.Phi[k].T
@@ -97,15 +105,12 @@ def run_consider(z: np.ndarray, theta_hat: np.ndarray, P_theta: np.ndarray, x0: 
         H[:, :, :3] = -A @ win.C[k]
         H[:, :, 6:] = skew(u)  # -[theta x] u = [u x] theta
         nu = z[:, k] - np.einsum("sij,sj->si", A, u)
-        R = Rvar[k][:, :, None] * np.eye(3)  # (S, 3, 3)
-        PHt = P @ np.swapaxes(H, 1, 2)  # (S, 9, 3)
-        Sm = H @ PHt + R
-        K = np.linalg.solve(Sm, np.swapaxes(PHt, 1, 2)).swapaxes(1, 2)  # (S, 9, 3)
-        K[:, 6:] = 0.0  # Schmidt: theta is considered, never updated
-        x = x + np.einsum("sij,sj->si", K[:, :6], nu)
-        IKH = I9 - K @ H
-        P = IKH @ P @ np.swapaxes(IKH, 1, 2) + K @ R @ np.swapaxes(K, 1, 2)
-        P = 0.5 * (P + np.swapaxes(P, 1, 2))
+        m[:, :6] = x
+        post = kalman.condition_on(m, P, H, Rvar[k], nu, joseph=True)
+        x = post.m[:, :6]
+        P_tt = P[:, 6:, 6:]
+        P = post.P
+        P[:, 6:, 6:] = P_tt  # Schmidt: theta is considered, never updated (module docstring)
         keep(k)
     return ConsiderResult(xf, Pf, nees)
 
