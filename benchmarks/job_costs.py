@@ -1,4 +1,5 @@
-"""Where a Snakemake run's CPU time goes: per rule, from the jobs' logs.
+"""Where a Snakemake run's CPU time goes: per rule, from the jobs' logs; and what the
+workflow scripts' imports cost, with ``python -X importtime``.
 
 Every successful job ends its log with ``job resources: cpu_s=... max_rss_mb=...``
 (:func:`opnav.core.snakeio.resource_line`: the whole process, interpreter start-up and
@@ -10,22 +11,36 @@ peak memory, sorted by total CPU; then the compiled kernels (``kernels_loaded=``
 them from numba's cache, and every job but ``compile_kernels`` that compiled some
 itself (a warm-up missing a signature the pipeline calls); then each job's start-up CPU
 (``startup_cpu_s=`` and its parts, :mod:`opnav.core.startup`): the mean per job and the
-groups whose start-up is largest. Usage::
+groups whose start-up is largest.
+
+``--imports`` measures, instead of reading logs, what each workflow script's imports cost
+(the part of a job's ``before_work_s`` that is not the interpreter or Snakemake's preamble):
+each script's top-level imports run in a fresh ``python -X importtime`` (the package on
+``src``), and the table gives the milliseconds they took and the modules that cost the most
+(self time, summed over the scripts). A lazy import inside a job's work is not seen here:
+it counts as the job's work. Usage::
 
     python benchmarks/job_costs.py results/quick
     python benchmarks/job_costs.py results --top 20
+    python benchmarks/job_costs.py --imports [--top 15]
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
+import os
 import re
+import subprocess
 import sys
 from pathlib import Path
 
+REPO = Path(__file__).resolve().parents[1]
+
 _LINE = re.compile(r"job resources: cpu_s=([0-9.]+) user_s=([0-9.]+) sys_s=([0-9.]+) max_rss_mb=([0-9.]+)")
 _KERNELS = re.compile(r"kernels_loaded=(\d+) kernels_compiled=(\d+)")
-_STARTUP = re.compile(r"startup_cpu_s=([0-9.]+) before_work_s=([0-9.]+) imports_s=([0-9.]+) kernel_load_s=([0-9.]+)")
+# imports_s= (the jobs' own import timing) only in logs of commits before issue 56: read, not needed
+_STARTUP = re.compile(r"startup_cpu_s=([0-9.]+) before_work_s=([0-9.]+) (?:imports_s=[0-9.]+ )?kernel_load_s=([0-9.]+)")
 #: rule compile_kernels' logs: its compiling is its work, and its start-up is not a job's
 _COMPILE_LOG = "kernels"
 
@@ -48,12 +63,11 @@ def kernel_counts(root: Path) -> list[tuple[str, int, int]]:
     return [(p, int(m.group(1)), int(m.group(2))) for p, m in _last_matches(root, _KERNELS)]
 
 
-def startups(root: Path) -> list[tuple[str, float, float, float, float]]:
-    """(log path relative to ``root``, start-up CPU seconds, of them before the work, in
-    imports during it, making kernels callable) of every job log whose resource line has
-    them (:mod:`opnav.core.startup`; logs of commits before issue 47 have none), the
-    ``compile_kernels`` jobs' aside."""
-    return [(p, *(float(m.group(i)) for i in range(1, 5))) for p, m in _last_matches(root, _STARTUP)
+def startups(root: Path) -> list[tuple[str, float, float, float]]:
+    """(log path relative to ``root``, start-up CPU seconds, of them before the work, making
+    kernels callable) of every job log whose resource line has them (:mod:`opnav.core.startup`;
+    logs of commits before issue 47 have none), the ``compile_kernels`` jobs' aside."""
+    return [(p, *(float(m.group(i)) for i in range(1, 4))) for p, m in _last_matches(root, _STARTUP)
             if Path(p).parent.parent.name != _COMPILE_LOG]
 
 
@@ -64,15 +78,70 @@ def startup_lines(root: Path, top: int = 8) -> list[str]:
     if not rows:
         return ["start-up: no job log carries the start-up figure (a commit before issue 47?)"]
     n = len(rows)
-    mean = [sum(r[i] for r in rows) / n for i in range(1, 5)]
+    mean = [sum(r[i] for r in rows) / n for i in range(1, 4)]
     out = [f"start-up CPU per job: mean {mean[0]:.2f} s over {n} jobs (before the work {mean[1]:.2f}, "
-           f"imports during it {mean[2]:.2f}, making kernels callable {mean[3]:.2f}); "
-           f"{sum(r[1] for r in rows):.1f} CPU-s in all"]
+           f"making kernels callable {mean[2]:.2f}); {sum(r[1] for r in rows):.1f} CPU-s in all "
+           "(the scripts' imports: --imports)"]
     groups: dict[str, list[float]] = {}
     for r in rows:
         groups.setdefault(family(r[0]), []).append(r[1])
     ranked = sorted(groups.items(), key=lambda kv: -sum(kv[1]) / len(kv[1]))[:top]
     out.append("  largest mean start-up: " + ", ".join(f"{g} {sum(v) / len(v):.2f} s ({len(v)})" for g, v in ranked))
+    return out
+
+
+def script_imports(script: Path) -> str:
+    """The top-level ``import`` statements of a workflow script, as one program."""
+    tree = ast.parse(script.read_text())
+    return "\n".join(ast.unparse(n) for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))
+                     and not (isinstance(n, ast.ImportFrom) and n.module == "__future__"))
+
+
+_IMPORTTIME = re.compile(r"^import time:\s+(\d+) \|\s+(\d+) \|( *)(\S.*)$")
+
+
+def parse_importtime(stderr: str) -> tuple[float, dict[str, float]]:
+    """From ``python -X importtime``'s report: the milliseconds of the top-level imports
+    (cumulative times of the least-indented lines) and each module's self milliseconds."""
+    total, selfs = 0.0, {}
+    for line in stderr.splitlines():
+        m = _IMPORTTIME.match(line)
+        if not m:
+            continue
+        self_us, cum_us, indent, name = int(m.group(1)), int(m.group(2)), len(m.group(3)), m.group(4).strip()
+        selfs[name] = selfs.get(name, 0.0) + self_us / 1000
+        if indent == 1:
+            total += cum_us / 1000
+    return total, selfs
+
+
+def import_costs(scripts: list[Path], src: Path = REPO / "src") -> list[tuple[str, float, dict[str, float]]]:
+    """(script name, ms its imports took, self ms per module) of each script, each in a fresh
+    ``python -X importtime`` with ``src`` on the path."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(src), os.environ.get("PYTHONPATH", "")) if p))
+    env.pop("PYTHONPROFILEIMPORTTIME", None)
+    out = []
+    for script in scripts:
+        proc = subprocess.run([sys.executable, "-X", "importtime", "-c", script_imports(script)],
+                              capture_output=True, text=True, env=env, cwd=REPO)
+        if proc.returncode:
+            raise RuntimeError(f"{script.name}: its imports failed: {proc.stderr.strip().splitlines()[-1]}")
+        out.append((script.name, *parse_importtime(proc.stderr)))
+    return out
+
+
+def import_lines(rows: list[tuple[str, float, dict[str, float]]], top: int = 10) -> list[str]:
+    """The --imports table: scripts by import time, then the modules costing the most."""
+    out = [f"{'script':40s} {'imports_ms':>10s}"]
+    out += [f"{name:40s} {ms:10.0f}" for name, ms, _ in sorted(rows, key=lambda r: -r[1])]
+    out.append(f"{'mean over ' + str(len(rows)) + ' scripts':40s} {sum(r[1] for r in rows) / max(len(rows), 1):10.0f}")
+    selfs: dict[str, float] = {}
+    for _, _, s in rows:
+        for k, v in s.items():
+            selfs[k] = selfs.get(k, 0.0) + v
+    heavy = sorted(selfs.items(), key=lambda kv: -kv[1])[:top]
+    out.append("largest self import time, summed over the scripts: "
+               + ", ".join(f"{k} {v:.0f} ms" for k, v in heavy))
     return out
 
 
@@ -92,9 +161,17 @@ def family(path: str) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results", type=Path, help="results folder of a finished run")
-    ap.add_argument("--top", type=int, default=0, help="also list the N most expensive jobs")
+    ap.add_argument("results", type=Path, nargs="?", help="results folder of a finished run")
+    ap.add_argument("--top", type=int, default=0, help="also list the N most expensive jobs (modules with --imports)")
+    ap.add_argument("--imports", action="store_true",
+                    help="time each workflow script's imports with python -X importtime instead")
     a = ap.parse_args(argv)
+    if a.imports:
+        for line in import_lines(import_costs(sorted((REPO / "workflow" / "scripts").glob("*.py"))), a.top or 10):
+            print(line)
+        return 0
+    if a.results is None:
+        ap.error("give a results folder, or --imports")
     if not a.results.is_dir():
         print(f"job_costs: results folder {a.results} not found", file=sys.stderr)
         return 2

@@ -13,10 +13,12 @@ from conftest import REPO
 
 from opnav.core import compiled
 
+PACKAGE = ('from opnav.core.compiled import register_kernel_modules\n'
+           'register_kernel_modules(__name__, ("kp.ka", "kp.kb"))\n')
 CALLEE = "from opnav.core.compiled import kernel\n\n\n@kernel\ndef f(x):\n    return x + {}\n"
 CALLER = textwrap.dedent("""\
     from opnav.core.compiled import kernel, warms
-    from ka import f
+    from kp.ka import f
 
 
     @kernel
@@ -30,10 +32,9 @@ CALLER = textwrap.dedent("""\
 """)
 RUN = textwrap.dedent("""\
     import json, opnav.core.compiled as c
-    c.KERNEL_MODULES = ("ka", "kb")
-    seconds = c.warm()
-    import kb
-    print(json.dumps({"g": kb.g(1.0), "modules": sorted(seconds), **c.cache_stats()}))
+    import kp.ka, kp.kb
+    seconds = c.warm(("kp.ka", "kp.kb"))
+    print(json.dumps({"g": kp.kb.g(1.0), "modules": sorted(seconds), **c.cache_stats()}))
 """)
 
 
@@ -47,29 +48,50 @@ def _run(tmp_path):
 
 @pytest.mark.slow  # four processes that import numba and compile: 5-6 CPU-s
 def test_cache_loaded_by_the_next_process_and_invalidated_by_a_callee_change(tmp_path):
-    (tmp_path / "ka.py").write_text(CALLEE.format("1.0"))
-    (tmp_path / "kb.py").write_text(CALLER)
+    kp = tmp_path / "kp"
+    kp.mkdir()
+    (kp / "__init__.py").write_text(PACKAGE)
+    (kp / "ka.py").write_text(CALLEE.format("1.0"))
+    (kp / "kb.py").write_text(CALLER)
     first = _run(tmp_path)
     # g and, as its callee, f
-    assert first == {"g": 4.0, "modules": ["kb"], "loaded": 0, "compiled": 2}
-    assert _run(tmp_path) == {"g": 4.0, "modules": ["kb"], "loaded": 1, "compiled": 0}
-    assert list((tmp_path / "__pycache__").glob("kb.g-*.nbi")), "cache written beside the source"
+    assert first == {"g": 4.0, "modules": ["kp.kb"], "loaded": 0, "compiled": 2}
+    assert _run(tmp_path) == {"g": 4.0, "modules": ["kp.kb"], "loaded": 1, "compiled": 0}
+    assert list((kp / "__pycache__").glob("kb.g-*.nbi")), "cache written beside the source"
     # the callee's module changes, the caller's file does not: g must see the new f
-    (tmp_path / "ka.py").write_text(CALLEE.format("10.0"))
-    assert _run(tmp_path) == {"g": 22.0, "modules": ["kb"], "loaded": 0, "compiled": 2}
-    assert _run(tmp_path) == {"g": 22.0, "modules": ["kb"], "loaded": 1, "compiled": 0}
+    (kp / "ka.py").write_text(CALLEE.format("10.0"))
+    assert _run(tmp_path) == {"g": 22.0, "modules": ["kp.kb"], "loaded": 0, "compiled": 2}
+    assert _run(tmp_path) == {"g": 22.0, "modules": ["kp.kb"], "loaded": 1, "compiled": 0}
 
 
 def test_kernel_sources_are_the_registered_modules_files():
-    files = compiled.kernel_sources()
-    assert files[0] == REPO / "src" / "opnav" / "core" / "compiled.py"
-    assert len(files) == 1 + len(compiled.KERNEL_MODULES)
-    for name, path in zip(compiled.KERNEL_MODULES, files[1:]):
-        assert path.is_file(), name
-        assert path.relative_to(REPO / "src").with_suffix("").parts == tuple(name.split("."))
+    """Each paper package registers its own kernel modules; a paper's set is the core's and its
+    own, found as files without importing them."""
+    import opnav.approach
+    import opnav.landing
+
+    for package in ("opnav.approach", "opnav.landing"):
+        names = compiled.kernel_modules(package)
+        files = compiled.kernel_sources(package)
+        assert files[:2] == [REPO / "src" / "opnav" / "core" / "compiled.py",
+                             REPO / "src" / "opnav" / "core" / "numba_adapter.py"]
+        assert len(files) == 2 + len(names) and names[0] == "opnav.core.rotations"
+        assert all(n.startswith((package + ".", "opnav.core.")) for n in names), names
+        for name, path in zip(names, files[2:]):
+            assert path.is_file(), name
+            assert path.relative_to(REPO / "src").with_suffix("").parts == tuple(name.split("."))
+    assert set(compiled.kernel_modules("opnav.approach")) & set(compiled.kernel_modules("opnav.landing")) \
+        == {"opnav.core.rotations"}
 
 
-DIGEST = "import opnav.core.compiled as c; print(c.kernel_set_digest())"
+def test_a_registration_outside_the_package_is_refused():
+    with pytest.raises(ValueError, match="not modules of the package"):
+        compiled.register_kernel_modules("opnav.approach", ("opnav.landing.ekf",))
+    with pytest.raises(KeyError, match="registered no kernel modules"):
+        compiled.kernel_modules("opnav.nothing")
+
+
+DIGEST = "import opnav.landing, opnav.core.compiled as c; print(c.kernel_set_digest('opnav.landing'))"
 
 
 def _digest(src):
@@ -85,7 +107,9 @@ def test_compile_estimates_outside_the_kernel_set_digest(tmp_path):
     shutil.copytree(REPO / "src" / "opnav", src / "opnav",
                     ignore=shutil.ignore_patterns("__pycache__", "*.npz", "*.nbi", "*.nbc"))
     estimates = src / "opnav" / compiled.COMPILE_ESTIMATES.relative_to(REPO / "src" / "opnav")
-    assert compiled.COMPILE_ESTIMATES not in compiled.kernel_sources() and estimates.is_file()
+    import opnav.landing
+
+    assert compiled.COMPILE_ESTIMATES not in compiled.kernel_sources("opnav.landing") and estimates.is_file()
     first = _digest(src)
     data = json.loads(estimates.read_text())
     data["cpu_s"]["opnav.landing.linalg"] = 99.0
@@ -97,12 +121,16 @@ def test_compile_estimates_outside_the_kernel_set_digest(tmp_path):
 
 
 def test_compile_estimates_name_registered_modules():
+    import opnav.approach
+    import opnav.landing
+
     estimate = compiled.compile_cpu_s()
-    assert set(estimate) <= set(compiled.KERNEL_MODULES) and all(v > 0 for v in estimate.values())
+    assert set(estimate) <= set(compiled.kernel_modules()) and all(v > 0 for v in estimate.values())
 
 
 ONE_SIGNATURE = textwrap.dedent("""\
     import json, opnav.core.compiled as c
+    import opnav.landing.linalg, opnav.landing.descent
     c.warm(("opnav.landing.linalg", "opnav.landing.descent"))
     print(json.dumps({f"{k.py_func.__module__}.{k.__name__}": [str(s) for s in k._dispatcher.signatures]
                       for k in c._KERNELS if k._dispatcher is not None}))
@@ -113,7 +141,7 @@ ONE_SIGNATURE = textwrap.dedent("""\
 def test_one_signature_per_kernel_when_kernels_pass_constants(tmp_path):
     """descent calls ``cholesky_in_place(L, 3)`` and ``cho_solve(L, 3, x)``, linalg's warm-up
     calls them with an int64: one compiled signature each, not a second one for the literal 3
-    (each a full compile; compiled._unliteral_calls)."""
+    (each a full compile; numba_adapter._unliteral_calls)."""
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_CACHE_DIR=str(tmp_path))
     out = subprocess.run([sys.executable, "-c", ONE_SIGNATURE], env=env, capture_output=True, text=True,
                          check=True)

@@ -427,7 +427,9 @@ def test_descent_record_equals_numpy_and_scipy(seed, B, att):
 # ================================================================= warm-ups
 
 WARM_AGAIN = """
-import json, opnav.core.compiled as c
+import importlib, json, opnav.approach, opnav.landing, opnav.core.compiled as c
+for m in c.kernel_modules():
+    importlib.import_module(m)
 seconds = c.warm()
 holding = sorted({k.py_func.__module__ for k in c._KERNELS})
 print(json.dumps({"modules": sorted(seconds), "holding": holding, **c.cache_stats()}))
@@ -435,18 +437,24 @@ print(json.dumps({"modules": sorted(seconds), "holding": holding, **c.cache_stat
 
 
 def test_every_kernel_module_registers_a_warm_up_and_a_warmed_cache_compiles_nothing():
-    """Every module holding kernels is in ``KERNEL_MODULES`` and registers a warm-up
+    """Every module holding kernels is registered by its package (``kernel_modules``) and registers a warm-up
     (``@warms``), or its package has one module that does for all (``landing.planning.warmup``
     calls the planning call of every kind, which calls every kernel of the package's
     families); and a second process's ``warm()`` on the cache this one filled loads every
     signature and compiles none (what the workflow's ``compile_kernels`` rule relies on: the
     jobs after it only load; that the warm-ups cover the signatures the jobs call is
     test_workflow's ``test_kernels_compiled_once_then_only_loaded``). A module of
-    ``KERNEL_MODULES`` without kernels (``landing.planning.layout``: slot numbers the kernels
+    ``kernel_modules`` without kernels (``landing.planning.layout``: slot numbers the kernels
     fold in) is there to key the cache. Mutations tried: a module's ``@warms`` removed ->
     fails (modules); ``landing.planning.warmup``'s -> fails (its package's families)."""
+    import importlib
+
+    import opnav.approach
+    import opnav.landing
     from opnav.core import compiled
 
+    for m in compiled.kernel_modules():
+        importlib.import_module(m)
     compiled.warm()                                  # fills the on-disk cache (a no-op if full)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         p for p in (str(REPO / "src"), os.environ.get("PYTHONPATH", "")) if p))
@@ -454,7 +462,7 @@ def test_every_kernel_module_registers_a_warm_up_and_a_warmed_cache_compiles_not
                          text=True, check=True)
     got = json.loads(out.stdout.splitlines()[-1])
     warmed = set(got["modules"])
-    assert warmed <= set(compiled.KERNEL_MODULES) and set(got["holding"]) <= set(compiled.KERNEL_MODULES)
+    assert warmed <= set(compiled.kernel_modules()) and set(got["holding"]) <= set(compiled.kernel_modules())
     unwarmed = [m for m in got["holding"] if m not in warmed
                 and not any(w.rpartition(".")[0] == m.rpartition(".")[0] != "opnav.landing" for w in warmed)]
     assert unwarmed == [], "modules without a warm-up"

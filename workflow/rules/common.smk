@@ -1,5 +1,6 @@
 # Shared helpers: config validation, output paths, and the final outputs (final_outputs).
-from opnav.core.compiled import KERNEL_MODULES, kernel_sources  # noqa: E402
+import opnav.approach, opnav.landing  # noqa: E402,F401  each registers its kernel modules
+from opnav.core import compiled as _compiled  # noqa: E402
 from opnav.core.errors import ConfigError  # noqa: E402
 from opnav.preflight import check_config  # noqa: E402
 from opnav.core.snakeio import compact_params_change_reasons  # noqa: E402
@@ -41,25 +42,24 @@ def res(*parts):
     return str(Path(RESULTS, *parts))
 
 
-# Compiled kernels (kernels.smk): the registered modules (opnav.core.compiled.KERNEL_MODULES,
-# read without importing numba) that each paper's jobs run.
+# Compiled kernels (kernels.smk): the modules each paper package registers
+# (opnav.core.compiled.register_kernel_modules, read without importing numba) and the core's.
 KERNEL_PAPERS = ("approach", "landing")
 
 
 def kernel_modules(paper):
-    """The registered kernel modules the jobs of ``paper`` (KERNEL_PAPERS) run: those of
-    its package and the shared ones (opnav.core.rotations, ...)."""
-    other = set(KERNEL_PAPERS) - {paper}
-    return [m for m in KERNEL_MODULES if not set(m.split(".")[1:2]) & other]
+    """The registered kernel modules the jobs of ``paper`` (KERNEL_PAPERS) run: the core's
+    (opnav.core.rotations, ...) and those its package registered."""
+    return list(_compiled.kernel_modules(f"opnav.{paper}"))
 
 
 def kernel_src(paper):
-    """opnav/core/compiled.py and the source files of kernel_modules(paper)."""
-    return [str(p) for p in kernel_sources(tuple(kernel_modules(paper)))]
+    """opnav/core/compiled.py, opnav/core/numba_adapter.py and the source files of kernel_modules(paper)."""
+    return [str(p) for p in _compiled.kernel_sources(f"opnav.{paper}")]
 
 
 def with_kernels(paper, files):
-    """``files`` and kernel_src(paper), each once: a module registered in KERNEL_MODULES
+    """``files`` and kernel_src(paper), each once: a module its package registered
     is an input of its paper's rules (editing it reruns them) without being named there."""
     return list(dict.fromkeys([*files, *kernel_src(paper)]))
 

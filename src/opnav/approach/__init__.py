@@ -53,3 +53,16 @@ Layers
     the edge. The tables' page views, the scorecard rows and the prose made from the numbers are
     in the report layer (``opnav.report.approach_views``, ``approach_scorecard``, ``approach_text``).
 """
+
+from opnav.core.compiled import register_kernel_modules as _register_kernel_modules
+
+# The modules holding this paper's compiled kernels, or whose source a kernel folds in
+# (landing.planning.layout's slot numbers), in warm-up order: they key the kernels' on-disk
+# cache and the workflow's compile_kernels job warms them (opnav.core.compiled).
+_register_kernel_modules(__name__, (
+    "opnav.approach.kalman",
+    "opnav.approach.ekf",
+    "opnav.approach.smoother",
+    "opnav.approach.em",
+    "opnav.approach.augmented",
+))

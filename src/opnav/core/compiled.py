@@ -5,23 +5,33 @@ arrays, decorated with :func:`kernel` (numba ``njit`` with an on-disk cache). Th
 Python-level API calls it; the paper's own definition (CasADi H, LAPACK SVD) stays
 as the reference that tests compare against.
 
+Which modules hold kernels: each package says so for its own modules, from its
+``__init__`` (:func:`register_kernel_modules`; ``opnav.core``, ``opnav.approach``,
+``opnav.landing``), so this module names none and the core depends on no paper. A package's
+kernels may call its own kernels and the core's, never another paper's (the import layers,
+tests/test_import_layers.py).
+
 Compilation cost: numba writes each compiled signature to an on-disk cache
 (``__pycache__`` beside the source, or ``NUMBA_CACHE_DIR``), so a job only loads what
-an earlier job compiled. :func:`warm` compiles every registered kernel once (the
-workflow's first rule, ``compile_kernels``, calls it, so parallel jobs do not all
-compile) and reports how long each module took; :func:`cache_stats` counts what this
+an earlier job compiled. :func:`warm` compiles the given kernel modules once (the
+workflow's first rules, ``compile_kernels``, one per paper, call it, so parallel jobs do not
+all compile) and reports how long each module took; :func:`cache_stats` counts what this
 process loaded and what it compiled (every job's log says it).
 
 Cache validity: numba keys a cached function by its own file's content only, so a
 kernel that calls a kernel of another module would be loaded with the callee's old
 code compiled in after the callee's file changed. A kernel's cache entry here is
-keyed by the content of every kernel module as well (:func:`kernel_set_digest`):
-editing any kernel module recompiles every kernel, once.
+keyed by the content of every kernel module its package registered and of the core's
+as well (:func:`kernel_set_digest`): editing a landing kernel module recompiles every
+landing kernel, once, and no approach kernel.
 
 A kernel becomes a numba dispatcher on its first call (:class:`LazyKernel`), so a job
 that imports a kernel module for its plain-Python parts (a table, a figure) does not
-import numba; a job that calls kernels loads only the signatures it calls. Each dispatch
-that loads or compiles is timed into the job's start-up (:mod:`opnav.core.startup`).
+import numba; a job that calls kernels loads only the signatures it calls. The CPU of making
+kernels callable and of compiling is counted into the job's start-up
+(:mod:`opnav.core.startup`). Every use of numba beyond its public API (the cache stamp, one
+signature per argument type, the proxy's rebinding) is in :mod:`opnav.core.numba_adapter`,
+pinned to the numba version by its test.
 
 A module that holds kernels registers a warm-up function with :func:`warms`; the
 function calls each of its kernels once with arguments of the types the pipeline
@@ -31,98 +41,89 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import importlib
-import importlib.util
 import json
 import sys
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterable
 
-from opnav.core import startup
+from opnav.core import numba_adapter, startup
 
-#: Modules holding kernels, imported by :func:`warm` (each registers its warm-up on import).
-KERNEL_MODULES: tuple[str, ...] = ("opnav.approach.kalman", "opnav.approach.ekf", "opnav.approach.smoother",
-                                    "opnav.approach.em", "opnav.approach.augmented",
-                                    "opnav.core.rotations", "opnav.landing.measurement", "opnav.landing.linalg",
-                                    "opnav.landing.ekf", "opnav.landing.ekf_update",
-                                    "opnav.landing.planning.layout", "opnav.landing.planning.geometry",
-                                    "opnav.landing.planning.depth",
-                                    "opnav.landing.planning.screens", "opnav.landing.planning.hmetrics",
-                                    "opnav.landing.planning.information", "opnav.landing.planning.search",
-                                    "opnav.landing.planning.warmup",
-                                    "opnav.landing.descent", "opnav.landing.imu")
-
+#: package -> the modules it registered (:func:`register_kernel_modules`), in its order
+_PACKAGES: dict[str, tuple[str, ...]] = {}
+#: the package whose kernel modules every package's kernels may call (this module's own)
+CORE = __name__.rpartition(".")[0]
 _WARMUPS: dict[str, Callable[[], None]] = {}
 _KERNELS: list = []  # every LazyKernel made by kernel(), for cache_stats
 
 
-def kernel_sources(modules: tuple[str, ...] | None = None) -> list[Path]:
-    """This file and the source file of every kernel module (``KERNEL_MODULES``), found
-    without importing them (``opnav.x.y`` -> ``<package>/x/y.py``)."""
-    root = Path(__file__).resolve().parents[1]  # the opnav package
-    out = [Path(__file__).resolve()]
-    for name in KERNEL_MODULES if modules is None else modules:
-        parts = name.split(".")
-        if parts[0] != root.name:
-            out.append(Path(importlib.util.find_spec(name).origin))
-            continue
-        base = root.joinpath(*parts[1:])
-        out.append(base / "__init__.py" if base.is_dir() else base.with_suffix(".py"))
-    return out
+def register_kernel_modules(package: str, modules: Iterable[str]) -> None:
+    """Record the modules of ``package`` (already imported: its ``__init__`` calls this) that
+    hold kernels, or whose source a kernel folds in (constants): their sources key the cache
+    of the package's kernels and the workflow's compile job imports and warms them."""
+    modules = tuple(modules)
+    bad = [m for m in modules if not m.startswith(package + ".")]
+    if bad:
+        raise ValueError(f"register_kernel_modules({package!r}): {bad} are not modules of the package")
+    _PACKAGES[package] = modules
+    kernel_set_digest.cache_clear()
+
+
+def _owner(module: str) -> str | None:
+    """The registered package ``module`` belongs to (the longest registered prefix), or None."""
+    owners = [p for p in _PACKAGES if module == p or module.startswith(p + ".")]
+    return max(owners, key=len) if owners else None
+
+
+def kernel_modules(package: str | None = None) -> tuple[str, ...]:
+    """The registered kernel modules the jobs of ``package`` may run: the core's, then the
+    package's own; without ``package``, those of every package registered so far."""
+    if package is None:
+        return tuple(m for p in _PACKAGES for m in _PACKAGES[p])
+    if package not in _PACKAGES:
+        raise KeyError(f"{package} registered no kernel modules (import it first; registered: "
+                       f"{', '.join(_PACKAGES) or 'none'})")
+    return tuple(dict.fromkeys([*_PACKAGES.get(CORE, ()), *_PACKAGES[package]]))
+
+
+def _source(module: str) -> Path:
+    """The source file of registered ``module``, found from its package's folder without
+    importing it (``p.x.y`` -> ``<p>/x/y.py`` or ``<p>/x/y/__init__.py``)."""
+    package = _owner(module)
+    base = Path(sys.modules[package].__file__).parent.joinpath(*module[len(package) + 1:].split("."))
+    return base / "__init__.py" if base.is_dir() else base.with_suffix(".py")
+
+
+def kernel_sources(package: str | None = None) -> list[Path]:
+    """This file, :mod:`opnav.core.numba_adapter`, and the source file of every module of
+    :func:`kernel_modules` (``package``)."""
+    here = Path(__file__).resolve()
+    return [here, here.with_name("numba_adapter.py"), *(_source(m) for m in kernel_modules(package))]
 
 
 @functools.lru_cache(maxsize=None)
-def kernel_set_digest() -> str:
-    """SHA-256 of the content of :func:`kernel_sources` (computed once a process)."""
+def kernel_set_digest(package: str = CORE) -> str:
+    """SHA-256 of the content of :func:`kernel_sources` (``package``; computed once a
+    process): the stamp of the cache entries of that package's kernels (a kernel of a module
+    no package registered: the core's)."""
     h = hashlib.sha256()
-    for path in kernel_sources():
+    for path in kernel_sources(package):
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return h.hexdigest()
 
 
-@functools.lru_cache(maxsize=None)
-def _kernel_cache_type():
-    """numba's ``FunctionCache`` whose entries are stamped with :func:`kernel_set_digest`
-    beside numba's own stamp (the function's file), so a change in a called kernel's
-    module invalidates them. Built on first use: importing this module does not import
-    numba (the Snakefile reads :func:`kernel_sources` at parse time)."""
-    from numba.core import caching
-
-    class Stamp:
-        def get_source_stamp(self):
-            return (super().get_source_stamp(), kernel_set_digest())
-
-    class Impl(caching.CompileResultCacheImpl):
-        # numba's own order: NUMBA_CACHE_DIR, else __pycache__ beside the source if
-        # writable, else the user-wide cache directory
-        _locator_classes = [type(f"KernelSet{c.__name__}", (Stamp, c), {})
-                            for c in (caching.UserProvidedCacheLocator, caching.InTreeCacheLocator,
-                                      caching.UserWideCacheLocator)]
-
-    return type("KernelCache", (caching.FunctionCache,), {"_impl_class": Impl})
+def _timed_load(load):
+    """A signature loaded from the on-disk cache, its CPU counted as the job's start-up; a
+    load that finds nothing (numba compiles next) counts as compile time."""
+    with startup.overhead("kernels_s") as block:
+        got = load()
+        if got is None:
+            block[0] = "compile_s"
+        return got
 
 
-def _timed_dispatch(compile_for_args):
-    """numba's dispatch of a call whose argument types this process has not met yet (the
-    target set up on the first, the signature loaded from the cache or compiled), its CPU
-    counted as the job's start-up if it loaded, as compile time if it compiled
-    (:func:`opnav.core.startup.overhead`); numba's C dispatcher looks ``_compile_for_args``
-    up on the instance, so the wrapper sees every miss."""
-
-    dispatcher = compile_for_args.__self__
-
-    @functools.wraps(compile_for_args)
-    def timed(*args, **kws):
-        with startup.overhead("kernels_s") as spent:
-            misses = sum(dispatcher.stats.cache_misses.values())
-            try:
-                return compile_for_args(*args, **kws)
-            finally:
-                if sum(dispatcher.stats.cache_misses.values()) > misses:  # compiled, not loaded
-                    spent["kind"] = "compile_s"
-
-    return timed
+def _compile_started():
+    startup.start("compile_s")
 
 
 class LazyKernel:
@@ -132,10 +133,10 @@ class LazyKernel:
     kernels (a table, a figure, the manuscript) does not import numba (0.2-0.4 CPU-s).
 
     Once made, the dispatcher takes the proxy's place in the namespace of every loaded
-    module that holds the proxy (``from m import k`` included), so later calls go to numba
-    straight; a reference kept elsewhere (a tuple, a partial made before the first call)
-    goes through :meth:`__call__`, one Python call more. numba types a proxy it meets as a
-    global of a kernel it compiles as the dispatcher's type (:func:`_typeof_lazy`)."""
+    module that holds the proxy (``from m import k`` included: :func:`numba_adapter.rebind`),
+    so later calls go to numba straight; a reference kept elsewhere (a tuple, a partial made
+    before the first call) goes through :meth:`__call__`, one Python call more. numba types a
+    proxy it meets as a global of a kernel it compiles as the dispatcher's type."""
 
     def __init__(self, f, settings: dict):
         self.py_func = f
@@ -148,7 +149,7 @@ class LazyKernel:
         d = self._dispatcher
         if d is None:
             d = self._dispatcher = _dispatcher(self.py_func, self._settings)
-            _rebind(self, d)
+            numba_adapter.rebind(self, d, self.py_func.__module__, __name__.split(".", 1)[0])
         return d
 
     def __call__(self, *args):
@@ -163,63 +164,13 @@ class LazyKernel:
         return f"<kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
 
 
-def _rebind(proxy: LazyKernel, d) -> None:
-    """Put dispatcher ``d`` where ``proxy`` is a module global (its own module, and every
-    loaded module that imported it by name)."""
-    home = proxy.py_func.__module__
-    for name, mod in list(sys.modules.items()):
-        if mod is None or not (name == home or name.split(".", 1)[0] == "opnav"):
-            continue
-        ns = getattr(mod, "__dict__", None)
-        if ns is None:
-            continue
-        for key, value in list(ns.items()):
-            if value is proxy:
-                ns[key] = d
-
-
-@functools.lru_cache(maxsize=None)
-def _register_typeof() -> None:
-    """numba's ``typeof`` of a :class:`LazyKernel` (a global of a kernel being compiled,
-    or an argument): its dispatcher's type."""
-    from numba.core.typing.typeof import typeof_impl
-
-    @typeof_impl.register(LazyKernel)
-    def _typeof_lazy(val, c):
-        return typeof_impl(val.dispatcher(), c)
-
-
 def _dispatcher(f, settings: dict):
-    """The numba dispatcher of kernel ``f``: numba's on-disk cache keyed by the kernel set
-    too, its dispatch misses timed (:func:`_timed_dispatch`)."""
-    from numba import njit
-
-    _register_typeof()
-    d = njit(**settings)(f)
-    if settings["cache"]:
-        d._cache = _kernel_cache_type()(d.py_func)  # keyed by the kernel set too
-    d._compile_for_args = _timed_dispatch(d._compile_for_args)
-    d.get_call_template = _unliteral_calls(d.get_call_template)
-    return d
-
-
-def _unliteral_calls(get_call_template):
-    """numba's typing of a call to this kernel from another kernel, with the argument types
-    made non-literal: numba would otherwise compile the callee once more for every constant
-    a caller passes (``cholesky_shifted(S, 12, ...)``: ``Literal[int](12)``, a tuple holding a
-    ``0``, a ``True`` flag), each such copy a full compile, and with ``n`` a constant LLVM
-    unrolls the callee's loops completely (``cholesky_shifted`` for n = 12: most of the
-    landing kernels' compile, docs/performance.md). One signature per argument type; the
-    arithmetic is the same IEEE operations in the same order (no fastmath), so the results
-    are the same bits."""
-    from numba.core import types
-
-    @functools.wraps(get_call_template)
-    def typed(args, kws):
-        return get_call_template(tuple(types.unliteral(a) for a in args),
-                                 {k: types.unliteral(v) for k, v in kws.items()})
-
-    return typed
+    """The numba dispatcher of kernel ``f`` (:func:`numba_adapter.dispatcher`): its cache
+    stamped with its package's :func:`kernel_set_digest`, its loads and compiles timed."""
+    with startup.overhead("kernels_s"):
+        numba_adapter.register_proxy_type(LazyKernel, LazyKernel.dispatcher)
+        numba_adapter.install_compile_timer(_compile_started, startup.stop)
+        return numba_adapter.dispatcher(f, settings, kernel_set_digest(_owner(f.__module__) or CORE), _timed_load)
 
 
 def kernel(fn=None, **options):
@@ -256,16 +207,18 @@ def compile_cpu_s() -> dict[str, float]:
     return {name: float(v) for name, v in json.loads(COMPILE_ESTIMATES.read_text())["cpu_s"].items()}
 
 
-def warm(modules: tuple[str, ...] | None = None,
+def warm(modules: Iterable[str] | None = None,
          progress: Callable[[str], None] | None = None) -> dict[str, float]:
-    """Import the kernel modules ``modules`` (default ``KERNEL_MODULES``) and run their
-    warm-ups, in that order; return wall seconds per module (compile time on an empty
-    cache, load time on a filled one). ``progress`` (``log.info``, say) gets a line as each
-    module starts, with its estimate (:func:`compile_cpu_s`), and one as it ends, with
-    the CPU it took and the signatures it compiled and loaded."""
-    names = list(KERNEL_MODULES if modules is None else modules)
-    for name in names:
-        importlib.import_module(name)
+    """Run the warm-ups of the kernel modules ``modules`` (default: every registered one), in
+    that order; each must be imported already (its ``@warms`` runs on import: the caller imports
+    them, ``workflow/scripts/compile_kernels.py`` say). Return wall seconds per module (compile
+    time on an empty cache, load time on a filled one). ``progress`` (``log.info``, say) gets a
+    line as each module starts, with its estimate (:func:`compile_cpu_s`), and one as it ends,
+    with the CPU it took and the signatures it compiled and loaded."""
+    names = list(kernel_modules() if modules is None else modules)
+    missing = [n for n in names if n not in sys.modules]
+    if missing:
+        raise RuntimeError(f"warm: import the kernel modules first: {', '.join(missing)}")
     todo = [n for n in names if n in _WARMUPS]
     say = progress or (lambda text: None)
     estimate = compile_cpu_s()
@@ -283,6 +236,11 @@ def warm(modules: tuple[str, ...] | None = None,
             f"{after['compiled'] - before['compiled']} signatures compiled, "
             f"{after['loaded'] - before['loaded']} loaded")
     return seconds
+
+
+def used() -> bool:
+    """Whether this process made any kernel callable (called it, or asked for its dispatcher)."""
+    return any(k._dispatcher is not None for k in _KERNELS)
 
 
 def cache_stats() -> dict[str, int]:

@@ -20,11 +20,11 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Iterator
 
-from opnav.core import startup
+from opnav.core import compiled, startup
 
 
 @contextlib.contextmanager
-def script_context(snakemake) -> Iterator[logging.Logger]:
+def script_context(snakemake, console: bool = False) -> Iterator[logging.Logger]:
     """Redirect output to ``snakemake.log[0]`` (if any) and yield a logger.
 
     An exception inside the block is logged with its traceback to the log file
@@ -32,6 +32,10 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
     A job that succeeds ends its log with one :func:`resource_line` (the whole
     process's CPU seconds and peak memory, start-up and imports included), which
     ``benchmarks/job_costs.py`` sums per rule.
+
+    ``console``: the logger's lines also go to the job's own stderr, which Snakemake shows
+    on its console (a long job's progress, rule ``compile_kernels``), each prefixed with the
+    rule and its wildcards (jobs run side by side).
     """
     if type(snakemake).__module__.startswith("snakemake"):   # a workflow job, not a script run by hand
         from opnav.core.runguard import stop_with_parent
@@ -55,6 +59,9 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         logger.addHandler(handler)
         logger.setLevel(logging.INFO)
         old_err, old_out = sys.stderr, sys.stdout
+        shown = _console_handler(snakemake, old_err) if console else None
+        if shown is not None:
+            logger.addHandler(shown)
         sys.stderr = sys.stdout = fh
         try:
             logger.info("started: %.2f CPU-s before the work (interpreter, Snakemake's preamble, imports)",
@@ -72,7 +79,20 @@ def script_context(snakemake) -> Iterator[logging.Logger]:
         finally:
             sys.stderr, sys.stdout = old_err, old_out
             logger.removeHandler(handler)
+            if shown is not None:
+                logger.removeHandler(shown)
             gc.freeze()  # and what the job imported or made since: the process ends now
+
+
+def _console_handler(snakemake, stream) -> logging.Handler:
+    """A handler writing ``<rule> (<wildcards>): <message>`` lines to ``stream`` (flushed each)."""
+    rule = getattr(snakemake, "rule", None) or Path(sys.argv[0]).stem or "job"
+    wc = getattr(snakemake, "wildcards", None)
+    items = wc.items() if hasattr(wc, "items") else []
+    label = rule + (f" ({', '.join(f'{k}={v}' for k, v in items)})" if items else "")
+    handler = logging.StreamHandler(stream)
+    handler.setFormatter(logging.Formatter(f"{label}: %(message)s"))
+    return handler
 
 
 #: prefix of the last log line of a successful job (:func:`resource_line`)
@@ -84,8 +104,8 @@ def resource_line() -> str:
     process so far, its finished child processes included (LaTeX, say):
     ``resource.getrusage``; the peak memory is ``VmHWM`` of ``/proc/self/status``
     (``ru_maxrss`` keeps the forking parent's peak across ``exec`` on Linux), else
-    ``ru_maxrss`` (KiB on Linux). A job that imported ``opnav.core.compiled`` also gets the
-    kernel signatures it loaded from numba's cache and compiled itself
+    ``ru_maxrss`` (KiB on Linux). A job that called compiled kernels also gets the kernel
+    signatures it loaded from numba's cache and compiled itself
     (:func:`opnav.core.compiled.cache_stats`; after rule ``compile_kernels``, none compiled),
     and last the job's start-up CPU (:func:`opnav.core.startup.fields`)."""
     me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -97,8 +117,7 @@ def resource_line() -> str:
                 rss_kib = float(line.split()[1])
     out = (f"{RESOURCE_PREFIX} cpu_s={user + sys_:.3f} user_s={user:.3f} "
            f"sys_s={sys_:.3f} max_rss_mb={rss_kib / 1024:.1f}")
-    compiled = sys.modules.get("opnav.core.compiled")  # a job that used kernels (not imported here)
-    if compiled is not None:
+    if compiled.used():  # a job that called kernels
         stats = compiled.cache_stats()
         out += f" kernels_loaded={stats['loaded']} kernels_compiled={stats['compiled']}"
     return f"{out} {startup.fields()}"

@@ -44,3 +44,25 @@ sec. 2.2   ``metrics.make_metric`` (svd, gdop, cond from the 6 x 12 H,     1/m (
            ``planning.reference.planned_metric``
 =========  ==========================================================  ===============================
 """
+
+from opnav.core.compiled import register_kernel_modules as _register_kernel_modules
+
+# The modules holding this paper's compiled kernels, or whose source a kernel folds in
+# (landing.planning.layout's slot numbers), in warm-up order: they key the kernels' on-disk
+# cache and the workflow's compile_kernels job warms them (opnav.core.compiled).
+_register_kernel_modules(__name__, (
+    "opnav.landing.measurement",
+    "opnav.landing.linalg",
+    "opnav.landing.ekf",
+    "opnav.landing.ekf_update",
+    "opnav.landing.planning.layout",
+    "opnav.landing.planning.geometry",
+    "opnav.landing.planning.depth",
+    "opnav.landing.planning.screens",
+    "opnav.landing.planning.hmetrics",
+    "opnav.landing.planning.information",
+    "opnav.landing.planning.search",
+    "opnav.landing.planning.warmup",
+    "opnav.landing.descent",
+    "opnav.landing.imu",
+))
