@@ -294,8 +294,12 @@ _hyp_settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repro"))
 # unmarked test must stay fast: one whose call takes more than UNMARKED_LIMIT_CPU_S of
 # CPU (this process plus the child processes it waited for), or UNMARKED_LIMIT_WALL_S of
 # wall time, fails with a line saying to mark it. CPU, not wall time, is the rule, so a
-# loaded machine does not fail a fast test; a call that compiled numba kernels (an empty
-# cache) is exempt, since a warm cache is the rule's premise.
+# loaded machine does not fail a fast test: the wall limit (it catches a test that waits)
+# grows with the load average beyond the cores (wall_limit_s). The CPU numba spends compiling kernels in this
+# process (opnav.core.startup's compile_s: an empty or stale kernel cache) is taken out of
+# both, so the verdict is the same on an empty cache as on a filled one (issue 56 item 5: a
+# test that compiled was exempt whole, and a 157.7 s test passed unnoticed); the session's
+# compile is reported once at the end instead (pytest_terminal_summary).
 UNMARKED_LIMIT_CPU_S = float(os.environ.get("OPNAV_UNMARKED_LIMIT_CPU_S", "5"))
 UNMARKED_LIMIT_WALL_S = float(os.environ.get("OPNAV_UNMARKED_LIMIT_WALL_S", "30"))
 
@@ -308,20 +312,32 @@ def _cpu_now() -> float:
     return time.process_time() + ch.ru_utime + ch.ru_stime
 
 
-def _kernels_compiled() -> int:
-    compiled = sys.modules.get("opnav.core.compiled")
-    return compiled.cache_stats()["compiled"] if compiled is not None else 0
+def _compile_cpu() -> float:
+    """CPU seconds this process spent compiling kernels so far (opnav.core.startup)."""
+    startup = sys.modules.get("opnav.core.startup")
+    return startup.seconds()["compile_s"] if startup is not None else 0.0
 
 
-def unmarked_too_slow(cpu_s: float, wall_s: float, compiled: bool) -> str | None:
-    """Why an unmarked test's call is too slow for the default run, or None."""
-    if compiled:
-        return None
-    if cpu_s > UNMARKED_LIMIT_CPU_S:
-        return f"took {cpu_s:.1f} CPU-s (> {UNMARKED_LIMIT_CPU_S:g})"
-    if wall_s > UNMARKED_LIMIT_WALL_S:
-        return f"took {wall_s:.1f} s wall (> {UNMARKED_LIMIT_WALL_S:g})"
+def wall_limit_s() -> float:
+    """UNMARKED_LIMIT_WALL_S, times the 1-minute load average per core when above 1 (a test
+    gets a share of a core on a shared machine)."""
+    return UNMARKED_LIMIT_WALL_S * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
+
+
+def unmarked_too_slow(cpu_s: float, wall_s: float, compile_s: float = 0.0,
+                      wall_limit: float | None = None) -> str | None:
+    """Why an unmarked test's call is too slow for the default run, or None; ``compile_s``
+    (numba compiling kernels during the call) is taken out of both figures."""
+    own_cpu, own_wall = cpu_s - compile_s, wall_s - compile_s
+    limit = UNMARKED_LIMIT_WALL_S if wall_limit is None else wall_limit
+    if own_cpu > UNMARKED_LIMIT_CPU_S:
+        return f"took {own_cpu:.1f} CPU-s (> {UNMARKED_LIMIT_CPU_S:g}; kernel compiling aside)"
+    if own_wall > limit:
+        return f"took {own_wall:.1f} s wall (> {limit:.0f} at this load; kernel compiling aside)"
     return None
+
+
+_session_compile = {"cpu_s": 0.0, "tests": 0}
 
 
 @pytest.hookimpl(wrapper=True)
@@ -330,9 +346,22 @@ def pytest_runtest_call(item):
 
     if item.get_closest_marker("slow") or item.get_closest_marker("cluster"):
         return (yield)
-    cpu0, wall0, comp0 = _cpu_now(), time.perf_counter(), _kernels_compiled()
+    cpu0, wall0, comp0 = _cpu_now(), time.perf_counter(), _compile_cpu()
     result = yield
-    why = unmarked_too_slow(_cpu_now() - cpu0, time.perf_counter() - wall0, _kernels_compiled() > comp0)
+    comp = _compile_cpu() - comp0
+    if comp:
+        _session_compile["cpu_s"] += comp
+        _session_compile["tests"] += 1
+    why = unmarked_too_slow(_cpu_now() - cpu0, time.perf_counter() - wall0, comp, wall_limit_s())
     if why:
         pytest.fail(f"unmarked test {why}: mark it @pytest.mark.slow or make it faster", pytrace=False)
     return result
+
+
+def pytest_terminal_summary(terminalreporter):
+    """One line when unmarked tests compiled kernels (an empty or stale cache): how much."""
+    if _session_compile["tests"]:
+        terminalreporter.write_line(
+            f"numba compiled kernels in {_session_compile['tests']} unmarked tests: "
+            f"{_session_compile['cpu_s']:.1f} CPU-s (an empty or stale kernel cache; the next run "
+            "loads them; the slow-test guard leaves it out)")
