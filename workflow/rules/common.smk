@@ -143,6 +143,8 @@ def result_outputs():
     if "stars" in config["approach"]["variants"]:
         a += [*rules.approach_stars_outputs.output.table, *rules.approach_stars_outputs.output.fig]
     a += [*rules.approach_nav_arc_outputs.output.table, *rules.approach_nav_arc_outputs.output.fig]
+    if A_CUSTOM:    # your own estimators (approach_custom.smk)
+        a += [*rules.approach_custom_outputs.output.table, *rules.approach_custom_outputs.output.fig]
     if HAVE_BSK:
         a += [*rules.approach_peer_tables.output.table, rules.approach_peer_tables.output.summary,
               *rules.approach_peer_figure.output]

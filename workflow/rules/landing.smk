@@ -45,6 +45,15 @@ except ValueError as exc:
 # the headline scenario's numbers also at its top level.
 B_SCENARIOS = list(B_SCENARIO_CFG)
 B_METHODS = list(config["landing"]["mc"]["methods"])
+# your own landmark-selection metrics (landing.custom_methods, opnav.landing.methods; docs/usage.md,
+# "Your own method"): flown beside B_METHODS on every run of every scenario, shown in B-T3, B-F6,
+# B-F7, the end-phase table and B-X1, and timed; not in the replication (no verdict reads them).
+# Only their own jobs see their entries (b_sim): registering one reruns no built-in method's job.
+from opnav.landing.methods import source_files as b_custom_files
+
+B_CUSTOM_CFG = config["landing"].get("custom_methods") or {}
+B_CUSTOM = list(B_CUSTOM_CFG)
+B_TABLE_METHODS = B_METHODS + B_CUSTOM   # B-T3's rows
 _BEQ = config["landing"]["equivalence"]
 # the equivalence test's methods, reference and negative controls beyond B_METHODS
 B_EQ_METHODS = [m for m in dict.fromkeys([_BEQ["reference"], *_BEQ["methods"], *_BEQ["controls"]])
@@ -64,9 +73,20 @@ B_SIM = canonical({**{k: config["landing"][k] for k in _B_SIM_KEYS},
 B_SRC = with_kernels("landing", src(
     "landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
     "landing/measurement.py", "landing/ekf.py", "landing/planning/reference.py",
-    "landing/planner.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
+    "landing/planner.py", "landing/methods.py", "core/registry.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
     "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "core/rotations.py"))
 B_SCN_RE = "|".join(B_SCENARIOS)
+
+
+def b_sim(scn, methods=()):
+    """B_SIMS[scn], with the landing.custom_methods entries of the custom methods among ``methods``."""
+    own = {m: B_CUSTOM_CFG[m] for m in methods if m in B_CUSTOM_CFG}
+    return canonical({**B_SIMS[scn], "custom_methods": own}) if own else B_SIMS[scn]
+
+
+def b_custom_src(methods):
+    """The files the custom methods among ``methods`` live in (an edit re-flies them)."""
+    return b_custom_files({m: B_CUSTOM_CFG[m] for m in methods if m in B_CUSTOM_CFG})
 
 
 # B-X1's runs per scenario (landing.extra.n_runs): the methods only B-X1 flies fly runs
@@ -79,7 +99,7 @@ def b_runs(scn, method):
     """Runs flown by ``method`` in scenario ``scn``: landing.mc.n_runs, or, for a method only
     B-X1 flies, landing.extra.n_runs[scn] where set (never more)."""
     n = config["landing"]["mc"]["n_runs"]
-    if method not in B_METHODS and method not in B_EQ_METHODS and scn in _BX1_RUNS:
+    if method not in B_TABLE_METHODS and method not in B_EQ_METHODS and scn in _BX1_RUNS:
         n = min(n, int(_BX1_RUNS[scn]))
     return n
 
@@ -107,7 +127,7 @@ def b_mc(scn, methods):
 # pack, scenario and chunk (rules landing_mc_pack1, ...) that flies each method's chunk in
 # turn and writes the same files as landing_mc_chunk, which flies the methods in no pack.
 _B_K = config["landing"]["mc"]["methods_per_job"]
-B_MC_METHODS = list(dict.fromkeys([*B_METHODS, *config["landing"]["extra"]["methods"], *B_EQ_METHODS]))
+B_MC_METHODS = list(dict.fromkeys([*B_TABLE_METHODS, *config["landing"]["extra"]["methods"], *B_EQ_METHODS]))
 B_PACKS = [B_MC_METHODS[i:i + _B_K] for i in range(0, len(B_MC_METHODS), _B_K)] if _B_K > 1 else []
 _B_PACKED = [m for p in B_PACKS for m in p]
 
@@ -116,6 +136,7 @@ rule landing_mc_chunk:
     """One Monte-Carlo job: runs of one planning method in one camera scenario (scatter)."""
     input:
         B_SRC,
+        lambda wc: b_custom_src([wc.bmethod]),
         kernels=kernels("landing"),
     output:
         f"{LANDING}/mc/{{bscn}}/chunks/{{bmethod}}/{{bchunk}}.npz",
@@ -124,7 +145,7 @@ rule landing_mc_chunk:
         bmethod="".join(f"(?!{m}(?![a-z0-9_-]))" for m in _B_PACKED) + "[a-z][a-z0-9_-]*",   # not in a pack
         bchunk=CHUNK_PATTERN,
     params:
-        landing=lambda wc: B_SIMS[wc.bscn],
+        landing=lambda wc: b_sim(wc.bscn, [wc.bmethod]),
         runs=lambda wc: chunk_runs(wc.bchunk),
         # the pick-ratio diagnostic scores every detected landmark once more per planning
         # call (half an information metric's descent); only B-T3 (landing.mc.methods) shows it
@@ -151,6 +172,7 @@ for _i, _pack in enumerate(B_PACKS, 1):
             f"landing_mc_pack{_i}"
         input:
             B_SRC,
+            b_custom_src(_pack),
             kernels=kernels("landing"),
         output:
             [f"{LANDING}/mc/{{bscn}}/chunks/{m}/{{bchunk}}.npz" for m in _pack],
@@ -158,7 +180,7 @@ for _i, _pack in enumerate(B_PACKS, 1):
             bscn=B_SCN_RE,
             bchunk=CHUNK_PATTERN,
         params:
-            landing=lambda wc: B_SIMS[wc.bscn],
+            landing=lambda wc, _pack=_pack: b_sim(wc.bscn, _pack),
             runs=lambda wc: chunk_runs(wc.bchunk),
             methods=_pack,
             pick_ratio=[m in B_METHODS for m in _pack],
@@ -283,7 +305,7 @@ rule landing_summary:
     (3-sigma envelopes per axis) and B-F7 (planning-time box plots): one job reads the
     scenario's Monte Carlo and planning times once for the table and the figures."""
     input:
-        mc=lambda wc: b_mc(wc.bscn, B_METHODS),
+        mc=lambda wc: b_mc(wc.bscn, B_TABLE_METHODS),
         mc_eq=lambda wc: b_mc(wc.bscn, B_EQ_METHODS),
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         single=f"{LANDING}/single/summary_{{bscn}}.json",
@@ -304,8 +326,9 @@ rule landing_summary:
     wildcard_constraints:
         bscn=B_SCN_RE,
     params:
-        methods=B_METHODS,
+        methods=B_TABLE_METHODS,
         eq_methods=B_EQ_METHODS,
+        custom=canonical(B_CUSTOM_CFG),    # legend names and colours of your own methods
         equivalence=canonical(_BEQ),
         yaw_ratio=config["landing"]["mc"]["yaw_ratio"],
         converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],

@@ -7,12 +7,14 @@
 
 _BX = config["landing"]["extra"]
 X1_METHODS = list(B_METHODS) + [m for m in _BX["methods"] if m not in B_METHODS]
+# B-X1's rows: those and your own methods (landing.custom_methods), on the same paired runs
+X1_ALL = X1_METHODS + [m for m in B_CUSTOM if m not in X1_METHODS]
 
 
 rule landing_x1_summary:
     """B-X1 of one scenario: all methods on the paired Monte Carlo, envelopes, ranking, JSON."""
     input:
-        mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
+        mc=lambda wc: b_mc(wc.bscn, X1_ALL),
         timing=f"{LANDING}/timing/{{bscn}}.npz",
         code=with_kernels("landing", src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py",
                                          "landing/timing_summary.py", "landing/plots.py", "core/tables.py", "core/figures.py", "opnav.mplstyle")),
@@ -24,7 +26,8 @@ rule landing_x1_summary:
     wildcard_constraints:
         bscn=B_SCN_RE,
     params:
-        methods=X1_METHODS,
+        methods=X1_ALL,
+        custom=canonical(B_CUSTOM_CFG),    # legend names and colours of your own methods
         extra=canonical(config["landing"]["extra"]),
         converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
     log:

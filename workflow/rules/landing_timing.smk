@@ -16,7 +16,9 @@ from opnav.landing.timing import timed_methods
 _BT = config["landing"]["timing"]
 # the methods timed: B-X1's flown ones and a real (LAPACK) SVD of the same H beside svd's
 # closed form (timed only: B-C4's "SVD"); the replication's timing times the same list
-B_TIMED = timed_methods(X1_METHODS)
+# and your own methods (landing.custom_methods), timed once on the built-in methods' recorded calls
+# (paired; a registration changes no call the timing claims read)
+B_TIMED = timed_methods(X1_METHODS) + B_CUSTOM
 # replayed n_replays times (compiled path): the timing claims' methods
 B_REPLAYED = list(B_METHODS)
 TIMING_CODE = B_SRC + src("landing/timing.py", "landing/timing_summary.py")
@@ -69,7 +71,7 @@ rule landing_timing:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
         replays=rules.landing_timing_replays.output,
         code=TIMING_CODE + src("landing/timing_plots.py", "core/figures.py", "opnav.mplstyle",
-                               "data/published.yaml"),
+                               "data/published.yaml") + b_custom_src(B_TIMED),
         kernels=kernels("landing"),
     output:
         timing=f"{LANDING}/timing/{{bscn}}.npz",
@@ -77,7 +79,7 @@ rule landing_timing:
     wildcard_constraints:
         bscn=B_SCN_RE,
     params:
-        landing=lambda wc: B_SIMS[wc.bscn],
+        landing=lambda wc: b_sim(wc.bscn, B_TIMED),   # with your own methods' entries
         flown=X1_METHODS,
         methods=B_TIMED,
         main=[m for m in B_TIMED if m not in B_REPLAYED],

@@ -9,6 +9,7 @@ import pandas as pd
 
 from opnav.core import figures, published
 from opnav.landing import plots, timing, timing_summary
+from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.montecarlo import load
 from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading, nees_retuned_text,
                                   scenario_summary, summary_table)
@@ -84,8 +85,11 @@ with script_context(snakemake) as log:
     out["end_phase_text"] = end_phase_text(out["end_phase"], scn, float(cut["min_update_altitude_m"]))
     write_json(snakemake.output.summary, out)
     t = next(iter(data.values()))["t"]
-    figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f6)
-    figures.save(plots.fig_planning_time(tm, methods, pub["depth_time_reduction_vs_svd_pct"]),
+    own = getattr(snakemake.params, "custom", None) or {}    # your own methods' legend names and colours
+    labels = method_labels(own)
+    colors = figures.own_colors(list(own), method_colors(own))
+    figures.save(plots.fig_nav_error_envelopes(t, data, labels, colors), snakemake.output.f6)
+    figures.save(plots.fig_planning_time(tm, methods, pub["depth_time_reduction_vs_svd_pct"], labels, colors),
                  snakemake.output.f7)
     log.info("B-T3 %s:\n%s\npairs:\n%s", scn, df.to_string(),
              pd.DataFrame(list(out["pairs"].values())).to_string())

@@ -7,6 +7,7 @@ import sys
 
 from opnav.core import figures
 from opnav.landing import plots, timing, timing_summary
+from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.montecarlo import first_runs, load
 from opnav.landing.ranking import headline, ranking_table
 from opnav.core.snakeio import mock_snakemake, script_context
@@ -40,7 +41,10 @@ with script_context(snakemake) as log:
                          f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
                          f"error below {conv:g} m. " + timing_summary.method_text(tm)))
     t = next(iter(data.values()))["t"]
-    figures.save(plots.fig_nav_error_envelopes(t, data), snakemake.output.f)
+    own = getattr(snakemake.params, "custom", None) or {}    # your own methods' legend names and colours
+    figures.save(plots.fig_nav_error_envelopes(t, data, method_labels(own),
+                                               figures.own_colors(list(own), method_colors(own))),
+                 snakemake.output.f)
     out = headline(df, ref)
     out["n_boot"] = n_boot
     with open(snakemake.output.summary, "w") as fh:

@@ -186,4 +186,8 @@ def approach_problems(a: dict) -> list[str]:
         if off >= half_fov:
             out.append(f"{k}{key}': a misalignment of {off:g} arcsec (x, y) puts Mars off the "
                        f"detector (half field of view {half_fov:g} arcsec)")
+    if not out:    # the user's own estimators: imported, signature, name, a probe on a small window
+        from .estimators import problems as estimator_problems
+
+        out += estimator_problems(a)
     return out

@@ -70,6 +70,22 @@ def color(label: str) -> str:
     return f"C{zlib.crc32(key.encode()) % 10}"
 
 
+#: colours for a user's own method without one (landing.custom_methods, approach.custom_estimators):
+#: none of them in :data:`PALETTE`, so an own method never takes a built-in method's colour
+OWN_COLORS = ("#117733", "#AA3377", "#44AA99", "#882255", "#999933", "#CC6677", "#88CCEE", "#DDCC77")
+
+
+def own_colors(names, given: dict | None = None) -> dict[str, str]:
+    """name -> colour of a user's own methods: the config's (``given``), else one of
+    :data:`OWN_COLORS` in registration order (none twice while they last)."""
+    given = {k: v for k, v in (given or {}).items() if v}
+    free = [c for c in OWN_COLORS if c not in given.values()]
+    out = {}
+    for i, n in enumerate(n for n in names if n not in given):
+        out[n] = free[i % len(free)] if free else OWN_COLORS[i % len(OWN_COLORS)]
+    return {n: given.get(n) or out[n] for n in names}
+
+
 def _save_settings() -> dict:
     """The style file's ``savefig.*`` settings as ``savefig`` keywords. They are passed
     explicitly because a figure is often saved after the :func:`style` context has

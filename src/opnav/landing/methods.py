@@ -54,25 +54,22 @@ boresight).
 from __future__ import annotations
 
 import functools
-import importlib
-import importlib.util
-import inspect
 import math
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Callable, Mapping, NamedTuple
 
 import numpy as np
 
+from opnav.core import registry
+from opnav.core.registry import CHECKOUT, CustomSpec, MethodError
 from opnav.landing.planning import layout
 
 __all__ = ["Candidate", "Method", "MethodError", "CustomSpec", "BUILTIN", "PICKER_NAMES", "builtin_names",
            "specs", "spec_items", "load", "resolve", "get", "probe", "probe_candidates", "problems",
            "objective", "eval_path", "display", "labels", "colors", "source_files", "CHECKOUT"]
 
-#: the checkout's root: a relative ``file.py:function`` path is read from here
-CHECKOUT = Path(__file__).resolve().parents[3]
+#: the config key of the registry
+SECTION = "landing.custom_methods"
 #: the built-in pickers (their functions are ``opnav.landing.planner.PICKERS``)
 PICKER_NAMES = ("random", "center", "closest")
 
@@ -96,25 +93,6 @@ class Candidate(NamedTuple):
     noise_scale: float       #: the filter's bearing-noise model / sigma_b_rad
     t_s: float               #: observation interval (the filter step), s
     n_obs: int               #: observations of a landmark before the next is planned (Fig. 3)
-
-
-class MethodError(ValueError):
-    """A registered method that cannot be used (preflight) or failed during a run: the message
-    is one line naming the method (``landing.custom_methods.<name>``)."""
-
-
-@dataclass(frozen=True)
-class CustomSpec:
-    """One entry of ``landing.custom_methods``."""
-
-    name: str
-    path: str
-    label: str = ""
-    color: str = ""
-
-    @property
-    def key(self) -> str:
-        return f"landing.custom_methods.{self.name}"
 
 
 @dataclass(frozen=True)
@@ -151,12 +129,7 @@ def builtin_names() -> tuple[str, ...]:
 def specs(custom_methods: Mapping | None) -> dict[str, CustomSpec]:
     """``landing.custom_methods`` (a mapping name -> ``{path, label, color}`` or name -> path)
     as :class:`CustomSpec` entries, in the config's order."""
-    out = {}
-    for name, v in dict(custom_methods or {}).items():
-        v = {"path": v} if isinstance(v, str) else dict(v)
-        out[str(name)] = CustomSpec(str(name), str(v.get("path", "")), str(v.get("label", "") or ""),
-                                    str(v.get("color", "") or ""))
-    return out
+    return registry.specs(custom_methods, SECTION)
 
 
 def spec_items(custom_methods: Mapping | None) -> tuple[tuple[str, str], ...]:
@@ -165,94 +138,16 @@ def spec_items(custom_methods: Mapping | None) -> tuple[tuple[str, str], ...]:
     return tuple((s.name, s.path) for s in specs(custom_methods).values())
 
 
-def _split(path: str, key: str) -> tuple[str, str]:
-    target, sep, attr = str(path).rpartition(":")
-    if not sep or not target or not attr.isidentifier():
-        raise MethodError(f"{key}: path {path!r} is not 'module:function' or 'file.py:function'")
-    return target, attr
-
-
-def _import(target: str, key: str):
-    """The module of ``target``: a ``.py`` file (relative to :data:`CHECKOUT` or absolute) or a
-    dotted module name (``sys.path``, then the checkout)."""
-    if target.endswith(".py"):
-        file = Path(target)
-        file = file if file.is_absolute() else CHECKOUT / file
-        if not file.is_file():
-            raise MethodError(f"{key}: file {target} not found (relative paths start at {CHECKOUT})")
-        name = "opnav_custom_" + "".join(c if c.isalnum() else "_" for c in str(file.resolve()))
-        if name in sys.modules:
-            return sys.modules[name]
-        spec = importlib.util.spec_from_file_location(name, file)
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[name] = mod
-        try:
-            spec.loader.exec_module(mod)
-        except (Exception, SystemExit) as exc:
-            del sys.modules[name]
-            raise MethodError(f"{key}: importing {target} raised {_what(exc)}") from exc
-        return mod
-    try:
-        return importlib.import_module(target)
-    except ModuleNotFoundError as exc:
-        first = exc
-    except (Exception, SystemExit) as exc:
-        raise MethodError(f"{key}: module {target!r} does not import: {_what(exc)}") from exc
-    if str(CHECKOUT) in sys.path:          # not under the checkout either
-        raise MethodError(f"{key}: module {target!r} does not import: {_what(first)}") from first
-    sys.path.append(str(CHECKOUT))
-    try:
-        return importlib.import_module(target)
-    except (Exception, SystemExit) as exc:
-        raise MethodError(f"{key}: module {target!r} does not import: {_what(exc)}") from exc
-    finally:
-        sys.path.remove(str(CHECKOUT))
-
-
-def _what(exc: BaseException) -> str:
-    return " ".join(f"{type(exc).__name__}: {exc}".split())
-
-
-def _is_numba(fn) -> bool:
-    return type(fn).__module__.startswith("numba") and hasattr(fn, "py_func")
-
-
-def _check_signature(fn, key: str) -> None:
-    """One positional parameter (the :class:`Candidate`); anything else is refused."""
-    py = fn.py_func if _is_numba(fn) else fn
-    try:
-        sig = inspect.signature(py)
-    except (TypeError, ValueError) as exc:
-        raise MethodError(f"{key}: its signature cannot be read ({_what(exc)})") from exc
-    pos = [p for p in sig.parameters.values()
-           if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty]
-    other = [p for p in sig.parameters.values() if p not in pos and p.default is p.empty
-             and p.kind is not p.VAR_KEYWORD and p.kind is not p.VAR_POSITIONAL]
-    if len(pos) != 1 or other:
-        raise MethodError(f"{key}: the function must take exactly one argument (a "
-                          f"opnav.landing.methods.Candidate), it takes {sig}")
-
-
 def load(spec: CustomSpec) -> Method:
     """The :class:`Method` of a registered metric: imported and its signature checked
     (:class:`MethodError`, one line naming the method)."""
-    key = spec.key
-    if spec.name in BUILTIN:
-        raise MethodError(f"{key}: the name {spec.name!r} is a built-in method's; choose another")
-    target, attr = _split(spec.path, key)
-    mod = _import(target, key)
-    fn = getattr(mod, attr, None)
-    if fn is None:
-        raise MethodError(f"{key}: {target} has no attribute {attr!r}")
-    if not callable(fn):
-        raise MethodError(f"{key}: {spec.path} is not a function")
-    _check_signature(fn, key)
-    return Method(spec.name, "custom", spec.label, spec.color, spec.path, fn, _is_numba(fn))
+    fn = registry.load_function(spec, BUILTIN, "opnav.landing.methods.Candidate")
+    return Method(spec.name, "custom", spec.label, spec.color, spec.path, fn, registry.is_numba(fn))
 
 
 @functools.lru_cache(maxsize=64)
 def _loaded(name: str, path: str) -> Method:
-    return load(CustomSpec(name, path))
+    return load(CustomSpec(name, path, section=SECTION))
 
 
 def resolve(name: str, custom: tuple = ()) -> Method | None:
@@ -284,7 +179,7 @@ def _score(method: Method, rec: Candidate) -> float:
     try:
         s = method.fn(rec)
     except Exception as exc:
-        raise MethodError(f"{key}: {method.path} raised {_what(exc)}") from exc
+        raise MethodError(f"{key}: {method.path} raised {registry.what(exc)}") from exc
     if isinstance(s, (bool, np.bool_)) or not isinstance(s, (int, float, np.integer, np.floating)):
         arr = np.asarray(s) if isinstance(s, np.ndarray) else None
         if arr is None or arr.shape != () or arr.dtype.kind not in "iuf":
@@ -394,9 +289,7 @@ def problems(landing_cfg: Mapping) -> list[str]:
             m = load(spec)
             probe(m, landing_cfg)
         except MethodError as exc:
-            msg = str(exc)
-            msg = msg[len(spec.key):].lstrip(": ") if msg.startswith(spec.key) else msg
-            out.append(f"invalid config key '{spec.key}': {msg}")
+            out.append(f"invalid config key '{spec.key}': {registry.strip_key(str(exc), spec.key)}")
     return out
 
 
@@ -421,28 +314,5 @@ def colors(custom_methods: Mapping | None) -> dict[str, str]:
 
 
 def source_files(custom_methods: Mapping | None) -> list[str]:
-    """The files the registered methods' functions live in (for the workflow's inputs, so an
-    edit of one re-flies its Monte Carlo): a ``file.py`` path as given, resolved; a module's
-    file where it can be found without importing it (else nothing)."""
-    out = []
-    for s in specs(custom_methods).values():
-        target = s.path.rpartition(":")[0]
-        if target.endswith(".py"):
-            f = Path(target)
-            out.append(str(f if f.is_absolute() else CHECKOUT / f))
-            continue
-        try:
-            found = importlib.util.find_spec(target.split(".")[0]) and importlib.util.find_spec(target)
-        except (ImportError, ValueError):
-            found = None
-        if found is None:
-            sys.path.append(str(CHECKOUT))
-            try:
-                found = importlib.util.find_spec(target)
-            except (ImportError, ValueError):
-                found = None
-            finally:
-                sys.path.remove(str(CHECKOUT))
-        if found is not None and found.origin and Path(found.origin).is_file():
-            out.append(found.origin)
-    return out
+    """The files the registered methods' functions live in (``core.registry.source_files``)."""
+    return registry.source_files(specs(custom_methods))

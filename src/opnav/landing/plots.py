@@ -22,8 +22,15 @@ METHOD_LABELS = {"depth": "depth error", "svd": "SVD", "gdop": "GDOP", "cond": "
                  "logdet_nav": "log-det (planned, nav.)", "closest": "closest (range)"}
 
 
-def _label(m):
-    return METHOD_LABELS.get(m, m)
+def _label(m, labels=None):
+    """A method's legend name: ``labels`` (a user's own method's, landing.custom_methods), then
+    :data:`METHOD_LABELS`, then the name."""
+    return (labels or {}).get(m) or METHOD_LABELS.get(m, m)
+
+
+def _color(m, colors=None):
+    """A method's colour: ``colors`` (a user's own method's), then the palette's."""
+    return (colors or {}).get(m) or figures.color(m)
 
 
 def fig_true_states(t, r, v, rpy_deg):
@@ -143,14 +150,15 @@ def _phase_ends(t, data: dict[str, dict]) -> dict:
     return {}
 
 
-def fig_nav_error_envelopes(t, data: dict[str, dict]):
+def fig_nav_error_envelopes(t, data: dict[str, dict], labels: dict | None = None, colors: dict | None = None):
     """B-F6 / B-X1: error envelopes over the runs, per axis, of the position (m),
     velocity (m/s) and attitude (roll/pitch/yaw, deg) errors, one line per method
     (log scale): 3 x the RMS about zero over the runs, ``3 sqrt(mean_runs e^2)``,
     which keeps any bias (3 x the standard deviation about the mean would drop
     it). The phases are marked: the median time of the last landmark update
     (after it, site bearings only) and of the last vision update (after it, the
-    IMU-only coast). The legend sits below the panels, clear of the curves."""
+    IMU-only coast). The legend sits below the panels, clear of the curves. ``labels``,
+    ``colors``: a user's own methods' legend names and colours (landing.custom_methods)."""
     import matplotlib.pyplot as plt
 
     rows = (("err_r", "position", "m", ("x", "y", "z")),
@@ -166,7 +174,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
                 for k, (m, d) in enumerate(data.items()):
                     e = d[key][:, :, j]
                     env = 3.0 * np.sqrt(np.mean(e**2, axis=0))
-                    ax.plot(t, env, color=figures.color(m), lw=1.0, label=_label(m),
+                    ax.plot(t, env, color=_color(m, colors), lw=1.0, label=_label(m, labels),
                             ls=("-", "--", "-.", ":")[k % 4])
                 ax.set_yscale("log")
                 figures.plain_log_labels(ax.yaxis)
@@ -186,7 +194,8 @@ def fig_nav_error_envelopes(t, data: dict[str, dict]):
         return fig
 
 
-def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float | None = None):
+def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float | None = None,
+                      labels: dict | None = None, colors: dict | None = None):
     """B-F7: planning-call thread CPU time (us, ``timing_summary.CLOCK``) per method on the replayed planning
     calls (``timing``: ``opnav.landing.timing.replay``, the same calls for every
     method), box = quartiles, whiskers = 5th and 95th percentiles (the paper's
@@ -194,14 +203,19 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
     medians and evaluations per call annotated. Methods timed on the
     alternative metric evaluation path too get a second, hatched box (on the
     calls timed there: the paper's definition on a subset, ``max_calls_paper``;
-    its reduction in the title on the calls timed on both)."""
+    its reduction in the title on the calls timed on both). A user's own method (``labels``,
+    ``colors``: landing.custom_methods) has its planning path under its name."""
     import matplotlib
     import matplotlib.pyplot as plt
 
     from opnav.landing import timing_summary as tsum
 
     methods = list(methods)
-    paths = {str(p): str(e) for p, e in zip(timing["variant_path"], timing["variant_eval_path"])}
+    # the built-in methods' paths (a user's own method names its own: methods.eval_path)
+    paths = {str(p): str(e) for p, e in zip(timing["variant_path"], timing["variant_eval_path"])
+             if not str(e).startswith("custom")}
+    own = {str(m): str(e) for m, e in zip(timing["variant_method"], timing["variant_eval_path"])
+           if str(e).startswith("custom")}
     main_name, alt_name = paths.get("main", ""), paths.get("alt", "")
     with figures.style():
         fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 3.0), constrained_layout=True)
@@ -212,12 +226,12 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             has_alt = va.size > 0
             pos.append(k - 0.18 if has_alt else k)
             vals.append(v)
-            cols.append(figures.color(m))
+            cols.append(_color(m, colors))
             hatch.append("")
             if has_alt:
                 pos.append(k + 0.18)
                 vals.append(va)
-                cols.append(figures.color(m))
+                cols.append(_color(m, colors))
                 hatch.append("///")
         # whiskers at the 5th and 95th percentiles: the extremes of a replay are
         # machine noise (a shared machine's 10-130 ms interruptions), not planning work
@@ -229,11 +243,11 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
             patch.set_hatch(h)
         ax.set_yscale("log")
         figures.plain_log_labels(ax.yaxis)
-        labels = []
+        ticks = []
         for m in methods:
             ev = tsum.median_evals(timing, m)
-            labels.append(f"{_label(m)}\n{ev:.0f} evals")
-        ax.set_xticks(range(1, len(methods) + 1), labels, fontsize="small")
+            ticks.append(f"{_label(m, labels)}\n{ev:.0f} evals" + ("\n(interpreted\nsearch)" if m in own else ""))
+        ax.set_xticks(range(1, len(methods) + 1), ticks, fontsize="small")
         for p_, v in zip(pos, vals):       # the median, above the upper whisker (clear of the box)
             if len(v):
                 med = float(np.median(v))

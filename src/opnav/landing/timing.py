@@ -138,7 +138,9 @@ def variants(methods, cfg, alt=True, main=None) -> list[tuple[str, str, object]]
     (``"main"``; only those of ``main`` if given), and, unless ``alt`` is false, every
     method with a search on the other path (``"alt"``, ``planner.alternative_path``:
     compiled <-> the paper's definition; for ``logdet_nav``, ``planning.reference`` in
-    numpy; only those of ``alt`` if it is a collection of methods)."""
+    numpy; only those of ``alt`` if it is a collection of methods). A user's own method
+    (landing.custom_methods) runs the same code on both paths: timed on ``"main"`` only."""
+    from opnav.landing.methods import BUILTIN
     from opnav.landing.planner import PICKERS, alternative_path
 
     alt_cfg = alternative_path(cfg)
@@ -147,7 +149,7 @@ def variants(methods, cfg, alt=True, main=None) -> list[tuple[str, str, object]]
         if main is None or m in main:
             out.append((m, "main", cfg))
         if (alt is True or (alt and not isinstance(alt, bool) and m in alt)) \
-                and m not in PICKERS and m not in COMPILED_ONLY:
+                and m not in PICKERS and m not in COMPILED_ONLY and m in BUILTIN:
             out.append((m, "alt", alt_cfg))
     return out
 
@@ -276,6 +278,7 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
     call's bracket is timed that many times back to back and the least thread CPU kept (the bracket
     the machine disturbed least: other processes only ever add to a call's time).
     """
+    from opnav.landing.methods import eval_path
     from opnav.landing.planner import PlanState, compiled_call, plan
 
     methods = list(methods)
@@ -413,7 +416,8 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
             "timed": timed_, "eval_ns": eval_ns, "dispatch_ns": np.float64(dispatch),
             "variant_method": np.array([v[0] for v in var]),
             "variant_path": np.array([v[1] for v in var]),
-            "variant_eval_path": np.array([v[2].eval_path for v in var]),
+            # a user's own method: its path named (methods.eval_path: the search interpreted, the score compiled or not)
+            "variant_eval_path": np.array([eval_path(v[0], v[2]) for v in var]),
             "mismatch": mismatch, "checked": checked, "reps": reps, "clock_ns": np.float64(clock_ns),
             "load_avg": np.array([load_start, os.getloadavg()[0]]), "n_cpu": np.int64(os.cpu_count() or 0),
             "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls),
