@@ -453,13 +453,19 @@ def test_main_and_replication_timing_time_one_list():
             assert re.search(rf"mc=lambda wc: b_mc\(wc.bscn, {flown}\)", b), (name, rule)
             assert re.search(rf"\bflown={flown}\b", b), (name, rule)
         assert re.search(r"\breplayed=B_REPLAYED\b", reps)
-        assert re.search(rf"\bmethods={timed}\b", other) and re.search(r"\breplays=rules\.", other)
+        # the millisecond job does not wait for the replays (it runs as soon as its Monte Carlo is
+        # there, beside other jobs); the summaries read both
+        assert re.search(rf"\bmethods={timed}\b", other) and "replays=" not in other
         # the replays run alone (threads: every core), so no other job shares the cores they time on;
         # the millisecond calls run beside other jobs
         assert re.search(r"^\s*threads: all_cores\(\)", reps, re.M), (name, rule)
         assert "threads:" not in other, (name, rule)
     # the replication flies B_METHODS and B_EQ_METHODS (its Monte Carlo rules): its timing replays
     # those calls but times only the claims' methods (no B-X1 method, no svd_lapack)
+    assert "timing=lambda wc: expand(B_TIMING, bscn=wc.bscn)" in block("landing.smk", "landing_summary")
+    assert "timing=lambda wc: expand(B_TIMING, bscn=wc.bscn)" in block("landing_extra.smk", "landing_x1_summary")
+    assert ("timing=[*rules.replication_landing_timing_replays.output.replays, "
+            "*rules.replication_landing_timing.output]") in block("replication.smk", "replication_landing_summary")
     rep = text["replication.smk"]
     assert "REP_B_FLOWN = list(dict.fromkeys([*B_METHODS, *B_EQ_METHODS]))" in rep
     assert re.search(r"for m in B_METHODS\]", rep) and re.search(r"for m in B_EQ_METHODS\]", rep)

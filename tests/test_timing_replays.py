@@ -246,6 +246,12 @@ def test_replays_in_processes_pick_what_the_monte_carlo_picked(recorded, tmp_pat
     other = timing.run_spec(timing.replay_spec(cfg, mc, ["depth", "svd", "random"], 6, alt=["depth", "svd"],
                                                main=["random"], max_calls_paper=2))
     tm = timing.merge(reps, other)
+    paths = []
+    for i, t in enumerate([*reps, other]):                  # as the jobs write them, as the summaries read them
+        paths.append(tmp_path / f"part{i}.npz")
+        timing.save(paths[-1], t)
+    loaded = timing.load([str(x) for x in paths])
+    assert all(np.array_equal(loaded[k], tm[k]) for k in ("cpu_ns", "timed", "pick", "replay", "variant_method"))
     assert int(np.sum(tm["mismatch"])) == 0
     assert int(np.sum(tm["checked"])) == sum(int(np.sum(r["checked"])) for r in [*reps, other])
     own = tm["source"] == list(tm["sources"]).index("depth")

@@ -151,7 +151,7 @@ def result_outputs():
     b = [*rules.landing_tables.output, *rules.landing_true_states.output,
          *expand(rules.landing_single.output.f5, bscn=B_SCENARIOS),
          *expand([*rules.landing_summary.output.f6, *rules.landing_summary.output.f7], bscn=B_SCENARIOS),
-         *expand(rules.landing_timing.output.f7o, bscn=B_SCENARIOS),
+         *expand(rules.landing_timing_replays.output.f7o, bscn=B_SCENARIOS),
          *expand(rules.landing_summary.output.t3, bscn=B_SCENARIOS),
          *rules.landing_summary_all.output,
          *expand(rules.landing_x1_summary.output.f, bscn=B_SCENARIOS),

@@ -307,7 +307,7 @@ rule landing_summary:
     input:
         mc=lambda wc: b_mc(wc.bscn, B_TABLE_METHODS),
         mc_eq=lambda wc: b_mc(wc.bscn, B_EQ_METHODS),
-        timing=f"{LANDING}/timing/{{bscn}}.npz",
+        timing=lambda wc: expand(B_TIMING, bscn=wc.bscn),   # replays + other (landing_timing.smk)
         single=f"{LANDING}/single/summary_{{bscn}}.json",
         tuning=f"{LANDING}/tuning.json",
         retuned=f"{LANDING}/retuned/{{bscn}}.json",   # the retuned filter's held-out NEES beside the paper's

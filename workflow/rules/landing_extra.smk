@@ -15,7 +15,7 @@ rule landing_x1_summary:
     """B-X1 of one scenario: all methods on the paired Monte Carlo, envelopes, ranking, JSON."""
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_ALL),
-        timing=f"{LANDING}/timing/{{bscn}}.npz",
+        timing=lambda wc: expand(B_TIMING, bscn=wc.bscn),   # replays + other (landing_timing.smk)
         code=with_kernels("landing", src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py",
                                          "landing/timing_summary.py", "landing/plots.py", "core/tables.py", "core/figures.py", "opnav.mplstyle")),
         kernels=kernels("landing"),

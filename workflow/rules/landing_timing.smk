@@ -5,11 +5,12 @@
 # Two jobs per scenario (issue 53):
 # * landing_timing_replays, alone on the machine: the compiled calls the timing claims read
 #   (landing.mc.methods: B-C4, B-C9; microseconds), landing.timing.n_replays times, each replay
-#   a fresh process, each call's evaluations timed alone too (the shared part / evaluations split);
-# * landing_timing, an ordinary job beside others: every other variant once on the same calls
-#   (milliseconds: the B-X1 information baselines, the LAPACK SVD, the pickers, and the paper's
-#   definition on landing.timing.max_calls_paper of them), merged with the replays into the one
-#   file the consumers read, and B-F7's overhead curve.
+#   a fresh process, each call's evaluations timed alone too (the shared part / evaluations split),
+#   and B-F7's overhead curve;
+# * landing_timing, an ordinary job beside others (it does not wait for the replays): every other
+#   variant once on the same calls (milliseconds: the B-X1 information baselines, the LAPACK SVD,
+#   the pickers, and the paper's definition on landing.timing.max_calls_paper of them).
+# The consumers read both (timing.load of the list merges them).
 # Included after landing_extra.smk (reuses LANDING, B_SIMS, B_SRC, X1_METHODS, b_mc).
 from opnav.landing.timing import timed_methods
 
@@ -22,6 +23,11 @@ B_TIMED = timed_methods(X1_METHODS) + B_CUSTOM
 # replayed n_replays times (compiled path): the timing claims' methods
 B_REPLAYED = list(B_METHODS)
 TIMING_CODE = B_SRC + src("landing/timing.py", "landing/timing_summary.py")
+# what a consumer of one scenario's planning times reads, {bscn} left to expand: the replays, then
+# the variants timed once (timing.load of the list merges them); landing.smk's and
+# landing_extra.smk's rules read it through a function (this file is included after theirs)
+B_TIMING = [f"{LANDING}/timing/{{bscn}}/replay{r}.npz" for r in range(_BT["n_replays"])] + [
+    f"{LANDING}/timing/{{bscn}}/other.npz"]
 
 
 def all_cores() -> int:
@@ -37,13 +43,16 @@ def all_cores() -> int:
 
 
 rule landing_timing_replays:
-    """Independent replays (separate processes) of the compiled calls the timing claims read."""
+    """Independent replays (separate processes) of the compiled calls the timing claims read, and
+    B-F7's overhead curve from them."""
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
-        code=TIMING_CODE,
+        code=TIMING_CODE + src("landing/timing_plots.py", "core/figures.py", "opnav.mplstyle",
+                               "data/published.yaml"),
         kernels=kernels("landing"),
     output:
-        [f"{LANDING}/timing/{{bscn}}/replay{r}.npz" for r in range(_BT["n_replays"])],
+        replays=[f"{LANDING}/timing/{{bscn}}/replay{r}.npz" for r in range(_BT["n_replays"])],
+        f7o=report_figure(f"{LANDING}/B-F7_overhead_{{bscn}}", "B-F7.overhead", "Paper B", "{bscn}"),
     wildcard_constraints:
         bscn=B_SCN_RE,
     params:
@@ -65,17 +74,14 @@ rule landing_timing_replays:
 
 
 rule landing_timing:
-    """Planning times of every method on the same recorded planning calls of one scenario: the
-    other variants timed once beside other jobs, merged with the replays; B-F7's overhead curve."""
+    """Planning times of the other variants on the same recorded planning calls of one scenario,
+    timed once beside other jobs (milliseconds a call), not waiting for the replays."""
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
-        replays=rules.landing_timing_replays.output,
-        code=TIMING_CODE + src("landing/timing_plots.py", "core/figures.py", "opnav.mplstyle",
-                               "data/published.yaml") + b_custom_src(B_TIMED),
+        code=TIMING_CODE + b_custom_src(B_TIMED),
         kernels=kernels("landing"),
     output:
-        timing=f"{LANDING}/timing/{{bscn}}.npz",
-        f7o=report_figure(f"{LANDING}/B-F7_overhead_{{bscn}}", "B-F7.overhead", "Paper B", "{bscn}"),
+        f"{LANDING}/timing/{{bscn}}/other.npz",
     wildcard_constraints:
         bscn=B_SCN_RE,
     params:
@@ -86,7 +92,7 @@ rule landing_timing:
         alt=B_TIMED,
         max_calls=_BT["max_calls"],
         max_calls_paper=_BT["max_calls_paper"],
-    priority: 10
+    priority: 10        # the longest timing job (site-tilt): started as soon as its Monte Carlo is
     log:
         f"{LANDING}/logs/timing_{{bscn}}.log",
     benchmark:

@@ -101,10 +101,10 @@ if REP_CFG["enabled"]:
         sample's recorded calls of the methods the replication flies (what varies is the clock)."""
         input:
             mc=lambda wc: b_mc(wc.bscn, REP_B_FLOWN),
-            code=TIMING_CODE,
+            code=TIMING_CODE + src("data/published.yaml"),
             kernels=kernels("landing"),
         output:
-            [f"{REP}/landing/timing/{{bscn}}/replay{r}.npz" for r in range(_BT["n_replays"])],
+            replays=[f"{REP}/landing/timing/{{bscn}}/replay{r}.npz" for r in range(_BT["n_replays"])],
         wildcard_constraints:
             bscn=B_SCN_RE,
         params:
@@ -121,16 +121,15 @@ if REP_CFG["enabled"]:
             "../scripts/landing_timing.py"
 
     rule replication_landing_timing:
-        """The replication's replays merged with the paper's definition of the same methods on its
-        subset of the calls (B-C4's other path), timed once beside other jobs: only what the
-        replicated timing claims read (B-X1's methods and the LAPACK SVD are the main replay's)."""
+        """The paper's definition of the replicated timing claims' methods on its subset of the
+        calls (B-C4's other path), timed once beside other jobs: only what the replicated timing
+        claims read (B-X1's methods and the LAPACK SVD are the main replay's)."""
         input:
             mc=lambda wc: b_mc(wc.bscn, REP_B_FLOWN),
-            replays=rules.replication_landing_timing_replays.output,
             code=TIMING_CODE,
             kernels=kernels("landing"),
         output:
-            timing=f"{REP}/landing/timing/{{bscn}}.npz",
+            f"{REP}/landing/timing/{{bscn}}/other.npz",
         wildcard_constraints:
             bscn=B_SCN_RE,
         params:
@@ -153,7 +152,7 @@ if REP_CFG["enabled"]:
         input:
             mc=lambda wc: [f"{REP}/landing/mc/{wc.bscn}/chunks/{m}/{REP_B_CHUNK}.npz" for m in B_METHODS],
             mc_eq=lambda wc: [f"{REP}/landing/mc/{wc.bscn}/chunks/{m}/{REP_B_CHUNK}.npz" for m in B_EQ_METHODS],
-            timing=f"{REP}/landing/timing/{{bscn}}.npz",
+            timing=[*rules.replication_landing_timing_replays.output.replays, *rules.replication_landing_timing.output],
             single=f"{LANDING}/single/summary_{{bscn}}.json",
             tuning=f"{LANDING}/tuning.json",
             plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step

@@ -2,16 +2,18 @@
 
 Rule ``landing_timing_replays`` (alone on the machine): ``landing.timing.n_replays`` independent
 replays of the compiled calls the timing claims read, each in a fresh process
-(``timing.replays_in_processes``), with each call's evaluations timed alone (the decomposition).
-Rule ``landing_timing`` (an ordinary job, beside others): the other variants (calls of
-milliseconds: the information baselines, the LAPACK SVD, the pickers, the paper's definition on
-its subset) once, on the same calls, merged with the replays (``timing.merge``) into the one
-file every consumer reads, and B-F7's overhead curve (main sample only).
+(``timing.replays_in_processes``), with each call's evaluations timed alone (the decomposition),
+and B-F7's overhead curve (main sample only).
+Rule ``landing_timing`` (an ordinary job, beside others, not waiting for the replays): the other
+variants (calls of milliseconds: the information baselines, the LAPACK SVD, the pickers, the
+paper's definition on its subset) once, on the same calls. The consumers read both
+(``timing.load`` of the list merges them, ``timing.merge``).
 """
 
 import sys
 import tempfile
 
+from opnav.core import published
 from opnav.landing import timing, timing_summary
 from opnav.core.snakeio import mock_snakemake, script_context
 
@@ -26,23 +28,24 @@ with script_context(snakemake) as log:
         spec = timing.replay_spec(p.landing, mc, p.replayed, int(p.max_calls), alt=False, decompose=True,
                                   best_of=timing.REPLAY_BEST_OF)
         with tempfile.TemporaryDirectory() as tmp:
-            reps = timing.replays_in_processes(spec, len(snakemake.output), tmp, log)
-        for r, path in zip(reps, snakemake.output):
+            reps = timing.replays_in_processes(spec, len(snakemake.output.replays), tmp, log)
+        for r, path in zip(reps, snakemake.output.replays):
             timing.save(path, r)
-    else:
-        reps = [timing.load(f) for f in snakemake.input.replays]
-        spec = timing.replay_spec(p.landing, mc, p.methods, int(p.max_calls), alt=list(p.alt), main=list(p.main),
-                                  max_calls_paper=int(p.max_calls_paper))
-        tm = timing.merge(reps, timing.run_spec(spec))
-        timing.save(snakemake.output.timing, tm)
+        tm = timing.merge(reps)
+        ev = timing_summary.planning_time_evidence(tm, published.load()["paper_b"]["depth_time_reduction_vs_svd_pct"])
         log.info("%s", timing_summary.method_text(tm))
-        log.info("%s", timing_summary.summary_frame(tm).to_string())
+        log.info("reductions between replays (mean, sd): %s; shared part at the published reduction: %.3f us",
+                 {k: (round(v["mean"], 2), round(v["sd_between"], 2)) for k, v in ev["reduction_pct"].items()},
+                 ev["shared_us_at_published"])
         if "f7o" in snakemake.output.keys():
-            from opnav.core import figures, published
+            from opnav.core import figures
             from opnav.landing import timing_plots
 
-            ev = timing_summary.planning_time_evidence(
-                tm, published.load()["paper_b"]["depth_time_reduction_vs_svd_pct"])
-            log.info("shared part at the published reduction: %.3f us; reductions: %s",
-                     ev["shared_us_at_published"], {k: round(v["mean"], 2) for k, v in ev["reduction_pct"].items()})
             figures.save(timing_plots.fig_overhead_curve(ev, snakemake.wildcards.bscn), snakemake.output.f7o)
+    else:
+        spec = timing.replay_spec(p.landing, mc, p.methods, int(p.max_calls), alt=list(p.alt), main=list(p.main),
+                                  max_calls_paper=int(p.max_calls_paper))
+        tm = timing.run_spec(spec)
+        timing.save(snakemake.output[0], tm)
+        log.info("%s", timing_summary.method_text(tm))
+        log.info("%s", timing_summary.summary_frame(tm).to_string())

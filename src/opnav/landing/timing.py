@@ -99,7 +99,7 @@ import time
 
 import numpy as np
 
-from opnav.landing.records import RECORD_KEYS, load, rng_from_words, save
+from opnav.landing.records import RECORD_KEYS, load as _load_one, rng_from_words, save
 
 __all__ = ["select_calls", "COMPILED_ONLY", "timed_methods", "variants", "pass_keys", "paper_limited", "replay",
            "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "CALL_INPUT_KEYS", "load_calls", "run_spec", "replay_spec", "replays_in_processes",
@@ -473,6 +473,22 @@ def clock_cost_ns(n: int = 2000, repeats: int = 5) -> float:
     return float(best)
 
 
+def load(path):
+    """A replay saved by :func:`save` (``records.load``), or, given several paths (a Snakemake input
+    list), their :func:`merge`: the files whose ``part`` is ``"replay"`` (the claims' replays, in
+    the given order) with the one other file (the variants timed once) as ``extra``."""
+    if isinstance(path, (str, os.PathLike)):
+        return _load_one(path)
+    parts = [_load_one(p) for p in path]
+    reps = [t for t in parts if str(t.get("part", "")) == "replay"]
+    other = [t for t in parts if str(t.get("part", "")) != "replay"]
+    if len(other) > 1:
+        raise ValueError(f"timing.load: {len(other)} files are not replays of the claims' calls; at most one may be")
+    if not reps:
+        return other[0]
+    return merge(reps, other[0] if other else None)
+
+
 #: per-call arrays of a replay (first axis: the replayed calls)
 _ROW_KEYS = ("source", "call", "run", "step")
 #: per (call, variant) arrays of a replay
@@ -644,7 +660,7 @@ def replays_in_processes(spec: dict, n: int, workdir, log=None) -> list[dict]:
         if proc.returncode:
             raise RuntimeError(f"timing replay {r} failed (exit {proc.returncode}): "
                                + (proc.stderr.strip().splitlines() or ["no output"])[-1])
-        out.append(load(target))
+        out.append({**_load_one(target), "part": np.array("replay")})   # load() merges these as replays
     return out
 
 
