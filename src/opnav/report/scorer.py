@@ -105,6 +105,8 @@ class Outcome:
     versus: str = ""
     #: the numbers ``threshold`` quotes (band ends, +-margin, a threshold), for the derived rows
     numbers: tuple[float, ...] = ()
+    #: a band's centre (the published value), where a sweep aims
+    target: float = math.nan
 
     @property
     def row(self) -> EvidenceRow | None:
@@ -280,6 +282,8 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
     o = Outcome(PASS, cond, (row,), scope=scope, versus=versus)
     if comp == "band":
         lo_b, hi_b, text, why = _band(ctx, cond, scope, row)
+        if cond.get("center") is not None and not cond.get("upper_factor") and not cond.get("factor"):
+            o.target = ctx.num(cond.get("center"), cond, scope, row)[0]
         if why:
             o.status, o.why, o.threshold = UNDECIDED, why, text
             return o
@@ -324,8 +328,13 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
         side = (row.hi < -m) if below else (row.lo > m)
         size = (-est >= eff) if below else (est >= eff)
         edge = row.hi if below else -row.lo
-        o.severity = (edge + m) / max(abs(est), 1e-300) if not side else (
-            (eff - abs(est)) / max(eff, 1e-300) if not size else -(-(edge + m)) / max(abs(est), 1e-300) * -1)
+        scale = max(abs(est), 1e-300)
+        if not side:       # how far the interval's edge is on the wrong side of the margin
+            o.severity = (edge + m) / scale
+        elif not size:     # the right side, but smaller than the effect the plan asks for
+            o.severity = (eff - abs(est)) / max(eff, 1e-300)
+        else:              # passing: how much room is left (negative)
+            o.severity = -min(-(edge + m) / scale, (abs(est) - eff) / max(eff, 1e-300) if eff else math.inf)
         o.status = PASS if (side and size) else FAIL
         return o
     if comp == "sign":
@@ -427,7 +436,7 @@ def _order(ctx: _Ctx, cond: Condition, scope: str, method: str) -> Outcome:
         o.status = FAIL
         a, b, ra, rb = fails[0]
         o.rows = (ra,) + ((rb,) if rb is not None else ()) + tuple(r for r in rows if r is not ra and r is not rb)
-        o.threshold = f"{a} before {b}"
+        o.threshold = (f"{a} before {b}" if items == "scope" else f"{ctx.plan.name(a)} before {ctx.plan.name(b)}")
         o.severity = float(len(fails))
     elif undecided:
         o.status, o.why = UNDECIDED, f"no {'interval' if cond.get('by') == 'interval' else 'value'} for " + ", ".join(
@@ -562,6 +571,12 @@ def _verdict(ctx: _Ctx, scopes: list[str]) -> Reading:
             rd.verdict = REPRODUCED
             if met:
                 rd.flags.append(("control_also_meets", f"{', '.join(met)} ({', '.join(scopes)})"))
+    elif passing and (lit is None or lit.status == UNDECIDED):
+        # a faithful variant meets it but the method as written was never judged: not tested as
+        # written (an addition is only named where the paper as written fails)
+        rd.verdict = NOT_TESTED
+        rd.named = f"no evidence for the method as written ({lit.why if lit is not None else 'no rows'})"
+        rd.flags.append(("holds_with", f"{rd.best.method} ({plan.addition(rd.best.method)})"))
     elif passing:
         rd.verdict, rd.named = WITH_ADDITION, plan.addition(rd.best.method)
     else:
@@ -743,10 +758,6 @@ def _cause(rd: Reading, test: ClaimTest, plan: Plan, scopes: list[str] | None = 
     return f"As written it fails: {_q(rd, o, plan)}{tail}"
 
 
-def the_others(per) -> str:
-    return "the others"
-
-
 def _choice_cause(per: dict[str, Reading], test: ClaimTest, plan: Plan, rd: Reading | None = None) -> str:
     ok = [s for s, r in per.items() if r.verdict == REPRODUCED]
     bad = [s for s, r in per.items() if r.verdict not in (REPRODUCED, NOT_TESTED)]
@@ -757,7 +768,7 @@ def _choice_cause(per: dict[str, Reading], test: ClaimTest, plan: Plan, rd: Read
             o = r.lit.worst()
             break
     why = f" ({_q(rd, o, plan) if rd is not None else quote(o, plan)})" if o is not None else ""
-    return (f"It holds in {', '.join(ok) or 'no scope'} but not in {', '.join(bad) or the_others(per)}{why}; the "
+    return (f"It holds in {', '.join(ok) or 'no scope'} but not in {', '.join(bad) or 'the others'}{why}; the "
             f"choice is {test.scopes.get('choice') or test.choice}")
 
 
@@ -893,19 +904,19 @@ def would_take(plan: Plan, claim_id: str, evidence: Evidence | Iterable[Evidence
     """What a claim not reproduced as written would take (the plan's ``would_take`` entries),
     as one text and the sweeps behind it (for the figures): [{setting, method, scope, points:
     [(value, estimate, lo, hi)], limit, flip, threshold}]."""
-    if j.verdict == REPRODUCED:
-        return "", []
     test = plan.test(claim_id)
     rows = [r for r in evidence if r.claim_id == claim_id]
     idx = _Index(rows)
     level = test.level
     parts, sweeps = [], []
     for w in test.would_take:
-        if w.kind == "sweep":
+        if w.kind == "sweep":      # swept whatever the verdict (the figure), quoted where it is not reproduced
             txt, sw = _sweep(plan, test, idx, level, w.params, j)
             sweeps += sw
-            if txt:
+            if txt and j.verdict != REPRODUCED:
                 parts.append(txt)
+        elif j.verdict == REPRODUCED:
+            continue
         elif w.kind == "margin":
             txt = _margin_take(plan, test, idx, level, w.params, j)
             if txt:
@@ -931,8 +942,10 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
     cond0 = test.conditions[w["like"]]
     cond = Condition(q, cond0.comparison, {k: v for k, v in cond0.params.items() if k != "setting"}, cond0.index)
     samples = [test.samples["main"], "main"]
-    cands = [r for r in idx.rows if r.quantity == q and r.sample in samples and _setting_value(r.setting, name) is not None
-             and r.role != "published"]
+    # the rows of this setting alone (a row also naming another choice, 'arc_s=4100;rule=last', is
+    # another curve)
+    cands = [r for r in idx.rows if r.quantity == q and r.sample in samples and r.role != "published"
+             and ";" not in r.setting and _setting_value(r.setting, name) is not None]
     if not cands:
         return "", []
     meth = w.get("method", "as_written")
@@ -960,7 +973,12 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
             pts.append((_setting_value(r.setting, name), rr.estimate, rr.lo, rr.hi, o.status))
         flip = None
         for (v1, e1, *_r1, s1), (v2, e2, *_r2, s2), o1, o2 in zip(pts, pts[1:], outs, outs[1:]):
-            if s1 != s2 and PASS in (s1, s2) and UNDECIDED not in (s1, s2):
+            aim = o1.target if math.isfinite(o1.target) else math.nan
+            if math.isfinite(aim) and (e1 - aim) * (e2 - aim) <= 0 and e1 != e2:
+                # a band around a published value: where the estimate meets the value itself
+                flip = v1 + (aim - e1) * (v2 - v1) / (e2 - e1)
+                break
+            if s1 != s2 and PASS in (s1, s2) and UNDECIDED not in (s1, s2) and not math.isfinite(aim):
                 lim = o2.limit if s2 == PASS else o1.limit
                 if math.isfinite(lim) and e2 != e1 and cond.comparison in ("band", "sign"):
                     if min(v1, v2, e1, e2, lim) > 0:     # power laws (bounds, errors): log-log
@@ -972,11 +990,13 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
                 else:
                     flip = v2 if s2 == PASS else v1
                 break
-        if flip is None and pts and pts[0][4] == PASS:
+        if flip is None and pts and pts[0][4] == PASS and not math.isfinite(outs[0].target):
             flip = pts[0][0]
         sweeps.append({"claim_id": test.claim_id, "setting": name, "method": method, "versus": versus, "scope": scope,
                        "quantity": q, "points": pts, "flip": flip, "threshold": outs[0].threshold if outs else "",
-                       "limit": outs[0].limit if outs else math.nan, "unit": rs[0].unit})
+                       "limit": outs[0].limit if outs else math.nan, "unit": rs[0].unit,
+                       "band": tuple(outs[0].numbers) if outs and outs[0].cond.comparison == "band" else (),
+                       "target": outs[0].target if outs else math.nan})
         j.quoted += rs
     if not sweeps:
         return "", []

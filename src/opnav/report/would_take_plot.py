@@ -61,8 +61,14 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
             if s["flip"] is not None:
                 ax.axvline(s["flip"], color=c, ls=":", lw=1)
         lim = s0.get("limit", math.nan)
-        if lim is not None and math.isfinite(lim):
+        band = [x for x in s0.get("band") or () if math.isfinite(x)]
+        if len(band) == 2:
+            ax.axhspan(band[0], band[1], color="0.85", zorder=0, label=f"test: {s0.get('threshold', '')}")
+        elif lim is not None and math.isfinite(lim):
             ax.axhline(lim, color="0.3", ls="--", lw=1, label=f"test: {s0.get('threshold', '')}")
+        tgt = s0.get("target", math.nan)
+        if tgt is not None and math.isfinite(tgt):
+            ax.axhline(tgt, color="0.3", ls="--", lw=1, label=f"published {tgt:g}")
         from opnav.report.evidence import QUANTITIES
 
         unit = s0.get("unit", "")
