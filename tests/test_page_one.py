@@ -88,7 +88,7 @@ def test_verdict_figure_is_a_grid_of_claims_by_verdict_without_cut_or_overlappin
     if replication:
         df["verdict_replication"] = ["not_reproduced" if i % 3 else v for i, v in enumerate(df["verdict"])]
     fig = verdict_plot.fig_verdicts(df)
-    assert len(_markers(fig, "o")) == len(df) + 1               # a dot per claim, one in the key
+    assert len(_markers(fig, "o")) == len(df) + 1               # the key's dot (drawn first), one per claim
     assert len(_markers(fig, "D")) == (len(df) + 1 if replication else 0)
     verdicts = list(dict.fromkeys([*df["verdict"], *(df["verdict_replication"] if replication else [])]))
     heads = {t for t, _ in _figure_texts(fig)}
@@ -104,7 +104,7 @@ def test_verdict_figure_is_a_grid_of_claims_by_verdict_without_cut_or_overlappin
         for t2, b2 in texts[i + 1:]:
             assert not b1.overlaps(b2), (t1, t2)
     # the dot of each claim lies in its verdict's column, under that column's head
-    for ln, v in zip(_markers(fig, "o"), df["verdict"]):
+    for ln, v in zip(_markers(fig, "o")[1:], df["verdict"]):   # the first dot is the key's
         x = fig.axes[0].transData.transform((ln.get_xdata()[0], ln.get_ydata()[0]))[0]
         head = [b for t, b in texts if t.replace("\n", " ") == verdict_plot.verdict_word(v)]
         assert head and head[0].x0 - 30 <= x <= head[0].x1 + 30, v

@@ -132,7 +132,7 @@ def _tables_in_pdf(aux: Path) -> int:
 
 
 @pytest.mark.slow
-def test_quick_build_prints_no_raw_text_and_every_table_at_7pt(quick_results):
+def test_quick_build_prints_no_raw_text_and_every_table_at_7pt_and_the_figure_on_page_1(quick_results):
     paper = quick_results / "results" / "quick" / "paper"
     assert print_size.raw_text_findings(paper) == []
     if not shutil.which("latexmk"):
@@ -141,3 +141,8 @@ def test_quick_build_prints_no_raw_text_and_every_table_at_7pt(quick_results):
     # every table of the PDF measured (a build without paper/print-size.tex measures none)
     assert len(sizes) == _tables_in_pdf(paper / "build" / "main.aux") > 0
     assert print_size.small_tables(sizes) == [], sizes
+    # page 1 holds the verdict figure (issue 55 item 3), not page 2
+    if shutil.which("pdftotext"):
+        page1 = subprocess.run(["pdftotext", "-f", "1", "-l", "1", str(paper / "main.pdf"), "-"],
+                               capture_output=True, text=True, check=True).stdout
+        assert "Figure 1:" in page1, page1[-800:]

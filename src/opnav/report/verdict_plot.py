@@ -65,10 +65,12 @@ FIG_WIDTH_IN = 6.7
 LABEL_PT = 7.0
 HEAD_PT = 6.5
 PAD_IN = 0.025
-LINE_IN = 0.135       # one text line of a row at LABEL_PT
-ROW_PAD_IN = 0.05
+LINE_IN = 0.118       # one text line of a row at LABEL_PT (leading 1.2)
+ROW_PAD_IN = 0.036
 #: the claim column is never narrower than this (the verdict columns' heads give way first)
 MIN_LABEL_IN = 2.4
+#: a verdict column is never narrower than this (a dot and a diamond side by side)
+MIN_COL_IN = 0.42
 #: the mark of each sample's verdict: a dot for the main sample, a diamond for the replication
 MARKERS = {"verdict": {"marker": "o", "ms": 6.5}, "verdict_replication": {"marker": "D", "ms": 5.5}}
 
@@ -107,15 +109,18 @@ def fig_verdicts(df):
     has_rep = "verdict_replication" in df.columns and df["verdict_replication"].map(_present).any()
     width = FIG_WIDTH_IN
     with figures.style():
-        # each verdict column as wide as its head (the verdict's words, at most two lines)
+        # each verdict column as wide as its own head (the verdict's words on at most two
+        # lines; wide enough for the two marks), the claim column the rest
         head_pt = HEAD_PT
         heads = [textwrap.wrap(verdict_word(v), 11, break_long_words=False) or [""] for v in verdicts]
         while True:
-            col_w = max([max(_width_in(line, head_pt) for line in h) + 2 * PAD_IN for h in heads] + [0.45])
-            if width - col_w * len(verdicts) >= MIN_LABEL_IN or head_pt <= 5.0:
+            col_ws = [max(max(_width_in(line, head_pt) for line in h) + 2 * PAD_IN + 0.04, MIN_COL_IN) for h in heads]
+            if width - sum(col_ws) >= MIN_LABEL_IN or head_pt <= 5.0:
                 break
             head_pt -= 0.25
-        label_w = width - col_w * len(verdicts)
+        label_w = width - sum(col_ws)
+        col_x = [label_w + sum(col_ws[:j]) for j in range(len(col_ws))]  # each column's left edge
+        col_c = [x + w / 2 for x, w in zip(col_x, col_ws)]               # and its centre
         ids = [str(r.get("claim_id", "")) for r in df.to_dict("records")]
         id_w = max([_width_in(i, LABEL_PT, "bold") for i in ids] + [0.0]) + 3 * PAD_IN
         rows = []  # (kind, paper, record or block, claim name lines)
@@ -127,23 +132,29 @@ def fig_verdicts(df):
                 rows.append(("claim", paper, r, wrap_to_width(name, label_w - id_w - PAD_IN, LABEL_PT)))
             rows.append(("count", paper, sub, [""]))
         heights = [len(lines) * LINE_IN + ROW_PAD_IN for _, _, _, lines in rows]
-        head_h = max(len(h) for h in heads + [[""]]) * 0.11 + 0.14
-        legend_h = 0.25
-        total_h = head_h + sum(heights) + legend_h
+        head_h = max(2, *(len(h) for h in heads)) * 0.105 + 0.1
+        total_h = head_h + sum(heights) + 0.02
         fig = plt.figure(figsize=(width, total_h))
         ax = fig.add_axes((0, 0, 1, 1))
         ax.set_xlim(0, width)
         ax.set_ylim(total_h, 0)
         ax.axis("off")
-        x0 = label_w
         # column heads: the verdict's words on its colour
         for j, (v, head) in enumerate(zip(verdicts, heads)):
             face, ink = VERDICT_COLORS.get(v, ("white", "black"))
-            ax.add_patch(Rectangle((x0 + j * col_w + 0.012, 0.02), col_w - 0.024, head_h - 0.06, facecolor=face,
+            ax.add_patch(Rectangle((col_x[j] + 0.012, 0.02), col_ws[j] - 0.024, head_h - 0.06, facecolor=face,
                                    edgecolor="0.3", lw=0.3))
-            ax.text(x0 + (j + 0.5) * col_w, head_h / 2 - 0.01, "\n".join(head),
+            ax.text(col_c[j], head_h / 2 - 0.01, "\n".join(head),
                     ha="center", va="center", fontsize=head_pt, color=ink, linespacing=1.0)
-        ax.text(PAD_IN, head_h / 2, "claim", ha="left", va="center", fontsize=LABEL_PT, fontweight="bold")
+        # the claim column's head, and the key under it: which mark is which sample
+        ax.text(PAD_IN, head_h * 0.3, "claim", ha="left", va="center", fontsize=LABEL_PT, fontweight="bold")
+        ky, kx = head_h * 0.72, PAD_IN + 0.05
+        for key, words in (("verdict", "main sample"), ("verdict_replication", "replication sample")):
+            if key == "verdict_replication" and not has_rep:
+                continue
+            ax.plot([kx], [ky], ls="none", mfc="0.6", mec="0.15", mew=0.6, **MARKERS[key])
+            ax.text(kx + 0.08, ky, words, ha="left", va="center", fontsize=HEAD_PT)
+            kx += 0.08 + _width_in(words, HEAD_PT) + 0.2
         y = head_h
         for (kind, paper, r, lines), h in zip(rows, heights):
             if kind == "claim":
@@ -155,7 +166,7 @@ def fig_verdicts(df):
                 for key, dx in (("verdict", -0.09 if has_rep else 0.0), ("verdict_replication", 0.09)):
                     v = str(r.get(key, "") or "")
                     if v in verdicts:
-                        cx = x0 + (verdicts.index(v) + 0.5) * col_w + dx
+                        cx = col_c[verdicts.index(v)] + dx
                         face = VERDICT_COLORS.get(v, ("0.5", "black"))[0]
                         ax.plot([cx], [y + h / 2], ls="none", mfc=face, mec="0.15", mew=0.6, **MARKERS[key])
             else:
@@ -164,16 +175,9 @@ def fig_verdicts(df):
                         ha="left", va="center", fontsize=LABEL_PT - 0.5, style="italic", color="0.25")
                 for j, v in enumerate(verdicts):
                     n = int(counts.get(v, 0))
-                    ax.text(x0 + (j + 0.5) * col_w, y + h / 2, str(n) if n else "", ha="center", va="center",
+                    ax.text(col_c[j], y + h / 2, str(n) if n else "", ha="center", va="center",
                             fontsize=LABEL_PT, fontweight="bold")
                 ax.plot([0, width], [y + h, y + h], color="k", lw=0.6)
             y += h
         ax.plot([0, width], [head_h, head_h], color="k", lw=0.6)
-        # the key
-        ky = y + legend_h / 2 + 0.02
-        ax.plot([0.1], [ky], ls="none", mfc="0.6", mec="0.15", mew=0.6, **MARKERS["verdict"])
-        ax.text(0.18, ky, "main sample (the verdict)", ha="left", va="center", fontsize=LABEL_PT)
-        if has_rep:
-            ax.plot([2.0], [ky], ls="none", mfc="0.6", mec="0.15", mew=0.6, **MARKERS["verdict_replication"])
-            ax.text(2.08, ky, "replication sample (independent seeds)", ha="left", va="center", fontsize=LABEL_PT)
     return fig
