@@ -65,6 +65,7 @@ def test_augmented_batch_ml_and_em_within_4_bound_sigma_and_ml_equals_em(roll_ca
     np.testing.assert_allclose(est["augmented"][:, :2], est["batch_ml"][:, :2], atol=1.0 * bound[:2].max())
 
 
+@pytest.mark.slow  # ~1.6 CPU-s (issue 56: the default run <= 90 s)
 def test_batch_ml_solution_is_stationary_and_gradient_exact(roll_case):
     _, geo, win, bound = roll_case
     z, dx0 = _data(geo, win, TRUTH, [5])
@@ -112,6 +113,7 @@ def test_batch_ml_zero_bias_truth(roll_case):
     assert np.all(np.abs(sc.arcsec(res.theta[:, -1, :2])) < 4.0 * bound[:2])
 
 
+@pytest.mark.slow  # ~2.3 CPU-s (issue 56: the default run <= 90 s)
 def test_jit_gives_the_same_objective(roll_case):
     _, geo, win, _ = roll_case
     z, dx0 = _data(geo, win, TRUTH, [0])
@@ -124,6 +126,7 @@ def test_jit_gives_the_same_objective(roll_case):
     np.testing.assert_allclose(vals[0], vals[1], rtol=1e-10)
 
 
+@pytest.mark.slow  # ~1.9 CPU-s (issue 56: the default run <= 90 s)
 def test_compiled_fold_gives_the_virtual_machines_numbers_bit_for_bit(roll_case):
     """The JIT-compiled fold of the step (and its reverse derivative, IPOPT's gradient) must
     give exactly the numbers of CasADi's virtual machine calling the compiled step, so that

@@ -245,6 +245,7 @@ def test_peer_variants_outside_table1_variants_are_refused():
     assert any("approach.peers.variants'" in p and "prior" in p for p in probs), probs
 
 
+@pytest.mark.slow  # a snakemake dry run: ~2 CPU-s (issue 56: the default run <= 90 s)
 def test_without_basilisk_the_workflow_skips_a_p1_with_one_line(workdir):
     """Basilisk hidden (None in sys.modules, as `import` treats it): the dry run still plans
     everything else, no A-P1 job, and says so in one line."""

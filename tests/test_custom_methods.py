@@ -245,6 +245,7 @@ def flown(landing):
     return out
 
 
+@pytest.mark.slow  # ~1.5 CPU-s (issue 56: the default run <= 90 s)
 def test_the_example_flies_and_picks_what_the_function_says(flown):
     """The example metric in the Monte Carlo: its picks equal direct calls of the function (edge
     calls in site-tilt, in-plane optima in interior)."""

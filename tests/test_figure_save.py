@@ -5,6 +5,7 @@ same box within a fraction of a point."""
 import re
 
 import numpy as np
+import pytest
 
 
 def _figure():
@@ -30,6 +31,7 @@ def _media_box(pdf: bytes) -> np.ndarray:
     return np.array(re.search(rb"MediaBox \[ ([^\]]*) \]", pdf).group(1).split(), float)
 
 
+@pytest.mark.slow  # ~1.5 CPU-s (issue 56: the default run <= 90 s)
 def test_save_png_is_savefig_tight_and_pdf_page_within_a_point(tmp_path):
     from opnav.core import figures
 

@@ -45,7 +45,8 @@ KNOWN_CYCLES: set[frozenset[str]] = set()
 #: Modules whose dynamic imports load the user's own code, never a module of the package (each
 #: with why): the checker cannot name their targets, so they are declared here.
 USER_CODE_IMPORTS = {
-    "opnav.landing.methods": "a user's own planning metric, landing.custom_methods 'module:function' (issue 58)",
+    "opnav.core.registry": "a user's own method: landing.custom_methods, approach.custom_estimators "
+                           "'module:function' or 'file.py:function' paths (issue 58)",
 }
 
 

@@ -24,6 +24,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 from scipy.stats import multivariate_normal
@@ -436,6 +437,7 @@ print(json.dumps({"modules": sorted(seconds), "holding": holding, **c.cache_stat
 """
 
 
+@pytest.mark.slow  # a process loading every kernel: ~1.6 CPU-s (issue 56: the default run <= 90 s)
 def test_every_kernel_module_registers_a_warm_up_and_a_warmed_cache_compiles_nothing():
     """Every module holding kernels is registered by its package (``kernel_modules``) and registers a warm-up
     (``@warms``), or its package has one module that does for all (``landing.planning.warmup``

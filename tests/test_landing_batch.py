@@ -153,6 +153,7 @@ def test_tracking_step_is_the_fig3_strategy():
     np.testing.assert_array_equal(n2, [0, 2, 3, 1, 4, 0])
 
 
+@pytest.mark.slow  # ~2 CPU-s a method (issue 56: the default run <= 90 s)
 @pytest.mark.parametrize("method", ["depth", "logdet"])
 def test_skipping_the_pick_ratio_changes_nothing_else(scenarios, method):
     """``pick_ratio=False`` (B-X1-only methods: no table shows it) leaves every pick, state and

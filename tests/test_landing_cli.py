@@ -22,6 +22,7 @@ def test_cli_flies_one_descent(capsys, method):
     assert out["scenario"] == "interior"                      # the headline scenario by default
 
 
+@pytest.mark.slow  # ~1.1 CPU-s (issue 56: the default run <= 90 s)
 def test_cli_scenario_flag_flies_that_camera(capsys):
     from opnav.core.config import load_config
     from opnav.landing.descent import build_scenario, run_descent

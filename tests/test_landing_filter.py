@@ -78,6 +78,7 @@ def test_zero_errors_zero_noise_stay_near_truth(landing):
     assert np.abs(run["err_v"]).max() < 0.5
 
 
+@pytest.mark.slow  # ~1.1 CPU-s (issue 56: the default run <= 90 s)
 def test_chunking_does_not_change_results(landing):
     # at one batch size chunking changes no bit; the batch size itself (a job's
     # chunk flown as one batch by default) changes numbers only at round-off
@@ -110,6 +111,7 @@ def paired(landing):
     return d, tm, summary_table(d, tm, published_reduction_vs_svd=29.03)
 
 
+@pytest.mark.slow  # ~1.9 CPU-s (issue 56: the default run <= 90 s)
 def test_methods_are_paired_and_the_table_is_complete(paired):
     d, tm, df = paired
     np.testing.assert_array_equal(d["depth"]["init_error"], d["svd"]["init_error"])

@@ -41,6 +41,7 @@ def scn():
     return build_scenario(load_config()["landing"])
 
 
+@pytest.mark.slow  # ~2.5 CPU-s (issue 56: the default run <= 90 s)
 def test_exact_visible_interval_matches_a_fine_grid():
     rng = np.random.default_rng(5)
     cam = camera_from_config(dict(fov_deg=60, pixels=1024, sigma_px=0.5, tilt_deg=45,

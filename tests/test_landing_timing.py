@@ -57,6 +57,7 @@ def test_replay_reproduces_every_recorded_pick(recorded):
     assert (tm["wall_ns"] > 0).all() and (tm["cpu_ns"] >= 0).all()
 
 
+@pytest.mark.slow  # ~1.3 CPU-s (issue 56: the default run <= 90 s)
 def test_the_pick_check_can_fail(recorded):
     """Replaying from the wrong filter step (the wrong image) or without the
     excluded landmark changes picks: the check counts them."""

@@ -22,6 +22,7 @@ def test_every_script_has_the_one_by_hand_entry(script):
     assert "snakemake.config" not in text  # params only: a rule gets the keys it uses
 
 
+@pytest.mark.slow  # parses the workflow thrice: ~2.2 CPU-s (issue 56: the default run <= 90 s)
 def test_a_script_run_by_hand_gets_the_rule_params_of_its_overlays(tmp_path):
     """landing_tables.py by hand with the quick profile plus an overlay that moves the
     initial position: B-T1 lands where the rule writes it (results/quick/...) and shows
@@ -39,6 +40,7 @@ def test_a_script_run_by_hand_gets_the_rule_params_of_its_overlays(tmp_path):
     assert (wd / "results" / "quick" / "landing" / "logs" / "landing_tables.log").is_file()
 
 
+@pytest.mark.slow  # parses the workflow: ~1.1 CPU-s (issue 56: the default run <= 90 s)
 def test_a_missing_wildcard_is_named(tmp_path):
     from opnav.core.snakeio import mock_snakemake
 

@@ -11,6 +11,8 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+
 from conftest import REPO
 
 JOB = textwrap.dedent("""\
@@ -60,6 +62,7 @@ def test_job_log_has_the_startup_line_and_fields(tmp_path):
     assert "kernels_loaded=" not in text, "a job that called no kernel counts none"
 
 
+@pytest.mark.slow  # two processes that import numba, one compiles: ~2 CPU-s (in-process: test_numba_adapter) (issue 56: the default run <= 90 s)
 def test_a_kernel_call_counts_as_compiling_then_as_loading(tmp_path):
     """First process: an empty cache, the call compiles (compile CPU; numba's import and the
     dispatcher are making it callable); second process: the call loads (load CPU, no compile)."""

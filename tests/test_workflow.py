@@ -58,7 +58,8 @@ def test_snakemake_refuses_a_bad_config_listing_every_problem(workdir):
     _refusal_lines_name(out.splitlines(), cases, out)
 
 
-@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/quick.yaml"])
+@pytest.mark.parametrize("configfile", [pytest.param("config/config.yaml", marks=pytest.mark.slow),  # ~2 CPU-s
+                                        "config/quick.yaml"])
 def test_dry_run_succeeds(workdir, configfile):
     proc = run_snakemake(workdir, "-n", "--cores", "2", "--configfile", configfile)
     assert proc.returncode == 0, proc.stderr[-3000:]
@@ -149,6 +150,7 @@ def test_kernels_compiled_once_then_only_loaded(quick_results):
         assert any(v[0] for k, v in jobs.items() if k not in first), jobs
 
 
+@pytest.mark.slow  # a dry run of the full workflow: ~2 CPU-s (issue 56: the default run <= 90 s)
 def test_slurm_profile_dry_run(workdir):
     pytest.importorskip("snakemake_executor_plugin_slurm")
     proc = run_snakemake(workdir, "-n", "--profile", "profiles/slurm", "--configfile", "config/quick.yaml")
@@ -156,6 +158,7 @@ def test_slurm_profile_dry_run(workdir):
     assert "Job stats" in proc.stdout
 
 
+@pytest.mark.slow  # a dry run of the full workflow: ~2 CPU-s (issue 56: the default run <= 90 s)
 def test_slurm_workflow_profile_dry_run_account_and_measured_resources(workdir):
     """README's cluster command: account and partition from the command line
     (no tracked file edited); each cluster rule gets its measured resources."""
