@@ -148,3 +148,29 @@ def test_one_signature_per_kernel_when_kernels_pass_constants(tmp_path):
     sigs = json.loads(out.stdout.splitlines()[-1])
     assert "opnav.landing.linalg.cholesky_in_place" in sigs
     assert {k: v for k, v in sigs.items() if len(v) != 1} == {}
+
+
+def test_every_module_with_kernels_is_registered_by_its_package():
+    """A module of the package that defines a ``@kernel`` or a ``@warms`` function is in its
+    package's registered kernel modules (read from the sources: no import, no numba), so its
+    kernels' cache is keyed by its package's kernel set and the compile job warms it. The
+    warm-up coverage itself (a warmed cache compiles nothing) is test_kernel_references' (slow)."""
+    import ast
+
+    import opnav.approach
+    import opnav.landing
+
+    registered = set(compiled.kernel_modules())
+    src = REPO / "src"
+    holding = set()
+    for f in (src / "opnav").rglob("*.py"):
+        tree = ast.parse(f.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.FunctionDef) and any(
+                    (d.id if isinstance(d, ast.Name) else getattr(getattr(d, "func", None), "id", "")) in ("kernel", "warms")
+                    for d in node.decorator_list):
+                holding.add(".".join(f.relative_to(src).with_suffix("").parts))
+                break
+    holding.discard("opnav.core.compiled")  # the decorators' own home
+    assert holding, "no kernel found: the scan is broken"
+    assert sorted(holding - registered) == []
