@@ -1009,7 +1009,8 @@ def test_battery_counts():
                                   "config files, rounds 1-2": len(BAD_FILES),
                                   "YAML traps (files)": len(YAML_TRAPS),
                                   "CLI, rounds 1-2": len(BAD_CLI), "CLI, round 3": len(NEW_CLI),
-                                  "accepted files": len(ACCEPTED_FILES)})
+                                  "accepted files": len(ACCEPTED_FILES),
+                                  "round four (config values)": len(ROUND_FOUR_CONFIGS) + len(ONCE)})
     counts.update(cls for cls, _, _ in NEW_CONFIGS)
     print("\n" + "\n".join(f"{n:4d}  {k}" for k, n in counts.items()) + f"\n{sum(counts.values()):4d}  total")
     assert sum(counts.values()) >= 150
@@ -1023,6 +1024,11 @@ SNAKEMAKE_CASES = [
     ("studies: {runs: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}\n",
      "invalid config key 'studies.runs': the name makes the rule study_runs"),
     ("results_dir: /proc/opnav\n", "invalid config key 'results_dir': '/proc/opnav' is under /proc"),
+    # round four: these ended in CreateRuleException and WildcardError after validation
+    ("jobs: {study_values_per_job: 2}\nstudies: {runs_pack1: {paper: landing, vary: {landing.camera.fov_deg: [45.0]}}}\n",
+     "invalid config key 'studies.runs_pack1': the name makes the rule study_runs_pack1"),
+    ("results_dir: 'results/{x}'\n", "invalid config key 'results_dir': 'results/{x}' holds '{'"),
+    ("profile: full\n", "invalid config key 'profile': 'full' claims"),
 ]
 
 
@@ -1040,4 +1046,5 @@ def test_snakemake_dry_run_refuses_round_three_input(tmp_path):
         out = proc.stdout + proc.stderr
         assert proc.returncode != 0 and "ConfigError (no job was run):" in out, out[-2000:]
         assert expected in out and "Traceback" not in out and "CreateRuleException" not in out, out[-2000:]
+        assert "WildcardError" not in out, out[-2000:]
     assert not (wd / "results").exists()

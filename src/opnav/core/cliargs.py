@@ -212,10 +212,15 @@ class RunConfig:
             return self.check(config, workflow=workflow)
         except ConfigError as exc:
             old = set(self.problems(before, workflow=workflow)) if before is not None else set()
-            lines = []
+            lines, listed = [], set()
             for line in str(exc).splitlines():
                 m = _KEY_RE.search(line)
                 bad = m.group(1) if m else ""
+                item = re.match(r"config key '([^'\[]+)\[\d+\]'", line[m.start():] if m else "")
+                if item and item.group(1) in given:          # one flag, one list: its first bad item
+                    if item.group(1) in listed:              # (--pixel-sigma 0 set three 3-sigmas)
+                        continue
+                    listed.add(item.group(1))
                 # the flag of the key the line names (or a parent or child of it), else of a
                 # key the line mentions (approach.table1_variants ... not in approach.variants)
                 names = [key for key in given

@@ -34,6 +34,25 @@ anchors, tags and scalar styles, which a constructed document has lost, and need
 recursion. Values it accepts are constructed exactly as PyYAML's safe constructor does
 (the workflow's reading), so both paths see the same numbers.
 
+Why not a YAML library's strict mode
+------------------------------------
+Measured for issue 56/57 (ruamel.yaml 0.19.1 in its YAML 1.2 mode, duplicate keys refused
+by default; strictyaml 1.7.3): neither does this module's job, which is to refuse where
+*two* readings differ (Snakemake's YAML 1.1, which the workflow validates, and YAML 1.2):
+
+* ruamel.yaml gives the 1.2 reading only: ``020200704`` is 20200704 there and 4260292 in
+  Snakemake's, ``1e-3`` a number there and a string in Snakemake's, ``yes`` a string there
+  and a boolean in Snakemake's, each accepted silently; it accepts ``1:`` as an int key,
+  anchors, aliases and ``<<`` merges, its round-trip mode drops an unknown ``!!python``
+  tag's meaning silently, 5,000-deep nesting ends in RecursionError, and it read
+  config/config.yaml in 146 ms (pure safe loader; 333 ms round-trip) against 35 ms here;
+* strictyaml refuses flow style (``landing: {mc: {n_runs: 10}}``, which every config of the
+  project and its docs use), and without a second schema beside the JSON schema returns
+  every scalar as a string (``1: 2`` read as ``{'1': '2'}``).
+
+Duplicate keys are the one rule either would take over; the comparison of the two
+readings, the event-level refusals (anchors, tags, depth) and the messages stay here.
+
 Use: :func:`read_config_text` (a file's text) and :func:`read_value` (one ``--set`` value).
 Errors are :class:`opnav.core.errors.ConfigError`, one line each.
 """
