@@ -129,9 +129,11 @@ class UnitReading:
         return max(sel, key=lambda o: (o.severity, -o.cond.index)) if sel else None
 
     def tightest(self) -> Outcome | None:
-        """The passing outcome closest to failing (the one a 'reproduced' cause quotes)."""
+        """The passing outcome of the claim's first condition (its quantity) closest to failing
+        (the one a 'reproduced' cause quotes); another condition's only when the first has none."""
         sel = [o for o in self.outcomes if o.status == PASS and o.row is not None]
-        return max(sel, key=lambda o: (o.severity, -o.cond.index)) if sel else None
+        first = [o for o in sel if o.cond.index == min(x.cond.index for x in sel)] if sel else []
+        return max(first, key=lambda o: o.severity) if first else None
 
     def first(self) -> Outcome | None:
         sel = [o for o in self.outcomes if o.row is not None]

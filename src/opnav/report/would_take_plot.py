@@ -74,7 +74,10 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
         unit = s0.get("unit", "")
         q = QUANTITIES.get(s0["quantity"])
         ax.set_xlabel(setting_label(s0["setting"]))
-        ax.set_ylabel((q.text if q is not None else s0["quantity"].replace("_", " ")) + (f" ({unit})" if unit else ""))
+        import textwrap
+
+        ylab = (q.text if q is not None else s0["quantity"].replace("_", " ")) + (f" ({unit})" if unit else "")
+        ax.set_ylabel("\n".join(textwrap.wrap(ylab, 28)))
         xs_all = [p[0] for s in sw for p in s["points"]]
         ys_all = [p[1] for s in sw for p in s["points"]] + ([lim] if lim is not None and math.isfinite(lim) else [])
         if xs_all and min(xs_all) > 0 and max(xs_all) / min(xs_all) > 8:
