@@ -296,12 +296,43 @@ def test_a_numba_function_flies_compiled_with_the_same_picks(landing, flown, tmp
     c = with_methods(camera_scenarios(landing)["interior"], jitted=f"{f}:score")
     assert M.problems({**landing, "custom_methods": c["custom_methods"]}) == []
     scn = build_scenario(c)
-    assert M.eval_path("jitted", scn.planner).startswith("custom (interpreted search, compiled score")
+    assert M.eval_path("jitted", scn.planner).startswith("custom (compiled search and score")
+    assert PL.compiled_kind("jitted", scn.planner) == PL.OWN_COMPILED
     assert M.eval_path("depth", scn.planner) == "compiled"
-    d = run_chunk(c, "jitted", [1])
-    ref = flown["interior"][1]
-    np.testing.assert_array_equal(d["plan_index"], ref["plan_index"])
-    np.testing.assert_allclose(d["plan_beta"], ref["plan_beta"], rtol=1e-12)
+    for name in ("interior", "site-tilt"):      # in-plane optima, then edge calls
+        c = with_methods(camera_scenarios(landing)[name], jitted=f"{f}:score")
+        d = run_chunk(c, "jitted", [1])
+        ref = flown[name][1]
+        np.testing.assert_array_equal(d["plan_index"], ref["plan_index"])
+        np.testing.assert_array_equal(d["plan_evals"], ref["plan_evals"])
+        np.testing.assert_allclose(d["plan_beta"], ref["plan_beta"], rtol=1e-12, atol=1e-15)
+    # the timed call is the compiled kernel itself, and it picks what plan() picks
+    scn = build_scenario(c)
+    i = 3
+    state = PL.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
+    k = int(d["plan_step"][i])
+    det = np.flatnonzero(scn.camera.in_view((scn.field.xyz - scn.truth.r[k]) @ scn.truth.R_LtoB[k].T,
+                                            scn.planner.margin_px))
+    call = PL.compiled_call("jitted", state, scn.camera, scn.field, scn.planner, int(d["plan_exclude"][i]), det)
+    call()
+    assert int(call.args[-1][-layout.NOUT + layout.O_PICK]) == int(d["plan_index"][i])
+
+
+@pytest.mark.slow
+def test_a_numba_function_scoring_nan_in_the_compiled_call_is_named(landing, tmp_path):
+    f = user_file(tmp_path, """
+        import math
+        import numba
+
+        @numba.njit(cache=False)
+        def score(c):
+            return math.nan if c.r_L[2] < 1500.0 else c.p_L[0] ** 2
+        """, "jit_nan.py")
+    c = with_methods(camera_scenarios(landing)["interior"], late=f"{f}:score")
+    assert M.problems(with_methods(landing, late=f"{f}:score")) == []
+    with pytest.raises(M.MethodError, match=r"^landing\.custom_methods\.late: \S+ returned nan or -inf .* in run 2, "
+                                            r"planning call \d+"):
+        run_chunk(c, "late", [2])
 
 
 # ---------------------------------------------------------------- failing in the Monte Carlo

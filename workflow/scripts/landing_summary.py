@@ -10,6 +10,7 @@ import pandas as pd
 from opnav.core import figures, published
 from opnav.landing import plots, timing, timing_summary
 from opnav.landing.methods import colors as method_colors, labels as method_labels
+from opnav.landing.own import compare_own, with_own
 from opnav.landing.montecarlo import load
 from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading, nees_retuned_text,
                                   scenario_summary, summary_table)
@@ -55,6 +56,9 @@ with script_context(snakemake) as log:
                          same_pick_max_pct=plan.margin("B-C1", "same_pick_max_pct"),
                          min_difference_s=plan.margin("B-C2", "min_difference_s"),
                          thresholds_m=tuple(plan.setting("converge_threshold_sweep_m")))
+    own = getattr(snakemake.params, "custom", None) or {}      # your own methods (landing.custom_methods)
+    if own:   # paired against SVD and depth, no verdict (evidence rows of role beyond)
+        acc = with_own(acc, compare_own(every, list(own), plan.margin("B-C1", "margin_rel"), (1.0 - plan.level) / 2.0))
     out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
                            eval_path=snakemake.params.eval_path,
                            yaw_ratio=plan.margin("B-C3", "yaw_ratio"),  # the plan's, its one home (issue 52)
@@ -85,7 +89,6 @@ with script_context(snakemake) as log:
     out["end_phase_text"] = end_phase_text(out["end_phase"], scn, float(cut["min_update_altitude_m"]))
     write_json(snakemake.output.summary, out)
     t = next(iter(data.values()))["t"]
-    own = getattr(snakemake.params, "custom", None) or {}    # your own methods' legend names and colours
     labels = method_labels(own)
     colors = figures.own_colors(list(own), method_colors(own))
     figures.save(plots.fig_nav_error_envelopes(t, data, labels, colors), snakemake.output.f6)

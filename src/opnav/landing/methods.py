@@ -56,13 +56,14 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Callable, Mapping, NamedTuple
+from typing import Callable, Mapping
 
 import numpy as np
 
 from opnav.core import registry
 from opnav.core.registry import CHECKOUT, CustomSpec, MethodError
 from opnav.landing.planning import layout
+from opnav.landing.planning.candidate import Candidate
 
 __all__ = ["Candidate", "Method", "MethodError", "CustomSpec", "BUILTIN", "PICKER_NAMES", "builtin_names",
            "specs", "spec_items", "load", "resolve", "get", "probe", "probe_candidates", "problems",
@@ -72,27 +73,6 @@ __all__ = ["Candidate", "Method", "MethodError", "CustomSpec", "BUILTIN", "PICKE
 SECTION = "landing.custom_methods"
 #: the built-in pickers (their functions are ``opnav.landing.planner.PICKERS``)
 PICKER_NAMES = ("random", "center", "closest")
-
-
-class Candidate(NamedTuple):
-    """What a selection metric receives for one candidate ground point: the candidate's
-    geometry and the filter's estimate at the planning instant (what the paper's metrics read:
-    the depth error reads r, v, a, P's velocity block and t_s; the H baselines r, R_LtoB, the
-    site and the candidate; the information baselines all of it). Units SI, frames as named.
-    Read-only: do not modify the arrays."""
-
-    p_L: np.ndarray          #: (3,) the candidate landmark / ground point, {L}, m
-    r_L: np.ndarray          #: (3,) estimated lander position, {L}, m
-    v_L: np.ndarray          #: (3,) estimated velocity, {L}, m/s
-    a_L: np.ndarray          #: (3,) estimated acceleration over the last filter step (gravity included), {L}, m/s^2
-    R_LtoB: np.ndarray       #: (3, 3) estimated attitude: v_B = R_LtoB v_L
-    P: np.ndarray            #: (12, 12) filter covariance of [r (m), v (m/s), dtheta (rad), p (m)] (p: the current landmark)
-    p_site_L: np.ndarray     #: (3,) the known landmark (landing site), {L}, m
-    R_BtoC: np.ndarray       #: (3, 3) camera mounting: v_C = R_BtoC v_B (boresight = row 2)
-    sigma_b_rad: float       #: true bearing noise, 1-sigma per component, rad (pixel noise / focal length)
-    noise_scale: float       #: the filter's bearing-noise model / sigma_b_rad
-    t_s: float               #: observation interval (the filter step), s
-    n_obs: int               #: observations of a landmark before the next is planned (Fig. 3)
 
 
 @dataclass(frozen=True)
@@ -224,12 +204,16 @@ def objective(method: Method, state, cfg, camera) -> tuple[Callable, Callable]:
 
 def eval_path(name: str, cfg) -> str:
     """The path a method's planning call runs on under ``cfg`` (a ``PlannerConfig``), as the
-    planning-time replay names it: ``cfg.eval_path`` for a built-in; for a custom method
-    ``custom:<path>`` with the search interpreted and the score ``compiled`` (numba) or
-    ``interpreted``: e.g. ``custom (interpreted search, compiled score: examples/x.py:f)``."""
+    planning-time replay names it: ``cfg.eval_path`` for a built-in; for a custom method its
+    path: a numba function on the compiled path runs the whole call compiled
+    (``planning.custom``: ``custom (compiled search and score: examples/x.py:f)``), else the
+    search is interpreted and the score compiled (numba) or interpreted
+    (``custom (interpreted search, interpreted score: ...)``)."""
     m = resolve(name, getattr(cfg, "custom", ()))
     if m is None or m.family != "custom":
         return cfg.eval_path
+    if m.compiled and cfg.eval_path == "compiled":
+        return f"custom (compiled search and score: {m.path})"
     return f"custom (interpreted search, {'compiled' if m.compiled else 'interpreted'} score: {m.path})"
 
 

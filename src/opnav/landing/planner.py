@@ -53,6 +53,7 @@ from typing import Callable
 
 import numpy as np
 
+from opnav.core.registry import what as _what
 from opnav.landing import methods as registry, metrics
 from opnav.landing.camera import Camera
 from opnav.landing.landmarks import LandmarkField
@@ -201,14 +202,18 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
     indices of the landmarks the image holds; ``exclude``: the current landmark
     (-1: none)."""
     kind = compiled_kind(method, cfg)
-    entry = registry.BUILTIN.get(method) if kind >= 0 else registry.get(method, cfg.custom)
+    entry = registry.get(method, cfg.custom)
     if entry.family == "picker":
         cand = detected[detected != exclude]
         k = -1 if cand.size == 0 else int(cand[PICKERS[method](field_, cand, state, camera, rng)])
         return PlanResult(method, k, math.nan, field_.xyz[k] if k >= 0 else np.full(3, np.nan),
                           math.nan, 0, 0), None
     xyz, c, cells = setup = _setup(field_, cfg, camera)
-    if kind >= 0:
+    if kind == OWN_COMPILED:          # a user's numba metric: the call compiled with it (planning.custom)
+        args = _own_args(state, setup, exclude, detected)
+        _run_own(entry, args)
+        work = args[-1]
+    elif kind >= 0:
         args = _kernel_args(kind, state, setup, exclude, detected)
         search.plan_run(*args)
         work = args[-1]
@@ -243,9 +248,47 @@ def plan_one(method: str, state: PlanState, camera: Camera, field_: LandmarkFiel
                       int(o[L.O_NEVAL]), 0, "", 0, o[L.O_EDGE] > 0), q
 
 
+#: :func:`compiled_kind` of a user's numba-compiled metric on the compiled path (``planning.custom``)
+OWN_COMPILED = 1000
+
+
 def compiled_kind(method: str, cfg: PlannerConfig) -> int:
-    """The compiled objective kind of ``method`` on ``cfg``'s path (``planning.layout.KINDS``); -1: none."""
-    return layout.KINDS.get(method, -1) if cfg.eval_path == "compiled" else -1
+    """The compiled objective kind of ``method`` on ``cfg``'s path (``planning.layout.KINDS``;
+    :data:`OWN_COMPILED` for a user's numba-compiled metric); -1: none."""
+    if cfg.eval_path != "compiled":
+        return -1
+    kind = layout.KINDS.get(method, -1)
+    if kind < 0 and cfg.custom:
+        entry = registry.resolve(method, cfg.custom)
+        if entry is not None and entry.family == "custom" and entry.compiled:
+            return OWN_COMPILED
+    return kind
+
+
+def _own_args(state: PlanState, setup: tuple, exclude: int, detected: np.ndarray) -> tuple:
+    """``planning.custom.plan_run``'s arguments but the function (``work`` last)."""
+    from opnav.landing.planning import custom
+
+    xyz, c, cells = setup
+    return (layout.estimate_arg(state.r, state.v, state.a, state.R_LtoB, state.P), c, xyz, detected, exclude,
+            cells, np.empty(custom.work_size()))
+
+
+def _run_own(entry, args) -> None:
+    """The compiled call of a user's numba metric; :class:`methods.MethodError` naming it if it
+    raised or scored NaN (as the interpreted path does)."""
+    from opnav.landing.planning import custom
+
+    key = f"{registry.SECTION}.{entry.name}"
+    try:
+        custom.plan_run(entry.fn, *args)
+    except Exception as exc:
+        raise registry.MethodError(f"{key}: {entry.path} raised {_what(exc)} "
+                                   "(compiled planning call)") from exc
+    n = args[-1][custom.X_NAN]
+    if n:
+        raise registry.MethodError(f"{key}: {entry.path} returned nan or -inf ({int(n)} of the call's scores; "
+                                   "scores are finite, or +inf for a refused candidate)")
 
 
 def _kernel_args(kind: int, state: PlanState, setup: tuple, exclude: int, detected: np.ndarray) -> tuple:
@@ -268,6 +311,12 @@ def compiled_call(method: str, state: PlanState, camera: Camera, field_: Landmar
     if kind < 0:
         return None
     setup = _setup(field_, cfg, camera)
+    if kind == OWN_COMPILED:
+        from opnav.landing.planning import custom
+
+        entry = registry.get(method, cfg.custom)
+        return functools.partial(custom.build(entry.fn), *_own_args(state, setup, int(exclude),
+                                                                  np.asarray(detected, np.int64)))
     return functools.partial(search.plan_run, *_kernel_args(kind, state, setup, int(exclude),
                                                        np.asarray(detected, np.int64)))
 
@@ -277,7 +326,7 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
     """The objective (minimised) of landmarks ``cand`` (field indices) at the call
     with per-run constants ``q`` (:func:`plan_one`): the edge rule's scores."""
     xyz = _setup(field_, cfg, camera)[0]
-    if compiled_kind(method, cfg) >= 0:
+    if 0 <= compiled_kind(method, cfg) != OWN_COMPILED:
         return search.score_points(q, xyz, cand)
     entry = registry.get(method, cfg.custom)
     if entry.family == "custom":
@@ -286,7 +335,10 @@ def candidate_scores(method: str, state: PlanState, camera: Camera, field_: Land
 
 
 def _diagnose(res: PlanResult, q, state, camera, field_, cfg, detected, exclude) -> None:
-    """``res.pick_ratio``: the picked landmark's score over the best detected one's."""
+    """``res.pick_ratio``: the picked landmark's score over the best detected one's (a user's
+    own metric has none: its score has no scale)."""
+    if res.method not in registry.BUILTIN:
+        return
     cand = detected[detected != exclude]
     if res.index < 0 or not cand.size or not math.isfinite(res.beta):
         return
