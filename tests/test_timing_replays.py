@@ -257,3 +257,19 @@ def test_replays_in_processes_pick_what_the_monte_carlo_picked(recorded, tmp_pat
     own = tm["source"] == list(tm["sources"]).index("depth")
     j = ts.variant_index(tm, "depth", "main")
     np.testing.assert_array_equal(tm["pick"][own, j], rec["depth"]["plan_index"][tm["call"][own]])
+
+
+def test_a_call_of_milliseconds_is_timed_as_it_comes_and_picks_alike(recorded, monkeypatch):
+    """``warm_compiled=False`` (the job of the calls of milliseconds): a compiled call whose first run
+    takes at least COLD_OK_NS is timed by that run and its pick read from the kernel's own result;
+    the picks equal the warm replay's and the Monte Carlo's (here every call takes that path:
+    COLD_OK_NS = 0), one bracket each. Mutation tried: the pick read from the wrong slot fails."""
+    _, scn, rec = recorded
+    warm = timing.replay(scn, rec, ["depth", "svd", "random"], max_calls=8, alt=False)
+    monkeypatch.setattr(timing, "COLD_OK_NS", 0)
+    cold = timing.replay(scn, rec, ["depth", "svd", "random"], max_calls=8, alt=False, warm_compiled=False)
+    np.testing.assert_array_equal(cold["pick"], warm["pick"])
+    np.testing.assert_array_equal(cold["n_evals"], warm["n_evals"])
+    assert int(np.sum(cold["mismatch"])) == 0 and int(np.sum(cold["checked"])) > 0
+    j = ts.variant_index(cold, "depth", "main")
+    assert (cold["reps"][:, j] == 1).all() and (cold["cpu_ns"][:, j] > 0).all()

@@ -44,7 +44,7 @@ with script_context(snakemake) as log:
             figures.save(timing_plots.fig_overhead_curve(ev, snakemake.wildcards.bscn), snakemake.output.f7o)
     else:
         spec = timing.replay_spec(p.landing, mc, p.methods, int(p.max_calls), alt=list(p.alt), main=list(p.main),
-                                  max_calls_paper=int(p.max_calls_paper))
+                                  max_calls_paper=int(p.max_calls_paper), warm_compiled=False)
         tm = timing.run_spec(spec)
         timing.save(snakemake.output[0], tm)
         log.info("%s", timing_summary.method_text(tm))

@@ -102,7 +102,7 @@ import numpy as np
 from opnav.landing.records import RECORD_KEYS, load as _load_one, rng_from_words, save
 
 __all__ = ["select_calls", "COMPILED_ONLY", "timed_methods", "variants", "pass_keys", "paper_limited", "replay",
-           "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "CALL_INPUT_KEYS", "load_calls", "run_spec", "replay_spec", "replays_in_processes",
+           "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "COLD_OK_NS", "CALL_INPUT_KEYS", "load_calls", "run_spec", "replay_spec", "replays_in_processes",
            "CLOCK_SHARE_INV", "clock_cost_ns", "replay_own", "from_times", "call_overhead", "save", "load"]
 
 
@@ -252,7 +252,8 @@ def null_dispatch_ns(args: tuple, n: int = 2000, repeats: int = 5) -> float:
 
 
 def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True,
-           max_calls_paper: int = 0, main=None, decompose: bool = False, best_of: int = 1) -> dict:
+           max_calls_paper: int = 0, main=None, decompose: bool = False, best_of: int = 1,
+           warm_compiled: bool = True) -> dict:
     """Replay recorded planning calls through every method (module docstring).
 
     ``scn``: the descent's scenario (``descent.build_scenario``); ``recorded``:
@@ -277,6 +278,12 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
     (:func:`null_dispatch_ns` with the first compiled call's arguments). ``best_of``: a compiled
     call's bracket is timed that many times back to back and the least thread CPU kept (the bracket
     the machine disturbed least: other processes only ever add to a call's time).
+    ``warm_compiled = False``: a compiled call is first run once, timed; if that took at least
+    :data:`COLD_OK_NS` of thread CPU (a call of milliseconds, which the caches the call before it
+    left barely move), that run is its time and its pick is read from the kernel's own result
+    (``planner.plan`` only where the kernel's status sends the planner to its fallback): half the
+    cost of a warm call and a timed one. Shorter calls are timed warm as above (the run served as
+    their warm-up).
     """
     from opnav.landing.methods import eval_path
     from opnav.landing.planner import PlanState, compiled_call, plan
@@ -359,37 +366,54 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
                 order = group[timed_[q, group]]
                 for s_, v in enumerate(np.roll(order, -(t % len(order)))):
                     m, _, cfg = var[v]
-                    # the pick from an untimed call (the descent's stream for a picker), then
-                    # the timed call: the kernel's call (compiled) or plan() (interpreted), warm
-                    res = plan(m, state, cam, field_, visible, cfg, exclude=exclude,
-                               rng=rng_from_words(words), detected=det, diagnose=False)
-                    if key[1] == 0:
+                    res = cold = call = None
+                    if key[1] == 0 and not warm_compiled:     # a call of milliseconds: timed as it comes
                         call = compiled_call(m, state, cam, field_, cfg, next(iter(exclude), -1), det)
+                        t0 = perf()
+                        c0 = thread()
+                        call()
+                        c1 = thread()
+                        t1 = perf()
+                        if c1 - c0 >= COLD_OK_NS:
+                            cold = (t1 - t0, c1 - c0)
+                            res = _kernel_result(call)
+                    if cold is not None:
+                        wall[q, v], cpu[q, v], reps[q, v] = cold[0], cold[1], 1
                     else:
-                        call = functools.partial(plan, m, state, cam, field_, visible, cfg, exclude=exclude,
-                                                 rng=rng_from_words(words), detected=det, diagnose=False)
-                    n_rep = 1
-                    while True:                     # back to back until the clock is < 5 % (REPS_RULE)
-                        t0 = perf()
-                        c0 = thread()
-                        for _ in range(n_rep):
-                            call()
-                        c1 = thread()
-                        t1 = perf()
-                        if c1 - c0 >= CLOCK_SHARE_INV * clock_ns or n_rep >= MAX_REPS:
-                            break
-                        n_rep *= 2
-                    wall[q, v], cpu[q, v] = (t1 - t0) // n_rep, (c1 - c0) // n_rep
-                    for _ in range(int(best_of) - 1 if key[1] == 0 else 0):   # the least disturbed bracket
-                        t0 = perf()
-                        c0 = thread()
-                        for _ in range(n_rep):
-                            call()
-                        c1 = thread()
-                        t1 = perf()
-                        if (c1 - c0) // n_rep < cpu[q, v]:
-                            wall[q, v], cpu[q, v] = (t1 - t0) // n_rep, (c1 - c0) // n_rep
-                    reps[q, v] = n_rep
+                        # the pick from an untimed call (the descent's stream for a picker), then the
+                        # timed call: the kernel's call (compiled) or plan() (interpreted), warm
+                        res = plan(m, state, cam, field_, visible, cfg, exclude=exclude,
+                                   rng=rng_from_words(words), detected=det, diagnose=False)
+                        if call is None and key[1] == 0:
+                            call = compiled_call(m, state, cam, field_, cfg, next(iter(exclude), -1), det)
+                        elif call is None:
+                            call = functools.partial(plan, m, state, cam, field_, visible, cfg, exclude=exclude,
+                                                     rng=rng_from_words(words), detected=det, diagnose=False)
+                        n_rep = 1
+                        while True:                     # back to back until the clock is < 5 % (REPS_RULE)
+                            t0 = perf()
+                            c0 = thread()
+                            for _ in range(n_rep):
+                                call()
+                            c1 = thread()
+                            t1 = perf()
+                            if c1 - c0 >= CLOCK_SHARE_INV * clock_ns or n_rep >= MAX_REPS:
+                                break
+                            n_rep *= 2
+                        wall[q, v], cpu[q, v] = (t1 - t0) // n_rep, (c1 - c0) // n_rep
+                        for _ in range(int(best_of) - 1 if key[1] == 0 else 0):   # the least disturbed bracket
+                            t0 = perf()
+                            c0 = thread()
+                            for _ in range(n_rep):
+                                call()
+                            c1 = thread()
+                            t1 = perf()
+                            if (c1 - c0) // n_rep < cpu[q, v]:
+                                wall[q, v], cpu[q, v] = (t1 - t0) // n_rep, (c1 - c0) // n_rep
+                        reps[q, v] = n_rep
+                    if res is None:        # the kernel's status sent the planner to its fallback
+                        res = plan(m, state, cam, field_, visible, cfg, exclude=exclude,
+                                   rng=rng_from_words(words), detected=det, diagnose=False)
                     if decompose and key[1] == 0:
                         ev = evaluation_inputs(m, state, cam, field_, cfg, next(iter(exclude), -1), det)
                         if ev is not None and ev[3] == res.n_evals:
@@ -424,6 +448,20 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
             "max_calls_paper": np.int64(max_calls_paper)}
 
 
+def _kernel_result(call):
+    """(pick, n_evals) of a compiled planning call just run (``planner.compiled_call``: its last
+    argument's tail is ``plan_run``'s out) as a ``PlanResult``-like record, or None where its status
+    is not OK (the planner's fallback then picks, ``planner.plan_one``)."""
+    import types
+
+    from opnav.landing.planning import layout as L
+
+    out = call.args[-1][-L.NOUT:]
+    if int(out[L.O_STATUS]) != L.OK:
+        return None
+    return types.SimpleNamespace(index=int(out[L.O_PICK]), n_evals=int(out[L.O_NEVAL]))
+
+
 def _time_evaluations(ev, clock_ns: float) -> int:
     """Thread CPU (ns) of a call's objective evaluations alone (:func:`evaluation_inputs`' ``ev``),
     inside the kernel (``planning.search.evaluations``, one dispatch a bracket): the repetition
@@ -443,6 +481,13 @@ def _time_evaluations(ev, clock_ns: float) -> int:
             return int((c1 - c0) // n_rep)
         n_rep *= 2
 
+
+#: ``replay(warm_compiled=False)``: a compiled call's first run at least this long (ns, thread CPU) is
+#: its time, without a warm call before it. Site-tilt, 40 calls, medians warm / first run (twice each,
+#: load ~9): logdet 11.27, 11.30 / 10.64, 10.99 ms; logdet_nav 13.34, 11.14 / 11.83, 12.11;
+#: svd_lapack 25.82, 26.12 / 25.62, 26.08 (alike); but mineig 0.27, 0.26 / 0.33, 0.30 ms and svd_w
+#: 0.70, 0.49 / 0.76, 0.82 ms (a first run of a sub-millisecond call is 15-25 % slower): 2 ms
+COLD_OK_NS = 2_000_000
 
 #: brackets of a compiled call in the claims' replays, the least kept (``replay(best_of=...)``): on
 #: the 2-core VM at load 14-16, 20 interior calls x 3 replays read depth vs SVD 28.4 % (sd between
@@ -606,16 +651,18 @@ def run_spec(spec: dict) -> dict:
     return replay(_scenario(spec), recorded, list(spec["methods"]), int(spec["max_calls"]),
                   alt=alt if isinstance(alt, bool) else list(alt), max_calls_paper=int(spec.get("max_calls_paper", 0)),
                   main=None if spec.get("main") is None else list(spec["main"]),
-                  decompose=bool(spec.get("decompose", False)), best_of=int(spec.get("best_of", 1)))
+                  decompose=bool(spec.get("decompose", False)), best_of=int(spec.get("best_of", 1)),
+                  warm_compiled=bool(spec.get("warm_compiled", True)))
 
 
 def replay_spec(landing: dict, mc: dict, methods, max_calls: int, *, alt=True, main=None,
-                max_calls_paper: int = 0, decompose: bool = False, best_of: int = 1) -> dict:
+                max_calls_paper: int = 0, decompose: bool = False, best_of: int = 1,
+                warm_compiled: bool = True) -> dict:
     """What :func:`run_spec` replays, as JSON-able data (a replay in another process reads it)."""
     return {"landing": landing, "mc": {str(m): str(p) for m, p in mc.items()}, "methods": list(methods),
             "max_calls": int(max_calls), "alt": alt if isinstance(alt, bool) else list(alt),
             "main": None if main is None else list(main), "max_calls_paper": int(max_calls_paper),
-            "decompose": bool(decompose), "best_of": int(best_of)}
+            "decompose": bool(decompose), "best_of": int(best_of), "warm_compiled": bool(warm_compiled)}
 
 
 def replays_in_processes(spec: dict, n: int, workdir, log=None) -> list[dict]:
