@@ -1,0 +1,166 @@
+"""House counts of issue 56 (reproducible with ``ast``): dict-returning functions, constant-string
+subscripts, ``.get("k")`` calls and lines of presentation in the paper packages.
+
+    python benchmarks/house_counts.py [SRC] [--by-file] [--list]
+
+SRC is the package folder (default ``src/opnav``). What is counted, per module:
+
+* **dict-returning function**: a function (or method) one of whose own ``return`` statements
+  (not a nested function's) returns a dict display (``{...}``), a dict comprehension or a
+  ``dict(...)`` call, or whose return annotation is ``dict`` / ``dict[...]`` / ``Dict[...]`` /
+  ``Mapping`` (with or without ``| None``). A function returning ``list[dict]`` counts too (its
+  annotation names ``dict`` inside ``list[...]``/``tuple[...]``);
+* **constant-string subscript**: ``x["k"]`` (any ``Subscript`` whose index is a str constant,
+  as a load, store or delete; pandas column lookups included);
+* **``.get("k")``**: a call ``x.get("k", ...)`` whose first argument is a str constant;
+* **presentation lines** in a paper package (``approach/``, ``landing/``, ``studies/``): the
+  lines of its modules that import matplotlib (plots), plus, in every other module of the
+  package, the lines of functions returning ``str`` (annotation ``-> str``) or whose name says
+  text (``*_text``, ``*_note``, ``*_label``, ``*_prose``, ``*caption*``): prose and labels.
+
+The totals are printed per part (approach, landing, core, studies, report, other) and for the
+whole tree; ``--by-file`` adds every module's counts, ``--list`` every dict-returning function.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+from collections import Counter, defaultdict
+from pathlib import Path
+
+PAPERS = ("approach", "landing", "studies")
+TEXT_NAMES = ("_text", "_note", "_label", "_prose", "caption", "_words", "_sentence")
+
+
+def _mentions_dict(ann: ast.AST | None) -> bool:
+    """Whether a return annotation is (or holds) a dict type."""
+    if ann is None:
+        return False
+    if isinstance(ann, ast.Constant) and isinstance(ann.value, str):  # a string annotation
+        try:
+            ann = ast.parse(ann.value, mode="eval").body
+        except SyntaxError:
+            return False
+    for node in ast.walk(ann):
+        if isinstance(node, ast.Name) and node.id in ("dict", "Dict", "Mapping", "MutableMapping"):
+            return True
+        if isinstance(node, ast.Attribute) and node.attr in ("Dict", "Mapping", "MutableMapping"):
+            return True
+    return False
+
+
+def _own_returns(fn: ast.AST):
+    """The return statements of ``fn`` itself (not of functions or classes nested in it)."""
+    stack = list(fn.body)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.Lambda)):
+            continue
+        if isinstance(node, ast.Return):
+            yield node
+        stack.extend(ast.iter_child_nodes(node))
+
+
+def _is_dict_value(v: ast.AST | None) -> bool:
+    if isinstance(v, (ast.Dict, ast.DictComp)):
+        return True
+    return isinstance(v, ast.Call) and isinstance(v.func, ast.Name) and v.func.id == "dict"
+
+
+def returns_dict(fn) -> bool:
+    if _mentions_dict(fn.returns):
+        return True
+    return any(_is_dict_value(r.value) for r in _own_returns(fn))
+
+
+def _is_text_function(fn) -> bool:
+    ann = fn.returns
+    if isinstance(ann, ast.Name) and ann.id == "str":
+        return True
+    if isinstance(ann, ast.Constant) and ann.value == "str":
+        return True
+    return any(t in fn.name for t in TEXT_NAMES)
+
+
+def _imports_matplotlib(tree: ast.AST) -> bool:
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import) and any(a.name.split(".")[0] == "matplotlib" for a in node.names):
+            return True
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "matplotlib":
+            return True
+    return False
+
+
+def count_module(path: Path) -> dict:
+    src = path.read_text()
+    tree = ast.parse(src)
+    c = Counter()
+    dict_fns = []
+    text_lines = 0
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            if returns_dict(node):
+                dict_fns.append(f"{node.name}:{node.lineno}")
+            if _is_text_function(node):
+                text_lines += node.end_lineno - node.lineno + 1
+        elif isinstance(node, ast.Subscript):
+            s = node.slice
+            if isinstance(s, ast.Constant) and isinstance(s.value, str):
+                c["str_subscripts"] += 1
+        elif isinstance(node, ast.Call):
+            f = node.func
+            if (isinstance(f, ast.Attribute) and f.attr == "get" and node.args
+                    and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
+                c["get_calls"] += 1
+    c["dict_functions"] = len(dict_fns)
+    c["lines"] = len(src.splitlines())
+    c["plot_lines"] = c["lines"] if _imports_matplotlib(tree) else 0
+    c["text_lines"] = 0 if c["plot_lines"] else text_lines
+    return {"counts": c, "dict_fns": dict_fns}
+
+
+def part_of(rel: Path) -> str:
+    top = rel.parts[0] if len(rel.parts) > 1 else "other"
+    return top if top in ("approach", "landing", "core", "studies", "report") else "other"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("src", nargs="?", default=str(Path(__file__).resolve().parents[1] / "src" / "opnav"))
+    ap.add_argument("--by-file", action="store_true")
+    ap.add_argument("--list", action="store_true")
+    a = ap.parse_args(argv)
+    root = Path(a.src)
+    parts: dict[str, Counter] = defaultdict(Counter)
+    files = {}
+    for p in sorted(root.rglob("*.py")):
+        rel = p.relative_to(root)
+        r = count_module(p)
+        files[rel] = r
+        parts[part_of(rel)].update(r["counts"])
+    keys = ("dict_functions", "str_subscripts", "get_calls", "plot_lines", "text_lines", "lines")
+    print(f"{'part':<10}" + "".join(f"{k:>16}" for k in keys))
+    total = Counter()
+    for name in ("approach", "landing", "studies", "core", "report", "other"):
+        total.update(parts[name])
+        print(f"{name:<10}" + "".join(f"{parts[name][k]:>16}" for k in keys))
+    print(f"{'total':<10}" + "".join(f"{total[k]:>16}" for k in keys))
+    pres = sum(parts[n]["plot_lines"] + parts[n]["text_lines"] for n in PAPERS)
+    print(f"presentation lines in paper packages ({', '.join(PAPERS)}): {pres}")
+    if a.by_file:
+        print()
+        for rel, r in files.items():
+            c = r["counts"]
+            if any(c[k] for k in keys[:5]):
+                print(f"{str(rel):<44}" + "".join(f"{c[k]:>8}" for k in keys[:5]))
+    if a.list:
+        print()
+        for rel, r in files.items():
+            for f in r["dict_fns"]:
+                print(f"{rel}:{f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
