@@ -96,9 +96,22 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     assert "Traceback" in text and "CorruptIntermediate" in text and chunk.name in text, text
 
 
+@pytest.fixture(scope="module")
+def signalled_workflow(tmp_path_factory):
+    """One copy of the workflow for both signals: the second run finds the kernels compiled
+    (SIGTERM runs first: it leaves the directory unlocked; SIGKILL, last, does not)."""
+    wd = tmp_path_factory.mktemp("signalled") / "wf"
+    wd.mkdir()
+    copy_workflow(wd)
+    # jobs of 200 runs: each outlasts the 3 s the test gives an orphan (a chunk of 4 runs ends
+    # by itself before that, and an orphan would go unseen)
+    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 400, runs_per_job: 200, methods_per_job: 1}}\n")
+    return wd
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("sig", ["SIGTERM", "SIGKILL"])
-def test_a_signal_to_the_build_alone_stops_it_and_its_jobs(tmp_path, sig):
+@pytest.mark.parametrize("sig,method", [("SIGTERM", "depth"), ("SIGKILL", "svd")])
+def test_a_signal_to_the_build_alone_stops_it_and_its_jobs(signalled_workflow, sig, method):
     """Issue 57 item 5: SIGTERM (or SIGKILL) to the snakemake process alone, as a batch system
     or `kill PID` sends it, while a Monte-Carlo job runs. SIGTERM: the build ends within
     10 s saying it was interrupted (Snakemake 9.27 alone waited for the jobs, then said "At
@@ -111,27 +124,28 @@ def test_a_signal_to_the_build_alone_stops_it_and_its_jobs(tmp_path, sig):
 
     from opnav.core.runguard import _descendants
 
-    wd = tmp_path / "wf"
-    wd.mkdir()
-    copy_workflow(wd)
-    (wd / "small.yaml").write_text("landing: {mc: {n_runs: 12, runs_per_job: 4, methods_per_job: 1}}\n")
-    target = "results/quick/landing/mc/site-tilt/depth.npz"
+    wd = signalled_workflow
+    target = f"results/quick/landing/mc/site-tilt/{method}.npz"
     env = dict(os.environ, PYTHONPATH=str(wd / "src"))
+    # output to a file, not a pipe: an orphan holding the pipe would keep communicate() waiting
+    # until it ended, and the test would see no orphan
+    log = wd / f"{sig}.log"
     proc = subprocess.Popen([sys.executable, "-m", "snakemake", target, "--cores", "2", "--configfile",
-                             "config/quick.yaml", "small.yaml"], cwd=wd, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+                             "config/quick.yaml", "small.yaml"], cwd=wd, env=env, stdout=log.open("w"),
+                            stderr=subprocess.STDOUT, start_new_session=True)
     try:
         deadline = time.time() + 300
         while time.time() < deadline and proc.poll() is None and not _job_in_flight(proc.pid, "landing_mc_chunk"):
             time.sleep(0.1)
-        assert proc.poll() is None, "the workflow ended before a job ran:\n" + proc.communicate()[0][-3000:]
+        assert proc.poll() is None, "the workflow ended before a job ran:\n" + log.read_text()[-3000:]
         time.sleep(1.0)                                  # the job past its start-up
         jobs = _descendants(proc.pid)
         assert jobs
         t0 = time.monotonic()
         os.kill(proc.pid, getattr(signal, sig))
-        out, _ = proc.communicate(timeout=60)
+        proc.wait(timeout=60)
         took = time.monotonic() - t0
+        out = log.read_text()
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
@@ -143,6 +157,8 @@ def test_a_signal_to_the_build_alone_stops_it_and_its_jobs(tmp_path, sig):
             alive.append(pid)
         except ProcessLookupError:
             pass
+    for pid in alive:                                    # no stray process after a failure
+        os.kill(pid, signal.SIGKILL)
     assert not alive, f"{len(alive)} job process(es) outlived the build by 3 s"
     if sig == "SIGTERM":
         assert took < 10 and proc.returncode == 143, (took, proc.returncode, out[-3000:])
