@@ -279,8 +279,10 @@ def kernel_report(wd: Path) -> list[str]:
     for log in sorted(wd.glob("results/**/kernels/logs/compile_*.log")):
         lines += [line for line in log.read_text(errors="replace").splitlines()
                   if (" INFO " in line or " WARNING " in line) and "job resources" not in line]
-    if (wd / "src" / "opnav" / "compiled.py").is_file():  # every kernel again in a fresh process
-        code = "import json, opnav.core.compiled as c; s = c.warm(); print(json.dumps({'seconds': s, **c.cache_stats()}))"
+    if (wd / "src" / "opnav" / "core" / "numba_adapter.py").is_file():  # every kernel again in a fresh process
+        code = ("import importlib, json, opnav.approach, opnav.landing, opnav.core.compiled as c; "
+                "[importlib.import_module(m) for m in c.kernel_modules()]; s = c.warm(); "
+                "print(json.dumps({'seconds': s, **c.cache_stats()}))")
         c0 = _children_cpu()
         proc = subprocess.run([sys.executable, "-c", code], cwd=wd, env=_env(wd), capture_output=True, text=True)
         if proc.returncode == 0:
