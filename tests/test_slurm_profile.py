@@ -113,12 +113,12 @@ def test_slurm_without_squeue_fails_fast_and_a_signal_stops_it(tmp_path, sig):
     fake, calls = _fake_slurm(tmp_path / "a", squeue=False)
     proc = _start_slurm_run(wd, fake, calls)
     try:
-        out, _ = proc.communicate(timeout=300)
+        out, _ = proc.communicate(timeout=180)
     except subprocess.TimeoutExpired:
         import os
 
         os.killpg(proc.pid, signal.SIGKILL)
-        pytest.fail("without squeue the SLURM run did not end in 300 s:\n" + proc.communicate()[0][-3000:])
+        pytest.fail("without squeue the SLURM run did not end in 180 s:\n" + proc.communicate()[0][-3000:])
     assert proc.returncode == 1, out[-3000:]
     line = [ln for ln in out.splitlines() if ln.startswith("opnav: the SLURM executor needs")]
     assert len(line) == 1 and "'squeue'" in line[0] and "nothing was submitted" in line[0], out[-3000:]
