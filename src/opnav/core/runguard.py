@@ -11,7 +11,7 @@ The Snakefile's ``onstart`` calls :func:`guard` and its ``onerror`` :func:`inter
 * :func:`slurm_problem`: with the SLURM executor, the commands it needs (``sbatch``,
   ``scancel``, ``sinfo`` and the job-status command, ``squeue`` or ``sacct``) must be on
   PATH, else one line and exit 1 before anything is submitted;
-* SIGTERM, SIGINT and SIGHUP: one line ("interrupted by SIGTERM: stopping N running
+* SIGTERM, SIGINT and SIGHUP (each unless ignored: ``nohup``'s SIGHUP stays ignored): one line ("interrupted by SIGTERM: stopping N running
   jobs"), the running jobs stopped (SIGTERM to every process the build started, then the
   executor's own cancel: ``scancel`` on a cluster), and the build ends within
   :data:`GRACE_S` s whatever the executor does: then the working directory's lock is
@@ -110,7 +110,8 @@ def guard(workflow) -> None:
         raise KeyboardInterrupt                           # the scheduler cancels through its executor
 
     for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
-        signal.signal(sig, handler)
+        if signal.getsignal(sig) is not signal.SIG_IGN:     # nohup's SIGHUP, a background & SIGINT: kept
+            signal.signal(sig, handler)
 
 
 def _quiet_after_signal(record) -> bool:
