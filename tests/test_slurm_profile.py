@@ -145,3 +145,13 @@ def test_slurm_without_squeue_fails_fast_and_a_signal_stops_it(tmp_path, sig):
     assert took < 10 and proc.returncode == 128 + getattr(signal, sig), (took, proc.returncode, out[-3000:])
     assert f"interrupted by {sig}" in out and "did not complete successfully" not in out, out[-3000:]
     assert "scancel" in calls.read_text(), calls.read_text()
+
+
+def test_profiles_hold_each_key_once():
+    """A rule given twice in set-resources keeps the last silently (two engineers adding the
+    same rule in one round did it): the profiles pass the strict reader (duplicate keys,
+    YAML 1.1 traps refused). Mutation: a second landing_optima line fails it."""
+    from opnav.core.yamlfile import read_config_file
+
+    for f in sorted((REPO / "profiles").glob("*/config.yaml")):
+        read_config_file(f)
