@@ -124,25 +124,9 @@ def _cases(tmp: Path):
                        ("study.yaml", "studies: {s: {paper: landing, vary: {landing.camera.fov_deg: [45, 45.0]}}}\n"),
                        ("trap.yaml", "landing: {mc: {base_seed: 010}}\n"), ("yte.yaml", "__use_yte__: true\n")):
         (tmp / name).write_text(text)
-    for argv, named in [*t.BAD_CLI, *t.NEW_CLI, *ROUND_FOUR_CLI]:
+    for argv, named in [*t.BAD_CLI, *t.NEW_CLI, *t.ROUND_FOUR_CLI]:
         argv = [a.replace("{tmp}", str(tmp)) for a in argv]
         yield "cli", argv[0] if not argv[0].startswith("-") else argv[2], " ".join(argv)[:70], _cli(argv), named
-
-
-#: Issue 57's command lines.
-ROUND_FOUR_CLI = [
-    (["approach", "--config", "config/quick.yaml", "--bogus-flag"], "unrecognized flag --bogus-flag"),
-    (["approach", "--set", "approach.n_seeds=-"], "--set approach.n_seeds: the value '-' reads as [null]"),
-    (["approach", "--set", "approach={}"], "--set approach={}: an empty map would replace the whole map"),
-    (["approach", "--config", "config/quick.yaml", "--set", "approach={}"], "--set approach={}"),
-    (["landing", "--set", "landing.camera={fov_deg: 45}"], "--set landing.camera={fov_deg: 45}: a map without"),
-    (["approach", "--seed", "1000000000", "--seeds", "2"], "--seed 1000000000"),
-    (["approach", "--seed", "99999999999999999999"], "--seed 99999999999999999999"),
-    (["landing", "--seed", "99999999999999999999"], "--seed"),
-    (["check"], "CONFIG"),
-    (["check", "{tmp}/nosuch.yaml"], "nosuch.yaml: not found"),
-    (["check", "{tmp}/study.yaml", "--timeout", "0"], "--timeout"),
-]
 
 
 def _reader_cases(tmp: Path):

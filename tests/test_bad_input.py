@@ -852,6 +852,22 @@ NEW_CLI = [
 ]
 
 
+# Round four (issue 57): (argv, text stderr must contain)
+ROUND_FOUR_CLI = [
+    (["approach", "--config", "config/quick.yaml", "--bogus-flag"], "unrecognized flag --bogus-flag"),
+    (["approach", "--set", "approach.n_seeds=-"], "--set approach.n_seeds: the value '-' reads as [null]"),
+    (["approach", "--set", "approach={}"], "--set approach={}: an empty map would replace the whole map"),
+    (["approach", "--config", "config/quick.yaml", "--set", "approach={}"], "--set approach={}"),
+    (["landing", "--set", "landing.camera={fov_deg: 45}"], "--set landing.camera={fov_deg: 45}: a map without"),
+    (["approach", "--seed", "1000000000", "--seeds", "2"], "--seed 1000000000"),
+    (["approach", "--seed", "99999999999999999999"], "--seed 99999999999999999999"),
+    (["landing", "--seed", "99999999999999999999"], "--seed"),
+    (["check"], "CONFIG"),
+    (["check", "{tmp}/nosuch.yaml"], "nosuch.yaml: not found"),
+    (["check", "{tmp}/study.yaml", "--timeout", "0"], "--timeout"),
+]
+
+
 @pytest.fixture()
 def no_work(monkeypatch):
     """Any simulation started fails the test: refusal must come first."""
@@ -867,7 +883,8 @@ def no_work(monkeypatch):
         monkeypatch.setattr(mod, name, forbidden)
 
 
-@pytest.mark.parametrize("argv,named", BAD_CLI + NEW_CLI, ids=[" ".join(a) for a, _ in BAD_CLI + NEW_CLI])
+@pytest.mark.parametrize("argv,named", BAD_CLI + NEW_CLI + ROUND_FOUR_CLI,
+                         ids=[" ".join(a) for a, _ in BAD_CLI + NEW_CLI + ROUND_FOUR_CLI])
 def test_bad_cli_refused_naming_flag(argv, named, tmp_path, capsys, no_work):
     from opnav.cli import EXIT_USER, main
 
@@ -1009,6 +1026,7 @@ def test_battery_counts():
                                   "config files, rounds 1-2": len(BAD_FILES),
                                   "YAML traps (files)": len(YAML_TRAPS),
                                   "CLI, rounds 1-2": len(BAD_CLI), "CLI, round 3": len(NEW_CLI),
+                                  "CLI, round 4": len(ROUND_FOUR_CLI),
                                   "accepted files": len(ACCEPTED_FILES),
                                   "round four (config values)": len(ROUND_FOUR_CONFIGS) + len(ONCE)})
     counts.update(cls for cls, _, _ in NEW_CONFIGS)
