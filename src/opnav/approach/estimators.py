@@ -140,8 +140,9 @@ def call(est: Estimator, prob: Problem, where: str = "") -> tuple[np.ndarray, np
             P = np.asarray(P, float)
         except (TypeError, ValueError):
             P = np.zeros(0)
-        if P.shape != (3, 3) or not np.isfinite(P).all() or not np.allclose(P, P.T, rtol=1e-6, atol=0.0) \
-                or np.any(np.diag(P) < 0):
+        ok = P.shape == (3, 3) and np.isfinite(P).all() and np.all(np.diag(P) >= 0)
+        # symmetric to round-off on the scale of each entry (sqrt(P_ii P_jj)), not of the entry itself
+        if not ok or np.any(np.abs(P - P.T) > 1e-8 * np.sqrt(np.outer(np.diag(P), np.diag(P))) + 1e-300):
             raise MethodError(f"{key}: {est.path} returned a covariance that is not a finite symmetric 3 x 3 "
                               f"matrix with a non-negative diagonal{at}")
     return th, P

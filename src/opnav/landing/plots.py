@@ -246,7 +246,9 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
         ticks = []
         for m in methods:
             ev = tsum.median_evals(timing, m)
-            ticks.append(f"{_label(m, labels)}\n{ev:.0f} evals" + ("\n(interpreted\nsearch)" if m in own else ""))
+            interp = m in own and "interpreted search" in own[m]     # a plain Python metric of the user's
+            name = _label(m, labels) if m not in own else _label(m, labels).replace(" ", "\n")   # own: narrow
+            ticks.append(f"{name}\n{ev:.0f} evals" + ("\n(interpreted\nsearch)" if interp else ""))
         ax.set_xticks(range(1, len(methods) + 1), ticks, fontsize="small")
         for p_, v in zip(pos, vals):       # the median, above the upper whisker (clear of the box)
             if len(v):
