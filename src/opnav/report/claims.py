@@ -248,11 +248,11 @@ def _published_text(plan: Plan, cid: str, rows: list[EvidenceRow], scope: str) -
         sel = [r for r in pubs if r.quantity == q]
         if agg in ("min", "max") and sel:
             v = (min if agg == "min" else max)(r.estimate for r in sel)
-            return fmt(v)
+            return f"{v:g}"   # a published number as printed in the paper
         for want in (sc, scope, ""):
             hit = next((r for r in sel if r.scope == want), None)
             if hit is not None:
-                return fmt(hit.estimate)
+                return f"{hit.estimate:g}"
         return "n/a"
 
     return re.sub(r"{([^}]+)}", one, str(plan.entry(cid)["published"]))

@@ -262,10 +262,6 @@ class _Ctx:
         return r.at_level(self.level) if r is not None else None
 
 
-def _unit(row: EvidenceRow) -> str:
-    return row.unit or QUANTITIES.get(row.quantity, None).unit if QUANTITIES.get(row.quantity) else row.unit
-
-
 def _u(unit: str) -> str:
     return f" {unit}" if unit and unit not in ("", "1") else ("" if unit != "%" else " %")
 
@@ -915,7 +911,7 @@ def would_take(plan: Plan, claim_id: str, evidence: Evidence | Iterable[Evidence
         if w.kind == "sweep":      # swept whatever the verdict (the figure), quoted where it is not reproduced
             txt, sw = _sweep(plan, test, idx, level, w.params, j)
             sweeps += sw
-            if txt and j.verdict != REPRODUCED:
+            if txt and j.verdict != REPRODUCED and not w.params.get("quiet"):
                 parts.append(txt)
         elif j.verdict == REPRODUCED:
             continue
