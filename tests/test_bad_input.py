@@ -420,9 +420,11 @@ def test_study_rule_names_are_read_from_the_workflow(tmp_path):
 def test_full_label_on_full_sizes_passes_and_quick_label_on_any():
     """The label is checked against the sizes it claims, from the schema's defaults (the full
     profile's): full on quick sizes refused (above); full on full sizes, quick on either, pass."""
-    validate_config(yaml.safe_load((REPO / "config" / "config.yaml").read_text()), root=REPO, workflow=True)
-    validate_config(_overlaid("{}"), root=REPO, workflow=True)
-    validate_config(_overlaid("approach: {n_seeds: 20}\nlanding: {mc: {n_runs: 300}}"), root=REPO)
+    from opnav.core.checks import profile_problems      # (the full profile itself: test_quick_and_full_profiles_pass)
+
+    assert not profile_problems(_overlaid("profile: full\napproach: {n_seeds: 20}\nlanding: {mc: {n_runs: 300}}"))
+    assert not profile_problems(_overlaid("approach: {n_seeds: 20}\nlanding: {mc: {n_runs: 300}}"))
+    assert not profile_problems(_overlaid("{}"))
 
 
 @pytest.mark.parametrize("where", ["studies", "landing.scenarios", "approach.camera", "", "landing.mc.methods[0]"])

@@ -71,22 +71,24 @@ def test_a_check_that_takes_too_long_is_stopped(monkeypatch, tmp_path, capsys):
     """The hard limits: a check that never ends is stopped at --timeout, one that grows past
     the memory limit is stopped; each one line. Mutation: running check_files unforked
     hangs the first."""
+    import opnav.cli as cli
     import opnav.preflight as preflight
 
     f = tmp_path / "ok.yaml"
     f.write_text("landing: {mc: {n_runs: 8}}\n")
     monkeypatch.setattr(preflight, "check_files", lambda files: time.sleep(60))
     t0 = time.monotonic()
-    rc, out, err = _check(capsys, f, "--timeout", "2")
+    rc, out, err = _check(capsys, f, "--timeout", "1")
     assert time.monotonic() - t0 < 10
-    assert rc == EXIT_USER and len(err) == 1 and "did not finish in 2 s" in err[0], err
+    assert rc == EXIT_USER and len(err) == 1 and "did not finish in 1 s" in err[0], err
 
     def grow(files):
         block = []
         while True:
-            block.append(bytearray(64 << 20))
+            block.append(bytearray(16 << 20))
 
     monkeypatch.setattr(preflight, "check_files", grow)
+    monkeypatch.setattr(cli, "CHECK_MEMORY_MB", 128)         # the same limit, reached sooner
     rc, out, err = _check(capsys, f)
     assert rc == EXIT_USER and len(err) == 1 and "ran out of memory" in err[0], err
 
