@@ -88,15 +88,16 @@ _KERNELS = r"""
 import json, sys, time
 import numpy as np
 from opnav.approach import em, ekf, smoother, scenario as sc
+from opnav.approach.setup import Setup
 from opnav.core.config import load_config
-cfg = load_config()["approach"]
+cfg = Setup.from_config(load_config()["approach"])
 rows = []
 for n in map(int, sys.argv[1].split(",")):
     geo = sc.build_geometry(cfg, "roll", n=n)
-    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    Rvar = sc.measurement_variance(geo, cfg, cfg.camera.sigma3_px)
     win = geo.window(Rvar)
     for S in map(int, sys.argv[2].split(",")):
-        z, _ = sc.simulate(geo, Rvar, sc.rad(cfg["truth_bias_arcsec"]), sc.seed_streams(1, 1, range(S)))
+        z, _ = sc.simulate(geo, Rvar, sc.rad(cfg.truth_bias_arcsec), sc.seed_streams(1, 1, range(S)))
         theta, x0 = np.full((S, 3), 1e-5), np.zeros((S, 6))
         em.em_map(theta, z, x0, geo.P0, win, 1e-6)  # warm-up (loads the kernels)
         f = ekf.run_filter(z, theta, x0, geo.P0, win, predicted=False)
@@ -147,13 +148,15 @@ def em_iteration_timing(n_samples: int = 250, seeds=(1, 20, 100), repeats: int =
     from opnav.approach import em, scenario as sc
     from opnav.core.config import load_config
 
-    cfg = load_config(REPO / "config" / "config.yaml")["approach"]
+    from opnav.approach.setup import Setup
+
+    cfg = Setup.from_config(load_config(REPO / "config" / "config.yaml")["approach"])
     geo = sc.build_geometry(cfg, "roll", n=n_samples)
-    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    Rvar = sc.measurement_variance(geo, cfg, cfg.camera.sigma3_px)
     win = geo.window(Rvar)
     rows = []
     for S in seeds:
-        z, _ = sc.simulate(geo, Rvar, sc.rad(cfg["truth_bias_arcsec"]), sc.seed_streams(1, 1, range(S)))
+        z, _ = sc.simulate(geo, Rvar, sc.rad(cfg.truth_bias_arcsec), sc.seed_streams(1, 1, range(S)))
         theta = np.zeros((S, 3))
         x0 = np.zeros((S, 6))
         em.em_map(theta, z, x0, geo.P0, win, 1e-6)  # warm-up

@@ -35,11 +35,13 @@ def main(argv=None) -> int:
     ap.add_argument("--cases", nargs="*", default=["T1-01", "T1-09", "T1-12"], help="case ids")
     ap.add_argument("--variants", nargs="*", default=["literal", "roll"])
     args = ap.parse_args(argv)
-    cfg = load_config(overlays=[REPO / "config" / "quick.yaml"] if args.quick else [])["approach"]
-    S = args.seeds or cfg["n_seeds"]
+    from opnav.approach.setup import Setup
+
+    cfg = Setup.from_config(load_config(overlays=[REPO / "config" / "quick.yaml"] if args.quick else [])["approach"])
+    S = args.seeds or cfg.n_seeds
     seeds = range(S)
     allc = {c.case_id: c for c in cases.table1_cases(cfg)}
-    print(f"profile={'quick' if args.quick else 'full'} seeds={S} segments={cfg['segments']}")
+    print(f"profile={'quick' if args.quick else 'full'} seeds={S} segments={cfg.segments.as_dict()}")
     hdr = f"{'variant':8s} {'case':6s} {'method':22s} {'s/seed':>9s} {'rmse_x':>8s} {'rmse_y':>8s}"
     print(hdr)
     print("-" * len(hdr))
@@ -53,7 +55,7 @@ def main(argv=None) -> int:
             def rmse(th):
                 return np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2, axis=0))
 
-            for m in cfg["methods"]:
+            for m in cfg.methods:
                 t = time.perf_counter()
                 r = cases.run_case(cfg, v, case, seeds, geo=geo, method=m)
                 dt = (time.perf_counter() - t) / S

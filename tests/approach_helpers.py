@@ -4,6 +4,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from opnav.approach.ekf import Window
+from opnav.approach.setup import Setup
 from opnav.core.config import load_config
 
 
@@ -23,6 +24,11 @@ def approach_cfg(**segments):
     cfg = load_config()["approach"]
     cfg["segments"].update(segments)
     return cfg
+
+
+def approach_setup(**segments) -> Setup:
+    """:func:`approach_cfg` parsed once: the :class:`Setup` every paper-A function takes."""
+    return Setup.from_config(approach_cfg(**segments))
 
 
 def random_filter_problem(seed, S, n, per_seed=False):

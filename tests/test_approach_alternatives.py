@@ -10,6 +10,7 @@ from opnav.approach import scenario as sc
 from opnav.approach.augmented import run_augmented
 from opnav.approach.batch_ml import BatchML
 from opnav.approach.em import em_window
+from opnav.approach.setup import Setup
 from opnav.core.config import load_config
 
 N_SAMPLES = 600
@@ -25,7 +26,7 @@ def _cfg():
 @pytest.fixture(scope="module")
 def roll_case():
     """Roll variant from the prior at t0, 600 samples (5 min, 30 deg of roll): theta is observable."""
-    cfg = _cfg()
+    cfg = Setup.from_config(_cfg())
     geo = sc.build_geometry(cfg, "roll", n=N_SAMPLES)
     Rvar = sc.measurement_variance(geo, cfg, [0.1, 0.1, 0.2])
     win = geo.window(Rvar)
@@ -308,8 +309,9 @@ def test_compiled_augmented_filter_equals_the_step_by_step_reference(seed, S, n,
 
 def test_compiled_augmented_filter_with_star_images_equals_the_reference():
     """With star images between compiled stretches (``stars`` variant), the same numbers."""
-    cfg = _cfg()
-    cfg["stars"]["every_K"] = 40
+    c = _cfg()
+    c["stars"]["every_K"] = 40
+    cfg = Setup.from_config(c)
     geo = sc.build_geometry(cfg, "stars", n=330)  # images every 40 samples after N0 = 200
     Rvar = sc.measurement_variance(geo, cfg, [0.1, 0.1, 0.2])
     seeds = [0, 1]

@@ -14,12 +14,13 @@ from opnav.approach import cases, pipeline
 from opnav.approach import scenario as sc
 
 from approach_helpers import approach_cfg
+from opnav.approach.setup import Setup
 
 
 def _cfg(att):
     cfg = approach_cfg(N0=50, N=50, M=2, L=2)
     cfg["camera"]["attitude_sigma_arcsec"] = att
-    return cfg
+    return Setup.from_config(cfg)
 
 
 def test_the_simulated_attitude_error_is_lateral_with_the_stated_variance():

@@ -103,11 +103,11 @@ def pinned(monkeypatch):
 
 def _pair(pin, variant, estimate):
     """``estimate(cfg, geo, case)`` on the clean and on the blind inputs (same data)."""
-    cfg = _cfg()
+    cfg = Setup.from_config(_cfg())
     geo = sc.build_geometry(cfg, variant)
     pin.geo = geo
     out = []
-    for c, g, truth in ((cfg, geo, PINNED), (_blind_cfg(cfg), _blind_geo(geo), OTHER)):
+    for c, g, truth in ((cfg, geo, PINNED), (Setup.from_config(_blind_cfg(_cfg())), _blind_geo(geo), OTHER)):
         out.append(estimate(c, g, replace(cases.headline_case(c), truth_arcsec=truth)))
     return out
 
@@ -128,7 +128,7 @@ def _same_or_control(variant, clean: dict, blind: dict, key: str):
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_em_is_blind(variant, mode, method, pinned):
     def em(cfg, geo, case):
-        s = Setup.of(cfg).scheme(mode)
+        s = cfg.scheme(mode)
         r = cases.run_cases(s, variant, [case], SEEDS, geo=geo, method=method)[0]
         return {k: r[k] for k in ("theta_iter_arcsec", "loglik_iter", "theta_ml_arcsec", "label",
                                   "dist_to_ml_over_bound", "theta_seg_arcsec")}
@@ -163,7 +163,8 @@ def test_convergence_study_is_blind(variant, pinned):
 @pytest.mark.parametrize("variant", ["literal", "roll", DIAGNOSTIC])
 def test_batch_ml_is_blind(variant, pinned):
     def ml(cfg, geo, case):
-        cfg["alternatives"]["batch_ml"].update(checkpoint_seeds=0, jit=False)
+        alt = cfg.alternatives
+        cfg = cfg.replace(alternatives=replace(alt, batch_ml=replace(alt.batch_ml, checkpoint_seeds=0, jit=False)))
         a = alternatives.run_case_alternatives(cfg, variant, case, SEEDS, geo)["methods"]["batch_ml"]
         return {"theta_final_arcsec": a["theta_final_arcsec"]}
 

@@ -7,11 +7,13 @@ from opnav.approach import scenario as sc
 from opnav.approach.ekf import run_filter
 
 from approach_helpers import approach_cfg
+from opnav.approach.setup import Setup
 
 
 def _data(variant="roll", seeds=range(8)):
     cfg = approach_cfg(N0=200, N=50, M=2, L=4)
     cfg["initial_error"]["mode"] = "sampled"
+    cfg = Setup.from_config(cfg)
     case = cases.headline_case(cfg)
     geo = sc.build_geometry(cfg, variant)
     return geo, cases.prepare_cases(cfg, variant, [case], seeds, geo=geo), np.asarray(case.truth_arcsec)

@@ -10,15 +10,16 @@ from opnav.approach import cases, crlb, ekf, em, pipeline, smoother
 from opnav.approach import scenario as sc
 from opnav.approach.dynamics import ARCSEC
 
-from approach_helpers import approach_cfg, random_filter_problem, small_window
+from approach_helpers import approach_cfg, approach_setup, random_filter_problem, small_window
+from opnav.approach.setup import Setup
 
 
 def _approach_window(variant="prior", n=200, bias=(10.0, 20.0, 10.0), seeds=range(3), N0=50):
-    cfg = approach_cfg(N0=N0)
+    cfg = approach_setup(N0=N0)
     geo = sc.build_geometry(cfg, variant, n=N0 + n)
-    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    Rvar = sc.measurement_variance(geo, cfg, cfg.camera.sigma3_px)
     win = geo.window(Rvar)
-    z, e0 = sc.simulate(geo, Rvar, sc.rad(bias), sc.seed_streams(cfg["base_seed"], 99, seeds))
+    z, e0 = sc.simulate(geo, Rvar, sc.rad(bias), sc.seed_streams(cfg.base_seed, 99, seeds))
     S = z.shape[0]
     dx0 = np.zeros((S, 6))
     f0 = ekf.run_filter(z[:, :N0 + 1], np.zeros((S, 3)), dx0, geo.P0, win.slice(0, N0))
@@ -115,7 +116,8 @@ def test_crlb_recursion_matches_batch_on_the_approach_geometry():
 def _converged_estimate(variant, bias, n, seeds, mode="fixed"):
     cfg = approach_cfg(N0=100)
     cfg["initial_error"]["mode"] = mode
-    case = cases.Case(1, "T", "size", tuple(bias), (0.0, 0.0, 0.0), tuple(cfg["camera"]["sigma3_px"]), 0.0)
+    cfg = Setup.from_config(cfg)
+    case = cases.Case(1, "T", "size", tuple(bias), (0.0, 0.0, 0.0), tuple(cfg.camera.sigma3_px), 0.0)
     r = cases.convergence_study(cfg, variant, case, seeds, n, 30, 0.05)
     geo = sc.build_geometry(cfg, variant, n=100 + n)
     Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
@@ -162,7 +164,7 @@ def test_data_to_converge_rule():
 
 
 def test_monte_carlo_runs_do_not_depend_on_chunking():
-    cfg = approach_cfg(N0=20, N=20, M=2, L=2)
+    cfg = approach_setup(N0=20, N=20, M=2, L=2)
     case = cases.table1_cases(cfg)[0]
     geo = sc.build_geometry(cfg, "roll")
     whole = cases.run_case(cfg, "roll", case, range(4), geo=geo)
@@ -174,7 +176,7 @@ def test_monte_carlo_runs_do_not_depend_on_chunking():
 
 
 def test_stacking_cases_in_one_batch_equals_separate_runs():
-    cfg = approach_cfg(N0=20, N=20, M=2, L=2)
+    cfg = approach_setup(N0=20, N=20, M=2, L=2)
     allc = cases.table1_cases(cfg)
     pix = [c for c in allc if c.group == "pixel"]
     geo = sc.build_geometry(cfg, "prior")
@@ -279,6 +281,7 @@ def test_em_schemes_sharing_a_jobs_simulation_equal_separate_runs():
     cfg = approach_cfg(N0=20, N=20, M=2, L=2)
     cfg["n_seeds"] = 2
     cfg["growing"]["N"] = 20
+    cfg = Setup.from_config(cfg)
     shared = {}
     for mode, method in (("sliding", "plain"), ("sliding", "squarem"), ("growing", "squarem")):
         alone = pipeline.run_group(cfg, "prior", "pixel", method, mode)
@@ -294,6 +297,7 @@ def _segment_run(variant, method="plain", seeds=range(4), init=None, **seg):
     cfg = approach_cfg(**{**dict(N0=200, N=50, M=5, L=6), **seg})
     if init is not None:
         cfg["theta_init_arcsec"] = list(init)
+    cfg = Setup.from_config(cfg)
     case = cases.headline_case(cfg)  # truth (10, 20, 10), EM start (0, 0, 0) unless init
     geo = sc.build_geometry(cfg, variant)
     r = cases.run_case(cfg, variant, case, seeds, geo=geo, method=method)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from approach_helpers import approach_cfg, random_filter_problem, small_window
+from approach_helpers import approach_setup, random_filter_problem, small_window
 from opnav.approach import crlb, kalman, pipeline
 from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
@@ -64,7 +64,7 @@ def test_batched_bound_recursion_equals_each_window_alone():
 
 @pytest.mark.parametrize("variant", ["prior", "reference-start"])
 def test_segment_bounds_of_many_items_equal_each_alone(variant):
-    cfg = approach_cfg(N0=20, N=10, L=3)
+    cfg = approach_setup(N0=20, N=10, L=3)
     geo = sc.build_geometry(cfg, variant)
     case = headline_case(cfg)
     R1, R2 = geo.measurement_variance(case.sigma3_px), geo.measurement_variance((0.5, 0.5, 1.0))

@@ -8,12 +8,12 @@ from opnav.approach import camera, dynamics, ekf
 from opnav.approach import scenario as sc
 from opnav.approach.dynamics import ARCSEC
 
-from approach_helpers import approach_cfg
+from approach_helpers import approach_cfg, approach_setup
 
 
 @pytest.fixture(scope="module")
 def geo():
-    cfg = approach_cfg(N0=10, N=10, L=2)
+    cfg = approach_setup(N0=10, N=10, L=2)
     return cfg, sc.build_geometry(cfg, "literal")
 
 
@@ -36,7 +36,7 @@ def test_start_is_1e6_km_from_mars_and_approaching(geo):
 
 def test_stm_matches_finite_differences_of_the_flow(geo):
     cfg, g = geo
-    el = dynamics.KeplerElements.from_config(cfg["mars_elements"])
+    el = cfg.mars
     t = g.t[:3]
     _, Phi = dynamics.propagate_with_stm(g.X_ref[0], t, el)
     Phi20 = Phi[2] @ Phi[1]
@@ -52,7 +52,7 @@ def test_stm_matches_finite_differences_of_the_flow(geo):
 def test_linearised_propagation_matches_nonlinear_for_the_paper_initial_error(geo):
     """The 'verified linearisation' of SPEC A.1: Phi dX vs the nonlinear flow, dX ~ 170 km."""
     cfg, g = geo
-    el = dynamics.KeplerElements.from_config(cfg["mars_elements"])
+    el = cfg.mars
     n = len(g.t) - 1
     Phi_cum = np.eye(6)
     for k in range(1, n + 1):
@@ -125,7 +125,7 @@ def test_camera_tracks_mars_and_roll_keeps_boresight(geo):
     np.testing.assert_allclose(groll.C[:, 2], g.C[:, 2], atol=1e-12)
     ang = np.arctan2(np.einsum("ki,ki->k", groll.C[:, 0], g.C[:, 1]),
                      np.einsum("ki,ki->k", groll.C[:, 0], g.C[:, 0]))
-    np.testing.assert_allclose(np.rad2deg(ang), cfg["roll"]["rate_deg_s"] * g.t, atol=1e-9)
+    np.testing.assert_allclose(np.rad2deg(ang), cfg.roll.rate_deg_s * g.t, atol=1e-9)
 
 
 def test_pinhole_noise_conversion():

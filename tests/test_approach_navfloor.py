@@ -28,7 +28,7 @@ def test_each_arc_is_the_run_of_that_arc_alone():
     data up to its end only, and a filtered error does not depend on later samples. The true-theta
     and theta = 0 filters too. Mutation tried: the longest arc's estimate used for every arc fails
     the short arc's row."""
-    cfg = _cfg()
+    cfg = Setup.from_config(_cfg())
     out = navfloor.nav_floor_by_arc(cfg, "roll", "growing-squarem", [75.0, 125.0])
     assert [r["samples"] for r in out["rows"]] == [150, 250]
     for row in out["rows"]:
@@ -36,8 +36,8 @@ def test_each_arc_is_the_run_of_that_arc_alone():
         c["growing"].update(N=50, M=3)
         c["n_seeds"] = 3
         c["em"]["ml_max_maps"] = 3  # the label's reference (not compared here)
-        s = Setup.of(c).scheme("growing")
-        r = cases.run_case(s, "roll", cases.headline_case(c), range(3), method="squarem")
+        s = Setup.from_config(c).scheme("growing")
+        r = cases.run_case(s, "roll", cases.headline_case(s), range(3), method="squarem")
         np.testing.assert_allclose(row["nav_err_km_rule"], r["nav_err_after_km"].mean(), rtol=2e-5)
         np.testing.assert_allclose(row["true_theta_km_rule"], r["nav_err_true_theta_km"].mean(), rtol=2e-5)
         np.testing.assert_allclose(row["before_km_rule"], r["nav_err_before_km"].mean(), rtol=2e-5)
@@ -50,12 +50,11 @@ def test_tz_does_not_move_the_navigation_error():
     (same seeds), filtered with the true (tx, ty) and tz = 0, the errors differ by far less than a
     metre per km of error; the same test on tx (left uncompensated) moves them by kilometres
     (control: the test can see an effect)."""
-    cfg = _cfg()
-    tz = navfloor.tz_nav_effect(cfg, "roll")
+    setup = Setup.from_config(_cfg())
+    tz = navfloor.tz_nav_effect(setup, "roll")
     assert tz["n_seeds"] == 3 and math.isfinite(tz["nav_err_km_tz_on"])
     assert abs(tz["diff_km_mean"]) < 1e-3 * tz["nav_err_km_tz_off"]
     # control: the same pairing with tx instead of tz
-    setup = Setup.of(cfg)
     from opnav.approach import scenario as sc
     from opnav.approach.ekf import run_filter
 
@@ -76,7 +75,7 @@ def test_arcs_that_end_before_the_data_are_refused_before_any_work():
     msg = approach_problems(cfg)
     assert len(msg) == 1 and "'approach.nav_floor.arcs_s'" in msg[0] and "90 s" in msg[0]
     with pytest.raises(ValueError, match="approach.nav_floor.arcs_s"):
-        navfloor.arc_samples(Setup.of(cfg), [90.0])
+        navfloor.arc_samples(Setup.from_config(cfg), [90.0])
     cfg["nav_floor"]["arcs_s"] = [1100.0, 1234.0]  # any arc after N0: a growing window ends at it
     assert approach_problems(cfg) == []
     assert navfloor.growing_windows(200, 250, [2200, 2468])[-2:] == [(200, 2450), (200, 2468)]

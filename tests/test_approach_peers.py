@@ -10,17 +10,17 @@ from opnav.approach import scenario as sc
 from opnav.approach.cases import headline_case
 from opnav.approach.camera import misalignment_small
 
-from approach_helpers import approach_cfg, small_window
+from approach_helpers import approach_cfg, approach_setup, small_window
 
 
 # ------------------------------------------------------------ model builders
 def _short_arc(n=40, variant="roll", seed=3):
     """A short arc of the approach geometry with real measurements (headline bias)."""
-    cfg = approach_cfg(N0=n, L=1, N=2)
+    cfg = approach_setup(N0=n, L=1, N=2)
     geo = sc.build_geometry(cfg, variant, n=n)
     case = headline_case(cfg)
     Rvar = sc.measurement_variance(geo, cfg, case.sigma3_px)
-    z, _ = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), sc.seed_streams(cfg["base_seed"], 1, [seed]))
+    z, _ = sc.simulate(geo, Rvar, sc.rad(case.truth_arcsec), sc.seed_streams(cfg.base_seed, 1, [seed]))
     theta = sc.rad(np.asarray(case.truth_arcsec)[None])
     return geo.window(Rvar), z, theta, np.zeros((1, 6)), geo.P0
 
@@ -145,20 +145,20 @@ def test_circle_variance_is_the_first_order_map_of_the_km_variance():
 
 
 def test_two_body_check_tidal_acceleration_by_hand():
-    cfg = approach_cfg(N0=10, L=1, N=2)
+    cfg = approach_setup(N0=10, L=1, N=2)
     geo = sc.build_geometry(cfg, "literal", n=12)
     tb = peers.two_body_check(geo)
     # tidal acceleration ~ 2 mu_sun d / r^3 for d along the Sun line, mu_sun d / r^3 across
     from opnav.approach.dynamics import MU_SUN
     r = np.linalg.norm(geo.X_mars[0, :3])
-    d = cfg["geometry"]["range_km"]
+    d = cfg.geometry.range_km
     assert MU_SUN * d / r**3 <= tb["sun_tidal_kms2_start"] <= 2.0 * MU_SUN * d / r**3 * 1.001
     assert tb["two_body_pos_err_km"] < 1e-3
 
 
 # ------------------------------------------------------------ Basilisk
 def _bsk_case(variant="roll", n=30, truth=None, start="prior", seeds=(0,)):
-    cfg = approach_cfg(N0=n, L=1, N=2)
+    cfg = approach_setup(N0=n, L=1, N=2)
     case = headline_case(cfg)
     return cfg, peers.run_peer(cfg, variant, case, list(seeds), truth_arcsec=truth, start=start, stride=1)
 
@@ -170,10 +170,10 @@ def test_module_model_reproduces_the_converted_measurement():
     from Basilisk.architecture import messaging
     from Basilisk.fswAlgorithms import pixelLineBiasUKF
 
-    cfg = approach_cfg(N0=10, L=1, N=2)
+    cfg = approach_setup(N0=10, L=1, N=2)
     for variant, k, install in (("roll", 7, 0.0), ("literal", 3, 45.0)):
         geo = sc.build_geometry(cfg, variant, n=12)
-        cam = peers.PeerCamera.from_config(cfg["camera"])
+        cam = peers.PeerCamera.of(cfg.camera.pixels, cfg.camera.ifov_arcsec)
         sBN, sCB = peers.ukf_inputs(geo, install)
         want = peers.circles_from_los(geo.u_true[k], cam)
         data = pixelLineBiasUKF.PixelLineBiasUKFConfig()
@@ -200,9 +200,9 @@ def test_basilisk_smoke_few_steps_are_finite_and_sensible():
     assert np.all(np.isfinite(r["theta_final_arcsec"])) and np.all(np.isfinite(r["sigma3_final_arcsec"]))
     assert np.all(r["sigma3_final_arcsec"] > 0)
     # the position stays within a few prior sigmas of the truth (100 km prior, ~10 s of data)
-    assert np.all(r["pos_err_final_km"] < 5 * cfg["prior_sigma"]["r_km"] * np.sqrt(3))
+    assert np.all(r["pos_err_final_km"] < 5 * cfg.prior_sigma.r_km * np.sqrt(3))
     # the bias is in whole pixels (the module rounds it after every update)
-    cam = peers.PeerCamera.from_config(cfg["camera"])
+    cam = peers.PeerCamera.of(cfg.camera.pixels, cfg.camera.ifov_arcsec)
     b = peers.bias_px_from_theta(np.r_[sc.rad(r["theta_final_arcsec"][0]), 0.0], cam)
     np.testing.assert_allclose(b, np.round(b), atol=1e-6)
 
@@ -266,7 +266,7 @@ def test_basilisk_bias_moves_with_the_user_guide_tuning():
     camera frame, from the position error, fixed in space). Mutation tried: the earlier
     ``bias_process_sigma_px: 1e-6`` gives no change after the first update and fails."""
     pytest.importorskip("Basilisk")
-    cfg = approach_cfg()
+    cfg = approach_setup()
     r = peers.run_peer(cfg, "roll", headline_case(cfg), [0], stride=50)
     assert np.all(np.abs(r["theta_final_arcsec"]).max(1) > 0)  # not its start
     assert r["bias_changes_after_first"][0] > 0, r["theta_hist_arcsec"][0, :, :]

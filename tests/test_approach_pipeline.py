@@ -6,13 +6,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from opnav.core import published
+from opnav.core.planvalues import accuracy_target_arcsec
 from opnav.approach import cases, labels, pipeline, summaries
 from opnav.approach import scenario as sc
 from opnav.approach.setup import Setup
 from opnav.report import approach_text
 
-from approach_helpers import approach_cfg
+from approach_helpers import approach_cfg, approach_setup
 
+TARGET = accuracy_target_arcsec()  # the claimed accuracy: the analysis plan's A-C1 target
 REQUIRED = ["variant", "group", "case_id", "truth_x_arcsec", "truth_y_arcsec", "truth_z_arcsec",
             "est_x_mean", "est_x_std", "est_y_mean", "est_y_std", "crlb_x_arcsec", "crlb_y_arcsec",
             "data_to_converge_samples", "nav_err_before_km", "nav_err_after_km"]
@@ -24,8 +26,9 @@ def small():
     cfg["n_seeds"] = 2
     cfg["variants"] = ["literal", "reference-start"]
     cfg["table1_variants"] = ["literal"]
+    cfg = Setup.from_config(cfg)
     res = []
-    for v in cfg["variants"]:
+    for v in cfg.variants:
         for g in pipeline.groups_for(cfg, v):
             if v == "literal" and g not in ("size", "pixel"):
                 continue
@@ -34,7 +37,7 @@ def small():
 
 
 def test_seventeen_cases_in_five_groups_match_published_ids():
-    cfg = approach_cfg()
+    cfg = approach_setup()
     cs = cases.table1_cases(cfg)
     assert [c.case_id for c in cs] == [r["case_id"] for r in published.paper_a()["table1"]]
     assert [c.group for c in cs] == [r["group"] for r in published.paper_a()["table1"]]
@@ -43,7 +46,7 @@ def test_seventeen_cases_in_five_groups_match_published_ids():
 
 def test_table1_columns_and_published_values(small):
     cfg, res = small
-    t1 = summaries.table1_frame(res, published.paper_a())
+    t1 = summaries.table1_frame(res, published.paper_a(), TARGET)
     for c in REQUIRED:
         assert c in t1.columns
     assert {"pub_est_x_mean", "pub_est_y_mean", "pub_nav_err_before_km", "pub_nav_err_after_km",
@@ -59,18 +62,19 @@ def test_table1_columns_and_published_values(small):
 
 def test_verdict_text_comes_from_the_numbers(small):
     cfg, res = small
-    t1 = summaries.table1_frame(res, published.paper_a())
-    geo = {v: sc.build_geometry(cfg, v) for v in cfg["variants"]}
+    t1 = summaries.table1_frame(res, published.paper_a(), TARGET)
+    geo = {v: sc.build_geometry(cfg, v) for v in cfg.variants}
     case = cases.headline_case(cfg)
     curves = {v: pipeline.bound_curve(cfg, g, sc.measurement_variance(g, cfg, case.sigma3_px),
                                       case.truth_arcsec, v) for v, g in geo.items()}
-    x1 = summaries.crlb_rows(cfg, curves, {}, t1)
-    text = approach_text.identifiability_text(cfg, x1)
+    x1 = summaries.crlb_rows(cfg, curves, {}, t1, TARGET)
+    text = approach_text.identifiability_text(cfg, x1, TARGET)
     lit = x1[x1.variant == "literal"].iloc[0]
     assert not lit["bound_reaches_target"]
     assert "**literal**" in text and "CANNOT support 2 arcsec" in text
     assert f"{lit['crlb_x_total_arcsec']:.2f}" in text
-    summ = summaries.summary(cfg, t1, x1)
+    summ = summaries.summary(cfg, t1, x1, TARGET)
+    assert summ["accuracy_target_arcsec"] == TARGET == 2.0  # the plan's A-C1 target
     assert set(summ["variants"]) == {"literal", "reference-start+squarem"}
     assert np.isfinite(summ["variants"]["literal"]["crlb_x_arcsec"])
 
@@ -89,7 +93,7 @@ def _summary_row(scenario, est, bound, label, dist=0.0, rate=0.2):
 @pytest.mark.parametrize("lit_bound, roll_stalled", [(20.6, True), (1.0, False)])
 def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalled):
     """The finding sentences come out the other way when the numbers do (nothing fixed)."""
-    cfg = approach_cfg()
+    cfg = approach_setup()
     summ = {"prior_bound_arcsec": summaries.prior_bound_arcsec(cfg), "convergence_max_maps": 40, "variants": {
         "literal": _summary_row("literal", (0.0, 0.0), lit_bound, "converged"),
         "roll": _summary_row("roll", (0.02, 0.07) if roll_stalled else (10.0, 20.0), 8.2 if roll_stalled else 0.1,
@@ -97,7 +101,7 @@ def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalle
                              rate=0.999 if roll_stalled else 0.2),
     }}
     pub = published.paper_a()["headline"]
-    txt = approach_text.findings(cfg, summaries.HeadlineSummary.from_json(summ), pub)
+    txt = approach_text.findings(cfg, summaries.HeadlineSummary.from_json(summ), pub, TARGET)
     assert ("no variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
     assert ("add almost nothing to the prior" in txt["bound"]) is bool(lit_bound > 0.8 * summ["prior_bound_arcsec"])
     assert ("stalled (4/4)" in txt["headline_roll"]) is roll_stalled
@@ -131,7 +135,7 @@ def test_nav_error_split_range_is_set_by_the_range_channel_not_theta():
     error is the same whether the filter assumes theta = 0, the estimate or the true theta,
     while the lateral part with the true theta falls far below the theta = 0 filter's (about
     rho * |theta|). The split recombines into the total error."""
-    cfg = approach_cfg(N0=100, N=50, M=2, L=2)
+    cfg = approach_setup(N0=100, N=50, M=2, L=2)
     case = cases.headline_case(cfg)
     r = cases.run_case(cfg, "literal", case, range(2))
     rb, ra, rt = (r[f"nav_err_{k}_rng_km"] for k in ("before", "after", "true_theta"))
@@ -147,7 +151,7 @@ def test_roll_rate_bounds_agree_with_the_roll_variant_and_the_target_rate_meets_
     variant's bound curve; the bound falls with the rate; at the rate found for the target the
     worse of (tx, ty) is the target (bisection), and a slower roll stays above it."""
     cfg = approach_cfg(N0=100, N=50, M=2, L=4)
-    setup = pipeline.Setup.of(cfg)
+    setup = pipeline.Setup.from_config(cfg)
     case = cases.headline_case(setup)
     geo = sc.build_geometry(setup, "roll")
     Rvar = geo.measurement_variance(case.sigma3_px)
@@ -172,11 +176,11 @@ def test_convergence_label_is_relative_to_the_bound_of_the_data_used():
     from opnav.approach import cases
     from opnav.approach import scenario as sc
 
-    cfg = approach_cfg(N0=100, N=50, M=2, L=2)
+    cfg = approach_setup(N0=100, N=50, M=2, L=2)
     case = cases.headline_case(cfg)
     geo = sc.build_geometry(cfg, "roll")
     d = cases.prepare_cases(cfg, "roll", [case], range(3), geo=geo)
-    b = cases.label_bounds(Setup.of(cfg), geo, [case], "roll")[0]
+    b = cases.label_bounds(cfg, geo, [case], "roll")[0]
     assert np.all(b[:2] > 0)
     lab = {}
     for scale in (1e6, 1.0, 1e-6):

@@ -5,14 +5,15 @@ import numpy as np
 from opnav.approach import camera, readings
 from opnav.core import published
 
-from approach_helpers import approach_cfg
+from approach_helpers import approach_cfg, approach_setup
+from opnav.approach.setup import Setup
 
 
 def test_installation_cancels_from_the_measurement_by_construction():
     """The chain A_m A_c^b A_b^i with the commanded body attitude gives the same data for every
     installation angle (rounding only). Mutation tried: a body attitude that ignores the
     installation (A_b^i = A_c^i) changes the data by ~1 and fails."""
-    chk = readings.installation_check(approach_cfg(), [0.0, 45.0, 90.0, 135.0, 180.0], (10.0, 20.0, 10.0), n=20)
+    chk = readings.installation_check(approach_setup(), [0.0, 45.0, 90.0, 135.0, 180.0], (10.0, 20.0, 10.0), n=20)
     assert chk["by_construction"] and chk["max_rel_change"] < 1e-12
     # a body-frame deviation would not cancel: ty takes tz's value at 90 deg (rot_x(90) (tx, ty, tz))
     np.testing.assert_allclose(chk["body_frame_theta_cam_arcsec"][2], camera.rot_x(np.pi / 2) @ [10.0, 20.0, 10.0])
@@ -22,11 +23,11 @@ def test_installation_cancels_from_the_measurement_by_construction():
 def test_sample_time_reading_puts_both_steps_side_by_side():
     """250 samples 'about 4 min' imply 0.96 s a sample; the config's step is beside it, and the
     roll variant's bound after 250 samples is smaller at the longer step (more roll turned)."""
-    cfg = approach_cfg(N0=200, N=50, L=5)
+    cfg = approach_setup(N0=200, N=50, L=5)
     pa = published.paper_a()
     st = readings.sample_time_reading(cfg, pa["headline"], pa["simulation"])
     assert st["dt_s"]["paper_4_min"] == 240.0 / 250
-    assert st["dt_s"]["config"] == cfg["dt_s"]
+    assert st["dt_s"]["config"] == cfg.dt_s
     assert abs(st["minutes_for_samples"]["paper_4_min"] - 4.0) < 1e-12
     b = st["bound_after_samples_arcsec"]["roll"]
     assert b["paper_4_min"] < b["config"]
@@ -42,6 +43,7 @@ def test_study_estimator_growing_squarem_converges_where_sliding_plain_stalls():
     cfg = approach_cfg(N0=200, N=50, M=5, L=8)
     cfg["initial_error"]["mode"] = "sampled"
     cfg["growing"].update(N=100, M=5)
+    cfg = Setup.from_config(cfg)
     em = study.run_runs(cfg, "roll", "em", [0, 1])
     gr = study.run_runs(cfg, "roll", "em_growing_squarem", [0, 1])
     assert (em["converged_pct"] == 0).all() and (gr["converged_pct"] == 100).all()

@@ -94,11 +94,11 @@ def test_filter_log_likelihood_equals_dense_gaussian_density():
 
 def test_smoothed_covariances_no_larger_and_spd_on_the_approach():
     from opnav.approach import scenario as sc
-    from approach_helpers import approach_cfg
+    from approach_helpers import approach_setup
 
-    cfg = approach_cfg()
+    cfg = approach_setup()
     geo = sc.build_geometry(cfg, "roll", n=300)
-    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    Rvar = sc.measurement_variance(geo, cfg, cfg.camera.sigma3_px)
     win = geo.window(Rvar)
     z, _ = sc.simulate(geo, Rvar, sc.rad([10, 20, 10]), sc.seed_streams(1, 1, range(3)))
     f = ekf.run_filter(z, np.full((3, 3), 1e-5), np.zeros((3, 6)), geo.P0, win)
@@ -116,11 +116,11 @@ def test_smoothed_covariances_no_larger_and_spd_on_the_approach():
 
 def _approach_filter(S=4, n=120, seed=3):
     from opnav.approach import scenario as sc
-    from approach_helpers import approach_cfg
+    from approach_helpers import approach_setup
 
-    cfg = approach_cfg()
+    cfg = approach_setup()
     geo = sc.build_geometry(cfg, "roll", n=n)
-    Rvar = sc.measurement_variance(geo, cfg, cfg["camera"]["sigma3_px"])
+    Rvar = sc.measurement_variance(geo, cfg, cfg.camera.sigma3_px)
     win = geo.window(Rvar)
     z, _ = sc.simulate(geo, Rvar, sc.rad([10, 20, 10]), sc.seed_streams(seed, 1, range(S)))
     theta = np.random.default_rng(seed).normal(size=(S, 3)) * 1e-4

@@ -42,12 +42,13 @@ def test_information_update_is_the_inverse_of_added_information():
     np.testing.assert_allclose(stars.theta_information_update(P, np.zeros((3, 3))), P)  # no star: no change
 
 
-def _stars_cfg(per_image=3):
+def _stars_cfg(per_image=3, **stars):
     cfg = approach_cfg(N0=100, N=100, M=3, L=4)
     # ideal attitude knowledge: these tests check the machinery (the floor has its own tests)
     cfg["stars"].update(every_K=100, per_image=per_image, attitude_sigma_arcsec=0.0, mode_drift_arcsec=0.0)
+    cfg["stars"].update(stars)
     cfg["growing"].update(N=100)
-    return cfg
+    return Setup.from_config(cfg)
 
 
 def test_star_bound_is_the_star_information_when_the_mars_channel_carries_none():
@@ -58,7 +59,7 @@ def test_star_bound_is_the_star_information_when_the_mars_channel_carries_none()
     Rvar = np.full((geo.t.size, 3), 1e16)
     c = pipeline.bound_curve(cfg, geo, Rvar, (10.0, 20.0, 10.0), "stars")
     J = geo.stars.info_per_sample(geo.t.size - 1).sum(0)
-    expect = sc.arcsec(np.sqrt(np.diag(np.linalg.inv(J + np.eye(3) / Setup.of(cfg).crlb_prior_sigma_rad ** 2))))
+    expect = sc.arcsec(np.sqrt(np.diag(np.linalg.inv(J + np.eye(3) / cfg.crlb_prior_sigma_rad ** 2))))
     np.testing.assert_allclose(c[-1], expect, rtol=1e-4)
 
 
@@ -67,7 +68,7 @@ def test_stars_make_tz_observable_and_the_estimators_reach_their_bound():
     EM-EKF (SQUAREM) and the augmented EKF agree on the same data and land within 4 bound-sigma
     of the truth in tx, ty, tz; more stars per image lower the bound."""
     cfg = _stars_cfg(10)
-    setup = Setup.of(cfg)
+    setup = cfg
     case = cases.headline_case(cfg)
     geo = sc.build_geometry(cfg, "stars")
     Rvar = geo.measurement_variance(case.sigma3_px)
@@ -94,8 +95,7 @@ def test_stars_make_tz_observable_and_the_estimators_reach_their_bound():
 
 
 def test_a_field_without_enough_stars_stops_with_the_key():
-    cfg = _stars_cfg()
-    cfg["stars"].update(mag_limit=-2.0)
+    cfg = _stars_cfg(mag_limit=-2.0)
     with pytest.raises(ValueError, match="approach.stars"):
         sc.build_geometry(cfg, "stars")
 
@@ -194,7 +194,7 @@ def _dense_window_bound(cfg, geo, Rvar, theta_arcsec, a, b):
     from opnav.approach import crlb, kalman
     from opnav.approach.camera import misalignment_small
 
-    setup = Setup.of(cfg)
+    setup = cfg
     win = geo.window(Rvar).slice(a, b)
     P_a = kalman.propagate(None, geo.P0, geo.Phi[:a + 1], geo.Q)[1][-1]
     A = misalignment_small(sc.rad(theta_arcsec))
@@ -223,14 +223,15 @@ def test_sliding_window_star_bound_is_the_windows_own_data_marginalised_exactly(
     arcsec on the last window of the full profile)."""
     cfg = approach_cfg(N0=100, N=60, M=3, L=4)
     cfg["stars"].update(every_K=30, per_image=3, attitude_sigma_arcsec=5.0, mode_drift_arcsec=3.0)
+    cfg = Setup.from_config(cfg)
     geo = sc.build_geometry(cfg, "stars")
     case = cases.headline_case(cfg)
     Rvar = geo.measurement_variance(case.sigma3_px)
     seg = pipeline.segment_bounds(cfg, geo, Rvar, case.truth_arcsec, "stars")
-    for l, (a, b) in enumerate(Setup.of(cfg).segments.windows()):
+    for l, (a, b) in enumerate(cfg.segments.windows()):
         np.testing.assert_allclose(seg[l], _dense_window_bound(cfg, geo, Rvar, case.truth_arcsec, a, b), rtol=2e-4)
     # the label reads the same exact bound (along the reference trajectory, at the start theta)
-    lab = cases.label_bounds(Setup.of(cfg), geo, [case], "stars")[0]
+    lab = cases.label_bounds(cfg, geo, [case], "stars")[0]
     np.testing.assert_allclose(lab[:2], seg[-1][:2], rtol=1e-3)
 
 
@@ -239,6 +240,7 @@ def test_a_window_whitens_its_own_star_rows():
     covariance information, and growing windows (from the first image) keep the arc's rows."""
     cfg = approach_cfg(N0=100, N=60, M=3, L=4)
     cfg["stars"].update(every_K=30, per_image=3, attitude_sigma_arcsec=5.0, mode_drift_arcsec=3.0)
+    cfg = Setup.from_config(cfg)
     geo = sc.build_geometry(cfg, "stars")
     y = geo.simulate_stars(sc.rad((10.0, 20.0, 10.0)), 7, 1, range(2))
     win = geo.window(geo.measurement_variance((0.1, 0.1, 0.2)), y)
@@ -265,7 +267,7 @@ def test_the_count_sweep_puts_that_many_stars_in_every_image(counts):
 
     cfg = approach_cfg(N0=100, N=100, M=3, L=4)
     cfg["stars"].update(every_K=100)
-    setup = Setup.of(cfg)
+    cfg = setup = Setup.from_config(cfg)
     geo = sc.build_geometry(cfg, "stars")
     cam = sc.camera_half_fov_rad(setup)
     case = cases.headline_case(cfg)
@@ -305,10 +307,9 @@ def test_the_stars_label_reads_tz(monkeypatch):
         return th, done, tr
 
     monkeypatch.setattr(cases, "ml_estimate", off_in_tz)
-    cfg = _stars_cfg(3)
-    cfg["stars"].update(attitude_sigma_arcsec=5.0, mode_drift_arcsec=1.0)
+    cfg = _stars_cfg(3, attitude_sigma_arcsec=5.0, mode_drift_arcsec=1.0)
     case = cases.headline_case(cfg)
-    setup = Setup.of(cfg).scheme("growing")
+    setup = cfg.scheme("growing")
     for variant, nax in (("stars", 3), ("prior", 2)):
         geo = sc.build_geometry(cfg, variant)
         BOUND_TZ[0] = cases.label_bounds(setup, geo, [case], variant)[0][2]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
-from test_approach_pipeline import _summary_row, approach_cfg
+from test_approach_pipeline import TARGET, _summary_row, approach_setup
 
 from opnav.approach.alternatives_summary import (
     METHOD_LABELS,
@@ -36,7 +36,7 @@ def test_headline_rows_are_read_by_scenario_method_and_mode_not_by_their_key():
     hs = HeadlineSummary.from_json(summ)
     assert [r.key for r in hs.rows] == ["row-a", "row-b", "row-c"]
     assert [r.as_written_scheme for r in hs.rows] == [True, False, False]
-    txt = approach_text.findings(approach_cfg(), hs, published.paper_a()["headline"])
+    txt = approach_text.findings(approach_setup(), hs, published.paper_a()["headline"], TARGET)
     assert "plain EM, sliding windows: converged in literal | growing squarem: stalled in literal | " \
            "squarem: converged in roll." in txt["stall"]
     assert "3 arcsec (literal), against" in txt["bound"]  # the paper's scheme only
@@ -46,7 +46,7 @@ def test_headline_rows_are_read_by_scenario_method_and_mode_not_by_their_key():
 def test_the_report_refuses_an_untyped_summary():
     """Mutation: accepting the dict again (the label-keyed boundary) fails."""
     with pytest.raises(TypeError, match="HeadlineSummary"):
-        approach_text.findings(approach_cfg(), {"variants": {}}, {})
+        approach_text.findings(approach_setup(), {"variants": {}}, {}, TARGET)
     with pytest.raises(TypeError, match="HeadlineSummary"):
         rows_paper_a(pd.DataFrame(), {}, {})
 
@@ -76,6 +76,6 @@ def test_a_x2_per_method_numbers_and_the_reports_table():
     table = x2_table(ms)
     assert list(table["method"]) == [METHOD_LABELS["em_plain"], METHOD_LABELS["augmented"]]
     assert table.loc[0, "T1-01 err_x sd"] == 0.5 and table.loc[0, "T1-01 err_x mean"] == 1.0
-    summ = summary_json(long, ms, approach_cfg())
+    summ = summary_json(long, ms, approach_setup())
     assert summ["variants"]["literal"]["em_plain"]["rmse_xy_all_cases_arcsec"] == em.rmse_xy_all_arcsec
     assert np.isnan(summ["variants"]["literal"]["augmented"]["err_x_mean_arcsec"])

@@ -35,7 +35,7 @@ SEEDS = range(6)
 def _cfg(mode):
     cfg = approach_cfg(N0=200, N=50, M=5, L=6)
     cfg["initial_error"]["mode"] = mode
-    return cfg
+    return Setup.from_config(cfg)
 
 
 def _run(variant, mode, method="squarem", seeds=SEEDS):
@@ -80,9 +80,9 @@ def test_the_augmented_ekf_does_not_beat_its_bound():
     out = alternatives.run_case_alternatives(cfg, "roll", case, SEEDS, geo, methods=("augmented",))
     th = out["methods"]["augmented"]["theta_final_arcsec"]
     Rvar = geo.measurement_variance(case.sigma3_px)
-    bound = pipeline.total_bound(Setup.of(cfg), geo, Rvar, case.truth_arcsec, "roll")
+    bound = pipeline.total_bound(cfg, geo, Rvar, case.truth_arcsec, "roll")
     ref_geo = sc.build_geometry(cfg, DIAGNOSTIC)
-    ref_bound = pipeline.total_bound(Setup.of(cfg), ref_geo, Rvar, case.truth_arcsec, DIAGNOSTIC)
+    ref_bound = pipeline.total_bound(cfg, ref_geo, Rvar, case.truth_arcsec, DIAGNOSTIC)
     assert np.all(bound[:2] > 2.0 * ref_bound[:2])
     assert np.all(_rmse(th, np.asarray(case.truth_arcsec)) >= 0.3 * bound[:2])
 

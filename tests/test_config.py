@@ -88,7 +88,9 @@ def test_the_approach_check_uses_the_closest_approach_of_the_configured_arc():
 
     a = load_config(REPO / "config" / "config.yaml")["approach"]
     T = 5.0e5
-    X0 = scenario.initial_truth(a) - dynamics.kepler_state(
+    from opnav.approach.setup import Setup
+
+    X0 = scenario.initial_truth(Setup.from_config(a)) - dynamics.kepler_state(
         dynamics.KeplerElements.from_config(a["mars_elements"]), 0.0)
     assert _approach_min_range_km(a, T) == pytest.approx(
         _integrated_min_range_km(X0[:3], X0[3:], T, dynamics.MU_MARS, dynamics.R_MARS_KM), rel=1e-6)

@@ -98,11 +98,11 @@ def test_the_preflight_carries_the_line(tmp_path):
 def test_the_problem_is_documented(approach):
     """The record's fields have the documented shapes; its measurements follow eq. 3 at theta0."""
     p = E.probe_problem(approach)
-    n1 = Setup.of(approach).segments.N + 1
+    n1 = Setup.from_config(approach).segments.N + 1
     assert isinstance(p, E.Problem)
     assert [np.shape(x) for x in p[:10]] == [(n1, 3), (n1,), (n1, 6, 6), (n1, 3, 3), (n1, 3), (n1, 3), (6, 6), (6,),
                                              (6, 6), (3,)]
-    np.testing.assert_allclose(np.diff(p.t_s), Setup.of(approach).dt_s)
+    np.testing.assert_allclose(np.diff(p.t_s), Setup.from_config(approach).dt_s)
     # across the line of sight z - u_ref is a tiny angle of u_ref (misalignment, position error, noise);
     # along it the range noise (Rvar's third entry, from the disc's size) dominates
     d = p.z[1:] - p.u_ref[1:]
@@ -112,7 +112,7 @@ def test_the_problem_is_documented(approach):
 
 @pytest.fixture(scope="module")
 def scored(approach):
-    setup = Setup.of(approach)
+    setup = Setup.from_config(approach)
     geo = sc.build_geometry(setup, "prior")
     est = E.load(E.specs({"batch_ls": EXAMPLE})["batch_ls"])
     return [E.run_case(setup, "prior", c, range(3), geo, [est]) for c in cases.table1_cases(setup)[:2]]
@@ -156,7 +156,7 @@ def test_a_failure_in_a_run_names_estimator_variant_case_seed_and_window(approac
         """, "late.py")
     a = with_estimators(approach, late=f"{f}:est")
     assert E.problems(a) == []
-    setup = Setup.of(a)
+    setup = Setup.from_config(a)
     geo = sc.build_geometry(setup, "prior")
     est = E.load(E.specs(a["custom_estimators"])["late"])
     with pytest.raises(MethodError, match=r"^approach\.custom_estimators\.late: \S+ raised LinAlgError: too long "

@@ -20,7 +20,6 @@ _NEW_STUDY = {"studies": {"accel": {"paper": "landing", "vary": {"landing.imu.si
 #: Every config edit the tests below dry-run on the completed quick run, by name.
 EDITS = {
     "nothing": {},
-    "accuracy_target": {"approach": {"accuracy_target_arcsec": 3.0}},
     "convergence_tol": {"approach": {"convergence_study": {"tol_arcsec": 0.2}}},
     "study_fov": {"studies": {"fov": {"vary": {"landing.camera.fov_deg": [45.0, 70.0]}}}},
     "study_ifov": {"studies": {"ifov": {"vary": {"approach.camera.ifov_arcsec": [10.0, 15.0]}}}},
@@ -48,10 +47,9 @@ def test_unchanged_config_lists_nothing(edits):
 
 
 @pytest.mark.parametrize("edit, only", [
-    # approach_crlb: the roll rate that reaches the target within the published data (issue 28)
-    # approach_stars: the attitude knowledge at which star calibration reaches the target (issue 44)
-    ("accuracy_target", {"approach_tables", "approach_x1_figure", "approach_crlb", "approach_stars",
-                         "approach_stars_outputs"}),
+    # (the claimed accuracy is the analysis plan's A-C1 target, no config key: the rules using it,
+    # approach_crlb, approach_stars, approach_stars_outputs, approach_tables and approach_x1_figure,
+    # pass it as a param and list the plan as an input)
     ("convergence_tol", {"approach_convergence", "approach_tables", "approach_x1_figure"}),
 ])
 def test_editing_one_key_reruns_only_its_users(edits, edit, only):

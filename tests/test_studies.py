@@ -120,7 +120,9 @@ def test_study_run_at_the_default_value_is_the_main_run_and_values_are_paired(qu
 def test_approach_study_runs_do_not_depend_on_chunking(quick):
     from opnav.approach.study import run_runs
 
-    cfg = _plan(quick)["ifov"].instances[1].sim
+    from opnav.approach.setup import Setup
+
+    cfg = Setup.from_config(_plan(quick)["ifov"].instances[1].sim)
     whole = run_runs(cfg, "roll", "em", [0, 1, 2])
     parts = pd.concat([run_runs(cfg, "roll", "em", [0, 1]), run_runs(cfg, "roll", "em", [2])],
                       ignore_index=True)

@@ -2,6 +2,8 @@
 # Simulation rules (Monte Carlo, convergence study, CRLB) write pickles under
 # results/approach/work/; table and figure rules only read them.
 
+from opnav.core.planvalues import accuracy_target_arcsec
+
 APPROACH = res("approach")
 A_WORK = f"{APPROACH}/work"
 # Each rule's params hold only the approach keys it reads (editing another key reruns nothing):
@@ -14,6 +16,11 @@ A_EM = A_SCENARIO + ("n_seeds", "em", "nav_error")
 A_GROUPS = ["size", "polarity", "initial", "pixel", "install"]
 A_VARIANTS = config["approach"]["variants"]
 A_METHODS = config["approach"]["methods"]
+# Paper A's accuracy claim (arcsec): A-C1's target in the analysis plan, its one home (read without
+# the report layer, opnav.core.planvalues); the rules that compute with it pass it as a param and list
+# the plan as an input
+A_PLAN = src("data/analysis_plan.yaml")[0]
+A_TARGET = accuracy_target_arcsec(A_PLAN)
 A_SRC = with_kernels("approach", src(
     "approach/dynamics.py", "approach/camera.py", "approach/kalman.py", "approach/ekf.py",
     "approach/smoother.py", "approach/em.py", "approach/augmented.py", "approach/crlb.py",
@@ -134,10 +141,12 @@ rule approach_crlb:
         A_SRC,
         src("core/published.py", "data/published.yaml", "approach/readings.py"),
         kernels=kernels("approach"),
+        plan=A_PLAN,
     output:
         f"{A_WORK}/crlb.pkl",
     params:
-        approach=cfg("approach", *A_SCENARIO, "variants", "roll_rate_study", "accuracy_target_arcsec"),
+        approach=cfg("approach", *A_SCENARIO, "variants", "roll_rate_study"),
+        target=A_TARGET,
     log:
         f"{APPROACH}/logs/crlb.log",
     benchmark:
@@ -153,10 +162,12 @@ rule approach_stars:
     input:
         A_SRC + src("approach/alternatives.py", "approach/batch_ml.py"),
         kernels=kernels("approach"),
+        plan=A_PLAN,
     output:
         f"{A_WORK}/stars.pkl",
     params:
-        approach=cfg("approach", *A_EM, "growing", "alternatives", "accuracy_target_arcsec"),
+        approach=cfg("approach", *A_EM, "growing", "alternatives"),
+        target=A_TARGET,
     log:
         f"{APPROACH}/logs/stars.log",
     benchmark:
@@ -170,13 +181,14 @@ rule approach_stars_outputs:
     and magnitude limit)."""
     input:
         stars=f"{A_WORK}/stars.pkl",
+        plan=A_PLAN,
         code=src("approach/summaries.py", "approach/labels.py", "approach/star_plots.py", "core/figures.py", "core/tables.py",
                  "opnav.mplstyle"),
     output:
         table=report_table(f"{APPROACH}/A-X6_stars", "A-X6", "Paper A"),
         fig=report_figure(f"{APPROACH}/A-X6_stars", "A-X6", "Paper A"),
     params:
-        target=config["approach"]["accuracy_target_arcsec"],
+        target=A_TARGET,
     log:
         f"{APPROACH}/logs/stars_outputs.log",
     localrule: True
@@ -192,6 +204,7 @@ rule approach_tables:
         crlb=f"{A_WORK}/crlb.pkl",
         stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
         nav_arc=f"{A_WORK}/nav_arc.pkl",
+        plan=A_PLAN,
         code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
                  "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:
@@ -200,8 +213,9 @@ rule approach_tables:
         verdict=f"{APPROACH}/A-X1_identifiability.md",
         summary=f"{APPROACH}/A-summary.json",
     params:
-        approach=cfg("approach", "segments", "accuracy_target_arcsec", "convergence_study", "crlb",
-                     "prior_sigma", "geometry", "em", "camera"),
+        approach=cfg("approach", "segments", "convergence_study", "crlb", "prior_sigma", "geometry", "em",
+                     "camera"),
+        target=A_TARGET,
         profile=config["profile"],
     log:
         f"{APPROACH}/logs/tables.log",
@@ -276,11 +290,13 @@ rule approach_x1_figure:
         crlb=f"{A_WORK}/crlb.pkl",
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         x1=f"{APPROACH}/A-X1_crlb.csv",
+        plan=A_PLAN,
         code=src("approach/plots.py", "core/figures.py", "opnav.mplstyle"),
     output:
         fig=report_figure(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),
     params:
-        approach=cfg("approach", "accuracy_target_arcsec", "segments"),
+        approach=cfg("approach", "segments"),
+        target=A_TARGET,
     log:
         f"{APPROACH}/logs/x1_figure.log",
     localrule: True

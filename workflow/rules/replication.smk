@@ -54,6 +54,7 @@ if REP_CFG["enabled"]:
             conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
             crlb=f"{A_WORK}/crlb.pkl",
             stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
+            plan=A_PLAN,
             code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
                      "approach/setup.py", "core/tables.py"),
         output:
@@ -62,8 +63,8 @@ if REP_CFG["enabled"]:
             verdict=f"{REP}/approach/A-X1_identifiability.md",
             summary=f"{REP}/approach/A-summary.json",
         params:
-            approach=cfg("approach", "segments", "accuracy_target_arcsec", "convergence_study", "crlb",
-                         "prior_sigma", "geometry", "em"),
+            approach=cfg("approach", "segments", "convergence_study", "crlb", "prior_sigma", "geometry", "em"),
+            target=A_TARGET,
             profile=config["profile"],
         log:
             f"{REP}/logs/approach_tables.log",

@@ -12,6 +12,6 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)
-    out = stars_study(setup, log)
+    out = stars_study(setup, snakemake.params.target, log)  # A-C1's target (the analysis plan)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], out)

@@ -23,18 +23,19 @@ with script_context(snakemake) as log:
         conv[c["variant"]] = c
     curves = load_pickle(snakemake.input.crlb)
     pub = published.paper_a()
-    t1 = summaries.table1_frame(results, pub, snakemake.params.profile)
+    target = snakemake.params.target  # the claimed accuracy: A-C1's target (the analysis plan)
+    t1 = summaries.table1_frame(results, pub, target)
     csv, tex, md = snakemake.output.t1
     cap = approach_views.CAPTIONS["A-T1"]
     write_table(t1, [csv], caption=cap)  # every column
     write_table(approach_views.table1_compact(t1), [tex, md], caption=cap)  # the columns that fit a page
-    x1 = summaries.crlb_rows(setup, curves["Q"], conv, t1, curves["Q0"])
+    x1 = summaries.crlb_rows(setup, curves["Q"], conv, t1, target, curves["Q0"])
     write_table(x1, snakemake.output.x1,
                 caption=approach_views.CAPTIONS["A-X1"])
-    atomic_write_text(snakemake.output.verdict, approach_text.identifiability_text(setup, x1))
-    summ = summaries.summary(setup, t1, x1, curves.get("roll_rate"))
+    atomic_write_text(snakemake.output.verdict, approach_text.identifiability_text(setup, x1, target))
+    summ = summaries.summary(setup, t1, x1, target, curves.get("roll_rate"))
     if snakemake.input.stars:  # the stars variant (beyond the paper)
-        summ["stars"] = summaries.stars_summary(load_pickle(snakemake.input.stars), setup.accuracy_target_arcsec)
+        summ["stars"] = summaries.stars_summary(load_pickle(snakemake.input.stars), target)
     summ["nees"] = summaries.nees_summary(t1)  # each compensated filter against the true-theta filter
     if "camera" in snakemake.params.approach:  # (the replication's tables pass no camera: main sample's bounds)
         summ["mars_attitude"] = summaries.mars_attitude_summary(setup, curves.get("mars_attitude"), curves["Q"])
@@ -46,7 +47,7 @@ with script_context(snakemake) as log:
         summ["tz_nav_effect"] = nav_arc["tz_nav_effect"]
     summ["figures_5_6"] = summaries.figures_5_6(results)
     summ["profile"] = snakemake.params.profile
-    summ["text"] = approach_text.findings(setup, summaries.HeadlineSummary.from_json(summ), pub["headline"])  # the manuscript's finding sentences
+    summ["text"] = approach_text.findings(setup, summaries.HeadlineSummary.from_json(summ), pub["headline"], target)  # the manuscript's finding sentences
     if "readings" in curves:  # the installation rows and the sample time (opnav.approach.readings)
         chk = curves["readings"]["installation"]
         summ["installation"] = {**chk, **summaries.installation_summary(chk)}

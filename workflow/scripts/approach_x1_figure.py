@@ -19,5 +19,5 @@ with script_context(snakemake) as log:
         c = load_pickle(p)
         conv[c["variant"]] = c
     x1 = load_table(snakemake.input.x1)
-    fig = plots.fig_crlb(curves, conv, x1, setup.accuracy_target_arcsec, setup.segments.N0)
+    fig = plots.fig_crlb(curves, conv, x1, snakemake.params.target, setup.segments.N0)
     figures.save(fig, snakemake.output.fig)

@@ -19,7 +19,10 @@ def fly(paper: str, sim: dict, units: list[str], runs: list[int], label: str, lo
     if paper == "landing":
         from opnav.landing.study import run_runs
     else:
+        from opnav.approach.setup import Setup
         from opnav.approach.study import run_runs
+
+        sim = Setup.from_config(sim)  # the edge: paper A's config parsed once
     frames, shared = [], {}  # paper A: the estimators of a variant share its geometry and bounds
     for unit in units:
         if paper == "landing":

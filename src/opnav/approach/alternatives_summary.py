@@ -164,10 +164,9 @@ def method_summaries(long: pd.DataFrame) -> tuple[MethodSummary, ...]:
     return tuple(out)
 
 
-def summary_json(long: pd.DataFrame, rows: Sequence[MethodSummary], setup: Setup | dict) -> dict:
+def summary_json(long: pd.DataFrame, rows: Sequence[MethodSummary], setup: Setup) -> dict:
     """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json);
     ``rows``: :func:`method_summaries` of ``long``."""
-    setup = Setup.of(setup)
     out = {"segments": setup.segments.as_dict(), "alternatives": setup.alternatives.as_dict(), "variants": {}}
     for r in rows:
         out["variants"].setdefault(r.variant, {})[r.method] = {

@@ -39,7 +39,7 @@ def _start_covariances(geo: sc.Geometry, win: Window, variant: str) -> np.ndarra
     return kalman.propagate(None, geo.P0, win.Phi, win.Q)[1]
 
 
-def bound_curve(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
+def bound_curve(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
                 zero_q: bool = False) -> np.ndarray:
     """1-sigma CRLB (arcsec) of theta after d = 0..n-N0 samples from N0, (n-N0+1, 3): the
     bound of the *cumulative* data (growing windows, all-data estimators).
@@ -53,9 +53,8 @@ def bound_curve(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_a
     return bound_curves(setup, geo, [(Rvar, theta_arcsec, zero_q)], variant)[0]
 
 
-def bound_curves(setup: Setup | dict, geo: sc.Geometry, items, variant: str) -> list[np.ndarray]:
+def bound_curves(setup: Setup, geo: sc.Geometry, items, variant: str) -> list[np.ndarray]:
     """:func:`bound_curve` of several ``(Rvar, theta_arcsec, zero_q)`` items in one batched recursion."""
-    setup = Setup.of(setup)
     N0 = setup.segments.N0
     a = 0 if sc.START_OF[variant] == "filter" else N0
     wins = [_window(geo, Rvar, zq) for Rvar, _, zq in items]
@@ -75,7 +74,7 @@ def _star_info(geo: sc.Geometry, idx, B: int) -> np.ndarray | None:
     return None if info is None else np.broadcast_to(info[idx], (B,) + info[idx].shape)
 
 
-def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
+def segment_bounds(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, variant: str,
                    zero_q: bool = False) -> np.ndarray:
     """The bound for the data each segment's estimate rests on (L, 3), arcsec, 1-sigma.
 
@@ -88,13 +87,12 @@ def segment_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, thet
     return segment_bounds_many(setup, geo, [(Rvar, theta_arcsec, zero_q)], variant)[0]
 
 
-def bound_data(setup: Setup | dict, variant: str) -> dict:
+def bound_data(setup: Setup, variant: str) -> dict:
     """The samples the last segment's bound (:func:`segment_bounds`) rests on: ``first`` and
     ``last`` sample indices (1-based after t0 = sample 0), whether the prior enters, and a
     phrase naming them. ``literal``: every sample from t0 (its window starts from the theta = 0
     filter, which carries them all); ``growing``: every sample after N0; ``sliding``: the
     last window."""
-    setup = Setup.of(setup)
     s = setup.segments
     a, b = s.windows()[-1]
     if sc.START_OF[variant] == "filter":
@@ -112,11 +110,10 @@ def _start_phrase(variant: str) -> str:
             else "started from the prior propagated without data")
 
 
-def segment_bounds_many(setup: Setup | dict, geo: sc.Geometry, items, variant: str,
+def segment_bounds_many(setup: Setup, geo: sc.Geometry, items, variant: str,
                         curves: list[np.ndarray] | None = None) -> list[np.ndarray]:
     """:func:`segment_bounds` of several ``(Rvar, theta_arcsec, zero_q)`` items, every window
     of every item in one batched recursion; ``curves``: their :func:`bound_curves`, if known."""
-    setup = Setup.of(setup)
     windows = setup.segments.windows()
     N0 = setup.segments.N0
     if setup.segments.mode == "growing" or sc.START_OF[variant] == "filter":

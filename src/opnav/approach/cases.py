@@ -72,9 +72,8 @@ class Case:
     init_mode: str | None = None  # initial-error mode of this run (None: the config's)
 
 
-def table1_cases(setup: Setup | dict) -> list[Case]:
+def table1_cases(setup: Setup) -> list[Case]:
     """The 17 cases of paper A Table 1 (ids T1-01..T1-17, paper row order)."""
-    setup = Setup.of(setup)
     truth = setup.truth_bias_arcsec
     init = setup.theta_init_arcsec
     px = setup.camera.sigma3_px
@@ -92,7 +91,7 @@ def table1_cases(setup: Setup | dict) -> list[Case]:
     return [Case(i + 1, f"T1-{i + 1:02d}", *r) for i, r in enumerate(rows)]
 
 
-def headline_case(setup: Setup | dict) -> Case:
+def headline_case(setup: Setup) -> Case:
     return table1_cases(setup)[0]
 
 
@@ -184,7 +183,7 @@ def start_states(start: str, starts, f0, dx_true: np.ndarray, dx0: np.ndarray, P
     raise ValueError(f"unknown start rule {start!r}")
 
 
-def run_case(setup: Setup | dict, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
+def run_case(setup: Setup, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
              method: str | None = None, init_mode: str | None = None) -> dict:
     """EM-EKF for one case and variant over the given seeds; arrays in arcsec / km."""
     return run_cases(setup, variant, [case], seed_indices, geo, method, init_mode)[0]
@@ -214,11 +213,10 @@ class CaseData:
     f_true: object = None
 
 
-def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
+def prepare_cases(setup: Setup, variant: str, case_list: list[Case], seed_indices,
                   geo: sc.Geometry | None = None, init_mode: str | None = None) -> CaseData:
     """Simulate every (case, seed) run of ``case_list`` (one row each of the stacked filter
     arrays; each keeps its own stream) and run the theta = 0 filter over the whole arc."""
-    setup = Setup.of(setup)
     geo = geo or sc.build_geometry(setup, variant)
     init_mode = init_mode or setup.initial_error.mode
     seed_indices = list(seed_indices)
@@ -248,7 +246,7 @@ def prepare_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed
     return CaseData(geo, z, dx0, Rvar, theta, win, f0, err_before, consistency(f0, geo.dx_true), {}, f_true)
 
 
-def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_indices,
+def run_cases(setup: Setup, variant: str, case_list: list[Case], seed_indices,
               geo: sc.Geometry | None = None, method: str | None = None, init_mode: str | None = None,
               data: CaseData | None = None, seg_bounds: list | None = None) -> list[dict]:
     """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
@@ -257,7 +255,6 @@ def run_cases(setup: Setup | dict, variant: str, case_list: list[Case], seed_ind
     (``method``, ``setup.segments``). ``seg_bounds``: per case, the 1-sigma bound (arcsec) of
     the data the last segment's estimate used (3,), for the convergence label; computed
     (:func:`label_bounds`) when not given."""
-    setup = Setup.of(setup)
     em_set = setup.em
     method = method or em_set.method
     seed_indices = list(seed_indices)
@@ -418,7 +415,7 @@ def label_bounds(setup: Setup, geo: sc.Geometry, case_list: list[Case], variant:
     return [b[-1] for b in segment_bounds_many(setup, geo.along_reference(), items, variant)]
 
 
-def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indices, data_samples: int,
+def convergence_study(setup: Setup, variant: str, case: Case, seed_indices, data_samples: int,
                       max_maps: int, tol_arcsec: float, geo: sc.Geometry | None = None,
                       init_mode: str | None = None) -> dict:
     """Iterations of plain EM and SQUAREM to reach the maximum-likelihood estimate.
@@ -431,7 +428,6 @@ def convergence_study(setup: Setup | dict, variant: str, case: Case, seed_indice
     ``max_maps`` is reported as ``max_maps + 1`` (stalled) together with the
     contraction rate per map measured over its last iterations.
     """
-    setup = Setup.of(setup)
     N0 = setup.segments.N0
     geo = geo or sc.build_geometry(setup, variant, n=N0 + data_samples)
     init_mode = init_mode or setup.initial_error.mode

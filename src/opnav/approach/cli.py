@@ -50,6 +50,7 @@ def run(args, rc) -> int:
     from opnav.core.checks import schema_node
     from opnav.core.cliargs import print_json
     from opnav.core.config import ConfigError
+    from opnav.core.planvalues import accuracy_target_arcsec
     from . import scenario as sc
     from .cases import Case, run_case
     from .pipeline import bound_curve, bound_data, segment_bounds
@@ -101,7 +102,7 @@ def run(args, rc) -> int:
     st = r["stalled"]
     tz = "unobservable" if r["tz_unobservable"] else None
     label, counts = row_label(r["label"])
-    target = setup.accuracy_target_arcsec
+    target = accuracy_target_arcsec()  # the analysis plan's A-C1 target
     cause = bound_cause(sc.START_OF[args.variant], s.mode, s.N)
     rate = r["contraction_per_map"]
     rate_med = float(np.nanmedian(rate)) if np.isfinite(rate).any() else float("nan")

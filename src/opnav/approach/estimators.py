@@ -233,7 +233,7 @@ def run_variant(approach_cfg: Mapping, variant: str, log=None) -> list[dict]:
     from . import scenario as sc
     from .setup import Setup
 
-    setup = Setup.of(approach_cfg)
+    setup = Setup.from_config(approach_cfg)
     ests = [load(s) for s in specs(approach_cfg.get("custom_estimators")).values()]
     geo = sc.build_geometry(setup, variant)
     seeds = range(setup.n_seeds)
@@ -256,7 +256,7 @@ def probe_problem(approach_cfg: Mapping, n_data: int | None = None) -> Problem:
     from . import scenario as sc
     from .setup import Setup
 
-    setup = Setup.of(approach_cfg)
+    setup = Setup.from_config(approach_cfg)
     seg = setup.segments
     n_data = int(n_data or seg.N)
     n = seg.N0 + n_data

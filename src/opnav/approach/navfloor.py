@@ -73,13 +73,12 @@ def _scheme(scheme: str) -> tuple[str, str]:
     return mode, method
 
 
-def nav_floor_by_arc(setup: Setup | dict, variant: str, scheme: str, arcs_s, log=None) -> dict:
+def nav_floor_by_arc(setup: Setup, variant: str, scheme: str, arcs_s, log=None) -> dict:
     """Navigation error against arc length (module docstring). Returns ``rule`` (the words),
     ``variant`` (the A-T1 row label), ``rows`` (one per arc: ``arc_s``, ``variant``,
     ``nav_err_km_rule``, ``nav_err_km_last``, ``true_theta_km_rule``, ``true_theta_km_last``,
     ``before_km_rule``, ``before_km_last``, their medians and sds over seeds, the estimate's seed
     mean (tx, ty) in arcsec, ``samples`` and ``n_seeds``) and the per-seed errors (``per_seed``)."""
-    setup = Setup.of(setup)
     mode, method = _scheme(scheme)
     ns = arc_samples(setup, arcs_s)
     nmax = max(ns)
@@ -132,12 +131,11 @@ def nav_floor_by_arc(setup: Setup | dict, variant: str, scheme: str, arcs_s, log
             "per_seed": {k: v.tolist() for k, v in per.items()}}
 
 
-def tz_nav_effect(setup: Setup | dict, variant: str) -> dict:
+def tz_nav_effect(setup: Setup, variant: str) -> dict:
     """Navigation error with the headline case's tz bias on and off (module docstring): paired
     seeds, the filter given the true (tx, ty) and tz = 0, over the profile's arc by the plan's
     rule. Returns ``nav_err_km_tz_on``, ``nav_err_km_tz_off`` (seed means), the paired
     difference's mean and sd, ``tz_arcsec``, ``n_seeds``, ``variant`` and ``rule``."""
-    setup = Setup.of(setup)
     geo = sc.build_geometry(setup, variant)
     case = cases.headline_case(setup)
     seeds = list(range(setup.n_seeds))

@@ -359,7 +359,7 @@ def ukf_inputs(geo: sc.Geometry, install_deg: float) -> tuple[np.ndarray, np.nda
     return mrp_from_dcm(A_b_i), mrp_from_dcm(camera.rot_x(np.deg2rad(install_deg)))
 
 
-def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec=None,
+def run_peer(setup: Setup, variant: str, case, seed_indices, truth_arcsec=None,
              geo: sc.Geometry | None = None, steps: int | None = None, stride: int = 10,
              start: str = "prior") -> dict:
     """The peer UKF on the measurements of ``case`` (same streams as the EM-EKF) per seed.
@@ -372,8 +372,6 @@ def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec
     (km) and, every ``stride`` samples, the estimate history for the figure.
     """
     from .cases import simulate_case
-
-    setup = Setup.of(setup)
     geo = geo or sc.build_geometry(setup, variant)
     cam, settings = peer_settings(setup)
     truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
@@ -412,7 +410,7 @@ def run_peer(setup: Setup | dict, variant: str, case, seed_indices, truth_arcsec
             "truth_bias_px": bias_px_from_theta(sc.rad(truth[:2].tolist() + [0.0]), cam)}
 
 
-def peer_bound(setup: Setup | dict, geo: sc.Geometry, case, truth_arcsec=None, zero_q: bool = False) -> np.ndarray:
+def peer_bound(setup: Setup, geo: sc.Geometry, case, truth_arcsec=None, zero_q: bool = False) -> np.ndarray:
     """1-sigma CRLB (tx, ty, tz) in arcsec on the peer's information: every sample from t0
     with the prior ``P_X0`` and the peer's bias prior (the EM-EKF's ``literal`` set);
     ``zero_q``: the same without process noise (the truth has none)."""
@@ -420,7 +418,7 @@ def peer_bound(setup: Setup | dict, geo: sc.Geometry, case, truth_arcsec=None, z
 
     from .crlb import crlb_curve
 
-    cam, settings = peer_settings(Setup.of(setup))
+    cam, settings = peer_settings(setup)
     truth = np.asarray(case.truth_arcsec if truth_arcsec is None else truth_arcsec, float)
     Rvar = geo.measurement_variance(case.sigma3_px)
     sig = settings.bias_prior_sigma_px * cam.pitch
@@ -435,11 +433,9 @@ RUN_LABELS = {"headline": "headline case", "bias_free": "zero misalignment (sani
               "truth_start": "prior mean at the truth (diagnostic)"}
 
 
-def run_variant(setup: Setup | dict, variant: str, log=None) -> dict:
+def run_variant(setup: Setup, variant: str, log=None) -> dict:
     """A-P1 simulation job: the headline case and the bias-free sanity case of ``variant``."""
     from .cases import headline_case
-
-    setup = Setup.of(setup)
     geo = sc.build_geometry(setup, variant)
     case = headline_case(setup)
     seeds = range(setup.n_seeds)

@@ -30,10 +30,9 @@ from .bounds import (_start_covariances, _star_info, _window, bound_curve, bound
                      bound_data, segment_bounds, segment_bounds_many)
 
 
-def groups_for(setup: Setup | dict, variant: str) -> list[str]:
+def groups_for(setup: Setup, variant: str) -> list[str]:
     """Case groups a variant runs (Snakemake jobs): the five groups (or "all" in one job when
     ``scatter: variant``) for ``table1_variants``, else the headline case only."""
-    setup = Setup.of(setup)
     if variant not in setup.table1_variants:
         return ["headline"]
     return list(cases.GROUPS) if setup.scatter == "group" else ["all"]
@@ -44,7 +43,7 @@ def groups_for(setup: Setup | dict, variant: str) -> list[str]:
 HEADLINE_EXTRA = {"stars": ("polarity",)}
 
 
-def cases_in(setup: Setup | dict, group: str, variant: str = "") -> list[cases.Case]:
+def cases_in(setup: Setup, group: str, variant: str = "") -> list[cases.Case]:
     """The Table-1 cases of a Snakemake job's ``group`` (``headline``: T1-01, and for the
     variants of :data:`HEADLINE_EXTRA` their extra groups)."""
     allc = cases.table1_cases(setup)
@@ -55,7 +54,7 @@ def cases_in(setup: Setup | dict, group: str, variant: str = "") -> list[cases.C
     return [c for c in allc if c.group == group]
 
 
-def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: str = "sliding",
+def run_group(setup: Setup, variant: str, group: str, method: str, mode: str = "sliding",
               log=None, shared: dict | None = None) -> list[dict]:
     """Monte Carlo of every case of ``group`` under ``variant``, EM ``method`` and segment
     ``mode``, each case with the bound of the data its estimate used (``crlb_arcsec``; per
@@ -67,7 +66,7 @@ def run_group(setup: Setup | dict, variant: str, group: str, method: str, mode: 
     same ``setup``, ``variant`` and ``group`` (one Snakemake job): they then share the
     geometry, the simulated measurements, the theta = 0 filter and the bounds of a mode,
     computed by the first call (the same numbers as computed by each)."""
-    base = Setup.of(setup)
+    base = setup
     setup = base.scheme(mode)
     shared = {} if shared is None else shared
     if shared.setdefault("key", (base, variant, group)) != (base, variant, group):
@@ -140,11 +139,10 @@ def total_bound(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, 
     return _at_total(setup, bound_curve(setup, geo, Rvar, theta_arcsec, variant))
 
 
-def mars_attitude_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar_of, theta_arcsec, variant: str) -> dict:
+def mars_attitude_bounds(setup: Setup, geo: sc.Geometry, Rvar_of, theta_arcsec, variant: str) -> dict:
     """The bound of all the data (tx, ty, tz; arcsec, 1-sigma, with Q) of ``variant`` at each Mars-image
     attitude knowledge of ``camera.attitude_study_arcsec`` (issue 54, item 3): the same arc with the
     estimators' variances for that knowledge (``Rvar_of(geo)``: the case's variances of a geometry)."""
-    setup = Setup.of(setup)
     out = {}
     for a in setup.camera.attitude_study_arcsec:
         g = replace(geo, attitude_sigma_rad=float(sc.rad(a)))
@@ -160,12 +158,11 @@ def _head(geo: sc.Geometry, n: int) -> sc.Geometry:
     return replace(geo, **cut)
 
 
-def roll_rate_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, rates_deg_s,
+def roll_rate_bounds(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, rates_deg_s,
                      samples: int, zero_q: bool = False) -> np.ndarray:
     """1-sigma CRLB (arcsec) of the ``roll`` variant after ``samples`` samples from N0, with the
     camera rolling at each rate of ``rates_deg_s`` (R, 3): the same arc and prior
     (:func:`opnav.approach.scenario.with_roll_rate`), every rate in one batched recursion."""
-    setup = Setup.of(setup)
     n = setup.segments.N0 + samples
     if n >= geo.t.shape[0]:
         raise ValueError(f"roll_rate_bounds: {samples} samples after N0 need an arc of {n} samples, "
@@ -184,7 +181,7 @@ def roll_rate_bounds(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, th
     return sc.arcsec(c[:, -1])
 
 
-def rate_to_target(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, samples: int,
+def rate_to_target(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, samples: int,
                    target_arcsec: float, bracket_deg_s, iterations: int = 40) -> float:
     """The smallest roll rate (deg/s) at which the bound of both tx and ty after ``samples``
     samples from N0 is at most ``target_arcsec``: bisection on log(rate) inside ``bracket_deg_s``
@@ -208,14 +205,13 @@ def rate_to_target(setup: Setup | dict, geo: sc.Geometry, Rvar: np.ndarray, thet
 ROLL_GRID_POINTS = 36
 
 
-def roll_rate_study(setup: Setup | dict, samples: int, target_arcsec: float) -> dict:
+def roll_rate_study(setup: Setup, samples: int, target_arcsec: float) -> dict:
     """The roll rows' dependence on the roll rate (headline case): the bound of tx, ty after
     ``samples`` samples and after all the data, with and without process noise, at each rate
     of ``roll_rate_study.rates_deg_s``; the log-log slope of the all-data bound against the
     rate; the rate that brings the bound to ``target_arcsec`` within ``samples`` samples; and the
     bound after ``samples`` on a log grid of :data:`ROLL_GRID_POINTS` rates over the searched
     bracket (``grid_rates_deg_s``, ``bound_grid_arcsec``)."""
-    setup = Setup.of(setup)
     case = cases.headline_case(setup)
     total = setup.segments.data_samples
     geo = sc.build_geometry(setup, "roll", n=setup.segments.N0 + max(samples, total))  # the arc may be shorter

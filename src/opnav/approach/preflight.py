@@ -36,8 +36,9 @@ def _approach_min_range_km(a: dict, T: float) -> float:
     nearly parabolic arc (energy lost in round-off) is integrated instead
     (:func:`_integrated_min_range_km`)."""
     from opnav.approach import dynamics, scenario
+    from opnav.approach.setup import Setup
 
-    X0 = scenario.initial_truth(a) - dynamics.kepler_state(
+    X0 = scenario.initial_truth(Setup.from_config(a)) - dynamics.kepler_state(
         dynamics.KeplerElements.from_config(a["mars_elements"]), 0.0)
     args = (X0[:3], X0[3:], T, dynamics.MU_MARS, dynamics.R_MARS_KM)
     try:
@@ -125,12 +126,13 @@ def _nav_floor_problem(a: dict) -> str | None:
 def approach_problems(a: dict) -> list[str]:
     """Cross-key problems of the ``approach`` section (see module docstring)."""
     from opnav.approach import dynamics, scenario
+    from opnav.approach.setup import Setup
 
     out: list[str] = []
     k = "invalid config key 'approach."
     dt = a["dt_s"]
     s = a["segments"]
-    n = scenario.n_samples(a)
+    n = Setup.from_config(a).segments.n_samples
     if n > MAX_APPROACH_SAMPLES:
         out.append(f"{k}segments': N0 + L*N = {n} samples exceeds the limit "
                    f"{MAX_APPROACH_SAMPLES} (memory)")

@@ -32,7 +32,7 @@ from . import scenario as sc
 from .setup import Setup
 
 
-def installation_check(setup: Setup | dict, install_deg, theta_arcsec, variant: str = "literal",
+def installation_check(setup: Setup, install_deg, theta_arcsec, variant: str = "literal",
                        n: int = 200) -> dict:
     """The measurement chain of paper A for each installation angle (module docstring).
 
@@ -40,7 +40,6 @@ def installation_check(setup: Setup | dict, install_deg, theta_arcsec, variant: 
     angle 0 over the first ``n`` samples (``max_rel_change``), whether it is rounding only
     (``by_construction``: below 1e-12), and the camera-frame (tx, ty, tz) a body-frame
     deviation ``theta_arcsec`` would become at each angle (``body_frame_theta_cam_arcsec``)."""
-    setup = Setup.of(setup)
     geo = sc.build_geometry(setup, variant, n=n)
     los = geo.X_mars[:, :3] - geo.X_true[:, :3]
     A_m = camera.misalignment_exact(sc.rad(theta_arcsec))
@@ -72,15 +71,13 @@ def installation_text(chk: dict) -> str:
             f"{cam[:, 1].min():.3g} to {cam[:, 1].max():.3g} arcsec across these angles.")
 
 
-def sample_time_reading(setup: Setup | dict, pub_headline: dict, pub_simulation: dict,
+def sample_time_reading(setup: Setup, pub_headline: dict, pub_simulation: dict,
                         variants=("literal", "roll")) -> dict:
     """Sample time: the config's ``dt_s``, the paper's stated step and the step implied by
     "250 samples = 4 min", with the minutes 250 samples span and the bound of (tx, ty) after
     them at each step (headline case, data after N0 / from t0 as for the variant's bound)."""
     from .cases import headline_case
     from .pipeline import bound_curve
-
-    setup = Setup.of(setup)
     samples = int(pub_headline["data_to_converge_samples"])
     implied = 60.0 * float(pub_headline["data_to_converge_minutes"]) / samples
     steps = {"config": setup.dt_s, "paper_stated": float(pub_simulation["dt_s"]), "paper_4_min": implied}

@@ -117,9 +117,8 @@ class Geometry:
         return camera.noise_sigma_km(self.rho_ref, self.ifov_arcsec, sigma3_px) ** 2
 
 
-def initial_truth(setup: Setup | dict) -> np.ndarray:
+def initial_truth(setup: Setup) -> np.ndarray:
     """Heliocentric truth state at t0: Mars state + hyperbolic approach state (km, km/s)."""
-    setup = Setup.of(setup)
     g = setup.geometry
     Xm = dynamics.kepler_state(setup.mars, 0.0)
     d = np.asarray(g.v_inf_dir, float)
@@ -132,9 +131,9 @@ def initial_truth(setup: Setup | dict) -> np.ndarray:
     return Xm + np.concatenate([r_rel, vmag * d])
 
 
-def n_samples(setup: Setup | dict) -> int:
+def n_samples(setup: Setup) -> int:
     """Samples after t0 that the arc needs: N0 + L*N."""
-    return Setup.of(setup).segments.n_samples
+    return setup.segments.n_samples
 
 
 def mars_disc_px(range_km: float, ifov_arcsec: float) -> float:
@@ -143,9 +142,8 @@ def mars_disc_px(range_km: float, ifov_arcsec: float) -> float:
     return 2.0 * np.rad2deg(np.arcsin(dynamics.R_MARS_KM / range_km)) * 3600.0 / ifov_arcsec
 
 
-def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> Geometry:
+def build_geometry(setup: Setup, variant: str, n: int | None = None) -> Geometry:
     """Truth, reference with STMs, attitude of ``variant`` (see module docstring)."""
-    setup = Setup.of(setup)
     if variant not in VARIANTS:
         raise ValueError(f"unknown approach variant {variant!r}; use one of {VARIANTS}")
     n = setup.segments.n_samples if n is None else n
@@ -173,14 +171,12 @@ def build_geometry(setup: Setup | dict, variant: str, n: int | None = None) -> G
                     cam.ifov_arcsec, field, sig, cam.attitude_sigma_arcsec * ARCSEC)
 
 
-def star_field_of(setup: Setup | dict, C: np.ndarray, half_fov_rad: float | None = None):
+def star_field_of(setup: Setup, C: np.ndarray, half_fov_rad: float | None = None):
     """The ``stars`` variant's star images along the Mars-tracking attitude ``C`` (n+1, 3, 3)
     with the setup's ``stars`` and ``camera`` (:func:`opnav.approach.stars.star_field`), and the
     centroid 1-sigma at ``stars.sigma_ref_mag`` (rad). ``half_fov_rad``: the star images' field
     half-width (default the camera's, ``pixels * ifov / 2``; the stars sweep widens it)."""
     from . import stars
-
-    setup = Setup.of(setup)
     st, cam = setup.stars, setup.camera
 
     def sigma_of_mag(m):
@@ -194,13 +190,13 @@ def star_field_of(setup: Setup | dict, C: np.ndarray, half_fov_rad: float | None
     return field, float(stars.sigma_rad(st.sigma_px, cam.ifov_arcsec))
 
 
-def camera_half_fov_rad(setup: Setup | dict) -> float:
+def camera_half_fov_rad(setup: Setup) -> float:
     """Half-width of the camera's square field, ``pixels * ifov / 2``, rad."""
-    cam = Setup.of(setup).camera
+    cam = setup.camera
     return 0.5 * cam.pixels * cam.ifov_arcsec * ARCSEC
 
 
-def with_stars(geo: Geometry, setup: Setup | dict, half_fov_rad: float | None = None) -> Geometry:
+def with_stars(geo: Geometry, setup: Setup, half_fov_rad: float | None = None) -> Geometry:
     """The same ``stars`` arc with the star images of ``setup.stars`` (no orbit propagated again),
     in a field of half-width ``half_fov_rad`` (default the camera's)."""
     from dataclasses import replace
@@ -226,11 +222,11 @@ def with_roll_rate(geo: Geometry, rate_deg_s: float) -> Geometry:
     return replace(geo, C=C, u_ref=u_ref, u_true=u_true, rho_ref=np.linalg.norm(u_ref, axis=1), variant="roll")
 
 
-def measurement_variance(geo: Geometry, setup: Setup | dict, sigma3_px) -> np.ndarray:
+def measurement_variance(geo: Geometry, setup: Setup, sigma3_px) -> np.ndarray:
     """:meth:`Geometry.measurement_variance`, for callers holding the config as well: the
     geometry carries the camera it was built for, and a different ``camera.ifov_arcsec``
     in ``setup`` is an error, not a silent override."""
-    ifov = Setup.of(setup).camera.ifov_arcsec
+    ifov = setup.camera.ifov_arcsec
     if ifov != geo.ifov_arcsec:
         raise ValueError(f"approach.camera.ifov_arcsec = {ifov:g} differs from the geometry's {geo.ifov_arcsec:g}")
     return geo.measurement_variance(sigma3_px)

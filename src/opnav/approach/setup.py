@@ -15,10 +15,9 @@ Description
     naming the key, so a rule whose params lack a key it needs stops at once
     instead of falling back on a default.
 
-    Public entry points (``build_geometry``, ``run_case``, ...) also accept the
-    raw section and call :meth:`Setup.of` on their first line (the tests and
-    notebooks call them that way); inside the package only the :class:`Setup`
-    travels.
+    The config is parsed once, at the edge (a workflow script, the CLI, a test's
+    :meth:`Setup.from_config`): every function of the package takes the :class:`Setup`,
+    none the raw section.
 Units: as the config keys say (km, km/s, s, arcsec, px, rad where named).
 """
 
@@ -331,7 +330,6 @@ _FIELDS: dict[str, tuple[str, Any]] = {
     "nav_last_fraction": ("nav_error", lambda c: float(c["last_fraction"])),
     "nav_floor": ("nav_floor", NavFloor.from_config),
     "crlb_prior_sigma_rad": ("crlb", lambda c: float(c["theta_prior_sigma_rad"])),
-    "accuracy_target_arcsec": ("accuracy_target_arcsec", float),
     "alternatives": ("alternatives", Alternatives.from_config),
     "peers": ("peers", Peers.from_config),
 }
@@ -371,7 +369,6 @@ class Setup:
     nav_last_fraction: float
     nav_floor: NavFloor
     crlb_prior_sigma_rad: float
-    accuracy_target_arcsec: float
     alternatives: Alternatives
     peers: Peers
 
@@ -384,11 +381,6 @@ class Setup:
         for name, (key, parse) in _FIELDS.items():
             kw[name] = parse(section[key]) if key in section else Missing(key)
         return cls(**kw)
-
-    @classmethod
-    def of(cls, x: "Setup | Mapping") -> "Setup":
-        """``x`` itself if it is a :class:`Setup`, else the parsed section (the edge)."""
-        return x if isinstance(x, Setup) else cls.from_config(x)
 
     def replace(self, **changes) -> "Setup":
         return dataclasses.replace(self, **changes)

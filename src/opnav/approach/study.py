@@ -34,10 +34,9 @@ from .pipeline import segment_bounds, total_bound
 from .setup import Setup
 
 
-def run_runs(setup: Setup | dict, variant: str, method: str, seeds, shared: dict | None = None) -> pd.DataFrame:
+def run_runs(setup: Setup, variant: str, method: str, seeds, shared: dict | None = None) -> pd.DataFrame:
     """One row per seed (module docstring). ``shared``: one dict for the calls of one job (same
     ``setup``): the estimators of a variant then share its geometry and bounds."""
-    setup = Setup.of(setup)
     seeds = [int(s) for s in seeds]
     case = cases.headline_case(setup)
     shared = {} if shared is None else shared

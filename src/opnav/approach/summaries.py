@@ -33,10 +33,12 @@ NAV_SPLIT_KEYS = ("nav_err_true_theta_km", "nav_err_consider_km") + tuple(
     f"nav_err_{k}_{p}_km" for k in ("before", "after", "true_theta") for p in ("lat", "rng"))
 
 
-def table1_frame(results: list[dict], published: dict, profile: str = "") -> pd.DataFrame:
-    """A-T1 long form: one row per case x variant x EM scheme, published values beside."""
+def table1_frame(results: list[dict], published: dict, target_arcsec: float) -> pd.DataFrame:
+    """A-T1 long form: one row per case x variant x EM scheme, published values beside;
+    ``target_arcsec`` (the claimed accuracy, the analysis plan's A-C1 target) sets the
+    ``identifiable`` column."""
     pub = {r["case_id"]: r for r in published["table1"]}
-    target = float(published["headline"]["accuracy_claim_arcsec"])
+    target = float(target_arcsec)
     rows = []
     for r in results:
         c: cases.Case = r["case"]
@@ -149,17 +151,18 @@ def nees_summary(t1: pd.DataFrame) -> dict:
     return out
 
 
-def crlb_rows(setup: Setup | dict, curves: dict, conv: dict, t1: pd.DataFrame, curves_q0: dict | None = None) -> pd.DataFrame:
+def crlb_rows(setup: Setup, curves: dict, conv: dict, t1: pd.DataFrame, target_arcsec: float,
+              curves_q0: dict | None = None) -> pd.DataFrame:
     """A-X1 table: the bound per variant beside the EM estimates' spread and EM iterations.
 
     The EM errors set beside the bound come from the headline case rerun with the initial
     error drawn from the prior (``*_sampled`` columns of A-T1): with the paper's fixed
     initial error the spread over seeds is noise only and is not comparable with a
     Bayesian bound. ``crlb_q0_*``: the bound if the truth, like ours, had no process noise.
+    ``target_arcsec``: the claimed accuracy (the analysis plan's A-C1 target).
     """
-    setup = Setup.of(setup)
     s = setup.segments
-    target = setup.accuracy_target_arcsec
+    target = float(target_arcsec)
     cs = setup.convergence_study
     rows = []
     for v, curve in curves.items():
@@ -216,10 +219,9 @@ def _first_window_bound(t1, variant, curve, s):
     return curve[min(s.N, len(curve) - 1), 0]
 
 
-def prior_bound_arcsec(setup: Setup | dict) -> float:
+def prior_bound_arcsec(setup: Setup) -> float:
     """What the prior alone bounds theta to: the 1-sigma prior position error seen from the
     initial range, ``sigma_r / rho`` (arcsec), from the config."""
-    setup = Setup.of(setup)
     return float(sc.arcsec(setup.prior_sigma.r_km / setup.geometry.range_km))
 
 
@@ -261,12 +263,11 @@ def roll_rate_summary(study: dict) -> dict:
             "target_arcsec": float(study["target_arcsec"]), "config_rate_deg_s": float(study["config_rate_deg_s"])}
 
 
-def mars_attitude_summary(setup: Setup | dict, bounds: Mapping[str, Mapping[float, Any]] | None,
+def mars_attitude_summary(setup: Setup, bounds: Mapping[str, Mapping[float, Any]] | None,
                           curves: Mapping[str, np.ndarray]) -> dict:
     """The Mars images' attitude knowledge (issue 54, item 3) for the summary: the configured
     value (``default_arcsec``) and why, and per variant the worse of (tx, ty) of the bound of all
     the data with it (``default``) and at each ``camera.attitude_study_arcsec`` value, arcsec."""
-    setup = Setup.of(setup)
     a0 = float(setup.camera.attitude_sigma_arcsec)
     why = ("paper A's measurement (eq. 3) takes the camera attitude A_c^i as known: the reproduction keeps the "
            "paper's model, and the bound with an attitude error is shown beside it" if a0 == 0.0 else
@@ -439,11 +440,12 @@ def stars_frame(study: list[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def summary(setup: Setup | dict, t1: pd.DataFrame, x1: pd.DataFrame, roll_rate: dict | None = None) -> dict:
-    """Headline numbers per variant and EM scheme for the manuscript macros; ``roll_rate``:
-    the roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`), if run."""
-    setup = Setup.of(setup)
-    out = {"profile_segments": setup.segments.as_dict(), "accuracy_target_arcsec": setup.accuracy_target_arcsec,
+def summary(setup: Setup, t1: pd.DataFrame, x1: pd.DataFrame, target_arcsec: float,
+            roll_rate: dict | None = None) -> dict:
+    """Headline numbers per variant and EM scheme for the manuscript macros; ``target_arcsec``: the
+    claimed accuracy (the analysis plan's A-C1 target); ``roll_rate``: the roll-rate study
+    (:func:`opnav.approach.pipeline.roll_rate_study`), if run."""
+    out = {"profile_segments": setup.segments.as_dict(), "accuracy_target_arcsec": float(target_arcsec),
            "prior_bound_arcsec": prior_bound_arcsec(setup),
            "convergence_max_maps": setup.convergence_study.max_maps, "variants": {}}
     if roll_rate is not None:

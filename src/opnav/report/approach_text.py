@@ -19,10 +19,10 @@ def _fmt(x, nd=2):
     return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
 
 
-def identifiability_text(setup: Setup | dict, x1: pd.DataFrame) -> str:
-    """Plain-language A-X1 verdict, generated from the numbers of the A-X1 table."""
-    setup = Setup.of(setup)
-    target = setup.accuracy_target_arcsec
+def identifiability_text(setup: Setup, x1: pd.DataFrame, target_arcsec: float) -> str:
+    """Plain-language A-X1 verdict, generated from the numbers of the A-X1 table; ``target_arcsec``:
+    the claimed accuracy (the analysis plan's A-C1 target, :func:`opnav.core.planvalues.accuracy_target_arcsec`)."""
+    target = target_arcsec
     s = setup.segments
     lines = ["# A-X1: what the data can tell about the camera misalignment", "",
              (f"Profile segments: N0 = {s.N0}, N = {s.N}, M = {s.M}, L = {s.L} ({s.mode}); "
@@ -264,7 +264,7 @@ def scheme_text(row: HeadlineRow) -> str:
     return " ".join(parts) or "plain EM, sliding windows"
 
 
-def findings(setup: Setup | dict, summ: HeadlineSummary, pub_headline: dict) -> dict:
+def findings(setup: Setup, summ: HeadlineSummary, pub_headline: dict, target_arcsec: float) -> dict:
     """Every sentence of the manuscript's paper-A results that states a finding, generated
     from the summary's flags and numbers (plain text; the macros escape it). ``summ``:
     :meth:`opnav.approach.summaries.HeadlineSummary.from_json` of the summary. Keys:
@@ -277,12 +277,13 @@ def findings(setup: Setup | dict, summ: HeadlineSummary, pub_headline: dict) -> 
                  used (not reproducible there), which schemes reach their bound, and which
                  of our rows lies closest to the published estimates.
     ``headline_<key>`` one sentence per Table-1 headline row (its A-T1 ``variant``).
+
+    ``target_arcsec``: the claimed accuracy (the analysis plan's A-C1 target).
     """
     if not isinstance(summ, HeadlineSummary):
         raise TypeError(f"approach_text.findings: summ must be a HeadlineSummary "
                         f"(HeadlineSummary.from_json(<summary>)), got {type(summ).__name__}")
-    setup = Setup.of(setup)
-    target = setup.accuracy_target_arcsec
+    target = target_arcsec
     rows = summ.rows
     base = {r.scenario: r for r in rows if r.as_written_scheme}  # plain EM, sliding: the paper's scheme
     out = {}

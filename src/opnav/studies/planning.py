@@ -261,9 +261,9 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
 def _check_approach_job_size(where: str, approach: Mapping, seeds_per_job: int) -> None:
     """A paper-A study job runs its seeds batched over the whole arc: the same memory
     limit as the Monte Carlo's (:data:`opnav.core.checks.MAX_APPROACH_SEED_SAMPLES`)."""
-    from opnav.approach.scenario import n_samples
+    from opnav.approach.setup import Setup
 
-    n = n_samples(approach)
+    n = Setup.from_config(approach).segments.n_samples
     if seeds_per_job * n > MAX_APPROACH_SEED_SAMPLES:
         raise ConfigError(f"{where}: runs_per_job = {seeds_per_job} seeds x {n} samples exceeds the limit "
                           f"{MAX_APPROACH_SEED_SAMPLES} (memory); lower runs_per_job")
