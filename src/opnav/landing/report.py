@@ -652,6 +652,11 @@ def evidence_text(ev: dict) -> str:
            f"{tsum.less_time_text(r['mean'])} time than the closed-form SVD's on average (per replay {per} %"
            + (f"; between-replay sd {sd:.1f} points, {100 * r['level']:.0f} % interval [{r['lo']:.1f}, {r['hi']:.1f}] %"
               if math.isfinite(sd) else "") + "). ")
+    rp = ev.get("replays") or [{}]
+    lo_hi = rp[0].get("median_interval_us", {}).get("depth")
+    if lo_hi and all(x is not None and math.isfinite(x) for x in lo_hi):
+        out += (f"Each replay's median rests on {rp[0]['n_calls']} calls (depth's in the first replay "
+                f"{rp[0]['median_us']['depth']:.2f} us, distribution-free 95 % interval [{lo_hi[0]:.2f}, {lo_hi[1]:.2f}] us). ")
     d, s = dec["depth"], dec["svd"]
     if all(math.isfinite(x) for x in (d["shared_us"], s["shared_us"], d["eval_us"], s["eval_us"])):
         c = ev.get("overhead_curve", {})

@@ -25,17 +25,18 @@ def fig_overhead_curve(ev: dict, camera: str = ""):
         fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.6), constrained_layout=True)
         if c["shared_us"]:
             ax.plot(c["shared_us"], c["reduction_pct"], color=figures.color(c["a"]),
-                    label=f"{c['a']} vs {c['b']}: measured calls, shared part varied")
+                    label="shared part varied")
             ax.plot(c["replay_shared_us"], c["replay_reduction_pct"], "o", color=figures.color(c["b"]),
-                    markersize=4, label=f"{len(c['replay_shared_us'])} replays (separate processes)")
+                    markersize=4, label=f"{len(c['replay_shared_us'])} replays")
         ax.axhline(pub, **{**figures.PUBLISHED_STYLE, "marker": None, "linestyle": "--",
-                           "label": f"published {pub:.2f} %"})
+                           "label": "published"})
         s = ev["shared_us_at_published"]
         if s is not None and math.isfinite(s):
-            ax.axvline(s, color="0.35", linestyle=":", label=f"published at {s:.2f} µs shared")
+            ax.axvline(s, color="0.35", linestyle=":", label=f"published at {s:.2f} µs")
         ax.set_xlabel("shared part of a call (µs, thread CPU)")
-        ax.set_ylabel(f"{c['a']}'s time reduction vs {c['b']} (%)")
+        ax.set_ylabel(f"{c['a']} vs {c['b']}: time reduction (%)")
         if camera:
-            ax.set_title(f"{camera} camera, {ev.get('eval_path') or ev['path']} path", fontsize="x-small")
+            ax.set_title(f"{camera} camera, {ev.get('eval_path') or ev['path']} path; published {pub:.2f} %",
+                         fontsize="x-small")
         figures.place_legend(ax, fontsize="xx-small", framealpha=0.9)
         return fig
