@@ -273,3 +273,25 @@ def test_a_call_of_milliseconds_is_timed_as_it_comes_and_picks_alike(recorded, m
     assert int(np.sum(cold["mismatch"])) == 0 and int(np.sum(cold["checked"])) > 0
     j = ts.variant_index(cold, "depth", "main")
     assert (cold["reps"][:, j] == 1).all() and (cold["cpu_ns"][:, j] > 0).all()
+
+
+def test_evidence_of_one_replay_and_without_svd_has_no_spread_and_no_curve():
+    """Hidden cases: one replay (landing.timing.n_replays 1) gives readings without a between-replay
+    spread (nan, never a bootstrap's) and the text says no spread; methods without svd give the
+    pairs they have and no overhead curve; neither raises."""
+    from opnav.landing.report import evidence_text
+
+    one = _merged([2.0])
+    ev = ts.planning_time_evidence(one, 29.03)
+    r = ev["reduction_pct"]["depth_vs_svd"]
+    assert ev["n_replays"] == 1 and len(r["per_replay"]) == 1 and math.isnan(r["sd_between"])
+    assert math.isnan(r["lo"]) and "between-replay sd" not in evidence_text(ev)
+    tm = _merged([1.0, 2.0, 3.0])
+    keep = np.asarray(tm["variant_method"]) == "depth"
+    for k in ("wall_ns", "cpu_ns", "pick", "n_evals", "slot", "timed", "eval_ns", "reps"):
+        tm[k] = tm[k][:, keep]
+    for k in ("variant_method", "variant_path", "variant_eval_path"):
+        tm[k] = np.asarray(tm[k])[keep]
+    ev = ts.planning_time_evidence(tm, 29.03)
+    assert ev["methods"] == ["depth"] and ev["reduction_pct"] == {} and ev["overhead_curve"]["shared_us"] == []
+    assert math.isnan(ev["shared_us_at_published"]) and evidence_text(ev) == ""
