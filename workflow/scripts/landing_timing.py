@@ -17,9 +17,10 @@ from opnav.core import published
 from opnav.landing import timing, timing_summary
 from opnav.core.snakeio import mock_snakemake, script_context
 
-if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md); rule=NAME picks
-    _rule = next((a.split("=", 1)[1] for a in sys.argv[1:] if a.startswith("rule=")), "landing_timing")
-    snakemake = mock_snakemake(_rule, argv=[a for a in sys.argv[1:] if not a.startswith("rule=")], bscn="site-tilt")
+if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md); --replays: the replays
+    _rule = "landing_timing_replays" if "--replays" in sys.argv else "landing_timing"
+    sys.argv = [a for a in sys.argv if a != "--replays"]
+    snakemake = mock_snakemake(_rule, argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
     p = snakemake.params
