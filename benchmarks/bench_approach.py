@@ -220,8 +220,13 @@ def max_rel_diff(a, b, path: str = "") -> tuple[float, str]:
     and NaN positions must match exactly (else ``inf``)."""
     import dataclasses
 
-    if dataclasses.is_dataclass(a) and not isinstance(a, type):
-        return (0.0, path) if a == b else (float("inf"), path)
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):  # a typed record: field by field
+        if type(a) is not type(b):
+            return float("inf"), f"{path}: types differ"
+        return max((max_rel_diff(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}")
+                    for f in dataclasses.fields(a)), default=(0.0, path))
+    if a is None or b is None:
+        return (0.0, path) if a is b else (float("inf"), f"{path}: None")
     if isinstance(a, dict):
         if set(a) != set(b):
             return float("inf"), f"{path}: keys differ"

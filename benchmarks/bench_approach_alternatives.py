@@ -59,18 +59,18 @@ def main(argv=None) -> int:
                 t = time.perf_counter()
                 r = cases.run_case(cfg, v, case, seeds, geo=geo, method=m)
                 dt = (time.perf_counter() - t) / S
-                e = rmse(r["theta_final_arcsec"])
+                e = rmse(r.theta_final_arcsec)
                 print(f"{v:8s} {cid:6s} {'EM-EKF (' + m + ')':22s} {dt:9.4f} {e[0]:8.3f} {e[1]:8.3f}")
             r = alt.run_case_alternatives(cfg, v, case, seeds, geo, cache)
-            a, b = r["methods"]["augmented"], r["methods"]["batch_ml"]
-            e = rmse(a["theta_final_arcsec"])
-            print(f"{v:8s} {cid:6s} {'augmented EKF':22s} {a['runtime_s_per_seed']:9.4f} {e[0]:8.3f} {e[1]:8.3f}")
-            e = rmse(b["theta_final_arcsec"])
-            print(f"{v:8s} {cid:6s} {'batch ML (incl build)':22s} {b['runtime_s_per_seed']:9.4f} {e[0]:8.3f} {e[1]:8.3f}")
-            print(f"{v:8s} {cid:6s} {'batch ML (solve only)':22s} {b['runtime_solve_s_per_seed']:9.4f}")
-            if "runtime_checkpoints_s_per_seed" in b:
-                print(f"{v:8s} {cid:6s} {'batch ML checkpoints':22s} {b['runtime_checkpoints_s_per_seed']:9.4f}"
-                      f"   ({len(b['checkpoint_data_used'])} growing windows)")
+            a, b = r.augmented, r.batch_ml
+            e = rmse(a.theta_final_arcsec)
+            print(f"{v:8s} {cid:6s} {'augmented EKF':22s} {a.runtime_s_per_seed:9.4f} {e[0]:8.3f} {e[1]:8.3f}")
+            e = rmse(b.theta_final_arcsec)
+            print(f"{v:8s} {cid:6s} {'batch ML (incl build)':22s} {b.runtime_s_per_seed:9.4f} {e[0]:8.3f} {e[1]:8.3f}")
+            print(f"{v:8s} {cid:6s} {'batch ML (solve only)':22s} {b.runtime_solve_s_per_seed:9.4f}")
+            if b.checkpoint_data_used is not None:
+                print(f"{v:8s} {cid:6s} {'batch ML checkpoints':22s} {b.runtime_checkpoints_s_per_seed:9.4f}"
+                      f"   ({len(b.checkpoint_data_used)} growing windows)")
     return 0
 
 

@@ -56,7 +56,7 @@ def test_the_filters_know_the_attitude_error():
     cfg = _cfg(5.0)
     case = replace(cases.headline_case(cfg), truth_arcsec=(0.0, 0.0, 0.0))
     d = cases.prepare_cases(cfg, "literal", [case], range(40))
-    nis = np.nanmean(d.cons_before["nis"])
+    nis = np.nanmean(d.cons_before.nis)
     assert abs(nis - 3.0) < 0.3, nis
     geo = sc.build_geometry(cfg, "roll")
     g0 = replace(geo, attitude_sigma_rad=0.0)

@@ -130,7 +130,7 @@ def test_em_is_blind(variant, mode, method, pinned):
     def em(cfg, geo, case):
         s = cfg.scheme(mode)
         r = cases.run_cases(s, variant, [case], SEEDS, geo=geo, method=method)[0]
-        return {k: r[k] for k in ("theta_iter_arcsec", "loglik_iter", "theta_ml_arcsec", "label",
+        return {k: getattr(r, k) for k in ("theta_iter_arcsec", "loglik_iter", "theta_ml_arcsec", "label",
                                   "dist_to_ml_over_bound", "theta_seg_arcsec")}
 
     clean, blind = _pair(pinned, variant, em)
@@ -141,8 +141,8 @@ def test_em_is_blind(variant, mode, method, pinned):
 def test_augmented_ekf_is_blind(variant, pinned):
     def aug(cfg, geo, case):
         a = alternatives.run_case_alternatives(cfg, variant, case, SEEDS, geo, methods=("augmented",))
-        a = a["methods"]["augmented"]
-        return {k: a[k] for k in ("theta_seg_arcsec", "sigma_final_arcsec")}
+        a = a.augmented
+        return {k: getattr(a, k) for k in ("theta_seg_arcsec", "sigma_final_arcsec")}
 
     clean, blind = _pair(pinned, variant, aug)
     _same_or_control(variant, clean, blind, "theta_seg_arcsec")
@@ -152,8 +152,8 @@ def test_augmented_ekf_is_blind(variant, pinned):
 def test_convergence_study_is_blind(variant, pinned):
     def conv(cfg, geo, case):
         c = cases.convergence_study(cfg, variant, case, SEEDS, 100, 6, 0.1, geo=geo)
-        return {"theta_star_arcsec": c["theta_star_arcsec"], "plain": c["plain"]["theta_hist_arcsec"],
-                "squarem": c["squarem"]["theta_hist_arcsec"]}
+        return {"theta_star_arcsec": c.theta_star_arcsec, "plain": c.plain.theta_hist_arcsec,
+                "squarem": c.squarem.theta_hist_arcsec}
 
     clean, blind = _pair(pinned, variant, conv)
     _same_or_control(variant, clean, blind, "theta_star_arcsec")
@@ -165,8 +165,8 @@ def test_batch_ml_is_blind(variant, pinned):
     def ml(cfg, geo, case):
         alt = cfg.alternatives
         cfg = cfg.replace(alternatives=replace(alt, batch_ml=replace(alt.batch_ml, checkpoint_seeds=0, jit=False)))
-        a = alternatives.run_case_alternatives(cfg, variant, case, SEEDS, geo)["methods"]["batch_ml"]
-        return {"theta_final_arcsec": a["theta_final_arcsec"]}
+        a = alternatives.run_case_alternatives(cfg, variant, case, SEEDS, geo).batch_ml
+        return {"theta_final_arcsec": a.theta_final_arcsec}
 
     clean, blind = _pair(pinned, variant, ml)
     _same_or_control(variant, clean, blind, "theta_final_arcsec")

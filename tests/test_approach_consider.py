@@ -43,7 +43,7 @@ def test_consider_filter_is_consistent_where_the_compensated_filter_is_not():
                               keep_cov=False)
     f = run_filter(d.z, th, d.dx0, geo.P0, d.win, predicted=False)
     half = d.z.shape[1] // 2
-    naive = cases.consistency(f, geo.dx_true)["nees_pos"][:, half:].mean()
+    naive = cases.consistency(f, geo.dx_true).nees_pos[:, half:].mean()
     cons = c.nees_pos[:, half:].mean()
     assert naive > 20.0, naive
     assert 0.3 < cons < 6.0, cons

@@ -130,7 +130,7 @@ def _converged_estimate(variant, bias, n, seeds, mode="fixed"):
         Pst = ekf.predict_only(np.zeros(6), geo.P0, win.slice(0, 100))[1]
     bound = sc.arcsec(crlb.crlb_curve(win.slice(100, 100 + n), geo.u_true[100:], Pst,
                                       sc.rad(bias), 1e-2)[-1])
-    return r["theta_star_arcsec"], bound
+    return r.theta_star_arcsec, bound
 
 
 def test_zero_bias_gives_estimate_within_few_crlb_of_zero():
@@ -169,10 +169,10 @@ def test_monte_carlo_runs_do_not_depend_on_chunking():
     geo = sc.build_geometry(cfg, "roll")
     whole = cases.run_case(cfg, "roll", case, range(4), geo=geo)
     parts = [cases.run_case(cfg, "roll", case, idx, geo=geo) for idx in (range(0, 1), range(1, 4))]
-    joined = np.concatenate([p["theta_final_arcsec"] for p in parts])
-    np.testing.assert_allclose(joined, whole["theta_final_arcsec"], rtol=1e-9, atol=1e-9)
+    joined = np.concatenate([p.theta_final_arcsec for p in parts])
+    np.testing.assert_allclose(joined, whole.theta_final_arcsec, rtol=1e-9, atol=1e-9)
     again = cases.run_case(cfg, "roll", case, range(4), geo=geo)
-    np.testing.assert_array_equal(again["theta_final_arcsec"], whole["theta_final_arcsec"])
+    np.testing.assert_array_equal(again.theta_final_arcsec, whole.theta_final_arcsec)
 
 
 def test_stacking_cases_in_one_batch_equals_separate_runs():
@@ -185,8 +185,8 @@ def test_stacking_cases_in_one_batch_equals_separate_runs():
     together = cases.run_cases(cfg, "prior", pix, range(2), geo=geo, method="plain")
     for c, r in zip(pix, together):
         alone = cases.run_case(cfg, "prior", c, range(2), geo=geo, method="plain")
-        np.testing.assert_allclose(r["theta_final_arcsec"], alone["theta_final_arcsec"], rtol=1e-8, atol=1e-8)
-        np.testing.assert_allclose(r["nav_err_after_km"], alone["nav_err_after_km"], rtol=1e-9)
+        np.testing.assert_allclose(r.theta_final_arcsec, alone.theta_final_arcsec, rtol=1e-8, atol=1e-8)
+        np.testing.assert_allclose(r.nav_err_after_km, alone.nav_err_after_km, rtol=1e-9)
 
 
 def test_each_seed_stops_its_ml_iteration_at_its_own_step_criterion():
@@ -313,12 +313,12 @@ def test_literal_em_converges_to_the_ml_of_its_window_which_cannot_tell_theta():
     theta is not identifiable from it. Fails if the truth leaks into the literal start (the ML
     estimate then moves to the truth)."""
     cfg, r, bound = _segment_run("literal")
-    th = r["theta_final_arcsec"][:, :2]
+    th = r.theta_final_arcsec[:, :2]
     assert np.all(np.abs(th.mean(0)) < 0.1)
     assert np.all(np.abs(th) < 0.25)
-    assert np.all(np.abs(r["theta_ml_arcsec"][:, :2]) < 0.25)
-    assert (r["label"] == "converged").all() and not r["stalled"].any()
-    assert np.isfinite(r["data_to_converge"]).all()
+    assert np.all(np.abs(r.theta_ml_arcsec[:, :2]) < 0.25)
+    assert (r.label == "converged").all() and not r.stalled.any()
+    assert np.isfinite(r.data_to_converge).all()
     assert bound[0] > 5.0  # the data used cannot tell theta to the published 2 arcsec
 
 
@@ -329,20 +329,20 @@ def test_same_data_from_two_starts_gives_the_same_label(variant):
     roll sliding plain EM: stalled both times, contracting by about 1 per map)."""
     _, r0, _ = _segment_run(variant, seeds=range(3))
     _, r1, _ = _segment_run(variant, seeds=range(3), init=(-20.0, -20.0, -20.0))
-    np.testing.assert_array_equal(r0["label"], r1["label"])
-    assert len(set(r0["label"])) == 1
-    if r0["label"][0] == "converged":
-        np.testing.assert_allclose(r0["theta_ml_arcsec"][:, :2], r1["theta_ml_arcsec"][:, :2], atol=0.05)
-        np.testing.assert_allclose(r0["theta_final_arcsec"][:, :2], r1["theta_final_arcsec"][:, :2], atol=0.5)
+    np.testing.assert_array_equal(r0.label, r1.label)
+    assert len(set(r0.label)) == 1
+    if r0.label[0] == "converged":
+        np.testing.assert_allclose(r0.theta_ml_arcsec[:, :2], r1.theta_ml_arcsec[:, :2], atol=0.05)
+        np.testing.assert_allclose(r0.theta_final_arcsec[:, :2], r1.theta_final_arcsec[:, :2], atol=0.5)
 
 
 def test_reference_start_em_recovers_the_truth_within_three_bound_sigma():
     cfg, r, bound = _segment_run("reference-start")
-    err = r["theta_final_arcsec"][:, :2] - np.array([10.0, 20.0])
+    err = r.theta_final_arcsec[:, :2] - np.array([10.0, 20.0])
     assert bound[0] < 1.0
     assert np.all(np.abs(err) < 3.0 * bound[:2])
-    assert not r["stalled"].any()
-    assert np.isfinite(r["data_to_converge"]).all()
+    assert not r.stalled.any()
+    assert np.isfinite(r.data_to_converge).all()
 
 
 def test_roll_sliding_plain_em_is_stalled_far_from_its_ml_estimate():
@@ -350,9 +350,9 @@ def test_roll_sliding_plain_em_is_stalled_far_from_its_ml_estimate():
     and ends many arcsec from the ML estimate of the same window; the bound it is shown
     beside is the window's (several arcsec), not the all-data bound."""
     cfg, r, bound = _segment_run("roll")
-    assert r["stalled"].all() and (r["label"] == "stalled").all()
-    assert np.all(r["contraction_per_map"] > 0.99)
-    assert np.all(r["dist_to_ml_arcsec"] > 1.0)
+    assert r.stalled.all() and (r.label == "stalled").all()
+    assert np.all(r.contraction_per_map > 0.99)
+    assert np.all(r.dist_to_ml_arcsec > 1.0)
     assert bound[0] > 2.0
 
 
@@ -381,7 +381,7 @@ def test_growing_squarem_reaches_its_cumulative_bound():
     """Growing windows + SQUAREM: the configuration that reaches the bound (roll); the bound set
     beside it is the cumulative one, far below one window's."""
     cfg, r, bound = _segment_run("roll", method="squarem", N=150, L=4, mode="growing", seeds=range(3))
-    err = r["theta_final_arcsec"][:, :2] - np.array([10.0, 20.0])
-    assert not r["stalled"].any()
+    err = r.theta_final_arcsec[:, :2] - np.array([10.0, 20.0])
+    assert not r.stalled.any()
     assert np.all(np.abs(err) < 4.0 * bound[:2])
     assert bound[0] < 2.0

@@ -4,6 +4,7 @@ A unit flown after another in the same job writes what a job of its own writes, 
 bit, each file holding its own unit; the quick profile flies its units in one job, the
 full profile keeps one job per unit."""
 
+import dataclasses
 import pickle
 import runpy
 
@@ -17,7 +18,13 @@ SCRIPT = REPO / "workflow" / "scripts" / "approach_mc.py"
 
 
 def _same(a, b, path="") -> list[str]:
-    """The paths at which two pickled Monte-Carlo results differ (arrays bit for bit)."""
+    """The paths at which two pickled Monte-Carlo results differ (arrays bit for bit; typed
+    records field by field)."""
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        if type(a) is not type(b):
+            return [path]
+        return [d for f in dataclasses.fields(a) for d in _same(getattr(a, f.name), getattr(b, f.name),
+                                                                 f"{path}.{f.name}")]
     if isinstance(a, dict):
         if set(a) != set(b):
             return [path]

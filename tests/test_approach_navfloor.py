@@ -38,11 +38,11 @@ def test_each_arc_is_the_run_of_that_arc_alone():
         c["em"]["ml_max_maps"] = 3  # the label's reference (not compared here)
         s = Setup.from_config(c).scheme("growing")
         r = cases.run_case(s, "roll", cases.headline_case(s), range(3), method="squarem")
-        np.testing.assert_allclose(row["nav_err_km_rule"], r["nav_err_after_km"].mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["true_theta_km_rule"], r["nav_err_true_theta_km"].mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["before_km_rule"], r["nav_err_before_km"].mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["nav_err_km_last"], r["err_after_t_km"][:, -1].mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["est_x_mean_arcsec"], r["theta_final_arcsec"][:, 0].mean(), rtol=2e-5)
+        np.testing.assert_allclose(row["nav_err_km_rule"], r.nav_err_after_km.mean(), rtol=2e-5)
+        np.testing.assert_allclose(row["true_theta_km_rule"], r.nav_err_true_theta_km.mean(), rtol=2e-5)
+        np.testing.assert_allclose(row["before_km_rule"], r.nav_err_before_km.mean(), rtol=2e-5)
+        np.testing.assert_allclose(row["nav_err_km_last"], r.err_after_t_km[:, -1].mean(), rtol=2e-5)
+        np.testing.assert_allclose(row["est_x_mean_arcsec"], r.theta_final_arcsec[:, 0].mean(), rtol=2e-5)
 
 
 def test_tz_does_not_move_the_navigation_error():

@@ -152,8 +152,8 @@ def test_two_body_check_tidal_acceleration_by_hand():
     from opnav.approach.dynamics import MU_SUN
     r = np.linalg.norm(geo.X_mars[0, :3])
     d = cfg.geometry.range_km
-    assert MU_SUN * d / r**3 <= tb["sun_tidal_kms2_start"] <= 2.0 * MU_SUN * d / r**3 * 1.001
-    assert tb["two_body_pos_err_km"] < 1e-3
+    assert MU_SUN * d / r**3 <= tb.sun_tidal_kms2_start <= 2.0 * MU_SUN * d / r**3 * 1.001
+    assert tb.two_body_pos_err_km < 1e-3
 
 
 # ------------------------------------------------------------ Basilisk
@@ -197,13 +197,13 @@ def test_module_model_reproduces_the_converted_measurement():
 def test_basilisk_smoke_few_steps_are_finite_and_sensible():
     pytest.importorskip("Basilisk")
     cfg, r = _bsk_case(n=20)
-    assert np.all(np.isfinite(r["theta_final_arcsec"])) and np.all(np.isfinite(r["sigma3_final_arcsec"]))
-    assert np.all(r["sigma3_final_arcsec"] > 0)
+    assert np.all(np.isfinite(r.theta_final_arcsec)) and np.all(np.isfinite(r.sigma3_final_arcsec))
+    assert np.all(r.sigma3_final_arcsec > 0)
     # the position stays within a few prior sigmas of the truth (100 km prior, ~10 s of data)
-    assert np.all(r["pos_err_final_km"] < 5 * cfg.prior_sigma.r_km * np.sqrt(3))
+    assert np.all(r.pos_err_final_km < 5 * cfg.prior_sigma.r_km * np.sqrt(3))
     # the bias is in whole pixels (the module rounds it after every update)
     cam = peers.PeerCamera.of(cfg.camera.pixels, cfg.camera.ifov_arcsec)
-    b = peers.bias_px_from_theta(np.r_[sc.rad(r["theta_final_arcsec"][0]), 0.0], cam)
+    b = peers.bias_px_from_theta(np.r_[sc.rad(r.theta_final_arcsec[0]), 0.0], cam)
     np.testing.assert_allclose(b, np.round(b), atol=1e-6)
 
 
@@ -211,8 +211,8 @@ def test_basilisk_recovers_the_bias_when_the_position_is_known():
     """Plumbing check with an informative start: the prior mean on the truth."""
     pytest.importorskip("Basilisk")
     _, r = _bsk_case(n=30, start="truth", seeds=(0, 1))
-    err = np.abs(r["theta_final_arcsec"] - r["truth_arcsec"][:2])
-    assert np.all(err <= r["sigma3_final_arcsec"]), (r["theta_final_arcsec"], r["sigma3_final_arcsec"])
+    err = np.abs(r.theta_final_arcsec - r.truth_arcsec[:2])
+    assert np.all(err <= r.sigma3_final_arcsec), (r.theta_final_arcsec, r.sigma3_final_arcsec)
 
 
 @pytest.mark.parametrize("start", ["truth", "prior"])
@@ -226,13 +226,13 @@ def test_basilisk_bias_free_sanity_roll(start):
     a change in the module or in our conversion shows up."""
     pytest.importorskip("Basilisk")
     _, r = _bsk_case(n=30, truth=np.zeros(3), start=start, seeds=(0, 1))
-    inside = np.all(np.abs(r["theta_final_arcsec"]) <= r["sigma3_final_arcsec"], axis=1)
+    inside = np.all(np.abs(r.theta_final_arcsec) <= r.sigma3_final_arcsec, axis=1)
     if start == "truth":
         assert inside.all()
     else:
         assert not inside.any()
         # the spurious bias is the prior position error seen from the range, in whole pixels
-        assert np.all(np.abs(r["theta_final_arcsec"]) <= 3 * 100 / 1e6 / sc.rad(1.0))
+        assert np.all(np.abs(r.theta_final_arcsec) <= 3 * 100 / 1e6 / sc.rad(1.0))
 
 
 # ------------------------------------------------------------ workflow
@@ -268,9 +268,9 @@ def test_basilisk_bias_moves_with_the_user_guide_tuning():
     pytest.importorskip("Basilisk")
     cfg = approach_setup()
     r = peers.run_peer(cfg, "roll", headline_case(cfg), [0], stride=50)
-    assert np.all(np.abs(r["theta_final_arcsec"]).max(1) > 0)  # not its start
-    assert r["bias_changes_after_first"][0] > 0, r["theta_hist_arcsec"][0, :, :]
+    assert np.all(np.abs(r.theta_final_arcsec).max(1) > 0)  # not its start
+    assert r.bias_changes_after_first[0] > 0, r.theta_hist_arcsec[0, :, :]
     # the move is in whole pixels (the module rounds its bias states: one pixel = one IFOV)
-    steps = np.diff(r["theta_hist_arcsec"][0], axis=0)
-    q = r["bias_quantum_arcsec"]
+    steps = np.diff(r.theta_hist_arcsec[0], axis=0)
+    q = r.bias_quantum_arcsec
     np.testing.assert_allclose(steps / q, np.round(steps / q), atol=1e-6)

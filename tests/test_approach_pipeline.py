@@ -138,12 +138,12 @@ def test_nav_error_split_range_is_set_by_the_range_channel_not_theta():
     cfg = approach_setup(N0=100, N=50, M=2, L=2)
     case = cases.headline_case(cfg)
     r = cases.run_case(cfg, "literal", case, range(2))
-    rb, ra, rt = (r[f"nav_err_{k}_rng_km"] for k in ("before", "after", "true_theta"))
+    rb, ra, rt = r.nav_err_before_rng_km, r.nav_err_after_rng_km, r.nav_err_true_theta_rng_km
     np.testing.assert_allclose(ra, rb, rtol=0.02)
     np.testing.assert_allclose(rt, rb, rtol=0.02)
-    assert np.all(r["nav_err_true_theta_lat_km"] < 0.1 * r["nav_err_before_lat_km"])
-    lat, rng = r["err_split_t_km"]["after"]
-    np.testing.assert_allclose(np.hypot(lat, rng), r["err_after_t_km"], rtol=1e-9)
+    assert np.all(r.nav_err_true_theta_lat_km < 0.1 * r.nav_err_before_lat_km)
+    lat, rng = r.err_split_t_km.after
+    np.testing.assert_allclose(np.hypot(lat, rng), r.err_after_t_km, rtol=1e-9)
 
 
 def test_roll_rate_bounds_agree_with_the_roll_variant_and_the_target_rate_meets_the_target():
@@ -186,8 +186,8 @@ def test_convergence_label_is_relative_to_the_bound_of_the_data_used():
     for scale in (1e6, 1.0, 1e-6):
         r = cases.run_cases(cfg, "roll", [case], range(3), geo=geo, method="plain", data=d,
                             seg_bounds=[b * scale])[0]
-        lab[scale] = r["label"]
-        dist = np.abs(r["theta_final_arcsec"] - r["theta_ml_arcsec"])[:, :2] / (b[:2] * scale)
-        np.testing.assert_allclose(r["dist_to_ml_over_bound"], dist.max(1), rtol=1e-12)
+        lab[scale] = r.label
+        dist = np.abs(r.theta_final_arcsec - r.theta_ml_arcsec)[:, :2] / (b[:2] * scale)
+        np.testing.assert_allclose(r.dist_to_ml_over_bound, dist.max(1), rtol=1e-12)
     assert np.all(lab[1e6] == "converged")
     assert not np.any(lab[1e-6] == "converged")

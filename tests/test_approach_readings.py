@@ -1,5 +1,7 @@
 """Paper A's installation rows and sample time read against the model (issue 44, item 5)."""
 
+from dataclasses import replace
+
 import numpy as np
 
 from opnav.approach import camera, readings
@@ -53,17 +55,20 @@ def test_study_estimator_growing_squarem_converges_where_sliding_plain_stalls():
 def _star_row(sweep, value, bound, per_image=10, att=5.0):
     curve = np.full((11, 3), bound)
     th = np.array([[10.0, 20.0, 10.0], [10.5, 19.5, 12.0]])
-    return {"sweep": sweep, "value": value, "per_image": per_image, "every_K": 200, "images": 10,
-            "attitude_sigma_arcsec": att, "mode_drift_arcsec": 1.0, "mag_limit": 8.0,
-            "stars_per_image": ({"min": per_image, "median": float(per_image), "max": per_image}
-                                if sweep == "per_image" else {"min": 10, "median": 10.0, "max": 10}),
-            "field_deg": 2.84 if per_image < 10 else 6.0, "camera_field_deg": 2.84, "floor_arcsec": 1.87,
-            "crlb_stars_only_arcsec": np.full(3, bound), "truth_arcsec": np.array([10.0, 20.0, 10.0]),
-            "total_samples": 10, "crlb_all_arcsec": np.full(3, bound), "crlb_all_q0_arcsec": np.full(3, bound),
-            "crlb_curve_arcsec": curve,
-            "estimators": {"em_growing_squarem": {"theta_final_arcsec": th, "label": np.array(["converged"] * 2),
-                                                  "theta_ml_arcsec": th}},
-            "attitude_threshold_arcsec": 5.38}
+    from opnav.approach.alternatives import StarCounts, StarsEstimate, StarsRow
+
+    return StarsRow(sweep=sweep, value=value, per_image=per_image, every_K=200, images=10,
+                    attitude_sigma_arcsec=att, mode_drift_arcsec=1.0, mag_limit=8.0,
+                    stars_per_image=(StarCounts(per_image, float(per_image), per_image)
+                                     if sweep == "per_image" else StarCounts(10, 10.0, 10)),
+                    field_deg=2.84 if per_image < 10 else 6.0, camera_field_deg=2.84, floor_arcsec=1.87,
+                    crlb_stars_only_arcsec=np.full(3, bound), truth_arcsec=np.array([10.0, 20.0, 10.0]),
+                    total_samples=10, crlb_all_arcsec=np.full(3, bound), crlb_all_q0_arcsec=np.full(3, bound),
+                    crlb_curve_arcsec=curve,
+                    estimators={"em_growing_squarem": StarsEstimate(th, np.full(2, 100.0),
+                                                                    label=np.array(["converged"] * 2),
+                                                                    theta_ml_arcsec=th)},
+                    attitude_threshold_arcsec=5.38)
 
 
 def test_stars_text_reads_the_objection_from_the_numbers():
@@ -82,6 +87,5 @@ def test_stars_text_reads_the_objection_from_the_numbers():
     assert "30 stars in every image (to magnitude 8 in a 6 deg field, widened from the camera's 2.84 deg)" in txt
     rows[1] = _star_row("per_image", 30, 0.95, per_image=30)
     assert "(50 % lower)" in approach_text.stars_text(summaries.stars_summary(rows, 2.0), 2.0)
-    for r in rows:
-        r["attitude_threshold_arcsec"] = 0.0
+    rows = [replace(r, attitude_threshold_arcsec=0.0) for r in rows]
     assert "does not answer" in approach_text.stars_text(summaries.stars_summary(rows, 2.0), 2.0)

@@ -82,9 +82,9 @@ def test_stars_make_tz_observable_and_the_estimators_reach_their_bound():
     # the ML estimate of the EM's data (SQUAREM to a 1e-4 arcsec step): the EM's own iterate is slow
     # here (the stars' information is small beside the Mars data's complete-data information), and
     # its label says how far it got, in bounds of its data
-    th_em, th_a = r["theta_ml_arcsec"], a["methods"]["augmented"]["theta_final_arcsec"]
-    assert not r["tz_unobservable"] and r["ml_converged"].all()
-    assert np.all((r["label"] == "converged") == (r["dist_to_ml_over_bound"] <= 0.1))
+    th_em, th_a = r.theta_ml_arcsec, a.augmented.theta_final_arcsec
+    assert not r.tz_unobservable and r.ml_converged.all()
+    assert np.all((r.label == "converged") == (r.dist_to_ml_over_bound <= 0.1))
     truth = np.asarray(case.truth_arcsec)
     assert np.all(np.abs(th_em - truth) < 4 * bound)
     assert np.all(np.abs(th_a - truth) < 4 * bound)
@@ -275,19 +275,19 @@ def test_the_count_sweep_puts_that_many_stars_in_every_image(counts):
     bounds = []
     for c in counts:
         cs = stars.count_settings(geo.C, 100, 100, c, 8.0, setup.stars.slew_deg, cam, stars.catalogue())
-        s_c = setup.replace(stars=replace(setup.stars, per_image=c, mag_limit=cs["mag_limit"]))
-        g = sc.with_stars(geo, s_c, cs["half_fov_rad"])
+        s_c = setup.replace(stars=replace(setup.stars, per_image=c, mag_limit=cs.mag_limit))
+        g = sc.with_stars(geo, s_c, cs.half_fov_rad)
         assert np.all(g.stars.n_stars == c), (c, g.stars.n_stars)
-        assert cs["widened"] == (cs["half_fov_rad"] > cam)
-        if not cs["widened"]:  # the brightest limit: a hair brighter, some image is short
-            s_b = setup.replace(stars=replace(setup.stars, per_image=c, mag_limit=cs["mag_limit"] - 1e-3))
+        assert cs.widened == (cs.half_fov_rad > cam)
+        if not cs.widened:  # the brightest limit: a hair brighter, some image is short
+            s_b = setup.replace(stars=replace(setup.stars, per_image=c, mag_limit=cs.mag_limit - 1e-3))
             try:
                 short = sc.with_stars(geo, s_b).stars.n_stars.min() < c
             except ValueError:  # an image with no star at all
                 short = True
             assert short
         else:
-            assert cs["mag_limit"] == 8.0
+            assert cs.mag_limit == 8.0
         bounds.append(pipeline.bound_curve(s_c, g, Rvar, case.truth_arcsec, "stars")[-1][:2].max())
     assert all(b1 < b0 for b0, b1 in zip(bounds, bounds[1:])), bounds
 
@@ -314,9 +314,9 @@ def test_the_stars_label_reads_tz(monkeypatch):
         geo = sc.build_geometry(cfg, variant)
         BOUND_TZ[0] = cases.label_bounds(setup, geo, [case], variant)[0][2]
         r = cases.run_case(setup, variant, case, range(2), geo=geo, method="squarem")
-        rel = np.abs(r["theta_final_arcsec"] - r["theta_ml_arcsec"]) / r["label_bound_arcsec"]
-        np.testing.assert_allclose(r["dist_to_ml_over_bound"], rel[:, :nax].max(1), rtol=1e-9)
-        assert np.all((r["label"] == "converged") == (variant != "stars")), (variant, r["label"])
+        rel = np.abs(r.theta_final_arcsec - r.theta_ml_arcsec) / r.label_bound_arcsec
+        np.testing.assert_allclose(r.dist_to_ml_over_bound, rel[:, :nax].max(1), rtol=1e-9)
+        assert np.all((r.label == "converged") == (variant != "stars")), (variant, r.label)
 
 
 BOUND_TZ = [1.0]

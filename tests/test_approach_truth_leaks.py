@@ -65,10 +65,10 @@ def test_no_estimate_beats_the_bound_of_the_data_it_used(variant):
     r, bound, truth = _run(variant, "sampled")
     ref, ref_bound, _ = _run(DIAGNOSTIC, "sampled")
     assert np.all(bound[:2] > 2.0 * ref_bound[:2]), (bound, ref_bound)
-    rmse = _rmse(r["theta_final_arcsec"], truth)
+    rmse = _rmse(r.theta_final_arcsec, truth)
     assert np.all(rmse >= 0.3 * bound[:2]), (rmse, bound)
     # control: the same statistic on the diagnostic that knows the true start state
-    assert np.all(_rmse(ref["theta_final_arcsec"], truth) < 0.3 * bound[:2])
+    assert np.all(_rmse(ref.theta_final_arcsec, truth) < 0.3 * bound[:2])
 
 
 def test_the_augmented_ekf_does_not_beat_its_bound():
@@ -78,7 +78,7 @@ def test_the_augmented_ekf_does_not_beat_its_bound():
     case = cases.headline_case(cfg)
     geo = sc.build_geometry(cfg, "roll")
     out = alternatives.run_case_alternatives(cfg, "roll", case, SEEDS, geo, methods=("augmented",))
-    th = out["methods"]["augmented"]["theta_final_arcsec"]
+    th = out.augmented.theta_final_arcsec
     Rvar = geo.measurement_variance(case.sigma3_px)
     bound = pipeline.total_bound(cfg, geo, Rvar, case.truth_arcsec, "roll")
     ref_geo = sc.build_geometry(cfg, DIAGNOSTIC)
@@ -95,7 +95,7 @@ def test_the_fixed_prior_error_stays_when_the_data_cannot_tell():
     r, bound, truth = _run("prior", "fixed", seeds=range(3))
     prior_alone = summaries.prior_bound_arcsec(_cfg("fixed"))  # sigma_r / rho
     assert bound[0] > 0.5 * prior_alone  # the data cannot tell theta much better than the prior
-    err = np.abs(r["theta_final_arcsec"][:, :2].mean(0) - truth[:2])
+    err = np.abs(r.theta_final_arcsec[:, :2].mean(0) - truth[:2])
     assert err.max() >= 0.25 * bound[:2].max(), (err, bound)
 
 

@@ -31,20 +31,22 @@ def _approach_runs(n_seeds=20, n_seg=8, per=5, n_t=200):
         before = 1e3 * np.exp(-t / 900.0) + 3.0 + 2.0 * rng.random((n_seeds, n_t))
         after = 3.0 + rng.random((n_seeds, n_t)) * np.linspace(8.0, 0.5, n_t)
         nis = 2.4 + 1.2 * rng.random((n_seeds, n_t))
-        runs[f"{mode}-{method}"] = {
-            "method": method, "mode": mode, "t_s": t, "case": SimpleNamespace(init_arcsec=(0.0, 0.0, 0.0)),
-            "truth_arcsec": np.array([10.0, 20.0, 10.0]), "theta_iter_arcsec": th,
-            "seg_data_used": d, "crlb_seg_arcsec": np.c_[30.0 / np.sqrt(np.arange(1, n_seg + 1)), 25.0 / np.sqrt(np.arange(1, n_seg + 1)), np.full(n_seg, np.inf)],
-            "label": np.array(["converged"] * 17 + ["stalled"] * 3), "crlb_arcsec": np.array([20.6, 20.6]),
-            "seg_lat_err_km": lat, "seg_lat_3sig_km": np.tile(30.0 * np.ones(n_seg), (n_seeds, 1)),
-            "seg_rng_err_km": lat / 10, "seg_rng_3sig_km": np.tile(8.0 * np.ones(n_seg), (n_seeds, 1)),
-            "err_before_t_km": 80.0 + rng.random((n_seeds, n_t)), "err_after_t_km": 20.0 + 60 * np.exp(-t / 500)[None] * rng.random((n_seeds, 1)),
-            "err_split_t_km": {k: (v + rng.random((n_seeds, n_t)), v / 5 + rng.random((n_seeds, n_t)))
-                               for k, v in (("before", 78.0), ("after", 18.0), ("true_theta", 15.0))},
-            "sampled": {"theta_final_arcsec": np.zeros((n_seeds, 3)),
-                        "consistency_t": {"before": {"nees_pos": before, "nis": nis},
-                                          "after": {"nees_pos": after, "nis": nis}}},
-        }
+        split = {k: (v + rng.random((n_seeds, n_t)), v / 5 + rng.random((n_seeds, n_t)))
+                 for k, v in (("before", 78.0), ("after", 18.0), ("true_theta", 15.0))}
+        runs[f"{mode}-{method}"] = SimpleNamespace(
+            method=method, mode=mode, t_s=t, case=SimpleNamespace(init_arcsec=(0.0, 0.0, 0.0)),
+            truth_arcsec=np.array([10.0, 20.0, 10.0]), theta_iter_arcsec=th, tz_unobservable=True,
+            seg_data_used=d, label=np.array(["converged"] * 17 + ["stalled"] * 3),
+            bounds=SimpleNamespace(crlb_arcsec=np.array([20.6, 20.6]), crlb_seg_arcsec=np.c_[
+                30.0 / np.sqrt(np.arange(1, n_seg + 1)), 25.0 / np.sqrt(np.arange(1, n_seg + 1)), np.full(n_seg, np.inf)]),
+            seg_lat_err_km=lat, seg_lat_3sig_km=np.tile(30.0 * np.ones(n_seg), (n_seeds, 1)),
+            seg_rng_err_km=lat / 10, seg_rng_3sig_km=np.tile(8.0 * np.ones(n_seg), (n_seeds, 1)),
+            err_before_t_km=80.0 + rng.random((n_seeds, n_t)),
+            err_after_t_km=20.0 + 60 * np.exp(-t / 500)[None] * rng.random((n_seeds, 1)),
+            err_split_t_km=SimpleNamespace(**split),
+            sampled=SimpleNamespace(theta_final_arcsec=np.zeros((n_seeds, 3)), consistency_t=SimpleNamespace(
+                before=SimpleNamespace(nees_pos=before, nis=nis), after=SimpleNamespace(nees_pos=after, nis=nis),
+                consider=SimpleNamespace(nees_pos=after), true_theta=SimpleNamespace(nees_pos=0.8 * after))))
     return runs
 
 
@@ -55,8 +57,9 @@ PUB_A = {"headline": {"est_x_arcsec": 11.43, "est_y_arcsec": 21.21, "nav_err_bef
 def _x1():
     curves = {v: np.c_[40.0 / np.sqrt(np.arange(1, 2001) / 50.0), np.ones(2000)] * (0.05 if v == "roll" else 1.0)
               for v in ("literal", "prior", "roll", "reference-start")}
-    conv = {v: {m: {"dist_arcsec": np.geomspace(10, 1e-3 if m == "squarem" else 1.0, 40)[None].repeat(3, 0)}
-                for m in ("plain", "squarem")} for v in curves}
+    conv = {v: SimpleNamespace(**{m: SimpleNamespace(dist_arcsec=np.geomspace(10, 1e-3 if m == "squarem" else 1.0,
+                                                                             40)[None].repeat(3, 0))
+                                  for m in ("plain", "squarem")}) for v in curves}
     x1 = pd.DataFrame([{"variant": v, "total_samples": 2000, "em_plain_rmse_x_arcsec": 20.0 if v != "roll" else 1.0,
                         "mle_samples": 2000, "mle_rmse_x_arcsec": 18.0 if v != "roll" else 0.5} for v in curves])
     from opnav.approach import plots

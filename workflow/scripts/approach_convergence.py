@@ -16,7 +16,7 @@ with script_context(snakemake) as log:
     for variant, out in zip(snakemake.params.variants, snakemake.output):
         res = convergence_study(setup, variant, headline_case(setup), range(cs.n_seeds), cs.data_samples,
                                 cs.max_maps, cs.tol_arcsec, init_mode=cs.initial_error_mode)
-        log.info("%s: theta* mean %s; maps plain %s squarem %s", variant, res["theta_star_arcsec"].mean(0),
-                 res["plain"]["maps_to_converge"], res["squarem"]["maps_to_converge"])
+        log.info("%s: theta* mean %s; maps plain %s squarem %s", variant, res.theta_star_arcsec.mean(0),
+                 res.plain.maps_to_converge, res.squarem.maps_to_converge)
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         save_pickle(out, res)

@@ -18,8 +18,8 @@ with script_context(snakemake) as log:
         runs = {}
         for p in snakemake.input[f"mc_{v}"]:
             for r in load_pickle(p):
-                if r["case_id"] == "T1-01":
-                    runs[f"{r.get('mode', 'sliding')}-{r['method']}"] = r
+                if r.case_id == "T1-01":
+                    runs[f"{r.mode}-{r.method}"] = r
         figures.save(plots.fig_bias_estimate(runs, v, pub, seg["N"], seg["M"]), out[f"f4_{v}"])
         figures.save(plots.fig_nav_accuracy(runs, v), out[f"f5_{v}"])
         figures.save(plots.fig_compensation(runs, v, pub), out[f"f6_{v}"])

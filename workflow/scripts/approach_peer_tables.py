@@ -11,10 +11,11 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 
 def load(paths):
+    """The records of the pickles: a Monte-Carlo list, an A-X2 job's ``results``, a peer variant."""
     out = []
     for p in paths:
         d = load_pickle(p)
-        out.extend(d if isinstance(d, list) else d.get("results", [d]))
+        out.extend(d if isinstance(d, list) else d["results"] if isinstance(d, dict) else [d])
     return out
 
 with script_context(snakemake) as log:

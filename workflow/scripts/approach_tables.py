@@ -20,7 +20,7 @@ with script_context(snakemake) as log:
     conv = {}
     for p in snakemake.input.conv:
         c = load_pickle(p)
-        conv[c["variant"]] = c
+        conv[c.variant] = c
     curves = load_pickle(snakemake.input.crlb)
     pub = published.paper_a()
     target = snakemake.params.target  # the claimed accuracy: A-C1's target (the analysis plan)

@@ -17,7 +17,7 @@ with script_context(snakemake) as log:
     conv = {}
     for p in snakemake.input.conv:
         c = load_pickle(p)
-        conv[c["variant"]] = c
+        conv[c.variant] = c
     x1 = load_table(snakemake.input.x1)
     fig = plots.fig_crlb(curves, conv, x1, snakemake.params.target, setup.segments.N0)
     figures.save(fig, snakemake.output.fig)

@@ -20,9 +20,9 @@ with script_context(snakemake) as log:
         if d["em_times"]:
             em_times[d["variant"]] = d["em_times"]
     em_res = []
-    variants = {r["variant"] for r in alt_res}
+    variants = {r.variant for r in alt_res}
     for p in snakemake.input.mc:
-        em_res.extend(r for r in load_pickle(p) if r["variant"] in variants)
+        em_res.extend(r for r in load_pickle(p) if r.variant in variants)
     long = alternatives_summary.long_frame(alt_res, em_res, em_times)
     long.to_csv(snakemake.output.long, index=False)
     rows = alternatives_summary.method_summaries(long)

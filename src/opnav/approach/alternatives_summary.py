@@ -16,6 +16,8 @@ import numpy as np
 import pandas as pd
 
 from . import scenario as sc
+from .alternatives import AltRun, BatchMLResult
+from .cases import CaseRun
 from .labels import row_label
 from .setup import Setup
 from .summaries import seed_sd
@@ -28,15 +30,15 @@ METHOD_LABELS = {
 }
 
 
-def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) -> pd.DataFrame:
+def long_frame(alt_results: list[AltRun], em_results: list[CaseRun], em_times: dict) -> pd.DataFrame:
     """One row per variant x method x case: error, spread, CRLB, nav error, data, run time.
 
-    ``em_results``: the EM-EKF Monte-Carlo dicts (:func:`opnav.approach.pipeline.run_group`);
+    ``em_results``: the EM-EKF Monte-Carlo runs (:func:`opnav.approach.pipeline.run_group`);
     ``em_times``: {variant: {"em_plain": s, ...}} measured on the headline case.
     """
     nan3 = np.full(3, np.nan)
-    crlb = {(r["variant"], r["case_id"]): r["crlb_total_arcsec"] for r in em_results}
-    crlb0 = {(r["variant"], r["case_id"]): r.get("crlb_total_q0_arcsec", nan3) for r in em_results}
+    crlb = {(r.variant, r.case_id): r.bounds.crlb_total_arcsec for r in em_results}
+    crlb0 = {(r.variant, r.case_id): r.bounds.crlb_total_q0_arcsec for r in em_results}
     rows = []
 
     def add(variant, case, method, truth, th, nav, data, runtime, extra=None, used=None, used_q0=None):
@@ -66,30 +68,30 @@ def long_frame(alt_results: list[dict], em_results: list[dict], em_times: dict) 
         rows.append(row)
 
     for r in em_results:
-        if r.get("mode", "sliding") != "sliding":
+        if r.mode != "sliding":
             continue
-        m = f"em_{r['method']}"
+        m = f"em_{r.method}"
         if m not in METHOD_LABELS:
             continue
-        rt = em_times.get(r["variant"], {}).get(m, math.nan) if r["case_id"] == "T1-01" else math.nan
-        add(r["variant"], r["case"], m, np.asarray(r["truth_arcsec"], float), r["theta_final_arcsec"],
-            r["nav_err_after_km"], r["data_to_converge"], rt,
-            {"nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
-             "label": row_label(r["label"])[0], "stalled_seeds": int(np.sum(r["stalled"]))},
-            used=r["crlb_arcsec"], used_q0=r["crlb_q0_arcsec"])
+        rt = em_times.get(r.variant, {}).get(m, math.nan) if r.case_id == "T1-01" else math.nan
+        add(r.variant, r.case, m, np.asarray(r.truth_arcsec, float), r.theta_final_arcsec,
+            r.nav_err_after_km, r.data_to_converge, rt,
+            {"nav_err_before_km": float(np.mean(r.nav_err_before_km)),
+             "label": row_label(r.label)[0], "stalled_seeds": int(np.sum(r.stalled))},
+            used=r.bounds.crlb_arcsec, used_q0=r.bounds.crlb_q0_arcsec)
     for r in alt_results:
-        for m, d in r["methods"].items():
+        for m, d in r.methods():
             extra = {}
-            if m == "batch_ml":
-                extra = {"ipopt_max_grad_norm": float(np.max(d["grad_norm"])),
-                         "ipopt_all_success": bool(np.all(d["ipopt_success"])),
-                         "ipopt_iterations_median": float(np.median(d["ipopt_iterations"])),
-                         "runtime_solve_s_per_seed": d["runtime_solve_s_per_seed"],
-                         "runtime_build_s": d["runtime_build_s"],
-                         "runtime_checkpoints_s_per_seed": d.get("runtime_checkpoints_s_per_seed", math.nan),
-                         "data_seeds": d.get("checkpoint_seeds", 0)}
-            add(r["variant"], r["case"], m, r["truth_arcsec"], d["theta_final_arcsec"],
-                d["nav_err_after_km"], d.get("data_to_converge"), d["runtime_s_per_seed"], extra)
+            if isinstance(d, BatchMLResult):
+                extra = {"ipopt_max_grad_norm": float(np.max(d.grad_norm)),
+                         "ipopt_all_success": bool(np.all(d.ipopt_success)),
+                         "ipopt_iterations_median": float(np.median(d.ipopt_iterations)),
+                         "runtime_solve_s_per_seed": d.runtime_solve_s_per_seed,
+                         "runtime_build_s": d.runtime_build_s,
+                         "runtime_checkpoints_s_per_seed": d.runtime_checkpoints_s_per_seed,
+                         "data_seeds": d.checkpoint_seeds}
+            add(r.variant, r.case, m, r.truth_arcsec, d.theta_final_arcsec,
+                d.nav_err_after_km, d.data_to_converge, d.runtime_s_per_seed, extra)
     df = pd.DataFrame(rows)
     vorder = {v: i for i, v in enumerate(sc.VARIANTS)}
     morder = {m: i for i, m in enumerate(METHOD_LABELS)}

@@ -43,7 +43,9 @@ Units: arcsec and km in outputs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -133,7 +135,45 @@ def lateral_range_t(xf: np.ndarray, dx_true: np.ndarray, C: np.ndarray) -> tuple
     return np.hypot(e[..., 0], e[..., 1]), np.abs(e[..., 2])
 
 
-def consistency(f, dx_true: np.ndarray) -> dict:
+@dataclass(frozen=True)
+class Consistency:
+    """One filter run's consistency over time, (S, n+1) each: the position NEES (3 dof) and the
+    NIS (3 dof; None where the run's innovations are not kept)."""
+
+    nees_pos: np.ndarray
+    nis: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class ConsistencySeries:
+    """:class:`Consistency` of the full-arc filters of a run: theta = 0 (``before``), the final
+    estimate as exact (``after``), the Schmidt filter carrying its covariance (``consider``, NEES
+    only) and the filter given the true theta (``true_theta``, NEES only: a diagnostic)."""
+
+    before: Consistency
+    after: Consistency
+    consider: Consistency
+    true_theta: Consistency
+
+
+class LateralRange(NamedTuple):
+    """A position error split across the line of sight (``lateral``) and along it (``range``), km."""
+
+    lateral: np.ndarray
+    range: np.ndarray
+
+
+@dataclass(frozen=True)
+class SplitSeries:
+    """:class:`LateralRange` over time, (S, n+1) each, of the theta = 0 filter (``before``), the
+    compensated one (``after``) and the filter given the true theta (``true_theta``)."""
+
+    before: LateralRange
+    after: LateralRange
+    true_theta: LateralRange
+
+
+def consistency(f, dx_true: np.ndarray) -> Consistency:
     """Position NEES (3 dof) and NIS (3 dof) of a filter run over time, (S, n+1) each:
     ``e^T P_rr^-1 e`` with ``e`` the filtered position error, and ``nu^T S^-1 nu`` with the
     innovation ``nu`` and its covariance ``S`` (index 0, the prior, has no NIS: NaN)."""
@@ -141,7 +181,7 @@ def consistency(f, dx_true: np.ndarray) -> dict:
     nees = np.einsum("ski,ski->sk", e, np.linalg.solve(f.Pf[:, :, :3, :3], e[..., None])[..., 0])
     nis = np.einsum("ski,skij,skj->sk", f.nu, f.Sinv, f.nu)
     nis[:, 0] = np.nan
-    return {"nees_pos": nees, "nis": nis}
+    return Consistency(nees, nis)
 
 
 def simulate_case(setup: Setup, geo: sc.Geometry, case: Case, seed_indices, init_mode: str | None = None,
@@ -183,8 +223,130 @@ def start_states(start: str, starts, f0, dx_true: np.ndarray, dx0: np.ndarray, P
     raise ValueError(f"unknown start rule {start!r}")
 
 
+@dataclass(frozen=True)
+class CaseBounds:
+    """The 1-sigma Cramer-Rao bounds of one case (arcsec, (3,) each; per segment (L, 3)): of the
+    data its estimate used (``crlb_arcsec``: the last window when sliding, the cumulative data
+    when growing; per segment ``crlb_seg_arcsec``), of all the segments' data
+    (``crlb_total_arcsec``), and each with Q = 0 (``*_q0_*``: the truth has no process noise).
+    Computed by :func:`opnav.approach.pipeline.case_bounds`."""
+
+    crlb_seg_arcsec: np.ndarray
+    crlb_seg_q0_arcsec: np.ndarray
+    crlb_arcsec: np.ndarray
+    crlb_q0_arcsec: np.ndarray
+    crlb_total_arcsec: np.ndarray
+    crlb_total_q0_arcsec: np.ndarray
+
+
+@dataclass(frozen=True)
+class SampledRun:
+    """The headline case rerun with the initial error drawn from the prior (the only spread that
+    may be set beside a Bayesian bound): the :class:`CaseRun` fields the tables read."""
+
+    theta_final_arcsec: np.ndarray
+    label: np.ndarray
+    stalled: np.ndarray
+    dist_to_ml_arcsec: np.ndarray
+    consistency_t: ConsistencySeries
+    nav_err_after_km: np.ndarray
+    nav_err_before_km: np.ndarray
+    nav_err_true_theta_km: np.ndarray
+
+    @classmethod
+    def of(cls, run: "CaseRun") -> "SampledRun":
+        return cls(**{f: getattr(run, f) for f in cls.__dataclass_fields__})
+
+
+#: the time series of a run (figures): kept for the headline case only (:meth:`CaseRun.without_series`)
+SERIES_FIELDS = ("err_before_t_km", "err_after_t_km", "err_split_t_km", "consistency_t")
+
+
+@dataclass(frozen=True)
+class CaseRun:
+    """The EM-EKF on one Table-1 case, variant and EM scheme over a batch of seeds
+    (:func:`run_cases`; module docstring for the rules). Per-seed arrays have the seeds first
+    (S, ...); arcsec, km, samples, s.
+
+    Estimates: ``theta_final_arcsec`` (S, 3); after each segment ``theta_seg_arcsec`` (S, L, 3);
+    every EM iterate ``theta_iter_arcsec`` (S, maps, 3) with its log-likelihood ``loglik_iter``
+    and the data it used ``iter_data_used``; ``seg_data_used`` (L,) samples after each segment;
+    ``maps_per_segment``. Position error at each segment's end (the filter inside the EM):
+    ``seg_pos_err_km`` and its lateral / range parts with the filter's 3-sigma. The convergence
+    label (SPEC A.3c): ``label``, ``stalled``, ``converged``, ``moved_arcsec`` (from the start),
+    ``contraction_per_map``, the ML estimate of the last segment's data ``theta_ml_arcsec`` (and
+    ``ml_converged``), the distance to it ``dist_to_ml_arcsec`` and in bounds of that data
+    ``dist_to_ml_over_bound`` (``label_bound_arcsec`` (3,)); ``data_to_converge`` (NaN unless
+    converged); ``tz_unobservable``. Navigation errors (RMS over the last
+    ``nav_error.last_fraction``, km): theta = 0 (``before``), compensated (``after``), split
+    across (``lat``) and along (``rng``) the line of sight, with the true theta and by the
+    Schmidt filter (``consider``). Time series (headline case only, else None): the error norms
+    ``err_before_t_km`` / ``err_after_t_km``, their split ``err_split_t_km`` and the filters'
+    consistency ``consistency_t``; ``t_s`` the sample times. Added by
+    :func:`opnav.approach.pipeline.run_group`: the job's case ``group``, the case's ``bounds``
+    and, for the headline case, the ``sampled`` rerun.
+    """
+
+    variant: str
+    mode: str
+    method: str
+    case: Case
+    seed_indices: np.ndarray
+    truth_arcsec: np.ndarray
+    theta_final_arcsec: np.ndarray
+    theta_seg_arcsec: np.ndarray
+    theta_iter_arcsec: np.ndarray
+    loglik_iter: np.ndarray
+    iter_data_used: np.ndarray
+    seg_data_used: np.ndarray
+    maps_per_segment: int
+    seg_pos_err_km: np.ndarray
+    seg_lat_err_km: np.ndarray
+    seg_rng_err_km: np.ndarray
+    seg_lat_3sig_km: np.ndarray
+    seg_rng_3sig_km: np.ndarray
+    tz_unobservable: bool
+    data_to_converge: np.ndarray
+    label: np.ndarray
+    stalled: np.ndarray
+    converged: np.ndarray
+    moved_arcsec: np.ndarray
+    contraction_per_map: np.ndarray
+    theta_ml_arcsec: np.ndarray
+    ml_converged: np.ndarray
+    dist_to_ml_arcsec: np.ndarray
+    dist_to_ml_over_bound: np.ndarray
+    label_bound_arcsec: np.ndarray
+    nav_err_before_km: np.ndarray
+    nav_err_after_km: np.ndarray
+    nav_err_before_lat_km: np.ndarray
+    nav_err_before_rng_km: np.ndarray
+    nav_err_after_lat_km: np.ndarray
+    nav_err_after_rng_km: np.ndarray
+    nav_err_true_theta_lat_km: np.ndarray
+    nav_err_true_theta_rng_km: np.ndarray
+    nav_err_true_theta_km: np.ndarray
+    nav_err_consider_km: np.ndarray
+    t_s: np.ndarray
+    err_before_t_km: np.ndarray | None = None
+    err_after_t_km: np.ndarray | None = None
+    err_split_t_km: SplitSeries | None = None
+    consistency_t: ConsistencySeries | None = None
+    group: str = ""
+    bounds: CaseBounds | None = None
+    sampled: SampledRun | None = field(default=None, repr=False)
+
+    @property
+    def case_id(self) -> str:
+        return self.case.case_id
+
+    def without_series(self) -> "CaseRun":
+        """The run without its time series (:data:`SERIES_FIELDS`)."""
+        return dataclasses.replace(self, **{f: None for f in SERIES_FIELDS})
+
+
 def run_case(setup: Setup, variant: str, case: Case, seed_indices, geo: sc.Geometry | None = None,
-             method: str | None = None, init_mode: str | None = None) -> dict:
+             method: str | None = None, init_mode: str | None = None) -> CaseRun:
     """EM-EKF for one case and variant over the given seeds; arrays in arcsec / km."""
     return run_cases(setup, variant, [case], seed_indices, geo, method, init_mode)[0]
 
@@ -208,7 +370,7 @@ class CaseData:
     win: object
     f0: object
     err_before: np.ndarray
-    cons_before: dict
+    cons_before: Consistency
     starts: dict
     f_true: object = None
 
@@ -248,7 +410,7 @@ def prepare_cases(setup: Setup, variant: str, case_list: list[Case], seed_indice
 
 def run_cases(setup: Setup, variant: str, case_list: list[Case], seed_indices,
               geo: sc.Geometry | None = None, method: str | None = None, init_mode: str | None = None,
-              data: CaseData | None = None, seg_bounds: list | None = None) -> list[dict]:
+              data: CaseData | None = None, seg_bounds: list | None = None) -> list[CaseRun]:
     """EM-EKF for several cases of one variant at once: every (case, seed) run is one row
     of the stacked filter arrays (runs are independent; each keeps its own stream).
     ``data``: the :func:`prepare_cases` of these arguments, shared by several EM schemes
@@ -325,56 +487,71 @@ def run_cases(setup: Setup, variant: str, case_list: list[Case], seed_indices,
     seg_lat3, seg_rng3 = np.stack(seg_lat3, 1), np.stack(seg_rng3, 1)
     nb, na = rms_last(err_before, frac), rms_last(err_after, frac)
     # the same errors split across / along the line of sight, and the floor with the true theta
-    split_t = {"before": lateral_range_t(f0.xf, dx_true, geo.C), "after": lateral_range_t(f1.xf, dx_true, geo.C),
-               "true_theta": lateral_range_t(data.f_true.xf, dx_true, geo.C)}
+    split_t = SplitSeries(before=LateralRange(*lateral_range_t(f0.xf, dx_true, geo.C)),
+                          after=LateralRange(*lateral_range_t(f1.xf, dx_true, geo.C)),
+                          true_theta=LateralRange(*lateral_range_t(data.f_true.xf, dx_true, geo.C)))
     err_true = np.linalg.norm(data.f_true.xf[:, :, :3] - dx_true[None, :, :3], axis=-1)
-    split = {f"nav_err_{k}_{part}_km": rms_last(v[j], frac) for k, v in split_t.items()
-             for j, part in enumerate(("lat", "rng"))}
-    split["nav_err_true_theta_km"] = rms_last(err_true, frac)
-    split["nav_err_consider_km"] = rms_last(err_consider, frac)
-    cons = {"before": data.cons_before, "after": consistency(f1, dx_true),
-            "consider": {"nees_pos": fc.nees_pos}, "true_theta": {"nees_pos": consistency(data.f_true, dx_true)["nees_pos"]}}
+    nav_true = rms_last(err_true, frac)
+    nav_consider = rms_last(err_consider, frac)
+    rms_b, rms_a, rms_t = (LateralRange(rms_last(v.lateral, frac), rms_last(v.range, frac))
+                           for v in (split_t.before, split_t.after, split_t.true_theta))
+    cons = ConsistencySeries(before=data.cons_before, after=consistency(f1, dx_true), consider=Consistency(fc.nees_pos),
+                             true_theta=Consistency(consistency(data.f_true, dx_true).nees_pos))
+
     out = []
     for i, case in enumerate(case_list):
         sl = slice(i * ns, (i + 1) * ns)
-        out.append({
-            "variant": variant,
-            "mode": setup.segments.mode,
-            "case_id": case.case_id,
-            "seed_indices": np.asarray(seed_indices),
-            "truth_arcsec": np.asarray(case.truth_arcsec, float),
-            "theta_final_arcsec": sc.arcsec(theta[sl]),
-            "theta_seg_arcsec": seg_theta_as[sl],
-            "theta_iter_arcsec": theta_iter[sl],
-            "loglik_iter": ll_iter[sl],
-            "iter_data_used": np.asarray(it_data),
-            "seg_data_used": seg_data,
-            "maps_per_segment": maps_per_segment(method, M),
-            "seg_pos_err_km": np.hypot(seg_lat[sl], seg_rng[sl]),
-            "seg_lat_err_km": seg_lat[sl], "seg_rng_err_km": seg_rng[sl],
-            "seg_lat_3sig_km": seg_lat3[sl], "seg_rng_3sig_km": seg_rng3[sl],
-            "tz_unobservable": bool(np.all(unobs[sl, 0])) if unobs is not None else False,
-            "data_to_converge": conv[sl],
-            "label": label[sl],
-            "stalled": label[sl] == STALLED,
-            "converged": label[sl] == CONVERGED,
-            "moved_arcsec": moved[sl],
-            "contraction_per_map": rate[sl],
-            "theta_ml_arcsec": sc.arcsec(theta_ml[sl]),
-            "ml_converged": ml_done[sl],
-            "dist_to_ml_arcsec": dist_ml[sl],
-            "dist_to_ml_over_bound": dist_rel[sl],
-            "label_bound_arcsec": np.asarray(seg_bounds[i], float),
-            "nav_err_before_km": nb[sl],
-            "nav_err_after_km": na[sl],
-            "err_before_t_km": err_before[sl],
-            "err_after_t_km": err_after[sl],
-            **{k: v[sl] for k, v in split.items()},
-            "err_split_t_km": {k: (v[0][sl], v[1][sl]) for k, v in split_t.items()},  # (lateral, range)
-            "consistency_t": {k: {q: v[q][sl] for q in v} for k, v in cons.items()},
-            "t_s": geo.t,
-        })
+        out.append(CaseRun(
+            variant=variant,
+            mode=setup.segments.mode,
+            method=method,
+            case=case,
+            seed_indices=np.asarray(seed_indices),
+            truth_arcsec=np.asarray(case.truth_arcsec, float),
+            theta_final_arcsec=sc.arcsec(theta[sl]),
+            theta_seg_arcsec=seg_theta_as[sl],
+            theta_iter_arcsec=theta_iter[sl],
+            loglik_iter=ll_iter[sl],
+            iter_data_used=np.asarray(it_data),
+            seg_data_used=seg_data,
+            maps_per_segment=maps_per_segment(method, M),
+            seg_pos_err_km=np.hypot(seg_lat[sl], seg_rng[sl]),
+            seg_lat_err_km=seg_lat[sl], seg_rng_err_km=seg_rng[sl],
+            seg_lat_3sig_km=seg_lat3[sl], seg_rng_3sig_km=seg_rng3[sl],
+            tz_unobservable=bool(np.all(unobs[sl, 0])) if unobs is not None else False,
+            data_to_converge=conv[sl],
+            label=label[sl],
+            stalled=label[sl] == STALLED,
+            converged=label[sl] == CONVERGED,
+            moved_arcsec=moved[sl],
+            contraction_per_map=rate[sl],
+            theta_ml_arcsec=sc.arcsec(theta_ml[sl]),
+            ml_converged=ml_done[sl],
+            dist_to_ml_arcsec=dist_ml[sl],
+            dist_to_ml_over_bound=dist_rel[sl],
+            label_bound_arcsec=np.asarray(seg_bounds[i], float),
+            nav_err_before_km=nb[sl],
+            nav_err_after_km=na[sl],
+            nav_err_before_lat_km=rms_b.lateral[sl], nav_err_before_rng_km=rms_b.range[sl],
+            nav_err_after_lat_km=rms_a.lateral[sl], nav_err_after_rng_km=rms_a.range[sl],
+            nav_err_true_theta_lat_km=rms_t.lateral[sl], nav_err_true_theta_rng_km=rms_t.range[sl],
+            nav_err_true_theta_km=nav_true[sl], nav_err_consider_km=nav_consider[sl],
+            t_s=geo.t,
+            err_before_t_km=err_before[sl],
+            err_after_t_km=err_after[sl],
+            err_split_t_km=SplitSeries(*(_rows_lr(v, sl) for v in (split_t.before, split_t.after, split_t.true_theta))),
+            consistency_t=ConsistencySeries(*(_rows_cons(c, sl) for c in (cons.before, cons.after, cons.consider,
+                                                                          cons.true_theta))),
+        ))
     return out
+
+
+def _rows_lr(v: LateralRange, sl: slice) -> LateralRange:
+    return LateralRange(v.lateral[sl], v.range[sl])
+
+
+def _rows_cons(c: Consistency, sl: slice) -> Consistency:
+    return Consistency(c.nees_pos[sl], None if c.nis is None else c.nis[sl])
 
 
 def em_segments(setup: Setup, variant: str, data: CaseData, method: str, theta: np.ndarray, windows=None):
@@ -415,9 +592,41 @@ def label_bounds(setup: Setup, geo: sc.Geometry, case_list: list[Case], variant:
     return [b[-1] for b in segment_bounds_many(setup, geo.along_reference(), items, variant)]
 
 
+@dataclass(frozen=True)
+class MapsToML:
+    """One EM scheme of :func:`convergence_study`, per seed: the maps (filter + smoother + M-step)
+    to reach the ML estimate (``maps_to_converge``; ``max_maps + 1`` when it does not within
+    ``max_maps``), the same extrapolated at the measured rate for a run that stalled
+    (``maps_extrapolated``), the distance to the ML estimate after each map ``dist_arcsec``
+    (S, maps), the iterates ``theta_hist_arcsec`` (S, maps, 3), their ``loglik`` and the
+    contraction ``rate_per_map`` over the last iterations."""
+
+    maps_to_converge: np.ndarray
+    maps_extrapolated: np.ndarray
+    dist_arcsec: np.ndarray
+    theta_hist_arcsec: np.ndarray
+    loglik: np.ndarray
+    rate_per_map: np.ndarray
+
+
+@dataclass(frozen=True)
+class ConvergenceStudy:
+    """Plain EM and SQUAREM to the ML estimate of one window (:func:`convergence_study`): the
+    reference ``theta_star_arcsec`` (S, 3), the case's truth, the window's samples and the map
+    budget, and each scheme's :class:`MapsToML`."""
+
+    variant: str
+    theta_star_arcsec: np.ndarray
+    truth_arcsec: np.ndarray
+    data_samples: int
+    max_maps: int
+    plain: MapsToML
+    squarem: MapsToML
+
+
 def convergence_study(setup: Setup, variant: str, case: Case, seed_indices, data_samples: int,
                       max_maps: int, tol_arcsec: float, geo: sc.Geometry | None = None,
-                      init_mode: str | None = None) -> dict:
+                      init_mode: str | None = None) -> ConvergenceStudy:
     """Iterations of plain EM and SQUAREM to reach the maximum-likelihood estimate.
 
     One window of ``data_samples`` samples from ``N0`` (start rule of the
@@ -447,30 +656,31 @@ def convergence_study(setup: Setup, variant: str, case: Case, seed_indices, data
     th, _, sq = ml_estimate(wz, theta0, x0, P0, ww, tz_tol, max(max_maps, 30), per_seed=False)
     sq_theta, sq_ll = sq.theta, sq.loglik
     ref_as = sc.arcsec(th)
-    traces = {"squarem": (sq_theta, sq_ll)}
     tr = em_window(wz, theta0, x0, P0, ww, max_maps, "plain", tz_tol)
-    traces["plain"] = (tr.theta, tr.loglik)
+    return ConvergenceStudy(variant=variant, theta_star_arcsec=ref_as, truth_arcsec=np.asarray(case.truth_arcsec),
+                            data_samples=data_samples, max_maps=max_maps,
+                            plain=_maps_to_ml(tr.theta, tr.loglik, ref_as, tol_arcsec, max_maps),
+                            squarem=_maps_to_ml(sq_theta, sq_ll, ref_as, tol_arcsec, max_maps))
 
-    out = {"variant": variant, "theta_star_arcsec": ref_as, "truth_arcsec": np.asarray(case.truth_arcsec),
-           "data_samples": data_samples, "max_maps": max_maps}
-    for method in ("plain", "squarem"):
-        th_list, ll_list = traces[method]
-        hist = sc.arcsec(np.stack(th_list, 1))  # (S, maps, 3)
-        dist = np.abs(hist[:, :, :2] - ref_as[:, None, :2]).max(-1)
-        ok = dist <= tol_arcsec
-        maps_needed = np.full(S, max(max_maps, hist.shape[1]) + 1)
-        for i in range(S):
-            bad = np.where(~ok[i])[0]
-            last_bad = bad[-1] if bad.size else -1
-            if last_bad + 1 < ok.shape[1]:
-                maps_needed[i] = last_bad + 2  # maps are 1-based
-        d = np.maximum(dist[:, -11:], 1e-300)
-        rate = np.exp(np.mean(np.diff(np.log(d), axis=1), axis=1))
-        # stalled runs: maps still needed at the measured linear rate (extrapolation, labelled so)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            extra = np.where(rate < 1.0, np.log(tol_arcsec / d[:, -1]) / np.log(rate), np.inf)
-        extrap = np.where(maps_needed > hist.shape[1], dist.shape[1] + np.maximum(extra, 0.0),
-                          maps_needed.astype(float))
-        out[method] = {"maps_to_converge": maps_needed, "maps_extrapolated": extrap, "dist_arcsec": dist,
-                       "theta_hist_arcsec": hist, "loglik": np.stack(ll_list, 1), "rate_per_map": rate}
-    return out
+
+def _maps_to_ml(th_list, ll_list, ref_as: np.ndarray, tol_arcsec: float, max_maps: int) -> MapsToML:
+    """:class:`MapsToML` of one scheme's iterates (rad) against the reference ``ref_as`` (arcsec)."""
+    hist = sc.arcsec(np.stack(th_list, 1))  # (S, maps, 3)
+    S = hist.shape[0]
+    dist = np.abs(hist[:, :, :2] - ref_as[:, None, :2]).max(-1)
+    ok = dist <= tol_arcsec
+    maps_needed = np.full(S, max(max_maps, hist.shape[1]) + 1)
+    for i in range(S):
+        bad = np.where(~ok[i])[0]
+        last_bad = bad[-1] if bad.size else -1
+        if last_bad + 1 < ok.shape[1]:
+            maps_needed[i] = last_bad + 2  # maps are 1-based
+    d = np.maximum(dist[:, -11:], 1e-300)
+    rate = np.exp(np.mean(np.diff(np.log(d), axis=1), axis=1))
+    # stalled runs: maps still needed at the measured linear rate (extrapolation, labelled so)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        extra = np.where(rate < 1.0, np.log(tol_arcsec / d[:, -1]) / np.log(rate), np.inf)
+    extrap = np.where(maps_needed > hist.shape[1], dist.shape[1] + np.maximum(extra, 0.0),
+                      maps_needed.astype(float))
+    return MapsToML(maps_to_converge=maps_needed, maps_extrapolated=extrap, dist_arcsec=dist,
+                    theta_hist_arcsec=hist, loglik=np.stack(ll_list, 1), rate_per_map=rate)

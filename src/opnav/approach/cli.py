@@ -98,13 +98,13 @@ def run(args, rc) -> int:
     curve0 = bound_curve(setup, geo, Rvar, truth, args.variant, zero_q=True)
     s = setup.segments
     used = min(s.data_samples, len(curve) - 1)
-    th = r["theta_final_arcsec"]
-    st = r["stalled"]
-    tz = "unobservable" if r["tz_unobservable"] else None
-    label, counts = row_label(r["label"])
+    th = r.theta_final_arcsec
+    st = r.stalled
+    tz = "unobservable" if r.tz_unobservable else None
+    label, counts = row_label(r.label)
     target = accuracy_target_arcsec()  # the analysis plan's A-C1 target
     cause = bound_cause(sc.START_OF[args.variant], s.mode, s.N)
-    rate = r["contraction_per_map"]
+    rate = r.contraction_per_map
     rate_med = float(np.nanmedian(rate)) if np.isfinite(rate).any() else float("nan")
     out = {
         "variant": args.variant, "method": method, "seeds": list(seeds), "segments": s.as_dict(),
@@ -113,7 +113,7 @@ def run(args, rc) -> int:
         # labels from the data (SPEC A.3c): distance to the ML estimate of the data the run used
         "label": label,
         "reading": reading_text(label, counts, len(st), float(max(bound[:2])), target,
-                                float(np.mean(r["dist_to_ml_arcsec"])), rate_med, cause),
+                                float(np.mean(r.dist_to_ml_arcsec)), rate_med, cause),
         "estimate_arcsec": {"mean": th.mean(0),
                             "std": th.std(0, ddof=1) if th.shape[0] > 1 else None,
                             "per_seed": th.round(4)},
@@ -129,21 +129,21 @@ def run(args, rc) -> int:
                                  "tz": tz or float(curve[used, 2])},
         "crlb_all_data_q0_arcsec": {"tx": float(curve0[used, 0]), "ty": float(curve0[used, 1]),
                                     "tz": tz or float(curve0[used, 2])},
-        "convergence": {"label": [str(v) for v in r["label"]],
-                  "moved_from_start_arcsec": [float(v) for v in r["moved_arcsec"]],
-                  "contraction_per_map": [float(v) for v in r["contraction_per_map"]],
-                  "ml_estimate_same_data_arcsec": r["theta_ml_arcsec"][:, :2].round(4).tolist(),
-                  "distance_to_ml_arcsec": [float(v) for v in r["dist_to_ml_arcsec"]],
-                  "distance_to_ml_over_bound": [float(v) for v in r["dist_to_ml_over_bound"]],
+        "convergence": {"label": [str(v) for v in r.label],
+                  "moved_from_start_arcsec": [float(v) for v in r.moved_arcsec],
+                  "contraction_per_map": [float(v) for v in r.contraction_per_map],
+                  "ml_estimate_same_data_arcsec": r.theta_ml_arcsec[:, :2].round(4).tolist(),
+                  "distance_to_ml_arcsec": [float(v) for v in r.dist_to_ml_arcsec],
+                  "distance_to_ml_over_bound": [float(v) for v in r.dist_to_ml_over_bound],
                   "rule": (f"converged if within {setup.em.converge_frac_of_bound:g} x the 1-sigma bound of the "
                            f"data used ({bound_data(setup, args.variant)['text']}; tx and ty each) of that "
                            f"data's ML estimate; else stalled if the contraction per map toward it is >= "
                            f"{setup.em.stall_rate:g}, not converged otherwise")},
-        "iterations": {"em_maps": int(r["theta_iter_arcsec"].shape[1]),
-                       "per_segment": int(r["maps_per_segment"]), "segments": s.L},
-        "data_to_converge_samples": [None if np.isnan(v) else int(v) for v in r["data_to_converge"]],
-        "nav_err_before_km": float(np.mean(r["nav_err_before_km"])),
-        "nav_err_after_km": float(np.mean(r["nav_err_after_km"])),
+        "iterations": {"em_maps": int(r.theta_iter_arcsec.shape[1]),
+                       "per_segment": int(r.maps_per_segment), "segments": s.L},
+        "data_to_converge_samples": [None if np.isnan(v) else int(v) for v in r.data_to_converge],
+        "nav_err_before_km": float(np.mean(r.nav_err_before_km)),
+        "nav_err_after_km": float(np.mean(r.nav_err_after_km)),
     }
     if counts["converged"] < st.size:
         print(f"opnav approach: WARNING: EM did not converge in {st.size - counts['converged']} of {st.size} "

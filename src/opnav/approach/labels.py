@@ -58,35 +58,35 @@ def reading_text(label: str, counts: dict, n: int, bound_arcsec: float, target_a
             f"contraction {rate_txt} per map")
 
 
-def label_columns(r: dict, target_arcsec: float) -> dict:
+def label_columns(r, target_arcsec: float) -> dict:
     """A-T1 label columns of one run (SPEC A.3c, labels from the data): the row label and the
     seeds of each label, ``stalled`` (kept for readers of the old column), the distance to and
     the ML estimate of the data used, the contraction per map, whether the bound of the data
     used reaches ``target_arcsec`` (``identifiable``), the reading sentence, and the data to
-    converge (median over the converged seeds)."""
-    lab, counts = row_label(r["label"])
-    conv = np.asarray(r["data_to_converge"], float)
+    converge (median over the converged seeds). ``r``: a :class:`opnav.approach.cases.CaseRun`
+    with its bounds (:func:`opnav.approach.pipeline.run_group`)."""
+    lab, counts = row_label(r.label)
+    conv = np.asarray(r.data_to_converge, float)
     ok = conv[np.isfinite(conv)]
-    bound = float(max(r["crlb_arcsec"][0], r["crlb_arcsec"][1]))
-    rate = (float(np.nanmedian(r["contraction_per_map"])) if np.isfinite(r["contraction_per_map"]).any()
+    crlb = r.bounds.crlb_arcsec
+    bound = float(max(crlb[0], crlb[1]))
+    rate = (float(np.nanmedian(r.contraction_per_map)) if np.isfinite(r.contraction_per_map).any()
             else math.nan)
-    dist = float(np.mean(r["dist_to_ml_arcsec"]))
-    seg = np.asarray(r["seg_data_used"])
-    mode = r.get("mode", "sliding")
-    cause = bound_cause(sc.START_OF[r["variant"]], mode, int(seg[0]))
+    dist = float(np.mean(r.dist_to_ml_arcsec))
+    seg = np.asarray(r.seg_data_used)
+    cause = bound_cause(sc.START_OF[r.variant], r.mode, int(seg[0]))
     return {
         "label": lab,
         "converged_seeds": counts["converged"],
         "stalled": lab == "stalled",
         "stalled_seeds": counts["stalled"],
-        "moved_arcsec": float(np.mean(r["moved_arcsec"])),
+        "moved_arcsec": float(np.mean(r.moved_arcsec)),
         "contraction_per_map": rate,
         "dist_to_ml_arcsec": dist,
         # the label's scale (issue 44): the distance in 1-sigma bounds of the data used (max of tx, ty)
-        "dist_to_ml_over_bound": (float(np.mean(r["dist_to_ml_over_bound"])) if "dist_to_ml_over_bound" in r
-                                  else math.nan),
-        "ml_x_mean": float(np.mean(r["theta_ml_arcsec"][:, 0])),
-        "ml_y_mean": float(np.mean(r["theta_ml_arcsec"][:, 1])),
+        "dist_to_ml_over_bound": float(np.mean(r.dist_to_ml_over_bound)),
+        "ml_x_mean": float(np.mean(r.theta_ml_arcsec[:, 0])),
+        "ml_y_mean": float(np.mean(r.theta_ml_arcsec[:, 1])),
         "identifiable": bound <= target_arcsec,
         "reading": reading_text(lab, counts, len(conv), bound, target_arcsec, dist, rate, cause),
         "data_to_converge_samples": float(np.median(ok)) if ok.size else math.nan,

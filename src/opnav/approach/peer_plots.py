@@ -24,19 +24,19 @@ def peer_figure(peer: list[dict], table):
         fig, axes = plt.subplots(2, nv, figsize=(figures.PAGE_WIDTH_IN, 4.6), sharex=True, squeeze=False,
                                  layout="constrained")
         for j, p in enumerate(peer):
-            v = p["variant"]
+            v = p.variant
             tv = table[table["variant"] == v]
             for i, comp in enumerate("xy"):
                 ax = axes[i, j]
                 t_end = 0.0
-                for name, r in p["runs"].items():
-                    t = r["t_hist_s"]
+                for name, r in p.runs.items():
+                    t = r.t_hist_s
                     t_end = max(t_end, t[-1])
-                    m = r["theta_hist_arcsec"][:, :, i].mean(0)
-                    s3 = r["sigma3_hist_arcsec"][:, :, i].mean(0)
+                    m = r.theta_hist_arcsec[:, :, i].mean(0)
+                    s3 = r.sigma3_hist_arcsec[:, :, i].mean(0)
                     ax.plot(t, m, color=RCOLORS[name], lw=1.0, label=f"UKF: {RUN_LABELS[name]}")
                     ax.fill_between(t, m - s3, m + s3, color=RCOLORS[name], alpha=0.2, lw=0)
-                    ax.axhline(r["truth_arcsec"][i], color=RCOLORS[name], lw=0.6, ls=":")
+                    ax.axhline(r.truth_arcsec[i], color=RCOLORS[name], lw=0.6, ls=":")
                 others = tv[tv["estimator"] != "Basilisk pixelLineBiasUKF"]
                 if len(others):
                     c3 = others[f"crlb_3sigma_{comp}_arcsec"].iloc[0]

@@ -88,7 +88,8 @@ Units: km, km/s, s, rad inside; px for the circle; arcsec in outputs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -194,7 +195,22 @@ def mrp_from_dcm(C: np.ndarray) -> np.ndarray:
 
 
 # ------------------------------------------------------------ two-body check
-def two_body_check(geo: sc.Geometry) -> dict:
+@dataclass(frozen=True)
+class TwoBodyCheck:
+    """What the peer's two-body (Mars only) dynamics neglect along the truth arc
+    (:func:`two_body_check`): the Sun's tidal acceleration at the start and its maximum (km/s^2),
+    the start range (km), the arc (s), the largest two-body position error (km) and the relative
+    difference of Basilisk's Mars GM from ours."""
+
+    sun_tidal_kms2_start: float
+    sun_tidal_kms2_max: float
+    range_km_start: float
+    arc_s: float
+    two_body_pos_err_km: float
+    mu_mars_relative_difference: float
+
+
+def two_body_check(geo: sc.Geometry) -> TwoBodyCheck:
     """What the module's two-body (Mars only) dynamics neglect along the truth arc.
 
     ``sun_tidal_kms2``: |a_Sun(r_sc) - a_Sun(r_Mars)| at the start (the
@@ -218,11 +234,10 @@ def two_body_check(geo: sc.Geometry) -> dict:
     X0 = geo.X_true[0] - geo.X_mars[0]
     sol = solve_ivp(f, (geo.t[0], geo.t[-1]), X0, method="DOP853", t_eval=geo.t, rtol=1e-13, atol=1e-9)
     err = np.linalg.norm(sol.y[:3].T - r_rel, axis=-1)
-    return {"sun_tidal_kms2_start": float(tidal[0]), "sun_tidal_kms2_max": float(tidal.max()),
-            "range_km_start": float(np.linalg.norm(r_rel[0])),
-            "arc_s": float(geo.t[-1] - geo.t[0]),
-            "two_body_pos_err_km": float(err.max()),
-            "mu_mars_relative_difference": float(abs(BSK_MU_MARS - MU_MARS) / MU_MARS)}
+    return TwoBodyCheck(sun_tidal_kms2_start=float(tidal[0]), sun_tidal_kms2_max=float(tidal.max()),
+                        range_km_start=float(np.linalg.norm(r_rel[0])), arc_s=float(geo.t[-1] - geo.t[0]),
+                        two_body_pos_err_km=float(err.max()),
+                        mu_mars_relative_difference=float(abs(BSK_MU_MARS - MU_MARS) / MU_MARS))
 
 
 # ------------------------------------------------------------------ the UKF
@@ -359,9 +374,49 @@ def ukf_inputs(geo: sc.Geometry, install_deg: float) -> tuple[np.ndarray, np.nda
     return mrp_from_dcm(A_b_i), mrp_from_dcm(camera.rot_x(np.deg2rad(install_deg)))
 
 
+@dataclass(frozen=True)
+class PeerRun:
+    """The peer UKF on one case's measurements (:func:`run_peer`), per seed: the final (tx, ty, tz)
+    estimate and its 3-sigma (arcsec), the estimate after the first update, the samples after it at
+    which the (whole-pixel) bias state changed, the bias quantum (arcsec), the radius bias (px), the
+    final and RMS position error (km), every ``stride`` samples the estimate history with its
+    3-sigma (``t_hist_s``), the true bias in pixels; and the bound of the peer's information
+    (``crlb_peer_arcsec``, Q = 0 beside; None until :func:`run_variant` sets it)."""
+
+    variant: str
+    case_id: str
+    seed_indices: np.ndarray
+    start: str
+    truth_arcsec: np.ndarray
+    theta_final_arcsec: np.ndarray
+    sigma3_final_arcsec: np.ndarray
+    theta_first_update_arcsec: np.ndarray
+    bias_changes_after_first: np.ndarray
+    bias_quantum_arcsec: float
+    radius_bias_px: np.ndarray
+    pos_err_final_km: np.ndarray
+    pos_err_rms_km: np.ndarray
+    t_hist_s: np.ndarray
+    theta_hist_arcsec: np.ndarray
+    sigma3_hist_arcsec: np.ndarray
+    truth_bias_px: np.ndarray
+    crlb_peer_arcsec: np.ndarray | None = None
+    crlb_peer_q0_arcsec: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class PeerVariant:
+    """A-P1's job for one variant (:func:`run_variant`): the two-body check and each run of
+    :data:`RUNS` by name."""
+
+    variant: str
+    two_body: TwoBodyCheck
+    runs: dict[str, PeerRun]
+
+
 def run_peer(setup: Setup, variant: str, case, seed_indices, truth_arcsec=None,
              geo: sc.Geometry | None = None, steps: int | None = None, stride: int = 10,
-             start: str = "prior") -> dict:
+             start: str = "prior") -> PeerRun:
     """The peer UKF on the measurements of ``case`` (same streams as the EM-EKF) per seed.
 
     ``truth_arcsec`` overrides the case's truth (the bias-free sanity case uses
@@ -400,14 +455,14 @@ def run_peer(setup: Setup, variant: str, case, seed_indices, truth_arcsec=None,
         hist.append(th[1::stride])  # from the first measurement (index 0: the prior)
         hist_sig.append(3.0 * sd[1::stride])
     n = len(geo.t) - 1 if steps is None else min(steps, len(geo.t) - 1)
-    return {"variant": variant, "case_id": case.case_id, "seed_indices": np.asarray(seeds), "start": start,
-            "truth_arcsec": truth, "theta_final_arcsec": np.stack(est), "sigma3_final_arcsec": np.stack(sig3),
-            "theta_first_update_arcsec": np.stack(first), "bias_changes_after_first": np.asarray(moves),
-            "bias_quantum_arcsec": float(sc.arcsec(cam.pitch)),
-            "radius_bias_px": np.asarray(rad_b), "pos_err_final_km": np.asarray(pos_fin),
-            "pos_err_rms_km": np.asarray(pos_rms), "t_hist_s": geo.t[1:n + 1:stride],
-            "theta_hist_arcsec": np.stack(hist), "sigma3_hist_arcsec": np.stack(hist_sig),
-            "truth_bias_px": bias_px_from_theta(sc.rad(truth[:2].tolist() + [0.0]), cam)}
+    return PeerRun(variant=variant, case_id=case.case_id, seed_indices=np.asarray(seeds), start=start,
+                   truth_arcsec=truth, theta_final_arcsec=np.stack(est), sigma3_final_arcsec=np.stack(sig3),
+                   theta_first_update_arcsec=np.stack(first), bias_changes_after_first=np.asarray(moves),
+                   bias_quantum_arcsec=float(sc.arcsec(cam.pitch)),
+                   radius_bias_px=np.asarray(rad_b), pos_err_final_km=np.asarray(pos_fin),
+                   pos_err_rms_km=np.asarray(pos_rms), t_hist_s=geo.t[1:n + 1:stride],
+                   theta_hist_arcsec=np.stack(hist), sigma3_hist_arcsec=np.stack(hist_sig),
+                   truth_bias_px=bias_px_from_theta(sc.rad(truth[:2].tolist() + [0.0]), cam))
 
 
 def peer_bound(setup: Setup, geo: sc.Geometry, case, truth_arcsec=None, zero_q: bool = False) -> np.ndarray:
@@ -433,22 +488,22 @@ RUN_LABELS = {"headline": "headline case", "bias_free": "zero misalignment (sani
               "truth_start": "prior mean at the truth (diagnostic)"}
 
 
-def run_variant(setup: Setup, variant: str, log=None) -> dict:
+def run_variant(setup: Setup, variant: str, log=None) -> PeerVariant:
     """A-P1 simulation job: the headline case and the bias-free sanity case of ``variant``."""
     from .cases import headline_case
     geo = sc.build_geometry(setup, variant)
     case = headline_case(setup)
     seeds = range(setup.n_seeds)
-    out = {"variant": variant, "two_body": two_body_check(geo), "runs": {}}
+    out = PeerVariant(variant=variant, two_body=two_body_check(geo), runs={})
     for name, truth, start in RUNS:
         r = run_peer(setup, variant, case, seeds, truth_arcsec=truth, geo=geo, start=start)
-        r["crlb_peer_arcsec"] = peer_bound(setup, geo, case, truth)
-        r["crlb_peer_q0_arcsec"] = peer_bound(setup, geo, case, truth, zero_q=True)
-        out["runs"][name] = r
+        r = replace(r, crlb_peer_arcsec=peer_bound(setup, geo, case, truth),
+                    crlb_peer_q0_arcsec=peer_bound(setup, geo, case, truth, zero_q=True))
+        out.runs[name] = r
         if log:
             log.info("A-P1 %s %s: UKF (tx, ty) %s +- %s arcsec (3 sigma, seed mean); truth %s",
-                     variant, name, np.round(r["theta_final_arcsec"].mean(0), 3),
-                     np.round(r["sigma3_final_arcsec"].mean(0), 4), r["truth_arcsec"][:2])
+                     variant, name, np.round(r.theta_final_arcsec.mean(0), 3),
+                     np.round(r.sigma3_final_arcsec.mean(0), 4), r.truth_arcsec[:2])
     return out
 
 
@@ -481,12 +536,12 @@ def _row(variant, method, run, truth, th, own3=None, crlb3=None, n_seeds=None, c
     return row
 
 
-def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id: str = "T1-01"):
+def comparison_frame(peer: list[PeerVariant], em: list, alt: list, case_id: str = "T1-01"):
     """A-P1 table: per variant, the EM-EKF (each scheme), augmented EKF, batch ML and the
     peer UKF (headline, zero-misalignment sanity, truth-start diagnostic), arcsec.
 
-    ``peer``: :func:`run_variant` outputs; ``em``: EM-EKF Monte-Carlo dicts
-    (:func:`opnav.approach.pipeline.run_group`); ``alt``: A-X2 dicts
+    ``peer``: :func:`run_variant` outputs; ``em``: EM-EKF Monte-Carlo runs
+    (:func:`opnav.approach.pipeline.run_group`); ``alt``: A-X2 runs
     (:func:`opnav.approach.alternatives.run_case_alternatives`). Each estimate is set
     beside the bound of the data it used, with Q = 0 beside: the EM-EKF's last window when
     sliding (``crlb_arcsec``, ``crlb_q0_arcsec``), all the segments' data for the augmented
@@ -499,28 +554,27 @@ def comparison_frame(peer: list[dict], em: list[dict], alt: list[dict], case_id:
 
     rows = []
     for p in peer:
-        v = p["variant"]
-        ems = [r for r in em if r["variant"] == v and r["case_id"] == case_id]
-        bound = 3.0 * np.asarray(ems[0]["crlb_total_arcsec"], float) if ems else None
-        nan3 = np.full(3, np.nan)
-        bound0 = 3.0 * np.asarray(ems[0].get("crlb_total_q0_arcsec", nan3), float) if ems else None
+        v = p.variant
+        ems = [r for r in em if r.variant == v and r.case_id == case_id]
+        bound = 3.0 * np.asarray(ems[0].bounds.crlb_total_arcsec, float) if ems else None
+        bound0 = 3.0 * np.asarray(ems[0].bounds.crlb_total_q0_arcsec, float) if ems else None
         for r in ems:
-            rows.append(_row(v, METHOD_LABELS.get(f"em_{r['method']}", r["method"]), "headline case",
-                             r["truth_arcsec"], r["theta_final_arcsec"], None, 3.0 * np.asarray(r["crlb_arcsec"]),
-                             crlb3_q0=3.0 * np.asarray(r.get("crlb_q0_arcsec", nan3))))
-        for a in (a for a in alt if a["variant"] == v and a["case_id"] == case_id):
-            for m, d in a["methods"].items():
-                own = 3.0 * d["sigma_final_arcsec"] if "sigma_final_arcsec" in d else None
-                rows.append(_row(v, METHOD_LABELS[m], "headline case", a["truth_arcsec"],
-                                 d["theta_final_arcsec"], own, bound, crlb3_q0=bound0))
-        for name, r in p["runs"].items():
-            rows.append(_row(v, "Basilisk pixelLineBiasUKF", RUN_LABELS[name], r["truth_arcsec"],
-                             r["theta_final_arcsec"], r["sigma3_final_arcsec"], 3.0 * r["crlb_peer_arcsec"],
-                             crlb3_q0=3.0 * np.asarray(r.get("crlb_peer_q0_arcsec", np.full(3, np.nan)))))
+            rows.append(_row(v, METHOD_LABELS.get(f"em_{r.method}", r.method), "headline case",
+                             r.truth_arcsec, r.theta_final_arcsec, None, 3.0 * np.asarray(r.bounds.crlb_arcsec),
+                             crlb3_q0=3.0 * np.asarray(r.bounds.crlb_q0_arcsec)))
+        for a in (a for a in alt if a.variant == v and a.case_id == case_id):
+            for m, d in a.methods():
+                own = 3.0 * d.sigma_final_arcsec if getattr(d, "sigma_final_arcsec", None) is not None else None
+                rows.append(_row(v, METHOD_LABELS[m], "headline case", a.truth_arcsec,
+                                 d.theta_final_arcsec, own, bound, crlb3_q0=bound0))
+        for name, r in p.runs.items():
+            rows.append(_row(v, "Basilisk pixelLineBiasUKF", RUN_LABELS[name], r.truth_arcsec,
+                             r.theta_final_arcsec, r.sigma3_final_arcsec, 3.0 * r.crlb_peer_arcsec,
+                             crlb3_q0=3.0 * np.asarray(r.crlb_peer_q0_arcsec)))
     return pd.DataFrame(rows)
 
 
-def summary(table, peer: list[dict]) -> dict:
+def summary(table, peer: list[PeerVariant]) -> dict:
     """Numbers for the manuscript macros (A-P1-summary.json)."""
     keys = {"EM-EKF (plain)": "em_plain", "EM-EKF (SQUAREM)": "em_squarem", "augmented EKF": "augmented",
             "batch ML (IPOPT)": "batch_ml"}
@@ -535,41 +589,39 @@ def summary(table, peer: list[dict]) -> dict:
                               "rmse_xy_arcsec",
                               "within_own_3sigma_text")}
     for p in peer:
-        v = out["variants"].setdefault(p["variant"], {})
-        h = p["runs"]["headline"]
-        v["ukf_pos_err_final_km"] = float(np.mean(h["pos_err_final_km"]))
-        v["ukf_truth_bias_pixel_px"], v["ukf_truth_bias_line_px"] = map(float, h["truth_bias_px"])
+        v = out["variants"].setdefault(p.variant, {})
+        h = p.runs["headline"]
+        v["ukf_pos_err_final_km"] = float(np.mean(h.pos_err_final_km))
+        v["ukf_truth_bias_pixel_px"], v["ukf_truth_bias_line_px"] = map(float, h.truth_bias_px)
         # what the bias state does (module docstring, 'Why the bias hardly moves'): its value after
         # the first update (seed mean), the seeds whose bias changed later in the arc, its quantum
         v["ukf_first_update_x_arcsec"], v["ukf_first_update_y_arcsec"] = map(
-            float, np.mean(h["theta_first_update_arcsec"], axis=0))
-        v["ukf_seeds_moving_after_first_update"] = int(np.count_nonzero(h["bias_changes_after_first"]))
-        v["ukf_bias_changes_after_first_mean"] = float(np.mean(h["bias_changes_after_first"]))
-        v["ukf_bias_quantum_arcsec"] = h["bias_quantum_arcsec"]
-        b = p["runs"]["bias_free"]
-        v["ukf_bias_free_within_own_3sigma_all"] = bool(np.all(
-            np.abs(b["theta_final_arcsec"]) <= b["sigma3_final_arcsec"]))
+            float, np.mean(h.theta_first_update_arcsec, axis=0))
+        v["ukf_seeds_moving_after_first_update"] = int(np.count_nonzero(h.bias_changes_after_first))
+        v["ukf_bias_changes_after_first_mean"] = float(np.mean(h.bias_changes_after_first))
+        v["ukf_bias_quantum_arcsec"] = h.bias_quantum_arcsec
+        b = p.runs["bias_free"]
+        v["ukf_bias_free_within_own_3sigma_all"] = bool(np.all(np.abs(b.theta_final_arcsec) <= b.sigma3_final_arcsec))
         hr = v["ukf_headline"]
         v["ukf_bound_over_own_3sigma_x"] = hr["crlb_3sigma_x_arcsec"] / hr["own_3sigma_x_arcsec"]
-    tb = peer[0]["two_body"]
-    out["two_body"] = tb
+    out["two_body"] = dataclasses.asdict(peer[0].two_body)
     out["n_seeds"] = int(table["n_seeds"].max())
     return out
 
 
-def seed_frame(peer: list[dict]):
+def seed_frame(peer: list[PeerVariant]):
     """Per seed and run: the peer's final (tx, ty), its 3-sigma and the position error (long CSV)."""
     import pandas as pd
 
     rows = []
     for p in peer:
-        for name, r in p["runs"].items():
-            for i, s in enumerate(r["seed_indices"]):
-                rows.append({"variant": p["variant"], "run": name, "seed": int(s),
-                             "truth_x_arcsec": r["truth_arcsec"][0], "truth_y_arcsec": r["truth_arcsec"][1],
-                             "est_x_arcsec": r["theta_final_arcsec"][i, 0], "est_y_arcsec": r["theta_final_arcsec"][i, 1],
-                             "sigma3_x_arcsec": r["sigma3_final_arcsec"][i, 0],
-                             "sigma3_y_arcsec": r["sigma3_final_arcsec"][i, 1],
-                             "radius_bias_px": r["radius_bias_px"][i],
-                             "pos_err_final_km": r["pos_err_final_km"][i], "pos_err_rms_km": r["pos_err_rms_km"][i]})
+        for name, r in p.runs.items():
+            for i, s in enumerate(r.seed_indices):
+                rows.append({"variant": p.variant, "run": name, "seed": int(s),
+                             "truth_x_arcsec": r.truth_arcsec[0], "truth_y_arcsec": r.truth_arcsec[1],
+                             "est_x_arcsec": r.theta_final_arcsec[i, 0], "est_y_arcsec": r.theta_final_arcsec[i, 1],
+                             "sigma3_x_arcsec": r.sigma3_final_arcsec[i, 0],
+                             "sigma3_y_arcsec": r.sigma3_final_arcsec[i, 1],
+                             "radius_bias_px": r.radius_bias_px[i],
+                             "pos_err_final_km": r.pos_err_final_km[i], "pos_err_rms_km": r.pos_err_rms_km[i]})
     return pd.DataFrame(rows)

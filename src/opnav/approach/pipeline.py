@@ -55,12 +55,13 @@ def cases_in(setup: Setup, group: str, variant: str = "") -> list[cases.Case]:
 
 
 def run_group(setup: Setup, variant: str, group: str, method: str, mode: str = "sliding",
-              log=None, shared: dict | None = None) -> list[dict]:
+              log=None, shared: dict | None = None) -> list[cases.CaseRun]:
     """Monte Carlo of every case of ``group`` under ``variant``, EM ``method`` and segment
-    ``mode``, each case with the bound of the data its estimate used (``crlb_arcsec``; per
-    segment ``crlb_seg_arcsec``; the same with Q = 0 beside), the bound of all data
-    (``crlb_total_arcsec``) and, for the headline case, a rerun with the initial error drawn
-    from the prior (``sampled``: the only spread that may be set beside a Bayesian bound).
+    ``mode`` (:class:`opnav.approach.cases.CaseRun` each), each case with its ``bounds``
+    (:class:`opnav.approach.cases.CaseBounds`: of the data its estimate used, per segment, of
+    all data, with Q and Q = 0) and, for the headline case, a rerun with the initial error
+    drawn from the prior (``sampled``: the only spread that may be set beside a Bayesian bound);
+    the time series are kept for the headline case only (figures).
 
     ``shared``: one dict passed to the calls of every EM scheme (``method``, ``mode``) of the
     same ``setup``, ``variant`` and ``group`` (one Snakemake job): they then share the
@@ -93,30 +94,24 @@ def run_group(setup: Setup, variant: str, group: str, method: str, mode: str = "
         shared[bkey] = case_bounds(setup, geo, clist, variant)
     bounds = shared[bkey]
     for case, r, b in zip(clist, runs, bounds):
-        r.update(b)
-        r.update(method=method, group=group, case=case)
+        r = replace(r, group=group, bounds=b)
         if case.case_index == 1:
-            smp = sampled[0]
-            r["sampled"] = {k: smp[k] for k in ("theta_final_arcsec", "label", "stalled", "dist_to_ml_arcsec",
-                                                "consistency_t", "nav_err_after_km", "nav_err_before_km",
-                                                "nav_err_true_theta_km")}
+            r = replace(r, sampled=cases.SampledRun.of(sampled[0]))
         else:  # time series only for the headline case (figures)
-            for k in ("err_before_t_km", "err_after_t_km", "err_split_t_km", "consistency_t"):
-                r.pop(k)
+            r = r.without_series()
         out.append(r)
         if log:
             log.info("%s %s %s/%s %s: est %s, bound %s, converged %d/%d, stalled %d", variant, group, mode,
-                     method, case.case_id, np.round(r["theta_final_arcsec"].mean(0), 3),
-                     np.round(r["crlb_arcsec"][:2], 3), r["converged"].sum(), r["converged"].size,
-                     r["stalled"].sum())
+                     method, case.case_id, np.round(r.theta_final_arcsec.mean(0), 3),
+                     np.round(b.crlb_arcsec[:2], 3), r.converged.sum(), r.converged.size, r.stalled.sum())
     return out
 
 
-def case_bounds(setup: Setup, geo: sc.Geometry, case_list: list[cases.Case], variant: str) -> list[dict]:
+def case_bounds(setup: Setup, geo: sc.Geometry, case_list: list[cases.Case], variant: str) -> list[cases.CaseBounds]:
     """Per case, the bound of the data its estimate used (``crlb_arcsec``; per segment
     ``crlb_seg_arcsec``; with Q = 0: ``crlb_q0_arcsec``, ``crlb_seg_q0_arcsec``) and of all
     the segments' data (``crlb_total_arcsec``; Q = 0: ``crlb_total_q0_arcsec``), arcsec,
-    1-sigma; every case and both Q at once."""
+    1-sigma (:class:`opnav.approach.cases.CaseBounds`); every case and both Q at once."""
     items = [(geo.measurement_variance(c.sigma3_px), c.truth_arcsec, zq) for c in case_list for zq in (False, True)]
     need_curves = setup.segments.mode == "growing" or sc.START_OF[variant] == "filter"
     curves = bound_curves(setup, geo, items, variant)
@@ -124,9 +119,9 @@ def case_bounds(setup: Setup, geo: sc.Geometry, case_list: list[cases.Case], var
     out = []
     for i in range(len(case_list)):
         seg, seg0 = segs[2 * i], segs[2 * i + 1]
-        out.append({"crlb_seg_arcsec": seg, "crlb_seg_q0_arcsec": seg0, "crlb_arcsec": seg[-1],
-                    "crlb_q0_arcsec": seg0[-1], "crlb_total_arcsec": _at_total(setup, curves[2 * i]),
-                    "crlb_total_q0_arcsec": _at_total(setup, curves[2 * i + 1])})
+        out.append(cases.CaseBounds(crlb_seg_arcsec=seg, crlb_seg_q0_arcsec=seg0, crlb_arcsec=seg[-1],
+                                    crlb_q0_arcsec=seg0[-1], crlb_total_arcsec=_at_total(setup, curves[2 * i]),
+                                    crlb_total_q0_arcsec=_at_total(setup, curves[2 * i + 1])))
     return out
 
 

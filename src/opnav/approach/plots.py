@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from opnav.approach.cases import CaseRun
 from opnav.core import figures
 
 
@@ -32,30 +33,28 @@ def _band_log(ax, x, y, color, label, ls="-"):
     ax.fill_between(x, lo, hi, color=color, alpha=0.2, lw=0)
 
 
-def run_label(r: dict) -> str:
+def run_label(r: CaseRun) -> str:
     """Legend label of one EM run: scheme, and its convergence label from the ML estimate of
     the data it used (seeds per label), with the bound of that data."""
-    mode = r.get("mode", "sliding")
-    lab = f"EM ({r['method']}{', growing' if mode == 'growing' else ''})"
-    labels = np.asarray(r.get("label", []), str)
+    lab = f"EM ({r.method}{', growing' if r.mode == 'growing' else ''})"
+    labels = np.asarray(r.label, str)
     if labels.size:
         counts = [(k, int(np.sum(labels == k))) for k in ("converged", "not converged", "stalled")]
         lab += ", " + ", ".join(f"{k} {n}/{labels.size}" for k, n in counts if n)
-    if "crlb_arcsec" in r:
-        lab += f'; bound {r["crlb_arcsec"][0]:.3g}"'
+    if r.bounds is not None:
+        lab += f'; bound {r.bounds.crlb_arcsec[0]:.3g}"'
     return lab
 
 
-def _color(r: dict) -> str:
-    growing = r.get("mode", "sliding") == "growing"
-    return figures.color(f"growing-{r['method']}" if growing else r["method"])
+def _color(r: CaseRun) -> str:
+    return figures.color(f"growing-{r.method}" if r.mode == "growing" else r.method)
 
 
-def iteration_axis(r: dict) -> np.ndarray:
+def iteration_axis(r: CaseRun) -> np.ndarray:
     """Data used (samples) at each EM map of a run, maps spread evenly inside their segment
     (index 0: the EM initial value at zero data)."""
-    d = np.asarray(r["seg_data_used"], float)
-    per = r["theta_iter_arcsec"].shape[1] // len(d)
+    d = np.asarray(r.seg_data_used, float)
+    per = r.theta_iter_arcsec.shape[1] // len(d)
     prev = np.r_[0.0, d[:-1]]
     frac = np.arange(1, per + 1) / per
     return np.r_[0.0, (prev[:, None] + frac[None, :] * (d - prev)[:, None]).ravel()]
@@ -70,17 +69,17 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
         fig, axes = plt.subplots(3, 1, figsize=(figures.PAGE_WIDTH_IN, 5.6), sharex=True, layout="constrained")
         truth = None
         for key, r in runs.items():
-            th = r["theta_iter_arcsec"]
-            init = np.broadcast_to(np.asarray(r["case"].init_arcsec, float), (th.shape[0], 1, 3))
+            th = r.theta_iter_arcsec
+            init = np.broadcast_to(np.asarray(r.case.init_arcsec, float), (th.shape[0], 1, 3))
             th = np.concatenate([init, th], axis=1)  # iteration 0 = the EM initial value
             x = iteration_axis(r)
-            truth = r["truth_arcsec"]
+            truth = r.truth_arcsec
             col = _color(r)
             for i, ax in enumerate(axes):
                 _band(ax, x, th[:, :, i], col, run_label(r))
-                if i < 2 and "crlb_seg_arcsec" in r:
-                    b = r["crlb_seg_arcsec"][:, i]
-                    d = r["seg_data_used"]
+                if i < 2 and r.bounds is not None:
+                    b = r.bounds.crlb_seg_arcsec[:, i]
+                    d = r.seg_data_used
                     ax.plot(d, truth[i] + b, color=col, ls=":", lw=0.8)
                     ax.plot(d, truth[i] - b, color=col, ls=":", lw=0.8)
         names = ["$\\theta_x$", "$\\theta_y$", "$\\theta_z$"]
@@ -95,7 +94,7 @@ def fig_bias_estimate(runs: dict, variant: str, pub: dict, N: int, M: int):
             span = max(abs(truth[i]), 5.0) * 3
             ax.set_ylim(max(lo, truth[i] - span), min(hi, truth[i] + span))
         axes[0].plot([], [], color="k", ls=":", lw=0.8, label=r"truth $\pm 1\sigma$ bound of the data used")
-        if all(r.get("tz_unobservable", True) for r in runs.values()):
+        if all(r.tz_unobservable for r in runs.values()):
             axes[2].text(0.01, 0.05, "$\\theta_z$: unobservable (held at its initial value)",
                          transform=axes[2].transAxes, fontsize=7)
         axes[-1].set_xlabel("data used (samples); EM iterations spread over each segment")
@@ -113,11 +112,12 @@ def fig_nav_accuracy(runs: dict, variant: str):
     with figures.style():
         fig, axes = plt.subplots(1, 2, figsize=(figures.PAGE_WIDTH_IN, 3.0), sharex=True, layout="constrained")
         for key, r in runs.items():
-            d = r["seg_data_used"]
+            d = r.seg_data_used
             col = _color(r)
-            for ax, comp in zip(axes, ("lat", "rng")):
-                _band_log(ax, d, r[f"seg_{comp}_err_km"], col, f"median error, {run_label(r)}")
-                ax.plot(d, r[f"seg_{comp}_3sig_km"].mean(0), color=col, ls=":")
+            for ax, err, sig3 in ((axes[0], r.seg_lat_err_km, r.seg_lat_3sig_km),
+                                  (axes[1], r.seg_rng_err_km, r.seg_rng_3sig_km)):
+                _band_log(ax, d, err, col, f"median error, {run_label(r)}")
+                ax.plot(d, sig3.mean(0), color=col, ls=":")
         axes[0].plot([], [], color="k", ls=":", label=r"filter's $3\sigma$ of that component (same colour)")
         for ax, name in zip(axes, ("lateral (across the line of sight)", "range (along it)")):
             ax.set_xlabel("data used (samples)")
@@ -154,22 +154,22 @@ def fig_consistency(runs: dict, variant: str):
         first = True
         n = 1
         for key, r in runs.items():
-            smp = r.get("sampled")
+            smp = r.sampled
             if not smp:
                 continue
-            t = r["t_s"]
-            n = smp["theta_final_arcsec"].shape[0]
-            ct = smp["consistency_t"]
+            t = r.t_s
+            n = smp.theta_final_arcsec.shape[0]
+            ct = smp.consistency_t
             for ax, q in zip(axes, ("nees_pos", "nis")):
                 if first:
-                    ax.plot(t, np.nanmean(ct["before"][q], 0), color="k", ls="--", label=r"$\theta = 0$")
-                    if q == "nees_pos" and "true_theta" in ct:
-                        ax.plot(t, np.nanmean(ct["true_theta"][q], 0), color="0.35", ls=":", lw=1.4, zorder=3,
+                    ax.plot(t, np.nanmean(getattr(ct.before, q), 0), color="k", ls="--", label=r"$\theta = 0$")
+                    if q == "nees_pos":
+                        ax.plot(t, np.nanmean(ct.true_theta.nees_pos, 0), color="0.35", ls=":", lw=1.4, zorder=3,
                                 label=r"true $\theta$, same runs (the reference)")
-                ax.plot(t, np.nanmean(ct["after"][q], 0), color=_color(r),
+                ax.plot(t, np.nanmean(getattr(ct.after, q), 0), color=_color(r),
                         label=rf"$\theta = \hat\theta$, {run_label(r)}")
-                if q == "nees_pos" and "consider" in ct:
-                    ax.plot(t, np.nanmean(ct["consider"][q], 0), color=_color(r), ls="-.", lw=0.8,
+                if q == "nees_pos":
+                    ax.plot(t, np.nanmean(ct.consider.nees_pos, 0), color=_color(r), ls="-.", lw=0.8,
                             label=rf"Schmidt filter, {run_label(r)}")
             first = False
         lo, hi = chi2_band(3, n)
@@ -196,25 +196,21 @@ def fig_compensation(runs: dict, variant: str, pub: dict):
         fig, axes = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 3.1), sharey=True, layout="constrained")
         first = True
         for method, r in runs.items():
-            t = r["t_s"]
-            split = r.get("err_split_t_km", {})
+            t = r.t_s
+            split = r.err_split_t_km
             if first:
-                axes[0].plot(t, r["err_before_t_km"].mean(0), color="k", ls="--", lw=1.2, zorder=3,
+                axes[0].plot(t, r.err_before_t_km.mean(0), color="k", ls="--", lw=1.2, zorder=3,
                              label=r"before ($\theta = 0$)")
-                if "true_theta" in split:
-                    lat, rng = split["true_theta"]
-                    axes[0].plot(t, np.hypot(lat, rng).mean(0), color="0.5", ls=":", lw=1.2, zorder=3,
-                                 label=r"true $\theta$ (diagnostic floor)")
+                lat, rng = split.true_theta
+                axes[0].plot(t, np.hypot(lat, rng).mean(0), color="0.5", ls=":", lw=1.2, zorder=3,
+                             label=r"true $\theta$ (diagnostic floor)")
                 for j, ax in enumerate(axes[1:]):
-                    if "before" in split:
-                        ax.plot(t, split["before"][j].mean(0), color="k", ls="--", lw=1.2, zorder=3)
-                    if "true_theta" in split:
-                        ax.plot(t, split["true_theta"][j].mean(0), color="0.5", ls=":", lw=1.2, zorder=3)
+                    ax.plot(t, split.before[j].mean(0), color="k", ls="--", lw=1.2, zorder=3)
+                    ax.plot(t, split.true_theta[j].mean(0), color="0.5", ls=":", lw=1.2, zorder=3)
                 first = False
-            axes[0].plot(t, r["err_after_t_km"].mean(0), color=_color(r), label=f"after, {run_label(r)}")
+            axes[0].plot(t, r.err_after_t_km.mean(0), color=_color(r), label=f"after, {run_label(r)}")
             for j, ax in enumerate(axes[1:]):
-                if "after" in split:
-                    ax.plot(t, split["after"][j].mean(0), color=_color(r))
+                ax.plot(t, split.after[j].mean(0), color=_color(r))
         hp = pub["headline"]
         axes[0].plot([t[-1]], [hp["nav_err_before_km"]], **{**figures.PUBLISHED_STYLE, "label": "published before/after"})
         axes[0].plot([t[-1]], [hp["nav_err_after_km"]], **{**figures.PUBLISHED_STYLE, "label": None})
@@ -259,8 +255,8 @@ def fig_crlb(curves: dict, conv: dict, x1, target: float, N0: int):
         _plain_log_ticks(a1, "both")
         for v, c in conv.items():
             col = figures.color(v)
-            for method, ls in (("plain", "-"), ("squarem", "--")):
-                dist = np.median(c[method]["dist_arcsec"], axis=0)
+            for method, maps, ls in (("plain", c.plain, "-"), ("squarem", c.squarem, "--")):
+                dist = np.median(maps.dist_arcsec, axis=0)
                 a2.plot(np.arange(1, len(dist) + 1), np.maximum(dist, 1e-6), color=col, ls=ls,
                         label=f"{v}, {method}")
         a2.set_yscale("log")

@@ -225,8 +225,18 @@ def star_field(C: np.ndarray, N0: int, every_K: int, per_image: int, mag_limit: 
                      float(attitude_sigma_rad), float(drift_sigma_rad))
 
 
+@dataclass(frozen=True)
+class CountSettings:
+    """What makes a star count real (:func:`count_settings`): the magnitude limit, the field's
+    half-width (rad) and whether it was widened past the camera's."""
+
+    mag_limit: float
+    half_fov_rad: float
+    widened: bool
+
+
 def count_settings(C: np.ndarray, N0: int, every_K: int, count: int, mag_cap: float, slew_deg: float,
-                   half_fov_rad: float, cat) -> dict:
+                   half_fov_rad: float, cat) -> CountSettings:
     """The magnitude limit and field at which *every* star image of the arc (:func:`star_field`'s
     images of the Mars-tracking attitude ``C``) holds at least ``count`` stars, so that with
     ``per_image = count`` each image holds exactly ``count`` (issue 54, item 4: the stars sweep
@@ -258,11 +268,11 @@ def count_settings(C: np.ndarray, N0: int, every_K: int, count: int, mag_cap: fl
             need_mag = np.inf
         need_tan = max(need_tan, float(np.sort(cheb)[count - 1]))
     if np.isfinite(need_mag):
-        return {"mag_limit": need_mag, "half_fov_rad": float(half_fov_rad), "widened": False}
+        return CountSettings(need_mag, float(half_fov_rad), False)
     if not np.isfinite(need_tan):
         raise ValueError(f"approach.stars.study_count: {count} stars per image are not in the sky in front of the "
                          f"camera to magnitude {mag_cap:g}")
-    return {"mag_limit": float(mag_cap), "half_fov_rad": float(np.arctan(need_tan * (1.0 + 1e-9))), "widened": True}
+    return CountSettings(float(mag_cap), float(np.arctan(need_tan * (1.0 + 1e-9))), True)
 
 
 def joint_covariance(G_raw: np.ndarray, sigma: np.ndarray, attitude_sigma_rad: float,

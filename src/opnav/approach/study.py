@@ -24,6 +24,8 @@ whether the stall rule flags the EM run (``stalled_pct``: 100 or 0; NaN for the 
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 import pandas as pd
 
@@ -32,6 +34,16 @@ from . import cases
 from . import scenario as sc
 from .pipeline import segment_bounds, total_bound
 from .setup import Setup
+
+
+@dataclass
+class _VariantShared:
+    """What the estimators of one variant share in a job: the geometry, the bound of all the data
+    after N0 and, per segment mode, the bound of the data the EM's last window used (arcsec)."""
+
+    geo: sc.Geometry
+    crlb: np.ndarray
+    crlb_used: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def run_runs(setup: Setup, variant: str, method: str, seeds, shared: dict | None = None) -> pd.DataFrame:
@@ -44,8 +56,8 @@ def run_runs(setup: Setup, variant: str, method: str, seeds, shared: dict | None
     if key not in shared:
         geo = sc.build_geometry(setup, variant)
         Rvar = geo.measurement_variance(case.sigma3_px)
-        shared[key] = {"geo": geo, "crlb": total_bound(setup, geo, Rvar, case.truth_arcsec, variant)}
-    geo, crlb = shared[key]["geo"], shared[key]["crlb"]
+        shared[key] = _VariantShared(geo, total_bound(setup, geo, Rvar, case.truth_arcsec, variant))
+    geo, crlb = shared[key].geo, shared[key].crlb
     used = setup.segments.data_samples
     if method.startswith("em"):
         name = method.removeprefix("em").lstrip("_")
@@ -53,27 +65,28 @@ def run_runs(setup: Setup, variant: str, method: str, seeds, shared: dict | None
         scheme = name.removeprefix("growing").lstrip("_") or setup.em.method
         s = setup.scheme(mode)
         r = cases.run_case(s, variant, case, seeds, geo=geo, method=scheme)
-        if ("crlb_used", mode) not in shared[key]:
-            shared[key][("crlb_used", mode)] = segment_bounds(s, geo, geo.measurement_variance(case.sigma3_px),
-                                                              case.truth_arcsec, variant)[-1]
-        crlb_used = shared[key][("crlb_used", mode)]
-        stalled = 100.0 * np.asarray(r["stalled"], float)
+        used_by_mode = shared[key].crlb_used
+        if mode not in used_by_mode:
+            used_by_mode[mode] = segment_bounds(s, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec,
+                                                variant)[-1]
+        crlb_used = used_by_mode[mode]
+        stalled = 100.0 * np.asarray(r.stalled, float)
+        converged = 100.0 * (np.asarray(r.label) == "converged").astype(float)
     elif method == "augmented":
-        r = alt.run_case_alternatives(setup, variant, case, seeds, geo, methods=("augmented",))
-        r = r["methods"]["augmented"]
+        r = alt.run_case_alternatives(setup, variant, case, seeds, geo, methods=("augmented",)).augmented
         crlb_used, stalled = crlb, np.full(len(seeds), np.nan)
+        converged = np.full(len(seeds), np.nan)
     else:
         raise ValueError(f"unknown paper-A study estimator {method!r}")
-    err = np.asarray(r["theta_final_arcsec"], float) - np.asarray(case.truth_arcsec, float)
+    err = np.asarray(r.theta_final_arcsec, float) - np.asarray(case.truth_arcsec, float)
     return pd.DataFrame({
         "run": seeds, "variant": variant, "method": method,
         "err_x_arcsec": err[:, 0], "err_y_arcsec": err[:, 1], "err_z_arcsec": err[:, 2],
-        "nav_err_after_km": np.asarray(r["nav_err_after_km"], float),
-        "data_to_converge_samples": np.asarray(r["data_to_converge"], float),
+        "nav_err_after_km": np.asarray(r.nav_err_after_km, float),
+        "data_to_converge_samples": np.asarray(r.data_to_converge, float),
         "crlb_x_arcsec": float(crlb[0]), "crlb_y_arcsec": float(crlb[1]),
         "crlb_used_x_arcsec": float(crlb_used[0]), "crlb_used_y_arcsec": float(crlb_used[1]),
         "stalled_pct": stalled,
-        "converged_pct": (100.0 * (np.asarray(r["label"]) == "converged").astype(float) if "label" in r
-                          else np.full(len(seeds), np.nan)),
+        "converged_pct": converged,
         "data_samples": used,
     })

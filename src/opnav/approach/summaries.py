@@ -9,10 +9,11 @@ the Monte Carlo. The sentences the manuscript makes from these numbers are in
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -21,6 +22,9 @@ from . import cases
 from . import scenario as sc
 from .labels import label_columns, row_label, variant_label
 from .setup import Setup
+
+if TYPE_CHECKING:  # the records only (alternatives imports CasADi)
+    from .alternatives import StarsRow
 
 
 def seed_sd(x: np.ndarray) -> float:
@@ -33,26 +37,25 @@ NAV_SPLIT_KEYS = ("nav_err_true_theta_km", "nav_err_consider_km") + tuple(
     f"nav_err_{k}_{p}_km" for k in ("before", "after", "true_theta") for p in ("lat", "rng"))
 
 
-def table1_frame(results: list[dict], published: dict, target_arcsec: float) -> pd.DataFrame:
-    """A-T1 long form: one row per case x variant x EM scheme, published values beside;
-    ``target_arcsec`` (the claimed accuracy, the analysis plan's A-C1 target) sets the
-    ``identifiable`` column."""
+def table1_frame(results: list[cases.CaseRun], published: dict, target_arcsec: float) -> pd.DataFrame:
+    """A-T1 long form: one row per case x variant x EM scheme (:func:`opnav.approach.pipeline.run_group`'s
+    runs), published values beside; ``target_arcsec`` (the claimed accuracy, the analysis plan's
+    A-C1 target) sets the ``identifiable`` column."""
     pub = {r["case_id"]: r for r in published["table1"]}
     target = float(target_arcsec)
     rows = []
     for r in results:
-        c: cases.Case = r["case"]
-        th = r["theta_final_arcsec"]
+        c, b, smp = r.case, r.bounds, r.sampled
+        th = r.theta_final_arcsec
         truth = np.asarray(c.truth_arcsec)
         p = pub.get(c.case_id, {})
-        mode = r.get("mode", "sliding")
-        smp = r.get("sampled")
+        ct = smp.consistency_t if smp else None
         rows.append({
-            "variant": variant_label(r["variant"], r["method"], mode),
-            "scenario": r["variant"],
-            "method": r["method"],
-            "mode": mode,
-            "maps_per_segment": r.get("maps_per_segment", math.nan),
+            "variant": variant_label(r.variant, r.method, r.mode),
+            "scenario": r.variant,
+            "method": r.method,
+            "mode": r.mode,
+            "maps_per_segment": r.maps_per_segment,
             "group": c.group,
             "case_id": c.case_id,
             "truth_x_arcsec": truth[0], "truth_y_arcsec": truth[1], "truth_z_arcsec": truth[2],
@@ -65,34 +68,36 @@ def table1_frame(results: list[dict], published: dict, target_arcsec: float) -> 
             "rmse_y_arcsec": float(np.sqrt(np.mean((th[:, 1] - truth[1]) ** 2))),
             # the bound of the data the estimate used (last window when sliding, cumulative when
             # growing), with Q = 0 beside (the truth has no process noise), and of all the data
-            "crlb_x_arcsec": r["crlb_arcsec"][0], "crlb_y_arcsec": r["crlb_arcsec"][1],
-            "crlb_q0_x_arcsec": r["crlb_q0_arcsec"][0], "crlb_q0_y_arcsec": r["crlb_q0_arcsec"][1],
-            "crlb_all_x_arcsec": r["crlb_total_arcsec"][0], "crlb_all_y_arcsec": r["crlb_total_arcsec"][1],
-            "tz_observable": not r["tz_unobservable"],
+            "crlb_x_arcsec": b.crlb_arcsec[0], "crlb_y_arcsec": b.crlb_arcsec[1],
+            "crlb_q0_x_arcsec": b.crlb_q0_arcsec[0], "crlb_q0_y_arcsec": b.crlb_q0_arcsec[1],
+            "crlb_all_x_arcsec": b.crlb_total_arcsec[0], "crlb_all_y_arcsec": b.crlb_total_arcsec[1],
+            "tz_observable": not r.tz_unobservable,
             **label_columns(r, target),
             # initial error drawn from the prior (headline case only): the spread to set beside the bound
-            "est_x_mean_sampled": smp["theta_final_arcsec"][:, 0].mean() if smp else math.nan,
-            "est_x_std_sampled": seed_sd(smp["theta_final_arcsec"][:, 0]) if smp else math.nan,
-            "est_y_std_sampled": seed_sd(smp["theta_final_arcsec"][:, 1]) if smp else math.nan,
-            "label_sampled": row_label(smp["label"])[0] if smp and "label" in smp else "",
-            "rmse_x_sampled": float(np.sqrt(np.mean((smp["theta_final_arcsec"][:, 0] - truth[0]) ** 2)))
+            "est_x_mean_sampled": smp.theta_final_arcsec[:, 0].mean() if smp else math.nan,
+            "est_x_std_sampled": seed_sd(smp.theta_final_arcsec[:, 0]) if smp else math.nan,
+            "est_y_std_sampled": seed_sd(smp.theta_final_arcsec[:, 1]) if smp else math.nan,
+            "label_sampled": row_label(smp.label)[0] if smp else "",
+            "rmse_x_sampled": float(np.sqrt(np.mean((smp.theta_final_arcsec[:, 0] - truth[0]) ** 2)))
             if smp else math.nan,
             # filter consistency (sampled initial error): mean over time and seeds, 3 dof each
-            **{f"{q}_{k}_mean": float(np.nanmean(smp["consistency_t"][k][q])) if smp else math.nan
-               for q in ("nees_pos", "nis") for k in ("before", "after")},
+            "nees_pos_before_mean": float(np.nanmean(ct.before.nees_pos)) if ct else math.nan,
+            "nees_pos_after_mean": float(np.nanmean(ct.after.nees_pos)) if ct else math.nan,
+            "nis_before_mean": float(np.nanmean(ct.before.nis)) if ct else math.nan,
+            "nis_after_mean": float(np.nanmean(ct.after.nis)) if ct else math.nan,
             # position NEES of the Schmidt (consider) EKF and of the true-theta filter (issue 44)
-            **{f"nees_pos_{k}_mean": float(np.nanmean(smp["consistency_t"][k]["nees_pos"]))
-               if smp and k in smp["consistency_t"] else math.nan for k in ("consider", "true_theta")},
+            "nees_pos_consider_mean": float(np.nanmean(ct.consider.nees_pos)) if ct else math.nan,
+            "nees_pos_true_theta_mean": float(np.nanmean(ct.true_theta.nees_pos)) if ct else math.nan,
             # each compensated filter against the true-theta filter of the same runs (issue 54: the truth has
             # no process noise while the filters' Q > 0, so the reference is that filter's NEES, not 3)
-            **_nees_paired(smp),
-            "nav_err_before_km": r["nav_err_before_km"].mean(),
-            "nav_err_before_km_std": r["nav_err_before_km"].std(ddof=1) if th.shape[0] > 1 else math.nan,
-            "nav_err_after_km": r["nav_err_after_km"].mean(),
-            "nav_err_after_km_std": r["nav_err_after_km"].std(ddof=1) if th.shape[0] > 1 else math.nan,
+            **dataclasses.asdict(nees_paired(ct)),
+            "nav_err_before_km": r.nav_err_before_km.mean(),
+            "nav_err_before_km_std": r.nav_err_before_km.std(ddof=1) if th.shape[0] > 1 else math.nan,
+            "nav_err_after_km": r.nav_err_after_km.mean(),
+            "nav_err_after_km_std": r.nav_err_after_km.std(ddof=1) if th.shape[0] > 1 else math.nan,
             # split across (lat) / along (rng) the line of sight, and the floor with the true theta
             # (diagnostic: the filter given the true misalignment), mean over seeds
-            **{k: float(np.mean(r[k])) for k in NAV_SPLIT_KEYS if k in r},
+            **{k: float(np.mean(getattr(r, k))) for k in NAV_SPLIT_KEYS},
             "pub_est_x_mean": p.get("est_x_arcsec", math.nan),
             "pub_est_y_mean": p.get("est_y_arcsec", math.nan),
             "pub_data_to_converge_samples": p.get("data_to_converge_samples", math.nan),
@@ -106,25 +111,32 @@ def table1_frame(results: list[dict], published: dict, target_arcsec: float) -> 
     return df
 
 
-def _nees_paired(smp: dict | None) -> dict:
+@dataclass(frozen=True)
+class NeesPaired:
     """Per compensated filter (``after``: theta_hat as exact; ``consider``: the Schmidt filter), the
     seed mean of (its time-mean position NEES minus the true-theta filter's of the same seed) and
-    its standard error over seeds, and the seeds (sampled initial error; NaN without)."""
-    out = {"nees_n_seeds": math.nan}
-    keys = ("after", "consider")
-    for k in keys:
-        out[f"nees_pos_{k}_minus_true_theta_mean"] = out[f"nees_pos_{k}_minus_true_theta_se"] = math.nan
-    if not smp or "true_theta" not in smp.get("consistency_t", {}):
-        return out
-    ct = smp["consistency_t"]
-    ref = np.nanmean(ct["true_theta"]["nees_pos"], axis=1)  # (S,) time means
-    out["nees_n_seeds"] = int(ref.size)
-    for k in keys:
-        if k in ct:
-            d = np.nanmean(ct[k]["nees_pos"], axis=1) - ref
-            out[f"nees_pos_{k}_minus_true_theta_mean"] = float(d.mean())
-            out[f"nees_pos_{k}_minus_true_theta_se"] = float(d.std(ddof=1) / np.sqrt(d.size)) if d.size > 1 else math.nan
-    return out
+    its standard error over seeds, and the seeds (sampled initial error; NaN without). The field
+    names are A-T1's columns."""
+
+    nees_n_seeds: float = math.nan
+    nees_pos_after_minus_true_theta_mean: float = math.nan
+    nees_pos_after_minus_true_theta_se: float = math.nan
+    nees_pos_consider_minus_true_theta_mean: float = math.nan
+    nees_pos_consider_minus_true_theta_se: float = math.nan
+
+
+def nees_paired(ct: cases.ConsistencySeries | None) -> NeesPaired:
+    """:class:`NeesPaired` of a sampled rerun's filter consistency (all NaN without one)."""
+    if ct is None:
+        return NeesPaired()
+    ref = np.nanmean(ct.true_theta.nees_pos, axis=1)  # (S,) time means
+    d_after = np.nanmean(ct.after.nees_pos, axis=1) - ref
+    d_cons = np.nanmean(ct.consider.nees_pos, axis=1) - ref
+
+    def se(d):
+        return float(d.std(ddof=1) / np.sqrt(d.size)) if d.size > 1 else math.nan
+
+    return NeesPaired(int(ref.size), float(d_after.mean()), se(d_after), float(d_cons.mean()), se(d_cons))
 
 
 def nees_summary(t1: pd.DataFrame) -> dict:
@@ -151,7 +163,8 @@ def nees_summary(t1: pd.DataFrame) -> dict:
     return out
 
 
-def crlb_rows(setup: Setup, curves: dict, conv: dict, t1: pd.DataFrame, target_arcsec: float,
+def crlb_rows(setup: Setup, curves: dict, conv: Mapping[str, cases.ConvergenceStudy], t1: pd.DataFrame,
+              target_arcsec: float,
               curves_q0: dict | None = None) -> pd.DataFrame:
     """A-X1 table: the bound per variant beside the EM estimates' spread and EM iterations.
 
@@ -180,32 +193,34 @@ def crlb_rows(setup: Setup, curves: dict, conv: dict, t1: pd.DataFrame, target_a
             "bound_reaches_target": bool(curve[d_total, :2].max() <= target),
             "samples_to_target": _first_below(curve[:, :2].max(1), target),
         }
-        h = t1[(t1["scenario"] == v) & (t1["case_id"] == "T1-01")]
-        for _, r in h.iterrows():
-            tag = r["method"] if r.get("mode", "sliding") == "sliding" else f"growing_{r['method']}"
-            sampled = not pd.isna(r.get("rmse_x_sampled", math.nan))
-            row[f"em_{tag}_est_x_mean"] = r["est_x_mean_sampled"] if sampled else r["est_x_mean"]
-            row[f"em_{tag}_est_x_std"] = r["est_x_std_sampled"] if sampled else r["est_x_std"]
-            row[f"em_{tag}_rmse_x_arcsec"] = r["rmse_x_sampled"] if sampled else r["rmse_x_arcsec"]
-            row[f"em_{tag}_crlb_x_arcsec"] = r["crlb_x_arcsec"]  # the bound of the data it used
-            row[f"em_{tag}_crlb_q0_x_arcsec"] = r["crlb_q0_x_arcsec"]
-            row[f"em_{tag}_label"] = (r["label_sampled"] if sampled and r.get("label_sampled") else r["label"])
-            row[f"em_{tag}_stalled"] = row[f"em_{tag}_label"] == "stalled"
+        for r in t1[(t1.scenario == v) & (t1.case_id == "T1-01")].itertuples():
+            tag = r.method if r.mode == "sliding" else f"growing_{r.method}"
+            sampled = not pd.isna(r.rmse_x_sampled)
+            label = r.label_sampled if sampled and r.label_sampled else r.label
+            row.update({
+                f"em_{tag}_est_x_mean": r.est_x_mean_sampled if sampled else r.est_x_mean,
+                f"em_{tag}_est_x_std": r.est_x_std_sampled if sampled else r.est_x_std,
+                f"em_{tag}_rmse_x_arcsec": r.rmse_x_sampled if sampled else r.rmse_x_arcsec,
+                f"em_{tag}_crlb_x_arcsec": r.crlb_x_arcsec,  # the bound of the data it used
+                f"em_{tag}_crlb_q0_x_arcsec": r.crlb_q0_x_arcsec,
+                f"em_{tag}_label": label,
+                f"em_{tag}_stalled": label == "stalled"})
         c = conv.get(v)
         if c is not None:
-            ts, tr = c["theta_star_arcsec"], c["truth_arcsec"]
-            row["mle_samples"] = c["data_samples"]
-            row["crlb_x_at_mle_samples"] = curve[min(c["data_samples"], len(curve) - 1), 0]
-            row["mle_x_mean"] = ts[:, 0].mean()
-            row["mle_x_std"] = ts[:, 0].std(ddof=1) if ts.shape[0] > 1 else math.nan
-            row["mle_rmse_x_arcsec"] = float(np.sqrt(np.mean((ts[:, 0] - tr[0]) ** 2)))
-            row["mle_rmse_y_arcsec"] = float(np.sqrt(np.mean((ts[:, 1] - tr[1]) ** 2)))
-            row["maps_plain_median"] = float(np.median(c["plain"]["maps_to_converge"]))
-            row["maps_plain_extrapolated_median"] = float(np.median(c["plain"]["maps_extrapolated"]))
-            row["plain_rate_per_map"] = float(np.median(c["plain"]["rate_per_map"]))
-            row["maps_squarem_median"] = float(np.median(c["squarem"]["maps_to_converge"]))
-            row["max_maps"] = c["max_maps"]
-            row["tol_arcsec"] = cs.tol_arcsec
+            ts, tr = c.theta_star_arcsec, c.truth_arcsec
+            row.update(
+                mle_samples=c.data_samples,
+                crlb_x_at_mle_samples=curve[min(c.data_samples, len(curve) - 1), 0],
+                mle_x_mean=ts[:, 0].mean(),
+                mle_x_std=ts[:, 0].std(ddof=1) if ts.shape[0] > 1 else math.nan,
+                mle_rmse_x_arcsec=float(np.sqrt(np.mean((ts[:, 0] - tr[0]) ** 2))),
+                mle_rmse_y_arcsec=float(np.sqrt(np.mean((ts[:, 1] - tr[1]) ** 2))),
+                maps_plain_median=float(np.median(c.plain.maps_to_converge)),
+                maps_plain_extrapolated_median=float(np.median(c.plain.maps_extrapolated)),
+                plain_rate_per_map=float(np.median(c.plain.rate_per_map)),
+                maps_squarem_median=float(np.median(c.squarem.maps_to_converge)),
+                max_maps=c.max_maps,
+                tol_arcsec=cs.tol_arcsec)
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -213,9 +228,9 @@ def crlb_rows(setup: Setup, curves: dict, conv: dict, t1: pd.DataFrame, target_a
 def _first_window_bound(t1, variant, curve, s):
     """Bound of one segment's data: from the A-T1 sliding rows when present, else the
     cumulative curve after N samples."""
-    h = t1[(t1["scenario"] == variant) & (t1["case_id"] == "T1-01") & (t1.get("mode", "sliding") == "sliding")]
-    if len(h) and "crlb_x_arcsec" in h:
-        return float(h["crlb_x_arcsec"].iloc[0])
+    h = t1[(t1.scenario == variant) & (t1.case_id == "T1-01") & (t1.mode == "sliding")]
+    if len(h):
+        return float(h.crlb_x_arcsec.iloc[0])
     return curve[min(s.N, len(curve) - 1), 0]
 
 
@@ -330,7 +345,7 @@ def nav_floor_frame(nf: dict) -> pd.DataFrame:
     return pd.DataFrame(nav_floor_summary(nf)["rows"])
 
 
-def figures_5_6(results: list[dict]) -> dict:
+def figures_5_6(results: list[cases.CaseRun]) -> dict:
     """Paper A's Figs. 5 and 6 (issue 54, item 7): what each states and the numbers of ours that
     answer it, from the headline (T1-01) runs of every variant and scheme. Fig. 5 (navigation
     accuracy during the estimation) states no number: the text reads it with Fig. 4 ("the algorithm
@@ -340,18 +355,18 @@ def figures_5_6(results: list[dict]) -> dict:
     its rows add the errors at the arc's last sample."""
     f5, f6 = [], []
     for r in results:
-        if r["case_id"] != "T1-01":
+        if r.case_id != "T1-01":
             continue
-        key = variant_label(r["variant"], r["method"], r.get("mode", "sliding"))
-        seg, used = np.asarray(r["seg_pos_err_km"]), np.asarray(r["seg_data_used"])
+        key = variant_label(r.variant, r.method, r.mode)
+        seg, used = np.asarray(r.seg_pos_err_km), np.asarray(r.seg_data_used)
         f5.append({"variant": key, "samples_first": int(used[0]), "pos_err_km_first": float(seg[:, 0].mean()),
                    "samples_last": int(used[-1]), "pos_err_km_last": float(seg[:, -1].mean()),
                    "n_seeds": int(seg.shape[0])})
-        row = {"variant": key, "before_km_rule": float(np.mean(r["nav_err_before_km"])),
-               "after_km_rule": float(np.mean(r["nav_err_after_km"])), "n_seeds": int(seg.shape[0])}
-        if "err_before_t_km" in r:
-            row.update(before_km_last_sample=float(np.asarray(r["err_before_t_km"])[:, -1].mean()),
-                       after_km_last_sample=float(np.asarray(r["err_after_t_km"])[:, -1].mean()))
+        row = {"variant": key, "before_km_rule": float(np.mean(r.nav_err_before_km)),
+               "after_km_rule": float(np.mean(r.nav_err_after_km)), "n_seeds": int(seg.shape[0])}
+        if r.err_before_t_km is not None:
+            row.update(before_km_last_sample=float(np.asarray(r.err_before_t_km)[:, -1].mean()),
+                       after_km_last_sample=float(np.asarray(r.err_after_t_km)[:, -1].mean()))
         f6.append(row)
     return {"A-F5": {"claims": [], "reason": ("states no number of its own: the text reads it together with Fig. 4 "
                                               "(tx and ty estimated effectively: A-C1); rows: the position error at "
@@ -362,16 +377,16 @@ def figures_5_6(results: list[dict]) -> dict:
                      "rows": f6}}
 
 
-def _stars_key(row: dict) -> str:
+def _stars_key(row: StarsRow) -> str:
     """Summary key of a stars-study row: ``m<k>`` (k stars in every image) or ``att<v>``
     (attitude knowledge, arcsec); '.' written 'p', '-' written 'n'."""
-    if row.get("sweep", "per_image") == "per_image":
-        return f"m{row['per_image']}"
-    tag = {"attitude_sigma_arcsec": "att"}[row["sweep"]]
-    return tag + f"{row['value']:g}".replace(".", "p").replace("-", "n")
+    if row.sweep == "per_image":
+        return f"m{row.per_image}"
+    tag = {"attitude_sigma_arcsec": "att"}[row.sweep]
+    return tag + f"{row.value:g}".replace(".", "p").replace("-", "n")
 
 
-def stars_summary(study: list[dict], target_arcsec: float) -> dict:
+def stars_summary(study: list[StarsRow], target_arcsec: float) -> dict:
     """The stars study (:func:`opnav.approach.alternatives.stars_study`) for the summary, per row
     (:func:`_stars_key`): its settings, stars per image along the arc, the bound of tx, ty, tz
     after all the data (Q and Q = 0) and of the star images alone, the attitude floor
@@ -381,61 +396,63 @@ def stars_summary(study: list[dict], target_arcsec: float) -> dict:
     reaches the target (``attitude_threshold_arcsec``)."""
     out = {}
     for row in study:
-        curve = np.asarray(row["crlb_curve_arcsec"])
+        curve = np.asarray(row.crlb_curve_arcsec)
         need = _first_below(curve[:, :2].max(1), target_arcsec)
-        truth = np.asarray(row["truth_arcsec"], float)
+        truth = np.asarray(row.truth_arcsec, float)
         est = {}
-        for name, e in row["estimators"].items():
-            th = np.asarray(e["theta_final_arcsec"], float)
+        for name, e in row.estimators.items():
+            th = np.asarray(e.theta_final_arcsec, float)
             d = {"mean_arcsec": [float(x) for x in th.mean(0)],
                  "sd_arcsec": [float(x) for x in (th.std(0, ddof=1) if th.shape[0] > 1 else np.full(3, np.nan))],
                  "rmse_xy_arcsec": float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2)))}
-            if "label" in e:
-                d["label"] = row_label(e["label"])[0]
-            if "theta_ml_arcsec" in e:
-                ml = np.asarray(e["theta_ml_arcsec"], float)
+            if e.label is not None:
+                d["label"] = row_label(e.label)[0]
+            if e.theta_ml_arcsec is not None:
+                ml = np.asarray(e.theta_ml_arcsec, float)
                 d["ml_rmse_xy_arcsec"] = float(np.sqrt(np.mean((ml[:, :2] - truth[:2]) ** 2)))
             est[name] = d
         out[_stars_key(row)] = {
-            "sweep": row.get("sweep", "per_image"), "per_image": row["per_image"], "every_K": row["every_K"],
-            "images": row["images"], "total_samples": row["total_samples"],
-            **{k: row[k] for k in ("attitude_sigma_arcsec", "mode_drift_arcsec", "mag_limit", "field_deg",
-                                   "camera_field_deg", "stars_per_image", "floor_arcsec") if k in row},
-            "crlb_arcsec": [float(x) for x in row["crlb_all_arcsec"]],
-            "crlb_q0_arcsec": [float(x) for x in row["crlb_all_q0_arcsec"]],
-            **({"crlb_stars_only_arcsec": [float(x) for x in row["crlb_stars_only_arcsec"]]}
-               if "crlb_stars_only_arcsec" in row else {}),
+            "sweep": row.sweep, "per_image": row.per_image, "every_K": row.every_K,
+            "images": row.images, "total_samples": row.total_samples,
+            "attitude_sigma_arcsec": row.attitude_sigma_arcsec, "mode_drift_arcsec": row.mode_drift_arcsec,
+            "mag_limit": row.mag_limit, "field_deg": row.field_deg, "camera_field_deg": row.camera_field_deg,
+            "stars_per_image": dataclasses.asdict(row.stars_per_image), "floor_arcsec": row.floor_arcsec,
+            "crlb_arcsec": [float(x) for x in row.crlb_all_arcsec],
+            "crlb_q0_arcsec": [float(x) for x in row.crlb_all_q0_arcsec],
+            "crlb_stars_only_arcsec": [float(x) for x in row.crlb_stars_only_arcsec],
             "samples_to_target": None if math.isnan(need) else need, "estimators": est}
-    if study and "attitude_threshold_arcsec" in study[0]:
-        out["objection"] = {"attitude_threshold_arcsec": float(study[0]["attitude_threshold_arcsec"]),
+    if study:
+        out["objection"] = {"attitude_threshold_arcsec": float(study[0].attitude_threshold_arcsec),
                             "target_arcsec": float(target_arcsec)}
     return out
 
 
-def stars_frame(study: list[dict]) -> pd.DataFrame:
+def stars_frame(study: list[StarsRow]) -> pd.DataFrame:
     """A-X6: one row per stars-study row (:func:`opnav.approach.alternatives.stars_study`): the
     swept setting, stars per image along the arc, the bound of tx, ty (all data; star images
     alone), the attitude floor and the EM-EKF's (growing windows, SQUAREM) seed mean and RMS
     error of (tx, ty), arcsec."""
     rows = []
     for r in study:
-        truth = np.asarray(r["truth_arcsec"], float)
-        e = r["estimators"]["em_growing_squarem"]
-        th = np.asarray(e["theta_final_arcsec"], float)
+        truth = np.asarray(r.truth_arcsec, float)
+        e = r.estimators["em_growing_squarem"]
+        th = np.asarray(e.theta_final_arcsec, float)
+        n = r.stars_per_image
         rows.append({
-            "sweep": r.get("sweep", "per_image"), "value": float(r.get("value", r["per_image"])),
-            "per_image": int(r["per_image"]), "attitude_sigma_arcsec": r.get("attitude_sigma_arcsec", math.nan),
-            "mode_drift_arcsec": r.get("mode_drift_arcsec", math.nan), "mag_limit": r.get("mag_limit", math.nan),
-            "field_deg": r.get("field_deg", math.nan),
-            "images": int(r["images"]),
-            **{f"stars_per_image_{k}": float(v) for k, v in r.get("stars_per_image", {}).items()},
-            "crlb_x_arcsec": float(r["crlb_all_arcsec"][0]), "crlb_y_arcsec": float(r["crlb_all_arcsec"][1]),
-            "crlb_stars_only_x_arcsec": float(r["crlb_stars_only_arcsec"][0]) if "crlb_stars_only_arcsec" in r else math.nan,
-            "crlb_stars_only_y_arcsec": float(r["crlb_stars_only_arcsec"][1]) if "crlb_stars_only_arcsec" in r else math.nan,
-            "floor_arcsec": r.get("floor_arcsec", math.nan),
+            "sweep": r.sweep, "value": float(r.value),
+            "per_image": int(r.per_image), "attitude_sigma_arcsec": r.attitude_sigma_arcsec,
+            "mode_drift_arcsec": r.mode_drift_arcsec, "mag_limit": r.mag_limit,
+            "field_deg": r.field_deg,
+            "images": int(r.images),
+            "stars_per_image_min": float(n.min), "stars_per_image_median": float(n.median),
+            "stars_per_image_max": float(n.max),
+            "crlb_x_arcsec": float(r.crlb_all_arcsec[0]), "crlb_y_arcsec": float(r.crlb_all_arcsec[1]),
+            "crlb_stars_only_x_arcsec": float(r.crlb_stars_only_arcsec[0]),
+            "crlb_stars_only_y_arcsec": float(r.crlb_stars_only_arcsec[1]),
+            "floor_arcsec": r.floor_arcsec,
             "em_est_x_mean_arcsec": float(th[:, 0].mean()), "em_est_y_mean_arcsec": float(th[:, 1].mean()),
             "em_rmse_xy_arcsec": float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2))),
-            "em_label": row_label(e["label"])[0], "n_seeds": int(th.shape[0]),
+            "em_label": row_label(e.label)[0], "n_seeds": int(th.shape[0]),
         })
     return pd.DataFrame(rows)
 
