@@ -238,10 +238,10 @@ def check_picks(d, scn, fn) -> dict:
 
 @pytest.fixture(scope="module")
 def flown(landing):
-    """The example flown for one run in each camera scenario, beside depth."""
+    """The example flown for two runs in each camera scenario."""
     out = {}
     for scn_name, c in camera_scenarios(with_methods(landing, parallax=EXAMPLE)).items():
-        out[scn_name] = (build_scenario(c), run_chunk(c, "parallax", [1]))
+        out[scn_name] = (build_scenario(c), run_chunk(c, "parallax", [1, 2]))
     return out
 
 
@@ -301,7 +301,7 @@ def test_a_numba_function_flies_compiled_with_the_same_picks(landing, flown, tmp
     assert M.eval_path("depth", scn.planner) == "compiled"
     for name in ("interior", "site-tilt"):      # in-plane optima, then edge calls
         c = with_methods(camera_scenarios(landing)[name], jitted=f"{f}:score")
-        d = run_chunk(c, "jitted", [1])
+        d = run_chunk(c, "jitted", [1, 2])
         ref = flown[name][1]
         np.testing.assert_array_equal(d["plan_index"], ref["plan_index"])
         np.testing.assert_array_equal(d["plan_evals"], ref["plan_evals"])
