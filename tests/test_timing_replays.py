@@ -109,6 +109,9 @@ def test_evidence_of_three_replays_known_answer():
     assert float(ts.reduction_at(s, c["unshared_a_us"], c["unshared_b_us"])) == pytest.approx(29.03, abs=1e-6)
     assert c["unshared_a_us"] == pytest.approx(ed, rel=1e-3) and c["mean_shared_us"] == pytest.approx(6.5 / 3, rel=1e-3)
     assert [rp["n_calls"] for rp in ev["replays"]] == [40, 40, 40]
+    # on the evaluations alone the shared part's moves are gone: 50 % in every replay, no spread
+    e = ev["eval_reduction_pct"]["depth_vs_svd"]
+    assert e["per_replay"] == pytest.approx([50.0] * 3, abs=0.05) and e["sd_between"] == pytest.approx(0, abs=0.05)
     assert ev["replays"][0]["load_avg"] == [0.5, 0.6] and ev["replays"][0]["dispatch_us"] == 0.7
     lo, hi = ev["replays"][0]["median_interval_us"]["depth"]
     assert lo <= ev["replays"][0]["median_us"]["depth"] <= hi
