@@ -32,6 +32,13 @@ from opnav.core.console import quiet_job_headers  # noqa: E402
 # file lists to three names (opnav.core.console): what reruns a job is unchanged.
 quiet_job_headers([Path(workflow.basedir, d) for d in ("src", "workflow", "paper", "config")])
 
+# A second --configfile replaces the first instead of adding to it (Snakemake's own
+# parser): refused in one line, as every config problem.
+from opnav.core.checks import configfile_flag_problem  # noqa: E402
+
+if (_flags := configfile_flag_problem(sys.argv[1:])) is not None:
+    config_exit(_flags)
+
 _config_files = [Path(workflow.basedir, "config", "config.yaml")]
 _config_files += list(getattr(getattr(workflow, "config_settings", None), "configfiles", None) or [])
 try:

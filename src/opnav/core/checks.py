@@ -103,6 +103,37 @@ def duplicates(items) -> list:
     return dup
 
 
+_CONFIGFILE_FLAGS = ("--configfile", "--configfiles")
+
+
+def configfile_flag_problem(argv) -> str | None:
+    """One line if a command line gives ``--configfile`` more than once, else None.
+
+    Snakemake's ``--configfile`` takes every file after one flag (argparse ``nargs="+"``);
+    a second ``--configfile`` replaces the first list instead of adding to it, so
+    ``--configfile config/quick.yaml --configfile mine.yaml`` silently builds the full
+    profile with ``mine.yaml`` on top. ``argv``: the command line's arguments (the
+    Snakefile passes ``sys.argv``)."""
+    groups: list[list[str]] = []
+    args = [str(a) for a in argv]
+    for i, a in enumerate(args):
+        flag, eq, val = a.partition("=")
+        if flag not in _CONFIGFILE_FLAGS:
+            continue
+        files = [val] if eq else []
+        for b in args[i + 1:] if not eq else ():
+            if b.startswith("-"):
+                break
+            files.append(b)
+        groups.append(files)
+    if len(groups) < 2:
+        return None
+    kept = " ".join(groups[-1]) or "nothing"
+    every = " ".join(f for g in groups for f in g)
+    return (f"--configfile is given {len(groups)} times: Snakemake keeps only the last one ({kept}) and "
+            f"drops the others; give every file after one flag: --configfile {every}")
+
+
 def config_problems(config: dict, root: str | Path | None = None,
                     workdir: str | Path | None = None, *, skip=(), sections=None,
                     workflow: bool = False) -> list[str]:
