@@ -300,3 +300,20 @@ def test_abstract_sentence_changes_with_a_verdict():
     df2 = df.copy()
     df2.loc[df2["claim_id"] == "A-C1", "verdict"] = C.NOT_REPRODUCED
     assert C.abstract(df2) != a and "not reproduced" in C.abstract(df2)
+
+
+def test_a_choice_claims_best_reading_is_where_it_holds_never_where_depth_does_worse():
+    """Issue 55 item 9: B-C1 held in one camera and failed in the other, with depth worse than
+    SVD there; e19e33d's table named the failing camera (site-tilt) as the 'best faithful
+    variant'. The best reading is the camera where the claim holds, 'ours, as written' quotes
+    the one where it fails, whichever camera is listed first."""
+    for good, bad in (("interior", "site-tilt"), ("site-tilt", "interior")):
+        sb = summary_b(**{good: {"d_depth": 0.0}, bad: {"d_depth": 0.08}})   # depth worse than SVD in `bad`
+        rows, _, _ = built(sb=sb)
+        r = rows["B-C1"]
+        assert r.verdict == C.DEPENDS, r
+        assert r.best_variant == good and f"({good})" in r.ours_best and "+0.08" not in r.ours_best, r
+        assert f"({bad})" in r.ours_as_written and "+0.08" in r.ours_as_written, r
+    # nothing holds anywhere: no best reading at all
+    rows, _, _ = built(sb=summary_b(interior={"d_depth": 0.08}, **{"site-tilt": {"d_depth": 0.08}}))
+    assert rows["B-C1"].verdict == C.NOT_REPRODUCED and rows["B-C1"].best_variant == ""

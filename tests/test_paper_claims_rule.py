@@ -45,7 +45,7 @@ def _run(tmp_path, rep_faster=None, profile="full"):
     opt.write_text(json.dumps({"scenario": "interior", "n_calls": 409, "calls_multi_minimum": 0}))
     inp["optima"] = [str(opt)]
     out = {k: str(tmp_path / f"out.{k}") for k in ("csv", "md", "tex", "detail", "json", "plan", "inputs", "evidence",
-                                                    "amendments", "amendments_tex")}
+                                                    "amendments", "amendments_tex", "would_take_tex")}
     sweep = [cid for cid, t in C.load_plan().tests().items() if any(w.kind == "sweep" for w in t.would_take)]
     out["would_take"] = [str(tmp_path / f"wt_{c}.png") for c in sweep]
     lc = CFG["landing"]
@@ -75,6 +75,10 @@ def test_the_job_writes_claims_plan_and_inputs(tmp_path):
     am = pd.read_csv(out["amendments"], keep_default_na=False)
     assert list(am.columns) == C.AMENDMENT_COLUMNS and len(am) >= len(plan.amendments())
     assert all(p.exists() and p.stat().st_size > 1000 for p in out["would_take"])
+    wt = out["would_take_tex"].read_text()   # the appendix's figures: one per swept claim, each with its caption
+    assert wt.count("\\begin{figure}") == len(out["would_take"])
+    assert all(f"would_take/{p.name[3:-4]}.pdf" in wt and f"{p.name[3:-4]}: what it would take" in wt
+               for p in out["would_take"])
     assert (df["verdict_replication"] == "").all(), "no replication sample was given"
     plan = pd.read_csv(out["plan"])
     assert list(plan.columns) == C.PLAN_COLUMNS and set(plan["claim_id"]) == set(df["claim_id"])

@@ -260,7 +260,7 @@ def test_superiority_needs_a_whole_step_and_sweeps_the_threshold():
     wt, sweeps = S.would_take(PLAN, "B-C2", rows(-0.5), j)
     flip = sweeps[0]["flip"]
     assert 50 <= flip <= 100 and "threshold" in wt
-    assert "min_difference_s 0.5" in wt, "the step at which it would count at the plan's threshold"
+    assert "minimum difference of 0.5 s instead of 1" in wt, "the step at which it would count at the plan's threshold"
 
 
 def test_count_and_sign():
@@ -302,4 +302,4 @@ def test_sweep_interpolates_where_the_bound_reaches_the_target():
     assert sw and abs(sw[0]["flip"] - 0.25) < 0.03 and "0.25" in wt
     half = PLAN.amended({"claims.A-C1.margins.target_arcsec": {"value": 1.0, "reason": "test"}})
     wt2, sw2 = S.would_take(half, "A-C1", rows, S.judge(half, "A-C1", rows))
-    assert sw2[0]["flip"] is None and "no roll_rate_deg_s from 0.1 to 0.4" in wt2
+    assert sw2[0]["flip"] is None and "no roll rate from 0.1 to 0.4 deg/s" in wt2

@@ -96,7 +96,7 @@ rule paper_claims:
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
         code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/evidence.py",
-                 "report/plan.py", "report/scorer.py", "report/would_take_plot.py", "report/manuscript.py",
+                 "report/plan.py", "report/scorer.py", "report/would_take_plot.py", "report/manuscript.py", "report/wording.py",
                  "core/published.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
@@ -104,6 +104,8 @@ rule paper_claims:
         amendments=f"{PAPER}/amendments.csv",
         amendments_tex=f"{PAPER}/amendments.tex",
         would_take=[f"{PAPER}/would_take/{cid}.png" for cid in SWEEP_CLAIMS],
+        would_take_pdf=[f"{PAPER}/would_take/{cid}.pdf" for cid in SWEEP_CLAIMS],
+        would_take_tex=f"{PAPER}/would_take.tex",
         md=f"{PAPER}/claims.md",
         tex=f"{PAPER}/claims_glance.tex",
         detail=f"{PAPER}/claims_detail.tex",
@@ -271,7 +273,8 @@ rule paper_page_one:
         inputs=rules.paper_claims.output.inputs,
         published=src("data/published.yaml"),
         choices=src("data/differences.yaml"),
-        code=src("report/manuscript.py", "report/claims_prose.py", "report/verdict_plot.py", "report/differences.py"),
+        code=src("report/manuscript.py", "report/claims_prose.py", "report/verdict_plot.py", "report/differences.py",
+                 "report/wording.py"),
     output:
         abstract=f"{PAPER}/abstract.tex",
         fig_pdf=f"{PAPER}/verdicts.pdf",

@@ -69,9 +69,11 @@ with script_context(snakemake) as log:
     am = claims.amendments(plan, ev, rep_ids)
     am.to_csv(out.amendments, index=False)
     atomic_write_text(out.amendments_tex, claims.amendments_latex(am, plan, prose_tex))
+    names = {k: plan.name(k) for k in plan.raw.get("names", {}) if isinstance(plan.raw["names"][k], str)}
     for cid, stem in zip(par.sweep_claims, out.would_take):
-        would_take_plot.plot(cid, sweeps, Path(stem).with_suffix(""), {k: plan.name(k) for k in plan.raw.get("names", {})
-                                                                       if isinstance(plan.raw["names"][k], str)})
+        would_take_plot.plot(cid, sweeps, Path(stem).with_suffix(""), names)
+    atomic_write_text(out.would_take_tex, would_take_plot.latex(
+        par.sweep_claims, sweeps, {r["claim_id"]: r for r in df.to_dict("records")}, names=names))
     ins = (inputs_a(pub["paper_a"], plan, float(par.dt_s)) if "A" in summ else []) + (
         inputs_b(summ["B"], pub["paper_b"], plan, dict(par.landing)) if "B" in summ else [])
     claims.inputs_frame(ins).to_csv(out.inputs, index=False)

@@ -2,6 +2,7 @@
 Python, package versions and git commit of this run (opnav.core.provenance)."""
 
 import sys
+from datetime import datetime, timezone
 
 import pandas as pd
 
@@ -14,6 +15,9 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     info = dict(snakemake.params.info)
+    # when this build ran (the job reruns with every new commit): README's findings name the build
+    # they quote by commit and date (python -m opnav.report.readme --from ...)
+    info["built_utc"] = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     df = pd.DataFrame(provenance.rows(info), columns=["item", "version"])
     write_table(df, [snakemake.output.csv, snakemake.output.md],
                 caption="Software environment and commit of this run")

@@ -269,6 +269,43 @@ def _first(rd: S.Reading | None) -> S.UnitReading | None:
     return None
 
 
+class _ScopeReading:
+    """A scope's reading of the method as written, quoted as a best variant is: the scope
+    (the choice that gives the claim) as its name, its tightest passing outcome first."""
+
+    def __init__(self, scope: str, unit: S.UnitReading):
+        self.method, self._unit = scope, unit
+
+    def first(self) -> S.Outcome | None:
+        return self._unit.tightest() or self._unit.first()
+
+
+class _FailingReading:
+    """The method as written in the scope where it fails, quoted by its worst outcome."""
+
+    def __init__(self, unit: S.UnitReading):
+        self.method, self._unit = unit.method, unit
+
+    def first(self) -> S.Outcome | None:
+        return self._unit.worst() or self._unit.first()
+
+
+def _choice_readings(j: S.Judgement) -> tuple[_FailingReading, _ScopeReading] | None:
+    """For a claim that depends on a choice of scope (the camera), the reading where the method
+    as written fails (quoted as 'ours, as written') and the one where it holds (quoted as the
+    best reading, named by its scope). The best reading is only ever one that passes, so a
+    scope where the claim fails (depth worse than SVD) is never shown as the best (issue 55
+    item 9). ``None`` for any other verdict."""
+    if j.verdict != DEPENDS or not j.main.per_scope:
+        return None
+    scoped = {s: r for s, r in j.main.per_scope.items() if s != "alternatives" and isinstance(r, S.Reading)}
+    good = [(s, r) for s, r in scoped.items() if r.verdict == REPRODUCED and r.lit is not None]
+    bad = [(s, r) for s, r in scoped.items() if r.verdict != REPRODUCED and r.lit is not None]
+    if not good or not bad:
+        return None
+    return _FailingReading(bad[0][1].lit), _ScopeReading(good[0][0], good[0][1].lit)
+
+
 def _ours(u: S.UnitReading | None, plan: Plan, cited: list | None = None) -> str:
     if u is None:
         return ""
@@ -295,6 +332,9 @@ def claim_row(plan: Plan, cid: str, ev: list[EvidenceRow], replicated: bool, pro
     mine = [r for r in ev if r.claim_id == cid]
     lit = _first(j.main)
     best = j.main.best
+    choice = _choice_readings(j)
+    if choice is not None:  # a choice the paper leaves open decides: ours as written where it fails, best where it holds
+        lit, best = choice
     if j.verdict == WITH_ADDITION and best is not None:
         wt = "; ".join(x for x in (f"{best.method.replace('+', ', ')} added ({plan.addition(best.method)})", wt) if x)
     scopes = [s for s in (j.main.per_scope or {}) if s != "alternatives"]
@@ -415,20 +455,30 @@ def _verdicts(plan: Plan, raw: list[EvidenceRow], rep: set, ids: Iterable[str] |
 
 
 def amendments_latex(df: pd.DataFrame, plan: Plan, prose_tex=lambda s: s) -> str:
-    """The report appendix's list of the plan's amendments (a LaTeX description list): per
-    amendment its date, what changed and why, and the verdicts it changed, before -> after.
-    ``prose_tex``: the text-to-LaTeX function (``opnav.report.manuscript.prose_tex``)."""
-    out = [f"The analysis plan is version {plan.version} (sha256 {plan.checksum}); "
-           f"{len(plan.amendments())} amendments after results existed:", r"\begin{description}"]
+    """The report appendix's list of the plan's amendments: a sentence with the plan's version
+    and checksum, then a table (a longtable, so it may break across pages) with a row per
+    amendment: its date, what changed, why, and the verdicts it changed, before -> after, on
+    this build's evidence. ``prose_tex``: the text-to-LaTeX function
+    (``opnav.report.manuscript.prose_tex``)."""
+    n = len(plan.amendments())
+    out = [prose_tex(f"The analysis plan is version {plan.version} (sha256 {plan.checksum}). It was amended "
+                     f"{n} {'time' if n == 1 else 'times'} after results existed. The table below lists each change "
+                     "with the verdicts it moved, before -> after, recomputed by the scorer on this build's evidence."),
+           "", r"{\footnotesize\setlength{\tabcolsep}{4pt}",   # a longtable: it may break across pages
+           r"\begin{longtable}{@{}p{0.09\linewidth}p{0.34\linewidth}p{0.30\linewidth}p{0.23\linewidth}@{}}",
+           r"\toprule date & what changed & why & verdicts before $\to$ after \\ \midrule\endfirsthead",
+           r"\toprule date & what changed & why & verdicts before $\to$ after \\ \midrule\endhead",
+           r"\bottomrule\endfoot"]
     for (date, what), g in df.groupby(["date", "what"], sort=False):
         r0 = g.iloc[0]
-        ch = [f"{r.claim_id} {VERDICT_SHORT.get(r.verdict_before, r.verdict_before)} $\\to$ "
-              f"{VERDICT_SHORT.get(r.verdict_after, r.verdict_after)}" for r in g.itertuples() if r.claim_id]
+        ch = [f"{r.claim_id}: {prose_tex(VERDICT_SHORT.get(r.verdict_before, r.verdict_before) or 'not in the plan')} $\\to$ "
+              f"{prose_tex(VERDICT_SHORT.get(r.verdict_after, r.verdict_after))}" for r in g.itertuples() if r.claim_id]
         how = "; ".join(dict.fromkeys(g["how"]))
-        out.append(rf"\item[{prose_tex(date)}] {prose_tex(what)}. {prose_tex(r0['why'])}. "
-                   + (("Verdicts: " + ", ".join(ch) + f" ({prose_tex(how)}).") if ch else prose_tex(how).capitalize() + "."))
-    out.append(r"\end{description}")
-    return "\n".join(out) + "\n"
+        recorded = " " + prose_tex(f"({how})") if "recorded in" in how else ""
+        cell = ("; ".join(ch) + recorded) if ch else "no verdict moved"
+        out.append(f"{prose_tex(str(date))} & {prose_tex(what)} & {prose_tex(str(r0['why']))} & {cell} \\\\")
+    out += [r"\end{longtable}}", ""]
+    return "\n".join(out)
 
 
 def raw_rows(evidence: Iterable[EvidenceRow]) -> list[EvidenceRow]:
@@ -460,8 +510,7 @@ def sample_sentence(df: pd.DataFrame) -> str:
     """Page 1's sentence on the sample (empty for a full-profile table)."""
     if df.empty or (df["sample"] == "full").all():
         return ""
-    return ("This build is the quick profile: its Monte-Carlo samples are too small for verdicts, so every "
-            "verdict below only shows that the pipeline runs, not what the papers' claims are.")
+    return "This build is the quick profile: its samples are too small for verdicts."
 
 
 def inputs_frame(rows: Iterable[dict]) -> pd.DataFrame:

@@ -273,6 +273,7 @@ _PROSE = [
     (re.compile(r"\brho\*theta\b"), r"$\\rho\\theta$"),
     (re.compile(r"(?<=\d) ?arcsec\b"), r"\\arcsec{}"),
     (re.compile(r"\+-"), r"$\\pm$"),
+    (re.compile(r"(?<= )->(?= )"), r"$\\to$"),
     (re.compile(r"(?<!\\)\btheta\\_([xyz])\b"), r"$\\theta_\1$"),
     (re.compile(r"(?<!\\)\btheta\b"), r"$\\theta$"),
     (re.compile(r"(?<!\\)\brho\b"), r"$\\rho$"),

@@ -39,6 +39,7 @@ from typing import Any
 
 from scipy import special
 
+from opnav.report import wording
 from opnav.report.evidence import QUANTITIES, Evidence, EvidenceRow, quantity
 from opnav.report.plan import ClaimTest, Condition, Plan, PlanError
 
@@ -56,17 +57,9 @@ PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
 
 # ------------------------------------------------------------ numbers as text
 def fmt(x: Any, nd: int = 3) -> str:
-    """A number as claim-table text: ``nd`` significant digits, ``n/a`` if missing."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        return str(x)
-    if not math.isfinite(v):
-        return "n/a"
-    if v == 0:
-        return "0"
-    s = f"{v:.{nd}g}" if abs(v) < 10 ** nd else f"{v:.0f}"
-    return s
+    """A number as claim-table text: ``nd`` significant digits, ``n/a`` if missing
+    (:func:`opnav.report.wording.num`: a ratio of 0.9999 is not '1')."""
+    return wording.num(x, nd)
 
 
 def _signed(x: float) -> str:
@@ -702,7 +695,8 @@ def quote(o: Outcome | None, plan: Plan | None = None, with_scope: bool = True) 
     name = (lambda k: plan.name(k)) if plan is not None else (lambda k: k)
     q = QUANTITIES.get(r.quantity)
     what = q.text if q is not None else r.quantity
-    who = "" if r.role == "bound" else name(r.method) + (
+    # the method as written alone needs no name ('RMS error 20 arcsec', not 'of EM as written')
+    who = "" if r.role == "bound" or (r.role == "as_written" and not r.versus) else name(r.method) + (
         f" minus {name(r.versus)}" if r.versus and r.quantity.startswith(("err_diff", "converge_time"))
         else f" against {name(r.versus)}" if r.versus else "")
     if o.cond.comparison == "order" and len(o.rows) >= 2 and o.rows[1] is not None and o.cond.get("by") == "estimate":
@@ -1017,7 +1011,8 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
                 versus=s["versus"], role="derived", quantity=q, estimate=float(s["flip"]),
                 n=len(s["points"]), source=f"scorer: the sweep of {s['quantity']} over {name}"))
         else:
-            texts.append(f"no {name} from {fmt(min(vals))} to {fmt(max(vals))} gives it ({who})")
+            words, unit = wording.key_words(name)
+            texts.append(f"no {words} from {fmt(min(vals))} to {fmt(max(vals))}{_u(unit)} gives it ({who})")
     return "; ".join(texts), sweeps
 
 
@@ -1046,7 +1041,7 @@ def _margin_take(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapp
                                  method=o.row.method, versus=o.row.versus, role="derived", quantity=q,
                                  estimate=float(v), n=o.row.n,
                                  source=f"scorer: {o.row.quantity} against condition {cond.index} of the plan"))
-    return f"{name} {fmt(v)} instead of {fmt(cur)} ({o.scope or o.row.method})"
+    return f"{wording.key_value(name, fmt(v))} instead of {fmt(cur)} ({o.scope or o.row.method})"
 
 
 def _needed(o: Outcome, name: str, plan: Plan, test: ClaimTest, idx: _Index) -> float | None:

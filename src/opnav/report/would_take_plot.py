@@ -76,7 +76,10 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
         ax.set_xlabel(setting_label(s0["setting"]))
         import textwrap
 
-        ylab = (q.text if q is not None else s0["quantity"].replace("_", " ")) + (f" ({unit})" if unit else "")
+        ylab = q.text if q is not None else s0["quantity"].replace("_", " ")
+        if s0.get("versus") and "diff" in s0["quantity"]:   # a paired difference: say which minus which
+            ylab += f", {names.get(s0['method'], s0['method'])} minus {names.get(s0['versus'], s0['versus'])}"
+        ylab += f" ({unit})" if unit else ""
         ax.set_ylabel("\n".join(textwrap.wrap(ylab, 28)))
         xs_all = [p[0] for s in sw for p in s["points"]]
         ys_all = [p[1] for s in sw for p in s["points"]] + ([lim] if lim is not None and math.isfinite(lim) else [])
@@ -89,3 +92,61 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
         ax.set_title(f"{claim_id}: what it would take", fontsize="small")
         figures.place_legend(ax, fontsize="x-small")
         return figures.save(fig, path)
+
+
+def caption(claim_id: str, sweeps: Iterable[Mapping[str, Any]], row: Mapping[str, Any] | None = None,
+            names: Mapping[str, str] | None = None) -> str:
+    """The figure's caption (plain text, every sentence short): which claim, what is drawn
+    against what, how the test and the flip are marked, and what the claims table says it
+    would take (``row``: the claim's row of the claims table)."""
+    from opnav.report import wording
+    from opnav.report.evidence import QUANTITIES
+
+    names = dict(names or {})
+    row = dict(row or {})
+    title = str(row.get("claim", "")).split(" (")[0].strip()
+    out = [f"{claim_id}" + (f", {title[0].lower() + title[1:]}" if title else "") + ": what it would take."]
+    sw = [s for s in sweeps if s["claim_id"] == claim_id]
+    if not sw:
+        return " ".join(out + [f"This build has no swept evidence for {claim_id}."])
+    s0 = sw[0]
+    q = QUANTITIES.get(s0["quantity"])
+    what = q.text if q is not None else s0["quantity"].replace("_", " ")
+    if s0.get("versus"):
+        how = "minus" if "diff" in s0["quantity"] else "against"
+        what += f" of {names.get(s0['method'], s0['method'])} {how} {names.get(s0['versus'], s0['versus'])}"
+    lines = wording.join([names.get(s["method"], s["method"]) + (f" ({s['scope']})" if s["scope"] else "") for s in sw])
+    out.append(f"The {what} against the {setting_label(s0['setting'])}, for {lines}.")
+    marks = []
+    if len([x for x in s0.get("band") or () if math.isfinite(x)]) == 2:
+        marks.append(f"the grey band is the test ({s0.get('threshold', '')})")
+    elif s0.get("limit") is not None and math.isfinite(s0.get("limit", math.nan)):
+        marks.append(f"the dashed line is the test ({s0.get('threshold', '')})")
+    if s0.get("target") is not None and math.isfinite(s0.get("target", math.nan)):
+        marks.append(f"the dashed line marks the published {wording.num(s0['target'])}")
+    if any(s["flip"] is not None for s in sw):
+        marks.append("a dotted line marks where the verdict flips")
+    if marks:
+        out.append(wording.join(marks).capitalize() + ".")
+    take = str(row.get("would_take", "")).strip()
+    if take:
+        take = "; ".join(dict.fromkeys(t.strip() for t in take.split("; ")))
+        out.append("The claims table reads: " + wording.shorten(take, wording.MAX_SENTENCE_WORDS - 4) + ".")
+    return " ".join(out)
+
+
+def latex(claim_ids: Iterable[str], sweeps: Iterable[Mapping[str, Any]], rows: Mapping[str, Mapping[str, Any]],
+          directory: str = r"\results/paper/would_take", names: Mapping[str, str] | None = None) -> str:
+    """The manuscript's would_take figures (an appendix block of figure floats, one per swept
+    claim, each with its :func:`caption`); ``directory``: where LaTeX finds ``<claim>.pdf``."""
+    from opnav.report.manuscript import prose_tex
+
+    sweeps = list(sweeps)
+    blocks = []
+    for cid in claim_ids:
+        cap = prose_tex(caption(cid, sweeps, rows.get(cid), names))
+        blocks.append("\\begin{figure}[htbp]\n  \\centering\n"
+                      f"  \\includegraphics{{{directory}/{cid}.pdf}}\n"
+                      f"  \\caption[{cid}: what it would take]{{{cap}}}\n"
+                      f"  \\label{{fig:would-take-{cid}}}\n\\end{{figure}}\n")
+    return "\n".join(blocks)
