@@ -1071,3 +1071,23 @@ def test_snakemake_dry_run_refuses_round_three_input(tmp_path):
         assert expected in out and "Traceback" not in out and "CreateRuleException" not in out, out[-2000:]
         assert "WildcardError" not in out, out[-2000:]
     assert not (wd / "results").exists()
+
+
+@pytest.mark.parametrize("profile,marker,expect", [
+    ("full", "quick", ["'profile'"]),          # the label is wrong: only the label is said
+    ("quick", "full", ["'results_dir'"]),      # control: a right label, another profile's folder
+])
+def test_a_wrong_profile_label_is_not_said_again_as_the_folder_owner(tmp_path, profile, marker, expect):
+    """A results_dir owned by another profile follows from a wrong ``profile`` label: one line
+    (the label), whatever the checkout's own results/ holds (the test makes its own folder).
+    Mutation (tried): the owner check run whatever the label fails the first case."""
+    import json
+
+    from opnav.core.checks import OWNER_MARKER, config_problems
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / OWNER_MARKER).write_text(json.dumps({"checkout": str(REPO.resolve()), "profile": marker}))
+    cfg = _overlaid(f"profile: {profile}\nresults_dir: {out}")
+    lines = config_problems(cfg, root=REPO, workflow=True)
+    assert len(lines) == len(expect) and all(k in line for k, line in zip(expect, lines)), lines

@@ -147,8 +147,12 @@ def config_problems(config: dict, root: str | Path | None = None,
                                                         "limits", "profile"}
     todo = want - set(skip)
     out: list[str] = []
+    # the profile label first: a results_dir owned by another profile follows from a wrong
+    # label, so the owner check is skipped when the label is broken (one message per problem)
+    label = (profile_problems(config) if workflow and "profile" in todo
+             and not set(skip) & {"profile", "approach", "landing"} else [])
     if "results_dir" in todo:
-        out += results_dir_problems(config, root, workdir)
+        out += results_dir_problems(config, root, workdir, owner=not label and "profile" not in set(skip))
     for name, check in (("approach", approach_rules), ("landing", landing_rules)):
         if name in todo and name in config:
             out += check(config[name], workflow=workflow)
@@ -156,8 +160,7 @@ def config_problems(config: dict, root: str | Path | None = None,
         out += seed_rules(config)
     if not workflow:
         return out
-    if "profile" in todo and not set(skip) & {"profile", "approach", "landing"}:
-        out += profile_problems(config)     # the label the workflow's outputs carry
+    out += label     # the label the workflow's outputs carry
     if "approach" in todo and "approach" not in set(skip):
         out += growing_problems(config["approach"])
     if "studies" in todo and "landing" not in set(skip):
@@ -550,11 +553,12 @@ def job_problems(config: dict) -> list[str]:
 
 
 def results_dir_problems(config_or_dir, root: str | Path | None = None,
-                         workdir: str | Path | None = None) -> list[str]:
+                         workdir: str | Path | None = None, owner: bool = True) -> list[str]:
     """``results_dir`` (the key of ``config_or_dir``, a config mapping, or the path
     itself): non-empty, no NUL or other control character, no unexpanded ``$VAR``, not
     under /proc, /sys or /dev, no symlink loop, not owned by another checkout or profile
-    (:func:`owner_problems`, given a config and ``root``), at most :data:`MAX_PATH_CHARS` characters (and
+    (:func:`owner_problems`, given a config and ``root``, unless ``owner`` is false: the
+    caller found the config's ``profile`` broken), at most :data:`MAX_PATH_CHARS` characters (and
     255 per component), ``~`` expanded (in the config, in place) or refused if it
     names no home; a writable directory (or creatable in a writable one), not a
     file; not the checkout ``root`` (default: the working directory) nor a folder
@@ -624,7 +628,7 @@ def results_dir_problems(config_or_dir, root: str | Path | None = None,
     nested = nested_problems(p, base, shown)
     if nested:
         return nested
-    if cfg is not None and root is not None and p.is_dir():
+    if owner and cfg is not None and root is not None and p.is_dir():
         return owner_problems(p, root, str(cfg.get("profile", "full")))
     return []
 
