@@ -5,11 +5,16 @@ subscripts, ``.get("k")`` calls and lines of presentation in the paper packages.
 
 SRC is the package folder (default ``src/opnav``). What is counted, per module:
 
-* **dict-returning function**: a function (or method) one of whose own ``return`` statements
-  (not a nested function's) returns a dict display (``{...}``), a dict comprehension or a
-  ``dict(...)`` call, or whose return annotation is ``dict`` / ``dict[...]`` / ``Dict[...]`` /
-  ``Mapping`` (with or without ``| None``). A function returning ``list[dict]`` counts too (its
-  annotation names ``dict`` inside ``list[...]``/``tuple[...]``);
+* **dict-returning function** (column ``dict_functions``): a function (or method) one of whose
+  own ``return`` statements (not a nested function's) returns a dict display (``{...}``), a dict
+  comprehension or a ``dict(...)`` call, or whose return annotation is ``dict`` / ``dict[...]`` /
+  ``Dict[...]`` / ``Mapping`` (with or without ``| None``). A function returning ``list[dict]``
+  counts too (its annotation names ``dict`` inside ``list[...]``/``tuple[...]``);
+* **record-as-dict function** (column ``record_dicts``, a subset): one that hands a *record* over
+  as a dict: it returns a dict display with a constant string key or a ``dict(k=...)`` call, or
+  its annotation is an untyped dict (``dict``, ``Mapping``, ``dict[str, Any]``, a dict of dicts,
+  ``list[dict]``). A mapping keyed by data whose values are typed (``dict[str, NeesRow]``,
+  ``dict[str, float]``: variant or method name to a record or a number) is not a record;
 * **constant-string subscript**: ``x["k"]`` (any ``Subscript`` whose index is a str constant,
   as a load, store or delete; pandas column lookups included);
 * **``.get("k")``**: a call ``x.get("k", ...)`` whose first argument is a str constant;
@@ -74,6 +79,50 @@ def returns_dict(fn) -> bool:
     return any(_is_dict_value(r.value) for r in _own_returns(fn))
 
 
+_TYPED_VALUES = ("float", "int", "str", "bool", "np.ndarray", "ndarray")
+
+
+def _untyped_dict_annotation(ann: ast.AST | None) -> bool:
+    """A dict annotation whose values are untyped: bare dict/Mapping, ``Any``/``object`` values,
+    dict values, or a list/tuple of dicts."""
+    if ann is None:
+        return False
+    if isinstance(ann, ast.Constant) and isinstance(ann.value, str):
+        try:
+            ann = ast.parse(ann.value, mode="eval").body
+        except SyntaxError:
+            return False
+    if isinstance(ann, ast.BinOp):  # X | None
+        return _untyped_dict_annotation(ann.left) or _untyped_dict_annotation(ann.right)
+    name = lambda n: n.id if isinstance(n, ast.Name) else (n.attr if isinstance(n, ast.Attribute) else "")  # noqa: E731
+    if name(ann) in ("dict", "Dict", "Mapping", "MutableMapping"):
+        return True
+    if isinstance(ann, ast.Subscript):
+        outer = name(ann.value)
+        args = ann.slice.elts if isinstance(ann.slice, ast.Tuple) else [ann.slice]
+        if outer in ("dict", "Dict", "Mapping", "MutableMapping"):
+            value = args[-1]
+            v = ast.unparse(value)
+            return v in ("Any", "object") or _mentions_dict(value)
+        if outer in ("list", "tuple", "Sequence", "Iterator", "Iterable"):
+            return any(_untyped_dict_annotation(a) for a in args)
+    return False
+
+
+def returns_record_dict(fn) -> bool:
+    if _untyped_dict_annotation(fn.returns):
+        return True
+    for r in _own_returns(fn):
+        v = r.value
+        if isinstance(v, ast.Dict) and any(isinstance(k, ast.Constant) and isinstance(k.value, str) for k in v.keys):
+            return True
+        if isinstance(v, ast.Call) and isinstance(v.func, ast.Name) and v.func.id == "dict" and v.keywords:
+            return True
+        if isinstance(v, ast.DictComp) and fn.returns is None:
+            return True
+    return False
+
+
 def _is_text_function(fn) -> bool:
     ann = fn.returns
     if isinstance(ann, ast.Name) and ann.id == "str":
@@ -101,7 +150,9 @@ def count_module(path: Path) -> dict:
     for node in ast.walk(tree):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             if returns_dict(node):
-                dict_fns.append(f"{node.name}:{node.lineno}")
+                rec = returns_record_dict(node)
+                c["record_dicts"] += rec
+                dict_fns.append(f"{node.name}:{node.lineno}{' (record)' if rec else ''}")
             if _is_text_function(node):
                 text_lines += node.end_lineno - node.lineno + 1
         elif isinstance(node, ast.Subscript):
@@ -139,21 +190,21 @@ def main(argv=None) -> int:
         r = count_module(p)
         files[rel] = r
         parts[part_of(rel)].update(r["counts"])
-    keys = ("dict_functions", "str_subscripts", "get_calls", "plot_lines", "text_lines", "lines")
-    print(f"{'part':<10}" + "".join(f"{k:>16}" for k in keys))
+    keys = ("dict_functions", "record_dicts", "str_subscripts", "get_calls", "plot_lines", "text_lines", "lines")
+    print(f"{'part':<10}" + "".join(f"{k:>15}" for k in keys))
     total = Counter()
     for name in ("approach", "landing", "studies", "core", "report", "other"):
         total.update(parts[name])
-        print(f"{name:<10}" + "".join(f"{parts[name][k]:>16}" for k in keys))
-    print(f"{'total':<10}" + "".join(f"{total[k]:>16}" for k in keys))
+        print(f"{name:<10}" + "".join(f"{parts[name][k]:>15}" for k in keys))
+    print(f"{'total':<10}" + "".join(f"{total[k]:>15}" for k in keys))
     pres = sum(parts[n]["plot_lines"] + parts[n]["text_lines"] for n in PAPERS)
     print(f"presentation lines in paper packages ({', '.join(PAPERS)}): {pres}")
     if a.by_file:
         print()
         for rel, r in files.items():
             c = r["counts"]
-            if any(c[k] for k in keys[:5]):
-                print(f"{str(rel):<44}" + "".join(f"{c[k]:>8}" for k in keys[:5]))
+            if any(c[k] for k in keys[:6]):
+                print(f"{str(rel):<44}" + "".join(f"{c[k]:>8}" for k in keys[:6]))
     if a.list:
         print()
         for rel, r in files.items():

@@ -46,6 +46,6 @@ def test_cli_names_the_data_its_bound_covers(capsys):
 
     cfg = approach_cfg(N0=50, N=20, M=2, L=3)
     d = pipeline.bound_data(Setup.from_config(cfg), "prior")
-    assert (d["first_sample"], d["last_sample"], d["n_samples"]) == (91, 110, 20)
+    assert (d.first_sample, d.last_sample, d.n_samples) == (91, 110, 20)
     cfg["segments"]["mode"] = "growing"
-    assert pipeline.bound_data(Setup.from_config(cfg), "roll")["first_sample"] == 51
+    assert pipeline.bound_data(Setup.from_config(cfg), "roll").first_sample == 51

@@ -1,6 +1,7 @@
 """Navigation error against arc length and tz's effect on navigation (issue 54, items 6-7), and
 the summary keys the claims table reads (the contract of issue 54)."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -30,19 +31,19 @@ def test_each_arc_is_the_run_of_that_arc_alone():
     the short arc's row."""
     cfg = Setup.from_config(_cfg())
     out = navfloor.nav_floor_by_arc(cfg, "roll", "growing-squarem", [75.0, 125.0])
-    assert [r["samples"] for r in out["rows"]] == [150, 250]
-    for row in out["rows"]:
-        c = approach_cfg(N0=50, N=50, M=2, L=(row["samples"] - 50) // 50)
+    assert [r.samples for r in out.rows] == [150, 250]
+    for row in out.rows:
+        c = approach_cfg(N0=50, N=50, M=2, L=(row.samples - 50) // 50)
         c["growing"].update(N=50, M=3)
         c["n_seeds"] = 3
         c["em"]["ml_max_maps"] = 3  # the label's reference (not compared here)
         s = Setup.from_config(c).scheme("growing")
         r = cases.run_case(s, "roll", cases.headline_case(s), range(3), method="squarem")
-        np.testing.assert_allclose(row["nav_err_km_rule"], r.nav_err_after_km.mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["true_theta_km_rule"], r.nav_err_true_theta_km.mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["before_km_rule"], r.nav_err_before_km.mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["nav_err_km_last"], r.err_after_t_km[:, -1].mean(), rtol=2e-5)
-        np.testing.assert_allclose(row["est_x_mean_arcsec"], r.theta_final_arcsec[:, 0].mean(), rtol=2e-5)
+        np.testing.assert_allclose(row.nav_err_km_rule, r.nav_err_after_km.mean(), rtol=2e-5)
+        np.testing.assert_allclose(row.true_theta_km_rule, r.nav_err_true_theta_km.mean(), rtol=2e-5)
+        np.testing.assert_allclose(row.before_km_rule, r.nav_err_before_km.mean(), rtol=2e-5)
+        np.testing.assert_allclose(row.nav_err_km_last, r.err_after_t_km[:, -1].mean(), rtol=2e-5)
+        np.testing.assert_allclose(row.est_x_mean_arcsec, r.theta_final_arcsec[:, 0].mean(), rtol=2e-5)
 
 
 def test_tz_does_not_move_the_navigation_error():
@@ -52,8 +53,8 @@ def test_tz_does_not_move_the_navigation_error():
     (control: the test can see an effect)."""
     setup = Setup.from_config(_cfg())
     tz = navfloor.tz_nav_effect(setup, "roll")
-    assert tz["n_seeds"] == 3 and math.isfinite(tz["nav_err_km_tz_on"])
-    assert abs(tz["diff_km_mean"]) < 1e-3 * tz["nav_err_km_tz_off"]
+    assert tz.n_seeds == 3 and math.isfinite(tz.nav_err_km_tz_on)
+    assert abs(tz.diff_km_mean) < 1e-3 * tz.nav_err_km_tz_off
     # control: the same pairing with tx instead of tz
     from opnav.approach import scenario as sc
     from opnav.approach.ekf import run_filter
@@ -83,19 +84,26 @@ def test_arcs_that_end_before_the_data_are_refused_before_any_work():
 
 def test_the_summary_holds_the_contract_keys():
     """The keys the claims engineer reads from A-summary.json (issue 54's contract)."""
-    nf = {"rule": "r", "variant": "roll+growing+squarem", "scenario": "roll", "scheme": "growing-squarem",
-          "rows": [{"arc_s": 1100.0, "variant": "roll+growing+squarem", "samples": 2200, "n_seeds": 3,
-                    "nav_err_km_rule": 21.0, "nav_err_km_last": 18.0, "true_theta_km_rule": 20.9,
-                    "true_theta_km_last": 18.1, "before_km_rule": 110.0}]}
-    s = summaries.nav_floor_summary(nf)
-    assert set(s) >= {"rule", "rows"}
+    from types import SimpleNamespace
+
+    from opnav.approach.navfloor import NavFloor, NavFloorRow
+    from opnav.approach.readings import InstallationCheck
+    from opnav.core.tables import json_ready
+    from opnav.report.approach import text as words
+
+    row = NavFloorRow(**{f.name: 1.0 for f in dataclasses.fields(NavFloorRow)})
+    nf = NavFloor(variant="roll+growing+squarem", scenario="roll", scheme="growing-squarem", n_seeds=3,
+                  last_fraction=0.5, rows=(row,))
+    s = json_ready(summaries.nav_floor_summary(nf))
+    assert set(s) == {"rule", "rows", "variant", "scenario", "scheme"}  # n_seeds, last_fraction: for the words only
     assert list(s["rows"][0])[:7] == ["arc_s", "variant", "nav_err_km_rule", "nav_err_km_last", "true_theta_km_rule",
                                       "true_theta_km_last", "n_seeds"]
-    rr = summaries.roll_rate_bound_summary({"grid_rates_deg_s": np.array([0.01, 0.1]), "samples": 250,
-                                            "bound_grid_arcsec": np.array([[9.0, 8.0, 1e3], [2.0, 3.0, 1e3]])})
-    assert rr["rate_deg_s"] == [0.01, 0.1] and rr["bound_arcsec"] == [9.0, 3.0]
-    ins = summaries.installation_summary({"by_construction": True, "max_rel_change": 1e-16, "install_deg": [0.0, 90.0]})
-    assert ins["by_construction"] is True and "cancels" in ins["why"]
+    rr = summaries.roll_rate_bound_summary(SimpleNamespace(grid_rates_deg_s=np.array([0.01, 0.1]), samples=250,
+                                                           bound_grid_arcsec=np.array([[9.0, 8.0, 1e3], [2.0, 3.0, 1e3]])))
+    assert rr.rate_deg_s == [0.01, 0.1] and rr.bound_arcsec == [9.0, 3.0]
+    ins = InstallationCheck(install_deg=[0.0, 90.0], max_rel_change=1e-16, by_construction=True,
+                            body_frame_theta_cam_arcsec=[[10.0, 20.0, 10.0], [10.0, -10.0, 20.0]])
+    assert json_ready(ins)["by_construction"] is True and "cancels" in words.installation_why(ins)
     import pandas as pd
 
     t1 = pd.DataFrame([{"case_id": "T1-01", "variant": "roll", "scenario": "roll", "method": "plain", "mode": "sliding",
@@ -104,7 +112,7 @@ def test_the_summary_holds_the_contract_keys():
                         **{f"nees_pos_{k}_minus_true_theta_{q}": 1.0 for k in ("after", "consider")
                            for q in ("mean", "se")}}])
     n = summaries.nees_summary(t1)["roll"]
-    assert (n["nees_mean"], n["reference_nees_mean"], n["n_seeds"]) == (13.8, 2.5, 20)
+    assert (n.nees_mean, n.reference_nees_mean, n.n_seeds) == (13.8, 2.5, 20)
 
 
 def test_the_nees_sentence_judges_against_the_true_theta_filter():
@@ -120,3 +128,25 @@ def test_the_nees_sentence_judges_against_the_true_theta_filter():
     assert "above it (optimistic" in txt and "below it (conservative)" in txt and "3 expected" not in txt
     nees["roll+growing+squarem"]["consider_minus_reference_mean"] = -0.1
     assert "indistinguishable from it" in approach_text.nees_text(nees)
+
+
+def test_the_a_x7_figure_and_table_draw_from_the_record():
+    """A-X7 is drawn and tabled from the typed record (opnav.approach.navfloor.NavFloor), its words
+    (the rule) made by the report layer; the table's columns are the row's fields in order."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from opnav.approach.navfloor import NavFloor, NavFloorRow
+    from opnav.report.approach import plots
+    from opnav.report.approach import text as words
+
+    rows = tuple(NavFloorRow(**{**{f.name: 1.0 + i for f in dataclasses.fields(NavFloorRow)},
+                                "variant": "roll+growing+squarem", "n_seeds": 3, "samples": 100 * (i + 1)})
+                 for i in range(3))
+    nf = NavFloor(variant="roll+growing+squarem", scenario="roll", scheme="growing-squarem", n_seeds=3,
+                  last_fraction=0.5, rows=rows)
+    frame = summaries.nav_floor_frame(nf)
+    assert list(frame.columns) == [f.name for f in dataclasses.fields(NavFloorRow)] and len(frame) == 3
+    fig = plots.fig_nav_floor(nf, 20.0)
+    assert "3 seeds" in fig.axes[0].get_title()
+    assert "RMS over the last 0.5 of the arc" in words.nav_floor_rule(nf.variant, nf.n_seeds, nf.last_fraction)

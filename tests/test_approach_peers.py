@@ -274,3 +274,36 @@ def test_basilisk_bias_moves_with_the_user_guide_tuning():
     steps = np.diff(r.theta_hist_arcsec[0], axis=0)
     q = r.bias_quantum_arcsec
     np.testing.assert_allclose(steps / q, np.round(steps / q), atol=1e-6)
+
+
+def test_the_a_p1_table_holds_keys_and_the_report_words_them():
+    """A-P1's table rows carry keys (estimator, run); the summary reads the keys, the report's
+    words (opnav.report.approach.text.p1_words) are the page's. Every estimator of a variant is in
+    the summary under its key, the peer's runs under ukf_<run>."""
+    from types import SimpleNamespace
+
+    from opnav.report.approach import text as words
+
+    rng = np.random.default_rng(0)
+    truth = np.array([10.0, 20.0, 10.0])
+    th = truth + rng.normal(size=(3, 3))
+    bounds = SimpleNamespace(crlb_total_arcsec=np.ones(3), crlb_total_q0_arcsec=np.ones(3),
+                             crlb_arcsec=np.ones(3), crlb_q0_arcsec=np.ones(3))
+    em = [SimpleNamespace(variant="roll", case_id="T1-01", method="plain", truth_arcsec=truth, theta_final_arcsec=th,
+                          bounds=bounds)]
+    aug = SimpleNamespace(theta_final_arcsec=th, sigma_final_arcsec=np.ones((3, 3)))
+    alt = [SimpleNamespace(variant="roll", case_id="T1-01", truth_arcsec=truth, methods=lambda: iter([("augmented", aug)]))]
+    run = SimpleNamespace(truth_arcsec=truth, theta_final_arcsec=th[:, :2], sigma3_final_arcsec=np.full((3, 2), 5.0),
+                          crlb_peer_arcsec=np.ones(3), crlb_peer_q0_arcsec=np.ones(3), pos_err_final_km=np.ones(3),
+                          truth_bias_px=np.array([1.0, 2.0]), theta_first_update_arcsec=th[:, :2],
+                          bias_changes_after_first=np.array([0, 1, 0]), bias_quantum_arcsec=7.0)
+    peer = [peers.PeerVariant(variant="roll", two_body=None, runs={name: run for name, _, _ in peers.RUNS})]
+    table = peers.comparison_frame(peer, em, alt)
+    assert list(table["estimator"]) == ["em_plain", "augmented"] + [peers.PEER] * 3
+    assert list(table["run"]) == ["headline", "headline", "headline", "bias_free", "truth_start"]
+    summ = peers.summary(table, peer)
+    assert set(summ.variants["roll"].estimators) == {"em_plain", "augmented", "ukf_headline", "ukf_bias_free",
+                                                      "ukf_truth_start"}
+    page = words.p1_words(table)
+    assert list(page["estimator"]) == ["EM-EKF (plain)", "augmented EKF"] + ["Basilisk pixelLineBiasUKF"] * 3
+    assert list(page["run"])[-2:] == ["zero misalignment (sanity)", "prior mean at the truth (diagnostic)"]

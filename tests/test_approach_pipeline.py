@@ -11,6 +11,7 @@ from opnav.approach import cases, labels, pipeline, summaries
 from opnav.approach import scenario as sc
 from opnav.approach.setup import Setup
 from opnav.report import approach_text
+from opnav.report.approach import text as words
 
 from approach_helpers import approach_cfg, approach_setup
 
@@ -68,15 +69,18 @@ def test_verdict_text_comes_from_the_numbers(small):
     curves = {v: pipeline.bound_curve(cfg, g, sc.measurement_variance(g, cfg, case.sigma3_px),
                                       case.truth_arcsec, v) for v, g in geo.items()}
     x1 = summaries.crlb_rows(cfg, curves, {}, t1, TARGET)
+    # one window's bound is the sliding headline row's (t1.mode, a DataFrame method, once read none)
+    lit_row = t1[(t1["scenario"] == "literal") & (t1["case_id"] == "T1-01") & (t1["mode"] == "sliding")].iloc[0]
+    assert x1[x1.variant == "literal"].iloc[0]["crlb_x_window_arcsec"] == lit_row["crlb_x_arcsec"]
     text = approach_text.identifiability_text(cfg, x1, TARGET)
     lit = x1[x1.variant == "literal"].iloc[0]
     assert not lit["bound_reaches_target"]
     assert "**literal**" in text and "CANNOT support 2 arcsec" in text
     assert f"{lit['crlb_x_total_arcsec']:.2f}" in text
     summ = summaries.summary(cfg, t1, x1, TARGET)
-    assert summ["accuracy_target_arcsec"] == TARGET == 2.0  # the plan's A-C1 target
-    assert set(summ["variants"]) == {"literal", "reference-start+squarem"}
-    assert np.isfinite(summ["variants"]["literal"]["crlb_x_arcsec"])
+    assert summ.accuracy_target_arcsec == TARGET == 2.0  # the plan's A-C1 target
+    assert set(summ.variants) == {"literal", "reference-start+squarem"}
+    assert np.isfinite(summ.variants["literal"].crlb_x_arcsec)
 
 
 def _summary_row(scenario, est, bound, label, dist=0.0, rate=0.2):
@@ -86,8 +90,8 @@ def _summary_row(scenario, est, bound, label, dist=0.0, rate=0.2):
             "crlb_all_x_arcsec": bound, "label": label, "stalled": label == "stalled",
             "stalled_seeds": 4 if label == "stalled" else 0, "n_seeds": 4, "dist_to_ml_arcsec": dist,
             "data_to_converge_samples": 250.0,
-            "reading": labels.reading_text(label, counts, 4, bound, 2.0, dist, rate,
-                                           labels.bound_cause(sc.START_OF[scenario], "sliding", 50))}
+            "reading": words.reading_text(label, counts, 4, bound, 2.0, dist, rate,
+                                          words.bound_cause(sc.START_OF[scenario], "sliding", 50))}
 
 
 @pytest.mark.parametrize("lit_bound, roll_stalled", [(20.6, True), (1.0, False)])
@@ -123,7 +127,7 @@ def test_chi2_band_is_scipy_stats_chi2_bit_for_bit(dof, n_runs, p):
     # than importing scipy.stats (0.4 CPU-s a figure job): scipy.stats.chi2.ppf's bits
     from scipy.stats import chi2
 
-    from opnav.approach.plots import chi2_band
+    from opnav.report.approach.plots import chi2_band
 
     a = (1.0 - p) / 2.0
     ref = (chi2.ppf(a, dof * n_runs) / n_runs, chi2.ppf(1.0 - a, dof * n_runs) / n_runs)

@@ -6,6 +6,7 @@ import numpy as np
 
 from opnav.approach import camera, readings
 from opnav.core import published
+from opnav.report.approach import text as words
 
 from approach_helpers import approach_cfg, approach_setup
 from opnav.approach.setup import Setup
@@ -16,10 +17,11 @@ def test_installation_cancels_from_the_measurement_by_construction():
     installation angle (rounding only). Mutation tried: a body attitude that ignores the
     installation (A_b^i = A_c^i) changes the data by ~1 and fails."""
     chk = readings.installation_check(approach_setup(), [0.0, 45.0, 90.0, 135.0, 180.0], (10.0, 20.0, 10.0), n=20)
-    assert chk["by_construction"] and chk["max_rel_change"] < 1e-12
+    assert chk.by_construction and chk.max_rel_change < 1e-12
     # a body-frame deviation would not cancel: ty takes tz's value at 90 deg (rot_x(90) (tx, ty, tz))
-    np.testing.assert_allclose(chk["body_frame_theta_cam_arcsec"][2], camera.rot_x(np.pi / 2) @ [10.0, 20.0, 10.0])
-    assert "by construction" in readings.installation_text(chk)
+    np.testing.assert_allclose(chk.body_frame_theta_cam_arcsec[2], camera.rot_x(np.pi / 2) @ [10.0, 20.0, 10.0])
+    assert "by construction" in words.installation_text(chk)
+    assert "cancels" in words.installation_why(chk)
 
 
 def test_sample_time_reading_puts_both_steps_side_by_side():
@@ -28,12 +30,12 @@ def test_sample_time_reading_puts_both_steps_side_by_side():
     cfg = approach_setup(N0=200, N=50, L=5)
     pa = published.paper_a()
     st = readings.sample_time_reading(cfg, pa["headline"], pa["simulation"])
-    assert st["dt_s"]["paper_4_min"] == 240.0 / 250
-    assert st["dt_s"]["config"] == cfg.dt_s
-    assert abs(st["minutes_for_samples"]["paper_4_min"] - 4.0) < 1e-12
-    b = st["bound_after_samples_arcsec"]["roll"]
-    assert b["paper_4_min"] < b["config"]
-    assert "0.96 s a sample" in readings.sample_time_text(st)
+    assert st.dt_s.paper_4_min == 240.0 / 250
+    assert st.dt_s.config == cfg.dt_s
+    assert abs(st.minutes_for_samples.paper_4_min - 4.0) < 1e-12
+    b = st.bound_after_samples_arcsec["roll"]
+    assert b.paper_4_min < b.config
+    assert "0.96 s a sample" in words.sample_time_text(st)
 
 
 def test_study_estimator_growing_squarem_converges_where_sliding_plain_stalls():
@@ -71,6 +73,13 @@ def _star_row(sweep, value, bound, per_image=10, att=5.0):
                     attitude_threshold_arcsec=5.38)
 
 
+def doc(record):
+    """A record as A-summary.json holds it (what the report reads back)."""
+    from opnav.core.tables import json_ready
+
+    return json_ready(record, nan_as_none=False)
+
+
 def test_stars_text_reads_the_objection_from_the_numbers():
     """The manuscript's answer to paper A's objection comes from the study's numbers: the
     threshold, and whether more stars lowered the bound (a gain or none, as measured)."""
@@ -79,13 +88,13 @@ def test_stars_text_reads_the_objection_from_the_numbers():
 
     rows = [_star_row("per_image", 3, 1.9, per_image=3), _star_row("per_image", 30, 1.9, per_image=30),
             _star_row("attitude_sigma_arcsec", 0.0, 1.07, att=0.0), _star_row("attitude_sigma_arcsec", 20.0, 6.1, att=20.0)]
-    st = summaries.stars_summary(rows, 2.0)
+    st = doc(summaries.stars_summary(rows, 2.0))
     assert set(st) == {"m3", "m30", "att0", "att20", "objection"}
     txt = approach_text.stars_text(st, 2.0)
     assert "better than 5.38 arcsec" in txt and "(unchanged)" in txt and "From 3 to 30 stars per image" in txt
     assert "3 stars in every image (to magnitude 8 in a 2.84 deg field)" in txt
     assert "30 stars in every image (to magnitude 8 in a 6 deg field, widened from the camera's 2.84 deg)" in txt
     rows[1] = _star_row("per_image", 30, 0.95, per_image=30)
-    assert "(50 % lower)" in approach_text.stars_text(summaries.stars_summary(rows, 2.0), 2.0)
+    assert "(50 % lower)" in approach_text.stars_text(doc(summaries.stars_summary(rows, 2.0)), 2.0)
     rows = [replace(r, attitude_threshold_arcsec=0.0) for r in rows]
-    assert "does not answer" in approach_text.stars_text(summaries.stars_summary(rows, 2.0), 2.0)
+    assert "does not answer" in approach_text.stars_text(doc(summaries.stars_summary(rows, 2.0)), 2.0)

@@ -10,7 +10,6 @@ import pytest
 from test_approach_pipeline import TARGET, _summary_row, approach_setup
 
 from opnav.approach.alternatives_summary import (
-    METHOD_LABELS,
     method_summaries,
     summary_json,
 )
@@ -18,6 +17,7 @@ from opnav.approach.summaries import HeadlineSummary
 from opnav.core import published
 from opnav.report import approach_text
 from opnav.report.approach_scorecard import rows_paper_a
+from opnav.report.approach.text import METHOD_LABELS
 from opnav.report.approach_views import x2_table
 
 
@@ -77,5 +77,5 @@ def test_a_x2_per_method_numbers_and_the_reports_table():
     assert list(table["method"]) == [METHOD_LABELS["em_plain"], METHOD_LABELS["augmented"]]
     assert table.loc[0, "T1-01 err_x sd"] == 0.5 and table.loc[0, "T1-01 err_x mean"] == 1.0
     summ = summary_json(long, ms, approach_setup())
-    assert summ["variants"]["literal"]["em_plain"]["rmse_xy_all_cases_arcsec"] == em.rmse_xy_all_arcsec
-    assert np.isnan(summ["variants"]["literal"]["augmented"]["err_x_mean_arcsec"])
+    assert summ.variants["literal"]["em_plain"].rmse_xy_all_cases_arcsec == em.rmse_xy_all_arcsec
+    assert np.isnan(summ.variants["literal"]["augmented"].err_x_mean_arcsec)

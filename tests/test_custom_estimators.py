@@ -142,7 +142,7 @@ def test_the_table_and_curves(scored):
     assert row["err_over_bound_x"] == pytest.approx(np.sqrt(np.mean(err ** 2)) / r["bound_seg_arcsec"][-1, 0])
     assert row["sigma_x_mean_arcsec"] == pytest.approx(e["sigma_final_arcsec"][:, 0].mean())
     c = ES.curves(scored)["prior"]
-    assert c["estimators"]["batch_ls"].shape == (3, len(c["data"]), 3)
+    assert c.estimators["batch_ls"].shape == (3, len(c.data), 3)
 
 
 def test_a_failure_in_a_run_names_estimator_variant_case_seed_and_window(approach, tmp_path):

@@ -62,12 +62,12 @@ def _x1():
                                   for m in ("plain", "squarem")}) for v in curves}
     x1 = pd.DataFrame([{"variant": v, "total_samples": 2000, "em_plain_rmse_x_arcsec": 20.0 if v != "roll" else 1.0,
                         "mle_samples": 2000, "mle_rmse_x_arcsec": 18.0 if v != "roll" else 0.5} for v in curves])
-    from opnav.approach import plots
+    from opnav.report.approach import plots
     return plots.fig_crlb(curves, conv, x1, 2.0, 200)
 
 
 def _approach(name):
-    from opnav.approach import plots
+    from opnav.report.approach import plots
     runs = _approach_runs()
     return {"A-F4": lambda: plots.fig_bias_estimate(runs, "roll", PUB_A, 50, 5),
             "A-F5": lambda: plots.fig_nav_accuracy(runs, "roll"),

@@ -8,8 +8,8 @@ from matplotlib.colors import to_rgba
 
 from opnav.core import figures
 from opnav.report import study_plots
-from opnav.approach import plots as aplots
-from opnav.approach.alternatives_summary import METHOD_LABELS
+from opnav.report.approach import plots as aplots
+from opnav.report.approach.text import METHOD_LABELS
 from opnav.core.config import load_config
 from opnav.landing import plots as lplots
 from opnav.landing.planner import available_methods

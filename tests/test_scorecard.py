@@ -130,7 +130,7 @@ def test_rows_paper_b_per_scenario_from_the_summary():
 def test_a_stalled_em_row_says_so_in_the_reason_and_never_converged():
     import pandas as pd
 
-    from opnav.approach.labels import reading_text
+    from opnav.report.approach.text import reading_text
     from opnav.approach.summaries import HeadlineSummary
     from opnav.report.approach_scorecard import rows_paper_a
 

@@ -182,7 +182,7 @@ rule approach_stars_outputs:
     input:
         stars=f"{A_WORK}/stars.pkl",
         plan=A_PLAN,
-        code=src("approach/summaries.py", "approach/labels.py", "approach/star_plots.py", "core/figures.py", "core/tables.py",
+        code=src("approach/summaries.py", "approach/labels.py", "report/approach/star_plots.py", "core/figures.py", "core/tables.py",
                  "opnav.mplstyle"),
     output:
         table=report_table(f"{APPROACH}/A-X6_stars", "A-X6", "Paper A"),
@@ -206,6 +206,7 @@ rule approach_tables:
         nav_arc=f"{A_WORK}/nav_arc.pkl",
         plan=A_PLAN,
         code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
+                 "report/approach/text.py",
                  "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{APPROACH}/A-T1_table1", "A-T1", "Paper A"),
@@ -248,7 +249,8 @@ rule approach_nav_arc_outputs:
     input:
         nav_arc=f"{A_WORK}/nav_arc.pkl",
         plan=src("data/analysis_plan.yaml")[0],
-        code=src("approach/summaries.py", "approach/plots.py", "core/figures.py", "core/tables.py", "opnav.mplstyle",
+        code=src("approach/summaries.py", "report/approach/plots.py", "report/approach/text.py", "core/figures.py",
+                 "core/tables.py", "opnav.mplstyle",
                  "report/plan.py"),
     output:
         table=report_table(f"{APPROACH}/A-X7_nav_floor", "A-X7", "Paper A"),
@@ -270,7 +272,7 @@ rule approach_figures:
     job's Python, matplotlib and pickles (about 0.65 CPU-s a job, measured)."""
     input:
         **{f"mc_{v}": a_headline_mc_of(v) for v in A_VARIANTS},
-        code=src("approach/plots.py", "core/figures.py", "opnav.mplstyle", "data/published.yaml"),
+        code=src("report/approach/plots.py", "core/figures.py", "opnav.mplstyle", "data/published.yaml"),
     output:
         **{f"{key}_{v}": report_figure(f"{APPROACH}/{fid}_{name}_{v}", fid, "Paper A", v)
            for v in A_VARIANTS for key, (fid, name) in A_FIGURES.items()},
@@ -291,7 +293,7 @@ rule approach_x1_figure:
         conv=expand(f"{A_WORK}/conv/{{variant}}.pkl", variant=A_VARIANTS),
         x1=f"{APPROACH}/A-X1_crlb.csv",
         plan=A_PLAN,
-        code=src("approach/plots.py", "core/figures.py", "opnav.mplstyle"),
+        code=src("report/approach/plots.py", "core/figures.py", "opnav.mplstyle"),
     output:
         fig=report_figure(f"{APPROACH}/A-X1_crlb", "A-X1", "Paper A"),
     params:

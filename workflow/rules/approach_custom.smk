@@ -33,7 +33,7 @@ rule approach_custom_outputs:
     (headline case)."""
     input:
         runs=expand(f"{A_WORK}/custom/{{variant}}.pkl", variant=A_CUSTOM_VARIANTS),
-        code=src("approach/estimator_summary.py", "approach/estimator_plots.py", "approach/summaries.py",
+        code=src("approach/estimator_summary.py", "report/approach/estimator_plots.py", "approach/summaries.py",
                  "core/tables.py", "core/figures.py", "opnav.mplstyle"),
     output:
         table=report_table(f"{APPROACH}/A-X8_custom_estimators", "A-X8", "Paper A"),

@@ -36,7 +36,7 @@ rule approach_x2_tables:
     input:
         x2=list(A_X2.values()),
         mc=[A_MC[(v, g, m)] for v in A_X2_VARIANTS for g in a_groups(v) for m in A_METHODS],
-        code=src("approach/alternatives_summary.py", "approach/labels.py", "approach/summaries.py", "approach/setup.py",
+        code=src("approach/alternatives_summary.py", "report/approach/text.py", "approach/labels.py", "approach/summaries.py", "approach/setup.py",
                  "core/tables.py", "report/approach_views.py"),
     output:
         table=report_table(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
@@ -56,7 +56,7 @@ rule approach_x2_figure:
     """A-X2 figure: error, spread and CRLB, navigation error, data needed and run time per method."""
     input:
         long=f"{A_WORK}/x2/A-X2_alternatives_cases.csv",
-        code=src("approach/plots.py", "approach/alternatives_summary.py", "core/figures.py", "opnav.mplstyle"),
+        code=src("report/approach/plots.py", "approach/alternatives_summary.py", "core/figures.py", "opnav.mplstyle"),
     output:
         fig=report_figure(f"{APPROACH}/A-X2_alternatives", "A-X2", "Paper A"),
     log:

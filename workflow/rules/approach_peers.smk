@@ -38,7 +38,7 @@ if HAVE_BSK:
             peer=expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
             mc=[A_MC[(v, a_groups(v)[0], m)] for v in A_P1_VARIANTS for m in A_METHODS],
             x2=[A_X2[v] for v in A_P1_VARIANTS],
-            code=src("approach/peers.py", "approach/alternatives_summary.py", "core/tables.py"),
+            code=src("approach/peers.py", "report/approach/text.py", "core/tables.py"),
         output:
             table=report_table(f"{APPROACH}/A-P1_peer_ukf", "A-P1", "Paper A"),
             long=f"{A_WORK}/peers/A-P1_seeds.csv",
@@ -54,7 +54,7 @@ if HAVE_BSK:
         input:
             peer=expand(f"{A_WORK}/peers/{{variant}}.pkl", variant=A_P1_VARIANTS),
             table=f"{APPROACH}/A-P1_peer_ukf.csv",
-            code=src("approach/peer_plots.py", "core/figures.py", "opnav.mplstyle"),
+            code=src("report/approach/peer_plots.py", "report/approach/text.py", "core/figures.py", "opnav.mplstyle"),
         output:
             fig=report_figure(f"{APPROACH}/A-P1_peer_ukf", "A-P1", "Paper A"),
         log:

@@ -56,6 +56,7 @@ if REP_CFG["enabled"]:
             stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
             plan=A_PLAN,
             code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
+                     "report/approach/text.py",
                      "approach/setup.py", "core/tables.py"),
         output:
             t1=table_outputs(f"{REP}/approach/A-T1_table1"),

@@ -33,13 +33,13 @@ with script_context(snakemake) as log:
         target = snakemake.params.target  # A-C1's target (the analysis plan)
         curves["roll_rate"] = roll_rate_study(setup, samples, target)
         log.info("roll rate reaching %g arcsec in %d samples: %s deg/s", target, samples,
-                 curves["roll_rate"]["rate_to_target_deg_s"])
+                 curves["roll_rate"].rate_to_target_deg_s)
     # two of the paper's statements read against the model (opnav.approach.readings)
     pa = published.paper_a()
     installs = [c.install_deg for c in table1_cases(setup) if c.group == "install"]
     curves["readings"] = {"installation": readings.installation_check(setup, installs, case.truth_arcsec),
                           "sample_time": readings.sample_time_reading(setup, pa["headline"], pa["simulation"])}
-    log.info("installation by construction: %s; sample time: %s", curves["readings"]["installation"]["by_construction"],
-             curves["readings"]["sample_time"]["bound_after_samples_arcsec"])
+    log.info("installation by construction: %s; sample time: %s", curves["readings"]["installation"].by_construction,
+             curves["readings"]["sample_time"].bound_after_samples_arcsec)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], curves)

@@ -3,7 +3,8 @@ truth and the bound of the data used) and convergence figure (headline case)."""
 
 import sys
 
-from opnav.approach import estimator_plots, estimator_summary
+from opnav.approach import estimator_summary
+from opnav.report.approach import estimator_plots
 from opnav.approach.estimators import colors
 from opnav.core import figures
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context

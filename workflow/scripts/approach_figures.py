@@ -4,7 +4,7 @@
 import sys
 
 from opnav.core import figures, published
-from opnav.approach import plots
+from opnav.report.approach import plots
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)

@@ -16,10 +16,9 @@ with script_context(snakemake) as log:
     nf = setup.nav_floor
     out = {"nav_floor_by_arc": navfloor.nav_floor_by_arc(setup, nf.variant, nf.scheme, nf.arcs_s, log=log),
            "tz_nav_effect": navfloor.tz_nav_effect(setup, nf.variant)}
-    for r in out["nav_floor_by_arc"]["rows"]:
-        log.info("arc %g s: after %.3g km (last %.3g), true theta %.3g km (last %.3g)", r["arc_s"], r["nav_err_km_rule"],
-                 r["nav_err_km_last"], r["true_theta_km_rule"], r["true_theta_km_last"])
-    log.info("tz on %.5g km, off %.5g km", out["tz_nav_effect"]["nav_err_km_tz_on"],
-             out["tz_nav_effect"]["nav_err_km_tz_off"])
+    for r in out["nav_floor_by_arc"].rows:
+        log.info("arc %g s: after %.3g km (last %.3g), true theta %.3g km (last %.3g)", r.arc_s, r.nav_err_km_rule,
+                 r.nav_err_km_last, r.true_theta_km_rule, r.true_theta_km_last)
+    log.info("tz on %.5g km, off %.5g km", out["tz_nav_effect"].nav_err_km_tz_on, out["tz_nav_effect"].nav_err_km_tz_off)
     Path(snakemake.output[0]).parent.mkdir(parents=True, exist_ok=True)
     save_pickle(snakemake.output[0], out)

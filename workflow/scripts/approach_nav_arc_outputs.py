@@ -2,7 +2,9 @@
 
 import sys
 
-from opnav.approach import plots, summaries
+from opnav.approach import summaries
+from opnav.report.approach import plots
+from opnav.report.approach import text as words
 from opnav.core import figures
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import write_table
@@ -15,7 +17,7 @@ with script_context(snakemake) as log:
     nf = load_pickle(snakemake.input.nav_arc)["nav_floor_by_arc"]
     frame = summaries.nav_floor_frame(nf)
     write_table(frame, snakemake.output.table,
-                caption=f"A-X7: navigation error against arc length ({nf['rule']}), km.")
+                caption=f"A-X7: navigation error against arc length ({words.nav_floor_rule(nf.variant, nf.n_seeds, nf.last_fraction)}), km.")
     limit = load_plan(snakemake.input.plan).margin("A-C7", "limit_km")  # the paper's limit (read only)
     figures.save(plots.fig_nav_floor(nf, limit), snakemake.output.fig)
     log.info("A-X7: %d arcs", len(frame))

@@ -4,7 +4,7 @@ import sys
 
 
 from opnav.core import figures
-from opnav.approach import peer_plots
+from opnav.report.approach import peer_plots
 from opnav.core.snakeio import load_pickle, load_table, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)

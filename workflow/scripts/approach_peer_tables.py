@@ -5,6 +5,7 @@ import sys
 from opnav.approach import peers
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
+from opnav.report.approach import text as words
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("approach_peer_tables", argv=sys.argv[1:])
@@ -20,8 +21,8 @@ def load(paths):
 
 with script_context(snakemake) as log:
     peer = load(snakemake.input.peer)
-    table = peers.comparison_frame(peer, load(snakemake.input.mc), load(snakemake.input.x2))
-    write_table(table, snakemake.output.table,
+    table = peers.comparison_frame(peer, load(snakemake.input.mc), load(snakemake.input.x2))  # keys
+    write_table(words.p1_words(table), snakemake.output.table,
                 caption="A-P1: Basilisk's pixelLineBiasUKF on paper A's measurements beside the EM-EKF, "
                         "the augmented EKF, batch ML and the Cramer-Rao bound (headline case; arcsec; "
                         "mean and sd over seeds, own 3-sigma: median of the estimator's covariance).")

@@ -4,7 +4,8 @@ and stars per image."""
 import sys
 
 from opnav.core import figures
-from opnav.approach import star_plots, summaries
+from opnav.approach import summaries
+from opnav.report.approach import star_plots
 from opnav.core.snakeio import load_pickle, mock_snakemake, script_context
 from opnav.core.tables import write_table
 

@@ -4,7 +4,7 @@ import sys
 
 
 from opnav.core import figures
-from opnav.approach import plots
+from opnav.report.approach import plots
 from opnav.approach.setup import Setup
 from opnav.core.snakeio import load_pickle, load_table, mock_snakemake, script_context
 

@@ -4,8 +4,8 @@ import sys
 
 
 from opnav.core import figures
-from opnav.approach import plots
-from opnav.approach.alternatives_summary import METHOD_LABELS
+from opnav.report.approach import plots
+from opnav.report.approach.text import METHOD_LABELS
 from opnav.core.snakeio import load_table, mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)

@@ -46,12 +46,17 @@ issue 54   navigation error against arc length; tz on and off          navfloor.
 Layers
     ``setup`` (the config parsed once, frozen) -> ``dynamics``, ``camera``, ``kalman`` ->
     ``ekf``, ``smoother``, ``augmented``, ``crlb``, ``em``, ``batch_ml``, ``consider`` ->
-    ``scenario``, ``labels`` (a run's convergence label and reading), ``cases`` -> ``pipeline``,
+    ``scenario``, ``labels`` (a run's convergence label), ``cases`` -> ``pipeline``,
     ``alternatives``, ``study``, ``peers``, ``readings``, ``navfloor`` -> ``summaries``, ``alternatives_summary``
-    (the tables' numbers, A-summary.json; the frozen ``HeadlineSummary``, ``ClaimsSummary`` and
-    ``MethodSummary`` the report reads), ``plots``, ``peer_plots``, ``star_plots``; ``cli`` at
-    the edge. The tables' page views, the scorecard rows and the prose made from the numbers are
-    in the report layer (``opnav.report.approach_views``, ``approach_scorecard``, ``approach_text``).
+    (the tables' numbers, A-summary.json's typed records; the frozen ``HeadlineSummary``,
+    ``ClaimsSummary`` and ``MethodSummary`` the report reads); ``cli`` at the edge. Every engine
+    returns typed records (``cases.CaseRun``, ``ConvergenceStudy``, ``alternatives.AltRun``,
+    ``StarsRow``, ``peers.PeerVariant``, ``navfloor.NavFloor`` ...); dicts only at the workflow
+    scripts' edge (JSON, pickles). The package draws and words nothing (issue 56 item 2,
+    ``tests/test_layers_presentation.py``): the figures, the readings and sentences, the methods'
+    and runs' words are in the report layer (``opnav.report.approach``: ``plots``, ``star_plots``,
+    ``peer_plots``, ``estimator_plots``, ``text``; ``opnav.report.approach_views``,
+    ``approach_scorecard``, ``approach_text``).
 """
 
 from opnav.core.compiled import register_kernel_modules as _register_kernel_modules

@@ -10,10 +10,13 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
+
+from opnav.core.tables import OMIT_NONE
 
 from . import scenario as sc
 from .alternatives import AltRun, BatchMLResult
@@ -22,16 +25,13 @@ from .labels import row_label
 from .setup import Setup
 from .summaries import seed_sd
 
-METHOD_LABELS = {
-    "em_plain": "EM-EKF (plain)",
-    "em_squarem": "EM-EKF (SQUAREM)",
-    "augmented": "augmented EKF",
-    "batch_ml": "batch ML (IPOPT)",
-}
+#: A-X2's methods, in the table's order (their words: opnav.report.approach.text.METHOD_LABELS)
+METHODS = ("em_plain", "em_squarem", "augmented", "batch_ml")
 
 
 def long_frame(alt_results: list[AltRun], em_results: list[CaseRun], em_times: dict) -> pd.DataFrame:
-    """One row per variant x method x case: error, spread, CRLB, nav error, data, run time.
+    """One row per variant x method x case: error, spread, CRLB, nav error, data, run time (the
+    methods' words, column ``method_label``, are the report's: :func:`opnav.report.approach.text.with_method_labels`).
 
     ``em_results``: the EM-EKF Monte-Carlo runs (:func:`opnav.approach.pipeline.run_group`);
     ``em_times``: {variant: {"em_plain": s, ...}} measured on the headline case.
@@ -48,7 +48,7 @@ def long_frame(alt_results: list[AltRun], em_results: list[CaseRun], em_times: d
         cb = crlb.get(key, nan3) if used is None else used
         cb0 = crlb0.get(key, nan3) if used_q0 is None else used_q0
         row = {
-            "variant": variant, "method": method, "method_label": METHOD_LABELS[method],
+            "variant": variant, "method": method,
             "group": case.group, "case_id": case.case_id,
             "truth_x_arcsec": truth[0], "truth_y_arcsec": truth[1],
             "n_seeds": th.shape[0],
@@ -71,7 +71,7 @@ def long_frame(alt_results: list[AltRun], em_results: list[CaseRun], em_times: d
         if r.mode != "sliding":
             continue
         m = f"em_{r.method}"
-        if m not in METHOD_LABELS:
+        if m not in METHODS:
             continue
         rt = em_times.get(r.variant, {}).get(m, math.nan) if r.case_id == "T1-01" else math.nan
         add(r.variant, r.case, m, np.asarray(r.truth_arcsec, float), r.theta_final_arcsec,
@@ -94,14 +94,14 @@ def long_frame(alt_results: list[AltRun], em_results: list[CaseRun], em_times: d
                 d.nav_err_after_km, d.data_to_converge, d.runtime_s_per_seed, extra)
     df = pd.DataFrame(rows)
     vorder = {v: i for i, v in enumerate(sc.VARIANTS)}
-    morder = {m: i for i, m in enumerate(METHOD_LABELS)}
+    morder = {m: i for i, m in enumerate(METHODS)}
     df = df.assign(_v=df["variant"].map(vorder), _m=df["method"].map(morder))
     return df.sort_values(["_v", "_m", "case_id"], kind="stable").drop(columns=["_v", "_m"]).reset_index(drop=True)
 
 
 @dataclass(frozen=True)
 class MethodSummary:
-    """A-X2 for one variant and method (a key of :data:`METHOD_LABELS`), by meaning (issue 41
+    """A-X2 for one variant and method (one of :data:`METHODS`), by meaning (issue 41
     item 4): the headline case (T1-01; NaN, label '' without it) and the all-case aggregates.
     The page's column names and method labels are the report's
     (:func:`opnav.report.approach_views.x2_table`).
@@ -166,27 +166,60 @@ def method_summaries(long: pd.DataFrame) -> tuple[MethodSummary, ...]:
     return tuple(out)
 
 
-def summary_json(long: pd.DataFrame, rows: Sequence[MethodSummary], setup: Setup) -> dict:
+@dataclass(frozen=True)
+class X2Head:
+    """One variant and method of A-X2-summary.json: the headline case's error (seed mean and sd),
+    bounds, label, navigation error, data to converge and run time, and the RMS error over every
+    case (:class:`MethodSummary`'s fields under the summary's names)."""
+
+    err_x_mean_arcsec: float
+    err_x_sd_arcsec: float
+    err_y_mean_arcsec: float
+    err_y_sd_arcsec: float
+    crlb_x_arcsec: float
+    crlb_q0_x_arcsec: float
+    crlb_all_x_arcsec: float
+    label: str
+    rmse_xy_all_cases_arcsec: float
+    nav_err_after_km: float
+    data_to_converge_samples: float
+    runtime_s_per_seed: float
+
+
+@dataclass(frozen=True)
+class X2Summary:
+    """A-X2-summary.json (:func:`summary_json`): the segments and alternatives' settings, per
+    variant and method its :class:`X2Head`, the EM's navigation error before compensation per
+    variant (headline case), batch ML's largest gradient norm and whether IPOPT succeeded
+    everywhere (None: not run, left out), and the build's profile (set by the workflow)."""
+
+    segments: Any
+    alternatives: Any
+    variants: dict[str, dict[str, X2Head]]
+    nav_err_before_km: dict[str, float] | None = field(default=None, metadata=OMIT_NONE)
+    batch_ml_max_grad_norm: float | None = field(default=None, metadata=OMIT_NONE)
+    batch_ml_all_success: bool | None = field(default=None, metadata=OMIT_NONE)
+    profile: str | None = field(default=None, metadata=OMIT_NONE)
+
+
+def summary_json(long: pd.DataFrame, rows: Sequence[MethodSummary], setup: Setup) -> X2Summary:
     """Headline numbers per variant and method for the manuscript macros (A-X2-summary.json);
     ``rows``: :func:`method_summaries` of ``long``."""
-    out = {"segments": setup.segments.as_dict(), "alternatives": setup.alternatives.as_dict(), "variants": {}}
+    variants: dict[str, dict[str, X2Head]] = {}
     for r in rows:
-        out["variants"].setdefault(r.variant, {})[r.method] = {
-            "err_x_mean_arcsec": r.head_err_x_mean_arcsec, "err_x_sd_arcsec": r.head_err_x_sd_arcsec,
-            "err_y_mean_arcsec": r.head_err_y_mean_arcsec, "err_y_sd_arcsec": r.head_err_y_sd_arcsec,
-            "crlb_x_arcsec": r.head_crlb_x_arcsec, "crlb_q0_x_arcsec": r.head_crlb_q0_x_arcsec,
-            "crlb_all_x_arcsec": r.head_crlb_all_x_arcsec, "label": r.head_label,
-            "rmse_xy_all_cases_arcsec": r.rmse_xy_all_arcsec,
-            "nav_err_after_km": r.head_nav_err_after_km,
-            "data_to_converge_samples": r.head_data_to_converge_samples,
-            "runtime_s_per_seed": r.head_runtime_s_per_seed,
-        }
+        variants.setdefault(r.variant, {})[r.method] = X2Head(
+            err_x_mean_arcsec=r.head_err_x_mean_arcsec, err_x_sd_arcsec=r.head_err_x_sd_arcsec,
+            err_y_mean_arcsec=r.head_err_y_mean_arcsec, err_y_sd_arcsec=r.head_err_y_sd_arcsec,
+            crlb_x_arcsec=r.head_crlb_x_arcsec, crlb_q0_x_arcsec=r.head_crlb_q0_x_arcsec,
+            crlb_all_x_arcsec=r.head_crlb_all_x_arcsec, label=r.head_label,
+            rmse_xy_all_cases_arcsec=r.rmse_xy_all_arcsec, nav_err_after_km=r.head_nav_err_after_km,
+            data_to_converge_samples=r.head_data_to_converge_samples, runtime_s_per_seed=r.head_runtime_s_per_seed)
+    nav_before = None
     if "nav_err_before_km" in long:
-        nb = long[long["case_id"] == "T1-01"].dropna(subset=["nav_err_before_km"])
-        out["nav_err_before_km"] = {v: float(g["nav_err_before_km"].iloc[0])
-                                    for v, g in nb.groupby("variant", sort=False)}
-    ml = long[long["method"] == "batch_ml"]
-    if len(ml):
-        out["batch_ml_max_grad_norm"] = float(ml["ipopt_max_grad_norm"].max())
-        out["batch_ml_all_success"] = bool(ml["ipopt_all_success"].all())
-    return out
+        nb = long[long.case_id == "T1-01"].dropna(subset=["nav_err_before_km"])
+        nav_before = {v: float(g.nav_err_before_km.iloc[0]) for v, g in nb.groupby("variant", sort=False)}
+    ml = long[long.method == "batch_ml"]
+    return X2Summary(segments=setup.segments, alternatives=setup.alternatives, variants=variants,
+                     nav_err_before_km=nav_before,
+                     batch_ml_max_grad_norm=float(ml.ipopt_max_grad_norm.max()) if len(ml) else None,
+                     batch_ml_all_success=bool(ml.ipopt_all_success.all()) if len(ml) else None)

@@ -12,7 +12,7 @@ Units: arcsec, samples.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -87,7 +87,18 @@ def segment_bounds(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcse
     return segment_bounds_many(setup, geo, [(Rvar, theta_arcsec, zero_q)], variant)[0]
 
 
-def bound_data(setup: Setup, variant: str) -> dict:
+@dataclass(frozen=True)
+class BoundData:
+    """The samples a bound rests on (:func:`bound_data`): first and last (1-based after t0), how
+    many, and a phrase naming them (the CLI's)."""
+
+    first_sample: int
+    last_sample: int
+    n_samples: int
+    text: str
+
+
+def bound_data(setup: Setup, variant: str) -> BoundData:
     """The samples the last segment's bound (:func:`segment_bounds`) rests on: ``first`` and
     ``last`` sample indices (1-based after t0 = sample 0), whether the prior enters, and a
     phrase naming them. ``literal``: every sample from t0 (its window starts from the theta = 0
@@ -101,8 +112,8 @@ def bound_data(setup: Setup, variant: str) -> dict:
         first, why = s.N0 + 1, f"all data after N0 = {s.N0} (growing segments), {_start_phrase(variant)}"
     else:
         first, why = a + 1, f"the last sliding window, {_start_phrase(variant)}"
-    return {"first_sample": int(first), "last_sample": int(b), "n_samples": int(b - first + 1),
-            "text": f"samples {first}..{b} ({why})"}
+    return BoundData(first_sample=int(first), last_sample=int(b), n_samples=int(b - first + 1),
+                     text=f"samples {first}..{b} ({why})")
 
 
 def _start_phrase(variant: str) -> str:

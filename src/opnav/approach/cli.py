@@ -54,7 +54,9 @@ def run(args, rc) -> int:
     from . import scenario as sc
     from .cases import Case, run_case
     from .pipeline import bound_curve, bound_data, segment_bounds
-    from .labels import bound_cause, reading_text, row_label
+    from opnav.report.approach.text import bound_cause, reading_text  # the edge words its run (report layer)
+
+    from .labels import row_label
     from .setup import Setup
 
     config = rc.load(args)  # defaults + --config overlays + --set keys, validated
@@ -119,7 +121,7 @@ def run(args, rc) -> int:
                             "per_seed": th.round(4)},
         # the bound of the data the estimate used: the last window (sliding) or all data from N0 (growing)
         "crlb_arcsec": {"tx": float(bound[0]), "ty": float(bound[1]), "tz": tz or float(bound[2]),
-                        "data": bound_data(setup, args.variant)["text"]},
+                        "data": bound_data(setup, args.variant).text},
         # the same with Q = 0: the simulated truth carries no process noise
         "crlb_q0_arcsec": {"tx": float(bound0[0]), "ty": float(bound0[1]), "tz": tz or float(bound0[2])},
         "crlb_all_data_arcsec": {"tx": float(curve[used, 0]), "ty": float(curve[used, 1]), "data_samples": int(used),
@@ -136,7 +138,7 @@ def run(args, rc) -> int:
                   "distance_to_ml_arcsec": [float(v) for v in r.dist_to_ml_arcsec],
                   "distance_to_ml_over_bound": [float(v) for v in r.dist_to_ml_over_bound],
                   "rule": (f"converged if within {setup.em.converge_frac_of_bound:g} x the 1-sigma bound of the "
-                           f"data used ({bound_data(setup, args.variant)['text']}; tx and ty each) of that "
+                           f"data used ({bound_data(setup, args.variant).text}; tx and ty each) of that "
                            f"data's ML estimate; else stalled if the contraction per map toward it is >= "
                            f"{setup.em.stall_rate:g}, not converged otherwise")},
         "iterations": {"em_maps": int(r.theta_iter_arcsec.shape[1]),

@@ -14,6 +14,7 @@ Table 1's rule); the navigation error before and after compensation (mean over s
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -54,16 +55,29 @@ def long_frame(results: list[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def curves(results: list[dict], case_id: str = "T1-01") -> dict:
-    """The convergence curves of case ``case_id`` per variant: data used (samples after N0), the
-    truth (3,), the bound per window (L, 3) and per estimator its estimates (seeds, L, 3), arcsec."""
+@dataclass(frozen=True)
+class Curves:
+    """The convergence curves of one case and variant (:func:`curves`): data used (samples after
+    N0), the truth (3,), the bound per window (L, 3), and per estimator its estimates (seeds, L, 3;
+    arcsec) and its legend label."""
+
+    data: np.ndarray
+    truth: np.ndarray
+    bound: np.ndarray
+    estimators: dict[str, np.ndarray]
+    labels: dict[str, str]
+
+
+def curves(results: list[dict], case_id: str = "T1-01") -> dict[str, Curves]:
+    """:class:`Curves` of case ``case_id`` per variant, from the estimators' runs
+    (:func:`opnav.approach.estimators.run_case`)."""
     out = {}
     for r in results:
         if r["case_id"] != case_id:
             continue
-        out[r["variant"]] = {"data": np.asarray(r["seg_data_used"]), "truth": np.asarray(r["truth_arcsec"], float),
-                             "bound": np.asarray(r["bound_seg_arcsec"], float),
-                             "estimators": {n: np.asarray(e["theta_seg_arcsec"], float)
-                                            for n, e in r["estimators"].items()},
-                             "labels": {n: e["label"] for n, e in r["estimators"].items()}}
+        out[r["variant"]] = Curves(data=np.asarray(r["seg_data_used"]), truth=np.asarray(r["truth_arcsec"], float),
+                                   bound=np.asarray(r["bound_seg_arcsec"], float),
+                                   estimators={n: np.asarray(e["theta_seg_arcsec"], float)
+                                               for n, e in r["estimators"].items()},
+                                   labels={n: e["label"] for n, e in r["estimators"].items()})
     return out

@@ -24,9 +24,11 @@ Units: s, km, arcsec.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from opnav.core.tables import JSON_SKIP
 
 from . import cases
 from . import scenario as sc
@@ -73,12 +75,59 @@ def _scheme(scheme: str) -> tuple[str, str]:
     return mode, method
 
 
-def nav_floor_by_arc(setup: Setup, variant: str, scheme: str, arcs_s, log=None) -> dict:
-    """Navigation error against arc length (module docstring). Returns ``rule`` (the words),
-    ``variant`` (the A-T1 row label), ``rows`` (one per arc: ``arc_s``, ``variant``,
-    ``nav_err_km_rule``, ``nav_err_km_last``, ``true_theta_km_rule``, ``true_theta_km_last``,
-    ``before_km_rule``, ``before_km_last``, their medians and sds over seeds, the estimate's seed
-    mean (tx, ty) in arcsec, ``samples`` and ``n_seeds``) and the per-seed errors (``per_seed``)."""
+@dataclass(frozen=True)
+class NavFloorRow:
+    """One arc length of :func:`nav_floor_by_arc` (km; mean over seeds, with median and sd): the
+    compensated filter's error by the plan's rule (``nav_err_km_rule``, RMS over the last
+    ``nav_error.last_fraction`` of the arc) and at the arc's last sample (``*_last``), the same of
+    the filter given the true theta (``true_theta_km_*``: a filter's floor) and of the theta = 0
+    filter (``before_km_*``), and the estimate's seed mean (tx, ty), arcsec. The field order is
+    A-X7's columns (the first seven: the claims engineer's contract, issue 54)."""
+
+    arc_s: float
+    variant: str
+    nav_err_km_rule: float
+    nav_err_km_last: float
+    true_theta_km_rule: float
+    true_theta_km_last: float
+    n_seeds: int
+    samples: int
+    nav_err_km_rule_median: float
+    nav_err_km_rule_sd: float
+    nav_err_km_last_median: float
+    nav_err_km_last_sd: float
+    true_theta_km_rule_median: float
+    true_theta_km_rule_sd: float
+    true_theta_km_last_median: float
+    true_theta_km_last_sd: float
+    before_km_rule: float
+    before_km_rule_median: float
+    before_km_rule_sd: float
+    before_km_last: float
+    before_km_last_median: float
+    before_km_last_sd: float
+    est_x_mean_arcsec: float
+    est_y_mean_arcsec: float
+
+
+@dataclass(frozen=True)
+class NavFloor:
+    """:func:`nav_floor_by_arc`: the A-T1 row label of its scheme (``variant``), the scenario and
+    scheme, the headline case's seeds and the rule's fraction of the arc (``last_fraction``), one
+    :class:`NavFloorRow` per arc and the per-seed errors (``per_seed``: ``after_rule`` ... (S, arcs),
+    km). Its words (``rule``) are the report's."""
+
+    variant: str
+    scenario: str
+    scheme: str
+    n_seeds: int
+    last_fraction: float
+    rows: tuple[NavFloorRow, ...]
+    per_seed: dict[str, list] = field(default_factory=dict, repr=False)
+
+
+def nav_floor_by_arc(setup: Setup, variant: str, scheme: str, arcs_s, log=None) -> NavFloor:
+    """Navigation error against arc length (module docstring): one :class:`NavFloorRow` per arc."""
     mode, method = _scheme(scheme)
     ns = arc_samples(setup, arcs_s)
     nmax = max(ns)
@@ -114,43 +163,55 @@ def nav_floor_by_arc(setup: Setup, variant: str, scheme: str, arcs_s, log=None) 
     label = variant_label(variant, method, mode)
     rows = []
     for j, n in enumerate(ns):
-        row = {"arc_s": float(n * setup.dt_s), "variant": label, "samples": int(n), "n_seeds": len(seeds)}
+        stats = {}
         for k, name in (("after", "nav_err_km"), ("true", "true_theta_km"), ("before", "before_km")):
             for r in ("rule", "last"):
                 x = per[f"{k}_{r}"][:, j]
-                row[f"{name}_{r}"] = float(x.mean())
-                row[f"{name}_{r}_median"] = float(np.median(x))
-                row[f"{name}_{r}_sd"] = float(x.std(ddof=1)) if x.size > 1 else math.nan
-        row["est_x_mean_arcsec"], row["est_y_mean_arcsec"] = (float(v) for v in theta_arc[:, j, :2].mean(0))
-        rows.append(row)
-    rule = (f"{label}, headline case, {len(seeds)} seeds: position error |r_hat - r_true| of the filter compensated "
-            f"with the estimate of the data up to the arc's end, RMS over the last {frac:g} of the arc (the "
-            f"plan's rule, nav_error.last_fraction; *_rule) and at the arc's last sample (*_last), mean over seeds; "
-            f"true_theta: the filter given the true theta (a filter's floor); before: theta = 0")
-    return {"rule": rule, "variant": label, "scenario": variant, "scheme": scheme, "rows": rows,
-            "per_seed": {k: v.tolist() for k, v in per.items()}}
+                stats[f"{name}_{r}"] = float(x.mean())
+                stats[f"{name}_{r}_median"] = float(np.median(x))
+                stats[f"{name}_{r}_sd"] = float(x.std(ddof=1)) if x.size > 1 else math.nan
+        ex, ey = (float(v) for v in theta_arc[:, j, :2].mean(0))
+        rows.append(NavFloorRow(arc_s=float(n * setup.dt_s), variant=label, samples=int(n), n_seeds=len(seeds),
+                                est_x_mean_arcsec=ex, est_y_mean_arcsec=ey, **stats))
+    return NavFloor(variant=label, scenario=variant, scheme=scheme, n_seeds=len(seeds), last_fraction=frac,
+                    rows=tuple(rows), per_seed={k: v.tolist() for k, v in per.items()})
 
 
-def tz_nav_effect(setup: Setup, variant: str) -> dict:
+@dataclass(frozen=True)
+class TzNavEffect:
+    """:func:`tz_nav_effect`: the navigation error (km, seed means) with the headline case's tz and
+    with tz = 0, the paired difference's mean and sd (km), tz (arcsec), the seeds, the variant and
+    the rule's fraction of the arc; ``rule``: its words (the report's, :mod:`opnav.report.approach.text`)."""
+
+    nav_err_km_tz_on: float
+    nav_err_km_tz_off: float
+    diff_km_mean: float
+    diff_km_sd: float
+    tz_arcsec: float
+    n_seeds: int
+    variant: str
+    last_fraction: float = field(metadata=JSON_SKIP)
+    rule: str = ""
+
+
+def tz_nav_effect(setup: Setup, variant: str) -> TzNavEffect:
     """Navigation error with the headline case's tz bias on and off (module docstring): paired
     seeds, the filter given the true (tx, ty) and tz = 0, over the profile's arc by the plan's
-    rule. Returns ``nav_err_km_tz_on``, ``nav_err_km_tz_off`` (seed means), the paired
-    difference's mean and sd, ``tz_arcsec``, ``n_seeds``, ``variant`` and ``rule``."""
+    rule."""
     geo = sc.build_geometry(setup, variant)
     case = cases.headline_case(setup)
     seeds = list(range(setup.n_seeds))
     truth = np.asarray(case.truth_arcsec, float)
     comp = np.broadcast_to(sc.rad([truth[0], truth[1], 0.0]), (len(seeds), 3))
-    out = {}
-    for tag, tz in (("on", truth[2]), ("off", 0.0)):
+    errs = []
+    for tz in (truth[2], 0.0):  # on, off
         Rvar, z, dx0 = cases.simulate_case(setup, geo, case, seeds, truth_arcsec=(truth[0], truth[1], tz))
         f = run_filter(z, comp, dx0, geo.P0, geo.window(Rvar), predicted=False)
         err = np.linalg.norm(f.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
-        out[tag] = cases.rms_last(err, setup.nav_last_fraction)
-    diff = out["on"] - out["off"]
-    return {"nav_err_km_tz_on": float(out["on"].mean()), "nav_err_km_tz_off": float(out["off"].mean()),
-            "diff_km_mean": float(diff.mean()), "diff_km_sd": float(diff.std(ddof=1)) if diff.size > 1 else math.nan,
-            "tz_arcsec": float(truth[2]), "n_seeds": len(seeds), "variant": variant,
-            "rule": (f"{variant} variant, headline case: the same seeds' measurements with tz = {truth[2]:g} arcsec "
-                     f"and with tz = 0, each filtered with the true (tx, ty) and tz = 0; RMS of |r_hat - r_true| "
-                     f"over the last {setup.nav_last_fraction:g} of the arc, mean over seeds")}
+        errs.append(cases.rms_last(err, setup.nav_last_fraction))
+    on, off = errs
+    diff = on - off
+    return TzNavEffect(nav_err_km_tz_on=float(on.mean()), nav_err_km_tz_off=float(off.mean()),
+                       diff_km_mean=float(diff.mean()), diff_km_sd=float(diff.std(ddof=1)) if diff.size > 1 else math.nan,
+                       tz_arcsec=float(truth[2]), n_seeds=len(seeds), variant=variant,
+                       last_fraction=setup.nav_last_fraction)

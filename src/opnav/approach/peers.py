@@ -89,9 +89,12 @@ Units: km, km/s, s, rad inside; px for the circle; arcsec in outputs.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
+
+from opnav.core.tables import OMIT_NONE
 
 from . import camera
 from . import scenario as sc
@@ -484,8 +487,9 @@ def peer_bound(setup: Setup, geo: sc.Geometry, case, truth_arcsec=None, zero_q: 
 
 #: The A-P1 runs per variant: (name, truth override, prior-mean rule).
 RUNS = (("headline", None, "prior"), ("bias_free", np.zeros(3), "prior"), ("truth_start", None, "truth"))
-RUN_LABELS = {"headline": "headline case", "bias_free": "zero misalignment (sanity)",
-              "truth_start": "prior mean at the truth (diagnostic)"}
+#: the peer UKF's key in A-P1's ``estimator`` column (the others': ``em_<scheme>``, ``augmented``,
+#: ``batch_ml``); the words of the keys and of the runs are the report's (opnav.report.approach.text)
+PEER = "ukf"
 
 
 def run_variant(setup: Setup, variant: str, log=None) -> PeerVariant:
@@ -508,37 +512,66 @@ def run_variant(setup: Setup, variant: str, log=None) -> PeerVariant:
 
 
 # ------------------------------------------------------------ A-P1 table
-def _row(variant, method, run, truth, th, own3=None, crlb3=None, n_seeds=None, crlb3_q0=None) -> dict:
+@dataclass(frozen=True)
+class TableRow:
+    """One A-P1 row (:func:`comparison_frame`; the field order is the table's columns): the
+    estimator and run, the truth, the seed mean and sd of (tx, ty), the RMS error, the estimator's
+    own 3-sigma (median over seeds; NaN without one) and the seeds within it, the CRLB 3-sigma of
+    the data the estimate used (Q = 0 beside) and the seeds within it; arcsec."""
+
+    variant: str
+    estimator: str
+    run: str
+    truth_x_arcsec: float
+    truth_y_arcsec: float
+    n_seeds: int
+    est_x_mean_arcsec: float
+    est_x_sd_arcsec: float
+    est_y_mean_arcsec: float
+    est_y_sd_arcsec: float
+    rmse_xy_arcsec: float
+    own_3sigma_x_arcsec: float
+    own_3sigma_y_arcsec: float
+    within_own_3sigma: float
+    within_own_3sigma_text: str
+    crlb_3sigma_x_arcsec: float
+    crlb_3sigma_y_arcsec: float
+    within_crlb_3sigma: float
+    crlb_q0_3sigma_x_arcsec: float
+    crlb_q0_3sigma_y_arcsec: float
+
+
+def _row(variant, method, run, truth, th, own3=None, crlb3=None, crlb3_q0=None) -> TableRow:
     """One table row: seed mean and sd of (tx, ty), own 3-sigma, CRLB 3-sigma of the data the
     estimate used (and with Q = 0: ``crlb3_q0``), coverage."""
     th = np.asarray(th, float)[:, :2]
     err = th - np.asarray(truth, float)[:2]
     sd = th.std(0, ddof=1) if len(th) > 1 else np.full(2, np.nan)
-    row = {"variant": variant, "estimator": method, "run": run,
-           "truth_x_arcsec": float(truth[0]), "truth_y_arcsec": float(truth[1]), "n_seeds": len(th),
-           "est_x_mean_arcsec": float(th[:, 0].mean()), "est_x_sd_arcsec": float(sd[0]),
-           "est_y_mean_arcsec": float(th[:, 1].mean()), "est_y_sd_arcsec": float(sd[1]),
-           "rmse_xy_arcsec": float(np.sqrt(np.mean(err**2)))}
     if own3 is not None:
         own3 = np.asarray(own3, float)[:, :2]
         inside = np.all(np.abs(err) <= own3, axis=1)
-        row.update(own_3sigma_x_arcsec=float(np.median(own3[:, 0])), own_3sigma_y_arcsec=float(np.median(own3[:, 1])),
-                   within_own_3sigma=float(np.mean(inside)),
-                   within_own_3sigma_text=f"{int(inside.sum())} of {len(inside)}")
+        own = (float(np.median(own3[:, 0])), float(np.median(own3[:, 1])), float(np.mean(inside)),
+               f"{int(inside.sum())} of {len(inside)}")
     else:
-        row.update(own_3sigma_x_arcsec=np.nan, own_3sigma_y_arcsec=np.nan, within_own_3sigma=np.nan,
-                   within_own_3sigma_text="--")
+        own = (np.nan, np.nan, np.nan, "--")
     c = np.full(2, np.nan) if crlb3 is None else np.asarray(crlb3, float)[:2]
-    row.update(crlb_3sigma_x_arcsec=float(c[0]), crlb_3sigma_y_arcsec=float(c[1]),
-               within_crlb_3sigma=float(np.mean(np.all(np.abs(err) <= c, axis=1))) if crlb3 is not None else np.nan)
     c0 = np.full(2, np.nan) if crlb3_q0 is None else np.asarray(crlb3_q0, float)[:2]
-    row.update(crlb_q0_3sigma_x_arcsec=float(c0[0]), crlb_q0_3sigma_y_arcsec=float(c0[1]))
-    return row
+    return TableRow(
+        variant=variant, estimator=method, run=run, truth_x_arcsec=float(truth[0]), truth_y_arcsec=float(truth[1]),
+        n_seeds=len(th), est_x_mean_arcsec=float(th[:, 0].mean()), est_x_sd_arcsec=float(sd[0]),
+        est_y_mean_arcsec=float(th[:, 1].mean()), est_y_sd_arcsec=float(sd[1]),
+        rmse_xy_arcsec=float(np.sqrt(np.mean(err**2))), own_3sigma_x_arcsec=own[0], own_3sigma_y_arcsec=own[1],
+        within_own_3sigma=own[2], within_own_3sigma_text=own[3],
+        crlb_3sigma_x_arcsec=float(c[0]), crlb_3sigma_y_arcsec=float(c[1]),
+        within_crlb_3sigma=float(np.mean(np.all(np.abs(err) <= c, axis=1))) if crlb3 is not None else np.nan,
+        crlb_q0_3sigma_x_arcsec=float(c0[0]), crlb_q0_3sigma_y_arcsec=float(c0[1]))
 
 
 def comparison_frame(peer: list[PeerVariant], em: list, alt: list, case_id: str = "T1-01"):
     """A-P1 table: per variant, the EM-EKF (each scheme), augmented EKF, batch ML and the
-    peer UKF (headline, zero-misalignment sanity, truth-start diagnostic), arcsec.
+    peer UKF (headline, zero-misalignment sanity, truth-start diagnostic), arcsec; the
+    ``estimator`` and ``run`` columns hold keys (``em_plain`` ... :data:`PEER`; a key of
+    :data:`RUNS`), their words are the report's (:func:`opnav.report.approach.text.p1_words`).
 
     ``peer``: :func:`run_variant` outputs; ``em``: EM-EKF Monte-Carlo runs
     (:func:`opnav.approach.pipeline.run_group`); ``alt``: A-X2 runs
@@ -550,8 +583,6 @@ def comparison_frame(peer: list[PeerVariant], em: list, alt: list, case_id: str 
     """
     import pandas as pd
 
-    from .alternatives_summary import METHOD_LABELS
-
     rows = []
     for p in peer:
         v = p.variant
@@ -559,54 +590,82 @@ def comparison_frame(peer: list[PeerVariant], em: list, alt: list, case_id: str 
         bound = 3.0 * np.asarray(ems[0].bounds.crlb_total_arcsec, float) if ems else None
         bound0 = 3.0 * np.asarray(ems[0].bounds.crlb_total_q0_arcsec, float) if ems else None
         for r in ems:
-            rows.append(_row(v, METHOD_LABELS.get(f"em_{r.method}", r.method), "headline case",
+            rows.append(_row(v, f"em_{r.method}", "headline",
                              r.truth_arcsec, r.theta_final_arcsec, None, 3.0 * np.asarray(r.bounds.crlb_arcsec),
                              crlb3_q0=3.0 * np.asarray(r.bounds.crlb_q0_arcsec)))
         for a in (a for a in alt if a.variant == v and a.case_id == case_id):
             for m, d in a.methods():
                 own = 3.0 * d.sigma_final_arcsec if getattr(d, "sigma_final_arcsec", None) is not None else None
-                rows.append(_row(v, METHOD_LABELS[m], "headline case", a.truth_arcsec,
+                rows.append(_row(v, m, "headline", a.truth_arcsec,
                                  d.theta_final_arcsec, own, bound, crlb3_q0=bound0))
         for name, r in p.runs.items():
-            rows.append(_row(v, "Basilisk pixelLineBiasUKF", RUN_LABELS[name], r.truth_arcsec,
+            rows.append(_row(v, PEER, name, r.truth_arcsec,
                              r.theta_final_arcsec, r.sigma3_final_arcsec, 3.0 * r.crlb_peer_arcsec,
                              crlb3_q0=3.0 * np.asarray(r.crlb_peer_q0_arcsec)))
-    return pd.DataFrame(rows)
+    return pd.DataFrame([dataclasses.asdict(r) for r in rows])
 
 
-def summary(table, peer: list[PeerVariant]) -> dict:
-    """Numbers for the manuscript macros (A-P1-summary.json)."""
-    keys = {"EM-EKF (plain)": "em_plain", "EM-EKF (SQUAREM)": "em_squarem", "augmented EKF": "augmented",
-            "batch ML (IPOPT)": "batch_ml"}
-    run_keys = {lab: k for k, lab in RUN_LABELS.items()}
-    out = {"ran": True, "variants": {}}
-    for _, r in table.iterrows():
-        k = keys.get(r["estimator"]) or "ukf_" + run_keys[r["run"]]
-        out["variants"].setdefault(r["variant"], {})[k] = {
-            c: r[c] for c in ("est_x_mean_arcsec", "est_x_sd_arcsec", "est_y_mean_arcsec", "est_y_sd_arcsec",
-                              "own_3sigma_x_arcsec", "own_3sigma_y_arcsec", "within_own_3sigma",
-                              "crlb_3sigma_x_arcsec", "crlb_3sigma_y_arcsec", "crlb_q0_3sigma_x_arcsec",
-                              "rmse_xy_arcsec",
-                              "within_own_3sigma_text")}
+#: the A-P1 table's columns each estimator's entry of A-P1-summary.json holds
+P1_FIELDS = ("est_x_mean_arcsec", "est_x_sd_arcsec", "est_y_mean_arcsec", "est_y_sd_arcsec", "own_3sigma_x_arcsec",
+             "own_3sigma_y_arcsec", "within_own_3sigma", "crlb_3sigma_x_arcsec", "crlb_3sigma_y_arcsec",
+             "crlb_q0_3sigma_x_arcsec", "rmse_xy_arcsec", "within_own_3sigma_text")
+
+
+@dataclass(frozen=True)
+class P1Variant:
+    """One variant of A-P1-summary.json (:func:`summary`): each estimator's table entry by its key
+    (``em_plain`` ... ``ukf_headline``; written at the variant's top level) and the peer's own
+    numbers: its final position error (km), the true bias in pixels, its bias after the first
+    update (arcsec), the seeds whose bias moved later and how often, the bias quantum (arcsec),
+    whether the bias-free run stays within its own 3-sigma, and the bound over its own 3-sigma."""
+
+    estimators: dict[str, dict[str, Any]] = field(metadata={"json_flatten": True})
+    ukf_pos_err_final_km: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_truth_bias_pixel_px: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_truth_bias_line_px: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_first_update_x_arcsec: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_first_update_y_arcsec: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_seeds_moving_after_first_update: int | None = field(default=None, metadata=OMIT_NONE)
+    ukf_bias_changes_after_first_mean: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_bias_quantum_arcsec: float | None = field(default=None, metadata=OMIT_NONE)
+    ukf_bias_free_within_own_3sigma_all: bool | None = field(default=None, metadata=OMIT_NONE)
+    ukf_bound_over_own_3sigma_x: float | None = field(default=None, metadata=OMIT_NONE)
+
+
+@dataclass(frozen=True)
+class P1Summary:
+    """A-P1-summary.json: per variant its :class:`P1Variant`, the two-body check and the seeds."""
+
+    ran: bool
+    variants: dict[str, P1Variant]
+    two_body: TwoBodyCheck
+    n_seeds: int
+
+
+def summary(table, peer: list[PeerVariant]) -> P1Summary:
+    """Numbers for the manuscript macros (A-P1-summary.json) from the A-P1 table and the peer runs."""
+    entries: dict[str, dict[str, dict[str, Any]]] = {}
+    for r in table.itertuples():
+        k = f"{PEER}_{r.run}" if r.estimator == PEER else r.estimator
+        entries.setdefault(r.variant, {})[k] = {c: getattr(r, c) for c in P1_FIELDS}
+    variants = {v: P1Variant(estimators=e) for v, e in entries.items()}
     for p in peer:
-        v = out["variants"].setdefault(p.variant, {})
-        h = p.runs["headline"]
-        v["ukf_pos_err_final_km"] = float(np.mean(h.pos_err_final_km))
-        v["ukf_truth_bias_pixel_px"], v["ukf_truth_bias_line_px"] = map(float, h.truth_bias_px)
+        h, b = p.runs["headline"], p.runs["bias_free"]
+        hr = entries.get(p.variant, {})["ukf_headline"]
         # what the bias state does (module docstring, 'Why the bias hardly moves'): its value after
         # the first update (seed mean), the seeds whose bias changed later in the arc, its quantum
-        v["ukf_first_update_x_arcsec"], v["ukf_first_update_y_arcsec"] = map(
-            float, np.mean(h.theta_first_update_arcsec, axis=0))
-        v["ukf_seeds_moving_after_first_update"] = int(np.count_nonzero(h.bias_changes_after_first))
-        v["ukf_bias_changes_after_first_mean"] = float(np.mean(h.bias_changes_after_first))
-        v["ukf_bias_quantum_arcsec"] = h.bias_quantum_arcsec
-        b = p.runs["bias_free"]
-        v["ukf_bias_free_within_own_3sigma_all"] = bool(np.all(np.abs(b.theta_final_arcsec) <= b.sigma3_final_arcsec))
-        hr = v["ukf_headline"]
-        v["ukf_bound_over_own_3sigma_x"] = hr["crlb_3sigma_x_arcsec"] / hr["own_3sigma_x_arcsec"]
-    out["two_body"] = dataclasses.asdict(peer[0].two_body)
-    out["n_seeds"] = int(table["n_seeds"].max())
-    return out
+        fx, fy = map(float, np.mean(h.theta_first_update_arcsec, axis=0))
+        px, ln = map(float, h.truth_bias_px)
+        variants[p.variant] = P1Variant(
+            estimators=entries.get(p.variant, {}), ukf_pos_err_final_km=float(np.mean(h.pos_err_final_km)),
+            ukf_truth_bias_pixel_px=px, ukf_truth_bias_line_px=ln, ukf_first_update_x_arcsec=fx,
+            ukf_first_update_y_arcsec=fy,
+            ukf_seeds_moving_after_first_update=int(np.count_nonzero(h.bias_changes_after_first)),
+            ukf_bias_changes_after_first_mean=float(np.mean(h.bias_changes_after_first)),
+            ukf_bias_quantum_arcsec=h.bias_quantum_arcsec,
+            ukf_bias_free_within_own_3sigma_all=bool(np.all(np.abs(b.theta_final_arcsec) <= b.sigma3_final_arcsec)),
+            ukf_bound_over_own_3sigma_x=hr["crlb_3sigma_x_arcsec"] / hr["own_3sigma_x_arcsec"])
+    return P1Summary(ran=True, variants=variants, two_body=peer[0].two_body, n_seeds=int(table["n_seeds"].max()))
 
 
 def seed_frame(peer: list[PeerVariant]):

@@ -17,7 +17,7 @@ Units: arcsec, km, samples.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -134,7 +134,8 @@ def total_bound(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcsec, 
     return _at_total(setup, bound_curve(setup, geo, Rvar, theta_arcsec, variant))
 
 
-def mars_attitude_bounds(setup: Setup, geo: sc.Geometry, Rvar_of, theta_arcsec, variant: str) -> dict:
+def mars_attitude_bounds(setup: Setup, geo: sc.Geometry, Rvar_of, theta_arcsec,
+                         variant: str) -> dict[float, np.ndarray]:
     """The bound of all the data (tx, ty, tz; arcsec, 1-sigma, with Q) of ``variant`` at each Mars-image
     attitude knowledge of ``camera.attitude_study_arcsec`` (issue 54, item 3): the same arc with the
     estimators' variances for that knowledge (``Rvar_of(geo)``: the case's variances of a geometry)."""
@@ -200,7 +201,29 @@ def rate_to_target(setup: Setup, geo: sc.Geometry, Rvar: np.ndarray, theta_arcse
 ROLL_GRID_POINTS = 36
 
 
-def roll_rate_study(setup: Setup, samples: int, target_arcsec: float) -> dict:
+@dataclass(frozen=True)
+class RollRateBounds:
+    """:func:`roll_rate_study`: the configured rates of ``roll_rate_study.rates_deg_s`` (deg/s) with
+    the bound (arcsec, (R, 3)) after ``samples`` samples and after all the data
+    (``total_samples``; with Q and Q = 0); the log-log slope of the all-data bound against the
+    rate; the rate reaching ``target_arcsec`` within ``samples`` (NaN: none in the bracket); the
+    bound after ``samples`` on a log grid over the searched bracket; the configured roll rate."""
+
+    rates_deg_s: np.ndarray
+    samples: int
+    total_samples: int
+    grid_rates_deg_s: np.ndarray
+    bound_grid_arcsec: np.ndarray
+    bound_at_samples_arcsec: np.ndarray
+    bound_all_arcsec: np.ndarray
+    bound_all_q0_arcsec: np.ndarray
+    slope_all: float
+    rate_to_target_deg_s: float
+    target_arcsec: float
+    config_rate_deg_s: float
+
+
+def roll_rate_study(setup: Setup, samples: int, target_arcsec: float) -> RollRateBounds:
     """The roll rows' dependence on the roll rate (headline case): the bound of tx, ty after
     ``samples`` samples and after all the data, with and without process noise, at each rate
     of ``roll_rate_study.rates_deg_s``; the log-log slope of the all-data bound against the
@@ -222,8 +245,7 @@ def roll_rate_study(setup: Setup, samples: int, target_arcsec: float) -> dict:
     # scorer reads the rate at which it reaches the plan's target from these points)
     grid = np.geomspace(*setup.roll_rate_study.search_deg_s, ROLL_GRID_POINTS)
     at_grid = roll_rate_bounds(setup, geo, Rvar, case.truth_arcsec, grid, samples)
-    return {"rates_deg_s": rates, "samples": samples, "total_samples": total,
-            "grid_rates_deg_s": grid, "bound_grid_arcsec": at_grid,
-            "bound_at_samples_arcsec": at_n, "bound_all_arcsec": at_all, "bound_all_q0_arcsec": at_all0,
-            "slope_all": slope, "rate_to_target_deg_s": rate, "target_arcsec": target_arcsec,
-            "config_rate_deg_s": setup.roll.rate_deg_s}
+    return RollRateBounds(rates_deg_s=rates, samples=samples, total_samples=total, grid_rates_deg_s=grid,
+                          bound_grid_arcsec=at_grid, bound_at_samples_arcsec=at_n, bound_all_arcsec=at_all,
+                          bound_all_q0_arcsec=at_all0, slope_all=slope, rate_to_target_deg_s=rate,
+                          target_arcsec=target_arcsec, config_rate_deg_s=setup.roll.rate_deg_s)

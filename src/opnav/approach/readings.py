@@ -23,7 +23,7 @@ Units: arcsec, s, deg.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -32,14 +32,24 @@ from . import scenario as sc
 from .setup import Setup
 
 
-def installation_check(setup: Setup, install_deg, theta_arcsec, variant: str = "literal",
-                       n: int = 200) -> dict:
-    """The measurement chain of paper A for each installation angle (module docstring).
+@dataclass(frozen=True)
+class InstallationCheck:
+    """:func:`installation_check`: the installation angles (deg), the largest relative change of the
+    noise-free measurement against angle 0 (``max_rel_change``), whether it is rounding only
+    (``by_construction``: below 1e-12), the camera-frame (tx, ty, tz) a body-frame deviation would
+    become at each angle (arcsec), and ``why``: its words (the report's)."""
 
-    Returns the angles, the largest relative change of the noise-free measurement against
-    angle 0 over the first ``n`` samples (``max_rel_change``), whether it is rounding only
-    (``by_construction``: below 1e-12), and the camera-frame (tx, ty, tz) a body-frame
-    deviation ``theta_arcsec`` would become at each angle (``body_frame_theta_cam_arcsec``)."""
+    install_deg: list
+    max_rel_change: float
+    by_construction: bool
+    body_frame_theta_cam_arcsec: list
+    why: str = ""
+
+
+def installation_check(setup: Setup, install_deg, theta_arcsec, variant: str = "literal",
+                       n: int = 200) -> InstallationCheck:
+    """The measurement chain of paper A for each installation angle (module docstring), over the
+    first ``n`` samples; ``theta_arcsec``: the deviation a body-frame reading would turn."""
     geo = sc.build_geometry(setup, variant, n=n)
     los = geo.X_mars[:, :3] - geo.X_true[:, :3]
     A_m = camera.misalignment_exact(sc.rad(theta_arcsec))
@@ -51,28 +61,42 @@ def installation_check(setup: Setup, install_deg, theta_arcsec, variant: str = "
     z = np.stack(z)
     rel = float(np.max(np.linalg.norm(z - z[0], axis=-1) / np.linalg.norm(z[0], axis=-1)))
     cam = [camera.rot_x(np.deg2rad(a)) @ np.asarray(theta_arcsec, float) for a in install_deg]
-    return {"install_deg": [float(a) for a in install_deg], "max_rel_change": rel,
-            "by_construction": bool(rel < 1e-12),
-            "body_frame_theta_cam_arcsec": [c.tolist() for c in cam]}
+    return InstallationCheck(install_deg=[float(a) for a in install_deg], max_rel_change=rel,
+                             by_construction=bool(rel < 1e-12), body_frame_theta_cam_arcsec=[c.tolist() for c in cam])
 
 
-def installation_text(chk: dict) -> str:
-    """The manuscript's reading of the installation rows, from :func:`installation_check`."""
-    cam = np.asarray(chk["body_frame_theta_cam_arcsec"])
-    angles = ", ".join(f"{a:g}" for a in chk["install_deg"])
-    if not chk["by_construction"]:
-        return (f"The installation angle changes the measurement (largest relative change "
-                f"{chk['max_rel_change']:.2g}): the installation rows test the estimator.")
-    return (f"With the misalignment defined in the camera frame and the body attitude commanded to put the "
-            f"installed boresight on Mars (paper A eq. 3-5), the installation angle ({angles} deg) cancels "
-            f"from the measurement (largest relative change {chk['max_rel_change']:.1g}, rounding): "
-            f"'unaffected by the installation matrix' holds by construction and its rows are noise "
-            f"replicates. Were the deviation fixed in the body frame, the camera would see ty from "
-            f"{cam[:, 1].min():.3g} to {cam[:, 1].max():.3g} arcsec across these angles.")
+@dataclass(frozen=True)
+class Steps:
+    """A value at each reading of the sample time: the config's ``dt_s``, the paper's stated step
+    and the step implied by "250 samples = 4 min"."""
+
+    config: float
+    paper_stated: float
+    paper_4_min: float
+
+
+@dataclass(frozen=True)
+class BoundAtSteps:
+    """The worse of the (tx, ty) bounds after the published samples at our step and at the step
+    "4 min" implies, arcsec."""
+
+    config: float
+    paper_4_min: float
+
+
+@dataclass(frozen=True)
+class SampleTimeReading:
+    """:func:`sample_time_reading`: the published samples, the three steps (s), the minutes the
+    samples span at each, and per variant the bound after them at two of the steps."""
+
+    samples: int
+    dt_s: Steps
+    minutes_for_samples: Steps
+    bound_after_samples_arcsec: dict[str, BoundAtSteps]
 
 
 def sample_time_reading(setup: Setup, pub_headline: dict, pub_simulation: dict,
-                        variants=("literal", "roll")) -> dict:
+                        variants=("literal", "roll")) -> SampleTimeReading:
     """Sample time: the config's ``dt_s``, the paper's stated step and the step implied by
     "250 samples = 4 min", with the minutes 250 samples span and the bound of (tx, ty) after
     them at each step (headline case, data after N0 / from t0 as for the variant's bound)."""
@@ -80,25 +104,16 @@ def sample_time_reading(setup: Setup, pub_headline: dict, pub_simulation: dict,
     from .pipeline import bound_curve
     samples = int(pub_headline["data_to_converge_samples"])
     implied = 60.0 * float(pub_headline["data_to_converge_minutes"]) / samples
-    steps = {"config": setup.dt_s, "paper_stated": float(pub_simulation["dt_s"]), "paper_4_min": implied}
+    steps = Steps(config=setup.dt_s, paper_stated=float(pub_simulation["dt_s"]), paper_4_min=implied)
     case = headline_case(setup)
     n = setup.segments.N0 + samples
-    out = {"samples": samples, "dt_s": steps, "minutes_for_samples": {k: v * samples / 60.0 for k, v in steps.items()},
-           "bound_after_samples_arcsec": {}}
-    for k in ("config", "paper_4_min"):
-        s = replace(setup, dt_s=steps[k])
-        for v in variants:
-            geo = sc.build_geometry(s, v, n=n)
-            c = bound_curve(s, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec, v)
-            out["bound_after_samples_arcsec"].setdefault(v, {})[k] = float(c[min(samples, len(c) - 1), :2].max())
-    return out
 
+    def bound(dt: float, v: str) -> float:
+        s = replace(setup, dt_s=dt)
+        geo = sc.build_geometry(s, v, n=n)
+        c = bound_curve(s, geo, geo.measurement_variance(case.sigma3_px), case.truth_arcsec, v)
+        return float(c[min(samples, len(c) - 1), :2].max())
 
-def sample_time_text(st: dict) -> str:
-    """One sentence: the two readings of the paper's sample time side by side."""
-    d, m, b = st["dt_s"], st["minutes_for_samples"], st["bound_after_samples_arcsec"]
-    parts = [f"{v}: {x['config']:.3g} vs {x['paper_4_min']:.3g} arcsec" for v, x in b.items()]
-    return (f"Paper A states a {d['paper_stated']:g} s step, yet calls {st['samples']} samples about "
-            f"{m['paper_4_min']:.0f} min, which implies {d['paper_4_min']:.2g} s a sample; we use "
-            f"{d['config']:g} s ({st['samples']} samples = {m['config']:.2g} min). The bound of (tx, ty) after "
-            f"{st['samples']} samples at our step and at {d['paper_4_min']:.2g} s: " + "; ".join(parts) + ".")
+    at = {v: BoundAtSteps(config=bound(steps.config, v), paper_4_min=bound(steps.paper_4_min, v)) for v in variants}
+    minutes = Steps(*(x * samples / 60.0 for x in (steps.config, steps.paper_stated, steps.paper_4_min)))
+    return SampleTimeReading(samples=samples, dt_s=steps, minutes_for_samples=minutes, bound_after_samples_arcsec=at)

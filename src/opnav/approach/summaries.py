@@ -1,10 +1,12 @@
 """Paper A's numbers from the simulation results: A-T1 in long form, the A-X1 bound table,
 the roll-rate and stars studies, and A-summary.json.
 
-Pure functions of the results of :mod:`opnav.approach.pipeline` and
-:mod:`opnav.approach.alternatives`; editing this module reruns only the table rules, never
-the Monte Carlo. The sentences the manuscript makes from these numbers are in
-:mod:`opnav.report.approach_text`. Units: arcsec, km, samples.
+Pure functions of the typed records of :mod:`opnav.approach.pipeline` and
+:mod:`opnav.approach.alternatives`, returning typed records (A-summary.json is
+:class:`ASummary`, written by the workflow's edge through :func:`opnav.core.tables.json_ready`);
+editing this module reruns only the table rules, never the Monte Carlo. The words beside the
+numbers (readings, notes, why, rule, reason) are :mod:`opnav.report.approach.text`'s, the
+manuscript's sentences :mod:`opnav.report.approach_text`'s. Units: arcsec, km, samples.
 """
 
 from __future__ import annotations
@@ -12,11 +14,13 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
+
+from opnav.core.tables import JSON_SKIP, OMIT_NONE, json_key
 
 from . import cases
 from . import scenario as sc
@@ -25,6 +29,8 @@ from .setup import Setup
 
 if TYPE_CHECKING:  # the records only (alternatives imports CasADi)
     from .alternatives import StarsRow
+    from .navfloor import NavFloor
+    from .pipeline import RollRateBounds
 
 
 def seed_sd(x: np.ndarray) -> float:
@@ -72,7 +78,7 @@ def table1_frame(results: list[cases.CaseRun], published: dict, target_arcsec: f
             "crlb_q0_x_arcsec": b.crlb_q0_arcsec[0], "crlb_q0_y_arcsec": b.crlb_q0_arcsec[1],
             "crlb_all_x_arcsec": b.crlb_total_arcsec[0], "crlb_all_y_arcsec": b.crlb_total_arcsec[1],
             "tz_observable": not r.tz_unobservable,
-            **label_columns(r, target),
+            **dataclasses.asdict(label_columns(r, target)),
             # initial error drawn from the prior (headline case only): the spread to set beside the bound
             "est_x_mean_sampled": smp.theta_final_arcsec[:, 0].mean() if smp else math.nan,
             "est_x_std_sampled": seed_sd(smp.theta_final_arcsec[:, 0]) if smp else math.nan,
@@ -139,27 +145,47 @@ def nees_paired(ct: cases.ConsistencySeries | None) -> NeesPaired:
     return NeesPaired(int(ref.size), float(d_after.mean()), se(d_after), float(d_cons.mean()), se(d_cons))
 
 
-def nees_summary(t1: pd.DataFrame) -> dict:
-    """Filter consistency of the headline rows (T1-01, initial error drawn from the prior, whole arc)
-    for the summary (issue 54, item 5): per row (its A-T1 ``variant``), the position NEES of the filter
-    compensated with the estimate taken as exact (``nees_mean``) and of the Schmidt filter carrying its
-    covariance (``consider_nees_mean``) beside the NEES of the filter given the true theta on the same
-    runs (``reference_nees_mean``: the truth has no process noise while the filters' Q > 0, so that
-    filter's NEES, not 3, is what a consistent compensation would show), with the paired difference
-    to it (seed mean and standard error) and ``n_seeds``."""
+@dataclass(frozen=True)
+class NeesRow:
+    """Filter consistency of one headline row (T1-01, initial error drawn from the prior, whole arc;
+    :func:`nees_summary`): the position NEES of the filter compensated with the estimate taken as
+    exact (``nees_mean``) and of the Schmidt filter carrying its covariance (``consider_nees_mean``)
+    beside the NEES of the filter given the true theta on the same runs (``reference_nees_mean``: the
+    truth has no process noise while the filters' Q > 0, so that filter's NEES, not 3, is what a
+    consistent compensation would show), the theta = 0 filter's, the paired differences to the
+    reference (seed mean and standard error), the seeds and the row's scheme (None: not held)."""
+
+    nees_mean: float | None
+    reference_nees_mean: float
+    consider_nees_mean: float | None
+    before_nees_mean: float | None
+    n_seeds: int | None
+    after_minus_reference_mean: float | None
+    after_minus_reference_se: float | None
+    consider_minus_reference_mean: float | None
+    consider_minus_reference_se: float | None
+    scenario: str
+    method: str
+    mode: str
+
+
+def nees_summary(t1: pd.DataFrame) -> dict[str, NeesRow]:
+    """Issue 54, item 5: per headline row (its A-T1 ``variant``) with the true-theta filter's NEES,
+    its :class:`NeesRow`."""
     out = {}
-    for _, r in t1[t1["case_id"] == "T1-01"].iterrows():
+    for r in t1[t1.case_id == "T1-01"].itertuples():
         ref = _num(r, "nees_pos_true_theta_mean")
         if ref is None:
             continue
-        out[r["variant"]] = {
-            "nees_mean": _num(r, "nees_pos_after_mean"), "reference_nees_mean": ref,
-            "consider_nees_mean": _num(r, "nees_pos_consider_mean"),
-            "before_nees_mean": _num(r, "nees_pos_before_mean"),
-            "n_seeds": int(r["nees_n_seeds"]) if _num(r, "nees_n_seeds") is not None else None,
-            **{f"{k}_minus_reference_{q}": _num(r, f"nees_pos_{k}_minus_true_theta_{q}")
-               for k in ("after", "consider") for q in ("mean", "se")},
-            "scenario": r["scenario"], "method": r["method"], "mode": r.get("mode", "sliding")}
+        out[r.variant] = NeesRow(
+            nees_mean=_num(r, "nees_pos_after_mean"), reference_nees_mean=ref,
+            consider_nees_mean=_num(r, "nees_pos_consider_mean"), before_nees_mean=_num(r, "nees_pos_before_mean"),
+            n_seeds=int(r.nees_n_seeds) if _num(r, "nees_n_seeds") is not None else None,
+            after_minus_reference_mean=_num(r, "nees_pos_after_minus_true_theta_mean"),
+            after_minus_reference_se=_num(r, "nees_pos_after_minus_true_theta_se"),
+            consider_minus_reference_mean=_num(r, "nees_pos_consider_minus_true_theta_mean"),
+            consider_minus_reference_se=_num(r, "nees_pos_consider_minus_true_theta_se"),
+            scenario=r.scenario, method=r.method, mode=r.mode)
     return out
 
 
@@ -228,7 +254,7 @@ def crlb_rows(setup: Setup, curves: dict, conv: Mapping[str, cases.ConvergenceSt
 def _first_window_bound(t1, variant, curve, s):
     """Bound of one segment's data: from the A-T1 sliding rows when present, else the
     cumulative curve after N samples."""
-    h = t1[(t1.scenario == variant) & (t1.case_id == "T1-01") & (t1.mode == "sliding")]
+    h = t1[(t1.scenario == variant) & (t1.case_id == "T1-01") & (t1["mode"] == "sliding")]  # (t1.mode: a method)
     if len(h):
         return float(h.crlb_x_arcsec.iloc[0])
     return curve[min(s.N, len(curve) - 1), 0]
@@ -246,113 +272,140 @@ def _first_below(values: np.ndarray, target: float) -> float:
     return float(idx[0]) if idx.size else math.nan
 
 
-def nav_note(r) -> str:
-    """What sets a row's navigation error after compensation, from its split (A-T1 columns):
-    ``after X km (lateral L, range R); with the true theta T km (lateral, range)`` (the filters'
-    consistency is :func:`nees_summary`'s)."""
-    def g(k):
-        v = _num(r, k)
-        return "n/a" if v is None else f"{v:.3g}"
-    if _num(r, "nav_err_after_rng_km") is None:
-        return ""
-    lat, rng = _num(r, "nav_err_after_lat_km"), _num(r, "nav_err_after_rng_km")
-    part = "range" if rng >= lat else "lateral"
-    return (f"after compensation {g('nav_err_after_km')} km (lateral {g('nav_err_after_lat_km')}, range "
-            f"{g('nav_err_after_rng_km')}: the {part} channel sets it); with the true theta "
-            f"{g('nav_err_true_theta_km')} km (lateral {g('nav_err_true_theta_lat_km')}, range "
-            f"{g('nav_err_true_theta_rng_km')})")
+@dataclass(frozen=True)
+class RollRateSummary:
+    """The roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`) for the summary: per
+    rate the worse of (tx, ty) bounds after the published data and after all the data (with Q and
+    Q = 0), arcsec; the log-log slope; the rate reaching the target in that data (deg/s; None: none
+    in the searched range); the target and the configured rate."""
+
+    rates_deg_s: list
+    samples: int
+    total_samples: int
+    bound_at_samples_arcsec: list
+    bound_all_arcsec: list
+    bound_all_q0_arcsec: list
+    slope_all: float
+    rate_to_target_deg_s: float | None
+    target_arcsec: float
+    config_rate_deg_s: float
 
 
-def roll_rate_summary(study: dict) -> dict:
-    """The roll-rate study (:func:`opnav.approach.pipeline.roll_rate_study`) for the summary:
-    per rate the worse of (tx, ty) bounds after the published data and after all the data (with
-    Q and Q = 0), arcsec; the log-log slope; the rate reaching the target in that data, deg/s."""
-    worst = {k: np.asarray(study[k])[:, :2].max(1) for k in
-             ("bound_at_samples_arcsec", "bound_all_arcsec", "bound_all_q0_arcsec")}
-    rate = study["rate_to_target_deg_s"]
-    return {"rates_deg_s": [float(r) for r in study["rates_deg_s"]], "samples": int(study["samples"]),
-            "total_samples": int(study["total_samples"]),
-            **{k: [float(v) for v in w] for k, w in worst.items()},
-            "slope_all": float(study["slope_all"]),
-            "rate_to_target_deg_s": None if not math.isfinite(rate) else float(rate),
-            "target_arcsec": float(study["target_arcsec"]), "config_rate_deg_s": float(study["config_rate_deg_s"])}
+def roll_rate_summary(study: RollRateBounds) -> RollRateSummary:
+    """:class:`RollRateSummary` of a roll-rate study."""
+    def worst(b):
+        return [float(v) for v in np.asarray(b)[:, :2].max(1)]
+
+    rate = study.rate_to_target_deg_s
+    return RollRateSummary(rates_deg_s=[float(r) for r in study.rates_deg_s], samples=int(study.samples),
+                           total_samples=int(study.total_samples),
+                           bound_at_samples_arcsec=worst(study.bound_at_samples_arcsec),
+                           bound_all_arcsec=worst(study.bound_all_arcsec),
+                           bound_all_q0_arcsec=worst(study.bound_all_q0_arcsec),
+                           slope_all=float(study.slope_all),
+                           rate_to_target_deg_s=None if not math.isfinite(rate) else float(rate),
+                           target_arcsec=float(study.target_arcsec), config_rate_deg_s=float(study.config_rate_deg_s))
+
+
+@dataclass(frozen=True)
+class MarsAttitude:
+    """The Mars images' attitude knowledge (issue 54, item 3) for the summary
+    (:func:`mars_attitude_summary`): the configured value (``default_arcsec``) and the study's
+    values, and per variant the worse of (tx, ty) of the bound of all the data with it
+    (``default``) and at each study value (keyed ``f"{value:g}"``), arcsec; ``why``: the words
+    (the report's)."""
+
+    default_arcsec: float
+    values_arcsec: list
+    bound_all_arcsec: dict[str, dict[str, float]]
+    why: str = ""
 
 
 def mars_attitude_summary(setup: Setup, bounds: Mapping[str, Mapping[float, Any]] | None,
-                          curves: Mapping[str, np.ndarray]) -> dict:
-    """The Mars images' attitude knowledge (issue 54, item 3) for the summary: the configured
-    value (``default_arcsec``) and why, and per variant the worse of (tx, ty) of the bound of all
-    the data with it (``default``) and at each ``camera.attitude_study_arcsec`` value, arcsec."""
-    a0 = float(setup.camera.attitude_sigma_arcsec)
-    why = ("paper A's measurement (eq. 3) takes the camera attitude A_c^i as known: the reproduction keeps the "
-           "paper's model, and the bound with an attitude error is shown beside it" if a0 == 0.0 else
-           f"our choice: each Mars image's attitude is known to {a0:g} arcsec (1-sigma per axis, independent per "
-           "image), which the paper's measurement (eq. 3) leaves out")
+                          curves: Mapping[str, np.ndarray]) -> MarsAttitude:
+    """:class:`MarsAttitude` from the bounds of :func:`opnav.approach.pipeline.mars_attitude_bounds`
+    per variant and the variants' bound curves."""
     d = setup.segments.data_samples
-    out = {"default_arcsec": a0, "why": why, "values_arcsec": [float(a) for a in setup.camera.attitude_study_arcsec],
-           "bound_all_arcsec": {}}
+    out = {}
     for v, c in curves.items():
         row = {"default": float(np.asarray(c)[min(d, len(c) - 1), :2].max())}
         for a, b in (bounds or {}).get(v, {}).items():
             row[f"{float(a):g}"] = float(np.asarray(b)[:2].max())
-        out["bound_all_arcsec"][v] = row
-    return out
+        out[v] = row
+    return MarsAttitude(default_arcsec=float(setup.camera.attitude_sigma_arcsec),
+                        values_arcsec=[float(a) for a in setup.camera.attitude_study_arcsec], bound_all_arcsec=out)
 
 
-def roll_rate_bound_summary(study: dict) -> dict:
-    """The roll variant's bound against the roll rate for the claims scorer (issue 54): on the log
-    grid of :func:`opnav.approach.pipeline.roll_rate_study`, the worse of the (tx, ty) 1-sigma
-    bounds after the published data (``samples`` after N0), arcsec; the scorer reads the rate at
-    which it reaches the plan's target."""
-    return {"rate_deg_s": [float(r) for r in study["grid_rates_deg_s"]],
-            "bound_arcsec": [float(b) for b in np.asarray(study["bound_grid_arcsec"])[:, :2].max(1)],
-            "samples": int(study["samples"]),
-            "rule": (f"roll variant, headline case: the worse of the 1-sigma Cramer-Rao bounds of tx and ty after "
-                     f"{int(study['samples'])} samples from N0 (the paper's data to converge), with the filter's Q, "
-                     f"the camera rolling at each rate")}
+@dataclass(frozen=True)
+class RollRateBound:
+    """The roll variant's bound against the roll rate for the claims scorer (issue 54,
+    :func:`roll_rate_bound_summary`): on the log grid of the roll-rate study, the worse of the
+    (tx, ty) 1-sigma bounds after the published data (``samples`` after N0), arcsec; the scorer
+    reads the rate at which it reaches the plan's target; ``rule``: the words (the report's)."""
+
+    rate_deg_s: list
+    bound_arcsec: list
+    samples: int
+    rule: str = ""
 
 
-def installation_summary(chk: dict) -> dict:
-    """Whether the installation cases of Table 1 test anything (issue 54, item 7), from
-    :func:`opnav.approach.readings.installation_check`: ``by_construction`` (the installation
-    angle cancels from the measurement), ``why`` and the measured largest relative change."""
-    why = ("the misalignment is defined in the camera frame and the body attitude is commanded to put the "
-           "installed boresight on Mars (paper A eq. 3-5), so the installation matrix cancels from the "
-           f"measurement (largest relative change over the angles {chk['max_rel_change']:.1g}, rounding): the "
-           "installation rows are noise replicates" if chk["by_construction"] else
-           f"the installation angle changes the measurement (largest relative change {chk['max_rel_change']:.2g})")
-    return {"by_construction": bool(chk["by_construction"]), "why": why,
-            "max_rel_change": float(chk["max_rel_change"]), "install_deg": list(chk["install_deg"])}
+def roll_rate_bound_summary(study: RollRateBounds) -> RollRateBound:
+    return RollRateBound(rate_deg_s=[float(r) for r in study.grid_rates_deg_s],
+                         bound_arcsec=[float(b) for b in np.asarray(study.bound_grid_arcsec)[:, :2].max(1)],
+                         samples=int(study.samples))
 
 
-#: the keys of each nav_floor_by_arc row (the claims engineer's contract, issue 54)
-NAV_FLOOR_ROW_KEYS = ("arc_s", "variant", "nav_err_km_rule", "nav_err_km_last", "true_theta_km_rule",
-                      "true_theta_km_last", "n_seeds")
+@dataclass(frozen=True)
+class NavFloorSummary:
+    """:func:`opnav.approach.navfloor.nav_floor_by_arc` for the summary: the rows (field order: the
+    claims engineer's contract first, issue 54), without the per-seed arrays; ``rule``: the words
+    (the report's)."""
+
+    variant: str
+    scenario: str
+    scheme: str
+    rows: tuple
+    n_seeds: int = field(default=0, metadata=JSON_SKIP)
+    last_fraction: float = field(default=math.nan, metadata=JSON_SKIP)
+    rule: str = ""
 
 
-def nav_floor_summary(nf: dict) -> dict:
-    """:func:`opnav.approach.navfloor.nav_floor_by_arc` for the summary: ``rule`` and ``rows``
-    (:data:`NAV_FLOOR_ROW_KEYS` first, then the theta = 0 filter's, the seed medians and sds and the
-    estimate's seed mean), without the per-seed arrays."""
-    rows = [{**{k: r[k] for k in NAV_FLOOR_ROW_KEYS}, **{k: v for k, v in r.items() if k not in NAV_FLOOR_ROW_KEYS}}
-            for r in nf["rows"]]
-    return {"rule": nf["rule"], "variant": nf["variant"], "scenario": nf["scenario"], "scheme": nf["scheme"],
-            "rows": rows}
+def nav_floor_summary(nf: NavFloor) -> NavFloorSummary:
+    return NavFloorSummary(variant=nf.variant, scenario=nf.scenario, scheme=nf.scheme, rows=nf.rows,
+                           n_seeds=nf.n_seeds, last_fraction=nf.last_fraction)
 
 
-def nav_floor_frame(nf: dict) -> pd.DataFrame:
-    """A-X7: one row per arc length (:func:`nav_floor_summary`'s rows)."""
-    return pd.DataFrame(nav_floor_summary(nf)["rows"])
+def nav_floor_frame(nf: NavFloor) -> pd.DataFrame:
+    """A-X7: one row per arc length (:class:`opnav.approach.navfloor.NavFloorRow`'s fields)."""
+    return pd.DataFrame([dataclasses.asdict(r) for r in nf.rows])
 
 
-def figures_5_6(results: list[cases.CaseRun]) -> dict:
-    """Paper A's Figs. 5 and 6 (issue 54, item 7): what each states and the numbers of ours that
-    answer it, from the headline (T1-01) runs of every variant and scheme. Fig. 5 (navigation
-    accuracy during the estimation) states no number: the text reads it with Fig. 4 ("the algorithm
-    estimates tx and ty effectively", A-C1); its rows are the position error at the end of the first
-    and the last segment (the filter inside the EM, mean over seeds). Fig. 6 (navigation before and
-    after compensation) carries the 79.13 km to 18.43 km of the text: A-C6 and A-C7 (Table 1's rule);
-    its rows add the errors at the arc's last sample."""
+@dataclass(frozen=True)
+class FigureRows:
+    """One of paper A's figures read against ours (:func:`figures_5_6`): the claims that judge its
+    numbers, its rows (dicts: the figure's quantities per A-T1 row) and ``reason``: the words (the
+    report's)."""
+
+    claims: list
+    rows: list
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Figures56:
+    """Paper A's Figs. 5 and 6 (issue 54, item 7), keyed ``A-F5`` and ``A-F6`` in JSON."""
+
+    f5: FigureRows = field(metadata=json_key("A-F5"))
+    f6: FigureRows = field(metadata=json_key("A-F6"))
+
+
+def figures_5_6(results: list[cases.CaseRun]) -> Figures56:
+    """Paper A's Figs. 5 and 6 (issue 54, item 7): the numbers of ours that answer each, from the
+    headline (T1-01) runs of every variant and scheme. Fig. 5 (navigation accuracy during the
+    estimation) states no number: its rows are the position error at the end of the first and the
+    last segment (the filter inside the EM, mean over seeds). Fig. 6 (navigation before and after
+    compensation) carries Table 1's numbers (A-C6, A-C7, by the table's rule); its rows add the
+    errors at the arc's last sample."""
     f5, f6 = [], []
     for r in results:
         if r.case_id != "T1-01":
@@ -368,13 +421,7 @@ def figures_5_6(results: list[cases.CaseRun]) -> dict:
             row.update(before_km_last_sample=float(np.asarray(r.err_before_t_km)[:, -1].mean()),
                        after_km_last_sample=float(np.asarray(r.err_after_t_km)[:, -1].mean()))
         f6.append(row)
-    return {"A-F5": {"claims": [], "reason": ("states no number of its own: the text reads it together with Fig. 4 "
-                                              "(tx and ty estimated effectively: A-C1); rows: the position error at "
-                                              "the end of the first and the last EM segment"), "rows": f5},
-            "A-F6": {"claims": ["A-C6", "A-C7"], "reason": ("its numbers (79.13 km before, 18.43 km after) are "
-                                                            "Table 1's, judged as A-C6 and A-C7 by the table's rule; "
-                                                            "rows add the errors at the arc's last sample"),
-                     "rows": f6}}
+    return Figures56(f5=FigureRows(claims=[], rows=f5), f6=FigureRows(claims=["A-C6", "A-C7"], rows=f6))
 
 
 def _stars_key(row: StarsRow) -> str:
@@ -386,14 +433,66 @@ def _stars_key(row: StarsRow) -> str:
     return tag + f"{row.value:g}".replace(".", "p").replace("-", "n")
 
 
-def stars_summary(study: list[StarsRow], target_arcsec: float) -> dict:
+@dataclass(frozen=True)
+class StarsEstimatorSummary:
+    """One estimator of a stars-study row in the summary: seed mean and sd of (tx, ty, tz), RMS error
+    in (tx, ty), arcsec; the EM's label and the RMS error of the ML estimate of its data (None: the
+    estimator has none)."""
+
+    mean_arcsec: list
+    sd_arcsec: list
+    rmse_xy_arcsec: float
+    label: str | None = field(default=None, metadata=OMIT_NONE)
+    ml_rmse_xy_arcsec: float | None = field(default=None, metadata=OMIT_NONE)
+
+
+@dataclass(frozen=True)
+class StarsRowSummary:
+    """One stars-study row in the summary (:func:`stars_summary`): its settings, stars per image along
+    the arc, the bound of tx, ty, tz after all the data (Q and Q = 0) and of the star images alone,
+    the attitude floor, samples after N0 until the bound of tx and ty is at most the target (None:
+    never), and per estimator its :class:`StarsEstimatorSummary`."""
+
+    sweep: str
+    per_image: int
+    every_K: int
+    images: int
+    total_samples: int
+    attitude_sigma_arcsec: float
+    mode_drift_arcsec: float
+    mag_limit: float
+    field_deg: float
+    camera_field_deg: float
+    stars_per_image: Any
+    floor_arcsec: float
+    crlb_arcsec: list
+    crlb_q0_arcsec: list
+    crlb_stars_only_arcsec: list
+    samples_to_target: float | None
+    estimators: dict[str, StarsEstimatorSummary]
+
+
+@dataclass(frozen=True)
+class StarsObjection:
+    """The attitude knowledge at which the stars bound reaches the target (arcsec), and the target."""
+
+    attitude_threshold_arcsec: float
+    target_arcsec: float
+
+
+@dataclass(frozen=True)
+class StarsSummary:
+    """The stars study for the summary: each row by its key (:func:`_stars_key`, written at the top
+    level of the JSON object) and ``objection``."""
+
+    rows: dict[str, StarsRowSummary] = field(metadata={"json_flatten": True})
+    objection: StarsObjection | None = field(default=None, metadata=OMIT_NONE)
+
+
+def stars_summary(study: list[StarsRow], target_arcsec: float) -> StarsSummary:
     """The stars study (:func:`opnav.approach.alternatives.stars_study`) for the summary, per row
-    (:func:`_stars_key`): its settings, stars per image along the arc, the bound of tx, ty, tz
-    after all the data (Q and Q = 0) and of the star images alone, the attitude floor
-    ``hypot(sigma_a / sqrt(images), drift)``, samples after N0 until the bound of tx and ty is at
-    most ``target_arcsec``, and per estimator the seed mean and sd of (tx, ty, tz), its RMS error
-    in tx, ty, and its label (EM); plus ``objection``: the attitude knowledge at which the bound
-    reaches the target (``attitude_threshold_arcsec``)."""
+    (:func:`_stars_key`; :class:`StarsRowSummary`), with the attitude knowledge at which the bound
+    reaches ``target_arcsec`` (``objection``)."""
     out = {}
     for row in study:
         curve = np.asarray(row.crlb_curve_arcsec)
@@ -402,29 +501,24 @@ def stars_summary(study: list[StarsRow], target_arcsec: float) -> dict:
         est = {}
         for name, e in row.estimators.items():
             th = np.asarray(e.theta_final_arcsec, float)
-            d = {"mean_arcsec": [float(x) for x in th.mean(0)],
-                 "sd_arcsec": [float(x) for x in (th.std(0, ddof=1) if th.shape[0] > 1 else np.full(3, np.nan))],
-                 "rmse_xy_arcsec": float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2)))}
-            if e.label is not None:
-                d["label"] = row_label(e.label)[0]
-            if e.theta_ml_arcsec is not None:
-                ml = np.asarray(e.theta_ml_arcsec, float)
-                d["ml_rmse_xy_arcsec"] = float(np.sqrt(np.mean((ml[:, :2] - truth[:2]) ** 2)))
-            est[name] = d
-        out[_stars_key(row)] = {
-            "sweep": row.sweep, "per_image": row.per_image, "every_K": row.every_K,
-            "images": row.images, "total_samples": row.total_samples,
-            "attitude_sigma_arcsec": row.attitude_sigma_arcsec, "mode_drift_arcsec": row.mode_drift_arcsec,
-            "mag_limit": row.mag_limit, "field_deg": row.field_deg, "camera_field_deg": row.camera_field_deg,
-            "stars_per_image": dataclasses.asdict(row.stars_per_image), "floor_arcsec": row.floor_arcsec,
-            "crlb_arcsec": [float(x) for x in row.crlb_all_arcsec],
-            "crlb_q0_arcsec": [float(x) for x in row.crlb_all_q0_arcsec],
-            "crlb_stars_only_arcsec": [float(x) for x in row.crlb_stars_only_arcsec],
-            "samples_to_target": None if math.isnan(need) else need, "estimators": est}
-    if study:
-        out["objection"] = {"attitude_threshold_arcsec": float(study[0].attitude_threshold_arcsec),
-                            "target_arcsec": float(target_arcsec)}
-    return out
+            ml = None if e.theta_ml_arcsec is None else np.asarray(e.theta_ml_arcsec, float)
+            est[name] = StarsEstimatorSummary(
+                mean_arcsec=[float(x) for x in th.mean(0)],
+                sd_arcsec=[float(x) for x in (th.std(0, ddof=1) if th.shape[0] > 1 else np.full(3, np.nan))],
+                rmse_xy_arcsec=float(np.sqrt(np.mean((th[:, :2] - truth[:2]) ** 2))),
+                label=None if e.label is None else row_label(e.label)[0],
+                ml_rmse_xy_arcsec=None if ml is None else float(np.sqrt(np.mean((ml[:, :2] - truth[:2]) ** 2))))
+        out[_stars_key(row)] = StarsRowSummary(
+            sweep=row.sweep, per_image=row.per_image, every_K=row.every_K, images=row.images,
+            total_samples=row.total_samples, attitude_sigma_arcsec=row.attitude_sigma_arcsec,
+            mode_drift_arcsec=row.mode_drift_arcsec, mag_limit=row.mag_limit, field_deg=row.field_deg,
+            camera_field_deg=row.camera_field_deg, stars_per_image=row.stars_per_image,
+            floor_arcsec=row.floor_arcsec, crlb_arcsec=[float(x) for x in row.crlb_all_arcsec],
+            crlb_q0_arcsec=[float(x) for x in row.crlb_all_q0_arcsec],
+            crlb_stars_only_arcsec=[float(x) for x in row.crlb_stars_only_arcsec],
+            samples_to_target=None if math.isnan(need) else need, estimators=est)
+    objection = (StarsObjection(float(study[0].attitude_threshold_arcsec), float(target_arcsec)) if study else None)
+    return StarsSummary(rows=out, objection=objection)
 
 
 def stars_frame(study: list[StarsRow]) -> pd.DataFrame:
@@ -457,53 +551,138 @@ def stars_frame(study: list[StarsRow]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+@dataclass(frozen=True)
+class VariantHeadline:
+    """One headline (T1-01) row of A-summary.json ``variants`` (:func:`summary`): its scheme, the
+    estimate's seed mean and sd and the sampled rerun's spread and RMS error, the bounds (of the
+    data used, Q = 0, all the data), the convergence label and its counts, the filters'
+    consistency, the distance to the ML estimate, the data to converge, the navigation errors and
+    their split, the convergence study's EM maps and the variant's bound against the target (A-X1).
+    A value the tables do not hold is None. ``reading`` and ``nav_note``: the row's words (the
+    report's, :mod:`opnav.report.approach.text`)."""
+
+    scenario: str
+    method: str
+    mode: str
+    est_x_mean: float
+    est_x_std: float
+    est_y_mean: float
+    est_y_std: float
+    est_x_std_sampled: float | None
+    rmse_x_sampled: float | None
+    crlb_x_arcsec: float
+    crlb_y_arcsec: float
+    crlb_q0_x_arcsec: float | None
+    crlb_all_x_arcsec: float | None
+    crlb_all_y_arcsec: float | None
+    label: str
+    converged_seeds: int
+    stalled: bool
+    stalled_seeds: int
+    n_seeds: int
+    identifiable: bool
+    nees_pos_before_mean: float | None
+    nees_pos_after_mean: float | None
+    nis_before_mean: float | None
+    nis_after_mean: float | None
+    nees_pos_consider_mean: float | None
+    nees_pos_true_theta_mean: float | None
+    contraction_per_map: float | None
+    dist_to_ml_arcsec: float | None
+    dist_to_ml_over_bound: float | None
+    data_to_converge_samples: float | None
+    nav_err_before_km: float
+    nav_err_after_km: float
+    nav_err_true_theta_km: float | None
+    nav_err_consider_km: float | None
+    nav_err_before_lat_km: float | None
+    nav_err_before_rng_km: float | None
+    nav_err_after_lat_km: float | None
+    nav_err_after_rng_km: float | None
+    nav_err_true_theta_lat_km: float | None
+    nav_err_true_theta_rng_km: float | None
+    iterations_plain_median: float | None
+    iterations_plain_extrapolated_median: float | None
+    iterations_squarem_median: float | None
+    mle_rmse_x_arcsec: float | None
+    bound_reaches_target: bool | None
+    reading: str = ""
+    nav_note: str = ""
+
+
+@dataclass(frozen=True)
+class ASummary:
+    """A-summary.json (:func:`summary`; written by the workflow's approach_tables rule): the
+    profile's segments, the claimed accuracy (the analysis plan's A-C1 target), what the prior
+    alone bounds theta to, the convergence study's map budget, the headline rows by their A-T1
+    ``variant`` (:class:`VariantHeadline`) and the studies' parts (None: not computed, left out of
+    the JSON): roll rate, stars, consistency, the Mars images' attitude, the roll-rate bound, the
+    navigation floor against arc length and tz, Figs. 5-6, the installation rows and the sample
+    time; the build's profile and the manuscript's finding sentences (``text``, the report's)."""
+
+    profile_segments: Any
+    accuracy_target_arcsec: float
+    prior_bound_arcsec: float
+    convergence_max_maps: int
+    variants: dict[str, VariantHeadline]
+    roll_rate: RollRateSummary | None = field(default=None, metadata=OMIT_NONE)
+    stars: StarsSummary | None = field(default=None, metadata=OMIT_NONE)
+    nees: dict[str, NeesRow] | None = field(default=None, metadata=OMIT_NONE)
+    mars_attitude: MarsAttitude | None = field(default=None, metadata=OMIT_NONE)
+    roll_rate_bound: RollRateBound | None = field(default=None, metadata=OMIT_NONE)
+    nav_floor_by_arc: NavFloorSummary | None = field(default=None, metadata=OMIT_NONE)
+    tz_nav_effect: Any = field(default=None, metadata=OMIT_NONE)
+    figures_5_6: Figures56 | None = field(default=None, metadata=OMIT_NONE)
+    installation: Any = field(default=None, metadata=OMIT_NONE)
+    sample_time: Any = field(default=None, metadata=OMIT_NONE)
+    profile: str | None = field(default=None, metadata=OMIT_NONE)
+    text: dict[str, str] | None = field(default=None, metadata=OMIT_NONE)
+
+    def replace(self, **changes) -> ASummary:
+        return dataclasses.replace(self, **changes)
+
+
 def summary(setup: Setup, t1: pd.DataFrame, x1: pd.DataFrame, target_arcsec: float,
-            roll_rate: dict | None = None) -> dict:
+            roll_rate: RollRateBounds | None = None) -> ASummary:
     """Headline numbers per variant and EM scheme for the manuscript macros; ``target_arcsec``: the
     claimed accuracy (the analysis plan's A-C1 target); ``roll_rate``: the roll-rate study
-    (:func:`opnav.approach.pipeline.roll_rate_study`), if run."""
-    out = {"profile_segments": setup.segments.as_dict(), "accuracy_target_arcsec": float(target_arcsec),
-           "prior_bound_arcsec": prior_bound_arcsec(setup),
-           "convergence_max_maps": setup.convergence_study.max_maps, "variants": {}}
-    if roll_rate is not None:
-        out["roll_rate"] = roll_rate_summary(roll_rate)
-    for _, r in t1[t1["case_id"] == "T1-01"].iterrows():
-        x = x1[x1["variant"] == r["scenario"]]
-        x = x.iloc[0] if len(x) else {}
-        out["variants"][r["variant"]] = {
-            "scenario": r["scenario"], "method": r["method"], "mode": r.get("mode", "sliding"),
-            "est_x_mean": r["est_x_mean"], "est_x_std": r["est_x_std"],
-            "est_y_mean": r["est_y_mean"], "est_y_std": r["est_y_std"],
-            "est_x_std_sampled": _num(r, "est_x_std_sampled"), "rmse_x_sampled": _num(r, "rmse_x_sampled"),
-            "crlb_x_arcsec": r["crlb_x_arcsec"], "crlb_y_arcsec": r["crlb_y_arcsec"],
-            "crlb_q0_x_arcsec": _num(r, "crlb_q0_x_arcsec"),
-            "crlb_all_x_arcsec": _num(r, "crlb_all_x_arcsec"), "crlb_all_y_arcsec": _num(r, "crlb_all_y_arcsec"),
-            "label": r["label"], "converged_seeds": int(r["converged_seeds"]),
-            "stalled": bool(r["stalled"]), "stalled_seeds": int(r["stalled_seeds"]), "n_seeds": int(r["n_seeds"]),
-            "identifiable": bool(r["identifiable"]), "reading": r["reading"],
-            **{f"{q}_{k}_mean": _num(r, f"{q}_{k}_mean") for q in ("nees_pos", "nis") for k in ("before", "after")},
-            "nees_pos_consider_mean": _num(r, "nees_pos_consider_mean"),
-            "nees_pos_true_theta_mean": _num(r, "nees_pos_true_theta_mean"),
-            "contraction_per_map": _num(r, "contraction_per_map"),
-            "dist_to_ml_arcsec": _num(r, "dist_to_ml_arcsec"),
-            "dist_to_ml_over_bound": _num(r, "dist_to_ml_over_bound"),
-            "data_to_converge_samples": _num(r, "data_to_converge_samples"),
-            "nav_err_before_km": r["nav_err_before_km"], "nav_err_after_km": r["nav_err_after_km"],
-            **{k: _num(r, k) for k in NAV_SPLIT_KEYS},
-            "nav_note": nav_note(r),
-            "iterations_plain_median": _num(x, "maps_plain_median"),
-            "iterations_plain_extrapolated_median": _num(x, "maps_plain_extrapolated_median"),
-            "iterations_squarem_median": _num(x, "maps_squarem_median"),
-            "mle_rmse_x_arcsec": _num(x, "mle_rmse_x_arcsec"),
-            "bound_reaches_target": bool(x["bound_reaches_target"]) if len(x) else None,
-        }
-    return out
+    (:func:`opnav.approach.pipeline.roll_rate_study`), if run. The studies' parts are added with
+    :meth:`ASummary.replace`."""
+    variants = {}
+    for r in t1[t1.case_id == "T1-01"].itertuples():
+        xs = x1[x1.variant == r.scenario]
+        x = next(xs.itertuples()) if len(xs) else None
+        variants[r.variant] = VariantHeadline(
+            scenario=r.scenario, method=r.method, mode=r.mode,
+            est_x_mean=r.est_x_mean, est_x_std=r.est_x_std, est_y_mean=r.est_y_mean, est_y_std=r.est_y_std,
+            est_x_std_sampled=_num(r, "est_x_std_sampled"), rmse_x_sampled=_num(r, "rmse_x_sampled"),
+            crlb_x_arcsec=r.crlb_x_arcsec, crlb_y_arcsec=r.crlb_y_arcsec,
+            crlb_q0_x_arcsec=_num(r, "crlb_q0_x_arcsec"),
+            crlb_all_x_arcsec=_num(r, "crlb_all_x_arcsec"), crlb_all_y_arcsec=_num(r, "crlb_all_y_arcsec"),
+            label=r.label, converged_seeds=int(r.converged_seeds), stalled=bool(r.stalled),
+            stalled_seeds=int(r.stalled_seeds), n_seeds=int(r.n_seeds), identifiable=bool(r.identifiable),
+            **{f: _num(r, f) for f in ("nees_pos_before_mean", "nees_pos_after_mean", "nis_before_mean",
+                                       "nis_after_mean", "nees_pos_consider_mean", "nees_pos_true_theta_mean",
+                                       "contraction_per_map", "dist_to_ml_arcsec", "dist_to_ml_over_bound",
+                                       "data_to_converge_samples") + NAV_SPLIT_KEYS},
+            nav_err_before_km=r.nav_err_before_km, nav_err_after_km=r.nav_err_after_km,
+            iterations_plain_median=_num(x, "maps_plain_median"),
+            iterations_plain_extrapolated_median=_num(x, "maps_plain_extrapolated_median"),
+            iterations_squarem_median=_num(x, "maps_squarem_median"),
+            mle_rmse_x_arcsec=_num(x, "mle_rmse_x_arcsec"),
+            bound_reaches_target=bool(x.bound_reaches_target) if x is not None else None)
+    return ASummary(profile_segments=setup.segments, accuracy_target_arcsec=float(target_arcsec),
+                    prior_bound_arcsec=prior_bound_arcsec(setup),
+                    convergence_max_maps=setup.convergence_study.max_maps, variants=variants,
+                    roll_rate=roll_rate_summary(roll_rate) if roll_rate is not None else None)
 
 
-def _num(row, key):
+def _num(row, key: str) -> float | None:
+    """A row's (``itertuples``) value of column ``key`` as a float, None when absent, not a number,
+    NaN or infinite."""
     try:
-        v = float(row[key])
-    except (KeyError, TypeError, ValueError):
+        v = float(getattr(row, key))
+    except (AttributeError, TypeError, ValueError):
         return None
     return None if math.isnan(v) else (v if math.isfinite(v) else None)
 

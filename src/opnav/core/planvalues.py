@@ -23,13 +23,17 @@ ACCURACY_TARGET = ("A-C1", "target_arcsec")
 
 
 @lru_cache(maxsize=8)
-def _claims(path: str, mtime_ns: int) -> dict:
-    del mtime_ns  # part of the cache key only: an edited plan is read again
+def _margins(path: str, mtime_ns: int) -> tuple[tuple[str, str, object], ...]:
+    """Every ``(claim id, margin name, value)`` of the plan at ``path`` (``mtime_ns``: part of the
+    cache key only, so an edited plan is read again)."""
+    del mtime_ns
     raw = yaml.load(Path(path).read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     claims = raw.get("claims") if isinstance(raw, dict) else None
     if not isinstance(claims, dict):
         raise ValueError(f"{path}: the analysis plan needs a 'claims' mapping")
-    return claims
+    return tuple((str(cid), str(name), m.get("value") if isinstance(m, dict) else None)
+                 for cid, c in claims.items() if isinstance(c, dict)
+                 for name, m in (c.get("margins") or {}).items())
 
 
 def margin(claim_id: str, name: str, path: str | Path | None = None) -> float:
@@ -37,13 +41,12 @@ def margin(claim_id: str, name: str, path: str | Path | None = None) -> float:
     package's ``data/analysis_plan.yaml``); ValueError naming the key when it is absent or not a number."""
     p = Path(path) if path is not None else PLAN_FILE
     try:
-        claims = _claims(str(p), p.stat().st_mtime_ns)
+        margins = _margins(str(p), p.stat().st_mtime_ns)
     except OSError as exc:
         raise ValueError(f"{p}: cannot read the analysis plan ({exc.strerror})") from None
-    try:
-        value = claims[claim_id]["margins"][name]["value"]
-    except (KeyError, TypeError):
-        raise ValueError(f"{p}: claims.{claim_id}.margins.{name}.value is missing") from None
+    value = next((v for cid, n, v in margins if (cid, n) == (claim_id, name)), None)
+    if value is None:
+        raise ValueError(f"{p}: claims.{claim_id}.margins.{name}.value is missing")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{p}: claims.{claim_id}.margins.{name}.value must be a number, got {value!r}")
     return float(value)

@@ -149,21 +149,49 @@ def write_checksum(path: str | Path, text: str) -> None:
     atomic_write_text(checksum_path(path), f"sha256={hashlib.sha256(data).hexdigest()} bytes={len(data)}\n")
 
 
-def json_ready(x):
-    """``x`` with numpy scalars as Python numbers and NaN/inf as ``None`` (valid JSON)."""
+#: dataclass field metadata for :func:`json_ready`: ``omit_none`` leaves the key out while the
+#: value is None (an optional part of a document), ``json_key`` writes the field under another key
+#: (one that is no Python name, e.g. ``A-F5``), ``json_skip`` never writes it (a number the
+#: record carries for its words, not part of the document)
+OMIT_NONE = {"omit_none": True}
+JSON_SKIP = {"json_skip": True}
+
+
+def json_key(key: str, omit_none: bool = False) -> dict:
+    """Field metadata writing a dataclass field under ``key`` in JSON (:func:`json_ready`)."""
+    return {"json_key": key, "omit_none": omit_none}
+
+
+def json_ready(x, nan_as_none: bool = True):
+    """``x`` with numpy scalars as Python numbers and NaN/inf as ``None`` (valid JSON;
+    ``nan_as_none=False`` keeps them: the document in memory); a dataclass (a typed record) as the
+    mapping of its fields (metadata: :data:`OMIT_NONE`, :func:`json_key`, :data:`JSON_SKIP`,
+    ``json_flatten``: a mapping field whose items are written into the record's own object)."""
+    import dataclasses
     import math
 
     import numpy as np
 
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        out = {}
+        for f in dataclasses.fields(x):
+            v = getattr(x, f.name)
+            if f.metadata.get("json_skip") or (f.metadata.get("omit_none") and v is None):
+                continue
+            if f.metadata.get("json_flatten"):
+                out.update(json_ready(v, nan_as_none))
+            else:
+                out[f.metadata.get("json_key", f.name)] = json_ready(v, nan_as_none)
+        return out
     if isinstance(x, dict):
-        return {str(k): json_ready(v) for k, v in x.items()}
+        return {str(k): json_ready(v, nan_as_none) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [json_ready(v) for v in x]
+        return [json_ready(v, nan_as_none) for v in x]
     if isinstance(x, np.ndarray):
-        return json_ready(x.tolist())
+        return json_ready(x.tolist(), nan_as_none)
     if isinstance(x, (np.floating, float)):
         x = float(x)
-        return x if math.isfinite(x) else None
+        return x if math.isfinite(x) or not nan_as_none else None
     if isinstance(x, (np.integer,)):
         return int(x)
     if isinstance(x, np.bool_):

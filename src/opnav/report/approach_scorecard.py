@@ -11,7 +11,8 @@ import math
 
 import pandas as pd
 
-from opnav.approach.summaries import HeadlineSummary, nav_note
+from opnav.approach.summaries import HeadlineSummary
+from opnav.report.approach.text import nav_note
 from opnav.core.verdicts import NOT_REPRODUCED, NOT_REPRODUCIBLE, REPRODUCED
 
 #: floors for values published with few digits (module docstring)

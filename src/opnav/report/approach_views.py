@@ -9,7 +9,8 @@ from collections.abc import Iterable
 
 import pandas as pd
 
-from opnav.approach.alternatives_summary import METHOD_LABELS, MethodSummary
+from opnav.approach.alternatives_summary import MethodSummary
+from opnav.report.approach.text import METHOD_LABELS
 from opnav.core.tables import cell_num, cell_pm
 
 #: the table captions of paper A's tables (their CSV/LaTeX/Markdown headers)

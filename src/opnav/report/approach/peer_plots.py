@@ -17,7 +17,7 @@ def peer_figure(peer: list[dict], table):
     seeds); shaded: truth +- 3 CRLB of the paper's estimators."""
     import matplotlib.pyplot as plt
 
-    from .peers import RUN_LABELS
+    from .text import RUN_LABELS
 
     nv = len(peer)
     with figures.style():

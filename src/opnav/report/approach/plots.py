@@ -358,16 +358,16 @@ def fig_nav_floor(nf: dict, limit_km: float | None = None):
     (black); ``limit_km`` (the paper's 20 km, from the analysis plan) dotted."""
     import matplotlib.pyplot as plt
 
-    rows = nf["rows"]
-    x = np.array([r["arc_s"] for r in rows], float)
+    rows = nf.rows
+    x = np.array([r.arc_s for r in rows], float)
     with figures.style():
         fig, ax = plt.subplots(figsize=(figures.PAGE_WIDTH_IN * 0.7, 3.4), layout="constrained")
         for key, color, name, z in (("true_theta_km", "0.55", r"true $\theta$ (a filter's floor)", 2),
-                                    ("nav_err_km", figures.color("growing-squarem"), f"{nf['variant']}, compensated", 3),
+                                    ("nav_err_km", figures.color("growing-squarem"), f"{nf.variant}, compensated", 3),
                                     ("before_km", "k", r"$\theta = 0$", 2)):
-            ax.plot(x, [r[f"{key}_rule"] for r in rows], "o-", color=color, lw=1.0 if z == 3 else 1.8, ms=3, zorder=z,
+            ax.plot(x, [getattr(r, f"{key}_rule") for r in rows], "o-", color=color, lw=1.0 if z == 3 else 1.8, ms=3, zorder=z,
                     label=f"{name}, RMS over the last part")
-            ax.plot(x, [r[f"{key}_last"] for r in rows], "s--", color=color, lw=0.8 if z == 3 else 1.6, ms=2.5,
+            ax.plot(x, [getattr(r, f"{key}_last") for r in rows], "s--", color=color, lw=0.8 if z == 3 else 1.6, ms=2.5,
                     zorder=z, label=f"{name}, last sample")
         if limit_km is not None:
             ax.axhline(limit_km, color="C3", lw=0.8, ls=":", label=f"paper's limit {limit_km:g} km")
@@ -375,6 +375,6 @@ def fig_nav_floor(nf: dict, limit_km: float | None = None):
         _plain_log_ticks(ax)
         ax.set_xlabel("arc length (s)")
         ax.set_ylabel("position error (km)")
-        ax.set_title(f"A-X7 navigation error against arc length, {rows[0]['n_seeds']} seeds", fontsize=8)
+        ax.set_title(f"A-X7 navigation error against arc length, {rows[0].n_seeds} seeds", fontsize=8)
         fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=5.5, ncol=2, frameon=False)
     return fig

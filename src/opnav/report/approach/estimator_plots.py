@@ -24,18 +24,18 @@ def fig_convergence(curves: dict, colors: dict | None = None):
                                 sharex=True, squeeze=False, constrained_layout=True)
         for i, v in enumerate(variants):
             c = curves[v]
-            d = c["data"]
+            d = c.data
             for j, ax_name in enumerate(("t_x", "t_y")):
                 ax = axs[i, j]
-                tr, b = c["truth"][j], c["bound"][:, j]
+                tr, b = c.truth[j], c.bound[:, j]
                 ax.axhline(tr, color="k", ls="--", lw=0.8, label="truth")
                 ax.plot(d, tr + b, color="0.4", ls=":", lw=0.8, label=r"truth $\pm$ 1-sigma bound of the data used")
                 ax.plot(d, tr - b, color="0.4", ls=":", lw=0.8)
-                for n, th in c["estimators"].items():
+                for n, th in c.estimators.items():
                     col = colors.get(n) or figures.color(n)
                     m = th[:, :, j].mean(axis=0)
                     sd = th[:, :, j].std(axis=0, ddof=1) if th.shape[0] > 1 else np.zeros_like(m)
-                    ax.plot(d, m, color=col, lw=1.2, marker="o", ms=2.5, label=c["labels"].get(n, n))
+                    ax.plot(d, m, color=col, lw=1.2, marker="o", ms=2.5, label=c.labels.get(n, n))
                     ax.fill_between(d, m - sd, m + sd, color=col, alpha=0.2, lw=0)
                 ax.set_title(f"{v}: ${ax_name}$", fontsize="medium")
                 if j == 0:
