@@ -353,7 +353,7 @@ def convergence_labels(dist_ml_arcsec: np.ndarray, rate: np.ndarray, ml_tol_arcs
     * ``not converged``: farther than that but still contracting (its map budget ran out).
 
     Whether a converged estimate means anything is the bound's reading, not this label's
-    (:func:`opnav.approach.labels.reading_text`). Two starts on the same data
+    (:func:`opnav.report.approach.text.reading_text`). Two starts on the same data
     reach the same ML estimate, hence the same label."""
     dist = np.asarray(dist_ml_arcsec, float)
     slow = np.nan_to_num(np.asarray(rate, float), nan=0.0) >= rate_max
