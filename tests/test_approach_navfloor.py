@@ -124,7 +124,7 @@ def test_the_nees_sentence_judges_against_the_true_theta_filter():
                                      "n_seeds": 20, "after_minus_reference_mean": 11.2, "after_minus_reference_se": 2.0,
                                      "consider_minus_reference_mean": -0.73, "consider_minus_reference_se": 0.1}}
     txt = approach_text.nees_text(nees)
-    assert "13.8" in txt and "2.53" in txt and "1.8" in txt
+    assert "13.8" in txt and "2.53" in txt and "1.8" in txt and "20 seeds" in txt
     assert "above it (optimistic" in txt and "below it (conservative)" in txt and "3 expected" not in txt
     nees["roll+growing+squarem"]["consider_minus_reference_mean"] = -0.1
     assert "indistinguishable from it" in approach_text.nees_text(nees)

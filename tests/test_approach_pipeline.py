@@ -108,11 +108,12 @@ def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalle
     txt = approach_text.findings(cfg, summaries.HeadlineSummary.from_json(summ), pub, TARGET)
     assert ("no variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
     assert ("add almost nothing to the prior" in txt["bound"]) is bool(lit_bound > 0.8 * summ["prior_bound_arcsec"])
-    assert ("stalled (4/4)" in txt["headline_roll"]) is roll_stalled
+    # the row's reading opens its own sentence (capitalised)
+    assert ("stalled (4/4)" in txt["headline_roll"].lower()) is roll_stalled
     assert "16.6 arcsec from the ML estimate" in txt["headline_roll"] if roll_stalled else \
-        "converged (4/4)" in txt["headline_roll"]
+        "converged (4/4)" in txt["headline_roll"].lower()
     # the literal row converged either way; whether it means anything is the bound's reading
-    assert "converged (4/4)" in txt["headline_literal"]
+    assert "converged (4/4)" in txt["headline_literal"].lower()
     assert ("not identifiable from this data (bound 20.6 arcsec)" in txt["headline_literal"]) is (lit_bound > 2.0)
     assert "stalled" not in txt["headline_literal"]
     assert ("within 3 bound-sigma of the truth: roll." in txt["reading"]) is (not roll_stalled)

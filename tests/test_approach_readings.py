@@ -91,9 +91,11 @@ def test_stars_text_reads_the_objection_from_the_numbers():
     st = doc(summaries.stars_summary(rows, 2.0))
     assert set(st) == {"m3", "m30", "att0", "att20", "objection"}
     txt = approach_text.stars_text(st, 2.0)
-    assert "better than 5.38 arcsec" in txt and "(unchanged)" in txt and "From 3 to 30 stars per image" in txt
-    assert "3 stars in every image (to magnitude 8 in a 2.84 deg field)" in txt
-    assert "30 stars in every image (to magnitude 8 in a 6 deg field, widened from the camera's 2.84 deg)" in txt
+    assert "better than 5.38 arcsec" in txt and "(unchanged)" in txt
+    assert "With 3 stars in every image (to magnitude 8 in a 2.84 deg field) the bound" in txt
+    assert "With 30 stars in every image (to magnitude 8 in a 6 deg field, widened from the camera's 2.84 deg)" in txt
+    from opnav.core import wording
+    assert not wording.long_sentences(txt), wording.long_sentences(txt)
     rows[1] = _star_row("per_image", 30, 0.95, per_image=30)
     assert "(50 % lower)" in approach_text.stars_text(doc(summaries.stars_summary(rows, 2.0)), 2.0)
     rows = [replace(r, attitude_threshold_arcsec=0.0) for r in rows]

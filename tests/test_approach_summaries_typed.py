@@ -37,8 +37,8 @@ def test_headline_rows_are_read_by_scenario_method_and_mode_not_by_their_key():
     assert [r.key for r in hs.rows] == ["row-a", "row-b", "row-c"]
     assert [r.as_written_scheme for r in hs.rows] == [True, False, False]
     txt = approach_text.findings(approach_setup(), hs, published.paper_a()["headline"], TARGET)
-    assert "plain EM, sliding windows: converged in literal | growing squarem: stalled in literal | " \
-           "squarem: converged in roll." in txt["stall"]
+    assert "Plain EM, sliding windows: converged in literal. Growing squarem: stalled in literal. " \
+           "Squarem: converged in roll." in txt["stall"]
     assert "3 arcsec (literal), against" in txt["bound"]  # the paper's scheme only
     assert {k for k in txt if k.startswith("headline_")} == {"headline_row-a", "headline_row-b", "headline_row-c"}
 

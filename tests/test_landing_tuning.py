@@ -126,8 +126,8 @@ def test_nees_retuned_text_and_table_read_the_numbers():
     assert t["reading"].tolist() == ["underconfident", "consistent in position, overconfident in velocity"]
     assert t["meas_noise_scale"].tolist() == [5.0, 2.3]
     s = nees_retuned_text(_record(2.85, 4.19, True))
-    assert "(interior camera: " in s and "2.3 against the paper tuning's 5" in s and "position 2.85 (consistent" in s
-    assert "velocity 4.19 (overconfident" in s and "0.30 to 0.50 m" in s
+    assert "the interior camera's bearing-noise scale is 2.3 against the paper tuning's 5" in s
+    assert "position 2.85 (consistent)" in s and "velocity 4.19 (overconfident)" in s and "0.30 to 0.50 m" in s
     assert "does not pin the mean" in s and "heavier-tailed" in s
     assert "velocity NEES is 1.47 times the position's (1.10 with the paper tuning)" in s
     s = nees_retuned_text(_record(2.85, 4.19, False, run_max=4.0))

@@ -48,7 +48,7 @@ def test_abstract_is_at_most_200_words_with_every_choice_and_cause():
     """Issue 55 item 5: page 1 names the choice of every claim that depends on one and the cause
     of every claim not reproduced, in at most 200 words with main.tex's framing, every sentence at
     most 40 words; the other groups and what they would take only while they fit."""
-    from opnav.report import wording
+    from opnav.core import wording
     from opnav.report.claims import MAX_CAUSE_WORDS
 
     assert len(LONG_CAUSE.split()) >= MAX_CAUSE_WORDS - 3

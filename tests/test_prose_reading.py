@@ -1,11 +1,12 @@
 """Prose a reader can follow (issue 55 item 4): numbers, counts and changes said through one
-helper (opnav.report.wording), and no generated sentence longer than 40 words; the checks
+helper (opnav.core.wording), and no generated sentence longer than 40 words; the checks
 find what e19e33d's outputs held (the ~313-word navigation sentence of pp. 4-5, '1 maps',
 '1 stars per image', '-0 % lower', a velocity 3-sigma ratio of 0.9999 printed as 1)."""
 
 import pytest
 
-from opnav.report import print_size, wording
+from opnav.core import wording
+from opnav.report import print_size
 
 #: e19e33d's quick build, results/paper/macros.tex: the navigation sentence (one macro, one
 #: sentence of 322 words here, repeated per variant) and the convergence sentence's slip
@@ -68,3 +69,55 @@ def test_long_sentences_and_slips_are_found_in_e19e33d_fragments(tmp_path):
         r"\newcommand{\ATextStars}{From " + wording.count(1, "star") + " per image the bound is "
         + wording.change(-0.2) + ".}\n")
     assert print_size.slip_findings(tmp_path, used) == [] and print_size.long_sentence_findings(tmp_path, used) == []
+
+
+def test_per_method_sentences_became_tables():
+    """e19e33d's paper B text quoted the equivalence test once per baseline in one run-on
+    sentence, and paper A's text listed each variant's navigation error in one ~313-word
+    sentence: both are tables now, one row per pair or variant, the numbers from the summaries."""
+    from opnav.report import text_tables
+
+    iv = {"mean": -0.027, "lo": -0.073, "hi": 0.019, "margin": 0.0186, "level": 0.9}
+    sec = {"reference": "svd", "methods": {"depth": {"lastlm_pos_err_m": iv, "lmrms_pos_err_m": iv,
+                                                     "equivalent": False, "same_pick_pct": 71.3},
+                                           "random": {"lastlm_pos_err_m": {**iv, "mean": 0.83}, "equivalent": False}}}
+    b = {"equivalence": sec, "equivalence_vs_baselines": {
+        "cond": {"reference": "cond", "methods": {"depth": {"lastlm_pos_err_m": iv, "equivalent": True}}},
+        "gdop": {"reference": "gdop", "methods": {"depth": {"lastlm_pos_err_m": iv, "equivalent": True}}}}}
+    rows = text_tables.equivalence_rows(b)
+    pair = "pair (90 % intervals)"
+    assert [r[pair] for r in rows] == ["depth minus SVD", "depth minus GDOP", "depth minus condition number",
+                                       "random minus SVD (control)"]
+    assert rows[0]["last landmark update (m)"] == "-0.027 [-0.073, 0.019] +-0.0186"
+    assert rows[0]["equivalent"] == "no" and rows[1]["equivalent"] == "yes"
+    assert rows[-1]["role"] == "control" and rows[0]["same pick (%)"] == "71"
+    a = {"variants": {"literal": {"nav_err_after_km": 113.4, "nav_err_before_km": 113.5, "nav_err_after_lat_km": 108.0,
+                                  "nav_err_after_rng_km": 29.4, "nav_err_true_theta_km": 29.4},
+                      "literal+squarem": {"nav_err_after_km": 1.0}},
+         "nees": {"literal": {"nees_mean": 5.2e5, "after_minus_reference_mean": 5.2e5, "after_minus_reference_se": 10.0,
+                              "consider_nees_mean": 2.6, "consider_minus_reference_mean": 0.1,
+                              "consider_minus_reference_se": 0.2, "reference_nees_mean": 2.5, "n_seeds": 20}}}
+    nav = text_tables.nav_rows(a)
+    assert [r["variant"] for r in nav] == ["literal"] and nav[0]["after (km)"] == "113"   # the paper's scheme only
+    nees = text_tables.nees_rows(a)
+    assert nees[0]["as exact vs reference"] == "above" and nees[0]["Schmidt vs reference"] == "same"
+    tex = text_tables.render(text_tables.table_macros({"A": a, "B": b}))
+    assert r"\newcommand{\BEquivalenceTable}{\begin{tabular}" in tex and r"\newcommand{\ANavTable}" in tex
+    assert r"$\pm$0.0186" in tex
+
+
+# ------------------------------------------------------------ on a quick build
+@pytest.mark.slow
+def test_quick_build_text_has_short_sentences_and_no_number_slips(quick_results):
+    """Every generated sentence a reader meets in a quick build (the manuscript's generated LaTeX
+    fragments and the macros its text uses, every Markdown table's caption and every generated
+    caption) is at most 40 words, and no number reads '1 maps' or '-0 %'. On e19e33d's outputs,
+    read with e19e33d's paper/ (the macros its text used), the same checks find 115 long sentences
+    and 4 slips in its quick build (the 322-word navigation sentence among them) and 138 and 7 in
+    its full build."""
+    from conftest import REPO
+
+    results = quick_results / "results" / "quick"
+    used = print_size.manuscript_macros(REPO / "paper")
+    assert print_size.long_sentence_findings(results, used) == []
+    assert print_size.slip_findings(results, used) == []

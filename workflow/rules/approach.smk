@@ -205,7 +205,7 @@ rule approach_tables:
         stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
         nav_arc=f"{A_WORK}/nav_arc.pkl",
         plan=A_PLAN,
-        code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
+        code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "core/wording.py", "report/approach_views.py",
                  "report/approach/text.py",
                  "approach/readings.py", "approach/setup.py", "core/tables.py", "core/published.py", "data/published.yaml"),
     output:

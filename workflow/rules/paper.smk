@@ -96,7 +96,7 @@ rule paper_claims:
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
         code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/evidence.py",
-                 "report/plan.py", "report/scorer.py", "report/would_take_plot.py", "report/manuscript.py", "report/wording.py",
+                 "report/plan.py", "report/scorer.py", "report/would_take_plot.py", "report/manuscript.py", "core/wording.py",
                  "core/published.py"),
     output:
         csv=report(f"{PAPER}/claims.csv", caption=_caption("claims"), category="Claims", subcategory="claims table"),
@@ -228,9 +228,10 @@ rule paper_macros:
         scorecard=rules.paper_scorecard.output.json,
         claims=rules.paper_claims.output.json,
         published=src("data/published.yaml"),
-        code=src("report/manuscript.py", "core/published.py"),
+        code=src("report/manuscript.py", "core/published.py", "report/text_tables.py", "core/wording.py"),
     output:
         f"{PAPER}/macros.tex",
+        tables=f"{PAPER}/tables.tex",
     params:
         profile=config["profile"],
         # the model configuration the text may quote (\Cfg... macros); study values are
@@ -274,7 +275,7 @@ rule paper_page_one:
         published=src("data/published.yaml"),
         choices=src("data/differences.yaml"),
         code=src("report/manuscript.py", "report/claims_prose.py", "report/verdict_plot.py", "report/differences.py",
-                 "report/wording.py"),
+                 "core/wording.py"),
     output:
         abstract=f"{PAPER}/abstract.tex",
         fig_pdf=f"{PAPER}/verdicts.pdf",

@@ -55,7 +55,7 @@ if REP_CFG["enabled"]:
             crlb=f"{A_WORK}/crlb.pkl",
             stars=f"{A_WORK}/stars.pkl" if "stars" in A_VARIANTS else [],
             plan=A_PLAN,
-            code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "report/approach_views.py",
+            code=src("approach/labels.py", "approach/summaries.py", "report/approach_text.py", "core/wording.py", "report/approach_views.py",
                      "report/approach/text.py",
                      "approach/setup.py", "core/tables.py"),
         output:

@@ -115,7 +115,7 @@ for _name, _s in STUDIES.items():
             f"study_{_name}_outputs"
         input:
             runs=[f for f, _ in _files],
-            code=src("studies/tables.py", "studies/metrics.py", "studies/values.py", "studies/captions.py",
+            code=src("studies/tables.py", "studies/metrics.py", "studies/values.py", "studies/captions.py", "core/wording.py",
                      "landing/study.py", "core/tables.py",
                      "report/study_plots.py", "core/figures.py",
                      "opnav.mplstyle"),

@@ -17,8 +17,8 @@ with script_context(snakemake) as log:
     write_table(frame, snakemake.output.table,
                 caption="A-X6: star calibration on Hipparcos stars against the stars in every image (each count "
                         "with the magnitude limit and field that make it real) and the attitude knowledge per star "
-                        "image: bound of tx, ty (all data; stars alone), the attitude floor and the EM-EKF (growing "
-                        "windows, SQUAREM) over the seeds, arcsec.")
+                        "image. Columns: the bound of tx, ty (all data; stars alone), the attitude floor and the "
+                        "EM-EKF (growing windows, SQUAREM) over the seeds, arcsec.")
     with figures.style():
         fig = star_plots.stars_figure(frame, snakemake.params.target)
         figures.save(fig, snakemake.output.fig)

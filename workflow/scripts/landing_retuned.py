@@ -24,8 +24,8 @@ with script_context(snakemake) as log:
     write_table(table, snakemake.output.table,
                 caption=(f"B-T3 NEES ({scn} camera): {snakemake.params.method} with the paper's filter tuning "
                          "(flown by default) and with the bearing-noise scale retuned on the tuning runs alone "
-                         f"(closest to the band's centre); mean NEES on the {rec['tuning_n_runs']} tuning runs, "
-                         f"held-out mean NEES and share of filter times in the 95 % band on the {n} Monte-Carlo "
-                         "runs, the reading, and median position errors at the last landmark update and at "
-                         "touchdown."))
+                         f"(closest to the band's centre). Columns: mean NEES on the {rec['tuning_n_runs']} tuning "
+                         f"runs; held-out mean NEES and share of filter times in the 95 % band on the {n} "
+                         "Monte-Carlo runs; the reading; median position errors at the last landmark update and "
+                         "at touchdown."))
     log.info("NEES %s:\n%s", scn, table.to_string())

@@ -31,18 +31,16 @@ with script_context(snakemake) as log:
     df = summary_table(data, tm, published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
                        converged_pos_err_m=float(snakemake.params.converged_pos_err_m))
     write_table(df, snakemake.output.t3,
-                caption=(f"B-T3 ({scn} camera): per planning method, navigation errors at touchdown "
-                         "(final), at the last vision update (lastvis) and RMS over the descent "
-                         "(mean, median, 3-sigma), filter NEES, planning calls on the edge of the "
-                         "visible interval and the picked landmark's metric over the best detected "
-                         "one's; per pair of methods the same-pick rate, median |delta beta*| and "
-                         "the paired difference of RMS and final position errors with its 95 % "
-                         "interval; median planning-call time ("
-                         f"baselines on the {snakemake.params.eval_path} path over timed_calls, _alt on the "
-                         "other over timed_calls_alt, its reductions on the calls timed on both) "
-                         "and its reduction against each other method (bootstrap standard "
-                         "deviation over runs); the published 29.03 % (depth vs SVD) is "
-                         "labelled published. Converged: final position error below "
+                caption=(f"B-T3 ({scn} camera), per planning method: navigation errors at touchdown (final), at "
+                         "the last vision update (lastvis) and RMS over the descent (mean, median, 3-sigma). It "
+                         "adds the filter NEES, the planning calls on the edge of the visible interval and the "
+                         "picked landmark's metric over the best detected one's. Per pair of methods: the "
+                         "same-pick rate, median |delta beta*| and the paired difference of RMS and final "
+                         "position errors with its 95 % interval. The median planning-call time has baselines "
+                         f"on the {snakemake.params.eval_path} path over timed_calls and _alt on the other over "
+                         "timed_calls_alt, with its reductions on the calls timed on both. Each reduction against "
+                         "another method has its bootstrap standard deviation over runs; the published 29.03 % "
+                         "(depth vs SVD) is labelled published. Converged: final position error below "
                          f"{snakemake.params.converged_pos_err_m:g} m. " + timing_summary.method_text(tm)))
     single = load_json(snakemake.input.single)
     every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
@@ -78,13 +76,12 @@ with script_context(snakemake) as log:
                        c["gravity_mps2"], float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2")).r[:, 2]
     end = end_phase_table(every, alt, float(cut["update_altitude_margin_m"]))
     write_table(end, snakemake.output.end_phase,
-                caption=(f"B-T3 end phase ({scn} camera): per method, over its runs, the time of the last "
-                         "landmark update and of the last vision update (median, min, max, s), the "
-                         "median time between them, and the runs taking a vision update with the true "
-                         f"altitude below 1 m and below the vision cut-off's margin "
-                         f"({float(cut['update_altitude_margin_m']):g} m; the cut-off compares the "
-                         f"estimated altitude less that margin with {float(cut['min_update_altitude_m']):g} m), "
-                         "counted from the per-step records."))
+                caption=(f"B-T3 end phase ({scn} camera), per method over its runs: the time of the last "
+                         "landmark update and of the last vision update (median, min, max, s) and the median time "
+                         "between them. It counts, from the per-step records, the runs taking a vision update "
+                         "with the true altitude below 1 m and below the vision cut-off's margin "
+                         f"({float(cut['update_altitude_margin_m']):g} m). The cut-off compares the estimated "
+                         f"altitude less that margin with {float(cut['min_update_altitude_m']):g} m."))
     out["end_phase"] = {r["method"]: {k: v for k, v in r.items() if k != "method"} for r in end.to_dict("records")}
     out["end_phase_text"] = end_phase_text(out["end_phase"], scn, float(cut["min_update_altitude_m"]))
     write_json(snakemake.output.summary, out)

@@ -29,17 +29,15 @@ with script_context(snakemake) as log:
     df = ranking_table(data, tm, reference=ref, n_boot=n_boot, seed=0, rtol=rtol,
                        converged_pos_err_m=conv)
     write_table(df, snakemake.output.t,
-                caption=(f"B-X1: all planning methods on the same paired Monte Carlo (runs 0-{n_runs - 1}, "
-                         f"{n_runs} runs: landing.extra.n_runs for this camera, sized by the information "
-                         f"baselines' cost), ranked by mean "
-                         f"position error at the last landmark update (rank_accuracy; ties share "
-                         f"a rank) and by median planning-call CPU time "
-                         f"(rank_time; methods within {100 * rtol:g} % of each other share the best "
-                         f"rank); paired differences method minus "
-                         f"{ref} of the per-run position errors (m) at the last landmark update (lastlm), "
-                         f"RMS over the landmark phase (lmrms), RMS over the descent and at touchdown (final) with 95 % paired-t "
-                         f"and bootstrap ({n_boot} resamples) intervals; converged: final position "
-                         f"error below {conv:g} m. " + timing_summary.method_text(tm)))
+                caption=(f"B-X1: all planning methods on the same paired Monte Carlo, runs 0-{n_runs - 1} "
+                         f"({n_runs} runs: landing.extra.n_runs for this camera, sized by the information "
+                         "baselines' cost). They are ranked by mean position error at the last landmark update "
+                         "(rank_accuracy; ties share a rank) and by median planning-call CPU time (rank_time; "
+                         f"methods within {100 * rtol:g} % of each other share the best rank). Paired differences "
+                         f"method minus {ref} of the per-run position errors (m) are given at the last landmark "
+                         "update (lastlm), as RMS over the landmark phase (lmrms) and over the descent, and at "
+                         f"touchdown (final). Each has 95 % paired-t and bootstrap ({n_boot} resamples) intervals; "
+                         f"converged: final position error below {conv:g} m. " + timing_summary.method_text(tm)))
     t = next(iter(data.values()))["t"]
     own = getattr(snakemake.params, "custom", None) or {}    # your own methods' legend names and colours
     figures.save(plots.fig_nav_error_envelopes(t, data, method_labels(own),

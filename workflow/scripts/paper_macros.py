@@ -1,4 +1,5 @@
-"""results/paper/macros.tex: one \\newcommand per number the manuscript quotes."""
+"""results/paper/macros.tex: one \\newcommand per number the manuscript quotes; results/paper/tables.tex:
+the tables the text sets where a sentence would repeat itself per method (opnav.report.text_tables)."""
 
 import sys
 
@@ -6,16 +7,21 @@ from opnav.core import published
 from opnav.report.manuscript import format_sci, macros_from_summary, prose_tex, render_macros
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text
+from opnav.report import text_tables
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("paper_macros", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
     macros = {}
+    summaries = {}
     for key in ("A", "B", "AX2", "BX1", "AP1"):
         name = f"summary_{key}"
         if name in snakemake.input.keys():
-            macros.update(macros_from_summary(load_json(snakemake.input[name]), key))
+            summaries[key] = load_json(snakemake.input[name])
+            macros.update(macros_from_summary(summaries[key], key))
+    # where a sentence would repeat itself per method or variant, a table (issue 55 item 4)
+    atomic_write_text(snakemake.output.tables, text_tables.render(text_tables.table_macros(summaries)))
     sc = load_json(snakemake.input.scorecard)
     macros.update(macros_from_summary(sc, "Score"))
     cl = load_json(snakemake.input.claims)

@@ -501,16 +501,18 @@ def end_phase_text(end: dict[str, dict], scenario: str, min_update_alt_m: float,
         s = (f"In the {scenario} camera, landmark updates continue until vision ends (medians: last "
              f"landmark update {lm}, last vision update {vis}). ")
     else:
-        s = (f"In the {scenario} camera, landmark updates stop at a median {lm} and vision updates "
-             f"(then the site's bearing alone) at {vis}, {gap} later. ")
+        s = (f"In the {scenario} camera, landmark updates stop at a median {lm}. Vision updates (then the "
+             f"site's bearing alone) stop at {vis}, {gap} later. ")
     cut = (f"Vision stops once the estimated altitude less {e0['margin_m']:g} m falls to "
            f"{min_update_alt_m:g} m")
     if not any(below) and not any(below_m):
         return s + (f"{cut}; no run of {n} takes a vision update with the true altitude below "
                     f"{e0['margin_m']:g} m.")
+    who = f" ({' / '.join(ms)})" if len(ms) > 1 else ""
+
     def counts(c):
-        return " / ".join(str(x) for x in c) + (" (" + " / ".join(ms) + ")" if len(ms) > 1 else "")
-    return s + (f"{cut}, and an estimate a few metres high keeps it on: of {n} runs, {counts(below)} "
+        return " / ".join(str(x) for x in c)
+    return s + (f"{cut}, and an estimate a few metres high keeps it on. Of {n} runs{who}, {counts(below)} "
                 f"take vision updates with the true altitude below {e0['ground_m']:g} m and "
                 f"{counts(below_m)} below {e0['margin_m']:g} m (lowest {_fmt(e0['min_true_alt_vision_m'], '{:.2f}')} m"
                 f" for {ms[0]}).")
@@ -526,15 +528,14 @@ def nees_reading(nees: dict, scenario: str | None = None) -> dict:
     for q in ("pos", "vel"):
         x = nees[f"{q}_mean"]
         out[q] = "consistent" if lo <= x <= hi else "underconfident" if x < lo else "overconfident"
-    word = {"pos": "position", "vel": "velocity"}
-    parts = [f"{word[q]} {nees[f'{q}_mean']:.2f} ({out[q]}; in the band at {nees[f'{q}_in_band_pct']:.1f} % "
-             f"of the filter times)" for q in ("pos", "vel")]
     verdict = out["pos"] if out["pos"] == out["vel"] else f"{out['pos']} in position, {out['vel']} in velocity"
     out["verdict"] = verdict
     where = f" of the {scenario} camera" if scenario else ""
-    out["text"] = (f"On the held-out runs{where} the filter is {verdict}: its mean NEES over {nees['n_runs']} runs is "
-                   + "; ".join(parts) + f", against the 95 % band [{lo:.2f}, {hi:.2f}] of a "
-                   f"{nees['n_runs']}-run mean for 3 degrees of freedom.")
+    out["text"] = (f"On the held-out runs{where} the filter is {verdict}. Its mean NEES over {nees['n_runs']} runs "
+                   f"is {nees['pos_mean']:.2f} in position and {nees['vel_mean']:.2f} in velocity, against the 95 % "
+                   f"band [{lo:.2f}, {hi:.2f}] of a {nees['n_runs']}-run mean for 3 degrees of freedom. The run mean "
+                   f"lies in the band at {nees['pos_in_band_pct']:.1f} % of the filter times in position and "
+                   f"{nees['vel_in_band_pct']:.1f} % in velocity.")
     return out
 
 
@@ -568,34 +569,34 @@ def nees_retuned_text(retuned: dict) -> str:
     p, r = retuned["paper"], retuned["retuned"]
     lo, hi = r["band"]
     rd = nees_reading(r)
-    word = {"pos": "position", "vel": "velocity"}
-    parts = "; ".join(f"{word[q]} {r[f'{q}_mean']:.2f} ({rd[q]}, in the band at {r[f'{q}_in_band_pct']:.1f} % "
-                      f"of the filter times)" for q in ("pos", "vel"))
-    s = (f"Retuned within the same protocol ({retuned['scenario']} camera: the bearing-noise scale whose NEES on the "
-         f"{retuned['tuning_n_runs']} tuning runs lies closest to the band's centre: {r['meas_noise_scale']:.3g} "
-         f"against the paper tuning's {p['meas_noise_scale']:.3g}), the held-out NEES is {parts}, against "
-         f"[{lo:.2f}, {hi:.2f}]; the median position error at the last landmark update goes from "
-         f"{_fmt(p['lastlm_pos_err_m_median'], '{:.2f}')} to {_fmt(r['lastlm_pos_err_m_median'], '{:.2f}')} m "
+    n = retuned["tuning_n_runs"]
+    s = (f"Retuned within the same protocol, the {retuned['scenario']} camera's bearing-noise scale is "
+         f"{r['meas_noise_scale']:.3g} against the paper tuning's {p['meas_noise_scale']:.3g}: the scale whose NEES "
+         f"on the {n} tuning runs lies closest to the band's centre. Held out, its NEES is position "
+         f"{r['pos_mean']:.2f} ({rd['pos']}) and velocity {r['vel_mean']:.2f} ({rd['vel']}) against "
+         f"[{lo:.2f}, {hi:.2f}], in the band at {r['pos_in_band_pct']:.1f} % and {r['vel_in_band_pct']:.1f} % of "
+         f"the filter times. The median position error at the last landmark update goes from "
+         f"{_fmt(p['lastlm_pos_err_m_median'], '{:.2f}')} to {_fmt(r['lastlm_pos_err_m_median'], '{:.2f}')} m, "
          f"and at touchdown from {_fmt(p['final_pos_err_m_median'], '{:.2f}')} to "
          f"{_fmt(r['final_pos_err_m_median'], '{:.2f}')} m.")
     if rd["verdict"] == "consistent":
         return s
     tlo, thi = retuned["tuning_band"]
     if r["tuning_in_band"]:
-        why = (f" On the {retuned['tuning_n_runs']} tuning runs both lay in their band [{tlo:.2f}, {thi:.2f}] "
-               f"({r['tuning_nees_pos']:.2f}, {r['tuning_nees_vel']:.2f}): that sample does not pin the mean")
+        why = [f"On the {n} tuning runs both lay in their band [{tlo:.2f}, {thi:.2f}] "
+               f"({r['tuning_nees_pos']:.2f}, {r['tuning_nees_vel']:.2f}): that sample does not pin the mean"]
     else:
-        why = (f" No scale tried puts both in the band on the tuning runs either (closest: position "
-               f"{r['tuning_nees_pos']:.2f}, velocity {r['tuning_nees_vel']:.2f} against [{tlo:.2f}, {thi:.2f}])")
+        why = [f"No scale tried puts both in the band on the tuning runs either (closest: position "
+               f"{r['tuning_nees_pos']:.2f}, velocity {r['tuning_nees_vel']:.2f} against [{tlo:.2f}, {thi:.2f}])"]
     if rd["pos"] != rd["vel"]:
-        why += (f"; held out, the velocity NEES is {r['vel_mean'] / r['pos_mean']:.2f} times the position's "
-                f"({p['vel_mean'] / p['pos_mean']:.2f} with the paper tuning), and one scale on the bearing noise "
-                "moves both together")
+        why.append(f"Held out, the velocity NEES is {r['vel_mean'] / r['pos_mean']:.2f} times the position's "
+                   f"({p['vel_mean'] / p['pos_mean']:.2f} with the paper tuning), and one scale on the bearing noise "
+                   "moves both together")
     med, big = r["tuning_nees_pos_run_median"], r["tuning_nees_pos_run_max"]
-    tail = (f"; the mean over runs rests on a few runs (position NEES of the median tuning run {med:.2f}, "
-            f"of the largest {big:.1f}), errors heavier-tailed than the Gaussian the filter assumes"
-            if big > HEAVY_TAIL_RATIO * med else "")
-    return s + why + tail + "."
+    if big > HEAVY_TAIL_RATIO * med:
+        why.append(f"The mean over runs rests on a few runs (position NEES of the median tuning run {med:.2f}, "
+                   f"of the largest {big:.1f}): errors heavier-tailed than the Gaussian the filter assumes")
+    return s + "".join(f" {w}." for w in why)
 
 
 #: wording rule of :func:`nees_retuned_text`: a largest tuning run's NEES above this many times
@@ -613,13 +614,13 @@ def planning_time_text(vs: dict, clock: dict, ev: dict | None = None) -> str:
     and why the compiled and the paper's paths differ."""
     from opnav.landing import timing_summary as tsum
 
-    def part(label, name):
+    def part(label, name):   # one sentence per baseline (issue 55 item 4)
         v = vs.get(label)
         if not v:
             return None
-        return (f"{v['depth_median_us']:.2f} against {v['median_us']:.2f} us for {name} (depth "
+        return (f"Against {name}: {v['depth_median_us']:.2f} against {v['median_us']:.2f} us (depth "
                 f"{tsum.less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
-                f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %)")
+                f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %).")
     parts = [p for p in (part("svd_closed_form", "the closed-form SVD"),
                          part("svd_lapack", "a LAPACK SVD of the same H"),
                          part("svd_paper", "the paper's definition of SVD (interpreted, depth likewise)")) if p]
@@ -629,7 +630,7 @@ def planning_time_text(vs: dict, clock: dict, ev: dict | None = None) -> str:
           f" Each call is the mean of back-to-back repetitions; the clock ({clock['clock_ns']:.0f} ns a "
           f"reading pair) is at most {clock['share_pct_max']:.1f} % of a timed bracket.")
     head = evidence_text(ev) if ev else ""
-    return head + "Median planning call (thread CPU, all replays pooled) of depth: " + "; ".join(parts) + "." + ck
+    return head + "Median planning call of depth (thread CPU, all replays pooled). " + " ".join(parts) + ck
 
 
 def evidence_text(ev: dict) -> str:
@@ -649,9 +650,9 @@ def evidence_text(ev: dict) -> str:
     sd = r["sd_between"]
     out = (f"Over {ev['n_replays']} independent replays (each a separate process, alone on the machine; "
            f"clock: {tsum.CLOCK_WORDS}) depth's median call on the {ev.get('eval_path') or ev['path']} path took "
-           f"{tsum.less_time_text(r['mean'])} time than the closed-form SVD's on average (per replay {per} %"
+           f"{tsum.less_time_text(r['mean'])} time than the closed-form SVD's on average. Per replay: {per} %"
            + (f"; between-replay sd {sd:.1f} points, {100 * r['level']:.0f} % interval [{r['lo']:.1f}, {r['hi']:.1f}] %"
-              if math.isfinite(sd) else "") + "). ")
+              if math.isfinite(sd) else "") + ". ")
     rp = ev.get("replays") or [{}]
     lo_hi = rp[0].get("median_interval_us", {}).get("depth")
     if lo_hi and all(x is not None and math.isfinite(x) for x in lo_hi):
@@ -663,7 +664,7 @@ def evidence_text(ev: dict) -> str:
         out += (f"A call is a part both methods share (numba's dispatch, argument unpacking, the search's own "
                 f"steps: {d['shared_us']:.2f} and {s['shared_us']:.2f} us) and its evaluations ({d['evals_per_call']:.0f} "
                 f"and {s['evals_per_call']:.0f} of {1e3 * d['per_eval_us']:.0f} and {1e3 * s['per_eval_us']:.0f} ns: "
-                f"{d['eval_us']:.2f} against {s['eval_us']:.2f} us); without the shared part depth's median call "
+                f"{d['eval_us']:.2f} against {s['eval_us']:.2f} us). Without the shared part depth's median call "
                 f"would take {tsum.less_time_text(c.get('no_shared_reduction_pct', math.nan))} time. ")
         sp = ev.get("shared_us_at_published")
         pub = ev.get("published_pct")
@@ -672,7 +673,7 @@ def evidence_text(ev: dict) -> str:
         elif pub is not None:
             out += f"No shared part would give the published {pub:g} %: the calls without it give less. "
         out += ("The shared part is what a busier machine lengthens, so the percentage moves with the load while "
-                "the evaluations' difference stays; on the paper's definition (interpreted Python, CasADi and "
+                "the evaluations' difference stays. On the paper's definition (interpreted Python, CasADi and "
                 "LAPACK) each evaluation costs tens of microseconds or more, the shared part is negligible and "
                 "the reduction is the metrics' own, which is why the two paths read so differently. ")
     return out

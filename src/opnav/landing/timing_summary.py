@@ -206,14 +206,14 @@ def method_text(tm: dict) -> str:
     mis = int(np.sum(tm["mismatch"]))
     npaper = _paper_calls(tm)
     paper = ("" if npaper in (0, n) else
-             f"; the paper's definition (interpreted, CasADi H) on {npaper} of them, evenly spaced "
-             f"(landing.timing.max_calls_paper = {int(tm.get('max_calls_paper', 0))}), its medians "
-             "and its comparisons on those calls")
+             f" The paper's definition (interpreted, CasADi H) runs on {npaper} of them, evenly spaced "
+             f"(landing.timing.max_calls_paper = {int(tm.get('max_calls_paper', 0))}), with its medians "
+             "and comparisons on those calls.")
     nr = n_replays(tm)
     reps = ("" if nr < 2 else
             f" The compiled calls of {', '.join(replayed_methods(tm))} were replayed {nr} times, each replay a "
             "separate process run alone on the machine (the between-replay spread is what the timing claims "
-            "are judged on); the other variants once, in a job that runs beside others (calls of "
+            "are judged on). The other variants were replayed once, in a job that runs beside others (calls of "
             "milliseconds).")
     cs = clock_share(tm)
     clock = ("" if cs["share_pct_max"] is None else
@@ -228,16 +228,17 @@ def method_text(tm: dict) -> str:
                 + f" over the replays ({int(tm.get('n_cpu', 0))} cores)")
         if "extra_load_avg" in tm:
             load += " and {:.1f}-{:.1f} over the other variants' job".format(*np.asarray(tm["extra_load_avg"], float))
-        load += ("; other processes sharing the cores lengthen microsecond calls, mostly their shared part, "
+        load += (". Other processes sharing the cores lengthen microsecond calls, mostly their shared part, "
                  "and narrow their differences.")
     elif "load_avg" in tm:
         load = (" The machine's 1-minute load average was {:.1f} at the start and {:.1f} at the end of the "
                 "replay ({} cores): other processes sharing the cores lengthen microsecond calls and "
                 "narrow their differences, so timing readings compare between builds at a like load."
                 .format(*np.asarray(tm["load_avg"], float)[:2], int(tm.get("n_cpu", 0))))
-    return (f"Planning times by replay: {subset} of the Monte Carlo of {srcs} replayed through "
-            "every method's planning call, one call at a time, interleaved across methods in one "
-            f"process (order rotated per call), the same states for every method{paper}; clock: "
+    # short sentences (issue 55 item 4): what is replayed, how, the paper's path, the clock and the check
+    return (f"Planning times by replay: {subset}, replayed one call at a time through every method's planning "
+            f"call. The calls come from the Monte Carlo of {srcs}. They are interleaved across methods in one "
+            f"process (order rotated per call), with the same states for every method.{paper} Clock: "
             f"{CLOCK_WORDS} (thread_time_ns); replayed picks equal to the recorded ones "
             f"in {int(np.sum(tm['checked'])) - mis} of {int(np.sum(tm['checked']))} own calls." + reps + clock + load)
 

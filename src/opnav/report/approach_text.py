@@ -13,6 +13,7 @@ import pandas as pd
 
 from opnav.approach.setup import Setup
 from opnav.approach.summaries import HeadlineRow, HeadlineSummary, prior_bound_arcsec
+from opnav.core import wording
 
 
 def _fmt(x, nd=2):
@@ -34,151 +35,149 @@ def identifiability_text(setup: Setup, x1: pd.DataFrame, target_arcsec: float) -
         b = r["crlb_x_total_arcsec"]
         verdict = "CAN" if r["bound_reaches_target"] else "CANNOT"
         need = r.get("samples_to_target")
-        need_txt = (f" The bound falls below {target:g} arcsec after {int(need)} samples."
+        need_txt = (f" The bound falls below {target:g} arcsec after {wording.count(int(need), 'sample')}."
                     if need is not None and not pd.isna(need) else "")
         ps, rng = setup.prior_sigma, setup.geometry.range_km
         ratio = f"{ps.r_km:g} km / {rng:.3g} km = {prior_bound_arcsec(setup):.3g} arcsec"
         why = {
-            "literal": "the camera looks at Mars without turning, so a misalignment shifts the Mars vector "
-                       "sideways by about rho*theta, which the data cannot tell from a lateral position error; "
-                       f"only the {ps.r_km:g} km prior separates them ({ratio}). The literal "
-                       "EM start X_N0 from the theta = 0 filter has already absorbed the offset",
-            "prior": "the same geometry: the lateral offset rho*theta looks like a position error, and the "
-                     f"prior ({ps.r_km:g} km, {ps.v_kms:g} km/s) only bounds theta to about {ratio}",
-            "roll": "turning the camera about its boresight turns the misalignment's offset in inertial space "
-                    "while a position error stays fixed, so the data separate the two",
-            "reference-start": "knowing the true start state removes the position ambiguity",
-            "stars": "star images (beyond the paper) measure the camera attitude directly, with no parallax, so "
-                     "theta is no longer confused with a position error, and stars off the boresight see tz",
+            "literal": ("The camera looks at Mars without turning, so a misalignment shifts the Mars vector "
+                        "sideways by about rho*theta, which the data cannot tell from a lateral position error. "
+                        f"Only the {ps.r_km:g} km prior separates them ({ratio}), and the literal EM start X_N0 "
+                        "from the theta = 0 filter has already absorbed the offset"),
+            "prior": ("In the same geometry the lateral offset rho*theta looks like a position error, and the "
+                      f"prior ({ps.r_km:g} km, {ps.v_kms:g} km/s) only bounds theta to about {ratio}"),
+            "roll": ("Turning the camera about its boresight turns the misalignment's offset in inertial space "
+                     "while a position error stays fixed, so the data separate the two"),
+            "reference-start": "Knowing the true start state removes the position ambiguity",
+            "stars": ("Star images (beyond the paper) measure the camera attitude directly, with no parallax, so "
+                      "theta is no longer confused with a position error; stars off the boresight see tz"),
         }.get(v, "")
         q0 = r.get("crlb_q0_x_total_arcsec", math.nan)
-        q0_txt = (f"; {_fmt(q0)} arcsec with Q = 0, the truth having no process noise" if not pd.isna(q0) else "")
-        lines.append(f"* **{v}**{diag}: CRLB(tx) = {_fmt(b)} arcsec after {int(r['total_samples'])} samples{q0_txt} "
-                     f"(one {s.N}-sample sliding segment: {_fmt(r['crlb_x_window_arcsec'])} arcsec). "
-                     f"The information in this variant's data and prior {verdict} support {target:g} arcsec: "
-                     f"{why}.{need_txt}")
+        q0_txt = (f"; {_fmt(q0)} with Q = 0, the truth having no process noise" if not pd.isna(q0) else "")
+        lines.append(f"* **{v}**{diag}: CRLB(tx) = {_fmt(b)} arcsec after {int(r['total_samples'])} samples "
+                     f"({_fmt(r['crlb_x_window_arcsec'])} on one {s.N}-sample sliding segment{q0_txt}). "
+                     f"The information in this variant's data and prior {verdict} support {target:g} arcsec."
+                     + (f" {why}." if why else "") + need_txt)
         extra = []
-        for tag, name in (("plain", "plain EM (paper's sliding segments)"),
+        for tag, name in (("plain", "Plain EM (paper's sliding segments)"),
                           ("growing_squarem", "SQUAREM on growing windows")):
             if f"em_{tag}_est_x_mean" in r and not pd.isna(r.get(f"em_{tag}_est_x_mean")):
                 lab = r.get(f"em_{tag}_label")
-                st = f"; labelled {lab} (from the ML estimate of the data it used)" if isinstance(lab, str) and lab else ""
+                st = f", labelled {lab}" if isinstance(lab, str) and lab else ""
                 extra.append(f"{name} ends at tx = {_fmt(r[f'em_{tag}_est_x_mean'])} +- "
-                             f"{_fmt(r[f'em_{tag}_est_x_std'])} arcsec (initial error drawn from the prior; "
-                             f"RMS error {_fmt(r[f'em_{tag}_rmse_x_arcsec'])}, bound of the data it used "
-                             f"{_fmt(r[f'em_{tag}_crlb_x_arcsec'])}, "
-                             f"{_fmt(r.get(f'em_{tag}_crlb_q0_x_arcsec', math.nan))} with Q = 0){st}")
+                             f"{_fmt(r[f'em_{tag}_est_x_std'])} arcsec{st}: RMS error "
+                             f"{_fmt(r[f'em_{tag}_rmse_x_arcsec'])}, bound of the data it used "
+                             f"{_fmt(r[f'em_{tag}_crlb_x_arcsec'])} "
+                             f"({_fmt(r.get(f'em_{tag}_crlb_q0_x_arcsec', math.nan))} with Q = 0).")
         if "maps_plain_median" in r and not pd.isna(r.get("maps_plain_median")):
             mp = r["maps_plain_median"]
-            mp_txt = (f"more than the {int(r['max_maps'])} run (about {r['maps_plain_extrapolated_median']:.3g} "
-                      f"extrapolated from its measured contraction factor {r['plain_rate_per_map']:.5f} per "
-                      f"iteration{'; stalled' if r['plain_rate_per_map'] > 0.999 else ''})"
-                      if mp > r["max_maps"] else f"{mp:.0f}")
-            extra.append(f"on one {int(r['mle_samples'])}-sample window the maximum-likelihood estimate "
-                         f"(SQUAREM, {r['maps_squarem_median']:.0f} EM maps) has RMS error "
+            mp_txt = (f"more than the {int(r['max_maps'])} maps run (about "
+                      f"{wording.num(r['maps_plain_extrapolated_median'])} at its contraction of "
+                      f"{r['plain_rate_per_map']:.5f} a map{': stalled' if r['plain_rate_per_map'] > 0.999 else ''})"
+                      if mp > r["max_maps"] else wording.count(round(float(mp)), "map"))
+            extra.append(f"On one {int(r['mle_samples'])}-sample window the maximum-likelihood estimate (SQUAREM, "
+                         f"{wording.count(round(float(r['maps_squarem_median'])), 'EM map', 'EM maps')}) has RMS error "
                          f"{_fmt(r['mle_rmse_x_arcsec'])} arcsec in tx against a CRLB of "
-                         f"{_fmt(r['crlb_x_at_mle_samples'])}; plain EM needs {mp_txt} iteration(s) to get within "
-                         f"{r['tol_arcsec']:g} arcsec of it")
+                         f"{_fmt(r['crlb_x_at_mle_samples'])}.")
+            extra.append(f"Plain EM needs {mp_txt} to get within {r['tol_arcsec']:g} arcsec of it.")
         if extra:
-            lines.append("  " + "; ".join(extra) + ".")
+            lines.append("  " + " ".join(extra))
         if not r["tz_observable"]:
-            lines.append("  tz (roll about the boresight) is unobservable: its bound stays at the diffuse prior.")
+            lines.append("  The roll about the boresight, tz, is unobservable: its bound stays at the diffuse prior.")
     lines += ["", ("Any published accuracy finer than a variant's CRLB cannot come from an unbiased estimator "
               "using that variant's measurements and prior; a match there would be luck or extra information.")]
     return "\n".join(lines) + "\n"
 
 
 def roll_rate_text(rr: dict) -> str:
-    """The manuscript's roll-rate sentence, from :func:`roll_rate_summary`."""
+    """The manuscript's roll-rate sentences, from :func:`roll_rate_summary`."""
     rates = rr["rates_deg_s"]
     parts = [f"{b:.3g} arcsec at {r:g} deg/s" for r, b in zip(rates, rr["bound_all_arcsec"])]
     rate = rr["rate_to_target_deg_s"]
-    reach = (f"the bound reaches the claimed {rr['target_arcsec']:g} arcsec within the paper's {rr['samples']} samples "
+    reach = (f"It reaches the claimed {rr['target_arcsec']:g} arcsec within the paper's {rr['samples']} samples "
              f"from a roll rate of {rate:.3g} deg/s" if rate is not None else
-             f"no rate in the searched range brings the bound to {rr['target_arcsec']:g} arcsec within "
+             f"No rate in the searched range brings it to {rr['target_arcsec']:g} arcsec within "
              f"{rr['samples']} samples")
-    return (f"The roll rows depend on the roll rate, which is our choice ({rr['config_rate_deg_s']:g} deg/s): the "
+    return (f"The roll rows depend on the roll rate, which is our choice ({rr['config_rate_deg_s']:g} deg/s). The "
             f"bound of all {rr['total_samples']} samples is " + _join(parts)
-            + f" (about rate^{rr['slope_all']:.2g}); {reach}.")
+            + f" (about rate^{rr['slope_all']:.2g}). {reach}.")
+
+
+def _stars_phrase(v: dict) -> str:
+    """'3 stars in every image (to magnitude 8 in a 2.84 deg field)' for one row of the stars sweep."""
+    spi = v.get("stars_per_image")
+    count = (f"{spi['min']}" if spi["min"] == spi["max"] else f"{spi['min']}-{spi['max']}") if spi else None
+    field = v.get("field_deg")
+    where = ""
+    if field is not None and v.get("mag_limit") is not None:
+        wide = v.get("camera_field_deg")
+        where = (f" (to magnitude {v['mag_limit']:.3g} in a {field:.3g} deg field"
+                 + (f", widened from the camera's {wide:.3g} deg" if wide is not None and field > wide + 1e-9 else "")
+                 + ")")
+    if count == str(v["per_image"]):
+        return wording.count(v["per_image"], "star") + " in every image" + where
+    return f"up to {v['per_image']} stars per image" + (f" ({count} in the field along the arc)" if spi else "") + where
 
 
 def stars_text(st: dict, target: float) -> str:
-    """The manuscript's stars sentences, from :func:`stars_summary`: the estimates per stars per
-    image, then the attitude-knowledge and magnitude sweeps and whether star calibration answers
-    paper A's objection (unsynchronised modes, the camera possibly the only sensor)."""
+    """The manuscript's stars sentences, from :func:`stars_summary` (each setting's numbers are
+    table A-X6's): what star images add, the bound from the fewest to the most stars in every image,
+    the attitude-knowledge sweep, and whether star calibration answers paper A's objection
+    (unsynchronised modes, the camera possibly the only sensor). Every sentence short."""
     rows = {k: v for k, v in st.items() if k != "objection"}
-    parts = []
-    for v in rows.values():
-        if v.get("sweep", "per_image") != "per_image":
-            continue
-        b, g, a = v["crlb_arcsec"], v["estimators"].get("em_growing_squarem"), v["estimators"].get("augmented")
-        need = v["samples_to_target"]
-        spi = v.get("stars_per_image")
-        count = (f"{spi['min']}" if spi['min'] == spi['max'] else f"{spi['min']}-{spi['max']}") if spi else None
-        field = v.get("field_deg")
-        where = ""
-        if field is not None and v.get("mag_limit") is not None:
-            wide = v.get("camera_field_deg")
-            where = (f" (to magnitude {v['mag_limit']:.3g} in a {field:.3g} deg field"
-                     + (f", widened from the camera's {wide:.3g} deg" if wide is not None and field > wide + 1e-9 else "")
-                     + ")")
-        txt = ((f"{count} star{'s' if v['per_image'] > 1 else ''} in every image" if count == str(v['per_image'])
-                else f"up to {v['per_image']} stars per image" + (f" ({count} in the field along the arc)" if spi else ""))
-               + where + f", {v['images']} images one every {v['every_K']} samples: bound "
-               f"(tx, ty, tz) = ({b[0]:.3g}, {b[1]:.3g}, {b[2]:.3g}) arcsec, "
-               + (f"{target:g} arcsec reached after {need:.0f} samples" if need is not None else
-                  f"{target:g} arcsec not reached"))
-        for name, e in (("EM-EKF (growing, SQUAREM)", g), ("augmented EKF", a)):
-            if e:
-                m, sd = e["mean_arcsec"], e["sd_arcsec"]
-                txt += (f"; {name} ({m[0]:.3g} +- {sd[0]:.2g}, {m[1]:.3g} +- {sd[1]:.2g}, {m[2]:.3g} +- {sd[2]:.2g})"
-                        + (f", {e['label']}" if e.get("label") else ""))
-        parts.append(txt)
-    if not parts:
+    mrows = sorted((v for v in rows.values() if v.get("sweep", "per_image") == "per_image"),
+                   key=lambda v: v["per_image"])
+    if not mrows:
         return ""
-    out = ("Beyond the paper, star images of Hipparcos stars calibrate the camera the way flight teams do: "
-           + "; ".join(parts) + ". Stars off the boresight also observe the roll tz.")
+    v0 = mrows[0]
+    out = [f"Beyond the paper, star images of Hipparcos stars calibrate the camera the way flight teams do "
+           f"({wording.count(v0['images'], 'image')}, one every {v0['every_K']} samples); stars off the boresight "
+           "also observe the roll tz"]
+    att_now = f" at the configured attitude knowledge ({mrows[-1].get('attitude_sigma_arcsec', float('nan')):g} arcsec)"
+    b0 = max(v0["crlb_arcsec"][:2])
+    if len(mrows) > 1:
+        b1 = max(mrows[-1]["crlb_arcsec"][:2])
+        how = wording.change(100 * (1 - b1 / b0))
+        out.append(f"With {_stars_phrase(v0)} the bound of (tx, ty) is {b0:.3g} arcsec{att_now}")
+        out.append(f"With {_stars_phrase(mrows[-1])} it is {b1:.3g} arcsec ({how})")
+    else:
+        out.append(f"With {_stars_phrase(v0)} the bound of (tx, ty) is {b0:.3g} arcsec{att_now}")
+    reached = [v for v in mrows if v["samples_to_target"] is not None]
+    out.append(f"It reaches {target:g} arcsec after {reached[0]['samples_to_target']:.0f} samples with "
+               f"{wording.count(reached[0]['per_image'], 'star')} in every image" if reached else
+               f"No count of stars brings it to {target:g} arcsec within the arc")
     att = sorted((v for v in rows.values() if v.get("sweep") == "attitude_sigma_arcsec"),
                  key=lambda v: v["attitude_sigma_arcsec"])
-    if att:
-        out += (" Against the attitude knowledge of each star image (drift "
-                f"{att[0]['mode_drift_arcsec']:g} arcsec): " + "; ".join(
-                    f"{v['attitude_sigma_arcsec']:g} arcsec: bound {max(v['crlb_arcsec'][:2]):.3g} "
-                    f"(stars alone {max(v['crlb_stars_only_arcsec'][:2]):.3g}, floor {v['floor_arcsec']:.3g}), "
-                    f"EM RMS {v['estimators']['em_growing_squarem']['rmse_xy_arcsec']:.3g}" for v in att) + ".")
+    if len(att) > 1:
+        a, z = att[0], att[-1]
+        out.append(f"Against each star image's attitude knowledge (drift {a['mode_drift_arcsec']:g} arcsec) the bound "
+                   f"goes from {max(a['crlb_arcsec'][:2]):.3g} at {a['attitude_sigma_arcsec']:g} arcsec to "
+                   f"{max(z['crlb_arcsec'][:2]):.3g} at {z['attitude_sigma_arcsec']:g} arcsec (attitude floor "
+                   f"{a['floor_arcsec']:.3g} to {z['floor_arcsec']:.3g}), and the EM RMS from "
+                   f"{a['estimators']['em_growing_squarem']['rmse_xy_arcsec']:.3g} to "
+                   f"{z['estimators']['em_growing_squarem']['rmse_xy_arcsec']:.3g}")
     obj = st.get("objection")
     if obj:
         thr = obj["attitude_threshold_arcsec"]
         if thr <= 0.0:
-            out += (f" Even perfect attitude knowledge of the star images leaves the bound above {target:g} arcsec: "
-                    "star calibration does not answer paper A's objection here.")
+            out.append(f"Even perfect attitude knowledge of the star images leaves the bound above {target:g} "
+                       "arcsec: star calibration does not answer paper A's objection here")
         else:
-            out += (f" Star calibration answers paper A's objection (the camera may be the only sensor and its "
-                    f"star and Mars modes are not synchronised) only while each star image's attitude relative to "
-                    f"the Mars images is known to better than {thr:.3g} arcsec (1-sigma per axis): beyond that "
-                    f"the bound exceeds {target:g} arcsec.")
-        mrows = sorted((v for v in rows.values() if v.get("sweep", "per_image") == "per_image"),
-                       key=lambda v: v["per_image"])
-        if len(mrows) > 1:
-            n0 = mrows[0].get("stars_per_image", {}).get("median", mrows[0]["per_image"])
-            n1 = mrows[-1].get("stars_per_image", {}).get("median", mrows[-1]["per_image"])
-            b0, b1 = max(mrows[0]["crlb_arcsec"][:2]), max(mrows[-1]["crlb_arcsec"][:2])
-            change = 100 * (1 - b1 / b0)
-            how = (f"{change:.0f} % lower" if change >= 0.5 else f"{-change:.0f} % higher" if change <= -0.5
-                   else "unchanged")
-            out += (f" From {n0:g} to {n1:g} stars per image the bound goes from {b0:.3g} to {b1:.3g} arcsec "
-                    f"({how}) at the configured attitude knowledge "
-                    f"({mrows[-1].get('attitude_sigma_arcsec', float('nan')):g} arcsec).")
-    return out
+            out.append(f"Star calibration answers paper A's objection (the camera may be the only sensor, its star "
+                       f"and Mars modes unsynchronised) only while each star image's attitude relative to the Mars "
+                       f"images is known to better than {thr:.3g} arcsec (1-sigma per axis)")
+            out.append(f"Beyond that the bound exceeds {target:g} arcsec")
+    return " ".join(o + "." for o in out)
 
 
 def nees_text(nees: dict, keys=None) -> str:
-    """The manuscript's consistency sentence, from :func:`opnav.approach.summaries.nees_summary`:
+    """The manuscript's consistency sentences, from :func:`opnav.approach.summaries.nees_summary`:
     each headline row's (those of ``keys``, all if None) compensated filters judged against the
     filter given the true theta on the same runs (the truth has no process noise while the
     filters' Q > 0, so that filter's NEES is the reference, not 3). A filter is above (optimistic)
     or below (conservative) the reference when the seed mean of its paired difference is more
-    than two standard errors from zero."""
+    than two standard errors from zero. (The manuscript sets the same numbers as a table:
+    :func:`opnav.report.text_tables.nees_rows`.)"""
     def side(d, se):
         if d is None or se is None or not math.isfinite(se):
             return "not judged (one seed)"
@@ -195,48 +194,45 @@ def nees_text(nees: dict, keys=None) -> str:
         ref, n = v.get("reference_nees_mean"), v.get("n_seeds")
         if ref is None or v.get("nees_mean") is None:
             continue
-        txt = (f"{key}: {v['nees_mean']:.3g} compensated with the estimate taken as exact, "
-               f"{side(v.get('after_minus_reference_mean'), v.get('after_minus_reference_se'))}")
+        txt = (f"In {key} the reference is {ref:.3g} ({wording.count(n, 'seed')}); taken as exact, the estimate "
+               f"gives {v['nees_mean']:.3g}, {side(v.get('after_minus_reference_mean'), v.get('after_minus_reference_se'))}")
         if v.get("consider_nees_mean") is not None:
-            txt += (f"; {v['consider_nees_mean']:.3g} with the Schmidt filter carrying its covariance, "
+            txt += (f", and the Schmidt filter carrying its covariance {v['consider_nees_mean']:.3g}, "
                     f"{side(v.get('consider_minus_reference_mean'), v.get('consider_minus_reference_se'))}")
-        parts.append(txt + f" (reference {ref:.3g}, {n} seeds)")
+        parts.append(txt + ".")
     if not parts:
         return ""
-    return ("Filter consistency (position NEES, initial error drawn from the prior, mean over the whole arc and the "
-            "seeds): the truth has no process noise while the filters assume Q > 0, so the reference is the NEES "
-            "of the filter given the true misalignment on the same runs, not 3; a filter is above or below it "
-            "when its paired difference over seeds exceeds two standard errors. " + "; ".join(parts) + ".")
+    return ("Filter consistency is read from the position NEES, initial error drawn from the prior, mean over the "
+            "whole arc and the seeds. The truth has no process noise while the filters assume Q > 0, so the "
+            "reference is the NEES of the filter given the true misalignment on the same runs, not 3. A filter is "
+            "above or below it when its paired difference over seeds exceeds two standard errors. " + " ".join(parts))
 
 
 def mars_attitude_text(ma: dict) -> str:
-    """The sentence on the Mars images' attitude knowledge, from
-    :func:`opnav.approach.summaries.mars_attitude_summary`: the default and why, and the bound of
-    all the data at the default and at each studied value."""
+    """The sentences on the Mars images' attitude knowledge, from
+    :func:`opnav.approach.summaries.mars_attitude_summary`: the default and why (the bound of all
+    the data at the default and at each studied value is the manuscript's table,
+    :func:`opnav.report.text_tables.mars_attitude_rows`)."""
     a0 = ma["default_arcsec"]
-    head = (f"The attitude of each Mars image is known exactly by default (camera.attitude_sigma_arcsec = 0): "
-            if a0 == 0.0 else f"Each Mars image's attitude is known to {a0:g} arcsec by default: ") + ma["why"] + "."
-    rows = ma.get("bound_all_arcsec") or {}
-    vals = [f"{float(a):g}" for a in ma.get("values_arcsec", [])]
-    parts = [", ".join(f"{r[k]:.3g}" for k in ["default", *vals] if k in r) + f" ({v})" for v, r in rows.items()]
-    if vals and parts:
-        head += (f" The bound of (tx, ty) after all the data at the default ({a0:g} arcsec) and at "
-                 f"{_join(vals)} arcsec per image (1-sigma per axis, independent per image): " + "; ".join(parts) + ".")
-    return head
+    head = ("The attitude of each Mars image is known exactly by default (camera.attitude_sigma_arcsec = 0)."
+            if a0 == 0.0 else f"Each Mars image's attitude is known to {a0:g} arcsec by default.")
+    why = " ".join(str(ma.get("why", "")).split())
+    return head + (f" Why: {why[0].lower() + why[1:]}." if why else "")
 
 
 def nav_floor_text(nf: dict) -> str:
-    """The sentence on the navigation error against arc length, from
-    :func:`opnav.approach.summaries.nav_floor_summary` (numbers only; the claims table reads the
-    arc at which it meets the paper's limit)."""
+    """The sentences on the navigation error against arc length, from
+    :func:`opnav.approach.summaries.nav_floor_summary` (numbers only; table A-X7 gives every arc, and
+    the claims table reads the arc at which it meets the paper's limit)."""
     rows = nf.get("rows") or []
     if not rows:
         return ""
-    parts = [f"{r['arc_s']:,.0f} s: {r['nav_err_km_rule']:.3g} km ({r['nav_err_km_last']:.3g} at the last sample; "
-             f"true theta {r['true_theta_km_rule']:.3g}, {r['true_theta_km_last']:.3g})" for r in rows]
-    return (f"The paper states no arc length for its navigation error. Against the arc, {nf['variant']} after "
-            f"compensation reads " + "; ".join(parts) + f" (RMS over the arc's last part, mean of {rows[0]['n_seeds']} "
-            "seeds; the filter given the true theta beside it).")
+    a, z = rows[0], rows[-1]
+    return ("The paper states no arc length for its navigation error. "
+            f"Against the arc, {nf['variant']} after compensation goes from {a['nav_err_km_rule']:.3g} km at "
+            f"{a['arc_s']:,.0f} s to {z['nav_err_km_rule']:.3g} km at {z['arc_s']:,.0f} s (RMS over the arc's last "
+            f"part, mean of {wording.count(rows[0]['n_seeds'], 'seed')}). The filter given the true theta reads "
+            f"{a['true_theta_km_rule']:.3g} and {z['true_theta_km_rule']:.3g} km there.")
 
 
 def tz_nav_text(tz: dict) -> str:
@@ -320,20 +316,23 @@ def findings(setup: Setup, summ: HeadlineSummary, pub_headline: dict, target_arc
         groups: dict[str, list[str]] = {}
         for scen, l_ in lst:
             groups.setdefault(l_ or "unlabelled", []).append(scen)
-        parts.append(f"{lab}: " + "; ".join(f"{l_} in {_join(sc_)}" for l_, sc_ in groups.items()))
+        parts.append(f"{lab[0].upper() + lab[1:]}: " + "; ".join(f"{l_} in {_join(sc_)}" for l_, sc_ in groups.items()))
     out["stall"] = ("An EM run is labelled converged when it ends within "
                     f"{setup.em.converge_frac_of_bound:g} times the 1-sigma bound of the data it used (in tx and ty) "
-                    "of the maximum-likelihood estimate of that data, stalled when it does not and its contraction per map toward that estimate is about 1 "
-                    f"(at least {setup.em.stall_rate:g}), whatever its start; whether a converged estimate means "
-                    "anything is read from the bound of that data. Headline rows: " + " | ".join(parts) + ".")
+                    "of the maximum-likelihood estimate of that data. It is stalled when it does not and its "
+                    f"contraction per map toward that estimate is about 1 (at least {setup.em.stall_rate:g}), "
+                    "whatever its start; whether a converged estimate means anything is read from the bound of "
+                    "that data. The headline rows read as follows. " + " ".join(p_ + "." for p_ in parts))
 
     for r in rows:
         conv = (f"; data to converge {nice(r.data_to_converge_samples, 4)} samples"
                 if r.label == "converged" else "")
+        reading = str(r.reading or "")
         out[f"headline_{r.key}"] = (f"{r.key}: tx = {nice(r.est_x_mean, 4)} +- {nice(r.est_x_std, 2)}, "
                                     f"ty = {nice(r.est_y_mean, 4)} +- {nice(r.est_y_std, 2)} arcsec, "
                                     f"bound of the data it used {nice(r.crlb_x_arcsec)} arcsec "
-                                    f"({nice(r.crlb_q0_x_arcsec)} with Q = 0); {r.reading}{conv}")
+                                    f"({nice(r.crlb_q0_x_arcsec)} with Q = 0)"
+                                    + (f". {reading[0].upper() + reading[1:]}{conv}" if reading else conv))
 
     truth = pub_headline.get("truth_arcsec", [math.nan] * 3)
     pe = max(abs(pub_headline.get("est_x_arcsec", math.nan) - truth[0]),
@@ -346,8 +345,11 @@ def findings(setup: Setup, summ: HeadlineSummary, pub_headline: dict, target_arc
     dist = {r.key: math.hypot(r.est_x_mean - pub_headline.get("est_x_arcsec", math.nan),
                               r.est_y_mean - pub_headline.get("est_y_arcsec", math.nan)) for r in rows}
     closest = min(dist, key=lambda k: (dist[k], k)) if dist else None
+    others = [r.key for r in rows if r.key not in nr]
+    which = (f" ({_join(nr)})" if len(nr) <= 3 else f" (all but {_join(others)})" if others and len(others) <= 3
+             else "")
     s = (f"The published error ({nice(pe)} arcsec) is below the bound of the data the estimator used in "
-         f"{len(nr)} of {len(rows)} headline rows ({_join(nr)}): there no unbiased estimator with the stated "
+         f"{len(nr)} of {len(rows)} headline rows{which}. There no unbiased estimator with the stated "
          "measurements and prior can know the misalignment that well, and we mark them not reproducible "
          "under stated assumptions. ")
     s += (f"Estimates converged, identifiable (bound at most {target:g} arcsec) and within 3 bound-sigma of "
@@ -370,21 +372,22 @@ def findings(setup: Setup, summ: HeadlineSummary, pub_headline: dict, target_arc
     out["nav_floor"] = nav_floor_text(summ.nav_floor_by_arc) if summ.nav_floor_by_arc else ""
     out["tz_nav"] = tz_nav_text(summ.tz_nav_effect) if summ.tz_nav_effect else ""
 
-    parts = [f"{diag.get(k, k)}: {r.nav_note}" for k, r in base.items() if r.nav_note]
-    out["nav"] = ("Navigation error (RMS over the last part of the arc) after compensation, split across and "
-                  "along the line of sight, beside the filter given the true theta (a diagnostic floor): "
-                  + "; ".join(parts) + "." if parts else "")
-
-    parts = []
+    # the per-variant numbers are the manuscript's tables (opnav.report.text_tables): here one
+    # sentence each, no per-variant repetition (issue 55 item 4)
+    after = {k: r.nav_err_after_km for k, r in base.items() if r.nav_err_after_km is not None}
+    out["nav"] = ""
+    if after:
+        lo, hi = min(after, key=after.get), max(after, key=after.get)
+        out["nav"] = (f"After compensation the navigation error under the paper's scheme ranges from "
+                      f"{nice(after[lo])} km ({diag.get(lo, lo)}) to {nice(after[hi])} km ({diag.get(hi, hi)}).")
     mx = summ.convergence_max_maps
-    for k, r in base.items():
-        mp, ex, sq = r.iterations_plain_median, r.iterations_plain_extrapolated_median, r.iterations_squarem_median
-        if mp is None:
-            continue
-        plain = (f"more than the {mx} maps run (about {nice(ex)} extrapolated from its measured contraction rate)"
-                 if mx is not None and mp > mx else f"{mp:.0f} maps")
-        parts.append(f"{diag.get(k, k)}: plain EM needs {plain}, SQUAREM {nice(sq)}")
-    out["convergence"] = ("On one window of the convergence study, the EM maps needed to come within "
-                          "the tolerance of the maximum-likelihood estimate are: " + "; ".join(parts) + "."
-                          if parts else "")
+    plain = {k: r.iterations_plain_median for k, r in base.items() if r.iterations_plain_median is not None}
+    sq = {k: r.iterations_squarem_median for k, r in base.items() if r.iterations_squarem_median is not None}
+    out["convergence"] = ""
+    if plain and sq:
+        over = [k for k, v in plain.items() if mx is not None and v > mx]
+        out["convergence"] = (f"On one window of the convergence study SQUAREM comes within the tolerance of the "
+                              f"maximum-likelihood estimate in at most {wording.count(round(max(sq.values())), 'map')}; "
+                              + (f"plain EM needs more than the {mx} maps run in {_join([diag.get(k, k) for k in over])}."
+                                 if over else f"plain EM in at most {wording.count(round(max(plain.values())), 'map')}."))
     return out

@@ -15,10 +15,10 @@ from opnav.core.tables import cell_num, cell_pm
 
 #: the table captions of paper A's tables (their CSV/LaTeX/Markdown headers)
 CAPTIONS = {
-    "A-T1": ("A-T1: paper A Table 1 reproduced; mean and sd over Monte-Carlo seeds; CRLB of the data each "
-             "estimate used (Q = 0 beside); EM label from the ML estimate of the data each run used (converged / "
-             "stalled / not converged), identifiable when that bound is at most the published accuracy; "
-             "pub_* = published."),
+    "A-T1": ("A-T1: paper A Table 1 reproduced, mean and sd over Monte-Carlo seeds, with the CRLB of the data "
+             "each estimate used (Q = 0 beside); pub_* = published. The EM label comes from the ML estimate of the "
+             "data each run used (converged / stalled / not converged); a row is identifiable when that bound is "
+             "at most the published accuracy."),
     "A-X1": "A-X1: CRLB of the misalignment per scenario variant beside the EM estimates and iterations.",
     "A-X2": ("A-X2: EM-EKF against the augmented EKF and batch ML (IPOPT) on the Table-1 cases; "
              "errors in arcsec (estimate minus truth), CRLB = Cramer-Rao bound, nav error in km, "

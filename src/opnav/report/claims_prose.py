@@ -11,7 +11,7 @@ import re
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING
 
-from opnav.report import wording
+from opnav.core import wording
 from opnav.report.manuscript import cell_text, prose_tex, sentence
 
 if TYPE_CHECKING:  # annotations only
@@ -113,7 +113,7 @@ class _Said:
         return sentence(self.head + (self.joiner + self.body if self.body else ""))
 
     def shorter(self) -> bool:
-        """Cut the body one step (:func:`opnav.report.wording.shorter`); False when it cannot."""
+        """Cut the body one step (:func:`opnav.core.wording.shorter`); False when it cannot."""
         nxt = wording.shorter(self.body, min_words=4) if self.body else None
         if nxt is None:
             return False
@@ -170,7 +170,7 @@ def group_sentences(grp: list[Mapping], verdict: str, said: set | None = None) -
     verdict names (the addition, the choice, the bound) in one sentence that names it once;
     each claim not reproduced with its own cause; then what they would take, each text once
     unless ``said`` (the texts already written) holds it. No sentence is longer than
-    :data:`opnav.report.wording.MAX_SENTENCE_WORDS` words."""
+    :data:`opnav.core.wording.MAX_SENTENCE_WORDS` words."""
     said = set() if said is None else said
     items = _group_items(grp, verdict)
     if verdict != "reproduced":

@@ -437,14 +437,14 @@ def claims_detail_latex(df: pd.DataFrame) -> str:
 
     out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
     for r in df.itertuples():
-        parts = [rf"\item[{r.claim_id}] {prose_tex(r.claim)}. \textit{{{prose_tex(VERDICT_TEXT[r.verdict])}}}"
+        parts = [rf"\item[{r.claim_id}] {prose_tex(r.claim)}. \textit{{{prose_tex(sentence(VERDICT_TEXT[r.verdict])[:-1])}}}"
                  + (f" ({prose_tex(r.named)})" if r.named else "") + "."]
-        parts.append(f"Published: {prose_tex(r.published)}; ours as written: {prose_tex(r.ours_as_written) or '--'}")
+        # one short sentence each (issue 55 item 4): published, ours, the best reading, the bound
+        parts.append(f"Published: {prose_tex(r.published)}. Ours as written: {prose_tex(r.ours_as_written) or '--'}.")
         if r.best_variant:
-            parts[-1] += f"; best faithful variant ({prose_tex(r.best_variant)}): {prose_tex(r.ours_best)}"
+            parts.append(f"Best faithful reading, {prose_tex(r.best_variant)}: {prose_tex(r.ours_best)}.")
         if r.bound:
-            parts[-1] += f"; bound: {prose_tex(r.bound)}"
-        parts[-1] += "."
+            parts.append(f"Bound: {prose_tex(r.bound)}.")
         parts.append(prose_tex(r.cause) + f" \\emph{{Evidence:}} {prose_tex(r.evidence)}.")
         out.append(" ".join(parts))
     out.append(r"\end{description}")
@@ -737,23 +737,42 @@ def latin_text(text: str) -> str:
     return head + (f", {rest}" if rest and _CJK.search(rest) is None else "")
 
 
+def _margin_reasons(margin: str, reasons: str) -> list[tuple[str, str]]:
+    """``[(name = value, reason)]`` from the plan table's ``margin`` ('a = 1; b = 2') and
+    ``margin_reason`` ('a: why; b: why') cells."""
+    parts = [m.strip() for m in margin.split("; ") if m.strip()]
+    names = [m.split(" = ")[0] for m in parts]
+    cuts = sorted((reasons.find(f"{n}: "), n) for n in names if reasons.find(f"{n}: ") >= 0)
+    why = {}
+    for k, (i, n) in enumerate(cuts):
+        j = cuts[k + 1][0] if k + 1 < len(cuts) else len(reasons)
+        why[n] = reasons[i + len(n) + 2:j].strip().rstrip(";").strip()
+    return [(m, why.get(n, "")) for m, n in zip(parts, names)]
+
+
 def plan_latex(plan: pd.DataFrame) -> str:
     """The analysis plan (results/paper/analysis_plan.csv) as a LaTeX description list, one
-    item per claim: the paper's sentence and where, what is compared and how, the margin with
-    its reason, the variants and controls, what the verdict depends on."""
+    item per claim, in short sentences: the paper's sentence and where, what is compared and
+    how, each margin with its reason, the variants and controls, what the verdict depends on."""
+    from opnav.core import wording
+
+    def said(text: str) -> str:
+        return prose_tex(sentence(wording.shorten(text, wording.MAX_SENTENCE_WORDS)))
+
     out = [r"\begin{description}\setlength{\itemsep}{2pt}"]
     for r in plan.to_dict("records"):
         c = {k: latin_text(cell_text(r, k)) for k in r}
-        s = rf"\item[{latex_escape(c.get('claim_id', ''))}] " + prose_tex(sentence(c.get("sentence", "")))
-        if c.get("where"):
-            s += " " + prose_tex(f"({c['where']}).")
-        parts = [f"Compared: {c.get('quantity', '')}" + (f" ({c['units']})" if c.get("units") else ""),
-                 f"{c.get('comparison', '')} with {c.get('margin', '')}" if c.get("margin") else c.get("comparison", ""),
-                 c.get("margin_reason", ""),
-                 f"variants: {c['variants']}" if c.get("variants") else "",
-                 f"controls: {c['controls']}" if c.get("controls") else "",
-                 f"depends on: {c['depends_on']}" if c.get("depends_on") else ""]
-        s += " " + prose_tex("; ".join(p for p in parts if p) + ".")
+        where = f" ({c['where']})" if c.get("where") else ""
+        s = rf"\item[{latex_escape(c.get('claim_id', ''))}] " + prose_tex(
+            sentence(c.get("sentence", "").rstrip(" .") + where))
+        parts = [f"Compared: {c.get('quantity', '')}" + (f" ({c['units']})" if c.get("units") else "")
+                 + (f", by {c['comparison']}" if c.get("comparison") else "")]
+        parts += [f"Margin {m}" + (f": {why}" if why else "") for m, why in
+                  _margin_reasons(c.get("margin", ""), c.get("margin_reason", ""))]
+        parts += [f"Variants: {c['variants']}" if c.get("variants") else "",
+                  f"Controls: {c['controls']}" if c.get("controls") else "",
+                  f"Depends on: {c['depends_on']}" if c.get("depends_on") else ""]
+        s += " " + " ".join(said(p) for p in parts if p)
         out.append(s)
     out.append(r"\end{description}")
     return "\n".join(out) + "\n"

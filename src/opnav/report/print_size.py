@@ -151,9 +151,9 @@ def prose_fragments(results: str | Path, used_macros: set[str] | None = None) ->
 def long_sentence_findings(results: str | Path, used_macros: set[str] | None = None,
                            max_words: int | None = None) -> list[str]:
     """``where (N words): sentence`` for every generated sentence longer than ``max_words``
-    (:data:`opnav.report.wording.MAX_SENTENCE_WORDS`) under ``results``; ``[]`` when every
+    (:data:`opnav.core.wording.MAX_SENTENCE_WORDS`) under ``results``; ``[]`` when every
     sentence a reader meets is short enough to follow."""
-    from opnav.report import wording
+    from opnav.core import wording
 
     limit = wording.MAX_SENTENCE_WORDS if max_words is None else max_words
     out = []

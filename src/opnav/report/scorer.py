@@ -39,7 +39,7 @@ from typing import Any
 
 from scipy import special
 
-from opnav.report import wording
+from opnav.core import wording
 from opnav.report.evidence import QUANTITIES, Evidence, EvidenceRow, quantity
 from opnav.report.plan import ClaimTest, Condition, Plan, PlanError
 
@@ -58,7 +58,7 @@ PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
 # ------------------------------------------------------------ numbers as text
 def fmt(x: Any, nd: int = 3) -> str:
     """A number as claim-table text: ``nd`` significant digits, ``n/a`` if missing
-    (:func:`opnav.report.wording.num`: a ratio of 0.9999 is not '1')."""
+    (:func:`opnav.core.wording.num`: a ratio of 0.9999 is not '1')."""
     return wording.num(x, nd)
 
 

@@ -99,7 +99,7 @@ def caption(claim_id: str, sweeps: Iterable[Mapping[str, Any]], row: Mapping[str
     """The figure's caption (plain text, every sentence short): which claim, what is drawn
     against what, how the test and the flip are marked, and what the claims table says it
     would take (``row``: the claim's row of the claims table)."""
-    from opnav.report import wording
+    from opnav.core import wording
     from opnav.report.evidence import QUANTITIES
 
     names = dict(names or {})

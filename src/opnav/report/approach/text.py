@@ -134,7 +134,7 @@ def installation_text(chk: InstallationCheck) -> str:
                 f"{chk.max_rel_change:.2g}): the installation rows test the estimator.")
     return (f"With the misalignment defined in the camera frame and the body attitude commanded to put the "
             f"installed boresight on Mars (paper A eq. 3-5), the installation angle ({angles} deg) cancels "
-            f"from the measurement (largest relative change {chk.max_rel_change:.1g}, rounding): "
+            f"from the measurement. Its largest relative change is {chk.max_rel_change:.1g}, rounding, so "
             f"'unaffected by the installation matrix' holds by construction and its rows are noise "
             f"replicates. Were the deviation fixed in the body frame, the camera would see ty from "
             f"{cam[:, 1].min():.3g} to {cam[:, 1].max():.3g} arcsec across these angles.")

@@ -124,7 +124,7 @@ def sentences(text: str) -> list[str]:
         if not para:
             continue
         buf = ""
-        for part in re.split(r"(?<=[.!?])\s+(?=[A-Z(\[\"'])", para):
+        for part in re.split(r"(?<=[.!?])\s+(?=[A-Z(\[\"'*])", para):
             buf = f"{buf} {part}".strip()
             if _ABBREV.search(buf):
                 continue
