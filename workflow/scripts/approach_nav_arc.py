@@ -1,11 +1,14 @@
 """The navigation error after compensation against arc length (A-C7's would_take) and with the
-tz bias on and off (opnav.approach.navfloor)."""
+tz bias on and off (opnav.approach.navfloor): tz's effect under the paper as written (the
+``literal`` variant: paper A's claim, A-C12), the arc lengths under the configured nav-floor
+variant."""
 
 import sys
 from pathlib import Path
 
 from opnav.approach import navfloor
 from opnav.approach.setup import Setup
+from opnav.approach.summaries import AS_WRITTEN
 from opnav.core.snakeio import mock_snakemake, save_pickle, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
@@ -15,7 +18,7 @@ with script_context(snakemake) as log:
     setup = Setup.from_config(snakemake.params.approach)
     nf = setup.nav_floor
     out = {"nav_floor_by_arc": navfloor.nav_floor_by_arc(setup, nf.variant, nf.scheme, nf.arcs_s, log=log),
-           "tz_nav_effect": navfloor.tz_nav_effect(setup, nf.variant)}
+           "tz_nav_effect": navfloor.tz_nav_effect(setup, AS_WRITTEN)}
     for r in out["nav_floor_by_arc"].rows:
         log.info("arc %g s: after %.3g km (last %.3g), true theta %.3g km (last %.3g)", r.arc_s, r.nav_err_km_rule,
                  r.nav_err_km_last, r.true_theta_km_rule, r.true_theta_km_last)
