@@ -211,7 +211,12 @@ NEW_CONFIGS = [
     ("ranges", "approach: {base_seed: 100000000000000000000000}", "'approach.base_seed'"),
     ("ranges", "approach: {crlb: {theta_prior_sigma_rad: 1.0e+9}}", "'approach.crlb.theta_prior_sigma_rad'"),
     # the claimed accuracy is the analysis plan's (A-C1's target), no longer a config key
-    ("unknown", "approach: {accuracy_target_arcsec: 2.0}", "('accuracy_target_arcsec' was unexpected)"),
+    ("unknown", "approach: {accuracy_target_arcsec: 2.0}", "'accuracy_target_arcsec' is no config key any more: "
+     "its one home is the analysis plan's claims.A-C1.margins.target_arcsec"),
+    # paper A's converged label likewise reads the plan's settings.converge_frac_of_bound
+    ("unknown", "approach: {em: {converge_frac_of_bound: 0.1}}", "its one home is the analysis plan's "
+     "settings.converge_frac_of_bound"),
+    ("unknown", "approach: {em: {bogus_key: 0.1}}", "('bogus_key' was unexpected)"),
     ("ranges", "approach: {geometry: {v_inf_dir: [1.0e+300, 0, 0]}}", "'approach.geometry.v_inf_dir[0]'"),
     ("ranges", "approach: {roll_rate_study: {rates_deg_s: [0.1, 1.0e+9]}}", "'approach.roll_rate_study.rates_deg_s[1]'"),
     ("ranges", "landing: {gravity_mps2: [0, 0, -1.0e+300]}", "'landing.gravity_mps2[2]'"),

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -16,6 +17,8 @@ from opnav.core import published
 from opnav.report import approach_claims as A
 from opnav.report import claims as C
 from opnav.report import landing_claims as B
+
+REPO = Path(__file__).resolve().parents[1]
 from opnav.report import scorer as S
 from opnav.report.evidence import COLUMNS as EV_COLUMNS
 from opnav.report.evidence import QUANTITIES, Evidence, read_csv, write_csv
@@ -152,10 +155,26 @@ def test_the_checksum_follows_the_text(tmp_path):
     assert C.load_plan(p).checksum != PLAN.checksum
 
 
-def test_a_config_that_disagrees_with_the_plans_setting_stops_naming_both():
-    with pytest.raises(C.PlanError, match="converge_frac_of_bound.*approach.em.converge_frac_of_bound"):
-        C.check_settings(C.load_plan(), {"converge_frac_of_bound": 0.2})
-    C.check_settings(C.load_plan(), {"converge_frac_of_bound": 0.1})
+def test_the_converged_fraction_has_one_home_the_plan(tmp_path):
+    """Paper A's converged label computes with the plan's settings.converge_frac_of_bound: no
+    config key holds it (the schema refuses one, naming where it went), a Setup built without it
+    reads the plan, and a plan with another value gives another label threshold."""
+    from opnav.approach.setup import EMSettings
+    from opnav.core import planvalues
+    from opnav.core.config import schema_problems
+
+    plan_value = C.load_plan().raw["settings"]["converge_frac_of_bound"]["value"]
+    em = {"method": "plain", "tz_tol": 1e-6, "converge_tol_arcsec": 0.5, "stall_rate": 0.95, "ml_max_maps": 60}
+    assert EMSettings.from_config(em).converge_frac_of_bound == plan_value
+    assert EMSettings.from_config({**em, "converge_frac_of_bound": 0.3}).converge_frac_of_bound == 0.3  # a rule's params
+    p = tmp_path / "plan.yaml"
+    p.write_text(C.PLAN_FILE.read_text().replace("converge_frac_of_bound:\n    value: 0.1", "converge_frac_of_bound:\n    value: 0.2"))
+    assert planvalues.converge_frac_of_bound(p) == 0.2 and planvalues.converge_frac_of_bound() == plan_value
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    assert "converge_frac_of_bound" not in cfg["approach"]["em"]
+    cfg["approach"]["em"]["converge_frac_of_bound"] = 0.1
+    lines = schema_problems(cfg)
+    assert len(lines) == 1 and "converge_frac_of_bound" in lines[0] and "analysis plan" in lines[0], lines
 
 
 def test_the_plan_states_the_replication_size_the_config_flies():

@@ -50,8 +50,7 @@ def _run(tmp_path, rep_faster=None, profile="full"):
     out["would_take"] = [str(tmp_path / f"wt_{c}.png") for c in sweep]
     lc = CFG["landing"]
     params = {"profile": profile, "replication": CFG["replication"], "windows": {"sliding": 50, "growing": 250}, "dt_s": 0.5,
-              "sweep_claims": sweep, "config_settings": {"converge_frac_of_bound": 0.1},
-              "landing": {k: lc[k] for k in ("duration_s", "gravity_mps2", "initial_state", "yaw_deg",
+              "sweep_claims": sweep, "landing": {k: lc[k] for k in ("duration_s", "gravity_mps2", "initial_state", "yaw_deg",
                                              "terminal_accel_mps2")}}
     runpy.run_path(str(REPO / "workflow" / "scripts" / "paper_claims.py"),
                    init_globals={"snakemake": _Job(inp, out, params, str(tmp_path / "log.txt"))})

@@ -90,11 +90,16 @@ def canonical(value):
     return value
 
 
+from opnav.core.planvalues import with_plan_values  # noqa: E402
+
+
 def cfg(section, *keys):
-    """The config values that a rule's params hold, sorted (canonical); e.g.
-    cfg("landing", "mc", "initial_state") -> {"initial_state": ..., "mc": ...}."""
+    """The config values that a rule's params hold, sorted (canonical), with the analysis plan's
+    numbers the paper code computes with inside the sub-sections that use them (their one home
+    is the plan; carried in params, a change of one reruns the rule: opnav.core.planvalues);
+    e.g. cfg("landing", "mc", "initial_state") -> {"initial_state": ..., "mc": ...}."""
     sec = config[section]
-    return canonical({k: sec[k] for k in keys} if keys else sec)
+    return canonical(with_plan_values(section, {k: sec[k] for k in keys} if keys else sec))
 
 
 def table_outputs(stem):

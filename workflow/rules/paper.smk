@@ -70,16 +70,6 @@ B_OPTIMA = [f"{LANDING}/optima/{s}.json" for s in B_SCENARIOS] if "B" in SUMMARI
 
 #: the claims whose plan entry sweeps a choice for what it would take (one figure each)
 SWEEP_CLAIMS = [cid for cid, t in _PLAN.tests().items() if any(w.kind == "sweep" for w in t.would_take)]
-#: the config keys the plan's settings name (their one home is the plan: the job checks they agree)
-_SETTING_KEYS = {name: s["config"] for name, s in (_PLAN.raw.get("settings") or {}).items()
-                 if isinstance(s, dict) and s.get("config")}
-
-
-def _config_at(key):
-    cur = config
-    for part in key.split("."):
-        cur = cur.get(part, {}) if isinstance(cur, dict) else {}
-    return cur if not isinstance(cur, dict) else None
 
 
 rule paper_claims:
@@ -116,7 +106,6 @@ rule paper_claims:
         profile=config["profile"],
         replication=canonical(config["replication"]),
         sweep_claims=SWEEP_CLAIMS,
-        config_settings={k: _config_at(v) for k, v in _SETTING_KEYS.items() if _config_at(v) is not None},
         # the smallest data-to-converge count each EM mode can report (its first window, samples)
         windows={"sliding": config["approach"]["segments"]["N"], "growing": config["approach"]["growing"]["N"]},
         dt_s=config["approach"]["dt_s"],

@@ -12,7 +12,7 @@ REP = res("replication")
 REPLICATION_SUMMARIES = {}
 
 if REP_CFG["enabled"]:
-    _rep_a = {**config["approach"], "base_seed": config["approach"]["base_seed"] + REP_CFG["seed_offset"],
+    _rep_a = {**cfg("approach"), "base_seed": config["approach"]["base_seed"] + REP_CFG["seed_offset"],
               "n_seeds": REP_CFG["approach_n_seeds"]}
     _REP_A_KEYS = A_EM + (("growing",) if config["approach"]["growing"]["methods"] else ())
     REP_A_MC = [f"{REP}/approach/mc/{v}__headline__{s}.pkl" for v in A_VARIANTS for s in A_SCHEMES]

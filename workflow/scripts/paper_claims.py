@@ -46,7 +46,6 @@ with script_context(snakemake) as log:
     inp, par, out = snakemake.input, snakemake.params, snakemake.output
     pub = published.load()
     plan = claims.load_plan(inp["plan"])
-    claims.check_settings(plan, dict(par.config_settings))
     windows = {k: float(v) for k, v in dict(par.windows).items()}
     optima = {}
     for p in (inp.get("optima") or []):

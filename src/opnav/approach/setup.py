@@ -234,6 +234,18 @@ class EMSettings(_Section):
     stall_rate: float
     ml_max_maps: int
 
+    @classmethod
+    def from_config(cls, c: Mapping):
+        """As every section, but ``converge_frac_of_bound`` is no config key: its one home is the
+        analysis plan (``settings.converge_frac_of_bound``, :mod:`opnav.core.planvalues`); a
+        workflow rule passes the plan's value inside ``em`` (so a change of it reruns the rule),
+        any other caller gets it from the plan."""
+        if "converge_frac_of_bound" not in c:
+            from opnav.core.planvalues import converge_frac_of_bound
+
+            c = {**c, "converge_frac_of_bound": converge_frac_of_bound()}
+        return super().from_config(c)
+
 
 @dataclass(frozen=True)
 class ConvergenceStudy(_Section):

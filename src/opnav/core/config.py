@@ -212,8 +212,26 @@ def schema_problems(config: dict, schema_path: Path = SCHEMA_PATH) -> list[str]:
     return lines
 
 
+#: Config keys that moved out of the config, and their one home now: a config that still sets
+#: one is told where it went (the schema alone would say only "unexpected").
+MOVED_KEYS = {
+    "approach.accuracy_target_arcsec": "the analysis plan's claims.A-C1.margins.target_arcsec",
+    "approach.em.converge_frac_of_bound": "the analysis plan's settings.converge_frac_of_bound",
+}
+
+
 def _message(err) -> str:
-    """jsonschema's message, shortened where it would print a long instance."""
+    """jsonschema's message, shortened where it would print a long instance; a key that moved
+    out of the config (:data:`MOVED_KEYS`) named with its new home."""
+    if err.validator == "additionalProperties" and isinstance(err.instance, dict):
+        allowed = set((err.schema or {}).get("properties") or {})
+        where = _dotted(err.absolute_path)
+        moved = [(k, MOVED_KEYS[f"{where}.{k}" if where else k]) for k in err.instance
+                 if k not in allowed and (f"{where}.{k}" if where else k) in MOVED_KEYS]
+        if moved:
+            k, home = moved[0]
+            return (f"'{k}' is no config key any more: its one home is {home} "
+                    "(src/opnav/data/analysis_plan.yaml); remove it from the config")
     if err.validator == "pattern" and isinstance(err.instance, str):
         shown = err.instance if len(err.instance) <= 60 else err.instance[:57] + "..."
         return f"{shown!r} is not a valid name here (pattern {err.validator_value})"

@@ -224,20 +224,6 @@ def replication_plan(plan: Plan, cfg: Mapping[str, Any]) -> list[str]:
     return ids
 
 
-def check_settings(plan: Plan, values: Mapping[str, Any]) -> None:
-    """Every plan setting that names a config key (``settings.<name>.config``) equals the
-    value the run used (``values``: setting name -> the config's value): the plan is the
-    number's home (one line naming both when they differ)."""
-    for name, s in (plan.raw.get("settings") or {}).items():
-        key = s.get("config") if isinstance(s, Mapping) else None
-        if not key or name not in values or values[name] is None:
-            continue
-        plan.mark_read(f"settings.{name}")
-        if float(values[name]) != float(s["value"]):
-            raise PlanError(f"{plan.source}: settings.{name} = {s['value']:g} but the config's {key} = "
-                            f"{float(values[name]):g}: the plan's number is the one the verdicts read")
-
-
 def _published_text(plan: Plan, cid: str, rows: list[EvidenceRow], scope: str) -> str:
     pubs = [r for r in rows if r.role == "published"]
 

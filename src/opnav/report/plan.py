@@ -46,6 +46,8 @@ EVIDENCE_SETTINGS = {
     "converge_threshold_sweep_m": "workflow/scripts/landing_summary.py (B-C2's sweep)",
     "converge_threshold_m": "workflow/scripts/landing_summary.py and B-C2's condition",
     "optimum_angle_grid": "rule landing_optima (B-C8's count)",
+    "converge_frac_of_bound": "paper A's converged label (approach.setup.EMSettings, every rule's params via "
+                              "workflow/rules/common.smk's PLAN_IN_PARAMS)",
 }
 
 

@@ -18,6 +18,7 @@ from opnav.core.checks import (
     study_spec_defaults,
 )
 from opnav.core.errors import ConfigError
+from opnav.core.planvalues import with_plan_values
 from opnav.studies.metrics import (
     APPROACH_METHODS,
     DEFAULT_METHODS,
@@ -244,7 +245,7 @@ def _plan_one(name, spec, config, shapes, validate, landing_methods, limit=MAX_S
             bad("vary", f"values {seen[label]} and {values} coincide (label {label!r})")
             continue
         seen[label] = values
-        sim = project(merged[paper], shapes[paper])
+        sim = project(with_plan_values(paper, merged[paper]), shapes[paper])   # as the rules' params (shapes)
         instances.append(Instance(label, values, sim, config_digest({"paper": paper, "sim": sim})))
     if problems:
         raise ConfigError("\n".join(dict.fromkeys(problems)))

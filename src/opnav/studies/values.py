@@ -140,7 +140,10 @@ SIM_KEYS = {
 
 
 def simulation_shapes(config: Mapping) -> dict[str, dict]:
-    """``{paper: the config section projected on SIM_KEYS[paper]}`` (keys sorted)."""
+    """``{paper: the config section projected on SIM_KEYS[paper]}`` (keys sorted), with the
+    analysis plan's numbers the rules carry beside them (:func:`opnav.core.planvalues.with_plan_values`)."""
+    from opnav.core.planvalues import with_plan_values
+
     out: dict[str, dict] = {}
     for paper, keys in SIM_KEYS.items():
         view: dict = {}
@@ -150,7 +153,7 @@ def simulation_shapes(config: Mapping) -> dict[str, dict]:
             for part in parents:
                 src, dst = src[part], dst.setdefault(part, {})
             dst[last] = copy.deepcopy(src[last])
-        out[paper] = _sorted(view)
+        out[paper] = _sorted(with_plan_values(paper, view))
     return out
 
 
