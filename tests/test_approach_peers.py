@@ -289,8 +289,11 @@ def test_the_a_p1_table_holds_keys_and_the_report_words_them():
     th = truth + rng.normal(size=(3, 3))
     bounds = SimpleNamespace(crlb_total_arcsec=np.ones(3), crlb_total_q0_arcsec=np.ones(3),
                              crlb_arcsec=np.ones(3), crlb_q0_arcsec=np.ones(3))
-    em = [SimpleNamespace(variant="roll", case_id="T1-01", method="plain", truth_arcsec=truth, theta_final_arcsec=th,
-                          bounds=bounds)]
+    # sliding plain and SQUAREM, growing SQUAREM: three keys (the growing run was keyed em_squarem
+    # too and the summary kept only the later of the two)
+    em = [SimpleNamespace(variant="roll", case_id="T1-01", mode=mode, method=m, truth_arcsec=truth,
+                          theta_final_arcsec=th + i, bounds=bounds)
+          for i, (mode, m) in enumerate((("sliding", "plain"), ("sliding", "squarem"), ("growing", "squarem")))]
     aug = SimpleNamespace(theta_final_arcsec=th, sigma_final_arcsec=np.ones((3, 3)))
     alt = [SimpleNamespace(variant="roll", case_id="T1-01", truth_arcsec=truth, methods=lambda: iter([("augmented", aug)]))]
     run = SimpleNamespace(truth_arcsec=truth, theta_final_arcsec=th[:, :2], sigma3_final_arcsec=np.full((3, 2), 5.0),
@@ -299,11 +302,14 @@ def test_the_a_p1_table_holds_keys_and_the_report_words_them():
                           bias_changes_after_first=np.array([0, 1, 0]), bias_quantum_arcsec=7.0)
     peer = [peers.PeerVariant(variant="roll", two_body=None, runs={name: run for name, _, _ in peers.RUNS})]
     table = peers.comparison_frame(peer, em, alt)
-    assert list(table["estimator"]) == ["em_plain", "augmented"] + [peers.PEER] * 3
-    assert list(table["run"]) == ["headline", "headline", "headline", "bias_free", "truth_start"]
+    ems = ["em_plain", "em_squarem", "em_growing_squarem"]
+    assert list(table["estimator"]) == ems + ["augmented"] + [peers.PEER] * 3
+    assert list(table["run"]) == ["headline"] * 5 + ["bias_free", "truth_start"]
     summ = peers.summary(table, peer)
-    assert set(summ.variants["roll"].estimators) == {"em_plain", "augmented", "ukf_headline", "ukf_bias_free",
-                                                      "ukf_truth_start"}
+    est = summ.variants["roll"].estimators
+    assert set(est) == {*ems, "augmented", "ukf_headline", "ukf_bias_free", "ukf_truth_start"}
+    assert est["em_squarem"]["est_x_mean_arcsec"] != est["em_growing_squarem"]["est_x_mean_arcsec"]
     page = words.p1_words(table)
-    assert list(page["estimator"]) == ["EM-EKF (plain)", "augmented EKF"] + ["Basilisk pixelLineBiasUKF"] * 3
+    assert list(page["estimator"]) == ["EM-EKF (plain)", "EM-EKF (SQUAREM)", "EM-EKF (growing windows, SQUAREM)",
+                                       "augmented EKF"] + ["Basilisk pixelLineBiasUKF"] * 3
     assert list(page["run"])[-2:] == ["zero misalignment (sanity)", "prior mean at the truth (diagnostic)"]

@@ -570,7 +570,8 @@ def _row(variant, method, run, truth, th, own3=None, crlb3=None, crlb3_q0=None) 
 def comparison_frame(peer: list[PeerVariant], em: list, alt: list, case_id: str = "T1-01"):
     """A-P1 table: per variant, the EM-EKF (each scheme), augmented EKF, batch ML and the
     peer UKF (headline, zero-misalignment sanity, truth-start diagnostic), arcsec; the
-    ``estimator`` and ``run`` columns hold keys (``em_plain`` ... :data:`PEER`; a key of
+    ``estimator`` and ``run`` columns hold keys (``em_plain``, ``em_squarem``, growing windows
+    ``em_growing_squarem`` ... :data:`PEER`; a key of
     :data:`RUNS`), their words are the report's (:func:`opnav.report.approach.text.p1_words`).
 
     ``peer``: :func:`run_variant` outputs; ``em``: EM-EKF Monte-Carlo runs
@@ -589,8 +590,9 @@ def comparison_frame(peer: list[PeerVariant], em: list, alt: list, case_id: str 
         ems = [r for r in em if r.variant == v and r.case_id == case_id]
         bound = 3.0 * np.asarray(ems[0].bounds.crlb_total_arcsec, float) if ems else None
         bound0 = 3.0 * np.asarray(ems[0].bounds.crlb_total_q0_arcsec, float) if ems else None
-        for r in ems:
-            rows.append(_row(v, f"em_{r.method}", "headline",
+        for r in ems:     # a scheme's key: em_<method> sliding, em_<mode>_<method> otherwise (no two alike)
+            key = f"em_{r.method}" if r.mode == "sliding" else f"em_{r.mode}_{r.method}"
+            rows.append(_row(v, key, "headline",
                              r.truth_arcsec, r.theta_final_arcsec, None, 3.0 * np.asarray(r.bounds.crlb_arcsec),
                              crlb3_q0=3.0 * np.asarray(r.bounds.crlb_q0_arcsec)))
         for a in (a for a in alt if a.variant == v and a.case_id == case_id):

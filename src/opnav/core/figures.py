@@ -57,6 +57,8 @@ PALETTE: dict[str, str] = {
 ALIASES: dict[str, str] = {
     "em_plain": "plain", "em_squarem": "squarem", "em_growing_squarem": "growing-squarem", "EM-EKF (plain)": "plain",
     "EM-EKF (SQUAREM)": "squarem", "augmented EKF": "augmented", "batch ML (IPOPT)": "batch_ml",
+    "em_growing_plain": "growing-plain", "EM-EKF (growing windows, plain)": "growing-plain",
+    "EM-EKF (growing windows, SQUAREM)": "growing-squarem",
 }
 
 

@@ -170,6 +170,8 @@ def tz_rule(variant: str, tz_arcsec: float, last_fraction: float) -> str:
 METHOD_LABELS = {
     "em_plain": "EM-EKF (plain)",
     "em_squarem": "EM-EKF (SQUAREM)",
+    "em_growing_plain": "EM-EKF (growing windows, plain)",
+    "em_growing_squarem": "EM-EKF (growing windows, SQUAREM)",
     "augmented": "augmented EKF",
     "batch_ml": "batch ML (IPOPT)",
 }
