@@ -54,7 +54,7 @@ def test_readme_gives_the_two_commands_and_the_quick_report():
     assert "not findings" in text
 
 
-def test_from_a_build_stamps_its_commit_and_date_and_the_timing_claims(tmp_path, monkeypatch):
+def test_from_a_build_stamps_its_commit_and_date_and_the_timing_claims(tmp_path, monkeypatch, capsys):
     """Issue 55 item 9: --from reads the build's provenance beside its results and the block
     names that build (commit, uncommitted edits, date) and says which verdicts time code on the
     build's machine; a table without provenance is refused, naming the file."""
@@ -72,6 +72,12 @@ def test_from_a_build_stamps_its_commit_and_date_and_the_timing_claims(tmp_path,
     assert not (tmp_path / "docs" / "claims.csv").exists()
     (results / "provenance.json").write_text(json.dumps(
         {"git_commit": "0123456789abcdef0123", "git_dirty": "yes", "built_utc": "2026-12-07 09:15 UTC"}))
+    quick = tmp_path / "q" / "paper" / "claims.csv"
+    quick.parent.mkdir(parents=True)
+    ref.assign(sample="quick").to_csv(quick, index=False)
+    (tmp_path / "q" / "provenance.json").write_text("{}")
+    assert readme.main(["--from", str(quick)]) == 2                                # a quick build: refused
+    assert "full build" in capsys.readouterr().err
     assert readme.main(["--from", str(results / "paper" / "claims.csv")]) == 0
     text = (tmp_path / "README.md").read_text()
     assert "From the full build of commit 0123456789ab with uncommitted edits (built 2026-12-07 09:15 UTC)." in text

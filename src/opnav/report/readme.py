@@ -135,7 +135,11 @@ def main(argv=None) -> int:
                   file=sys.stderr)
             return 2
         df = read_reference(src)
-        findings_block(df, read_provenance(prov_file))  # refuses a quick build's table before anything is written
+        try:  # refuses a quick build's table before anything is written
+            findings_block(df, read_provenance(prov_file))
+        except ValueError as exc:
+            print(f"--from {src}: {exc}", file=sys.stderr)
+            return 2
         REFERENCE.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(src, REFERENCE)
         shutil.copyfile(prov_file, REFERENCE_PROVENANCE)
