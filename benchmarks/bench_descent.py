@@ -62,16 +62,21 @@ def fly(scn, method, runs, batch):
     return out, time.process_time() - t0, PLAN_CPU[0]
 
 
+def _field(run, k):
+    """A field of a Descent record, or a key of the frozen reference's dict."""
+    return run[k] if isinstance(run, dict) else getattr(run, k)
+
+
 def max_rel_diff(a, b) -> float:
     worst = 0.0
     for x, y in zip(a, b):
         for k in ("err_r", "err_v", "sig_r", "plan_beta"):
-            u, v = np.asarray(x[k], float), np.asarray(y[k], float)
+            u, v = np.asarray(_field(x, k), float), np.asarray(_field(y, k), float)
             if u.shape != v.shape:
                 return np.inf
             fin = np.isfinite(v)
             worst = max(worst, float(np.max(np.abs(u[fin] - v[fin]) / (1e-9 + np.abs(v[fin])), initial=0)))
-        if not np.array_equal(x["plan_index"], y["plan_index"]):
+        if not np.array_equal(_field(x, "plan_index"), _field(y, "plan_index")):
             return np.inf
     return worst
 

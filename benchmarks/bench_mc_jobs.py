@@ -31,7 +31,7 @@ def job_cpu(scenario: str, method: str, runs: int, configfiles: list[str]) -> tu
     run_chunk(sm.params.landing, method, [0], pick_ratio=False)
     t0 = time.process_time()
     d = run_chunk(sm.params.landing, method, list(range(1, runs + 1)), pick_ratio=bool(sm.params.pick_ratio))
-    return time.process_time() - t0, len(d["plan_index"])
+    return time.process_time() - t0, len(d.plan_index)
 
 
 def main(argv=None) -> int:

@@ -36,10 +36,10 @@ def record(a) -> None:
     for name, cfg in scns.items():
         for m in a.methods.split(","):
             d = run_chunk(cfg, m, range(a.runs), pick_ratio=False)
-            for k, v in d.items():
+            for k, v in d.arrays().items():
                 if k.startswith("plan_"):
                     out[f"{name}|{m}|{k}"] = np.asarray(v)
-            print(name, m, len(d["plan_index"]), "calls", flush=True)
+            print(name, m, len(d.plan_index), "calls", flush=True)
     np.savez_compressed(a.out, **out)
 
 

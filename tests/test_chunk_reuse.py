@@ -55,8 +55,8 @@ def test_raising_n_runs_flies_only_the_new_runs(tmp_path, landing):
     assert _fly(tmp_path, landing, 4, 6) == [0, 1, 2, 3]
     assert _fly(tmp_path, landing, 6, 6) == [4, 5]
     assert _fly(tmp_path, landing, 7, 6) == [6]
-    fresh = run_chunk(landing, "depth", range(6))
-    got = load(tmp_path / "r0000-0005.npz")
+    fresh = run_chunk(landing, "depth", range(6)).arrays()
+    got = load(tmp_path / "r0000-0005.npz").arrays()
     assert set(got) - {"method", "reuse_key"} == set(fresh)
     for k in fresh:
         x = np.asarray(fresh[k])

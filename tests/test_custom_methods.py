@@ -194,8 +194,8 @@ def test_the_preflight_refuses_before_any_work(tmp_path):
 def _candidate(d, i, p, scn) -> M.Candidate:
     """The documented record of recorded call ``i`` at point ``p``, built here from the records."""
     cam, cfg = scn.camera, scn.planner
-    P = d["plan_P"][i]
-    return M.Candidate(np.asarray(p, float), d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i],
+    P = d.plan_P[i]
+    return M.Candidate(np.asarray(p, float), d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i],
                        0.5 * (P + P.T), np.zeros(3), cam.R_BtoC, cam.sigma_b, cfg.noise_scale, cfg.t_s,
                        cfg.obs_per_landmark)
 
@@ -207,22 +207,22 @@ def check_picks(d, scn, fn) -> dict:
     detected landmark nearest (horizontally) to beta*'s ground point."""
     counts = {"edge": 0, "plane": 0}
     tr, cam, xyz = scn.truth, scn.camera, scn.field.xyz
-    for i in range(len(d["plan_index"])):
-        k = int(d["plan_step"][i])
+    for i in range(len(d.plan_index)):
+        k = int(d.plan_step[i])
         det = np.flatnonzero(cam.in_view((xyz - tr.r[k]) @ tr.R_LtoB[k].T, scn.planner.margin_px))
-        cand = det[det != d["plan_exclude"][i]]
-        pick = int(d["plan_index"][i])
-        if d["plan_edge"][i]:
+        cand = det[det != d.plan_exclude[i]]
+        pick = int(d.plan_index[i])
+        if d.plan_edge[i]:
             s = np.array([fn(_candidate(d, i, xyz[j], scn)) for j in cand])
             best = s.min()
             assert pick == cand[np.flatnonzero(s <= best + TIE_RTOL * abs(best))[0]], i
             counts["edge"] += 1
             continue
-        beta = float(d["plan_beta"][i])
+        beta = float(d.plan_beta[i])
         if not math.isfinite(beta):          # the documented fallback (no visible interval)
             continue
-        geom = geometry.plane_geometry(d["plan_r"][i], d["plan_v"][i])
-        ivals = PL.visible_intervals(geom, d["plan_R"][i], cam, scn.planner.margin_px)
+        geom = geometry.plane_geometry(d.plan_r[i], d.plan_v[i])
+        ivals = PL.visible_intervals(geom, d.plan_R[i], cam, scn.planner.margin_px)
         grid = np.concatenate([np.linspace(a + 1e-9, b - 1e-9, 200) for a, b in ivals])
         f = lambda b: fn(_candidate(d, i, geometry.ground_points(b, geom)[0], scn))  # noqa: E731
         f_grid = np.array([f(b) for b in grid])
@@ -252,8 +252,8 @@ def test_the_example_flies_and_picks_what_the_function_says(flown):
     parallax_score = example_function()
     seen = {"edge": 0, "plane": 0}
     for name, (scn, d) in flown.items():
-        assert len(d["plan_index"]) > 10 and str(d.get("method", "parallax")) == "parallax"
-        assert np.all(np.isnan(d["plan_ratio"]))          # a user's score has no scale: no ratio
+        assert len(d.plan_index) > 10 and (d.method or "parallax") == "parallax"
+        assert np.all(np.isnan(d.plan_ratio))          # a user's score has no scale: no ratio
         for k, v in check_picks(d, scn, parallax_score).items():
             seen[k] += v
     assert seen["edge"] >= 5 and seen["plane"] >= 5, seen
@@ -265,7 +265,7 @@ def test_a_builtin_is_unchanged_by_a_registration(landing, flown):
     plain = run_chunk(c, "depth", [1])
     reg = run_chunk({**c, "custom_methods": {"parallax": EXAMPLE}}, "depth", [1])
     for k in ("plan_index", "plan_beta", "err_r", "nees_r"):
-        np.testing.assert_array_equal(plain[k], reg[k], err_msg=k)
+        np.testing.assert_array_equal(getattr(plain, k), getattr(reg, k), err_msg=k)
 
 
 def test_the_mutated_function_would_fail_the_pick_check(flown):
@@ -303,19 +303,19 @@ def test_a_numba_function_flies_compiled_with_the_same_picks(landing, flown, tmp
         c = with_methods(camera_scenarios(landing)[name], jitted=f"{f}:score")
         d = run_chunk(c, "jitted", [1, 2])
         ref = flown[name][1]
-        np.testing.assert_array_equal(d["plan_index"], ref["plan_index"])
-        np.testing.assert_array_equal(d["plan_evals"], ref["plan_evals"])
-        np.testing.assert_allclose(d["plan_beta"], ref["plan_beta"], rtol=1e-12, atol=1e-15)
+        np.testing.assert_array_equal(d.plan_index, ref.plan_index)
+        np.testing.assert_array_equal(d.plan_evals, ref.plan_evals)
+        np.testing.assert_allclose(d.plan_beta, ref.plan_beta, rtol=1e-12, atol=1e-15)
     # the timed call is the compiled kernel itself, and it picks what plan() picks
     scn = build_scenario(c)
     i = 3
-    state = PL.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
-    k = int(d["plan_step"][i])
+    state = PL.PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i], d.plan_P[i])
+    k = int(d.plan_step[i])
     det = np.flatnonzero(scn.camera.in_view((scn.field.xyz - scn.truth.r[k]) @ scn.truth.R_LtoB[k].T,
                                             scn.planner.margin_px))
-    call = PL.compiled_call("jitted", state, scn.camera, scn.field, scn.planner, int(d["plan_exclude"][i]), det)
+    call = PL.compiled_call("jitted", state, scn.camera, scn.field, scn.planner, int(d.plan_exclude[i]), det)
     call()
-    assert int(call.args[-1][-layout.NOUT + layout.O_PICK]) == int(d["plan_index"][i])
+    assert int(call.args[-1][-layout.NOUT + layout.O_PICK]) == int(d.plan_index[i])
 
 
 @pytest.mark.slow

@@ -87,8 +87,10 @@ def _b_f6():
     from opnav.landing import plots
     t = np.linspace(0, 198, 199)
     rng = np.random.default_rng(1)
-    data = {m: {k: rng.normal(size=(6, 199, 3)) * np.geomspace(100, 1, 199)[None, :, None]
-                for k in ("err_r", "err_v", "err_rpy_deg")} for m in ("depth", "svd", "gdop", "cond")}
+    from opnav.landing.records import MonteCarlo
+
+    data = {m: MonteCarlo(**{k: rng.normal(size=(6, 199, 3)) * np.geomspace(100, 1, 199)[None, :, None]
+                             for k in ("err_r", "err_v", "err_rpy_deg")}) for m in ("depth", "svd", "gdop", "cond")}
     return plots.fig_nav_error_envelopes(t, data)
 
 

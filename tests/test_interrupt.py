@@ -75,8 +75,8 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
                                        overlays=[REPO / "config" / "quick.yaml", wd / "small.yaml"])["landing"])["site-tilt"]
     # each job flies its chunk of four runs as one batch: the clean run does the same
     # (batch size changes numbers only at round-off, tests/test_landing_batch.py)
-    clean = gather([run_chunk(cfg, "depth", list(range(a, a + 4)), batch_size=4) for a in (0, 4, 8)])
-    got = load(wd / target)
+    clean = gather([run_chunk(cfg, "depth", list(range(a, a + 4)), batch_size=4) for a in (0, 4, 8)]).arrays()
+    got = load(wd / target).arrays()
     assert set(got) - {"method", "reuse_key"} == set(clean)
     differ = {k for k in clean if not np.array_equal(np.asarray(got[k]), np.asarray(clean[k]),
                                                      equal_nan=np.asarray(clean[k]).dtype.kind == "f")}

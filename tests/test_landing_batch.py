@@ -31,9 +31,14 @@ def scenarios():
     return {name: build_scenario(c) for name, c in camera_scenarios(load_config()["landing"]).items()}
 
 
-def assert_same_run(a: dict, b: dict, rtol: float = 1e-7, atol: float = 1e-9):
+def _field(run, k):
+    """A field of a Descent record, or a key of the frozen reference's dict."""
+    return run[k] if isinstance(run, dict) else getattr(run, k)
+
+
+def assert_same_run(a, b, rtol: float = 1e-7, atol: float = 1e-9):
     for k in KEYS:
-        x, y = np.asarray(a[k]), np.asarray(b[k])
+        x, y = np.asarray(_field(a, k)), np.asarray(_field(b, k))
         assert x.shape == y.shape, k
         if x.dtype.kind in "bi":
             np.testing.assert_array_equal(x, y, err_msg=k)
@@ -64,9 +69,9 @@ def test_a_run_alone_equals_the_run_inside_batches(scenarios):
         assert_same_run(got, alone, rtol=1e-9, atol=1e-10)
         # the recorded planning inputs (timing replay) too
         for k in ("plan_step", "plan_exclude", "plan_rng"):
-            np.testing.assert_array_equal(got[k], alone[k], err_msg=k)
+            np.testing.assert_array_equal(getattr(got, k), getattr(alone, k), err_msg=k)
         for k in ("plan_r", "plan_v", "plan_a", "plan_R", "plan_P"):
-            np.testing.assert_allclose(got[k], alone[k], rtol=1e-9, atol=1e-10, err_msg=k)
+            np.testing.assert_allclose(getattr(got, k), getattr(alone, k), rtol=1e-9, atol=1e-10, err_msg=k)
     # ...and the batch of one is run_descent itself
     assert_same_run(run_descents(scn, "svd", [2])[0], alone, rtol=0, atol=0)
 
@@ -77,9 +82,9 @@ def test_runs_differ_and_draws_follow_the_run_index(scenarios):
     position in the batch."""
     scn = scenarios["interior"]
     a, b = run_descents(scn, "depth", [5, 6])
-    assert not np.allclose(a["err_r"], b["err_r"])
+    assert not np.allclose(a.err_r, b.err_r)
     ss = np.random.SeedSequence([scn.base_seed, 6]).spawn(4)[0]
-    np.testing.assert_array_equal(b["init_error"], REF.initial_error(np.random.default_rng(ss), scn.bounds))
+    np.testing.assert_array_equal(b.init_error, REF.initial_error(np.random.default_rng(ss), scn.bounds))
 
 
 def _planning_calls(scn, runs):
@@ -161,16 +166,17 @@ def test_skipping_the_pick_ratio_changes_nothing_else(scenarios, method):
     scn = scenarios["interior"]
     on = run_descents(scn, method, [0, 1])
     off = run_descents(scn, method, [0, 1], pick_ratio=False)
+    import dataclasses
+
     for a, b in zip(on, off):
-        assert set(a) == set(b)
-        for k in a:
+        for k in (f.name for f in dataclasses.fields(a)):
             if k == "plan_ratio":
                 continue
-            x, y = np.asarray(a[k]), np.asarray(b[k])
+            x, y = np.asarray(getattr(a, k)), np.asarray(getattr(b, k))
             assert np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), k
-        r = np.asarray(a["plan_ratio"], float)
+        r = np.asarray(a.plan_ratio, float)
         assert np.isfinite(r).any() and (r[np.isfinite(r)] >= 1 - 1e-12).all()
-        assert np.isnan(np.asarray(b["plan_ratio"], float)).all()
+        assert np.isnan(np.asarray(b.plan_ratio, float)).all()
 
 
 def test_a_chunk_is_already_in_gathered_order():
@@ -182,8 +188,9 @@ def test_a_chunk_is_already_in_gathered_order():
                            ["landing"])["site-tilt"]
     d = run_chunk(cfg, "depth", [0, 1, 2])
     g = gather([d])
-    assert set(g) == set(d)
-    for k in d:
-        x = np.asarray(d[k])
-        assert np.array_equal(x, np.asarray(g[k]), equal_nan=x.dtype.kind == "f"), k
-    assert (np.diff(d["plan_run"]) >= 0).all() and len(set(d["plan_run"])) == 3
+    da, ga = d.arrays(), g.arrays()
+    assert set(ga) == set(da)
+    for k in da:
+        x = np.asarray(da[k])
+        assert np.array_equal(x, np.asarray(ga[k]), equal_nan=x.dtype.kind == "f"), k
+    assert (np.diff(d.plan_run) >= 0).all() and len(set(d.plan_run)) == 3

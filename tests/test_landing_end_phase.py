@@ -30,11 +30,11 @@ def test_end_phase_equals_the_per_step_records_counted_by_hand(small_run):
     d, z, cfg = small_run
     margin = float(cfg["filter"]["update_altitude_margin_m"])
     got = end_phase(d, z, margin)
-    t = d["t"]
+    t = d.t
     last_lm, last_vis, below1, belowm, lowest = [], [], 0, 0, math.inf
-    for run in range(len(d["run_index"])):
-        lm = [t[k] for k in range(len(t)) if d["lm_updated"][run][k]]
-        vis = [k for k in range(len(t)) if d["updated"][run][k]]
+    for run in range(d.n_runs):
+        lm = [t[k] for k in range(len(t)) if d.lm_updated[run][k]]
+        vis = [k for k in range(len(t)) if d.updated[run][k]]
         last_lm.append(lm[-1])
         last_vis.append(t[vis[-1]])
         below1 += any(z[k] < 1.0 for k in vis)
@@ -51,7 +51,10 @@ def test_end_phase_equals_the_per_step_records_counted_by_hand(small_run):
 
 
 def _rec(updated, lm_updated, t):
-    return {"t": np.asarray(t, float), "updated": np.asarray(updated, bool), "lm_updated": np.asarray(lm_updated, bool)}
+    from opnav.landing.records import MonteCarlo
+
+    return MonteCarlo(t=np.asarray(t, float), updated=np.asarray(updated, bool),
+                      lm_updated=np.asarray(lm_updated, bool))
 
 
 def test_end_phase_on_hand_made_records_and_its_sentences():

@@ -233,7 +233,9 @@ def test_landmark_phase_and_time_below():
     err[0, :, 0] = [500, 300, 150, 90, 120, 80, 10, 5]
     err[1, :, 0] = 200
     t = np.arange(8.0)
-    out = time_below({"err_r": err, "t": t}, 100.0)
+    from opnav.landing.records import MonteCarlo
+
+    out = time_below(MonteCarlo(err_r=err, t=t), 100.0)
     assert out[0] == 3.0 and np.isnan(out[1])
 
 
@@ -293,14 +295,14 @@ def test_vision_cut_off_uses_the_estimate_never_the_truth():
     true_alt = scn.truth.r[:, 2]
     checked = 0
     for d in runs:
-        cut = d["cut_alt_m"]
-        assert not np.any(d["updated"][1:] & ~(cut[1:] > lim))
+        cut = d.cut_alt_m
+        assert not np.any(d.updated[1:] & ~(cut[1:] > lim))
         stop = np.flatnonzero(~(cut[1:-1] > lim))[0] + 1
         # after the cut-off the truth is still above the limit (the margin) yet no update
-        assert true_alt[stop] > lim and not d["updated"][stop:].any()
+        assert true_alt[stop] > lim and not d.updated[stop:].any()
         checked += 1
         # the recorded quantity is the estimate less the margin, not the truth's
-        est_alt = true_alt - d["err_r"][:, 2]
+        est_alt = true_alt - d.err_r[:, 2]
         assert not np.allclose(cut[1:], vision_cutoff_altitude(np.column_stack(
             [np.zeros((len(true_alt), 2)), true_alt]), scn.update_margin_m)[1:])
         assert np.all(np.isfinite(est_alt))

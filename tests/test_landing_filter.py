@@ -23,7 +23,7 @@ def landing():
 
 def _nees(cfg, n=N_RUNS, method="depth"):
     d = run_chunk(cfg, method, range(n))
-    return d["nees_r"].mean(axis=0), d["nees_v"].mean(axis=0)
+    return d.nees_r.mean(axis=0), d.nees_v.mean(axis=0)
 
 
 def _check_chi2(mean_nees, n, frac_inside):
@@ -56,13 +56,13 @@ def test_single_descent_converges_in_position_and_velocity(landing):
     scn = build_scenario(landing)
     run = run_descent(scn, "depth", 0)
     s = summarize_run(run)
-    e0 = np.linalg.norm(run["init_error"][0:3])
+    e0 = np.linalg.norm(run.init_error[0:3])
     assert s["final_pos_err_m"] < 0.1 * e0
-    assert s["final_vel_err_mps"] < 0.2 * np.linalg.norm(run["init_error"][3:6])
+    assert s["final_vel_err_mps"] < 0.2 * np.linalg.norm(run.init_error[3:6])
     assert s["n_landmarks"] >= 30
-    assert np.all(run["plan_evals"] > 0)
+    assert np.all(run.plan_evals > 0)
     # the filter's own 1-sigma shrinks with the errors
-    assert np.linalg.norm(run["sig_r"][-1]) < 0.1 * np.linalg.norm(run["sig_r"][0])
+    assert np.linalg.norm(run.sig_r[-1]) < 0.1 * np.linalg.norm(run.sig_r[0])
 
 
 def test_zero_errors_zero_noise_stay_near_truth(landing):
@@ -73,9 +73,9 @@ def test_zero_errors_zero_noise_stay_near_truth(landing):
     cfg["camera"]["sigma_px"] = 1e-3
     scn = build_scenario(cfg)
     run = run_descent(scn, "depth", 0, imu_noise=False, init_error=False)
-    assert np.abs(run["err_r"]).max() < 20.0
-    assert np.abs(run["err_r"][-1]).max() < 1.0
-    assert np.abs(run["err_v"]).max() < 0.5
+    assert np.abs(run.err_r).max() < 20.0
+    assert np.abs(run.err_r[-1]).max() < 1.0
+    assert np.abs(run.err_v).max() < 0.5
 
 
 @pytest.mark.slow  # ~1.1 CPU-s (issue 56: the default run <= 90 s)
@@ -84,15 +84,14 @@ def test_chunking_does_not_change_results(landing):
     # chunk flown as one batch by default) changes numbers only at round-off
     whole = run_chunk(landing, "depth", [0, 1, 2], batch_size=1)
     parts = [run_chunk(landing, "depth", c, batch_size=1) for c in ([2], [0, 1])]
-    for p in parts:
-        p["method"] = np.array("depth")
-    g = gather(parts)
+    g = gather([p.replace(method="depth") for p in parts])
+    assert g.method == "depth"
     # nothing clock-based is recorded (planning time is measured by replay): every field equal
-    a, b = whole, {k: v for k, v in g.items() if k != "method"}
+    a, b = whole.arrays(), g.replace(method=None).arrays()
     assert set(a) == set(b)
     for k in a:
         np.testing.assert_array_equal(a[k], b[k], err_msg=k)
-    batched = run_chunk(landing, "depth", [0, 1, 2])
+    batched = run_chunk(landing, "depth", [0, 1, 2]).arrays()
     for k in a:
         if np.asarray(a[k]).dtype.kind == "f":
             np.testing.assert_allclose(batched[k], a[k], rtol=1e-7, atol=1e-9, err_msg=k)
@@ -114,8 +113,8 @@ def paired(landing):
 @pytest.mark.slow  # ~1.9 CPU-s (issue 56: the default run <= 90 s)
 def test_methods_are_paired_and_the_table_is_complete(paired):
     d, tm, df = paired
-    np.testing.assert_array_equal(d["depth"]["init_error"], d["svd"]["init_error"])
-    np.testing.assert_array_equal(d["depth"]["err_r"][:, 0], d["svd"]["err_r"][:, 0])
+    np.testing.assert_array_equal(d["depth"].init_error, d["svd"].init_error)
+    np.testing.assert_array_equal(d["depth"].err_r[:, 0], d["svd"].err_r[:, 0])
     assert tm["mismatch"].tolist() == [0, 0]
     for col in ("final_pos_err_m_mean", "final_pos_err_m_3sigma", "rms_vel_err_mps_mean",
                 "rms_att_err_deg_3sigma", "median_plan_time_us", "metric_evals_per_call",
@@ -125,8 +124,8 @@ def test_methods_are_paired_and_the_table_is_complete(paired):
     assert not df.drop(columns=pair_cols).isna().any().any()
     # the same-pick rate is the share of matched planning calls with the same landmark
     t = df.set_index("method")
-    ka = {(r, t_): i for r, t_, i in zip(d["depth"]["plan_run"], d["depth"]["plan_t"], d["depth"]["plan_index"])}
-    kb = {(r, t_): i for r, t_, i in zip(d["svd"]["plan_run"], d["svd"]["plan_t"], d["svd"]["plan_index"])}
+    ka = {(r, t_): i for r, t_, i in zip(d["depth"].plan_run, d["depth"].plan_t, d["depth"].plan_index)}
+    kb = {(r, t_): i for r, t_, i in zip(d["svd"].plan_run, d["svd"].plan_t, d["svd"].plan_index)}
     common = set(ka) & set(kb)
     want = 100.0 * sum(ka[k] == kb[k] for k in common) / len(common)
     assert t.loc["svd", "same_pick_as_depth_pct"] == pytest.approx(want)
@@ -190,19 +189,19 @@ def test_iterated_oc_update_keeps_the_nullspace(landing, iterations):
     of the prior's unobservable direction it collapses; that H N = 0 in every
     iteration is tests/test_landing_ekf_kernels.py)."""
     run = _descent(landing, iterations)
-    assert run["updated"].sum() > 50
+    assert run.updated.sum() > 50
     # yaw is unobservable with one known landmark: its sigma keeps (most of) its
     # prior; it shrinks a little only through the position prior, which bounds how
     # far the whole geometry can turn about the site (measured 0.93; 0.68 with the
     # iterated update unprojected)
-    assert run["sig_yaw_deg"][-1] > 0.9 * run["sig_yaw_deg"][0]
+    assert run.sig_yaw_deg[-1] > 0.9 * run.sig_yaw_deg[0]
 
 
 def test_plain_ekf_gains_spurious_yaw_information(landing):
     """The contrast that makes the test above meaningful: without the
     constraint the same descent's yaw sigma shrinks well below its prior."""
     run = _descent(landing, 3, oc=False)
-    assert run["sig_yaw_deg"][-1] < 0.8 * run["sig_yaw_deg"][0]
+    assert run.sig_yaw_deg[-1] < 0.8 * run.sig_yaw_deg[0]
 
 
 def test_last_vision_update_precedes_the_coast(paired):
@@ -214,7 +213,7 @@ def test_last_vision_update_precedes_the_coast(paired):
     d = paired[0]["depth"]  # run_chunk(landing, "depth", [0, 1]), flown once for the module
     st = per_run_stats(d)
     for i in range(2):
-        k = last_update_index(d["updated"][i])
-        assert 0 < k < d["t"].size - 1
-        assert not d["updated"][i, k + 1:].any()
-        assert st["lastvis_pos_err_m"].iloc[i] == pytest.approx(np.linalg.norm(d["err_r"][i, k]))
+        k = last_update_index(d.updated[i])
+        assert 0 < k < d.t.size - 1
+        assert not d.updated[i, k + 1:].any()
+        assert st["lastvis_pos_err_m"].iloc[i] == pytest.approx(np.linalg.norm(d.err_r[i, k]))

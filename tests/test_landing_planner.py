@@ -128,12 +128,12 @@ def _recorded_calls(scn, method, runs=(0, 1)):
     out = []
     for run in runs:
         d = run_descent(scn, method, run)
-        for i in range(len(d["plan_index"])):
-            k = int(d["plan_step"][i])
+        for i in range(len(d.plan_index)):
+            k = int(d.plan_step[i])
             r_t, R_t = scn.truth.r[k], scn.truth.R_LtoB[k]
             det = np.flatnonzero(scn.camera.in_view((scn.field.xyz - r_t) @ R_t.T, scn.planner.margin_px))
-            out.append((PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i],
-                                  d["plan_P"][i]), det, int(d["plan_exclude"][i])))
+            out.append((PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i],
+                                  d.plan_P[i]), det, int(d.plan_exclude[i])))
     return out
 
 

@@ -141,6 +141,16 @@ def _fake_mc(rms_scale, runs, plan_us, seed):
             "plan_t": np.tile([1.0, 2.0, 3.0], n), "plan_index": np.tile([1, 2, 3], n)}
 
 
+def _records(data):
+    """The fake Monte Carlos as records (their hand-made planning times left out: ``_timing``)."""
+    import dataclasses
+
+    from opnav.landing.records import MonteCarlo
+
+    names = {f.name for f in dataclasses.fields(MonteCarlo)}
+    return {m: MonteCarlo(**{k: v for k, v in d.items() if k in names}) for m, d in data.items()}
+
+
 def _timing(data):
     """The replay result of the fake Monte Carlos' planning times (same calls)."""
     from opnav.landing.timing import from_times
@@ -158,7 +168,7 @@ def test_ranking_table_ties_and_paired_difference():
             "gdop": _fake_mc(base + 1.0, runs, 900.0, 2),     # same errors as svd: a tie
             "random": _fake_mc(base * 0.5, runs, 50.0, 3)}
     data["svd"]["plan_beta"] = np.tile([0.01, -0.03, np.nan], 6)   # optimum's angle to the velocity, rad
-    df = ranking_table(data, _timing(data), "depth", n_boot=100)
+    df = ranking_table(_records(data), _timing(data), "depth", n_boot=100)
     t = df.set_index("method")
     # median |beta| over the calls with an optimum (mutation tried: no abs fails); none recorded: NaN
     assert t.loc["svd", "median_abs_beta_deg"] == pytest.approx(math.degrees(0.02))
@@ -185,9 +195,9 @@ def test_ranking_refuses_unpaired_runs():
     a = _fake_mc(np.ones(3), np.arange(3), 1.0, 0)
     b = _fake_mc(np.ones(3), np.arange(1, 4), 1.0, 0)
     with pytest.raises(ValueError, match="not paired"):
-        ranking_table({"depth": a, "svd": b}, _timing({"depth": a, "svd": a}))
+        ranking_table(_records({"depth": a, "svd": b}), _timing({"depth": a, "svd": a}))
     with pytest.raises(ValueError, match="reference"):
-        ranking_table({"svd": a}, _timing({"svd": a}), reference="depth")
+        ranking_table(_records({"svd": a}), _timing({"svd": a}), reference="depth")
 
 
 def test_headline_feeds_manuscript_macros():
@@ -202,7 +212,7 @@ def test_headline_feeds_manuscript_macros():
             "logdet": _fake_mc(np.arange(2.0, 7.0), runs, 900.0, 2)}
     data["depth"]["plan_beta"] = np.full(15, math.radians(60.0))
     data["logdet"]["plan_beta"] = np.full(15, -math.radians(2.5))
-    df = ranking_table(data, _timing(data), "depth", n_boot=50, rtol=1e-3)
+    df = ranking_table(_records(data), _timing(data), "depth", n_boot=50, rtol=1e-3)
     t = df.set_index("method")
     assert t.loc["svd", "rank_accuracy"] == t.loc["depth", "rank_accuracy"] == 1   # within 0.1 %
     h = json.loads(json.dumps(headline(df, "depth")))
@@ -224,7 +234,7 @@ def test_tied_order_is_by_method_name_not_timing():
     def build(times):
         data = {m: _fake_mc(base + (0.0 if m in ("depth", "svd", "cond") else 1.0), runs, times[m], i)
                 for i, m in enumerate(["svd", "depth", "mineig", "cond", "gdop"])}
-        df = ranking_table(data, _timing(data), "depth", n_boot=20, rtol=1e-3)
+        df = ranking_table(_records(data), _timing(data), "depth", n_boot=20, rtol=1e-3)
         return df, headline(df, "depth")
 
     df1, h1 = build({"svd": 900.0, "depth": 100.0, "mineig": 50.0, "cond": 400.0, "gdop": 60.0})
@@ -248,11 +258,17 @@ def _calls_data(runs, times, idx, beta, err):
             "n_landmarks": np.ones(n, int)}
 
 
+def _calls_record(*args):
+    from opnav.landing.records import MonteCarlo
+
+    return MonteCarlo(**_calls_data(*args))
+
+
 def test_pair_comparison_on_hand_made_calls():
     from opnav.landing.ranking import pair_comparison
 
-    a = _calls_data([0, 0, 1, 1], [1, 4, 1, 4], [5, 6, 7, 8], [0.1, 0.2, 0.3, 0.4], [1.0, 2.0])
-    b = _calls_data([0, 0, 1, 1], [1, 4, 1, 4], [5, 9, 7, 9], [0.1, 0.25, 0.3, 0.5], [2.0, 4.0])
+    a = _calls_record([0, 0, 1, 1], [1, 4, 1, 4], [5, 6, 7, 8], [0.1, 0.2, 0.3, 0.4], [1.0, 2.0])
+    b = _calls_record([0, 0, 1, 1], [1, 4, 1, 4], [5, 9, 7, 9], [0.1, 0.25, 0.3, 0.5], [2.0, 4.0])
     pc = pair_comparison(a, b)
     assert pc["same_pick_pct"] == pytest.approx(50.0)
     # |dbeta| = 0, 0.05, 0, 0.1 rad: median 0.025 rad
@@ -276,8 +292,11 @@ def test_first_runs_keeps_the_paired_runs_and_their_calls():
 
     for k in CALL_KEYS:
         a.setdefault(k, np.zeros(5))
+    from opnav.landing.records import MonteCarlo
+
+    a = MonteCarlo(**a)
     b = first_runs(a, 2)
-    assert list(b["run_index"]) == [0, 1] and list(b["plan_run"]) == [0, 0, 1, 1]
-    assert list(b["plan_index"]) == [5, 6, 7, 8] and b["err_r"].shape[0] == 2
+    assert list(b.run_index) == [0, 1] and list(b.plan_run) == [0, 0, 1, 1]
+    assert list(b.plan_index) == [5, 6, 7, 8] and b.err_r.shape[0] == 2
     with pytest.raises(ValueError, match="lacks some of runs 0..3"):
         first_runs(a, 4)

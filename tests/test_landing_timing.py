@@ -51,7 +51,7 @@ def test_replay_reproduces_every_recorded_pick(recorded):
     scn, rec = recorded
     tm = timing.replay(scn, {m: rec[m] for m in ("depth", "random", "center")},
                        ["depth", "random", "center"], max_calls=0)
-    n = sum(len(rec[m]["plan_index"]) for m in ("depth", "random", "center"))
+    n = sum(len(rec[m].plan_index) for m in ("depth", "random", "center"))
     assert len(tm["source"]) == n and tm["checked"].sum() == n
     assert tm["mismatch"].tolist() == [0, 0, 0]
     assert (tm["wall_ns"] > 0).all() and (tm["cpu_ns"] >= 0).all()
@@ -63,8 +63,7 @@ def test_the_pick_check_can_fail(recorded):
     excluded landmark changes picks: the check counts them."""
     scn, rec = recorded
     for key, bad in (("plan_step", lambda x: x + 3), ("plan_exclude", lambda x: np.full_like(x, -1))):
-        d = dict(rec["depth"])
-        d[key] = bad(d[key])
+        d = rec["depth"].replace(**{key: bad(getattr(rec["depth"], key))})
         tm = timing.replay(scn, {"depth": d}, ["depth"], max_calls=0)
         assert tm["mismatch"][0] > 0, key
 
@@ -88,7 +87,7 @@ def test_replay_deterministic_and_order_independent(recorded):
                                       a["pick"][:, timing_summary.variant_index(a, m, "main")])
     # the subset's calls are the full pool's calls at the selected indices
     sel = timing.select_calls(int(a["n_pool"]), 12)
-    pool_src = np.concatenate([np.full(len(rec[m]["plan_index"]), i) for i, m in enumerate(METHODS)])
+    pool_src = np.concatenate([np.full(len(rec[m].plan_index), i) for i, m in enumerate(METHODS)])
     np.testing.assert_array_equal(a["source"], pool_src[sel])
     svd_calls = a["source"] == list(METHODS).index("svd")
     # (the full replay's rows are every source's calls in pool order: find svd's)
@@ -382,11 +381,11 @@ def test_the_timed_compiled_call_is_the_planning_call(recorded):
     cam, field_, tr = scn.camera, scn.field, scn.truth
     for m in ("depth", "svd"):
         d = rec[m]
-        for i in range(len(d["plan_step"])):
-            k = int(d["plan_step"][i])
+        for i in range(len(d.plan_step)):
+            k = int(d.plan_step[i])
             det = np.flatnonzero(cam.in_view((field_.xyz - tr.r[k]) @ tr.R_LtoB[k].T, scn.planner.margin_px))
-            st = planner.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
-            ex = int(d["plan_exclude"][i])
+            st = planner.PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i], d.plan_P[i])
+            ex = int(d.plan_exclude[i])
             res = planner.plan(m, st, cam, field_, None, scn.planner, exclude={ex} - {-1}, detected=det,
                                diagnose=False)
             call = planner.compiled_call(m, st, cam, field_, scn.planner, ex, det)

@@ -81,7 +81,9 @@ def _figures():
     yield "B study", study_plots.fig_study(_study_tidy("landing", [], b["methods"], b["metrics"]), b), lambda lab: lab
     t = np.linspace(0, 1, 5)
     rng = np.random.default_rng(0)
-    data = {m: {k: rng.normal(size=(3, 5, 3)) for k in ("err_r", "err_v", "err_rpy_deg")}
+    from opnav.landing.records import MonteCarlo
+
+    data = {m: MonteCarlo(**{k: rng.normal(size=(3, 5, 3)) for k in ("err_r", "err_v", "err_rpy_deg")})
             for m in ("depth", "svd", "cond")}
     names = {lplots._label(m): m for m in data}
     yield "B-F6", lplots.fig_nav_error_envelopes(t, data), names.get

@@ -111,10 +111,10 @@ def test_study_run_at_the_default_value_is_the_main_run_and_values_are_paired(qu
     main = run_chunk(quick["landing"], "depth", [1])
     at_default = run_chunk(plan["obs"].instances[1].sim, "depth", [1])      # obs = 3, configured
     for k in ("err_r", "err_v", "nees_r", "plan_index", "plan_t", "init_error"):
-        assert np.array_equal(main[k], at_default[k]), k
+        assert np.array_equal(getattr(main, k), getattr(at_default, k)), k
     other = run_chunk(plan["obs"].instances[0].sim, "depth", [1])            # obs = 2
-    assert np.array_equal(other["init_error"], main["init_error"])
-    assert not np.array_equal(other["err_r"], main["err_r"])
+    assert np.array_equal(other.init_error, main.init_error)
+    assert not np.array_equal(other.err_r, main.err_r)
 
 
 def test_approach_study_runs_do_not_depend_on_chunking(quick):

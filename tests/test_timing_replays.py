@@ -223,11 +223,11 @@ def test_decomposition_of_the_real_call(recorded):
 def _inputs(scn, d, i):
     from opnav.landing.planner import PlanState
 
-    k = int(d["plan_step"][i])
+    k = int(d.plan_step[i])
     det = np.flatnonzero(scn.camera.in_view((scn.field.xyz - scn.truth.r[k]) @ scn.truth.R_LtoB[k].T,
                                             scn.planner.margin_px))
-    st = PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
-    return st, scn.camera, scn.field, scn.planner, int(d["plan_exclude"][i]), det
+    st = PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i], d.plan_P[i])
+    return st, scn.camera, scn.field, scn.planner, int(d.plan_exclude[i]), det
 
 
 @pytest.mark.slow
@@ -259,7 +259,7 @@ def test_replays_in_processes_pick_what_the_monte_carlo_picked(recorded, tmp_pat
     assert int(np.sum(tm["checked"])) == sum(int(np.sum(r["checked"])) for r in [*reps, other])
     own = tm["source"] == list(tm["sources"]).index("depth")
     j = ts.variant_index(tm, "depth", "main")
-    np.testing.assert_array_equal(tm["pick"][own, j], rec["depth"]["plan_index"][tm["call"][own]])
+    np.testing.assert_array_equal(tm["pick"][own, j], rec["depth"].plan_index[tm["call"][own]])
 
 
 def test_a_call_of_milliseconds_is_timed_as_it_comes_and_picks_alike(recorded, monkeypatch):

@@ -29,4 +29,4 @@ with script_context(snakemake) as log:
                                         pick_ratio=pick_ratio, batch_size=int(snakemake.params.batch_size))
         save(out, data, method)
         log.info("%s: runs %s..%s (%d flown, %d taken from earlier chunks), %d planning calls", method,
-                 runs[0], runs[-1], len(flown), len(runs) - len(flown), len(data["plan_index"]))
+                 runs[0], runs[-1], len(flown), len(runs) - len(flown), len(data.plan_index))

@@ -10,6 +10,5 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 
 with script_context(snakemake) as log:
     data = gather([load(p) for p in snakemake.input])
-    save(snakemake.output[0], {k: v for k, v in data.items() if k != "method"},
-         snakemake.wildcards.bmethod)
-    log.info("%s: %d runs gathered", snakemake.wildcards.bmethod, len(data["run_index"]))
+    save(snakemake.output[0], data, snakemake.wildcards.bmethod)
+    log.info("%s: %d runs gathered", snakemake.wildcards.bmethod, data.n_runs)

@@ -16,7 +16,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     scn = snakemake.wildcards.bscn
     d = load(snakemake.input.mc)
-    n = int(len(d["nees_r"]))
+    n = d.n_runs
     rec = retuned_record(load_json(snakemake.input.tuning), scn, snakemake.params.landing,
                          snakemake.params.method, n, {**nees_consistency(d), **errors(d)})
     write_json(snakemake.output.record, rec)

@@ -33,10 +33,10 @@ with script_context(snakemake) as log:
                  "field_best_dr_m": dm["field_best_dr"],
                  "optimum_inside_image": dm["optimum_inside_image"],
                  "visible_interval_deg": dm["interval_deg"]},
-             final_err_pos_m_xyz=[float(x) for x in run["err_r"][-1]],
-             final_err_vel_mps_xyz=[float(x) for x in run["err_v"][-1]],
-             final_err_rpy_deg=[float(x) for x in run["err_rpy_deg"][-1]],
-             init_error=[float(x) for x in run["init_error"]])
+             final_err_pos_m_xyz=[float(x) for x in run.err_r[-1]],
+             final_err_vel_mps_xyz=[float(x) for x in run.err_v[-1]],
+             final_err_rpy_deg=[float(x) for x in run.err_rpy_deg[-1]],
+             init_error=[float(x) for x in run.init_error])
     with open(snakemake.output.summary, "w") as fh:
         json.dump(s, fh, indent=2, sort_keys=True)
     log.info("single descent: %s", json.dumps(s))

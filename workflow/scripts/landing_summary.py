@@ -71,7 +71,7 @@ with script_context(snakemake) as log:
         out["nees_retuned_text"] = nees_retuned_text(out["nees_retuned"])
     # the descent's end from the per-step records against the true altitude
     c, cut = snakemake.params.landing, snakemake.params.cutoff
-    t = next(iter(data.values()))["t"]
+    t = next(iter(data.values())).t
     alt = truth_states(t, c["initial_state"]["r_m"], c["initial_state"]["v_mps"], float(c["duration_s"]),
                        c["gravity_mps2"], float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2")).r[:, 2]
     end = end_phase_table(every, alt, float(cut["update_altitude_margin_m"]))
@@ -85,7 +85,7 @@ with script_context(snakemake) as log:
     out["end_phase"] = {r["method"]: {k: v for k, v in r.items() if k != "method"} for r in end.to_dict("records")}
     out["end_phase_text"] = end_phase_text(out["end_phase"], scn, float(cut["min_update_altitude_m"]))
     write_json(snakemake.output.summary, out)
-    t = next(iter(data.values()))["t"]
+    t = next(iter(data.values())).t
     labels = method_labels(own)
     colors = figures.own_colors(list(own), method_colors(own))
     figures.save(plots.fig_nav_error_envelopes(t, data, labels, colors), snakemake.output.f6)

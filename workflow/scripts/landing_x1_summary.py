@@ -19,7 +19,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 with script_context(snakemake) as log:
     methods = list(snakemake.params.methods)
     data = {m: load(p) for m, p in zip(methods, snakemake.input.mc)}
-    n_runs = min(len(d["run_index"]) for d in data.values())   # the paired runs all flew
+    n_runs = min(d.n_runs for d in data.values())   # the paired runs all flew
     data = {m: first_runs(d, n_runs) for m, d in data.items()}
     ref = snakemake.params.extra["reference"]
     n_boot = int(snakemake.params.extra["n_boot"])
@@ -38,7 +38,7 @@ with script_context(snakemake) as log:
                          "update (lastlm), as RMS over the landmark phase (lmrms) and over the descent, and at "
                          f"touchdown (final). Each has 95 % paired-t and bootstrap ({n_boot} resamples) intervals; "
                          f"converged: final position error below {conv:g} m. " + timing_summary.method_text(tm)))
-    t = next(iter(data.values()))["t"]
+    t = next(iter(data.values())).t
     own = getattr(snakemake.params, "custom", None) or {}    # your own methods' legend names and colours
     figures.save(plots.fig_nav_error_envelopes(t, data, method_labels(own),
                                                figures.own_colors(list(own), method_colors(own))),

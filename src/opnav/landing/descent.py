@@ -85,14 +85,14 @@ from opnav.landing import ekf, imu
 from opnav.landing.metrics import MetricContext
 from opnav.landing.methods import MethodError
 from opnav.landing.planner import PlanState, plan_batch
-from opnav.landing.records import append_call, new_calls, record_plan_inputs, stack_calls
+from opnav.landing.records import CallLog, Descent
 from opnav.landing.scenario import Scenario, build_scenario
 from opnav.landing.trajectory import euler_rpy_deg
 from opnav.core.compiled import kernel, warms
 from opnav.landing.linalg import cho_solve, cholesky_in_place
 from opnav.core.rotations import exp_so3, log_so3_into
 
-__all__ = ["Scenario", "build_scenario", "run_descent", "run_descents", "initial_error",
+__all__ = ["Scenario", "Descent", "build_scenario", "run_descent", "run_descents", "initial_error",
            "tracking_step", "vision_cutoff_altitude"]
 
 def initial_error(rng: np.random.Generator, bounds: tuple) -> np.ndarray:
@@ -223,15 +223,15 @@ def _draws(scn: Scenario, runs: list[int], seed: int, imu_noise: bool, init_erro
 
 
 def run_descent(scn: Scenario, method: str, run_index: int, *, base_seed: int | None = None,
-                imu_noise: bool = True, init_error: bool = True) -> dict:
+                imu_noise: bool = True, init_error: bool = True) -> Descent:
     """Fly one descent: the batch of one of :func:`run_descents`."""
     return run_descents(scn, method, [run_index], base_seed=base_seed, imu_noise=imu_noise,
                         init_error=init_error)[0]
 
 
 def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | None = None,
-                 imu_noise: bool = True, init_error: bool = True, pick_ratio: bool = True) -> list[dict]:
-    """Fly the runs ``run_indices`` as one batch; one dict per run (module docstring).
+                 imu_noise: bool = True, init_error: bool = True, pick_ratio: bool = True) -> list[Descent]:
+    """Fly the runs ``run_indices`` as one batch; one :class:`Descent` record per run (module docstring).
 
     A run's numbers do not depend on the batch it is flown in (to round-off).
     ``pick_ratio = False`` skips the pick-ratio diagnostic (every detected landmark
@@ -265,7 +265,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     updated = np.zeros((B, n + 1), bool)
     lm_updated = np.zeros((B, n + 1), bool)      # a landmark bearing among the update's
     cut_alt = np.full((B, n + 1), np.nan)        # the cut-off quantity at each image, m
-    calls = [new_calls() for _ in range(B)]      # per planning call: inputs (replay) and results
+    calls = [CallLog() for _ in range(B)]      # per planning call: inputs (replay) and results
     cur = np.full(B, -1, np.int64)
     n_obs = np.zeros(B, np.int64)
     n_used = np.zeros(B, np.int64)
@@ -321,7 +321,7 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
             ip = np.flatnonzero(need)
             if ip.size:
                 for b in ip:
-                    record_plan_inputs(calls[b], k, st.r[b], st.v[b], a_est[b], st.R[b], st.P[b],
+                    calls[b].record_inputs(k, st.r[b], st.v[b], a_est[b], st.R[b], st.P[b],
                                        cur[b], rng_pick[b])
                 states = PlanState(st.r[ip], st.v[ip], a_est[ip], st.R[ip], st.P[ip])
                 try:
@@ -329,10 +329,10 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
                                      [rng_pick[b] for b in ip], np.flatnonzero(det), diagnose=pick_ratio)
                 except MethodError as exc:     # a user's method failed: name the run and the call
                     b = ip[getattr(exc, "batch_position", 0)]
-                    raise MethodError(f"{exc} in run {runs[b]}, planning call {len(calls[b]['plan_step'])} "
+                    raise MethodError(f"{exc} in run {runs[b]}, planning call {calls[b].n_calls} "
                                       f"(t = {k * scn.Dt:g} s; method {method!r})") from exc
                 for b, rs in zip(ip, res):
-                    append_call(calls[b], k * scn.Dt, rs)
+                    calls[b].append(k * scn.Dt, rs)
                 cur[ip] = [rs.index for rs in res]
                 n_obs[ip] = 0
                 ii = ip[cur[ip] >= 0]
@@ -370,18 +370,16 @@ def run_descents(scn: Scenario, method: str, run_indices, *, base_seed: int | No
     rpy_t = euler_rpy_deg(tr.R_LtoB)
     out = []
     for b in range(B):
-        d = {
-            "t": tr.t.copy(),
-            "err_r": err_r[b], "err_v": err_v[b], "err_th_deg": np.degrees(err_th[b]),
-            "err_rpy_deg": _wrap_deg(rpy_t - _est_rpy(tr.R_LtoB, err_th[b])),
-            "sig_r": sig[b, :, 0:3], "sig_v": sig[b, :, 3:6], "sig_th_deg": np.degrees(sig[b, :, 6:9]),
-            "sig_yaw_deg": np.degrees(sig_yaw[b]),
-            "nees_r": nees_r[b], "nees_v": nees_v[b], "updated": updated[b],
-            "lm_updated": lm_updated[b], "cut_alt_m": cut_alt[b],
-            "n_landmarks": int(n_used[b]), "init_error": e0[b],
-        }
-        d.update(stack_calls(calls[b]))
-        out.append(d)
+        out.append(Descent(
+            t=tr.t.copy(),
+            err_r=err_r[b], err_v=err_v[b], err_th_deg=np.degrees(err_th[b]),
+            err_rpy_deg=_wrap_deg(rpy_t - _est_rpy(tr.R_LtoB, err_th[b])),
+            sig_r=sig[b, :, 0:3], sig_v=sig[b, :, 3:6], sig_th_deg=np.degrees(sig[b, :, 6:9]),
+            sig_yaw_deg=np.degrees(sig_yaw[b]),
+            nees_r=nees_r[b], nees_v=nees_v[b], updated=updated[b],
+            lm_updated=lm_updated[b], cut_alt_m=cut_alt[b],
+            n_landmarks=int(n_used[b]), init_error=e0[b],
+            **calls[b].arrays()))
     return out
 
 

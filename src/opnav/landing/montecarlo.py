@@ -42,14 +42,12 @@ if TYPE_CHECKING:
 # the workflow parses this module at start-up and the gather jobs only stack arrays.
 
 from opnav.landing import records   # numpy only
-from opnav.landing.records import CALL_KEYS, load
+from opnav.landing.records import CALL_KEYS, TRACK_KEYS, Descent, MonteCarlo
 
 __all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
-           "same_pick_pct", "pick_quality", "first_runs", "end_phase", "landmark_phase", "phase_rms", "time_below", "nees_band", "nees_consistency"]
-
-_TRACKS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th_deg",
-           "sig_yaw_deg", "nees_r", "nees_v", "updated", "lm_updated", "cut_alt_m")
+           "same_pick_pct", "pick_quality", "first_runs", "end_phase", "landmark_phase", "phase_rms", "time_below",
+           "nees_band", "nees_consistency", "MonteCarlo", "Descent"]
 
 
 def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
@@ -107,7 +105,7 @@ def earlier_chunks(path, run_indices) -> list[tuple[Path, list[int]]]:
 
 
 def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_indices,
-                      pick_ratio: bool = True, batch_size: int | None = None) -> tuple[dict, list[int]]:
+                      pick_ratio: bool = True, batch_size: int | None = None) -> tuple[MonteCarlo, list[int]]:
     """:func:`run_chunk` for the chunk file ``path``, taking the runs already
     flown in :func:`earlier_chunks` whose stored ``reuse_key`` (a digest of
     everything the runs depend on, given by the caller) equals ``reuse_key``:
@@ -118,14 +116,14 @@ def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_
     parts = []
     for p, _ in earlier_chunks(path, idx):
         old = load(p)
-        if str(old.get("reuse_key", "")) == reuse_key:
-            parts.append({k: v for k, v in old.items() if k not in ("method", "reuse_key")})
-    have = {int(i) for part in parts for i in part["run_index"]}
+        if (old.reuse_key or "") == reuse_key:
+            parts.append(old.replace(method=None, reuse_key=None))
+    have = {int(i) for part in parts for i in part.run_index}
     todo = [i for i in idx if i not in have]
     if todo:
         parts.append(run_chunk(landing_cfg, method, todo, batch_size=batch_size, pick_ratio=pick_ratio))
     data = parts[0] if len(parts) == 1 else gather(parts)
-    return {**data, "reuse_key": np.array(reuse_key)}, todo
+    return data.replace(reuse_key=str(reuse_key)), todo
 
 
 #: Snakemake wildcard pattern of :func:`chunk_label`.
@@ -133,8 +131,8 @@ CHUNK_PATTERN = r"r[0-9]+-[0-9]+"
 
 
 def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | None = None,
-              pick_ratio: bool = True) -> dict:
-    """Fly the runs ``run_indices`` with ``method``; stacked arrays (see module doc).
+              pick_ratio: bool = True) -> MonteCarlo:
+    """Fly the runs ``run_indices`` with ``method``; their records stacked (see module doc).
 
     Runs are flown in batches of ``batch_size`` (default ``landing.mc.batch_size``;
     0 = all runs as one batch); the numbers do not depend on it (to round-off).
@@ -154,102 +152,97 @@ def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | Non
     return stack_runs(idx, runs, scn.truth.t)
 
 
-def stack_runs(run_indices, runs: list[dict], t: np.ndarray) -> dict:
-    """The per-run dicts of :func:`opnav.landing.descent.run_descents` as one
+def stack_runs(run_indices, runs: list[Descent], t: np.ndarray) -> MonteCarlo:
+    """The :class:`Descent` records of :func:`opnav.landing.descent.run_descents` as one
     chunk: tracks stacked (runs x ...), planning calls concatenated with their
-    run index (``plan_run``)."""
-    out = {"run_index": np.asarray(list(run_indices), np.int64), "t": np.asarray(t).copy()}
-    for k in _TRACKS:
-        out[k] = np.stack([r[k] for r in runs])
-    for k in CALL_KEYS:
-        out[k] = np.concatenate([r[k] for r in runs]) if runs else np.zeros(0)
-    out["plan_run"] = np.concatenate([np.full(len(r["plan_t"]), int(i), np.int64)
-                                      for i, r in zip(run_indices, runs)]) if runs else np.zeros(0, np.int64)
-    out["n_landmarks"] = np.array([r["n_landmarks"] for r in runs], np.int64)
-    out["init_error"] = np.stack([r["init_error"] for r in runs])
-    return out
+    run index (``plan_run``); :meth:`MonteCarlo.of_runs`."""
+    return MonteCarlo.of_runs(run_indices, runs, t)
 
 
-def summarize_run(run: dict, run_index: int = 0) -> dict:
+def summarize_run(run: Descent, run_index: int = 0) -> dict:
     """One run of :func:`opnav.landing.descent.run_descent`: its
     :func:`per_run_stats` row (final, last-vision and RMS error norms, mean
     NEES, landmarks used) plus the final yaw error (deg), the number of
     planning calls and their median evaluation count (planning time: replay
     the run's calls, ``opnav.landing.timing.replay_own``)."""
-    data = stack_runs([run_index], [run], run["t"])
+    data = MonteCarlo.of_descent(run, run_index)
     out = {k: (int(v) if k == "n_landmarks" else float(v))
            for k, v in per_run_stats(data).iloc[0].items()}
-    out["final_yaw_err_deg"] = float(run["err_rpy_deg"][-1, 2])
-    out["n_plans"] = int(len(run["plan_t"]))
-    out["median_plan_evals"] = float(np.median(run["plan_evals"])) if len(run["plan_evals"]) else math.nan
+    out["final_yaw_err_deg"] = float(run.err_rpy_deg[-1, 2])
+    out["n_plans"] = int(len(run.plan_t))
+    out["median_plan_evals"] = float(np.median(run.plan_evals)) if len(run.plan_evals) else math.nan
     return out
 
 
-def save(path, data: dict, method: str) -> None:
-    """Write a chunk or gathered result of ``method`` (``records.save``: ``.npz``,
-    atomically; read it with :func:`load`, ``records.load``)."""
-    records.save(path, {"method": np.array(method), **data})
+def save(path, data: MonteCarlo, method: str) -> None:
+    """Write a chunk or gathered result of ``method`` (the file edge: ``records.save`` of
+    :meth:`MonteCarlo.arrays`, ``.npz``, atomically; read it with :func:`load`)."""
+    records.save(path, data.replace(method=str(method)).arrays())
 
 
-def gather(parts: list[dict]) -> dict:
+def load(path) -> MonteCarlo:
+    """A :func:`save` file as its record (``records.load``: a truncated or corrupt file raises
+    ``CorruptIntermediate`` naming it)."""
+    return MonteCarlo.from_arrays(records.load(path))
+
+
+def gather(parts: list[MonteCarlo]) -> MonteCarlo:
     """Concatenate chunk results in run-index order; checks for gaps/duplicates."""
     if not parts:
         raise ValueError("no Monte-Carlo chunks to gather")
-    methods = {str(p["method"]) for p in parts if "method" in p}
+    methods = {p.method for p in parts if p.method is not None}
     if len(methods) > 1:
         raise ValueError(f"chunks of different methods gathered together: {sorted(methods)}")
-    idx = np.concatenate([p["run_index"] for p in parts])
+    idx = np.concatenate([p.run_index for p in parts])
     order = np.argsort(idx, kind="stable")
     if len(np.unique(idx)) != len(idx):
         raise ValueError("duplicate run indices in the Monte-Carlo chunks")
-    out = {"run_index": idx[order], "t": parts[0]["t"]}
-    for k in _TRACKS + ("n_landmarks", "init_error"):
-        out[k] = np.concatenate([p[k] for p in parts])[order]
-    pr = np.concatenate([p["plan_run"] for p in parts])
+    out = {"run_index": idx[order], "t": parts[0].t}
+    for k in TRACK_KEYS + ("n_landmarks", "init_error"):
+        out[k] = np.concatenate([getattr(p, k) for p in parts])[order]
+    pr = np.concatenate([p.plan_run for p in parts])
     po = np.argsort(pr, kind="stable")
     for k in CALL_KEYS:
-        out[k] = np.concatenate([p[k] for p in parts])[po]
+        out[k] = np.concatenate([getattr(p, k) for p in parts])[po]
     out["plan_run"] = pr[po]
-    if methods:
-        out["method"] = np.array(methods.pop())
-    return out
+    return MonteCarlo(**out, method=methods.pop() if methods else None)
 
 
-def first_runs(data: dict, n: int) -> dict:
+def first_runs(data: MonteCarlo, n: int) -> MonteCarlo:
     """``data`` (:func:`gather`'s layout) restricted to its runs of index < ``n`` (tracks by
     ``run_index``, planning calls by ``plan_run``): the paired runs every method of B-X1
     flew. Raises ``ValueError`` if it lacks one of runs 0..n-1."""
-    keep = np.asarray(data["run_index"]) < n
-    if int(keep.sum()) != n or not np.array_equal(np.sort(data["run_index"][keep]), np.arange(n)):
-        raise ValueError(f"Monte Carlo of {str(data.get('method', '?'))!r} lacks some of runs 0..{n - 1}")
-    calls = np.asarray(data["plan_run"]) < n
-    out = dict(data)
-    for k in _TRACKS + ("n_landmarks", "init_error", "run_index"):
-        out[k] = np.asarray(data[k])[keep]
+    keep = np.asarray(data.run_index) < n
+    if int(keep.sum()) != n or not np.array_equal(np.sort(data.run_index[keep]), np.arange(n)):
+        raise ValueError(f"Monte Carlo of {data.method or '?'!r} lacks some of runs 0..{n - 1}")
+    calls = np.asarray(data.plan_run) < n
+    out = {}
+    for k in TRACK_KEYS + ("n_landmarks", "init_error", "run_index"):
+        out[k] = np.asarray(getattr(data, k))[keep]
     for k in CALL_KEYS + ("plan_run",):
-        out[k] = np.asarray(data[k])[calls]
-    return out
+        out[k] = np.asarray(getattr(data, k))[calls]
+    return data.replace(**out)
 
 
-def per_run_stats(data: dict) -> pd.DataFrame:
+def per_run_stats(data: MonteCarlo) -> pd.DataFrame:
     """Per run: final and RMS error norms (m, m/s, deg) and mean NEES."""
     import pandas as pd
 
     rows = {}
     for key, name in (("err_r", "pos_err_m"), ("err_v", "vel_err_mps"), ("err_th_deg", "att_err_deg")):
-        nrm = np.linalg.norm(data[key], axis=2)
+        nrm = np.linalg.norm(getattr(data, key), axis=2)
         rows[f"final_{name}"] = nrm[:, -1]
-        if "updated" in data:      # at the last vision update (then the IMU-only coast)
-            rows[f"lastvis_{name}"] = nrm[np.arange(len(nrm)), last_update_index(data["updated"])]
-        if "lm_updated" in data:   # what selection can move: the landmark-tracking phase
-            first, last = landmark_phase(data["lm_updated"])
+        if data.updated is not None:      # at the last vision update (then the IMU-only coast)
+            rows[f"lastvis_{name}"] = nrm[np.arange(len(nrm)), last_update_index(data.updated)]
+        if data.lm_updated is not None:   # what selection can move: the landmark-tracking phase
+            first, last = landmark_phase(data.lm_updated)
             rows[f"lastlm_{name}"] = nrm[np.arange(len(nrm)), last]
             rows[f"lmrms_{name}"] = phase_rms(nrm, first, last)
         rows[f"rms_{name}"] = np.sqrt(np.mean(nrm**2, axis=1))
-    rows["mean_nees_pos"] = data["nees_r"].mean(axis=1)
-    rows["mean_nees_vel"] = data["nees_v"].mean(axis=1)
-    rows["n_landmarks"] = data["n_landmarks"]
-    return pd.DataFrame(rows, index=pd.Index(data["run_index"], name="run"))
+    rows["mean_nees_pos"] = data.nees_r.mean(axis=1)
+    rows["mean_nees_vel"] = data.nees_v.mean(axis=1)
+    rows["n_landmarks"] = data.n_landmarks
+    return pd.DataFrame(rows, index=pd.Index(data.run_index, name="run"))
 
 
 def landmark_phase(lm_updated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -271,12 +264,12 @@ def phase_rms(nrm: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarra
     return np.sqrt((nrm**2 * w).sum(axis=1) / w.sum(axis=1))
 
 
-def time_below(data: dict, threshold_m: float) -> np.ndarray:
+def time_below(data: MonteCarlo, threshold_m: float) -> np.ndarray:
     """Per run, the first filter time (s) at which the position error norm is
     below ``threshold_m`` (m); NaN if never. "Converges faster" is a paired
     comparison of these times (``opnav.landing.equivalence.converges_faster``)."""
-    below = np.linalg.norm(data["err_r"], axis=2) < float(threshold_m)
-    t = np.asarray(data["t"], float)
+    below = np.linalg.norm(data.err_r, axis=2) < float(threshold_m)
+    t = np.asarray(data.t, float)
     return np.where(below.any(axis=1), t[np.argmax(below, axis=1)], np.nan)
 
 
@@ -291,17 +284,17 @@ def nees_band(n_runs: int, dof: int = 3, level: float = 0.95) -> tuple[float, fl
     return float(special.chdtri(v, 1.0 - a)) / n_runs, float(special.chdtri(v, a)) / n_runs
 
 
-def nees_consistency(data: dict, level: float = 0.95) -> dict:
+def nees_consistency(data: MonteCarlo, level: float = 0.95) -> dict:
     """Filter consistency on the Monte Carlo (held-out evidence when the tuning
     was chosen on other runs): per state (position, velocity; 3 dof each) the
     NEES averaged over the runs at each filter time after the start, the share
     of those times whose average lies in the :func:`nees_band` of an
     ``n_runs`` mean (%), its time average and median, and the band."""
-    out = {"n_runs": int(len(data["nees_r"])), "level": float(level)}
+    out = {"n_runs": int(len(data.nees_r)), "level": float(level)}
     lo, hi = nees_band(out["n_runs"], 3, level)
     out["band"] = [lo, hi]
     for key, name in (("nees_r", "pos"), ("nees_v", "vel")):
-        avg = np.asarray(data[key], float)[:, 1:].mean(axis=0)
+        avg = np.asarray(getattr(data, key), float)[:, 1:].mean(axis=0)
         out[f"{name}_in_band_pct"] = float(100.0 * np.mean((avg >= lo) & (avg <= hi)))
         out[f"{name}_mean"] = float(avg.mean())
         out[f"{name}_median"] = float(np.median(avg))
@@ -318,7 +311,7 @@ def last_update_index(updated: np.ndarray):
     return int(out) if u.ndim == 1 else out
 
 
-def end_phase(data: dict, alt_true_m: np.ndarray, margin_m: float, ground_m: float = 1.0) -> dict:
+def end_phase(data: MonteCarlo, alt_true_m: np.ndarray, margin_m: float, ground_m: float = 1.0) -> dict:
     """The end of the descent counted from the per-step records of ``data`` (gathered
     Monte Carlo: ``t`` (s), ``updated`` and ``lm_updated`` (runs, times)) and the true
     altitude at each filter time ``alt_true_m`` (m; the truth is the same in every run):
@@ -329,9 +322,9 @@ def end_phase(data: dict, alt_true_m: np.ndarray, margin_m: float, ground_m: flo
     own margin on the estimated altitude), and the lowest true altitude of a vision update
     (m). The cut-off itself compares the ESTIMATED altitude less the margin
     (``descent.vision_cutoff_altitude``): these counts say what that does in truth."""
-    t = np.asarray(data["t"], float)
+    t = np.asarray(data.t, float)
     z = np.asarray(alt_true_m, float)
-    upd, lm = np.asarray(data["updated"], bool), np.asarray(data["lm_updated"], bool)
+    upd, lm = np.asarray(data.updated, bool), np.asarray(data.lm_updated, bool)
     if z.shape != t.shape or upd.shape[-1] != t.size:
         raise ValueError(f"end_phase: {t.size} filter times, {z.size} true altitudes, {upd.shape[-1]} records")
     out = {"n_runs": int(upd.shape[0]), "ground_m": float(ground_m), "margin_m": float(margin_m)}
@@ -353,14 +346,14 @@ def end_phase(data: dict, alt_true_m: np.ndarray, margin_m: float, ground_m: flo
     return out
 
 
-def pick_quality(d: dict) -> dict:
+def pick_quality(d: MonteCarlo) -> dict:
     """Per method: share of planning calls whose in-plane optimum fell on an end
     of the visible interval (edge rule, %), and the median / max over calls of
     the picked landmark's metric over the best detected landmark's (1 = best)."""
     out = {"edge_calls_pct": math.nan, "pick_ratio_median": math.nan, "pick_ratio_max": math.nan}
-    if "plan_edge" in d and len(d["plan_edge"]):
-        out["edge_calls_pct"] = float(100.0 * np.mean(d["plan_edge"]))
-    r = np.asarray(d.get("plan_ratio", []), float)
+    if d.plan_edge is not None and len(d.plan_edge):
+        out["edge_calls_pct"] = float(100.0 * np.mean(d.plan_edge))
+    r = np.asarray(d.plan_ratio if d.plan_ratio is not None else [], float)
     r = r[np.isfinite(r)]
     if r.size:
         out["pick_ratio_median"] = float(np.median(r))
@@ -368,22 +361,22 @@ def pick_quality(d: dict) -> dict:
     return out
 
 
-def same_pick_pct(a: dict, b: dict) -> float:
+def same_pick_pct(a: MonteCarlo, b: MonteCarlo) -> float:
     """Percentage of planning calls (matched by run and time) at which two
     methods chose the same landmark."""
-    ka = {(int(r), float(t)): int(i) for r, t, i in zip(a["plan_run"], a["plan_t"], a["plan_index"])}
-    kb = {(int(r), float(t)): int(i) for r, t, i in zip(b["plan_run"], b["plan_t"], b["plan_index"])}
+    ka = {(int(r), float(t)): int(i) for r, t, i in zip(a.plan_run, a.plan_t, a.plan_index)}
+    kb = {(int(r), float(t)): int(i) for r, t, i in zip(b.plan_run, b.plan_t, b.plan_index)}
     common = set(ka) & set(kb)
     if not common:
         return math.nan
     return 100.0 * sum(ka[k] == kb[k] for k in common) / len(common)
 
 
-def yaw_convergence(data: dict, ratio: float, method: str) -> dict:
+def yaw_convergence(data: MonteCarlo, ratio: float, method: str) -> dict:
     """Does the Monte-Carlo 3-sigma envelope of the yaw error shrink (paper B: it
     does not, one known landmark leaves yaw unobservable)? Converging means the
     3-sigma at touchdown is below ``ratio`` times the one at the start (deg)."""
-    yaw = data["err_rpy_deg"][:, :, 2]
+    yaw = data.err_rpy_deg[:, :, 2]
     s_first, s_last = float(3 * yaw[:, 0].std(ddof=1)), float(3 * yaw[:, -1].std(ddof=1))
     converges = s_last < ratio * s_first
     return {"converges": bool(converges), "n_runs": int(yaw.shape[0]),

@@ -27,6 +27,7 @@ from opnav.landing.planning.depth import baseline, error_radius
 from opnav.landing.planning.geometry import plane_geometry
 from opnav.landing.planning.layout import DegenerateGeometry
 from opnav.landing.planning.reference import signed_depth_error
+from opnav.landing.records import MonteCarlo
 
 #: two values closer than this (relative) are a tie, not a descent
 TIE_RTOL = 1e-12
@@ -84,19 +85,19 @@ def call_minima(state, cfg, camera, n_grid: int) -> list[int] | None:
     return out
 
 
-def count_calls(scn, data: Mapping[str, Any], n_grid: int, max_calls: int = 0) -> dict:
-    """Every recorded planning call of one Monte Carlo (``data``: the gathered dict of the
+def count_calls(scn, data: MonteCarlo, n_grid: int, max_calls: int = 0) -> dict:
+    """Every recorded planning call of one Monte Carlo (``data``: the gathered record of the
     depth method, ``montecarlo.gather``) in scenario ``scn`` (``descent.build_scenario``):
     per call the minima on each side. ``max_calls``: at most that many calls, evenly spaced
     (0: all)."""
     from opnav.landing.planner import PlanState
 
-    n = len(data["plan_step"])
+    n = len(data.plan_step)
     idx = np.arange(n) if not max_calls or max_calls >= n else np.unique(
         np.round(np.linspace(0, n - 1, int(max_calls))).astype(int))
     per_call, skipped = [], 0
     for i in idx:
-        st = PlanState(data["plan_r"][i], data["plan_v"][i], data["plan_a"][i], data["plan_R"][i], data["plan_P"][i])
+        st = PlanState(data.plan_r[i], data.plan_v[i], data.plan_a[i], data.plan_R[i], data.plan_P[i])
         m = call_minima(st, scn.planner, scn.camera, n_grid)
         if m is None or not m:
             skipped += 1

@@ -138,19 +138,19 @@ def fig_depth_error_map(dm: dict):
         return fig
 
 
-def _phase_ends(t, data: dict[str, dict]) -> dict:
+def _phase_ends(t, data: dict) -> dict:
     """Median over the runs (of the first method that has them) of the time (s) of
     the last update with a landmark bearing and of the last vision update."""
     from opnav.landing.montecarlo import last_update_index
 
     for d in data.values():
-        if "lm_updated" in d:
-            return {"last landmark update": float(np.median(t[last_update_index(d["lm_updated"])])),
-                    "last vision update": float(np.median(t[last_update_index(d["updated"])]))}
+        if d.lm_updated is not None:
+            return {"last landmark update": float(np.median(t[last_update_index(d.lm_updated)])),
+                    "last vision update": float(np.median(t[last_update_index(d.updated)]))}
     return {}
 
 
-def fig_nav_error_envelopes(t, data: dict[str, dict], labels: dict | None = None, colors: dict | None = None):
+def fig_nav_error_envelopes(t, data: dict, labels: dict | None = None, colors: dict | None = None):
     """B-F6 / B-X1: error envelopes over the runs, per axis, of the position (m),
     velocity (m/s) and attitude (roll/pitch/yaw, deg) errors, one line per method
     (log scale): 3 x the RMS about zero over the runs, ``3 sqrt(mean_runs e^2)``,
@@ -172,7 +172,7 @@ def fig_nav_error_envelopes(t, data: dict[str, dict], labels: dict | None = None
             for j in range(3):
                 ax = axs[i, j]
                 for k, (m, d) in enumerate(data.items()):
-                    e = d[key][:, :, j]
+                    e = getattr(d, key)[:, :, j]
                     env = 3.0 * np.sqrt(np.mean(e**2, axis=0))
                     ax.plot(t, env, color=_color(m, colors), lw=1.0, label=_label(m, labels),
                             ls=("-", "--", "-.", ":")[k % 4])

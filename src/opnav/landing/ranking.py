@@ -35,7 +35,7 @@ import pandas as pd
 # scipy.stats is a heavier import than scipy.special (docs/performance.md).
 from scipy import special
 
-from opnav.landing.montecarlo import per_run_stats, same_pick_pct
+from opnav.landing.montecarlo import MonteCarlo, per_run_stats, same_pick_pct
 
 __all__ = ["paired_t_interval", "bootstrap_mean_interval", "paired_difference",
            "competition_rank", "ranking_table", "headline", "median_abs_dbeta_deg",
@@ -98,13 +98,13 @@ def paired_difference(a, b, n_boot: int = 2000, seed: int = 0, level: float = 0.
             "equal_pct": float(100.0 * np.mean(a == b)), "n": int(d.size)}
 
 
-def _calls(d: dict) -> dict:
-    beta = d.get("plan_beta", np.full(len(d["plan_index"]), np.nan))
+def _calls(d: MonteCarlo) -> dict:
+    beta = d.plan_beta if d.has("plan_beta") else np.full(len(d.plan_index), np.nan)
     return {(int(r), float(t)): (int(i), float(b)) for r, t, i, b in
-            zip(d["plan_run"], d["plan_t"], d["plan_index"], beta)}
+            zip(d.plan_run, d.plan_t, d.plan_index, beta)}
 
 
-def median_abs_dbeta_deg(a: dict, b: dict) -> float:
+def median_abs_dbeta_deg(a: MonteCarlo, b: MonteCarlo) -> float:
     """Median over planning calls matched by (run, time) of |beta*_a - beta*_b|
     (deg), the in-plane optima of two methods; NaN if no call has both."""
     ka, kb = _calls(a), _calls(b)
@@ -113,7 +113,7 @@ def median_abs_dbeta_deg(a: dict, b: dict) -> float:
     return float(np.degrees(np.median(d))) if d else math.nan
 
 
-def pair_comparison(a: dict, b: dict, level: float = 0.95) -> dict:
+def pair_comparison(a: MonteCarlo, b: MonteCarlo, level: float = 0.95) -> dict:
     """What a comparison of two methods' accuracy rests on (same paired runs):
     the share of planning calls where they chose the same landmark (%), the
     median |delta beta*| (deg), and the paired difference a - b of the per-run
@@ -138,7 +138,7 @@ def pair_comparison(a: dict, b: dict, level: float = 0.95) -> dict:
     return out
 
 
-def pair_table(data: dict[str, dict], level: float = 0.95) -> pd.DataFrame:
+def pair_table(data: dict[str, MonteCarlo], level: float = 0.95) -> pd.DataFrame:
     """:func:`pair_comparison` for every unordered pair of methods (in order)."""
     names = list(data)
     rows = [{"method_a": a, "method_b": b, **pair_comparison(data[a], data[b], level)}
@@ -187,10 +187,10 @@ def _rank_by(stats: pd.DataFrame) -> str:
     return RANK_BY if f"{RANK_BY}_err_m" in stats else "rms_pos"
 
 
-def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth", n_boot: int = 2000,
+def ranking_table(data: dict[str, MonteCarlo], timing: dict, reference: str = "depth", n_boot: int = 2000,
                   seed: int = 0, level: float = 0.95, rtol: float = 0.0,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
-    """B-X1: one row per method of ``data`` (gathered Monte-Carlo dicts, same
+    """B-X1: one row per method of ``data`` (gathered Monte Carlo records, same
     runs), ranked; see the module docstring for the columns. Paired columns
     ``d_rms_pos_vs_ref_*`` / ``d_final_pos_vs_ref_*`` / ``d_lastlm_pos_vs_ref_*``
     / ``d_lmrms_pos_vs_ref_*`` are method minus
@@ -230,8 +230,8 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
         row["converged_runs_pct"] = float(100.0 * (s["final_pos_err_m"] < converged_pos_err_m).mean())
         row["mean_nees_pos"] = float(s["mean_nees_pos"].mean())
         row["landmarks_per_run"] = float(s["n_landmarks"].mean())
-        row["plan_calls"] = int(len(d["plan_index"]))
-        idx = np.asarray(d["plan_index"])
+        row["plan_calls"] = int(len(d.plan_index))
+        idx = np.asarray(d.plan_index)
         row["no_pick_pct"] = float(100.0 * np.mean(idx < 0)) if idx.size else math.nan
         row["median_plan_time_us"] = tsum.median_us(timing, m)
         row["median_plan_cpu_us"] = tsum.median_us(timing, m, clock="cpu")
@@ -252,7 +252,7 @@ def ranking_table(data: dict[str, dict], timing: dict, reference: str = "depth",
         row["median_abs_dbeta_vs_ref_deg"] = (0.0 if m == reference
                                               else median_abs_dbeta_deg(d, data[reference]))
         # the optimum's in-plane angle to the estimated velocity (0: no parallax; planning.reference)
-        beta = np.abs(np.asarray(d.get("plan_beta", []), float))
+        beta = np.abs(np.asarray(d.plan_beta if d.has("plan_beta") else [], float))
         row["median_abs_beta_deg"] = (float(np.degrees(np.median(beta[np.isfinite(beta)])))
                                       if np.isfinite(beta).any() else math.nan)
         lo, hi = row[f"d_{rank_by}_vs_ref_t_lo"], row[f"d_{rank_by}_vs_ref_t_hi"]

@@ -100,7 +100,7 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
         # the alternative path's medians rest on its own calls (the paper path: a subset,
         # landing.timing.max_calls_paper), its reductions on the calls timed on both
         row["timed_calls_alt"] = tsum.timed_calls(timing, m, alt_m)
-        ev = data[m]["plan_evals"]
+        ev = data[m].plan_evals
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
         row.update(pick_quality(data[m]))
@@ -233,7 +233,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
     methods = list(data)
     yaw = yaw_convergence(data[methods[0]], float(yaw_ratio), methods[0])
     ym = "depth" if "depth" in data else methods[0]
-    yaw_err = np.asarray(data[ym]["err_rpy_deg"])[:, :, 2]
+    yaw_err = np.asarray(data[ym].err_rpy_deg)[:, :, 2]
     pairs = pair_table(data)
     att = initial_attitude_report(landing_cfg)
     t = table.set_index("method")

@@ -21,21 +21,21 @@ import math
 import numpy as np
 import pandas as pd
 
-from opnav.landing.montecarlo import per_run_stats, run_chunk
+from opnav.landing.montecarlo import MonteCarlo, per_run_stats, run_chunk
 
 
-def per_run_metrics(data: dict, timing: dict, method: str) -> pd.DataFrame:
-    """One row per run of a chunk or gathered Monte-Carlo dict (module docstring);
+def per_run_metrics(data: MonteCarlo, timing: dict, method: str) -> pd.DataFrame:
+    """One row per run of a chunk or gathered Monte Carlo (module docstring);
     ``timing``: the replay of its planning calls (``timing.replay_own``)."""
     from opnav.landing.timing_summary import per_run_median_us
 
     st = per_run_stats(data).reset_index()
     runs = st["run"].to_numpy()
-    pr = np.asarray(data["plan_run"])
+    pr = np.asarray(data.plan_run)
     wall, cpu = per_run_median_us(timing, method), per_run_median_us(timing, method, "cpu")
     nopick = []
     for r in runs:
-        idx = np.asarray(data["plan_index"])[pr == r]
+        idx = np.asarray(data.plan_index)[pr == r]
         nopick.append(float(100.0 * np.mean(idx < 0)) if idx.size else math.nan)
     st["median_plan_time_us"] = [wall.get(int(r), math.nan) for r in runs]
     st["median_plan_cpu_us"] = [cpu.get(int(r), math.nan) for r in runs]

@@ -99,7 +99,7 @@ import time
 
 import numpy as np
 
-from opnav.landing.records import RECORD_KEYS, load as _load_one, rng_from_words, save
+from opnav.landing.records import RECORD_KEYS, MonteCarlo, load as _load_one, rng_from_words, save
 
 __all__ = ["select_calls", "COMPILED_ONLY", "timed_methods", "variants", "pass_keys", "paper_limited", "replay",
            "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "COLD_OK_NS", "CALL_INPUT_KEYS", "load_calls", "run_spec", "replay_spec", "replays_in_processes",
@@ -173,19 +173,19 @@ def paper_limited(var) -> np.ndarray:
     return np.array([p == "alt" and c.eval_path == "paper" for _, p, c in var], bool)
 
 
-def _pool(recorded: dict) -> tuple[np.ndarray, np.ndarray, list[str]]:
+def _pool(recorded: dict[str, MonteCarlo]) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """(source method position, call position within its Monte Carlo) of every recorded call."""
     names = list(recorded)
     src, pos = [], []
     for i, m in enumerate(names):
         d = recorded[m]
-        missing = [k for k in RECORD_KEYS if k not in d]
+        missing = [k for k in RECORD_KEYS if not d.has(k)]
         if missing:
             raise ValueError(f"Monte Carlo of {m!r} holds no planning inputs ({', '.join(missing)}): "
                              "rebuild it with this version")
-        n = len(d["plan_step"])
+        n = len(d.plan_step)
         for k in ("plan_r", "plan_v", "plan_a", "plan_R", "plan_P"):
-            if len(d[k]) != n or not np.isfinite(d[k]).all():
+            if len(getattr(d, k)) != n or not np.isfinite(getattr(d, k)).all():
                 raise ValueError(f"Monte Carlo of {m!r}: recorded {k} not finite or not one per call")
         src.append(np.full(n, i, np.int64))
         pos.append(np.arange(n, dtype=np.int64))
@@ -251,13 +251,13 @@ def null_dispatch_ns(args: tuple, n: int = 2000, repeats: int = 5) -> float:
     return float(best)
 
 
-def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True,
+def replay(scn, recorded: dict[str, MonteCarlo], methods, max_calls: int = 0, alt=True,
            max_calls_paper: int = 0, main=None, decompose: bool = False, best_of: int = 1,
            warm_compiled: bool = True) -> dict:
     """Replay recorded planning calls through every method (module docstring).
 
     ``scn``: the descent's scenario (``descent.build_scenario``); ``recorded``:
-    method -> gathered Monte-Carlo dict (``montecarlo.gather``), the sources of
+    method -> gathered Monte Carlo (``records.MonteCarlo``, its calls), the sources of
     the calls; ``methods``: the methods timed. Returns arrays: per replayed call
     ``source`` (position in ``sources``), ``run``, ``call`` (position in its
     source's calls), ``step``; per call and variant ``wall_ns``, ``cpu_ns``,
@@ -319,16 +319,16 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
     def inputs(q):
         d = recorded[names[src[sel[q]]]]
         i = pos[sel[q]]
-        k = int(d["plan_step"][i])
+        k = int(d.plan_step[i])
         r_t, R_t = tr.r[k], tr.R_LtoB[k]
 
         def visible(pts, margin=margin, r_t=r_t, R_t=R_t):
             return cam.in_view((np.asarray(pts) - r_t) @ R_t.T, margin)
 
-        state = PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
-        ex = int(d["plan_exclude"][i])
+        state = PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i], d.plan_P[i])
+        ex = int(d.plan_exclude[i])
         return (d, i, k, state, visible, {ex} if ex >= 0 else set(),
-                np.flatnonzero(visible(xyz)), d["plan_rng"][i])
+                np.flatnonzero(visible(xyz)), d.plan_rng[i])
 
     perf, thread = time.perf_counter_ns, time.thread_time_ns
     clock_ns = clock_cost_ns()
@@ -361,7 +361,7 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
                 if q not in seen:           # built once per call, whatever the passes
                     seen[q] = inputs(q)
                 d, i, k, state, visible, exclude, det, words = seen[q]
-                run[q] = int(d["plan_run"][i]) if "plan_run" in d else -1
+                run[q] = int(d.plan_run[i]) if d.has("plan_run") else -1
                 step[q] = k
                 order = group[timed_[q, group]]
                 for s_, v in enumerate(np.roll(order, -(t % len(order)))):
@@ -431,7 +431,7 @@ def replay(scn, recorded: dict[str, dict], methods, max_calls: int = 0, alt=True
         mine = src[sel] == own[m]
         v = next((x for x, (mm, path, _) in enumerate(var) if mm == m and path == "main"), None)
         if v is not None and own[m] >= 0 and mine.any():     # checked where the configured path is timed
-            recorded_pick = recorded[m]["plan_index"][pos[sel][mine]]
+            recorded_pick = recorded[m].plan_index[pos[sel][mine]]
             checked[j] = int(mine.sum())
             mismatch[j] = int(np.sum(pick[mine, v] != recorded_pick))
     return {"sources": np.array(names), "methods": np.array(methods),
@@ -613,16 +613,16 @@ def merge(replays: list[dict], extra: dict | None = None) -> dict:
 CALL_INPUT_KEYS = RECORD_KEYS + ("plan_index", "plan_run")
 
 
-def load_calls(path) -> dict:
-    """The recorded planning calls of a Monte-Carlo file (:data:`CALL_INPUT_KEYS`; a compressed
-    ``.npz`` is read per array, so the runs' time series are not decompressed)."""
+def load_calls(path) -> MonteCarlo:
+    """The recorded planning calls of a Monte-Carlo file (its record holding :data:`CALL_INPUT_KEYS`
+    only; a compressed ``.npz`` is read per array, so the runs' time series are not decompressed)."""
     import zipfile
 
     from opnav.core.snakeio import corrupt_intermediate
 
     try:
         with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in CALL_INPUT_KEYS if k in z.files}
+            return MonteCarlo(**{k: z[k] for k in CALL_INPUT_KEYS if k in z.files})
     except FileNotFoundError:
         raise
     except (zipfile.BadZipFile, EOFError, ValueError, OSError, KeyError) as exc:
@@ -722,13 +722,11 @@ def _replay_process(spec_path: str, target: str) -> None:
     print(resource_line(), flush=True)
 
 
-def replay_own(scn, data: dict, method: str, max_calls: int = 0) -> dict:
-    """Replay a Monte-Carlo dict's (or one ``run_descent`` output's) own calls
-    through its own method, configured evaluation path only (parameter
-    studies, the CLI: no other methods to interleave with)."""
-    d = dict(data)
-    if "plan_run" not in d:
-        d["plan_run"] = np.zeros(len(d["plan_index"]), np.int64)
+def replay_own(scn, data, method: str, max_calls: int = 0) -> dict:
+    """Replay a Monte Carlo's (``records.MonteCarlo``) or one descent's (``records.Descent``,
+    its calls counted as run 0) own calls through its own method, configured evaluation path
+    only (parameter studies, the CLI: no other methods to interleave with)."""
+    d = data if isinstance(data, MonteCarlo) else MonteCarlo.of_descent(data, 0)
     return replay(scn, {method: d}, [method], max_calls, alt=False)
 
 
@@ -773,7 +771,7 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     from opnav.landing import planner as pl
 
     d = recorded[method]
-    sel = select_calls(len(d["plan_step"]), max_calls)
+    sel = select_calls(len(d.plan_step), max_calls)
     cam, field_, tr = scn.camera, scn.field, scn.truth
     cfg = dataclasses.replace(scn.planner, eval_path="compiled")
     thread = time.thread_time_ns
@@ -782,10 +780,10 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
     gc.disable()
     try:
         for i in sel:
-            k = int(d["plan_step"][i])
+            k = int(d.plan_step[i])
             det = np.flatnonzero(cam.in_view((field_.xyz - tr.r[k]) @ tr.R_LtoB[k].T, cfg.margin_px))
-            st = pl.PlanState(d["plan_r"][i], d["plan_v"][i], d["plan_a"][i], d["plan_R"][i], d["plan_P"][i])
-            ex = int(d["plan_exclude"][i])
+            st = pl.PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i], d.plan_P[i])
+            ex = int(d.plan_exclude[i])
             exclude = {ex} if ex >= 0 else set()
             c0 = thread()
             res = pl.plan(method, st, cam, field_, None, cfg, exclude=exclude, detected=det, diagnose=False)
