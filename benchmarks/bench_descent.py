@@ -37,7 +37,8 @@ sys.path.insert(0, str(REPO / "tests"))
 from opnav.core.config import load_config  # noqa: E402
 from opnav.landing import descent  # noqa: E402
 from opnav.landing.descent import run_descents  # noqa: E402
-from opnav.landing.scenario import build_scenario, camera_scenarios  # noqa: E402
+from opnav.landing.scenario import build_scenario  # noqa: E402
+from opnav.landing.setup import Setup  # noqa: E402
 
 
 PLAN_CPU = [0.0]      # CPU s spent in the planner (descent.plan_batch) since the last reset
@@ -93,10 +94,10 @@ def main(argv=None) -> int:
     global _plan_batch
     _plan_batch = descent.plan_batch
     descent.plan_batch = _timed_plan_batch
-    cfg = load_config()["landing"]
-    batch = int(cfg["mc"]["batch_size"]) if args.batch is None else args.batch
+    cfg = Setup.from_config(load_config()["landing"])
+    batch = int(cfg.mc.batch_size) if args.batch is None else args.batch
     runs = list(range(args.runs))
-    scns = camera_scenarios(cfg)
+    scns = cfg.scenarios_by_name()
     ref = None
     if not args.no_reference:
         import descent_reference as ref

@@ -30,7 +30,6 @@ Use::
 from __future__ import annotations
 
 import argparse
-import copy
 import dataclasses
 import shutil
 import subprocess
@@ -49,7 +48,7 @@ from opnav.landing import descent as D  # noqa: E402
 from opnav.landing import planner as PL  # noqa: E402
 
 
-def planning_states(landing: dict, run_index: int = 0):
+def planning_states(landing, run_index: int = 0):
     """(PlanState, visible-function) at every planning instant of one depth descent."""
     scn = D.build_scenario(landing)
     captured = []
@@ -130,8 +129,10 @@ def main(argv=None) -> int:
     ap.add_argument("--methods", default=None, help="comma list (default landing.mc.methods)")
     ap.add_argument("--mc", action="store_true", help="also time the full Monte Carlo (--cores 2)")
     args = ap.parse_args(argv)
-    landing = copy.deepcopy(load_config(overlays=[args.config] if args.config else [])["landing"])
-    methods = args.methods.split(",") if args.methods else list(landing["mc"]["methods"])
+    from opnav.landing.setup import Setup
+
+    landing = Setup.from_config(load_config(overlays=[args.config] if args.config else [])["landing"])
+    methods = args.methods.split(",") if args.methods else list(landing.mc.methods)
     scn, states = planning_states(landing)
     print(f"{len(states)} planning states from run 0 (depth), {args.reps} rounds, "
           f"methods interleaved per state")
@@ -148,7 +149,7 @@ def main(argv=None) -> int:
     table(t, e)
     if args.mc:
         wall = run_mc(args.config)
-        n = landing["mc"]["n_runs"]
+        n = landing.mc.n_runs
         print(f"\nMonte Carlo: {len(methods)} methods x {n} runs, snakemake --cores 2: {wall:.1f} s wall")
     return 0
 

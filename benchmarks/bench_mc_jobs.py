@@ -28,9 +28,12 @@ def job_cpu(scenario: str, method: str, runs: int, configfiles: list[str]) -> tu
 
     argv = ["--configfile", *configfiles] if configfiles else []
     sm = mock_snakemake("landing_mc_chunk", argv=argv, bscn=scenario, bmethod=method, bchunk="r0000-0000")
-    run_chunk(sm.params.landing, method, [0], pick_ratio=False)
+    from opnav.landing.setup import Setup
+
+    setup = Setup.from_config(sm.params.landing)
+    run_chunk(setup, method, [0], pick_ratio=False)
     t0 = time.process_time()
-    d = run_chunk(sm.params.landing, method, list(range(1, runs + 1)), pick_ratio=bool(sm.params.pick_ratio))
+    d = run_chunk(setup, method, list(range(1, runs + 1)), pick_ratio=bool(sm.params.pick_ratio))
     return time.process_time() - t0, len(d.plan_index)
 
 

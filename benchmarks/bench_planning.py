@@ -33,7 +33,7 @@ from opnav.core.config import load_config
 from opnav.landing import timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
-from opnav.landing.scenario import camera_scenarios
+from opnav.landing.setup import Setup
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -44,7 +44,7 @@ def main() -> None:
     ap.add_argument("--reps", type=int, default=200, help="calls in a row per timing (hot)")
     a = ap.parse_args()
     land = load_config()["landing"]
-    scns = camera_scenarios(land)
+    scns = Setup.from_config(land).scenarios_by_name()
     names = [a.scenario] if a.scenario else list(scns)
     methods = a.methods.split(",")
     if "depth" not in methods:

@@ -29,9 +29,9 @@ METHODS = "depth,svd,gdop,cond,logdet,mineig,svd_w"
 def record(a) -> None:
     from opnav.core.config import load_config
     from opnav.landing.montecarlo import run_chunk
-    from opnav.landing.scenario import camera_scenarios
+    from opnav.landing.setup import Setup
 
-    scns = camera_scenarios(load_config()["landing"])
+    scns = Setup.from_config(load_config()["landing"]).scenarios_by_name()
     out = {}
     for name, cfg in scns.items():
         for m in a.methods.split(","):
@@ -48,11 +48,11 @@ def compare(a) -> None:
     from opnav.landing.planning import geometry as K
     from opnav.landing import planner as pl
     from opnav.landing.descent import build_scenario
-    from opnav.landing.scenario import camera_scenarios
+    from opnav.landing.setup import Setup
 
     z = np.load(a.calls)
     keys = sorted({tuple(k.split("|")[:2]) for k in z.files})
-    scns = camera_scenarios(load_config()["landing"])
+    scns = Setup.from_config(load_config()["landing"]).scenarios_by_name()
     tot_far = tot_agree = tot_all = tot_all_agree = 0
     for name, m in keys:
         scn = build_scenario(scns[name])

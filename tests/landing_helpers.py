@@ -1,9 +1,23 @@
-"""Small shared builders for the paper-B filter tests."""
+"""Small shared builders for the paper-B tests: filter states, and the ``landing`` config
+parsed once, as the workflow's scripts parse it (opnav.landing.setup)."""
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from opnav.landing import ekf
+from opnav.landing.setup import Setup, scenario_sections
+
+
+def landing_setup(section) -> Setup:
+    """A ``landing`` config mapping (or a rule's part of it) parsed: the :class:`Setup` every
+    paper-B function takes."""
+    return Setup.from_config(section)
+
+
+def scenario_setups(section) -> dict[str, Setup]:
+    """The setup of every camera scenario of a ``landing`` config mapping, in config order (the
+    workflow's per-scenario mappings, ``setup.scenario_sections``, each parsed)."""
+    return {n: Setup.from_config(c) for n, c in scenario_sections(section).items()}
 
 
 def random_nav_states(rng: np.random.Generator, n: int) -> ekf.NavState:

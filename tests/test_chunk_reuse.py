@@ -3,7 +3,6 @@ chunk was partial (issue 30): a chunk job takes over the runs of an earlier, sma
 chunk beside it (``montecarlo.earlier_chunks``) when they were flown with the same
 reuse key, and the chunk it writes is the one a fresh job would write."""
 
-import copy
 
 import numpy as np
 import pytest
@@ -12,16 +11,15 @@ from conftest import REPO
 from opnav.core.config import load_config
 from opnav.landing.montecarlo import (chunk_label, chunks, earlier_chunks, load, run_chunk,
                                       run_chunk_reusing, save)
-from opnav.landing.scenario import camera_scenarios
+from landing_helpers import scenario_setups
 
 
 @pytest.fixture(scope="module")
 def landing():
-    cfg = camera_scenarios(load_config(REPO / "config" / "config.yaml",
-                                       overlays=[REPO / "config" / "quick.yaml"])["landing"])["site-tilt"]
-    cfg = copy.deepcopy(cfg)
-    cfg["mc"]["batch_size"] = 1     # one batch per run: chunking changes no bit (test_landing_filter)
-    return cfg
+    cfg = scenario_setups(load_config(REPO / "config" / "config.yaml",
+                                      overlays=[REPO / "config" / "quick.yaml"])["landing"])["site-tilt"]
+    # one batch per run: chunking changes no bit (test_landing_filter)
+    return cfg.replace(mc=cfg.mc.replace(batch_size=1))
 
 
 def _fly(folder, cfg, n_runs, runs_per_job, key="k1"):

@@ -18,7 +18,9 @@ from opnav.landing import planner as PL
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.planning import geometry, layout
 from opnav.landing.planning.screens import TIE_RTOL
-from opnav.landing.scenario import build_scenario, camera_scenarios
+from opnav.landing.scenario import build_scenario
+from opnav.landing.setup import scenario_sections as camera_scenarios
+from landing_helpers import landing_setup
 
 EXAMPLE = "examples/parallax.py:parallax_score"
 
@@ -99,15 +101,15 @@ def test_the_schema_takes_the_key_and_no_registration_is_the_default():
 # ---------------------------------------------------------------- refusals
 
 def _one_line(landing, name, **entries) -> str:
-    lines = M.problems(with_methods(landing, **entries))
+    lines = M.problems(landing_setup(with_methods(landing, **entries)))
     assert len(lines) == 1, lines
     assert lines[0].startswith(f"invalid config key 'landing.custom_methods.{name}'") and "\n" not in lines[0]
     return lines[0]
 
 
 def test_the_example_passes_preflight(landing):
-    assert M.problems(with_methods(landing, parallax=EXAMPLE)) == []
-    assert M.problems(landing) == []
+    assert M.problems(landing_setup(with_methods(landing, parallax=EXAMPLE))) == []
+    assert M.problems(landing_setup(landing)) == []
 
 
 @pytest.mark.parametrize("path, match", [
@@ -137,7 +139,7 @@ def test_a_wrong_signature_is_refused(landing, tmp_path, sig):
 
 def test_optional_extra_parameters_are_accepted(landing, tmp_path):
     f = user_file(tmp_path, "def score(c, scale=1.0, **kw):\n    return -scale * float(c.p_L[0] ** 2)\n")
-    assert M.problems(with_methods(landing, mine=f"{f}:score")) == []
+    assert M.problems(landing_setup(with_methods(landing, mine=f"{f}:score"))) == []
 
 
 @pytest.mark.parametrize("name", ["depth", "svd", "logdet_nav", "random", "closest"])
@@ -165,7 +167,7 @@ def test_the_probe_sees_a_documented_candidate(landing, tmp_path):
     seen = []
     f = user_file(tmp_path, "SEEN = []\n\ndef score(c):\n    SEEN.append(c)\n    return 0.0\n", "seen.py")
     m = M.load(M.CustomSpec("mine", f"{f}:score"))
-    M.probe(m, landing)
+    M.probe(m, landing_setup(landing))
     seen = m.fn.__globals__["SEEN"]
     assert len(seen) == 2
     c = seen[0]
@@ -241,7 +243,7 @@ def flown(landing):
     """The example flown for two runs in each camera scenario."""
     out = {}
     for scn_name, c in camera_scenarios(with_methods(landing, parallax=EXAMPLE)).items():
-        out[scn_name] = (build_scenario(c), run_chunk(c, "parallax", [1, 2]))
+        out[scn_name] = (build_scenario(landing_setup(c)), run_chunk(landing_setup(c), "parallax", [1, 2]))
     return out
 
 
@@ -262,8 +264,8 @@ def test_the_example_flies_and_picks_what_the_function_says(flown):
 def test_a_builtin_is_unchanged_by_a_registration(landing, flown):
     """Registering a method changes no built-in method's run (the same picks and errors)."""
     c = camera_scenarios(landing)["interior"]
-    plain = run_chunk(c, "depth", [1])
-    reg = run_chunk({**c, "custom_methods": {"parallax": EXAMPLE}}, "depth", [1])
+    plain = run_chunk(landing_setup(c), "depth", [1])
+    reg = run_chunk(landing_setup({**c, "custom_methods": {"parallax": EXAMPLE}}), "depth", [1])
     for k in ("plan_index", "plan_beta", "err_r", "nees_r"):
         np.testing.assert_array_equal(getattr(plain, k), getattr(reg, k), err_msg=k)
 
@@ -294,20 +296,20 @@ def test_a_numba_function_flies_compiled_with_the_same_picks(landing, flown, tmp
             return -speed * c.t_s * math.sqrt(max(0.0, 1.0 - cos_t * cos_t)) / rho
         """, "jitted.py")
     c = with_methods(camera_scenarios(landing)["interior"], jitted=f"{f}:score")
-    assert M.problems({**landing, "custom_methods": c["custom_methods"]}) == []
-    scn = build_scenario(c)
+    assert M.problems(landing_setup({**landing, "custom_methods": c["custom_methods"]})) == []
+    scn = build_scenario(landing_setup(c))
     assert M.eval_path("jitted", scn.planner).startswith("custom (compiled search and score")
     assert PL.compiled_kind("jitted", scn.planner) == PL.OWN_COMPILED
     assert M.eval_path("depth", scn.planner) == "compiled"
     for name in ("interior", "site-tilt"):      # in-plane optima, then edge calls
         c = with_methods(camera_scenarios(landing)[name], jitted=f"{f}:score")
-        d = run_chunk(c, "jitted", [1, 2])
+        d = run_chunk(landing_setup(c), "jitted", [1, 2])
         ref = flown[name][1]
         np.testing.assert_array_equal(d.plan_index, ref.plan_index)
         np.testing.assert_array_equal(d.plan_evals, ref.plan_evals)
         np.testing.assert_allclose(d.plan_beta, ref.plan_beta, rtol=1e-12, atol=1e-15)
     # the timed call is the compiled kernel itself, and it picks what plan() picks
-    scn = build_scenario(c)
+    scn = build_scenario(landing_setup(c))
     i = 3
     state = PL.PlanState(d.plan_r[i], d.plan_v[i], d.plan_a[i], d.plan_R[i], d.plan_P[i])
     k = int(d.plan_step[i])
@@ -329,10 +331,10 @@ def test_a_numba_function_scoring_nan_in_the_compiled_call_is_named(landing, tmp
             return math.nan if c.r_L[2] < 1500.0 else c.p_L[0] ** 2
         """, "jit_nan.py")
     c = with_methods(camera_scenarios(landing)["interior"], late=f"{f}:score")
-    assert M.problems(with_methods(landing, late=f"{f}:score")) == []
+    assert M.problems(landing_setup(with_methods(landing, late=f"{f}:score"))) == []
     with pytest.raises(M.MethodError, match=r"^landing\.custom_methods\.late: \S+ returned nan or -inf .* in run 2, "
                                             r"planning call \d+"):
-        run_chunk(c, "late", [2])
+        run_chunk(landing_setup(c), "late", [2])
 
 
 # ---------------------------------------------------------------- failing in the Monte Carlo
@@ -347,10 +349,10 @@ def test_a_method_failing_in_the_monte_carlo_names_the_method_run_and_call(landi
     f = user_file(tmp_path, f"import math\n\ndef score(c):\n    if c.r_L[2] < 1500.0:\n        {body}\n"
                             "    return float(c.p_L[0] ** 2)\n", f"late{abs(hash(body))}.py")
     entry = {"late": f"{f}:score"}
-    assert M.problems(with_methods(landing, **entry)) == []
+    assert M.problems(landing_setup(with_methods(landing, **entry))) == []
     c = with_methods(camera_scenarios(landing)["interior"], **entry)
     with pytest.raises(M.MethodError, match=r"^landing\.custom_methods\.late: \S+:score " + match):
-        run_chunk(c, "late", [2])
+        run_chunk(landing_setup(c), "late", [2])
 
 
 def test_a_failing_job_writes_nothing(landing, tmp_path):
@@ -364,6 +366,6 @@ def test_a_failing_job_writes_nothing(landing, tmp_path):
     out = tmp_path / "chunks" / "late" / "r0000-0000.npz"
     out.parent.mkdir(parents=True)
     with pytest.raises(M.MethodError):
-        data, _ = run_chunk_reusing(out, "key", c, "late", [0])
+        data, _ = run_chunk_reusing(out, "key", landing_setup(c), "late", [0])
         save(out, data, "late")
     assert list(out.parent.iterdir()) == []

@@ -69,9 +69,9 @@ def test_sigint_mid_monte_carlo_then_rerun_is_identical(tmp_path):
     rerun = run_snakemake(wd, *args, timeout=600)
     assert rerun.returncode == 0, rerun.stdout + rerun.stderr
 
-    from opnav.landing.scenario import camera_scenarios
+    from landing_helpers import scenario_setups
 
-    cfg = camera_scenarios(load_config(REPO / "config" / "config.yaml",
+    cfg = scenario_setups(load_config(REPO / "config" / "config.yaml",
                                        overlays=[REPO / "config" / "quick.yaml", wd / "small.yaml"])["landing"])["site-tilt"]
     # each job flies its chunk of four runs as one batch: the clean run does the same
     # (batch size changes numbers only at round-off, tests/test_landing_batch.py)

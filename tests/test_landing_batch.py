@@ -15,7 +15,8 @@ import pytest
 from opnav.core.config import load_config
 from opnav.landing import planner as PL
 from opnav.landing.descent import run_descent, run_descents, tracking_step
-from opnav.landing.scenario import build_scenario, camera_scenarios
+from opnav.landing.scenario import build_scenario
+from landing_helpers import scenario_setups
 
 sys.path.insert(0, str(Path(__file__).parent))
 import descent_reference as REF  # noqa: E402
@@ -28,7 +29,7 @@ KEYS = ("err_r", "err_v", "err_th_deg", "err_rpy_deg", "sig_r", "sig_v", "sig_th
 
 @pytest.fixture(scope="module")
 def scenarios():
-    return {name: build_scenario(c) for name, c in camera_scenarios(load_config()["landing"]).items()}
+    return {name: build_scenario(c) for name, c in scenario_setups(load_config()["landing"]).items()}
 
 
 def _field(run, k):
@@ -184,7 +185,7 @@ def test_a_chunk_is_already_in_gathered_order():
     ``b_mc``): ``run_chunk`` holds runs and planning calls in run order, as ``gather``."""
     from opnav.landing.montecarlo import gather, run_chunk
 
-    cfg = camera_scenarios(load_config(overlays=[Path(__file__).parents[1] / "config" / "quick.yaml"])
+    cfg = scenario_setups(load_config(overlays=[Path(__file__).parents[1] / "config" / "quick.yaml"])
                            ["landing"])["site-tilt"]
     d = run_chunk(cfg, "depth", [0, 1, 2])
     g = gather([d])

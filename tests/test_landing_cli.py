@@ -27,12 +27,12 @@ def test_cli_scenario_flag_flies_that_camera(capsys):
     from opnav.core.config import load_config
     from opnav.landing.descent import build_scenario, run_descent
     from opnav.landing.montecarlo import summarize_run
-    from opnav.landing.scenario import camera_scenarios
+    from landing_helpers import scenario_setups
 
     quick = str(REPO / "config" / "quick.yaml")
     assert main(["--config", quick, "landing", "--scenario", "site-tilt", "--seed", "1"]) == 0
     out = json.loads(capsys.readouterr().out)
-    cfg = camera_scenarios(load_config(overlays=[quick])["landing"])["site-tilt"]
+    cfg = scenario_setups(load_config(overlays=[quick])["landing"])["site-tilt"]
     want = summarize_run(run_descent(build_scenario(cfg), "depth", 1))
     assert out["scenario"] == "site-tilt"
     assert out["final_pos_err_m"] == pytest.approx(want["final_pos_err_m"], rel=1e-9)

@@ -16,9 +16,10 @@ def small_run():
     """Two site-tilt descents of depth (the main seed stream, runs 0-1) and the truth altitude."""
     from opnav.core.config import load_config
     from opnav.landing.montecarlo import run_chunk
-    from opnav.landing.scenario import build_scenario, camera_scenarios
+    from landing_helpers import scenario_setups
+    from opnav.landing.scenario import build_scenario
 
-    cfg = camera_scenarios(load_config()["landing"])["site-tilt"]
+    cfg = scenario_setups(load_config()["landing"])["site-tilt"]
     d = run_chunk(cfg, "depth", [0, 1], pick_ratio=False)
     return d, build_scenario(cfg).truth.r[:, 2], cfg
 
@@ -28,7 +29,7 @@ def test_end_phase_equals_the_per_step_records_counted_by_hand(small_run):
     """Mutation tried: the last vision update taken from lm_updated fails (this test and the
     next)."""
     d, z, cfg = small_run
-    margin = float(cfg["filter"]["update_altitude_margin_m"])
+    margin = float(cfg.filter.update_altitude_margin_m)
     got = end_phase(d, z, margin)
     t = d.t
     last_lm, last_vis, below1, belowm, lowest = [], [], 0, 0, math.inf

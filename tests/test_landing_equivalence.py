@@ -267,9 +267,10 @@ def test_closest_picks_the_nearest_detected_landmark_by_range():
 
 def test_near_site_field_follows_the_descent():
     from opnav.landing.landmarks import make_field
+    from opnav.landing.setup import NearSite
 
     plain = make_field(12000.0, 20000, seed=7)
-    dense = make_field(12000.0, 20000, seed=7, near_site={"count": 5000, "r_min_m": 1.0})
+    dense = make_field(12000.0, 20000, seed=7, near_site=NearSite(count=5000, r_min_m=1.0))
     assert np.array_equal(dense.xyz[:20000], plain.xyz)        # the uniform part unchanged
     r = np.hypot(*dense.xyz[20000:, :2].T)
     for h in (10.0, 100.0, 1000.0):                             # ~ the same count per decade
@@ -286,12 +287,13 @@ def test_vision_cut_off_uses_the_estimate_never_the_truth():
     fail this test."""
     from opnav.core.config import load_config
     from opnav.landing.descent import run_descents, vision_cutoff_altitude
-    from opnav.landing.scenario import build_scenario, camera_scenarios
+    from landing_helpers import scenario_setups
+    from opnav.landing.scenario import build_scenario
 
-    cfg = camera_scenarios(load_config()["landing"])["interior"]
+    cfg = scenario_setups(load_config()["landing"])["interior"]
     scn = build_scenario(cfg)
     runs = run_descents(scn, "closest", [0, 1])
-    lim = cfg["filter"]["min_update_altitude_m"]
+    lim = cfg.filter.min_update_altitude_m
     true_alt = scn.truth.r[:, 2]
     checked = 0
     for d in runs:

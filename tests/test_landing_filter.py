@@ -1,7 +1,6 @@
 """Paper B filter: NEES consistency on small Monte Carlos, convergence of a
 single descent, and the Monte-Carlo bookkeeping (paired, chunk-independent)."""
 
-import copy
 
 import numpy as np
 import pytest
@@ -12,13 +11,14 @@ from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
 from opnav.landing.montecarlo import chunks, gather, run_chunk
 from opnav.landing.report import summary_table
+from opnav.landing.setup import Setup
 
 N_RUNS = 12
 
 
 @pytest.fixture(scope="module")
 def landing():
-    return load_config()["landing"]
+    return Setup.from_config(load_config()["landing"])
 
 
 def _nees(cfg, n=N_RUNS, method="depth"):
@@ -44,9 +44,9 @@ def test_nees_within_chi2_bounds_default_filter(landing):
 def test_plain_ekf_with_true_noise_is_consistent_for_small_initial_errors(landing):
     """The noise tuning only absorbs linearisation error: with a tenth of the
     Table 2 errors the plain EKF with the true pixel noise is consistent."""
-    cfg = copy.deepcopy(landing)
-    cfg["filter"].update(observability_constrained=False, meas_noise_scale=1.0, iterations=1)
-    cfg["mc"]["bounds"] = {k: v / 10 for k, v in cfg["mc"]["bounds"].items()}
+    b = landing.mc.bounds
+    cfg = landing.with_filter(observability_constrained=False, meas_noise_scale=1.0, iterations=1)
+    cfg = cfg.replace(mc=cfg.mc.replace(bounds=b.replace(r_m=b.r_m / 10, v_mps=b.v_mps / 10, att_deg=b.att_deg / 10)))
     pos, vel = _nees(cfg)
     _check_chi2(pos[:150], N_RUNS, 0.6)
     _check_chi2(vel[:150], N_RUNS, 0.6)
@@ -69,8 +69,7 @@ def test_zero_errors_zero_noise_stay_near_truth(landing):
     """A perfect start with (nearly) perfect sensors stays near the truth: the
     only departures are second-order terms of updates made with the large
     initial covariance (577 m, 5.8 m/s, 1.2 deg 1-sigma)."""
-    cfg = copy.deepcopy(landing)
-    cfg["camera"]["sigma_px"] = 1e-3
+    cfg = landing.replace(camera=landing.camera.replace(sigma_px=1e-3))
     scn = build_scenario(cfg)
     run = run_descent(scn, "depth", 0, imu_noise=False, init_error=False)
     assert np.abs(run.err_r).max() < 20.0
@@ -165,8 +164,8 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
     yaw = yaw_convergence(d["depth"], 0.5, "depth")
     assert (s["yaw_converges"], s["yaw_reason"], s["n_runs"]) == (yaw["converges"], yaw["reason"], 2)
     att = initial_attitude_report(landing)
-    assert s["initial_attitude_deg"] == att["paper_convention_deg"]
-    assert s["initial_tilt_deg"] == att["tilt_deg"] and s["single"] == {"n_plans": 7}
+    assert s["initial_attitude_deg"] == att.paper_convention_deg
+    assert s["initial_tilt_deg"] == att.tilt_deg and s["single"] == {"n_plans": 7}
     assert s["timing"]["checked_calls"] == int(tm["checked"].sum())
     json.dumps(s, default=float)
     alone = scenario_summary("interior", df[df["method"] == "depth"], {"depth": d["depth"]}, tm, {},
@@ -177,8 +176,7 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
 
 def _descent(landing, iterations, oc=True):
     """One seeded descent with the filter's update iterations and OC switch."""
-    cfg = copy.deepcopy(landing)
-    cfg["filter"].update(iterations=iterations, observability_constrained=oc)
+    cfg = landing.with_filter(iterations=iterations, observability_constrained=oc)
     return run_descent(build_scenario(cfg), "depth", 3)
 
 

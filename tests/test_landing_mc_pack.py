@@ -14,7 +14,7 @@ from conftest import REPO, dry_run_jobs, copy_workflow
 from opnav.core.config import load_config
 from opnav.core.snakeio import stand_in
 from opnav.landing.montecarlo import load
-from opnav.landing.scenario import camera_scenarios
+from opnav.landing.setup import scenario_sections
 
 SCRIPT = REPO / "workflow" / "scripts" / "landing_mc_chunk.py"
 #: the keys of the rule's params.landing (landing.smk's B_SIMS)
@@ -24,7 +24,7 @@ SIM_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_
 
 @pytest.fixture(scope="module")
 def sim():
-    c = camera_scenarios(load_config(REPO / "config" / "config.yaml",
+    c = scenario_sections(load_config(REPO / "config" / "config.yaml",
                                      overlays=[REPO / "config" / "quick.yaml"])["landing"])["interior"]
     out = {k: copy.deepcopy(c[k]) for k in SIM_KEYS}
     out["mc"] = {k: c["mc"][k] for k in ("base_seed", "bounds")}
@@ -38,7 +38,7 @@ def _job(tmp_path, sim, methods, tag):
                    params={"landing": sim, "runs": [1], "methods": list(methods),
                            "pick_ratio": [True] * len(methods), "batch_size": 0})
     runpy.run_path(str(SCRIPT), init_globals={"snakemake": smk})
-    return {m: load(o) for m, o in zip(methods, outs)}
+    return {m: load(o).arrays() for m, o in zip(methods, outs)}
 
 
 def _same(a: dict, b: dict) -> None:

@@ -415,10 +415,11 @@ def test_lapack_svd_of_H_equals_the_closed_form(r, R, seed):
     from opnav.landing.camera import Camera  # noqa: F401  (the planner's camera type)
     from opnav.landing.landmarks import LandmarkField
     from opnav.landing.planner import PlanState, candidate_scores, plan_one
-    from opnav.landing.scenario import build_scenario, camera_scenarios
+    from landing_helpers import scenario_setups
+    from opnav.landing.scenario import build_scenario
     from opnav.core.config import load_config
 
-    scn = _SCN.get("s") or _SCN.setdefault("s", build_scenario(camera_scenarios(load_config()["landing"])["interior"]))
+    scn = _SCN.get("s") or _SCN.setdefault("s", build_scenario(scenario_setups(load_config()["landing"])["interior"]))
     rng = np.random.default_rng(seed)
     cand = _ground(rng, 30, half=6000.0)
     st_ = PlanState(np.asarray(r, float), V0, np.zeros(3), R, np.eye(12))

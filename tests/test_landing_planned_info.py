@@ -101,9 +101,10 @@ def test_oc_keeps_yaw_unobservable():
 def test_planner_objective_uses_the_filter_noise_model_and_strategy():
     from opnav.core.config import load_config
     from opnav.landing.planner import PlanState, candidate_scores, plan_one
-    from opnav.landing.scenario import build_scenario, camera_scenarios
+    from landing_helpers import scenario_setups
+    from opnav.landing.scenario import build_scenario
 
-    scn = build_scenario(camera_scenarios(load_config()["landing"])["interior"])
+    scn = build_scenario(scenario_setups(load_config()["landing"])["interior"])
     cfg = scn.planner
     assert (cfg.noise_scale, cfg.obs_per_landmark) == (scn.noise_scale, scn.obs_per_landmark) != (1.0, 1)
     r, v, a, R, P, cand = _state(3)
@@ -120,9 +121,10 @@ def test_planner_objective_uses_the_filter_noise_model_and_strategy():
 @functools.lru_cache(maxsize=None)
 def _scenario(name):
     from opnav.core.config import load_config
-    from opnav.landing.scenario import build_scenario, camera_scenarios
+    from landing_helpers import scenario_setups
+    from opnav.landing.scenario import build_scenario
 
-    return build_scenario(camera_scenarios(load_config()["landing"])[name])
+    return build_scenario(scenario_setups(load_config()["landing"])[name])
 
 
 @pytest.mark.slow   # 3-6 s a kind (30 drawn cases, both paths)

@@ -8,7 +8,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from opnav.core.config import load_config
-from opnav.landing.camera import camera_from_config
+from opnav.landing.camera import make_camera
+from opnav.landing.setup import CameraSettings, scenario_sections
+from landing_helpers import landing_setup
 from opnav.landing.descent import build_scenario
 from opnav.landing.planning import screens
 from opnav.landing.planning.geometry import plane_geometry
@@ -38,14 +40,14 @@ def _grid_intervals(geom, R, cam, margin, n=72001):
 
 @pytest.fixture(scope="module")
 def scn():
-    return build_scenario(load_config()["landing"])
+    return build_scenario(landing_setup(load_config()["landing"]))
 
 
 @pytest.mark.slow  # ~2.5 CPU-s (issue 56: the default run <= 90 s)
 def test_exact_visible_interval_matches_a_fine_grid():
     rng = np.random.default_rng(5)
-    cam = camera_from_config(dict(fov_deg=60, pixels=1024, sigma_px=0.5, tilt_deg=45,
-                                  tilt_azimuth_deg=-107))
+    cam = make_camera(CameraSettings(fov_deg=60, pixels=1024, sigma_px=0.5, tilt_deg=45,
+                                     tilt_azimuth_deg=-107))
     n_cmp = 0
     for _ in range(300):
         r = np.r_[rng.uniform(-5e3, 5e3, 2), rng.uniform(100, 8e3)]
@@ -327,9 +329,9 @@ def test_camera_scenario_puts_the_depth_optimum_inside_or_outside_the_image(scen
     instant the depth optimum is strictly inside the visible interval (interior)
     or outside it (site-tilt, where every metric's search ends on an edge)."""
     from opnav.landing import descent as D
-    from opnav.landing.scenario import camera_scenarios
+    from landing_helpers import scenario_setups
 
-    cfg = camera_scenarios(load_config()["landing"])[scenario]
+    cfg = scenario_setups(load_config()["landing"])[scenario]
     scn_ = D.build_scenario(cfg)
     from opnav.landing.planner import PlanState
 
@@ -351,12 +353,12 @@ def test_camera_scenario_puts_the_depth_optimum_inside_or_outside_the_image(scen
 
 
 def test_unknown_headline_scenario_is_refused():
-    from opnav.landing.scenario import camera_scenarios
-
     cfg = load_config()["landing"]
     cfg = {**cfg, "headline_scenario": "nope"}
     with pytest.raises(ValueError, match="landing.headline_scenario"):
-        camera_scenarios(cfg)
+        scenario_sections(cfg)
+    with pytest.raises(ValueError, match="landing.headline_scenario"):
+        landing_setup(cfg).scenarios_by_name()
 
 
 def test_tie_rule_lowest_index_within_the_stated_tolerance():

@@ -13,7 +13,7 @@ from opnav.landing import records, timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.report import summary_table
-from opnav.landing.scenario import camera_scenarios
+from landing_helpers import scenario_setups
 
 METHODS = ("depth", "svd", "random", "center")
 
@@ -21,7 +21,7 @@ METHODS = ("depth", "svd", "random", "center")
 @pytest.fixture(scope="module")
 def recorded():
     """One run of each method in the interior scenario (quick profile)."""
-    cfg = camera_scenarios(load_config(overlays=["config/quick.yaml"])["landing"])["interior"]
+    cfg = scenario_setups(load_config(overlays=["config/quick.yaml"])["landing"])["interior"]
     rec = {m: run_chunk(cfg, m, [1]) for m in METHODS}
     return build_scenario(cfg), rec
 

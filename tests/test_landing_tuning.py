@@ -26,19 +26,20 @@ def test_choice_prefers_consistent_then_not_overconfident_smallest_scale():
 
 def test_tuning_runs_use_their_own_stream():
     from conftest import REPO
+    from landing_helpers import scenario_setups
     from opnav.core.config import load_config
-    from opnav.landing.scenario import camera_scenarios
+    from opnav.landing.setup import Tuning
 
     cfg = load_config(overlays=[str(REPO / "config" / "quick.yaml")])["landing"]
-    scn = {"interior": camera_scenarios(cfg)["interior"]}
-    tc = {"base_seed": 5, "n_runs": 2, "method": "closest", "candidates": [[5.0, 3]]}
+    scn = {"interior": scenario_setups(cfg)["interior"]}
+    tc = Tuning(base_seed=5, n_runs=2, method="closest", candidates=((5.0, 3),))
     out = tuning_report(scn, tc)
     assert out["configured"] == {"meas_noise_scale": 5.0, "iterations": 3}
     assert out["config_matches"] == (out["chosen"]["meas_noise_scale"] == 5.0)
     row = out["scenarios"]["interior"]["candidates"][0]
     assert row["nees_pos"] > 0 and out["band"][0] < 3 < out["band"][1]
     with pytest.raises(ValueError, match="must differ"):
-        tuning_report(scn, {**tc, "base_seed": cfg["mc"]["base_seed"]})
+        tuning_report(scn, tc.replace(base_seed=cfg["mc"]["base_seed"]))
 
 
 def _fake_runs(monkeypatch, seen):
@@ -49,8 +50,8 @@ def _fake_runs(monkeypatch, seen):
     from opnav.landing import montecarlo
 
     def run_chunk(cfg, method, runs, pick_ratio=True, batch_size=None):
-        seen.append(int(cfg["mc"]["base_seed"]))
-        s = float(cfg["filter"]["meas_noise_scale"])
+        seen.append(int(cfg.mc.base_seed))
+        s = float(cfg.filter.meas_noise_scale)
         return {"pos": 9.0 / s, "vel": 10.5 / s, "n": len(list(runs))}
 
     def per_run_stats(d):
@@ -62,6 +63,17 @@ def _fake_runs(monkeypatch, seen):
     monkeypatch.setattr(montecarlo, "per_run_stats", per_run_stats)
 
 
+def _land():
+    """A rule's part of the landing config: the filter's tuning and the Monte Carlo's seed."""
+    from opnav.landing.setup import Setup
+
+    return Setup.from_config({"filter": {"dt_s": 1.0, "obs_per_landmark": 3, "depth_sigma_frac": 0.1,
+                                         "min_update_altitude_m": 3.0, "update_altitude_margin_m": 5.0,
+                                         "observability_constrained": True, "meas_noise_scale": 5.0,
+                                         "iterations": 3},
+                              "mc": {"base_seed": 11}})
+
+
 def test_retune_uses_the_tuning_runs_only_and_reaches_the_band_centre(monkeypatch):
     """The retuned scale is chosen on the tuning stream alone (every flown set has the tuning
     seed) and lands where the larger log distance of both NEES from the band's centre is
@@ -71,13 +83,14 @@ def test_retune_uses_the_tuning_runs_only_and_reaches_the_band_centre(monkeypatc
     import math
 
     from opnav.landing.montecarlo import nees_band
+    from opnav.landing.setup import Tuning
     from opnav.landing.tuning import retune, tuning_rows
 
     seen = []
     _fake_runs(monkeypatch, seen)
-    land = {"filter": {"meas_noise_scale": 5.0, "iterations": 3}, "mc": {"base_seed": 11}}
-    tc = {"base_seed": 77, "n_runs": 40, "method": "depth", "retune_points": 8,
-          "candidates": [[2.0, 3], [3.0, 3], [4.0, 3], [5.0, 3], [8.0, 1]]}
+    land = _land()
+    tc = Tuning(base_seed=77, n_runs=40, method="depth", retune_points=8,
+                candidates=((2.0, 3), (3.0, 3), (4.0, 3), (5.0, 3), (8.0, 1)))
     rows = tuning_rows(land, tc)
     out = retune(land, tc, rows, 3)
     assert set(seen) == {77}
@@ -88,7 +101,7 @@ def test_retune_uses_the_tuning_runs_only_and_reaches_the_band_centre(monkeypatc
     assert out["in_band"] and out["iterations"] == 3
     assert [r["meas_noise_scale"] for r in out["evaluated"]] == sorted(r["meas_noise_scale"] for r in out["evaluated"])
     # no refinement: the closest candidate
-    assert retune(land, {**tc, "retune_points": 0}, rows, 3)["meas_noise_scale"] == 3.0
+    assert retune(land, tc.replace(retune_points=0), rows, 3)["meas_noise_scale"] == 3.0
 
 
 def test_heldout_flies_the_monte_carlos_runs(monkeypatch):
@@ -98,10 +111,10 @@ def test_heldout_flies_the_monte_carlos_runs(monkeypatch):
     seen = []
     _fake_runs(monkeypatch, seen)
     monkeypatch.setattr(montecarlo, "nees_consistency", lambda d: {"pos_mean": d["pos"], "vel_mean": d["vel"]})
-    land = {"filter": {"meas_noise_scale": 5.0, "iterations": 3}, "mc": {"base_seed": 11}}
+    land = _land()
     out = heldout(land, "depth", 6, 3.0, 3)
     assert seen == [11] and out["pos_mean"] == 3.0 and out["lastlm_pos_err_m_median"] == 0.5
-    assert land["filter"]["meas_noise_scale"] == 5.0          # the config is not changed
+    assert land.filter.meas_noise_scale == 5.0          # the setup is not changed
 
 
 def _record(pos, vel, tuning_in_band, run_median=2.0, run_max=30.0):

@@ -2,13 +2,13 @@
 
 import numpy as np
 
-from opnav.landing.montecarlo import yaw_convergence
+from opnav.landing.montecarlo import MonteCarlo, yaw_convergence
 
 
-def _runs(shrink: float) -> dict:
+def _runs(shrink: float) -> MonteCarlo:
     rng = np.random.default_rng(3)
     scale = np.linspace(1.0, shrink, 40)[None, :, None]
-    return {"err_rpy_deg": rng.normal(size=(200, 40, 3)) * scale}
+    return MonteCarlo(err_rpy_deg=rng.normal(size=(200, 40, 3)) * scale)
 
 
 def test_shrinking_yaw_envelope_reads_converging_and_a_flat_one_does_not():

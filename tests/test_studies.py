@@ -11,6 +11,7 @@ from scipy import stats
 
 from opnav.core.config import ConfigError, load_config
 from opnav.landing.montecarlo import run_chunk
+from landing_helpers import landing_setup
 from opnav.landing.planner import available_methods
 from opnav.preflight import check_config
 from opnav.studies import captions, planning, tables, values
@@ -108,11 +109,11 @@ def test_study_run_at_the_default_value_is_the_main_run_and_values_are_paired(qu
     """Run i of a study is main Monte-Carlo run i at the configured value (bit for bit);
     another value draws the same initial error (paired) but flies differently."""
     plan = _plan(quick)
-    main = run_chunk(quick["landing"], "depth", [1])
-    at_default = run_chunk(plan["obs"].instances[1].sim, "depth", [1])      # obs = 3, configured
+    main = run_chunk(landing_setup(quick["landing"]), "depth", [1])
+    at_default = run_chunk(landing_setup(plan["obs"].instances[1].sim), "depth", [1])      # obs = 3, configured
     for k in ("err_r", "err_v", "nees_r", "plan_index", "plan_t", "init_error"):
         assert np.array_equal(getattr(main, k), getattr(at_default, k)), k
-    other = run_chunk(plan["obs"].instances[0].sim, "depth", [1])            # obs = 2
+    other = run_chunk(landing_setup(plan["obs"].instances[0].sim), "depth", [1])            # obs = 2
     assert np.array_equal(other.init_error, main.init_error)
     assert not np.array_equal(other.err_r, main.err_r)
 

@@ -198,9 +198,9 @@ def recorded():
     from opnav.core.config import load_config
     from opnav.landing.descent import build_scenario
     from opnav.landing.montecarlo import run_chunk
-    from opnav.landing.scenario import camera_scenarios
+    from landing_helpers import scenario_setups
 
-    cfg = camera_scenarios(load_config(overlays=["config/quick.yaml"])["landing"])["interior"]
+    cfg = scenario_setups(load_config(overlays=["config/quick.yaml"])["landing"])["interior"]
     return cfg, build_scenario(cfg), {m: run_chunk(cfg, m, [1]) for m in ("depth", "svd", "random")}
 
 

@@ -6,8 +6,8 @@ LANDING = res("landing")
 rule landing_tables:
     """B-T1 and B-T2, rendered from the config."""
     input:
-        src("landing/scenario.py", "landing/trajectory.py", "core/tables.py", "core/published.py",
-            "data/published.yaml"),
+        src("landing/scenario.py", "landing/setup.py", "core/sections.py", "landing/trajectory.py", "core/tables.py",
+            "core/published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
         t2=report_table(f"{LANDING}/B-T2_error_bounds", "B-T2", "Paper B"),
@@ -32,11 +32,11 @@ rule landing_tables:
 # only the new runs, and no chunk's params mention n_runs.
 from opnav.landing.montecarlo import CHUNK_PATTERN, chunk_label, chunk_runs, chunks as mc_chunks
 
-from opnav.landing.scenario import camera_scenarios, headline_scenario
+from opnav.landing.setup import Setup as _BSetup, scenario_sections
 
 try:
-    B_SCENARIO_CFG = camera_scenarios(config["landing"])
-    B_HEADLINE = headline_scenario(config["landing"])
+    B_SCENARIO_CFG = scenario_sections(config["landing"])
+    B_HEADLINE = _BSetup.from_config(config["landing"]).headline()
 except ValueError as exc:
     config_exit(exc)  # checked before (opnav.core.checks): the one way out, should it happen
 # Camera scenarios (landing.scenarios): each flies its own Monte Carlo under
@@ -74,7 +74,8 @@ B_SRC = with_kernels("landing", src(
     "landing/trajectory.py", "landing/imu.py", "landing/camera.py", "landing/landmarks.py",
     "landing/measurement.py", "landing/ekf.py", "landing/planning/reference.py",
     "landing/planner.py", "landing/methods.py", "core/registry.py", "landing/descent.py", "landing/montecarlo.py", "landing/scenario.py",
-    "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "core/rotations.py"))
+    "landing/depth_map.py", "landing/metrics.py", "landing/casadi_model.py", "core/rotations.py",
+    "landing/setup.py", "core/sections.py"))
 B_SCN_RE = "|".join(B_SCENARIOS)
 
 
@@ -216,7 +217,8 @@ rule landing_mc_gather:
 rule landing_true_states:
     """B-F4: the truth trajectory (the same in every camera scenario)."""
     input:
-        src("landing/trajectory.py", "landing/plots.py", "core/figures.py", "opnav.mplstyle"),
+        src("landing/trajectory.py", "landing/setup.py", "core/sections.py", "landing/plots.py",
+            "core/figures.py", "opnav.mplstyle"),
     output:
         f4=report_figure(f"{LANDING}/B-F4_true_states", "B-F4", "Paper B"),
     params:
@@ -256,7 +258,7 @@ rule landing_tuning:
     stream in every camera scenario; the one tuning for all, checked against the config."""
     input:
         B_SRC,
-        src("landing/tuning.py"),
+        src("landing/tuning.py", "landing/setup.py", "core/sections.py"),
         kernels=kernels("landing"),
     output:
         f"{LANDING}/tuning.json",
@@ -277,7 +279,7 @@ rule landing_retuned:
     method, beside the paper tuning's Monte Carlo: the held-out NEES of both (B-T3 NEES table)."""
     input:
         B_SRC,
-        src("landing/tuning.py", "landing/report.py"),
+        src("landing/tuning.py", "landing/report.py", "landing/setup.py", "core/sections.py"),
         tuning=f"{LANDING}/tuning.json",
         mc=lambda wc: b_mc(wc.bscn, [config["landing"]["tuning"]["method"]])[0],
         kernels=kernels("landing"),
@@ -315,6 +317,7 @@ rule landing_summary:
         code=with_kernels("landing", src(
             "landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/scenario.py", "landing/plots.py",
             "landing/report.py", "landing/equivalence.py", "landing/ranking.py", "landing/trajectory.py",
+            "landing/setup.py", "core/sections.py",
             "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),
         kernels=kernels("landing"),
     output:

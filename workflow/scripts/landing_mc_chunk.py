@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from opnav.landing.montecarlo import run_chunk_reusing, save
+from opnav.landing.setup import Setup
 from opnav.core.snakeio import mock_snakemake, script_context
 from opnav.studies.values import config_digest
 
@@ -21,11 +22,12 @@ with script_context(snakemake) as log:
     # runs of an earlier, smaller chunk beside this one are taken over, not flown again,
     # when flown with the same simulation, method, diagnostics and source code (the
     # rule's inputs are the src modules): the reuse key
+    setup = Setup.from_config(snakemake.params.landing)    # the edge: paper B's config parsed once
     code = sorted(hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in snakemake.input)
     for method, pick_ratio, out in zip(methods, pick_ratios, snakemake.output, strict=True):
         key = config_digest({"landing": snakemake.params.landing, "method": method, "pick_ratio": pick_ratio,
                              "code": code})
-        data, flown = run_chunk_reusing(out, key, snakemake.params.landing, method, runs,
+        data, flown = run_chunk_reusing(out, key, setup, method, runs,
                                         pick_ratio=pick_ratio, batch_size=int(snakemake.params.batch_size))
         save(out, data, method)
         log.info("%s: runs %s..%s (%d flown, %d taken from earlier chunks), %d planning calls", method,

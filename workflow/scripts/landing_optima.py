@@ -9,12 +9,13 @@ from opnav.core.tables import write_json
 from opnav.landing import optima
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import load
+from opnav.landing.setup import Setup
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_optima", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
-    scn = build_scenario(snakemake.params.landing)
+    scn = build_scenario(Setup.from_config(snakemake.params.landing))    # the edge: parsed once
     counts = optima.count_calls(scn, load(snakemake.input.mc), int(snakemake.params.n_grid),
                                 int(snakemake.params.max_calls))
     out = optima.count_summary(counts, snakemake.wildcards.bscn)

@@ -6,6 +6,7 @@ import sys
 
 from opnav.landing.montecarlo import load, nees_consistency
 from opnav.landing.report import nees_table
+from opnav.landing.setup import Setup
 from opnav.landing.tuning import errors, retuned_record
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
@@ -17,7 +18,7 @@ with script_context(snakemake) as log:
     scn = snakemake.wildcards.bscn
     d = load(snakemake.input.mc)
     n = d.n_runs
-    rec = retuned_record(load_json(snakemake.input.tuning), scn, snakemake.params.landing,
+    rec = retuned_record(load_json(snakemake.input.tuning), scn, Setup.from_config(snakemake.params.landing),
                          snakemake.params.method, n, {**nees_consistency(d), **errors(d)})
     write_json(snakemake.output.record, rec)
     table = nees_table(rec)

@@ -9,19 +9,20 @@ from opnav.landing import plots
 from opnav.landing.depth_map import depth_map
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
+from opnav.landing.setup import Setup
 from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_single", argv=sys.argv[1:], bscn="site-tilt")
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.landing
+    cfg = Setup.from_config(snakemake.params.landing)    # the edge: paper B's config parsed once
     scn = build_scenario(cfg)
-    dm = depth_map(scn, float(cfg["figures"]["f5_time_s"]))
+    dm = depth_map(scn, float(cfg.figures.f5_time_s))
     figures.save(plots.fig_depth_error_map(dm), snakemake.output.f5)
 
-    method = cfg["single"]["method"]
-    idx = int(cfg["single"]["run_index"])
+    method = cfg.single.method
+    idx = int(cfg.single.run_index)
     run = run_descent(scn, method, idx)
     s = summarize_run(run)
     s.update(method=method, run_index=idx,

@@ -14,7 +14,8 @@ from opnav.landing.own import compare_own, with_own
 from opnav.landing.montecarlo import load
 from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading, nees_retuned_text,
                                   scenario_summary, summary_table)
-from opnav.landing.trajectory import truth_states
+from opnav.landing.trajectory import nominal_truth
+from opnav.landing.setup import Equivalence, Setup
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
 from opnav.report.claims import load_plan
@@ -48,7 +49,8 @@ with script_context(snakemake) as log:
     # numbers, their one home
     plan = load_plan(snakemake.input.plan)
     # and (issue 52) B-C2's threshold and its sweep, and the one interval level (alpha = (1 - level) / 2)
-    acc = accuracy_tests(every, {**snakemake.params.equivalence, "alpha": (1.0 - plan.level) / 2.0},
+    eq = Equivalence.from_config(snakemake.params.equivalence).replace(alpha=(1.0 - plan.level) / 2.0)
+    acc = accuracy_tests(every, eq,
                          plan.setting("converge_threshold_m"),
                          margin_rel=plan.margin("B-C1", "margin_rel"),
                          same_pick_max_pct=plan.margin("B-C1", "same_pick_max_pct"),
@@ -57,7 +59,8 @@ with script_context(snakemake) as log:
     own = getattr(snakemake.params, "custom", None) or {}      # your own methods (landing.custom_methods)
     if own:   # paired against SVD and depth, no verdict (evidence rows of role beyond)
         acc = with_own(acc, compare_own(every, list(own), plan.margin("B-C1", "margin_rel"), (1.0 - plan.level) / 2.0))
-    out = scenario_summary(scn, df, data, tm, single, snakemake.params.landing,
+    setup = Setup.from_config(snakemake.params.landing)    # the edge: paper B's config parsed once
+    out = scenario_summary(scn, df, data, tm, single, setup,
                            eval_path=snakemake.params.eval_path,
                            yaw_ratio=plan.margin("B-C3", "yaw_ratio"),  # the plan's, its one home (issue 52)
                            published_reduction_vs_svd=pub["depth_time_reduction_vs_svd_pct"],
@@ -70,10 +73,9 @@ with script_context(snakemake) as log:
         out["nees_retuned"] = load_json(snakemake.input.retuned)
         out["nees_retuned_text"] = nees_retuned_text(out["nees_retuned"])
     # the descent's end from the per-step records against the true altitude
-    c, cut = snakemake.params.landing, snakemake.params.cutoff
+    cut = snakemake.params.cutoff
     t = next(iter(data.values())).t
-    alt = truth_states(t, c["initial_state"]["r_m"], c["initial_state"]["v_mps"], float(c["duration_s"]),
-                       c["gravity_mps2"], float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2")).r[:, 2]
+    alt = nominal_truth(setup, t).r[:, 2]
     end = end_phase_table(every, alt, float(cut["update_altitude_margin_m"]))
     write_table(end, snakemake.output.end_phase,
                 caption=(f"B-T3 end phase ({scn} camera), per method over its runs: the time of the last "

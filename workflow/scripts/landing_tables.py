@@ -3,6 +3,7 @@
 import sys
 
 from opnav.landing.scenario import error_bounds_table, initial_state_table
+from opnav.landing.setup import Setup
 from opnav.core.snakeio import mock_snakemake, script_context
 from opnav.core.tables import write_table
 
@@ -10,7 +11,7 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
     snakemake = mock_snakemake("landing_tables", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
-    cfg = snakemake.params.landing
+    cfg = Setup.from_config(snakemake.params.landing)    # the edge: paper B's config parsed once
     write_table(initial_state_table(cfg), snakemake.output.t1,
                 caption="B-T1: lander initial state in the landing frame {L} (paper B Table 1).")
     write_table(error_bounds_table(cfg), snakemake.output.t2,

@@ -6,17 +6,17 @@ import numpy as np
 
 from opnav.core import figures
 from opnav.landing import plots
-from opnav.landing.trajectory import euler_rpy_deg, truth_states
+from opnav.landing.setup import Setup
+from opnav.landing.trajectory import euler_rpy_deg, nominal_truth
 from opnav.core.snakeio import mock_snakemake, script_context
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_true_states", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
-    c = snakemake.params.landing
-    T = float(c["duration_s"])
+    c = Setup.from_config(snakemake.params.landing)    # the edge: paper B's config parsed once
+    T = float(c.duration_s)
     t = np.linspace(0.0, T, int(round(T)) * 10 + 1)
-    tr = truth_states(t, c["initial_state"]["r_m"], c["initial_state"]["v_mps"], T,
-                      c["gravity_mps2"], float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2"))
+    tr = nominal_truth(c, t)
     figures.save(plots.fig_true_states(tr.t, tr.r, tr.v, euler_rpy_deg(tr.R_LtoB)), snakemake.output.f4)
     log.info("B-F4 over %d samples", t.size)

@@ -4,6 +4,7 @@ against the configured landing.filter."""
 
 import sys
 
+from opnav.landing.setup import Setup, Tuning
 from opnav.landing.tuning import tuning_report
 from opnav.core.snakeio import mock_snakemake, script_context
 from opnav.core.tables import write_json
@@ -12,7 +13,9 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
     snakemake = mock_snakemake("landing_tuning", argv=sys.argv[1:])
 
 with script_context(snakemake) as log:
-    out = tuning_report(dict(snakemake.params.scenarios), dict(snakemake.params.tuning))
+    # the edge: paper B's config parsed once (every scenario's setup, the tuning section)
+    out = tuning_report({n: Setup.from_config(c) for n, c in snakemake.params.scenarios.items()},
+                        Tuning.from_config(snakemake.params.tuning))
     write_json(snakemake.output[0], out)
     log.info("tuning: chosen %s (configured %s, matches: %s)", out["chosen"], out["configured"],
              out["config_matches"])

@@ -17,7 +17,10 @@ if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/R
 def fly(paper: str, sim: dict, units: list[str], runs: list[int], label: str, log) -> pd.DataFrame:
     """Every unit's runs at one value: the table rule study_runs writes."""
     if paper == "landing":
+        from opnav.landing.setup import Setup
         from opnav.landing.study import run_runs
+
+        sim = Setup.from_config(sim)  # the edge: paper B's config parsed once
     else:
         from opnav.approach.setup import Setup
         from opnav.approach.study import run_runs

@@ -26,7 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Camera", "camera_from_config"]
+from opnav.landing.setup import CameraSettings
+
+__all__ = ["Camera", "make_camera"]
 
 
 @dataclass(frozen=True)
@@ -67,15 +69,15 @@ class Camera:
         return c @ self.R_BtoC
 
 
-def camera_from_config(cam: dict) -> Camera:
-    """Build the :class:`Camera` from ``landing.camera`` config values."""
-    fov = np.radians(float(cam["fov_deg"]))
+def make_camera(cam: CameraSettings) -> Camera:
+    """Build the :class:`Camera` from the ``landing.camera`` settings (``setup.CameraSettings``)."""
+    fov = np.radians(float(cam.fov_deg))
     if not 0 < fov < np.pi:
-        raise ValueError(f"landing.camera.fov_deg must be in (0, 180), got {cam['fov_deg']}")
-    half = float(cam["pixels"]) / 2.0
+        raise ValueError(f"landing.camera.fov_deg must be in (0, 180), got {cam.fov_deg}")
+    half = float(cam.pixels) / 2.0
     focal = half / np.tan(fov / 2)
-    tilt = np.radians(float(cam["tilt_deg"]))
-    az = np.radians(float(cam["tilt_azimuth_deg"]))
+    tilt = np.radians(float(cam.tilt_deg))
+    az = np.radians(float(cam.tilt_azimuth_deg))
     horiz = np.array([np.cos(az), np.sin(az), 0.0])
     z_C = np.cos(tilt) * np.array([0.0, 0.0, -1.0]) + np.sin(tilt) * horiz
     e_y = np.array([-np.sin(az), np.cos(az), 0.0])
@@ -83,5 +85,5 @@ def camera_from_config(cam: dict) -> Camera:
     x_C /= np.linalg.norm(x_C)
     y_C = np.cross(z_C, x_C)
     R_BtoC = np.stack([x_C, y_C, z_C])
-    return Camera(R_BtoC=R_BtoC, focal_px=focal, half_px=half, sigma_px=float(cam["sigma_px"]),
-                  margin_px=float(cam.get("plan_margin_px", 0.0)))
+    return Camera(R_BtoC=R_BtoC, focal_px=focal, half_px=half, sigma_px=float(cam.sigma_px),
+                  margin_px=float(cam.plan_margin_px))

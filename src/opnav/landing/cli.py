@@ -25,12 +25,13 @@ def _run(args, rc) -> int:
     # the planner's registry and the seed's limits are checked as the config's
     # landing.single.method / run_index (opnav.core.checks), naming the flag
     from opnav.core.config import ConfigError
-    from opnav.landing.scenario import camera_scenarios, headline_scenario
+    from opnav.landing.setup import Setup
 
-    landing = rc.with_flags(config, {"landing.single.method": ("--method", args.method),
-                                  "landing.single.run_index": ("--seed", args.seed)})["landing"]
-    scenarios = camera_scenarios(landing)
-    name = headline_scenario(landing) if args.scenario is None else args.scenario
+    checked = rc.with_flags(config, {"landing.single.method": ("--method", args.method),
+                                     "landing.single.run_index": ("--seed", args.seed)})
+    setup = Setup.from_config(checked["landing"])    # the edge: paper B's config parsed once
+    scenarios = setup.scenarios_by_name()
+    name = setup.headline() if args.scenario is None else args.scenario
     if name not in scenarios:
         raise ConfigError(f"--scenario {name!r}: not a camera scenario of landing.scenarios "
                           f"({', '.join(scenarios)})")

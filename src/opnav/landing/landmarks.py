@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from opnav.landing.setup import NearSite
+
 __all__ = ["LandmarkField", "make_field", "near_site_xy", "nearest_brute_force"]
 
 
@@ -57,10 +59,10 @@ def near_site_xy(count: int, r_min_m: float, r_max_m: float, rng: np.random.Gene
     return np.column_stack([r * np.cos(az), r * np.sin(az)])
 
 
-def make_field(half_width_m: float, count: int, seed: int, near_site: dict | None = None
+def make_field(half_width_m: float, count: int, seed: int, near_site: NearSite | None = None
                ) -> LandmarkField:
     """Random field: ``count`` landmarks uniform on the square of half width
-    ``half_width_m`` (m), plus, if ``near_site`` (``{count, r_min_m}``) has a
+    ``half_width_m`` (m), plus, if ``near_site`` (``setup.NearSite``) has a
     positive count, that many around the site (:func:`near_site_xy`, out to
     ``half_width_m``); ``seed`` fixes both (the uniform part is the same with
     or without the near-site part)."""
@@ -69,8 +71,8 @@ def make_field(half_width_m: float, count: int, seed: int, near_site: dict | Non
                          f"{half_width_m}, {count}")
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 0xB1A7]))
     xy = rng.uniform(-half_width_m, half_width_m, size=(int(count), 2))
-    if near_site and int(near_site["count"]) > 0:
+    if near_site is not None and int(near_site.count) > 0:
         rng_near = np.random.default_rng(np.random.SeedSequence([int(seed), 0xB1A8]))
-        xy = np.vstack([xy, near_site_xy(int(near_site["count"]), float(near_site["r_min_m"]),
+        xy = np.vstack([xy, near_site_xy(int(near_site.count), float(near_site.r_min_m),
                                          float(half_width_m), rng_near)])
     return LandmarkField(xyz=np.column_stack([xy, np.zeros(len(xy))]))

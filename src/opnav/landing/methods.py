@@ -219,40 +219,37 @@ def eval_path(name: str, cfg) -> str:
 
 # ---------------------------------------------------------------- preflight
 
-def probe_candidates(landing_cfg: Mapping) -> list[Candidate]:
+def probe_candidates(setup) -> list[Candidate]:
     """Candidates of the scenario's start for the probe call: the estimate equal to the truth at
     t = 0 (acceleration the truth's), the Monte Carlo's prior covariance (``mc.bounds``: uniform
     errors, variance bound^2 / 3; the landmark block dormant, 1e8 m^2), the base camera; the
     candidates the landing site and the ground point of the boresight (both in view at the start:
-    ``landing.preflight``)."""
-    from opnav.landing.camera import camera_from_config
-    from opnav.landing.trajectory import truth_states
+    ``landing.preflight``); ``setup``: the landing ``setup.Setup``."""
+    from opnav.landing.camera import make_camera
+    from opnav.landing.trajectory import nominal_truth
 
-    c = landing_cfg
-    s0 = c["initial_state"]
-    tr = truth_states(np.array([0.0]), s0["r_m"], s0["v_mps"], float(c["duration_s"]), c["gravity_mps2"],
-                      float(c.get("yaw_deg", 0.0)), c.get("terminal_accel_mps2"))
-    cam = camera_from_config(c["camera"])
-    b = c["mc"]["bounds"]
+    tr = nominal_truth(setup, [0.0])
+    cam = make_camera(setup.camera)
+    b = setup.mc.bounds
     P = np.zeros((12, 12))
-    P[:9, :9] = np.diag(np.repeat([b["r_m"] ** 2 / 3, b["v_mps"] ** 2 / 3, math.radians(b["att_deg"]) ** 2 / 3], 3))
+    P[:9, :9] = np.diag(np.repeat([b.r_m ** 2 / 3, b.v_mps ** 2 / 3, math.radians(b.att_deg) ** 2 / 3], 3))
     P[9:, 9:] = np.eye(3) * 1e8
     r, R = tr.r[0], tr.R_LtoB[0]
     bs_L = R.T @ cam.boresight_B
     ground = r + bs_L * (r[2] / -bs_L[2]) if bs_L[2] < 0 else np.array([0.0, 0.0, 0.0])
     ground[2] = 0.0
-    fl = c["filter"]
+    fl = setup.filter
     base = Candidate(np.zeros(3), r.copy(), tr.v[0].copy(), tr.a[0].copy(), R.copy(), P, np.zeros(3),
-                     cam.R_BtoC.copy(), float(cam.sigma_b), float(fl["meas_noise_scale"]), float(fl["dt_s"]),
-                     int(fl["obs_per_landmark"]))
+                     cam.R_BtoC.copy(), float(cam.sigma_b), float(fl.meas_noise_scale), float(fl.dt_s),
+                     int(fl.obs_per_landmark))
     return [base._replace(p_L=np.zeros(3)), base._replace(p_L=ground)]
 
 
-def probe(method: Method, landing_cfg: Mapping) -> None:
+def probe(method: Method, setup) -> None:
     """The probe call (module docstring): :class:`MethodError` if the function raises or a score
     is not finite."""
     key = f"landing.custom_methods.{method.name}"
-    for rec in probe_candidates(landing_cfg):
+    for rec in probe_candidates(setup):
         try:
             s = _score(method, rec)
         except MethodError as exc:
@@ -264,14 +261,14 @@ def probe(method: Method, landing_cfg: Mapping) -> None:
                               "a probe score must be finite")
 
 
-def problems(landing_cfg: Mapping) -> list[str]:
-    """One line per registered method that cannot be used (module docstring); [] if none is
-    registered."""
+def problems(setup) -> list[str]:
+    """One line per registered method of the landing ``setup.Setup`` that cannot be used (module
+    docstring); [] if none is registered."""
     out = []
-    for spec in specs(landing_cfg.get("custom_methods")).values():
+    for spec in setup.custom_methods:
         try:
             m = load(spec)
-            probe(m, landing_cfg)
+            probe(m, setup)
         except MethodError as exc:
             out.append(f"invalid config key '{spec.key}': {registry.strip_key(str(exc), spec.key)}")
     return out

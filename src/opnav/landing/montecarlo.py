@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 
 from opnav.landing import records   # numpy only
 from opnav.landing.records import CALL_KEYS, TRACK_KEYS, Descent, MonteCarlo
+from opnav.landing.setup import Setup
 
 __all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
@@ -104,7 +105,7 @@ def earlier_chunks(path, run_indices) -> list[tuple[Path, list[int]]]:
     return out
 
 
-def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_indices,
+def run_chunk_reusing(path, reuse_key: str, setup: Setup, method: str, run_indices,
                       pick_ratio: bool = True, batch_size: int | None = None) -> tuple[MonteCarlo, list[int]]:
     """:func:`run_chunk` for the chunk file ``path``, taking the runs already
     flown in :func:`earlier_chunks` whose stored ``reuse_key`` (a digest of
@@ -121,7 +122,7 @@ def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_
     have = {int(i) for part in parts for i in part.run_index}
     todo = [i for i in idx if i not in have]
     if todo:
-        parts.append(run_chunk(landing_cfg, method, todo, batch_size=batch_size, pick_ratio=pick_ratio))
+        parts.append(run_chunk(setup, method, todo, batch_size=batch_size, pick_ratio=pick_ratio))
     data = parts[0] if len(parts) == 1 else gather(parts)
     return data.replace(reuse_key=str(reuse_key)), todo
 
@@ -130,9 +131,10 @@ def run_chunk_reusing(path, reuse_key: str, landing_cfg: dict, method: str, run_
 CHUNK_PATTERN = r"r[0-9]+-[0-9]+"
 
 
-def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | None = None,
+def run_chunk(setup: Setup, method: str, run_indices, batch_size: int | None = None,
               pick_ratio: bool = True) -> MonteCarlo:
-    """Fly the runs ``run_indices`` with ``method``; their records stacked (see module doc).
+    """Fly the runs ``run_indices`` with ``method`` in the scenario of the landing ``setup``; their
+    records stacked (see module doc).
 
     Runs are flown in batches of ``batch_size`` (default ``landing.mc.batch_size``;
     0 = all runs as one batch); the numbers do not depend on it (to round-off).
@@ -141,10 +143,10 @@ def run_chunk(landing_cfg: dict, method: str, run_indices, batch_size: int | Non
     from opnav.landing.descent import run_descents
     from opnav.landing.scenario import build_scenario
 
-    scn = build_scenario(landing_cfg)
+    scn = build_scenario(setup)
     idx = [int(i) for i in run_indices]
     if batch_size is None:
-        batch_size = int(landing_cfg.get("mc", {}).get("batch_size", 0))
+        batch_size = int(setup.mc.batch_size)
     size = len(idx) if batch_size <= 0 else int(batch_size)
     runs = []
     for a in range(0, len(idx), max(size, 1)):

@@ -15,6 +15,8 @@ units as in the config.
 
 from __future__ import annotations
 
+from typing import Mapping
+
 import numpy as np
 
 from opnav.core.checks import MAX_LANDING_IMU_SAMPLES, multiple as _multiple
@@ -22,13 +24,16 @@ from opnav.core.checks import MAX_LANDING_IMU_SAMPLES, multiple as _multiple
 __all__ = ["landing_problems"]
 
 
-def landing_problems(c: dict) -> list[str]:
-    """Cross-key problems of the ``landing`` section (see module docstring)."""
-    from opnav.landing.trajectory import truth_states
+def landing_problems(section: Mapping) -> list[str]:
+    """Cross-key problems of the ``landing`` section (see module docstring), parsed here, at the
+    edge, into its :class:`~opnav.landing.setup.Setup`."""
+    from opnav.landing.trajectory import nominal_truth
+    from opnav.landing.setup import Setup
 
+    c = Setup.from_config(section)
     out: list[str] = []
     k = "invalid config key 'landing."
-    T, Dt, rate = c["duration_s"], c["filter"]["dt_s"], c["imu"]["rate_hz"]
+    T, Dt, rate = c.duration_s, c.filter.dt_s, c.imu.rate_hz
     if not _multiple(T, Dt):
         out.append(f"{k}duration_s': {T} s is not a multiple of landing.filter.dt_s = {Dt} s")
     if not _multiple(rate * Dt, 1.0):
@@ -38,24 +43,24 @@ def landing_problems(c: dict) -> list[str]:
     if T * rate > MAX_LANDING_IMU_SAMPLES:
         out.append(f"{k}imu.rate_hz': duration_s x rate_hz = {T * rate:.0f} IMU samples exceeds "
                    f"the limit {MAX_LANDING_IMU_SAMPLES} (memory)")
-    f5 = c["figures"]["f5_time_s"]
+    f5 = c.figures.f5_time_s
     if not (0 <= f5 < T) or (f5 > 0 and not _multiple(f5, Dt)):
         out.append(f"{k}figures.f5_time_s': {f5} s must be a filter step "
                    f"(multiple of filter.dt_s = {Dt} s) in [0, duration_s = {T} s)")
 
-    r0 = np.asarray(c["initial_state"]["r_m"], float)
-    alt_min = c["filter"]["min_update_altitude_m"]
+    r0 = np.asarray(c.initial_state.r_m, float)
+    alt_min = c.filter.min_update_altitude_m
     if r0[2] <= 0:
         out.append(f"{k}initial_state.r_m': the lander starts at altitude {r0[2]:g} m, "
                    "not above the ground z = 0")
         return out
-    if c["mc"]["bounds"]["r_m"] >= r0[2]:
-        out.append(f"{k}mc.bounds.r_m': initial position errors up to {c['mc']['bounds']['r_m']:g} m "
+    if c.mc.bounds.r_m >= r0[2]:
+        out.append(f"{k}mc.bounds.r_m': initial position errors up to {c.mc.bounds.r_m:g} m "
                    f"would start estimates below the ground (the lander starts at {r0[2]:g} m)")
-    out += _margin_problems(c["planner"]["margin_px"], c["camera"], f"{k}planner.margin_px'")
+    out += _margin_problems(c.planner.margin_px, c.camera, f"{k}planner.margin_px'")
     scenarios = _scenario_cameras(c, out)
     for name, cam in scenarios.items():
-        out += _margin_problems(c["planner"]["margin_px"], cam, f"{k}scenarios.{name}'")
+        out += _margin_problems(c.planner.margin_px, cam, f"{k}scenarios.{name}'")
     if r0[2] <= alt_min:
         out.append(f"{k}initial_state.r_m': the lander starts at {r0[2]:g} m, not above "
                    f"filter.min_update_altitude_m = {alt_min:g} m (no measurement would be taken)")
@@ -63,7 +68,8 @@ def landing_problems(c: dict) -> list[str]:
         return out
     t = Dt * np.arange(n_steps + 1)
     try:
-        tr = truth_states(t, r0, c["initial_state"]["v_mps"], T, c["gravity_mps2"], c["yaw_deg"])
+        # the nominal trajectory without the terminal acceleration, as this check always read it
+        tr = nominal_truth(c, t, terminal=False)
     except (ValueError, np.linalg.LinAlgError) as exc:
         return [*out, f"{k}initial_state': the nominal guidance trajectory is undefined: {exc}"]
     below = np.nonzero(tr.r[:-1, 2] < 0)[0]
@@ -73,7 +79,7 @@ def landing_problems(c: dict) -> list[str]:
         return out
     measuring = tr.r[:, 2] > alt_min                 # where the filter takes bearings
     to_site_B = np.einsum("kij,kj->ki", tr.R_LtoB, -tr.r)
-    for key, cam in {"camera": c["camera"], **{f"scenarios.{n}": v for n, v in scenarios.items()}}.items():
+    for key, cam in {"camera": c.camera, **{f"scenarios.{n}": v for n, v in scenarios.items()}}.items():
         out += _view_problems(cam, f"{k}{key}'", t, to_site_B, measuring)
     if not out:    # the user's own methods: imported, signature, name, a probe on the sound start
         from opnav.landing.methods import problems as method_problems
@@ -82,50 +88,45 @@ def landing_problems(c: dict) -> list[str]:
     return out
 
 
-def _scenario_cameras(c: dict, out: list[str]) -> dict[str, dict]:
+def _scenario_cameras(c, out: list[str]) -> dict:
     """``{scenario: merged camera}`` of the camera scenarios (``landing.scenarios``) whose
     camera differs from ``landing.camera`` (each is checked as the base camera is); a
     ``landing.headline_scenario`` that names none of them is appended to ``out``."""
-    from opnav.landing.scenario import camera_scenarios
-
-    scen = c.get("scenarios") or {}
-    head = c.get("headline_scenario")
-    if head is not None and scen and head not in scen:
-        out.append(f"invalid config key 'landing.headline_scenario': {head!r} is not one of "
-                   f"landing.scenarios ({', '.join(scen)})")
+    if not c.scenarios:
         return {}
-    try:
-        merged = camera_scenarios(c)
-    except ValueError as exc:
-        out.append(f"invalid config key 'landing.scenarios': {exc}")
+    names = c.scenario_names()
+    if c.headline_scenario is not None and c.headline_scenario not in names:
+        out.append(f"invalid config key 'landing.headline_scenario': {c.headline_scenario!r} is not one of "
+                   f"landing.scenarios ({', '.join(names)})")
         return {}
-    return {n: s["camera"] for n, s in merged.items() if s["camera"] != c["camera"]}
+    merged = c.scenarios_by_name()
+    return {n: s.camera for n, s in merged.items() if s.camera != c.camera}
 
 
-def _margin_problems(margin: float, cam: dict, key: str) -> list[str]:
-    half = cam["pixels"] / 2.0
+def _margin_problems(margin: float, cam, key: str) -> list[str]:
+    half = cam.pixels / 2.0
     if margin >= half:
         return [f"{key}: landing.planner.margin_px = {margin:g} px leaves no part of the "
-                f"{cam['pixels']} px detector to plan landmarks in (must be < {half:g})"]
+                f"{cam.pixels} px detector to plan landmarks in (must be < {half:g})"]
     return []
 
 
-def _view_problems(camera: dict, key: str, t, to_site_B, measuring) -> list[str]:
+def _view_problems(camera, key: str, t, to_site_B, measuring) -> list[str]:
     """The landing site in ``camera``'s view at the start and while the filter measures."""
-    from opnav.landing.camera import camera_from_config
+    from opnav.landing.camera import make_camera
 
-    fov = camera["fov_deg"]
+    fov = camera.fov_deg
     try:
-        cam = camera_from_config(camera)
+        cam = make_camera(camera)
     except ValueError as exc:
         return [f"{key}: {exc}"]
     seen = cam.in_view(to_site_B)
     if not seen[0]:
         return [f"{key}: the landing site is not in the camera's view at t = 0 "
-                f"(fov_deg {fov:g}, tilt_deg {camera['tilt_deg']:g}, "
-                f"tilt_azimuth_deg {camera['tilt_azimuth_deg']:g})"]
+                f"(fov_deg {fov:g}, tilt_deg {camera.tilt_deg:g}, "
+                f"tilt_azimuth_deg {camera.tilt_azimuth_deg:g})"]
     if not np.all(seen[measuring]):
         t_out = t[np.nonzero(measuring & ~seen)[0][0]]
         return [f"{key}: the landing site leaves the camera's view at t = {t_out:g} s "
-                f"of the nominal descent (fov_deg {fov:g}, tilt_deg {camera['tilt_deg']:g})"]
+                f"of the nominal descent (fov_deg {fov:g}, tilt_deg {camera.tilt_deg:g})"]
     return []

@@ -26,8 +26,11 @@ from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
 if TYPE_CHECKING:
     import pandas as pd
 
+    from opnav.landing.records import MonteCarlo
+    from opnav.landing.setup import Equivalence, Setup
 
-def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_svd: float | None = None,
+
+def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction_vs_svd: float | None = None,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-T3 (paper B sec. 3, Table 3): one row per method of ``data`` (method ->
     gathered Monte Carlo, ``opnav.landing.montecarlo.gather``).
@@ -133,13 +136,13 @@ def summary_table(data: dict[str, dict], timing: dict, published_reduction_vs_sv
     return df
 
 
-def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: float, *,
+def accuracy_tests(data: dict[str, MonteCarlo], eq: Equivalence, converged_pos_err_m: float, *,
                    margin_rel: float, same_pick_max_pct: float, min_difference_s: float,
                    thresholds_m: tuple[float, ...] = ()) -> dict:
     """The accuracy claims of one scenario as tests that can fail
     (:mod:`opnav.landing.equivalence`), from the gathered Monte Carlo of every
     method flown (``data``, the controls included), ``landing.equivalence``
-    (``eq_cfg``: reference, methods, controls, alpha) and the analysis plan's B-C1
+    (``eq``: reference, methods, controls, alpha) and the analysis plan's B-C1
     numbers, passed in by the caller (the landing package does not read the plan):
     ``margin_rel`` (margin = that fraction of the reference's mean error) and
     ``same_pick_max_pct`` (same picks in that share of the calls or more: not
@@ -162,14 +165,15 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
     from opnav.landing import equivalence as eqv
     from opnav.landing.montecarlo import nees_consistency, per_run_stats, same_pick_pct, time_below
 
-    ref = eq_cfg["reference"]
-    tested = list(eq_cfg["methods"]) + list(eq_cfg["controls"])
+    ref = eq.reference
+    tested = list(eq.methods) + list(eq.controls)
     missing = [m for m in [ref, *tested] if m not in data]
     if missing:
         raise ValueError(f"landing.equivalence: methods {missing} were not flown")
     stats = {m: per_run_stats(d) for m, d in data.items()}
     picks = {m: same_pick_pct(data[m], data[ref]) for m in tested}
-    eq = eqv.equivalence(stats, ref, tested, float(margin_rel), float(eq_cfg["alpha"]), picks)
+    alpha = float(eq.alpha)
+    res = eqv.equivalence(stats, ref, tested, float(margin_rel), alpha, picks)
     errors = {}
     for m, st in stats.items():
         errors[m] = {}
@@ -181,39 +185,39 @@ def accuracy_tests(data: dict[str, dict], eq_cfg: dict, converged_pos_err_m: flo
                             "3sigma": float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan}
     t_ref = time_below(data[ref], converged_pos_err_m)
     faster = {m: eqv.converges_faster(time_below(data[m], converged_pos_err_m), t_ref, m, ref,
-                                      converged_pos_err_m, float(eq_cfg["alpha"]),
+                                      converged_pos_err_m, alpha,
                                       min_difference_s=float(min_difference_s))
-              for m in eq_cfg["methods"]}
+              for m in eq.methods}
     by_thr = {}
     for thr in dict.fromkeys(float(x) for x in thresholds_m):
         t_ref_k = time_below(data[ref], thr)
         by_thr[f"{thr:g}"] = {m: eqv.converges_faster(time_below(data[m], thr), t_ref_k, m, ref, thr,
-                                                      float(eq_cfg["alpha"]), min_difference_s=float(min_difference_s))
-                              for m in eq_cfg["methods"]}
+                                                      alpha, min_difference_s=float(min_difference_s))
+                              for m in eq.methods}
     by_base = {}
     for b in ("svd", "gdop", "cond"):
         if b in data:
-            tested_b = [m for m in eq_cfg["methods"] if m != b]
-            by_base[b] = eqv.equivalence(stats, b, tested_b, float(margin_rel), float(eq_cfg["alpha"]),
+            tested_b = [m for m in eq.methods if m != b]
+            by_base[b] = eqv.equivalence(stats, b, tested_b, float(margin_rel), alpha,
                                          {m: same_pick_pct(data[m], data[b]) for m in tested_b})
-    return {"equivalence": eq,
+    return {"equivalence": res,
             "equivalence_vs_baselines": by_base,
             "same_pick_max_pct": float(same_pick_max_pct),
-            "controls": list(eq_cfg["controls"]),
-            "controls_equivalent": [c for c in eq_cfg["controls"] if eq["methods"][c]["equivalent"]],
+            "controls": list(eq.controls),
+            "controls_equivalent": [c for c in eq.controls if res["methods"][c]["equivalent"]],
             "converges_faster": faster, "converges_faster_by_threshold": by_thr, "errors": errors,
             "nees": {m: nees_consistency(d) for m, d in data.items()}}
 
 
-def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], timing: dict,
-                     single: dict, landing_cfg: dict, *, eval_path: str, yaw_ratio: float,
+def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCarlo], timing: dict,
+                     single: dict, setup: Setup, *, eval_path: str, yaw_ratio: float,
                      published_reduction_vs_svd: float, accuracy: dict | None = None) -> dict:
     """The summary JSON of one camera scenario (``B-summary.json`` per scenario,
     read by the manuscript macros and the scorecard, :func:`rows_paper_b`).
 
     ``table``: its B-T3 (:func:`summary_table` of ``data``, method -> gathered
     Monte Carlo); ``timing``: the replay behind it; ``single``: the single
-    descent's summary; ``landing_cfg``: the scenario's ``landing`` config (the
+    descent's summary; ``setup``: the scenario's landing setup (the
     initial attitude, ``scenario.initial_attitude_report``). Holds per method its
     B-T3 row, per pair of methods ``ranking.pair_comparison``, the depth method's
     time reduction against SVD (%, None unless both were flown) beside the
@@ -235,7 +239,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
     ym = "depth" if "depth" in data else methods[0]
     yaw_err = np.asarray(data[ym].err_rpy_deg)[:, :, 2]
     pairs = pair_table(data)
-    att = initial_attitude_report(landing_cfg)
+    att = initial_attitude_report(setup)
     t = table.set_index("method")
     same_pick = [float(t.loc[m, "same_pick_as_depth_pct"]) for m in methods
                  if m != "depth" and "same_pick_as_depth_pct" in t.columns]
@@ -254,9 +258,9 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, dict], 
                                    and f"time_reduction_vs_svd{x}_pct" in t.columns},
         "timing": tsum.method_summary(timing),
         "published_time_reduction_vs_svd_pct": published_reduction_vs_svd,
-        "initial_attitude_deg": att["paper_convention_deg"],
-        "initial_tilt_deg": att["tilt_deg"],
-        "initial_azimuth_deg": att["azimuth_deg"],
+        "initial_attitude_deg": att.paper_convention_deg,
+        "initial_tilt_deg": att.tilt_deg,
+        "initial_azimuth_deg": att.azimuth_deg,
         "yaw_converges": yaw["converges"],
         "yaw_reason": yaw["reason"],
         # the numbers behind it (the claims judge them against the analysis plan's ratio)

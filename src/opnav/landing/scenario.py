@@ -1,9 +1,10 @@
-"""Paper B's simulation scenario: the ``landing`` config parsed once into the
+"""Paper B's simulation scenario: the landing :class:`~opnav.landing.setup.Setup` built into the
 frozen :class:`Scenario` shared by every run and method (truth trajectory,
 noise-free IMU, landmark field, camera, process noise, filter and planner
-settings; :func:`build_scenario`), the camera scenarios of the config
-(:func:`camera_scenarios`), and the scenario as tables: initial state
-(Table 1) and Monte-Carlo initial-error bounds (Table 2).
+settings; :func:`build_scenario`), the nominal guidance trajectory (:func:`nominal_truth`),
+the initial attitude (:class:`InitialAttitude`), and the scenario as tables: initial state
+(Table 1) and Monte-Carlo initial-error bounds (Table 2). The camera scenarios of the config
+are ``Setup.scenarios_by_name`` (and ``setup.scenario_sections``, the workflow's mappings).
 
 Units: position m, velocity m/s, attitude deg, frame {L} (landing site origin,
 z up).
@@ -11,7 +12,6 @@ z up).
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from functools import lru_cache
@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from opnav.core import published
-from opnav.landing.trajectory import Truth, truth_states
+from opnav.landing.setup import Setup
+from opnav.landing.trajectory import Truth, nominal_truth
 
 if TYPE_CHECKING:  # pandas only for the B-T1/B-T2 tables: not imported by every Monte-Carlo job
     import pandas as pd
@@ -59,19 +60,17 @@ class Scenario:
     base_seed: int
 
 
-def _scenario_from_json(text: str) -> Scenario:
+def _scenario(setup: Setup) -> Scenario:
     # the simulation's parts imported here, where a scenario is built: the B-T1/B-T2 and
     # B-T3 summary jobs and the Snakefile parse use this module's config-only functions
     from opnav.landing import ekf, imu
-    from opnav.landing.camera import camera_from_config
+    from opnav.landing.camera import make_camera
     from opnav.landing.landmarks import make_field
     from opnav.landing.planner import PlannerConfig, alternative_path
-    from opnav.landing.methods import spec_items as methods_spec_items
 
-    c = json.loads(text)
-    T = float(c["duration_s"])
-    Dt = float(c["filter"]["dt_s"])
-    rate = float(c["imu"]["rate_hz"])
+    T = float(setup.duration_s)
+    Dt = float(setup.filter.dt_s)
+    rate = float(setup.imu.rate_hz)
     n_sub = int(round(rate * Dt))
     if n_sub < 1 or abs(n_sub / rate - Dt) > 1e-9:
         raise ValueError(f"landing.imu.rate_hz ({rate}) times landing.filter.dt_s ({Dt}) "
@@ -80,110 +79,103 @@ def _scenario_from_json(text: str) -> Scenario:
     if abs(n_steps * Dt - T) > 1e-9:
         raise ValueError(f"landing.duration_s ({T}) must be a multiple of landing.filter.dt_s ({Dt})")
     dt = Dt / n_sub
-    g = np.asarray(c["gravity_mps2"], float)
-    s0 = c["initial_state"]
-    yaw = float(c.get("yaw_deg", 0.0))
+    g = np.asarray(setup.gravity_mps2, float)
     t_imu = np.arange(n_steps * n_sub + 1) * dt
-    tr_imu = truth_states(t_imu, s0["r_m"], s0["v_mps"], T, g, yaw, c.get("terminal_accel_mps2"))
+    tr_imu = nominal_truth(setup, t_imu)
     tr = Truth(t=tr_imu.t[::n_sub], r=tr_imu.r[::n_sub], v=tr_imu.v[::n_sub],
                a=tr_imu.a[::n_sub], R_LtoB=tr_imu.R_LtoB[::n_sub])
     f, w = imu.synthesize(tr_imu.v, tr_imu.R_LtoB, dt, g)
-    sa = float(c["imu"]["sigma_a_mps2"])
-    sw = math.radians(float(c["imu"]["sigma_w_degps"]))
-    pl = c["planner"]
-    pcfg = PlannerConfig(t_s=Dt, n_sigma_v=float(pl["n_sigma_v"]), tol_rad=float(pl["tol_rad"]),
-                         margin_px=float(pl["margin_px"]), eval_path=str(pl["eval_path"]),
-                         noise_scale=float(c["filter"]["meas_noise_scale"]),
-                         depth_sigma_frac=float(c["filter"]["depth_sigma_frac"]),
-                         obs_per_landmark=int(c["filter"]["obs_per_landmark"]),
-                         oc=bool(c["filter"]["observability_constrained"]),
+    sa = float(setup.imu.sigma_a_mps2)
+    sw = math.radians(float(setup.imu.sigma_w_degps))
+    pl, fl = setup.planner, setup.filter
+    pcfg = PlannerConfig(t_s=Dt, n_sigma_v=float(pl.n_sigma_v), tol_rad=float(pl.tol_rad),
+                         margin_px=float(pl.margin_px), eval_path=str(pl.eval_path),
+                         noise_scale=float(fl.meas_noise_scale),
+                         depth_sigma_frac=float(fl.depth_sigma_frac),
+                         obs_per_landmark=int(fl.obs_per_landmark),
+                         oc=bool(fl.observability_constrained),
                          g=tuple(float(x) for x in g),
-                         custom=methods_spec_items(c.get("custom_methods")))
-    lm = c["landmarks"]
-    b = c["mc"]["bounds"]
-    fl = c["filter"]
+                         custom=setup.custom_items)
+    lm = setup.landmarks
+    b = setup.mc.bounds
     return Scenario(truth=tr, truth_imu=tr_imu, f=f, w=w, g=g, dt_imu=dt, n_sub=n_sub, Dt=Dt,
                     n_steps=n_steps, Q=ekf.process_noise(sa, sw, dt, n_sub), sigma_a=sa, sigma_w=sw,
-                    camera=camera_from_config(c["camera"]),
-                    field=make_field(float(lm["half_width_m"]), int(lm["count"]), int(lm["seed"]),
-                                     near_site=lm["near_site"]),
-                    planner=pcfg, planner_alt=alternative_path(pcfg), obs_per_landmark=int(fl["obs_per_landmark"]),
-                    depth_sigma_frac=float(fl["depth_sigma_frac"]),
-                    min_update_alt=float(fl["min_update_altitude_m"]),
-                    update_margin_m=float(fl["update_altitude_margin_m"]),
-                    oc=bool(fl["observability_constrained"]),
-                    iterations=int(fl["iterations"]),
-                    noise_scale=float(fl["meas_noise_scale"]),
-                    bounds=(float(b["r_m"]), float(b["v_mps"]), math.radians(float(b["att_deg"]))),
-                    base_seed=int(c["mc"]["base_seed"]))
+                    camera=make_camera(setup.camera),
+                    field=make_field(float(lm.half_width_m), int(lm.count), int(lm.seed), near_site=lm.near_site),
+                    planner=pcfg, planner_alt=alternative_path(pcfg), obs_per_landmark=int(fl.obs_per_landmark),
+                    depth_sigma_frac=float(fl.depth_sigma_frac),
+                    min_update_alt=float(fl.min_update_altitude_m),
+                    update_margin_m=float(fl.update_altitude_margin_m),
+                    oc=bool(fl.observability_constrained),
+                    iterations=int(fl.iterations),
+                    noise_scale=float(fl.meas_noise_scale),
+                    bounds=(float(b.r_m), float(b.v_mps), math.radians(float(b.att_deg))),
+                    base_seed=int(setup.mc.base_seed))
 
 
-_KEYS = ("duration_s", "gravity_mps2", "initial_state", "yaw_deg", "terminal_accel_mps2", "imu", "camera", "landmarks",
-         "filter", "planner", "mc", "custom_methods")
-
-
-def build_scenario(landing_cfg: dict) -> Scenario:
-    """The shared scenario of a ``landing`` config (cached per distinct config)."""
-    sub = {k: landing_cfg[k] for k in _KEYS if k in landing_cfg}
-    return _cached(json.dumps(sub, sort_keys=True))
+def build_scenario(setup: Setup) -> Scenario:
+    """The shared scenario of a landing :class:`~opnav.landing.setup.Setup` (cached per distinct setup)."""
+    if not isinstance(setup, Setup):
+        raise TypeError(f"build_scenario: expected a landing Setup (opnav.landing.setup), got {type(setup).__name__}")
+    return _cached(setup)
 
 
 @lru_cache(maxsize=4)
-def _cached(text: str) -> Scenario:
-    return _scenario_from_json(text)
+def _cached(setup: Setup) -> Scenario:
+    return _scenario(setup)
 
 
 def _vec(v) -> str:
     return "[" + ", ".join(f"{x:g}" for x in v) + "]"
 
 
-def derived_initial_attitude_deg(landing_cfg: dict) -> np.ndarray:
+def derived_initial_attitude_deg(setup: Setup) -> np.ndarray:
     """Our initial (roll, pitch, yaw), deg: body +z along the guidance thrust at
     t = 0 with the configured yaw (``opnav.landing.trajectory``)."""
     from opnav.landing.trajectory import euler_rpy_deg
 
-    s = landing_cfg["initial_state"]
-    tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),
-                      landing_cfg["gravity_mps2"], float(landing_cfg.get("yaw_deg", 0.0)),
-                      landing_cfg.get("terminal_accel_mps2"))
-    return euler_rpy_deg(tr.R_LtoB[0])
+    return euler_rpy_deg(nominal_truth(setup, [0.0]).R_LtoB[0])
 
 
-def thrust_tilt_azimuth_deg(landing_cfg: dict) -> tuple[float, float]:
+def thrust_tilt_azimuth_deg(setup: Setup) -> tuple[float, float]:
     """Initial thrust axis (body +z in {L}) as (tilt from the vertical, azimuth
     from +x toward +y), deg."""
-
-    s = landing_cfg["initial_state"]
-    tr = truth_states(np.array([0.0]), s["r_m"], s["v_mps"], float(landing_cfg["duration_s"]),
-                      landing_cfg["gravity_mps2"], float(landing_cfg.get("yaw_deg", 0.0)),
-                      landing_cfg.get("terminal_accel_mps2"))
-    z = tr.R_LtoB[0][2]
+    z = nominal_truth(setup, [0.0]).R_LtoB[0][2]
     return (float(np.degrees(np.arccos(np.clip(z[2], -1.0, 1.0)))),
             float(np.degrees(np.arctan2(z[1], z[0]))))
 
 
-def initial_attitude_report(landing_cfg: dict) -> dict:
-    """Our initial attitude in the convention that matches the paper's Table 1
-    triple: ``-(yaw, pitch, roll)`` of the Z-Y-X sequence with roll 0 that
-    points body +z along the initial thrust, i.e. ``-(azimuth, tilt, 0)``
-    (deg). The tilt follows from the Table 1 state and the touchdown; the
-    azimuth also from the unstated terminal horizontal acceleration."""
-    tilt, az = thrust_tilt_azimuth_deg(landing_cfg)
-    return {"paper_convention_deg": [-az, -tilt, 0.0], "tilt_deg": tilt, "azimuth_deg": az,
-            "rpy_deg": [float(x) for x in derived_initial_attitude_deg(landing_cfg)]}
+@dataclass(frozen=True)
+class InitialAttitude:
+    """Our initial attitude in the convention that matches the paper's Table 1 triple:
+    ``paper_convention_deg`` = ``-(yaw, pitch, roll)`` of the Z-Y-X sequence with roll 0 that
+    points body +z along the initial thrust, i.e. ``-(azimuth, tilt, 0)`` (deg); the thrust's
+    tilt and azimuth (deg) and our roll/pitch/yaw (deg). The tilt follows from the Table 1 state
+    and the touchdown; the azimuth also from the unstated terminal horizontal acceleration."""
+
+    paper_convention_deg: list
+    tilt_deg: float
+    azimuth_deg: float
+    rpy_deg: list
 
 
-def initial_state_table(landing_cfg: dict) -> "pd.DataFrame":
+def initial_attitude_report(setup: Setup) -> InitialAttitude:
+    """:class:`InitialAttitude` of ``setup``'s descent."""
+    tilt, az = thrust_tilt_azimuth_deg(setup)
+    return InitialAttitude([-az, -tilt, 0.0], tilt, az, [float(x) for x in derived_initial_attitude_deg(setup)])
+
+
+def initial_state_table(setup: Setup) -> "pd.DataFrame":
     """B-T1: the lander's initial state in {L} (paper Table 1), config beside
     published, and the simulation's initial state (the attitude derived from the
     guidance thrust direction)."""
-    s = landing_cfg["initial_state"]
+    s = setup.initial_state
     pub = published.paper_b()["table1_initial_state"]
-    att = initial_attitude_report(landing_cfg)["paper_convention_deg"]
+    att = initial_attitude_report(setup).paper_convention_deg
     rows = [
-        ("position", "m", s["r_m"], pub["r_m"], s["r_m"]),
-        ("velocity", "m/s", s["v_mps"], pub["v_mps"], s["v_mps"]),
-        ("attitude -(yaw, pitch, roll), Z-Y-X, roll 0", "deg", s["att_deg"], pub["att_deg"],
+        ("position", "m", s.r_m, pub["r_m"], s.r_m),
+        ("velocity", "m/s", s.v_mps, pub["v_mps"], s.v_mps),
+        ("attitude -(yaw, pitch, roll), Z-Y-X, roll 0", "deg", s.att_deg, pub["att_deg"],
          np.round(att, 2)),
     ]
     import pandas as pd
@@ -200,15 +192,15 @@ def initial_state_table(landing_cfg: dict) -> "pd.DataFrame":
     )
 
 
-def error_bounds_table(landing_cfg: dict) -> "pd.DataFrame":
+def error_bounds_table(setup: Setup) -> "pd.DataFrame":
     """B-T2: Monte-Carlo initial-error bounds (paper Table 2), uniform per axis."""
-    b = landing_cfg["mc"]["bounds"]
+    b = setup.mc.bounds
     pub = published.paper_b()["table2_error_bounds"]
-    n = landing_cfg["mc"]["n_runs"]
+    n = setup.mc.n_runs
     rows = [
-        ("position", "m", b["r_m"], pub["r_m"]),
-        ("velocity", "m/s", b["v_mps"], pub["v_mps"]),
-        ("attitude", "deg", b["att_deg"], pub["att_deg"]),
+        ("position", "m", b.r_m, pub["r_m"]),
+        ("velocity", "m/s", b.v_mps, pub["v_mps"]),
+        ("attitude", "deg", b.att_deg, pub["att_deg"]),
     ]
     import pandas as pd
 
@@ -223,27 +215,3 @@ def error_bounds_table(landing_cfg: dict) -> "pd.DataFrame":
             "runs": [n] * 3,
         }
     )
-
-
-def camera_scenarios(landing_cfg: dict) -> dict[str, dict]:
-    """The ``landing`` config of every camera scenario (``landing.scenarios``:
-    name -> overlay on ``landing.camera``), in config order; each holds the
-    merged ``camera`` and no ``scenarios`` key. Raises ``ValueError`` naming
-    ``landing.headline_scenario`` if it is not one of the scenarios."""
-    scen = landing_cfg.get("scenarios") or {"default": {}}
-    head = landing_cfg.get("headline_scenario")
-    if head is not None and head not in scen:
-        raise ValueError(f"landing.headline_scenario: {head!r} is not one of landing.scenarios "
-                         f"({', '.join(scen)})")
-    out = {}
-    for name, overlay in scen.items():
-        cfg = {k: v for k, v in landing_cfg.items() if k not in ("scenarios", "headline_scenario")}
-        cfg["camera"] = {**landing_cfg["camera"], **(overlay or {})}
-        out[name] = cfg
-    return out
-
-
-def headline_scenario(landing_cfg: dict) -> str:
-    """The scenario the manuscript leads with (validated by :func:`camera_scenarios`)."""
-    scen = camera_scenarios(landing_cfg)
-    return landing_cfg.get("headline_scenario") or next(iter(scen))

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from opnav.landing.montecarlo import MonteCarlo, per_run_stats, run_chunk
+from opnav.landing.setup import Setup
 
 
 def per_run_metrics(data: MonteCarlo, timing: dict, method: str) -> pd.DataFrame:
@@ -43,15 +44,15 @@ def per_run_metrics(data: MonteCarlo, timing: dict, method: str) -> pd.DataFrame
     return st
 
 
-def run_runs(landing_cfg: dict, method: str, run_indices) -> pd.DataFrame:
-    """Fly ``run_indices`` with ``method``; one row per run (module docstring). The replay
-    budget is ``landing_cfg["timing"]["max_calls"]`` (0: every call)."""
+def run_runs(setup: Setup, method: str, run_indices) -> pd.DataFrame:
+    """Fly ``run_indices`` with ``method`` (``setup``: the study value's landing setup); one row
+    per run (module docstring). The replay budget is ``setup.timing.max_calls`` (0: every call)."""
     from opnav.landing.descent import build_scenario
     from opnav.landing.timing import replay_own
 
-    max_calls = int(landing_cfg["timing"]["max_calls"])
-    data = run_chunk(landing_cfg, method, list(run_indices), pick_ratio=False)   # no study metric reads it
-    df = per_run_metrics(data, replay_own(build_scenario(landing_cfg), data, method, max_calls), method)
+    max_calls = int(setup.timing.max_calls)
+    data = run_chunk(setup, method, list(run_indices), pick_ratio=False)   # no study metric reads it
+    df = per_run_metrics(data, replay_own(build_scenario(setup), data, method, max_calls), method)
     df.insert(1, "method", method)
     return df
 

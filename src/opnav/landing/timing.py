@@ -91,18 +91,21 @@ clock's share, the method sentence) is :mod:`opnav.landing.timing_summary`.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import gc
 import math
 import os
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from opnav.landing.records import RECORD_KEYS, MonteCarlo, load as _load_one, rng_from_words, save
+from opnav.landing.setup import Setup
 
 __all__ = ["select_calls", "COMPILED_ONLY", "timed_methods", "variants", "pass_keys", "paper_limited", "replay",
-           "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "COLD_OK_NS", "CALL_INPUT_KEYS", "load_calls", "run_spec", "replay_spec", "replays_in_processes",
+           "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "COLD_OK_NS", "CALL_INPUT_KEYS", "load_calls", "ReplaySpec", "run_spec", "replay_spec", "replays_in_processes",
            "CLOCK_SHARE_INV", "clock_cost_ns", "replay_own", "from_times", "call_overhead", "save", "load"]
 
 
@@ -629,49 +632,87 @@ def load_calls(path) -> MonteCarlo:
         raise corrupt_intermediate(path, exc) from exc
 
 
-def _scenario(spec: dict):
-    """The spec's scenario: unpickled from ``spec["scenario_pickle"]`` (built once by the parent of
-    several replay processes, :func:`replays_in_processes`), else built from ``spec["landing"]``."""
-    if spec.get("scenario_pickle"):
-        import pickle
+@dataclass(frozen=True)
+class ReplaySpec:
+    """What :func:`run_spec` replays: the scenario (``setup``, the landing setup it is built from,
+    or ``scenario_pickle``, the file a parent of several replay processes built it into once,
+    :func:`replays_in_processes`), the recorded calls (``mc``: ``(method, gathered Monte-Carlo
+    file)`` pairs in the pool's order), the methods timed and :func:`replay`'s variants and
+    limits. JSON only for a replay in another process (:meth:`as_json`, :meth:`from_json`: the
+    scenario then travels pickled, never as config)."""
 
-        with open(spec["scenario_pickle"], "rb") as f:
-            return pickle.load(f)
-    from opnav.landing.descent import build_scenario
+    mc: tuple
+    methods: tuple
+    max_calls: int
+    alt: bool | tuple = True
+    main: tuple | None = None
+    max_calls_paper: int = 0
+    decompose: bool = False
+    best_of: int = 1
+    warm_compiled: bool = True
+    setup: Setup | None = None
+    scenario_pickle: str | None = None
 
-    return build_scenario(spec["landing"])
+    def scenario(self):
+        """The spec's scenario: unpickled from :attr:`scenario_pickle`, else built from :attr:`setup`."""
+        if self.scenario_pickle:
+            import pickle
+
+            with open(self.scenario_pickle, "rb") as f:
+                return pickle.load(f)
+        from opnav.landing.descent import build_scenario
+
+        return build_scenario(self.setup)
+
+    def as_json(self) -> str:
+        """The spec for a replay process (its scenario pickled: no setup)."""
+        import json
+
+        if not self.scenario_pickle:
+            raise ValueError("ReplaySpec.as_json: a replay process reads its scenario from scenario_pickle")
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "setup"}
+        return json.dumps(d)
+
+    @classmethod
+    def from_json(cls, text: str) -> "ReplaySpec":
+        import json
+
+        tuples = {"mc": lambda v: tuple(tuple(x) for x in v), "methods": tuple,
+                  "alt": lambda v: v if isinstance(v, bool) else tuple(v),
+                  "main": lambda v: None if v is None else tuple(v)}
+        return cls(**{k: tuples.get(k, lambda v: v)(v) for k, v in json.loads(text).items()})
 
 
-def run_spec(spec: dict) -> dict:
-    """:func:`replay` of a spec (:func:`replay_spec`): the scenario built from ``spec["landing"]``,
-    the recorded calls read from ``spec["mc"]`` (method -> gathered Monte-Carlo file, the pool's
-    order; :func:`load_calls`), the variants and limits as given."""
-    recorded = {m: load_calls(path) for m, path in spec["mc"].items()}
-    alt = spec.get("alt", True)
-    return replay(_scenario(spec), recorded, list(spec["methods"]), int(spec["max_calls"]),
-                  alt=alt if isinstance(alt, bool) else list(alt), max_calls_paper=int(spec.get("max_calls_paper", 0)),
-                  main=None if spec.get("main") is None else list(spec["main"]),
-                  decompose=bool(spec.get("decompose", False)), best_of=int(spec.get("best_of", 1)),
-                  warm_compiled=bool(spec.get("warm_compiled", True)))
+def run_spec(spec: ReplaySpec) -> dict:
+    """:func:`replay` of a spec (:func:`replay_spec`): its scenario, the recorded calls read from
+    its ``mc`` files (the pool's order; :func:`load_calls`), the variants and limits as given."""
+    recorded = {m: load_calls(path) for m, path in spec.mc}
+    alt = spec.alt
+    return replay(spec.scenario(), recorded, list(spec.methods), int(spec.max_calls),
+                  alt=alt if isinstance(alt, bool) else list(alt), max_calls_paper=int(spec.max_calls_paper),
+                  main=None if spec.main is None else list(spec.main),
+                  decompose=bool(spec.decompose), best_of=int(spec.best_of),
+                  warm_compiled=bool(spec.warm_compiled))
 
 
-def replay_spec(landing: dict, mc: dict, methods, max_calls: int, *, alt=True, main=None,
+def replay_spec(setup: Setup, mc, methods, max_calls: int, *, alt=True, main=None,
                 max_calls_paper: int = 0, decompose: bool = False, best_of: int = 1,
-                warm_compiled: bool = True) -> dict:
-    """What :func:`run_spec` replays, as JSON-able data (a replay in another process reads it)."""
-    return {"landing": landing, "mc": {str(m): str(p) for m, p in mc.items()}, "methods": list(methods),
-            "max_calls": int(max_calls), "alt": alt if isinstance(alt, bool) else list(alt),
-            "main": None if main is None else list(main), "max_calls_paper": int(max_calls_paper),
-            "decompose": bool(decompose), "best_of": int(best_of), "warm_compiled": bool(warm_compiled)}
+                warm_compiled: bool = True) -> ReplaySpec:
+    """What :func:`run_spec` replays (``setup``: the scenario's landing setup; ``mc``: method ->
+    gathered Monte-Carlo file)."""
+    return ReplaySpec(mc=tuple((str(m), str(p)) for m, p in dict(mc).items()), methods=tuple(methods),
+                      max_calls=int(max_calls), alt=alt if isinstance(alt, bool) else tuple(alt),
+                      main=None if main is None else tuple(main), max_calls_paper=int(max_calls_paper),
+                      decompose=bool(decompose), best_of=int(best_of), warm_compiled=bool(warm_compiled),
+                      setup=setup)
 
 
-def replays_in_processes(spec: dict, n: int, workdir, log=None) -> list[dict]:
+def replays_in_processes(spec: ReplaySpec, n: int, workdir, log=None) -> list[dict]:
     """``n`` independent replays of ``spec``, each in a fresh Python process run one after the
     other (its own address-space layout, hash seed and caches: pyperf's reason for spawning
     worker processes, CONVENTIONS.md; a fork would share this process's layout), each process
     writing its replay to ``workdir``; returns them in order. ``log``: a logger for each
     process's output (its own ``job resources`` line: kernels loaded and compiled)."""
-    import json
     import subprocess
     import sys
     from pathlib import Path
@@ -682,16 +723,15 @@ def replays_in_processes(spec: dict, n: int, workdir, log=None) -> list[dict]:
         raise ValueError(f"landing.timing.n_replays must be >= 1, got {n}")
     work = Path(workdir)
     work.mkdir(parents=True, exist_ok=True)
-    if not spec.get("scenario_pickle"):          # built once here, read by every replay process
+    if not spec.scenario_pickle:          # built once here, read by every replay process
         import pickle
 
-        from opnav.landing.descent import build_scenario
-
-        spec = {**spec, "scenario_pickle": str(work / "scenario.pkl")}
-        with open(spec["scenario_pickle"], "wb") as f:
-            pickle.dump(build_scenario(spec["landing"]), f, protocol=pickle.HIGHEST_PROTOCOL)
+        scn = spec.scenario()
+        spec = dataclasses.replace(spec, scenario_pickle=str(work / "scenario.pkl"))
+        with open(spec.scenario_pickle, "wb") as f:
+            pickle.dump(scn, f, protocol=pickle.HIGHEST_PROTOCOL)
     spec_path = work / "spec.json"
-    spec_path.write_text(json.dumps(spec))
+    spec_path.write_text(spec.as_json())
     env = dict(os.environ)
     root = str(Path(opnav.__file__).resolve().parents[1])
     env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
@@ -714,11 +754,9 @@ def replays_in_processes(spec: dict, n: int, workdir, log=None) -> list[dict]:
 def _replay_process(spec_path: str, target: str) -> None:
     """One replay in this process (:func:`replays_in_processes`' child): :func:`run_spec` of the
     JSON spec, saved to ``target``; prints its resource line."""
-    import json
-
     from opnav.core.snakeio import resource_line
 
-    save(target, run_spec(json.loads(open(spec_path).read())))
+    save(target, run_spec(ReplaySpec.from_json(open(spec_path).read())))
     print(resource_line(), flush=True)
 
 

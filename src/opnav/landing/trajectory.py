@@ -114,3 +114,12 @@ def euler_rpy_deg(R_LtoB: np.ndarray) -> np.ndarray:
     ypr = Rotation.from_matrix(R_BtoL).as_euler("ZYX", degrees=True)
     rpy = ypr[:, ::-1]
     return rpy[0] if single else rpy
+
+
+def nominal_truth(setup, t, terminal: bool = True) -> Truth:
+    """The guidance trajectory of the landing ``setup.Setup``'s descent at times ``t`` (s): from
+    the Table 1 state to touchdown at ``duration_s`` with the configured yaw and (``terminal``)
+    terminal horizontal acceleration (:func:`truth_states`)."""
+    s = setup.initial_state
+    return truth_states(np.asarray(t, float), s.r_m, s.v_mps, float(setup.duration_s), setup.gravity_mps2,
+                        float(setup.yaw_deg), setup.terminal_accel_mps2 if terminal else None)

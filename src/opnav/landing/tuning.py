@@ -39,10 +39,11 @@ Gaussian the filter assumes.
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
+
+from opnav.landing.setup import Setup, Tuning
 
 __all__ = ["tuning_report", "tuning_rows", "choose", "tuning_row", "distance_to_centre", "retune", "heldout", "errors",
            "retuned_record"]
@@ -68,17 +69,16 @@ def choose(rows: list[dict]) -> dict:
     return _tiers({"one": rows})
 
 
-def tuning_rows(landing_cfg: dict, tuning_cfg: dict) -> list[dict]:
-    """Fly the tuning runs of one scenario (``landing_cfg``: its ``landing``
-    config) for every candidate of ``tuning_cfg`` (``landing.tuning``): one
-    :func:`tuning_row` each."""
-    if int(tuning_cfg["base_seed"]) == int(landing_cfg["mc"]["base_seed"]):
+def tuning_rows(setup: Setup, tuning: Tuning) -> list[dict]:
+    """Fly the tuning runs of one scenario (``setup``: its landing setup) for every candidate of
+    ``tuning`` (``landing.tuning``): one :func:`tuning_row` each."""
+    if int(tuning.base_seed) == int(setup.mc.base_seed):
         raise ValueError("landing.tuning.base_seed must differ from landing.mc.base_seed "
                          "(the tuning runs must not be the reported runs)")
-    return [tuning_row(landing_cfg, tuning_cfg, scale, iters) for scale, iters in tuning_cfg["candidates"]]
+    return [tuning_row(setup, tuning, scale, iters) for scale, iters in tuning.candidates]
 
 
-def tuning_row(landing_cfg: dict, tuning_cfg: dict, scale: float, iters: int) -> dict:
+def tuning_row(setup: Setup, tuning: Tuning, scale: float, iters: int) -> dict:
     """The tuning runs (``landing.tuning``'s stream, ``n_runs``, ``method``) flown with the
     filter's bearing-noise scale ``scale`` and ``iters`` update iterations: the mean position
     and velocity NEES, whether both lie in the band (``consistent``) or at least not above it
@@ -86,12 +86,10 @@ def tuning_row(landing_cfg: dict, tuning_cfg: dict, scale: float, iters: int) ->
     touchdown and last-landmark position errors (m)."""
     from opnav.landing.montecarlo import nees_band, per_run_stats, run_chunk
 
-    n = int(tuning_cfg["n_runs"])
+    n = int(tuning.n_runs)
     lo, hi = nees_band(n, 3, 0.95)
-    cfg = copy.deepcopy(landing_cfg)
-    cfg["filter"].update(meas_noise_scale=float(scale), iterations=int(iters))
-    cfg["mc"] = {**cfg["mc"], "base_seed": int(tuning_cfg["base_seed"])}
-    st = per_run_stats(run_chunk(cfg, tuning_cfg["method"], range(n), pick_ratio=False))
+    cfg = setup.with_filter(meas_noise_scale=float(scale), iterations=int(iters)).with_seed(tuning.base_seed)
+    st = per_run_stats(run_chunk(cfg, tuning.method, range(n), pick_ratio=False))
     npos, nvel = float(st["mean_nees_pos"].mean()), float(st["mean_nees_vel"].mean())
     return {"meas_noise_scale": float(scale), "iterations": int(iters), "nees_pos": npos, "nees_vel": nvel,
             "nees_pos_run_median": float(st["mean_nees_pos"].median()),
@@ -110,18 +108,18 @@ def distance_to_centre(row: dict, centre: float) -> float:
     return max(abs(math.log(row["nees_pos"] / centre)), abs(math.log(row["nees_vel"] / centre)))
 
 
-def retune(landing_cfg: dict, tuning_cfg: dict, rows: list[dict], iterations: int) -> dict:
+def retune(setup: Setup, tuning: Tuning, rows: list[dict], iterations: int) -> dict:
     """The retuned bearing-noise scale of one scenario, on its tuning runs only (module
     docstring): among ``rows`` (:func:`tuning_rows`) at ``iterations``, the candidate
     closest to the band's centre (:func:`distance_to_centre`; ties: the smaller scale), then
-    ``tuning_cfg["retune_points"]`` scales log-spaced strictly between its neighbouring
+    ``tuning.retune_points`` scales log-spaced strictly between its neighbouring
     candidates (at the ends half or twice the candidate, never below 1: the filter's noise
     is not assumed smaller than the true one), flown; the closest of
     all. Returns that row, its ``distance``, the ``centre``, ``in_band`` (both NEES in the
     tuning runs' band) and every row ``evaluated`` in scale order."""
     from opnav.landing.montecarlo import nees_band
 
-    lo, hi = nees_band(int(tuning_cfg["n_runs"]), 3, 0.95)
+    lo, hi = nees_band(int(tuning.n_runs), 3, 0.95)
     centre = 0.5 * (lo + hi)
     rows = sorted((r for r in rows if int(r["iterations"]) == int(iterations)), key=lambda r: r["meas_noise_scale"])
     if not rows:
@@ -135,9 +133,9 @@ def retune(landing_cfg: dict, tuning_cfg: dict, rows: list[dict], iterations: in
     i = scales.index(b["meas_noise_scale"])
     left = scales[i - 1] if i > 0 else b["meas_noise_scale"] / 2.0
     right = scales[i + 1] if i + 1 < len(scales) else b["meas_noise_scale"] * 2.0
-    k = int(tuning_cfg.get("retune_points", 0))
+    k = int(tuning.retune_points)
     new = [float(x) for x in np.geomspace(max(left, 1.0), right, k + 2)[1:-1]] if k > 0 else []
-    rows = rows + [tuning_row(landing_cfg, tuning_cfg, x, iterations) for x in new if x not in scales]
+    rows = rows + [tuning_row(setup, tuning, x, iterations) for x in new if x not in scales]
     rows.sort(key=lambda r: r["meas_noise_scale"])
     b = best(rows)
     return {**b, "distance": distance_to_centre(b, centre), "centre": centre, "band": [lo, hi],
@@ -145,15 +143,14 @@ def retune(landing_cfg: dict, tuning_cfg: dict, rows: list[dict], iterations: in
             "evaluated": [{k_: r[k_] for k_ in ("meas_noise_scale", "nees_pos", "nees_vel")} for r in rows]}
 
 
-def heldout(landing_cfg: dict, method: str, n_runs: int, meas_noise_scale: float, iterations: int) -> dict:
-    """``method`` flown on the Monte Carlo's own runs ``0..n_runs-1`` (``landing_cfg``'s
+def heldout(setup: Setup, method: str, n_runs: int, meas_noise_scale: float, iterations: int) -> dict:
+    """``method`` flown on the Monte Carlo's own runs ``0..n_runs-1`` (``setup``'s
     ``mc.base_seed``: never the tuning runs) with the filter's bearing-noise scale and
     iterations set to the given ones: ``montecarlo.nees_consistency`` of those runs and their
     median last-landmark and touchdown position errors (m)."""
     from opnav.landing.montecarlo import nees_consistency, run_chunk
 
-    cfg = copy.deepcopy(landing_cfg)
-    cfg["filter"].update(meas_noise_scale=float(meas_noise_scale), iterations=int(iterations))
+    cfg = setup.with_filter(meas_noise_scale=float(meas_noise_scale), iterations=int(iterations))
     d = run_chunk(cfg, method, range(int(n_runs)), pick_ratio=False)
     return {**nees_consistency(d), **errors(d)}
 
@@ -168,29 +165,28 @@ def errors(data: dict) -> dict:
             "final_pos_err_m_median": float(st["final_pos_err_m"].median())}
 
 
-def tuning_report(scenario_cfgs: dict[str, dict], tuning_cfg: dict) -> dict:
-    """:func:`tuning_rows` of every camera scenario (name -> its ``landing``
-    config), the choice per scenario and the one tuning for all (:func:`_tiers`:
+def tuning_report(scenarios: dict[str, Setup], tuning: Tuning) -> dict:
+    """:func:`tuning_rows` of every camera scenario (name -> its landing setup), the choice per scenario and the one tuning for all (:func:`_tiers`:
     the smallest scale meeting the best tier in every scenario), whether the
     configured ``landing.filter`` (the same in every scenario) is that choice, and per
     scenario the retuned scale (:func:`retune`, at the chosen iterations; ``retuned``)."""
     from opnav.landing.montecarlo import nees_band
 
-    rows = {s: tuning_rows(c, tuning_cfg) for s, c in scenario_cfgs.items()}
+    rows = {s: tuning_rows(c, tuning) for s, c in scenarios.items()}
     joint = _tiers(rows)
-    retuned = {s: retune(c, tuning_cfg, rows[s], joint["iterations"]) for s, c in scenario_cfgs.items()}
-    f = next(iter(scenario_cfgs.values()))["filter"]
-    n = int(tuning_cfg["n_runs"])
-    return {"base_seed": int(tuning_cfg["base_seed"]), "n_runs": n, "method": tuning_cfg["method"],
+    retuned = {s: retune(c, tuning, rows[s], joint["iterations"]) for s, c in scenarios.items()}
+    f = next(iter(scenarios.values())).filter
+    n = int(tuning.n_runs)
+    return {"base_seed": int(tuning.base_seed), "n_runs": n, "method": tuning.method,
             "band": list(nees_band(n, 3, 0.95)), "scenarios": {s: {"candidates": r, "chosen": choose(r)}
                                                               for s, r in rows.items()},
             "chosen": joint, "retuned": retuned,
-            "configured": {"meas_noise_scale": float(f["meas_noise_scale"]), "iterations": int(f["iterations"])},
-            "config_matches": (float(f["meas_noise_scale"]) == joint["meas_noise_scale"]
-                               and int(f["iterations"]) == joint["iterations"])}
+            "configured": {"meas_noise_scale": float(f.meas_noise_scale), "iterations": int(f.iterations)},
+            "config_matches": (float(f.meas_noise_scale) == joint["meas_noise_scale"]
+                               and int(f.iterations) == joint["iterations"])}
 
 
-def retuned_record(tuning: dict, scenario: str, landing_cfg: dict, method: str, n_runs: int,
+def retuned_record(tuning: dict, scenario: str, setup: Setup, method: str, n_runs: int,
                    paper_heldout: dict) -> dict:
     """The paper tuning and the retuned scale of ``scenario`` side by side on the held-out
     runs: ``tuning`` is :func:`tuning_report`'s output, ``paper_heldout`` the Monte Carlo's own
@@ -213,4 +209,4 @@ def retuned_record(tuning: dict, scenario: str, landing_cfg: dict, method: str, 
                       **tuning_side(row), **paper_heldout},
             "retuned": {"meas_noise_scale": float(r["meas_noise_scale"]), "iterations": int(r["iterations"]),
                         **tuning_side(r), "tuning_in_band": bool(r["in_band"]),
-                        **heldout(landing_cfg, method, n_runs, r["meas_noise_scale"], r["iterations"])}}
+                        **heldout(setup, method, n_runs, r["meas_noise_scale"], r["iterations"])}}

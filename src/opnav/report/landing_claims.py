@@ -360,12 +360,15 @@ def terminal_accel_to_match(landing_cfg: Mapping[str, Any], tilt_deg: float, azi
     from scipy.optimize import least_squares
 
     from opnav.landing.scenario import thrust_tilt_azimuth_deg
+    from opnav.landing.setup import Setup
+
+    setup = Setup.from_config(landing_cfg)
 
     def resid(a):
-        t, z = thrust_tilt_azimuth_deg({**landing_cfg, "terminal_accel_mps2": [float(a[0]), float(a[1])]})
+        t, z = thrust_tilt_azimuth_deg(setup.replace(terminal_accel_mps2=(float(a[0]), float(a[1]))))
         return [t - tilt_deg, (z - azimuth_deg + 180.0) % 360.0 - 180.0]
 
-    a0 = landing_cfg.get("terminal_accel_mps2") or [0.0, 0.0]
+    a0 = setup.terminal_accel_mps2 or [0.0, 0.0]
     sol = least_squares(resid, x0=[float(a0[0]), float(a0[1])], xtol=1e-12, ftol=1e-12)
     return [float(sol.x[0]), float(sol.x[1])]
 
@@ -400,8 +403,9 @@ def input_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan,
 
 def _tilt_az(cfg):
     from opnav.landing.scenario import thrust_tilt_azimuth_deg
+    from opnav.landing.setup import Setup
 
-    return thrust_tilt_azimuth_deg(cfg)
+    return thrust_tilt_azimuth_deg(Setup.from_config(cfg))
 
 
 def fmt_(x: float) -> str:
