@@ -217,6 +217,8 @@ NEW_CONFIGS = [
     ("unknown", "approach: {em: {converge_frac_of_bound: 0.1}}", "its one home is the analysis plan's "
      "settings.converge_frac_of_bound"),
     ("unknown", "approach: {em: {bogus_key: 0.1}}", "('bogus_key' was unexpected)"),
+    ("unknown", "landing: {mc: {yaw_ratio: 0.5}}", "its one home is the analysis plan's claims.B-C3.margins.yaw_ratio"),
+    ("unknown", "landing: {equivalence: {alpha: 0.05}}", "its one home is the analysis plan's level"),
     ("ranges", "approach: {geometry: {v_inf_dir: [1.0e+300, 0, 0]}}", "'approach.geometry.v_inf_dir[0]'"),
     ("ranges", "approach: {roll_rate_study: {rates_deg_s: [0.1, 1.0e+9]}}", "'approach.roll_rate_study.rates_deg_s[1]'"),
     ("ranges", "landing: {gravity_mps2: [0, 0, -1.0e+300]}", "'landing.gravity_mps2[2]'"),

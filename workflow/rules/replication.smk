@@ -172,7 +172,6 @@ if REP_CFG["enabled"]:
             methods=B_METHODS,
             eq_methods=B_EQ_METHODS,
             equivalence=canonical(_BEQ),
-            yaw_ratio=config["landing"]["mc"]["yaw_ratio"],
             converged_pos_err_m=config["landing"]["mc"]["converged_pos_err_m"],
             eval_path=config["landing"]["planner"]["eval_path"],
             landing=cfg("landing", "duration_s", "gravity_mps2", "initial_state", "yaw_deg",

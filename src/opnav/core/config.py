@@ -217,6 +217,8 @@ def schema_problems(config: dict, schema_path: Path = SCHEMA_PATH) -> list[str]:
 MOVED_KEYS = {
     "approach.accuracy_target_arcsec": "the analysis plan's claims.A-C1.margins.target_arcsec",
     "approach.em.converge_frac_of_bound": "the analysis plan's settings.converge_frac_of_bound",
+    "landing.mc.yaw_ratio": "the analysis plan's claims.B-C3.margins.yaw_ratio",
+    "landing.equivalence.alpha": "the analysis plan's level (one interval level for every verdict)",
 }
 
 
