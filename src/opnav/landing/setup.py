@@ -183,7 +183,8 @@ class Bounds(Section):
 @dataclass(**_FROZEN)
 class MonteCarloSettings(Section):
     """``mc``: runs, job and batch sizes (speed only; ``batch_size`` 0 = a job's chunk), the
-    methods, the seed, B-T3's converged threshold (m) and yaw ratio, the error bounds."""
+    methods, the seed, B-T3's converged threshold (m), the error bounds (B-C3's yaw ratio is the
+    analysis plan's, its one home)."""
 
     KEY = "landing.mc"
     n_runs: int
@@ -193,7 +194,6 @@ class MonteCarloSettings(Section):
     methods: tuple[str, ...]
     base_seed: int
     converged_pos_err_m: float
-    yaw_ratio: float
     bounds: Bounds
 
 
@@ -236,6 +236,10 @@ class Tuning(Section):
 @register
 @dataclass(**_FROZEN)
 class Equivalence(Section):
+    """``equivalence``: the reference, the tested methods and the controls; ``alpha`` is no config
+    key (each one-sided test's level is ``(1 - level) / 2`` of the analysis plan's one interval
+    level: the caller sets it with ``replace``)."""
+
     KEY = "landing.equivalence"
     reference: str
     methods: tuple[str, ...]
