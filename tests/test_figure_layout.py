@@ -76,7 +76,7 @@ def _approach(name):
 
 
 def _b_f4():
-    from opnav.landing import plots
+    from opnav.report.landing import plots
     t = np.linspace(0, 198, 199)
     s = np.linspace(1, 0, 199)[:, None]
     return plots.fig_true_states(t, np.array([3300, 5870, 6570]) * s, np.array([-56, -66, -90]) * s,
@@ -84,7 +84,7 @@ def _b_f4():
 
 
 def _b_f6():
-    from opnav.landing import plots
+    from opnav.report.landing import plots
     t = np.linspace(0, 198, 199)
     rng = np.random.default_rng(1)
     from opnav.landing.records import MonteCarlo

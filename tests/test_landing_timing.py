@@ -152,7 +152,7 @@ def test_b_f7_boxes_are_the_replayed_times():
     import matplotlib
 
     matplotlib.use("Agg")
-    from opnav.landing.plots import fig_planning_time
+    from opnav.report.landing.plots import fig_planning_time
 
     runs = np.repeat(np.arange(4), 5)
     tm = _fake_timing({"depth": np.full(20, 123.0), "svd": np.full(20, 4567.0)},
@@ -271,7 +271,7 @@ def test_consumers_ignore_untimed_entries(recorded):
     import matplotlib
 
     matplotlib.use("Agg")
-    from opnav.landing.plots import fig_planning_time
+    from opnav.report.landing.plots import fig_planning_time
 
     tm, sub = _subset_timing()
     assert timing_summary.median_us(tm, "svd", "alt") == pytest.approx(5000.0)

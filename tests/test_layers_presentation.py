@@ -15,10 +15,10 @@ from conftest import REPO
 SRC = REPO / "src"
 #: the paper packages
 PAPERS = ("approach", "landing", "studies")
-#: paper packages whose presentation has moved out entirely (issue 56 item 2): no matplotlib,
-#: no plots or text modules. Paper B's plots and report rows are its owners' (landing/plots.py,
-#: landing/timing_plots.py, landing/report.py) and are still inside its package.
-NO_PRESENTATION = ("approach",)
+#: paper packages that draw nothing (issue 56 item 2): no matplotlib, no plots or text modules
+#: (paper A's figures and words are in opnav.report.approach, paper B's figures in
+#: opnav.report.landing)
+NO_PRESENTATION = ("approach", "landing")
 #: the edge inside a paper package (as tests/test_import_layers.py's EDGE): a paper's CLI prints
 #: its run in words and may import the report layer
 EDGE = {"opnav/approach/cli.py", "opnav/landing/cli.py"}
@@ -59,9 +59,10 @@ def test_no_paper_package_imports_the_report_layer():
     assert not bad, "\n".join(bad)
 
 
-def test_paper_a_draws_and_words_nothing():
-    """Paper A's package imports no matplotlib and holds no plots or text module: its figures and
-    its words are in opnav.report.approach (mutation: moving plots.py back fails it)."""
+def test_the_papers_draw_and_word_nothing():
+    """Neither paper's package imports matplotlib or holds a plots or text module: their figures
+    and words are in opnav.report.approach and opnav.report.landing (mutation: moving
+    approach/plots.py or landing/plots.py back fails it)."""
     bad = []
     for paper in NO_PRESENTATION:
         for f, pkg in _modules(paper):

@@ -11,7 +11,7 @@ from opnav.report import study_plots
 from opnav.report.approach import plots as aplots
 from opnav.report.approach.text import METHOD_LABELS
 from opnav.core.config import load_config
-from opnav.landing import plots as lplots
+from opnav.report.landing import plots as lplots
 from opnav.landing.planner import available_methods
 from opnav.studies.metrics import APPROACH_METHODS
 

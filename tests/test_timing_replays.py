@@ -144,7 +144,7 @@ def test_text_and_tables_read_the_verdicts_clock():
     import matplotlib
 
     matplotlib.use("Agg")
-    from opnav.landing.plots import fig_planning_time
+    from opnav.report.landing.plots import fig_planning_time
     from opnav.landing.report import planning_time_text
 
     tm = _merged([2.0, 2.0, 2.0])

@@ -217,7 +217,7 @@ rule landing_mc_gather:
 rule landing_true_states:
     """B-F4: the truth trajectory (the same in every camera scenario)."""
     input:
-        src("landing/trajectory.py", "landing/setup.py", "core/sections.py", "landing/plots.py",
+        src("landing/trajectory.py", "landing/setup.py", "core/sections.py", "report/landing/plots.py",
             "core/figures.py", "opnav.mplstyle"),
     output:
         f4=report_figure(f"{LANDING}/B-F4_true_states", "B-F4", "Paper B"),
@@ -235,7 +235,7 @@ rule landing_single:
     """The single descent of one scenario and B-F5 (depth-error maps)."""
     input:
         B_SRC,
-        src("landing/plots.py", "core/figures.py", "opnav.mplstyle"),
+        src("report/landing/plots.py", "core/figures.py", "opnav.mplstyle"),
         kernels=kernels("landing"),
     output:
         summary=f"{LANDING}/single/summary_{{bscn}}.json",
@@ -315,7 +315,7 @@ rule landing_summary:
         retuned=f"{LANDING}/retuned/{{bscn}}.json",   # the retuned filter's held-out NEES beside the paper's
         plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step
         code=with_kernels("landing", src(
-            "landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/scenario.py", "landing/plots.py",
+            "landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/scenario.py", "report/landing/plots.py",
             "landing/report.py", "landing/equivalence.py", "landing/ranking.py", "landing/trajectory.py",
             "landing/setup.py", "core/sections.py",
             "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),

@@ -17,7 +17,7 @@ rule landing_x1_summary:
         mc=lambda wc: b_mc(wc.bscn, X1_ALL),
         timing=lambda wc: expand(B_TIMING, bscn=wc.bscn),   # replays + other (landing_timing.smk)
         code=with_kernels("landing", src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py",
-                                         "landing/timing_summary.py", "landing/plots.py", "core/tables.py", "core/figures.py", "opnav.mplstyle")),
+                                         "landing/timing_summary.py", "report/landing/plots.py", "core/tables.py", "core/figures.py", "opnav.mplstyle")),
         kernels=kernels("landing"),
     output:
         f=report_figure(f"{LANDING}/B-X1_envelopes_{{bscn}}", "B-X1", "Paper B", "beyond"),

@@ -47,7 +47,7 @@ rule landing_timing_replays:
     B-F7's overhead curve from them."""
     input:
         mc=lambda wc: b_mc(wc.bscn, X1_METHODS),
-        code=TIMING_CODE + src("landing/timing_plots.py", "core/figures.py", "opnav.mplstyle",
+        code=TIMING_CODE + src("report/landing/timing_plots.py", "core/figures.py", "opnav.mplstyle",
                                "data/published.yaml"),
         kernels=kernels("landing"),
     output:

@@ -5,7 +5,7 @@ import json
 import sys
 
 from opnav.core import figures
-from opnav.landing import plots
+from opnav.report.landing import plots
 from opnav.landing.depth_map import depth_map
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run

@@ -8,7 +8,8 @@ import sys
 import pandas as pd
 
 from opnav.core import figures, published
-from opnav.landing import plots, timing, timing_summary
+from opnav.landing import timing, timing_summary
+from opnav.report.landing import plots
 from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.own import compare_own, with_own
 from opnav.landing.montecarlo import load

@@ -42,7 +42,7 @@ with script_context(snakemake) as log:
                  ev["shared_us_at_published"])
         if "f7o" in snakemake.output.keys():
             from opnav.core import figures
-            from opnav.landing import timing_plots
+            from opnav.report.landing import timing_plots
 
             figures.save(timing_plots.fig_overhead_curve(ev, snakemake.wildcards.bscn), snakemake.output.f7o)
     else:

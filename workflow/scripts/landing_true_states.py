@@ -5,7 +5,7 @@ import sys
 import numpy as np
 
 from opnav.core import figures
-from opnav.landing import plots
+from opnav.report.landing import plots
 from opnav.landing.setup import Setup
 from opnav.landing.trajectory import euler_rpy_deg, nominal_truth
 from opnav.core.snakeio import mock_snakemake, script_context

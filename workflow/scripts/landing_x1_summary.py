@@ -6,7 +6,8 @@ import json
 import sys
 
 from opnav.core import figures
-from opnav.landing import plots, timing, timing_summary
+from opnav.landing import timing, timing_summary
+from opnav.report.landing import plots
 from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.montecarlo import first_runs, load
 from opnav.landing.ranking import headline, ranking_table

@@ -1,7 +1,7 @@
 """The shared figure style, the one colour palette, and deterministic figure saving.
 
 Every plot of the pipeline is drawn by a plots module (:mod:`opnav.report.approach.plots`,
-:mod:`opnav.report.approach.peer_plots`, :mod:`opnav.landing.plots`,
+:mod:`opnav.report.approach.peer_plots`, :mod:`opnav.report.landing.plots`,
 :mod:`opnav.report.study_plots`) under :func:`style` (one matplotlib style file,
 ``opnav.mplstyle``, sized for a journal column), coloured by :func:`color` (one
 colour per method and per scenario variant, the same in every figure of both
