@@ -34,6 +34,7 @@ from opnav.landing import timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
 from opnav.landing.setup import Setup
+from opnav.report.landing import timing_text
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -60,7 +61,7 @@ def main() -> None:
               f"{tm['wall_ns'].shape[1]} variants in {time.perf_counter() - t0:.2f} s wall, "
               f"{time.process_time() - c0:.2f} s CPU; pick mismatches {int(tm['mismatch'].sum())} "
               f"of {int(tm['checked'].sum())}")
-        print(timing_summary.summary_frame(tm)[["method", "path", "eval_path", "calls",
+        print(timing_text.summary_frame(tm)[["method", "path", "eval_path", "calls",
                                         "cpu_median_us", "cpu_p05_us", "cpu_p95_us",
                                         "median_evals"]].to_string(index=False))
         for m in methods:                  # the call's two parts (timing_summary.decomposition)
@@ -71,7 +72,7 @@ def main() -> None:
                       f"{d['fit_shared_us']:.2f} us, {1e3 * d['fit_per_eval_us']:.0f} ns an evaluation)")
         if "svd" in methods:
             red = timing_summary.time_reduction(tm, "depth", "svd")
-            print(f"[{name}] depth vs svd median reduction ({timing_summary.CLOCK_WORDS}): {red[0]:.1f} % "
+            print(f"[{name}] depth vs svd median reduction ({timing_text.CLOCK_WORDS}): {red[0]:.1f} % "
                   f"+- {red[1]:.1f} (one replay's bootstrap; the claims read the spread between replays)")
         ov = timing.call_overhead(scn, rec, "depth", a.calls, reps=a.reps)
         call, ev = ov["call_ns"] / 1e3, ov["evals_ns"] / 1e3

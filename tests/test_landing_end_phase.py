@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from opnav.landing.montecarlo import end_phase
-from opnav.landing.report import end_phase_text, nees_reading
+from opnav.report.landing.summary import end_phase_text, nees_reading
 
 
 @pytest.fixture(scope="module")

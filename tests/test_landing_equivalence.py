@@ -107,7 +107,7 @@ def test_claim_reproduced_and_flagged_when_a_control_passes():
     """As the claims table reads B-C1: a control that meets the margin too leaves the
     claim reproduced and the reason says the test cannot credit the metric."""
     from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED
-    from opnav.landing.report import same_accuracy_verdict
+    from opnav.report.landing.summary import same_accuracy_verdict
 
     st = _runs()
     acc = _accuracy(st, 90.0)
@@ -126,7 +126,7 @@ def test_same_pick_threshold_is_the_recorded_plan_number():
     """The not-tested threshold is the one the summary records (the plan's B-C1
     same_pick_max_pct), not a number in code: 92 % same picks are tested under 95 and
     not under 90 (a threshold fixed at 90 in code fails the first)."""
-    from opnav.landing.report import same_accuracy_verdict
+    from opnav.report.landing.summary import same_accuracy_verdict
 
     st = _runs()
     assert "not tested" not in same_accuracy_verdict(_accuracy(st, 95.0, 92.0), "depth").reason
@@ -203,7 +203,7 @@ def test_faster_reading_agrees_with_the_claims_table(shift):
     import pandas as pd
 
     from opnav.core.verdicts import REPRODUCED
-    from opnav.landing.report import rows_paper_b
+    from opnav.report.landing.summary import rows_paper_b
     claim = None
     rng = np.random.default_rng(4)
     tb = 10 + rng.uniform(0, 5, 300)
@@ -318,7 +318,7 @@ def test_scorecard_reading_agrees_with_the_claims_table(case):
     one margin, one same-pick threshold (a margin back on the runs' random gap splits them in
     the random_far case: tried once)."""
     from opnav.core.verdicts import REPRODUCED
-    from opnav.landing.report import same_accuracy_verdict
+    from opnav.report.landing.summary import same_accuracy_verdict
     from opnav.report import claims as C
     from opnav.report.claims import load_plan
 

@@ -10,7 +10,7 @@ from opnav.core.config import load_config
 from opnav.landing.descent import build_scenario, run_descent
 from opnav.landing.montecarlo import summarize_run
 from opnav.landing.montecarlo import chunks, gather, run_chunk
-from opnav.landing.report import summary_table
+from opnav.report.landing.summary import summary_table
 from opnav.landing.setup import Setup
 
 N_RUNS = 12
@@ -143,7 +143,7 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
     import pandas as pd
 
     from opnav.landing.montecarlo import yaw_convergence
-    from opnav.landing.report import scenario_summary
+    from opnav.report.landing.summary import scenario_summary
     from opnav.landing.scenario import initial_attitude_report
 
     d, tm, df = paired

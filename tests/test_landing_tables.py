@@ -1,7 +1,7 @@
 import numpy as np
 
 from opnav.core.config import load_config
-from opnav.landing.scenario import error_bounds_table, initial_state_table
+from opnav.report.landing.tables import error_bounds_table, initial_state_table
 from opnav.landing.setup import Setup
 from conftest import REPO
 

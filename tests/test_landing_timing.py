@@ -12,7 +12,8 @@ from opnav.core.config import load_config
 from opnav.landing import records, timing, timing_summary
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import run_chunk
-from opnav.landing.report import summary_table
+from opnav.report.landing import timing_text
+from opnav.report.landing.summary import summary_table
 from landing_helpers import scenario_setups
 
 METHODS = ("depth", "svd", "random", "center")
@@ -234,7 +235,7 @@ def test_replay_times_the_paper_path_on_its_subset_only(recorded):
         assert (a["slot"][np.ix_(calls, g)] < g.size).all()
     s = timing_summary.method_summary(a)
     assert s["timed_calls"] == 12 and s["timed_calls_paper"] == 4 and s["max_calls_paper"] == 4
-    assert "on 4 of them" in timing_summary.method_text(a)
+    assert "on 4 of them" in timing_text.method_text(a)
     assert timing_summary.method_summary(full)["timed_calls_paper"] == 12
 
 
@@ -279,7 +280,7 @@ def test_consumers_ignore_untimed_entries(recorded):
     assert timing_summary.times_ns(tm, "svd", "alt").size == sub.sum()
     assert timing_summary.median_evals(tm, "svd", "alt") == 31 and timing_summary.median_evals(tm, "svd") == 7
     assert timing_summary.timed_calls(tm, "svd", "alt") == 10 and timing_summary.timed_calls(tm, "svd") == 40
-    f = timing_summary.summary_frame(tm).set_index(["method", "path"])
+    f = timing_text.summary_frame(tm).set_index(["method", "path"])
     assert f.loc[("svd", "alt"), "calls"] == 10 and f.loc[("svd", "alt"), "cpu_p05_us"] == pytest.approx(5000)
     assert f.loc[("depth", "alt"), "median_evals"] == 31
     assert set(timing_summary.per_run_median_us(tm, "svd", path="alt").values()) == {5000.0}
@@ -362,7 +363,7 @@ def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monke
 
 def test_less_time_text_says_more_for_a_negative_reduction():
     """B-F7's title and the manuscript's sentence: a negative reduction is more time."""
-    from opnav.landing.timing_summary import less_time_text
+    from opnav.report.landing.timing_text import less_time_text
 
     assert less_time_text(34.2) == "34.2 % less"
     assert less_time_text(-137.4) == "137.4 % more"
@@ -411,16 +412,16 @@ def test_repetitions_keep_the_clock_below_5_pct_of_a_recorded_call(recorded, tmp
     ok = a["timed"] & (a["reps"] > 0)
     assert np.all(a["reps"][ok] * a["cpu_ns"][ok] >= 0.95 * timing.CLOCK_SHARE_INV * a["clock_ns"])
     assert cs["reps_max"] > 1                                   # a compiled call needs repeating
-    assert "below 5 %" in timing_summary.method_text(a)
+    assert "below 5 %" in timing_text.method_text(a)
     # the machine's load during the replay is kept and stated with the times (other processes
     # on the cores lengthen microsecond calls), and survives the file round trip
     import os
 
     assert a["load_avg"].shape == (2,) and np.all(np.isfinite(a["load_avg"])) and a["n_cpu"] == os.cpu_count()
     lo, hi = a["load_avg"]
-    assert f"load average was {lo:.1f} at the start and {hi:.1f} at the end" in timing_summary.method_text(a)
+    assert f"load average was {lo:.1f} at the start and {hi:.1f} at the end" in timing_text.method_text(a)
     timing.save(tmp_path / "t.npz", a)
-    assert timing_summary.method_text(timing.load(tmp_path / "t.npz")) == timing_summary.method_text(a)
+    assert timing_text.method_text(timing.load(tmp_path / "t.npz")) == timing_text.method_text(a)
     # the closed form and the LAPACK SVD of the same H pick alike
     v = list(a["variant_method"])
     assert np.array_equal(a["pick"][:, v.index("svd")], a["pick"][:, v.index("svd_lapack")])

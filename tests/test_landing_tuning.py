@@ -132,7 +132,7 @@ def test_nees_retuned_text_and_table_read_the_numbers():
     """Both rows in the table; the sentence states the retuned reading from the band and says
     why it is not consistent only when it is not, heavy tails only when the largest run is
     far above the median (mutations: a fixed 'consistent', or the tail clause always on, fail)."""
-    from opnav.landing.report import nees_retuned_text, nees_table
+    from opnav.report.landing.summary import nees_retuned_text, nees_table
 
     t = nees_table(_record(2.85, 4.19, True))
     assert t["tuning"].tolist() == ["paper", "retuned"]

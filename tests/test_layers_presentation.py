@@ -66,7 +66,7 @@ def test_the_papers_draw_and_word_nothing():
     bad = []
     for paper in NO_PRESENTATION:
         for f, pkg in _modules(paper):
-            if f.stem.endswith("plots") or f.stem in ("text", "labels_text", "prose"):
+            if f.stem.endswith(("plots", "_text")) or f.stem in ("text", "labels_text", "prose", "report"):
                 bad.append(f"{f.relative_to(SRC)}: a presentation module")
             bad += [f"{f.relative_to(SRC)}:{line} imports {mod}" for line, mod in _imports(f, pkg)
                     if mod.split(".")[0] == "matplotlib"]

@@ -70,7 +70,7 @@ def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
 def test_rows_paper_b_timing():
     import pandas as pd
 
-    from opnav.landing.report import rows_paper_b
+    from opnav.report.landing.summary import rows_paper_b
 
     t3 = pd.DataFrame([
         {"method": "depth", "time_reduction_vs_svd_pct": 80.0, "rms_pos_err_m_mean": 100.0},
@@ -89,7 +89,7 @@ def test_wide_band_does_not_count_as_reproduced():
 def test_rows_paper_b_per_scenario_from_the_summary():
     import pandas as pd
 
-    from opnav.landing.report import rows_paper_b
+    from opnav.report.landing.summary import rows_paper_b
 
     def methods(pick):
         return {"depth": {"method": "depth", "time_reduction_vs_svd_pct": 30.0, "rms_pos_err_m_mean": 100.0,
@@ -157,7 +157,7 @@ def test_timing_rows_take_the_plans_band():
     in score_rows fails this: tried once)."""
     import pandas as pd
 
-    from opnav.landing.report import rows_paper_b
+    from opnav.report.landing.summary import rows_paper_b
     from opnav.report.claims import load_plan
 
     t3 = pd.DataFrame([{"method": "depth", "time_reduction_vs_svd_pct": 25.0, "time_reduction_vs_svd_pct_std": 0.5}])
@@ -181,7 +181,7 @@ def test_the_timing_row_reads_the_spread_between_replays_not_one_replays_bootstr
     B-T3's bootstrap sd of one replay (0.5) would read it not reproduced (mutation tried once)."""
     import pandas as pd
 
-    from opnav.landing.report import rows_paper_b
+    from opnav.report.landing.summary import rows_paper_b
 
     t3 = pd.DataFrame([{"method": "depth", "time_reduction_vs_svd_pct": 24.0, "time_reduction_vs_svd_pct_std": 0.5}])
     pub = {"depth_time_reduction_vs_svd_pct": 29.03}

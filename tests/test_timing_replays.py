@@ -144,8 +144,9 @@ def test_text_and_tables_read_the_verdicts_clock():
     import matplotlib
 
     matplotlib.use("Agg")
+    from opnav.report.landing import timing_text as tt
     from opnav.report.landing.plots import fig_planning_time
-    from opnav.landing.report import planning_time_text
+    from opnav.report.landing.summary import planning_time_text
 
     tm = _merged([2.0, 2.0, 2.0])
     ev = ts.planning_time_evidence(tm, 29.03)
@@ -158,16 +159,16 @@ def test_text_and_tables_read_the_verdicts_clock():
     assert vs["depth_median_us"] == pytest.approx(d_cpu)
     text = planning_time_text(ts.vs_depth(tm), ts.clock_share(tm), ev)
     assert f"{d_cpu:.2f} against" in text and f"{d_wall:.2f}" not in text
-    assert f"clock: {ts.CLOCK_WORDS}" in text and "(thread CPU" in text and "wall" not in text
+    assert f"clock: {tt.CLOCK_WORDS}" in text and "(thread CPU" in text and "wall" not in text
     red = ev["reduction_pct"]["depth_vs_svd"]["mean"]
-    assert f"took {ts.less_time_text(red)} time" in text
+    assert f"took {tt.less_time_text(red)} time" in text
     assert ts.time_reduction(tm, "depth", "svd", n_boot=0)[0] == pytest.approx(red, abs=1e-9)
-    assert ts.less_time_text(red) in ts.less_time_text(ts.time_reduction(tm, "depth", "svd", n_boot=0)[0])
-    assert "thread CPU time" in ts.method_text(tm)
+    assert tt.less_time_text(red) in tt.less_time_text(ts.time_reduction(tm, "depth", "svd", n_boot=0)[0])
+    assert "thread CPU time" in tt.method_text(tm)
     fig = fig_planning_time(tm, ["depth", "svd"], 29.03)
     notes = [t.get_text() for t in fig.axes[0].texts]
     assert f"{d_cpu:.1f}" in notes and f"{d_wall:.1f}" not in notes
-    f = ts.summary_frame(tm)
+    f = tt.summary_frame(tm)
     assert not [c for c in f.columns if c.startswith("wall")]
 
 
@@ -282,7 +283,7 @@ def test_evidence_of_one_replay_and_without_svd_has_no_spread_and_no_curve():
     """Hidden cases: one replay (landing.timing.n_replays 1) gives readings without a between-replay
     spread (nan, never a bootstrap's) and the text says no spread; methods without svd give the
     pairs they have and no overhead curve; neither raises."""
-    from opnav.landing.report import evidence_text
+    from opnav.report.landing.summary import evidence_text
 
     one = _merged([2.0])
     ev = ts.planning_time_evidence(one, 29.03)

@@ -6,7 +6,8 @@ LANDING = res("landing")
 rule landing_tables:
     """B-T1 and B-T2, rendered from the config."""
     input:
-        src("landing/scenario.py", "landing/setup.py", "core/sections.py", "landing/trajectory.py", "core/tables.py",
+        src("report/landing/tables.py", "landing/scenario.py", "landing/setup.py", "core/sections.py",
+            "landing/trajectory.py", "core/tables.py",
             "core/published.py", "data/published.yaml"),
     output:
         t1=report_table(f"{LANDING}/B-T1_initial_state", "B-T1", "Paper B"),
@@ -279,7 +280,7 @@ rule landing_retuned:
     method, beside the paper tuning's Monte Carlo: the held-out NEES of both (B-T3 NEES table)."""
     input:
         B_SRC,
-        src("landing/tuning.py", "landing/report.py", "landing/setup.py", "core/sections.py"),
+        src("landing/tuning.py", "report/landing/summary.py", "report/landing/timing_text.py", "landing/setup.py", "core/sections.py"),
         tuning=f"{LANDING}/tuning.json",
         mc=lambda wc: b_mc(wc.bscn, [config["landing"]["tuning"]["method"]])[0],
         kernels=kernels("landing"),
@@ -316,7 +317,8 @@ rule landing_summary:
         plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step
         code=with_kernels("landing", src(
             "landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/scenario.py", "report/landing/plots.py",
-            "landing/report.py", "landing/equivalence.py", "landing/ranking.py", "landing/trajectory.py",
+            "report/landing/summary.py", "report/landing/timing_text.py", "landing/accuracy.py", "landing/equivalence.py",
+            "landing/ranking.py", "landing/trajectory.py",
             "landing/setup.py", "core/sections.py",
             "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),
         kernels=kernels("landing"),
@@ -350,7 +352,7 @@ rule landing_summary_all:
     """B-summary.json: every scenario's summary, the headline's also at the top level."""
     input:
         parts=expand(f"{LANDING}/summaries/B-summary_{{bscn}}.json", bscn=B_SCENARIOS),
-        code=src("landing/report.py"),
+        code=src("report/landing/summary.py", "report/landing/timing_text.py"),
     output:
         f"{LANDING}/B-summary.json",
     params:

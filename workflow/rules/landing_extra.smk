@@ -17,7 +17,8 @@ rule landing_x1_summary:
         mc=lambda wc: b_mc(wc.bscn, X1_ALL),
         timing=lambda wc: expand(B_TIMING, bscn=wc.bscn),   # replays + other (landing_timing.smk)
         code=with_kernels("landing", src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py",
-                                         "landing/timing_summary.py", "report/landing/plots.py", "core/tables.py", "core/figures.py", "opnav.mplstyle")),
+                                         "landing/timing_summary.py", "report/landing/plots.py", "report/landing/timing_text.py",
+                                         "core/tables.py", "core/figures.py", "opnav.mplstyle")),
         kernels=kernels("landing"),
     output:
         f=report_figure(f"{LANDING}/B-X1_envelopes_{{bscn}}", "B-X1", "Paper B", "beyond"),
@@ -41,7 +42,7 @@ rule landing_x1_summary_all:
     """B-X1-summary.json: every scenario's B-X1 summary, the headline's also at the top level."""
     input:
         parts=expand(f"{LANDING}/summaries/B-X1-summary_{{bscn}}.json", bscn=B_SCENARIOS),
-        code=src("landing/report.py"),
+        code=src("report/landing/summary.py", "report/landing/timing_text.py"),
     output:
         f"{LANDING}/B-X1-summary.json",
     params:

@@ -171,7 +171,7 @@ rule paper_floats:
         tables_csv=[c for c in (t[:-4] + ".csv" for t in PDF_FLOATS["approach"] + PDF_FLOATS["landing"]) if c in _targets],
         captions=sorted(str(p) for p in CAPTIONS.glob("*.rst")),
         study_captions=[t for ts in STUDY_TARGETS.values() for t in ts if t.endswith(".rst")],
-        code=src("report/manuscript.py", "report/approach_views.py", "landing/report.py", "core/tables.py"),
+        code=src("report/manuscript.py", "report/approach_views.py", "report/landing/summary.py", "report/landing/timing_text.py", "core/tables.py"),
     output:
         approach=f"{PAPER}/floats_approach.tex",
         landing=f"{PAPER}/floats_landing.tex",
@@ -196,7 +196,7 @@ rule paper_scorecard:
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # B-C4's band for the timing rows
-        code=src("report/scorecard.py", "core/verdicts.py", "report/approach_scorecard.py", "approach/summaries.py", "landing/report.py", "core/published.py"),
+        code=src("report/scorecard.py", "core/verdicts.py", "report/approach_scorecard.py", "approach/summaries.py", "report/landing/summary.py", "report/landing/timing_text.py", "core/published.py"),
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
         longtable=f"{PAPER}/scorecard_longtable.tex",

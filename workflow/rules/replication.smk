@@ -158,7 +158,7 @@ if REP_CFG["enabled"]:
             single=f"{LANDING}/single/summary_{{bscn}}.json",
             tuning=f"{LANDING}/tuning.json",
             plan=src("data/analysis_plan.yaml")[0],  # B-C1's margin and same-pick threshold, B-C2's step
-            code=src("landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/report.py", "landing/equivalence.py",
+            code=src("landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "report/landing/summary.py", "report/landing/timing_text.py", "landing/accuracy.py", "landing/equivalence.py",
                      "landing/ranking.py", "landing/trajectory.py"),
         output:
             t3=table_outputs(f"{REP}/landing/B-T3_summary_{{bscn}}"),
@@ -187,7 +187,7 @@ if REP_CFG["enabled"]:
         """B-summary.json of the replication sample."""
         input:
             parts=expand(f"{REP}/landing/summaries/B-summary_{{bscn}}.json", bscn=B_SCENARIOS),
-            code=src("landing/report.py"),
+            code=src("report/landing/summary.py", "report/landing/timing_text.py"),
         output:
             f"{REP}/landing/B-summary.json",
         params:

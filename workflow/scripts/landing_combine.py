@@ -4,7 +4,7 @@ scenario's keys also at the top level (the manuscript's default numbers)."""
 
 import sys
 
-from opnav.landing.report import combine_scenarios
+from opnav.report.landing.summary import combine_scenarios
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json
 

@@ -5,7 +5,7 @@ tuning's Monte Carlo: its record (JSON) and the NEES table."""
 import sys
 
 from opnav.landing.montecarlo import load, nees_consistency
-from opnav.landing.report import nees_table
+from opnav.report.landing.summary import nees_table
 from opnav.landing.setup import Setup
 from opnav.landing.tuning import errors, retuned_record
 from opnav.core.snakeio import load_json, mock_snakemake, script_context

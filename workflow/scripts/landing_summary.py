@@ -10,10 +10,12 @@ import pandas as pd
 from opnav.core import figures, published
 from opnav.landing import timing, timing_summary
 from opnav.report.landing import plots
+from opnav.report.landing.timing_text import method_text
 from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.own import compare_own, with_own
 from opnav.landing.montecarlo import load
-from opnav.landing.report import (accuracy_tests, end_phase_table, end_phase_text, nees_reading, nees_retuned_text,
+from opnav.landing.accuracy import accuracy_tests
+from opnav.report.landing.summary import (end_phase_table, end_phase_text, nees_reading, nees_retuned_text,
                                   scenario_summary, summary_table)
 from opnav.landing.trajectory import nominal_truth
 from opnav.landing.setup import Equivalence, Setup
@@ -43,7 +45,7 @@ with script_context(snakemake) as log:
                          "timed_calls_alt, with its reductions on the calls timed on both. Each reduction against "
                          "another method has its bootstrap standard deviation over runs; the published 29.03 % "
                          "(depth vs SVD) is labelled published. Converged: final position error below "
-                         f"{snakemake.params.converged_pos_err_m:g} m. " + timing_summary.method_text(tm)))
+                         f"{snakemake.params.converged_pos_err_m:g} m. " + method_text(tm)))
     single = load_json(snakemake.input.single)
     every = {**data, **{m: load(p) for m, p in zip(snakemake.params.eq_methods, snakemake.input.mc_eq)}}
     # B-C1's margin and same-pick threshold, B-C2's smallest difference: the analysis plan's

@@ -2,7 +2,7 @@
 
 import sys
 
-from opnav.landing.scenario import error_bounds_table, initial_state_table
+from opnav.report.landing.tables import error_bounds_table, initial_state_table
 from opnav.landing.setup import Setup
 from opnav.core.snakeio import mock_snakemake, script_context
 from opnav.core.tables import write_table

@@ -15,6 +15,7 @@ import tempfile
 
 from opnav.core import published
 from opnav.landing import timing, timing_summary
+from opnav.report.landing import timing_text
 from opnav.landing.setup import Setup
 from opnav.core.snakeio import mock_snakemake, script_context
 
@@ -36,7 +37,7 @@ with script_context(snakemake) as log:
             timing.save(path, r)
         tm = timing.merge(reps)
         ev = timing_summary.planning_time_evidence(tm, published.load()["paper_b"]["depth_time_reduction_vs_svd_pct"])
-        log.info("%s", timing_summary.method_text(tm))
+        log.info("%s", timing_text.method_text(tm))
         log.info("reductions between replays (mean, sd): %s; shared part at the published reduction: %.3f us",
                  {k: (round(v["mean"], 2), round(v["sd_between"], 2)) for k, v in ev["reduction_pct"].items()},
                  ev["shared_us_at_published"])
@@ -50,5 +51,5 @@ with script_context(snakemake) as log:
                                   max_calls_paper=int(p.max_calls_paper), warm_compiled=False)
         tm = timing.run_spec(spec)
         timing.save(snakemake.output[0], tm)
-        log.info("%s", timing_summary.method_text(tm))
-        log.info("%s", timing_summary.summary_frame(tm).to_string())
+        log.info("%s", timing_text.method_text(tm))
+        log.info("%s", timing_text.summary_frame(tm).to_string())

@@ -8,6 +8,7 @@ import sys
 from opnav.core import figures
 from opnav.landing import timing, timing_summary
 from opnav.report.landing import plots
+from opnav.report.landing.timing_text import method_text
 from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.montecarlo import first_runs, load
 from opnav.landing.ranking import headline, ranking_table
@@ -38,7 +39,7 @@ with script_context(snakemake) as log:
                          f"method minus {ref} of the per-run position errors (m) are given at the last landmark "
                          "update (lastlm), as RMS over the landmark phase (lmrms) and over the descent, and at "
                          f"touchdown (final). Each has 95 % paired-t and bootstrap ({n_boot} resamples) intervals; "
-                         f"converged: final position error below {conv:g} m. " + timing_summary.method_text(tm)))
+                         f"converged: final position error below {conv:g} m. " + method_text(tm)))
     t = next(iter(data.values())).t
     own = getattr(snakemake.params, "custom", None) or {}    # your own methods' legend names and colours
     figures.save(plots.fig_nav_error_envelopes(t, data, method_labels(own),

@@ -7,7 +7,7 @@ from opnav.approach.summaries import HeadlineSummary
 from opnav.core import published
 from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
-from opnav.landing.report import rows_paper_b
+from opnav.report.landing.summary import rows_paper_b
 from opnav.report import scorecard
 from opnav.report.approach_scorecard import rows_paper_a
 from opnav.report.claims import load_plan

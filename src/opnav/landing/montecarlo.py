@@ -11,7 +11,7 @@ flies a list of run indices (in batches of ``landing.mc.batch_size``) and
 stacks the per-run arrays; :func:`summarize_run` is one run's
 :func:`per_run_stats` row; :func:`gather` concatenates chunks
 in run order. (B-T3, the table of these statistics per method, is
-``opnav.landing.report.summary_table``.)
+``opnav.report.landing.summary.summary_table``.)
 
 Statistics (per method, over the runs): final (touchdown) and RMS (over time)
 error norms of position (m), velocity (m/s) and attitude (deg, small-angle

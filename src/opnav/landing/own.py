@@ -36,7 +36,7 @@ def compare_own(data: Mapping[str, dict], names, margin_rel: float, alpha: float
 
 
 def with_own(accuracy: dict, own: Mapping[str, dict]) -> dict:
-    """``accuracy`` (``landing.report.accuracy_tests``) with :func:`compare_own`'s sections in
+    """``accuracy`` (``landing.accuracy.accuracy_tests``) with :func:`compare_own`'s sections in
     its ``equivalence_vs_baselines`` (a baseline's existing section gains the own methods)."""
     by_base = dict(accuracy.get("equivalence_vs_baselines") or {})
     for b, sec in own.items():

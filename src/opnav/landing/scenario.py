@@ -2,8 +2,8 @@
 frozen :class:`Scenario` shared by every run and method (truth trajectory,
 noise-free IMU, landmark field, camera, process noise, filter and planner
 settings; :func:`build_scenario`), the nominal guidance trajectory (:func:`nominal_truth`),
-the initial attitude (:class:`InitialAttitude`), and the scenario as tables: initial state
-(Table 1) and Monte-Carlo initial-error bounds (Table 2). The camera scenarios of the config
+and the initial attitude (:class:`InitialAttitude`); the scenario as tables (B-T1, B-T2) is the
+report layer's (``opnav.report.landing.tables``). The camera scenarios of the config
 are ``Setup.scenarios_by_name`` (and ``setup.scenario_sections``, the workflow's mappings).
 
 Units: position m, velocity m/s, attitude deg, frame {L} (landing site origin,
@@ -19,13 +19,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from opnav.core import published
 from opnav.landing.setup import Setup
 from opnav.landing.trajectory import Truth, nominal_truth
 
-if TYPE_CHECKING:  # pandas only for the B-T1/B-T2 tables: not imported by every Monte-Carlo job
-    import pandas as pd
-
+if TYPE_CHECKING:
     from opnav.landing.camera import Camera
     from opnav.landing.landmarks import LandmarkField
     from opnav.landing.planner import PlannerConfig
@@ -125,10 +122,6 @@ def _cached(setup: Setup) -> Scenario:
     return _scenario(setup)
 
 
-def _vec(v) -> str:
-    return "[" + ", ".join(f"{x:g}" for x in v) + "]"
-
-
 def derived_initial_attitude_deg(setup: Setup) -> np.ndarray:
     """Our initial (roll, pitch, yaw), deg: body +z along the guidance thrust at
     t = 0 with the configured yaw (``opnav.landing.trajectory``)."""
@@ -163,55 +156,3 @@ def initial_attitude_report(setup: Setup) -> InitialAttitude:
     """:class:`InitialAttitude` of ``setup``'s descent."""
     tilt, az = thrust_tilt_azimuth_deg(setup)
     return InitialAttitude([-az, -tilt, 0.0], tilt, az, [float(x) for x in derived_initial_attitude_deg(setup)])
-
-
-def initial_state_table(setup: Setup) -> "pd.DataFrame":
-    """B-T1: the lander's initial state in {L} (paper Table 1), config beside
-    published, and the simulation's initial state (the attitude derived from the
-    guidance thrust direction)."""
-    s = setup.initial_state
-    pub = published.paper_b()["table1_initial_state"]
-    att = initial_attitude_report(setup).paper_convention_deg
-    rows = [
-        ("position", "m", s.r_m, pub["r_m"], s.r_m),
-        ("velocity", "m/s", s.v_mps, pub["v_mps"], s.v_mps),
-        ("attitude -(yaw, pitch, roll), Z-Y-X, roll 0", "deg", s.att_deg, pub["att_deg"],
-         np.round(att, 2)),
-    ]
-    import pandas as pd
-
-    return pd.DataFrame(
-        {
-            "state": [r[0] for r in rows],
-            "unit": [r[1] for r in rows],
-            "config": [_vec(r[2]) for r in rows],
-            "published": [_vec(r[3]) for r in rows],
-            "simulated (ours)": [_vec(r[4]) for r in rows],
-            "norm (config)": [float(np.linalg.norm(r[2])) for r in rows],
-        }
-    )
-
-
-def error_bounds_table(setup: Setup) -> "pd.DataFrame":
-    """B-T2: Monte-Carlo initial-error bounds (paper Table 2), uniform per axis."""
-    b = setup.mc.bounds
-    pub = published.paper_b()["table2_error_bounds"]
-    n = setup.mc.n_runs
-    rows = [
-        ("position", "m", b.r_m, pub["r_m"]),
-        ("velocity", "m/s", b.v_mps, pub["v_mps"]),
-        ("attitude", "deg", b.att_deg, pub["att_deg"]),
-    ]
-    import pandas as pd
-
-    return pd.DataFrame(
-        {
-            "state": [r[0] for r in rows],
-            "unit": [r[1] for r in rows],
-            "bound (config)": [float(r[2]) for r in rows],
-            "bound (published)": [float(r[3]) for r in rows],
-            "distribution": ["uniform in [-bound, +bound] per axis"] * 3,
-            "1-sigma": [float(r[2]) / np.sqrt(3.0) for r in rows],
-            "runs": [n] * 3,
-        }
-    )

@@ -2,7 +2,7 @@
 claim may read, as :class:`opnav.report.evidence.EvidenceRow` rows, with no verdict logic.
 
 :func:`evidence_rows` reads one sample's B-summary.json (the dict
-:func:`opnav.landing.report.combine_scenarios` writes; each camera scenario is a ``scope``) and
+:func:`opnav.report.landing.summary.combine_scenarios` writes; each camera scenario is a ``scope``) and
 writes, for every method and every baseline or control the summary pairs it with:
 
 * ``err_diff_{lastlm,lmrms,final}_m``: the paired mean difference ``method - versus`` of the

@@ -257,9 +257,9 @@ def float_block(paths: Iterable[str | Path], captions_dir: str | Path, relative_
 
 # ------------------------------------------------------------ compact tables
 #: Manuscript views of tables too wide for a page, by SPEC id: each paper's report module
-#: holds its own (opnav.report.approach_views, opnav.landing.report).
+#: holds its own (opnav.report.approach_views, opnav.report.landing.summary).
 def _compact_views() -> dict:
-    from opnav.landing import report as b_report
+    from opnav.report.landing import summary as b_report
     from opnav.report import approach_views
 
     return {**approach_views.COMPACT_VIEWS, **b_report.COMPACT_VIEWS}

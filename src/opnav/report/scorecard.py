@@ -1,7 +1,7 @@
 """The reproduced-vs-published scorecard: every published number of both papers beside
 ours, with the verdict of :mod:`opnav.core.verdicts` (its module docstring states the rule).
 Each paper's rows come from its own module (:func:`opnav.report.approach_scorecard.rows_paper_a`,
-:func:`opnav.landing.report.rows_paper_b`); here they are scored and laid out.
+:func:`opnav.report.landing.summary.rows_paper_b`); here they are scored and laid out.
 """
 
 from __future__ import annotations

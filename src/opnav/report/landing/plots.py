@@ -209,6 +209,7 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
     import matplotlib.pyplot as plt
 
     from opnav.landing import timing_summary as tsum
+    from opnav.report.landing.timing_text import less_time_text
 
     methods = list(methods)
     # the built-in methods' paths (a user's own method names its own: methods.eval_path)
@@ -272,10 +273,10 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
                       fontsize="x-small")
         if published_reduction_vs_svd is not None and {"depth", "svd"} <= set(methods):
             ours = tsum.time_reduction(timing, "depth", "svd", n_boot=0)[0]
-            title = f"depth vs SVD: {tsum.less_time_text(ours)} time ({main_name})"
+            title = f"depth vs SVD: {less_time_text(ours)} time ({main_name})"
             if tsum.times_ns(timing, "svd", "alt").size:
                 da = "alt" if tsum.times_ns(timing, "depth", "alt").size else "main"   # both on that path
                 ours_alt = tsum.time_reduction(timing, "depth", "svd", path_a=da, path_b="alt", n_boot=0)[0]
-                title += f", {tsum.less_time_text(ours_alt)} ({alt_name})"
+                title += f", {less_time_text(ours_alt)} ({alt_name})"
             ax.set_title(f"{title}\npublished {published_reduction_vs_svd:.2f} % less", fontsize="x-small")
         return fig

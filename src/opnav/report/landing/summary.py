@@ -1,5 +1,5 @@
-"""Paper-B reporting pieces: B-T3, the summary JSON, and the pieces for the
-manuscript and the scorecard.
+"""Paper B's reporting pieces: B-T3, the summary JSON, and the pieces for the
+manuscript and the scorecard (the report layer: it reads opnav.landing, never the reverse).
 
 :func:`summary_table` is B-T3 (per-method accuracy and replayed planning time of
 one camera scenario); :func:`scenario_summary` is that scenario's summary JSON
@@ -20,6 +20,7 @@ import numpy as np
 
 from opnav.core.tables import cell_num, cell_pm
 from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
+from opnav.report.landing.timing_text import CLOCK_WORDS, less_time_text
 
 # pandas is imported by the functions that build frames: the jobs that only combine the
 # scenarios' summaries (combine_scenarios) do without its ~0.13 s of import
@@ -27,7 +28,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from opnav.landing.records import MonteCarlo
-    from opnav.landing.setup import Equivalence, Setup
+    from opnav.landing.setup import Setup
 
 
 def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction_vs_svd: float | None = None,
@@ -136,79 +137,6 @@ def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction
     return df
 
 
-def accuracy_tests(data: dict[str, MonteCarlo], eq: Equivalence, converged_pos_err_m: float, *,
-                   margin_rel: float, same_pick_max_pct: float, min_difference_s: float,
-                   thresholds_m: tuple[float, ...] = ()) -> dict:
-    """The accuracy claims of one scenario as tests that can fail
-    (:mod:`opnav.landing.equivalence`), from the gathered Monte Carlo of every
-    method flown (``data``, the controls included), ``landing.equivalence``
-    (``eq``: reference, methods, controls, alpha) and the analysis plan's B-C1
-    numbers, passed in by the caller (the landing package does not read the plan):
-    ``margin_rel`` (margin = that fraction of the reference's mean error) and
-    ``same_pick_max_pct`` (same picks in that share of the calls or more: not
-    tested), both recorded in the result for :func:`same_accuracy_verdict`, and
-    B-C2's ``min_difference_s`` (s: "converges faster" needs at least that).
-    Returns ``equivalence`` (each method of ``methods`` and each control
-    against ``reference``: margin, metric, paired intervals, same-pick rate),
-    ``controls_equivalent`` (the controls that passed: the test is void if any
-    did), ``converges_faster`` (each method of ``methods`` vs ``reference``,
-    first time below ``converged_pos_err_m``), ``errors`` (per method: mean,
-    median and 3-sigma of the error at the last landmark update, RMS over the
-    landmark phase and at touchdown, m), ``nees`` (per method,
-    ``montecarlo.nees_consistency``) and ``equivalence_vs_baselines``: the same paired
-    test of each method of ``methods`` against each of the paper's H baselines flown
-    (svd, gdop, cond: the claim names all three; same margins, alpha and runs);
-    ``converges_faster_by_threshold``: the same paired first-time rule at each threshold of
-    ``thresholds_m`` (m; the analysis plan's sweep, for what B-C2 would take), keyed by the
-    threshold. ``errors`` also holds the RMS velocity and attitude errors over the descent
-    (mean, median, 3-sigma; B-C10's envelopes for every method, controls included)."""
-    from opnav.landing import equivalence as eqv
-    from opnav.landing.montecarlo import nees_consistency, per_run_stats, same_pick_pct, time_below
-
-    ref = eq.reference
-    tested = list(eq.methods) + list(eq.controls)
-    missing = [m for m in [ref, *tested] if m not in data]
-    if missing:
-        raise ValueError(f"landing.equivalence: methods {missing} were not flown")
-    stats = {m: per_run_stats(d) for m, d in data.items()}
-    picks = {m: same_pick_pct(data[m], data[ref]) for m in tested}
-    alpha = float(eq.alpha)
-    res = eqv.equivalence(stats, ref, tested, float(margin_rel), alpha, picks)
-    errors = {}
-    for m, st in stats.items():
-        errors[m] = {}
-        for q in eqv.PRIMARY_METRICS + (eqv.TOUCHDOWN_METRIC, "rms_vel_err_mps", "rms_att_err_deg"):
-            if q not in st:
-                continue
-            col = st[q]
-            errors[m][q] = {"mean": float(col.mean()), "median": float(col.median()),
-                            "3sigma": float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan}
-    t_ref = time_below(data[ref], converged_pos_err_m)
-    faster = {m: eqv.converges_faster(time_below(data[m], converged_pos_err_m), t_ref, m, ref,
-                                      converged_pos_err_m, alpha,
-                                      min_difference_s=float(min_difference_s))
-              for m in eq.methods}
-    by_thr = {}
-    for thr in dict.fromkeys(float(x) for x in thresholds_m):
-        t_ref_k = time_below(data[ref], thr)
-        by_thr[f"{thr:g}"] = {m: eqv.converges_faster(time_below(data[m], thr), t_ref_k, m, ref, thr,
-                                                      alpha, min_difference_s=float(min_difference_s))
-                              for m in eq.methods}
-    by_base = {}
-    for b in ("svd", "gdop", "cond"):
-        if b in data:
-            tested_b = [m for m in eq.methods if m != b]
-            by_base[b] = eqv.equivalence(stats, b, tested_b, float(margin_rel), alpha,
-                                         {m: same_pick_pct(data[m], data[b]) for m in tested_b})
-    return {"equivalence": res,
-            "equivalence_vs_baselines": by_base,
-            "same_pick_max_pct": float(same_pick_max_pct),
-            "controls": list(eq.controls),
-            "controls_equivalent": [c for c in eq.controls if res["methods"][c]["equivalent"]],
-            "converges_faster": faster, "converges_faster_by_threshold": by_thr, "errors": errors,
-            "nees": {m: nees_consistency(d) for m, d in data.items()}}
-
-
 def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCarlo], timing: dict,
                      single: dict, setup: Setup, *, eval_path: str, yaw_ratio: float,
                      published_reduction_vs_svd: float, accuracy: dict | None = None) -> dict:
@@ -252,7 +180,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCa
                                       if {"svd", "depth"} <= set(t.index) else None),
         "eval_path": eval_path,
         # the reductions in words for the manuscript ("34.2 % less", "137.4 % more")
-        "depth_vs_svd_time_text": {p: tsum.less_time_text(float(t.loc["depth", f"time_reduction_vs_svd{x}_pct"]))
+        "depth_vs_svd_time_text": {p: less_time_text(float(t.loc["depth", f"time_reduction_vs_svd{x}_pct"]))
                                    for p, x in (("path", ""), ("alt", "_alt"))
                                    if {"svd", "depth"} <= set(t.index)
                                    and f"time_reduction_vs_svd{x}_pct" in t.columns},
@@ -623,7 +551,7 @@ def planning_time_text(vs: dict, clock: dict, ev: dict | None = None) -> str:
         if not v:
             return None
         return (f"Against {name}: {v['depth_median_us']:.2f} against {v['median_us']:.2f} us (depth "
-                f"{tsum.less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
+                f"{less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
                 f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %).")
     parts = [p for p in (part("svd_closed_form", "the closed-form SVD"),
                          part("svd_lapack", "a LAPACK SVD of the same H"),
@@ -653,8 +581,8 @@ def evidence_text(ev: dict) -> str:
     per = ", ".join(f"{x:.1f}" for x in r["per_replay"])
     sd = r["sd_between"]
     out = (f"Over {ev['n_replays']} independent replays (each a separate process, alone on the machine; "
-           f"clock: {tsum.CLOCK_WORDS}) depth's median call on the {ev.get('eval_path') or ev['path']} path took "
-           f"{tsum.less_time_text(r['mean'])} time than the closed-form SVD's on average. Per replay: {per} %"
+           f"clock: {CLOCK_WORDS}) depth's median call on the {ev.get('eval_path') or ev['path']} path took "
+           f"{less_time_text(r['mean'])} time than the closed-form SVD's on average. Per replay: {per} %"
            + (f"; between-replay sd {sd:.1f} points, {100 * r['level']:.0f} % interval [{r['lo']:.1f}, {r['hi']:.1f}] %"
               if math.isfinite(sd) else "") + ". ")
     rp = ev.get("replays") or [{}]
@@ -669,7 +597,7 @@ def evidence_text(ev: dict) -> str:
                 f"steps: {d['shared_us']:.2f} and {s['shared_us']:.2f} us) and its evaluations ({d['evals_per_call']:.0f} "
                 f"and {s['evals_per_call']:.0f} of {1e3 * d['per_eval_us']:.0f} and {1e3 * s['per_eval_us']:.0f} ns: "
                 f"{d['eval_us']:.2f} against {s['eval_us']:.2f} us). Without the shared part depth's median call "
-                f"would take {tsum.less_time_text(c.get('no_shared_reduction_pct', math.nan))} time. ")
+                f"would take {less_time_text(c.get('no_shared_reduction_pct', math.nan))} time. ")
         sp = ev.get("shared_us_at_published")
         pub = ev.get("published_pct")
         if sp is not None and math.isfinite(sp):
