@@ -107,34 +107,36 @@ def test_claim_reproduced_and_flagged_when_a_control_passes():
     """As the claims table reads B-C1: a control that meets the margin too leaves the
     claim reproduced and the reason says the test cannot credit the metric."""
     from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED
+    from opnav.landing.bsummary import ScenarioSummary
     from opnav.report.landing.summary import same_accuracy_verdict
 
     st = _runs()
     acc = _accuracy(st, 90.0)
-    v = same_accuracy_verdict(acc, "depth")
+    v = same_accuracy_verdict(ScenarioSummary.from_json(acc), "depth")
     assert v.verdict == REPRODUCED and "cannot credit" not in v.reason and "random not equivalent" in v.reason
     near = {**st, "closest": st["svd"] + 0.001 * (st["closest"] - st["svd"])}    # a control as good as svd
     acc = _accuracy(near, 90.0)
     assert acc["controls_equivalent"] == ["closest"]
-    v = same_accuracy_verdict(acc, "depth")
+    v = same_accuracy_verdict(ScenarioSummary.from_json(acc), "depth")
     assert v.verdict == REPRODUCED and "closest pass it too, so the test cannot credit" in v.reason
     worse = {**near, "depth": st["closest"]}                                     # depth fails, the control passes
-    assert same_accuracy_verdict(_accuracy(worse, 90.0), "depth").verdict == NOT_REPRODUCED
+    assert same_accuracy_verdict(ScenarioSummary.from_json(_accuracy(worse, 90.0)), "depth").verdict == NOT_REPRODUCED
 
 
 def test_same_pick_threshold_is_the_recorded_plan_number():
     """The not-tested threshold is the one the summary records (the plan's B-C1
     same_pick_max_pct), not a number in code: 92 % same picks are tested under 95 and
     not under 90 (a threshold fixed at 90 in code fails the first)."""
+    from opnav.landing.bsummary import ScenarioSummary
     from opnav.report.landing.summary import same_accuracy_verdict
 
     st = _runs()
-    assert "not tested" not in same_accuracy_verdict(_accuracy(st, 95.0, 92.0), "depth").reason
-    assert "not tested (same pick >= 90 %)" in same_accuracy_verdict(_accuracy(st, 90.0, 92.0), "depth").reason
+    assert "not tested" not in same_accuracy_verdict(ScenarioSummary.from_json(_accuracy(st, 95.0, 92.0)), "depth").reason
+    assert "not tested (same pick >= 90 %)" in same_accuracy_verdict(ScenarioSummary.from_json(_accuracy(st, 90.0, 92.0)), "depth").reason
     acc = _accuracy(st, 90.0)
     del acc["same_pick_max_pct"]
     with pytest.raises(ValueError, match="same_pick_max_pct"):
-        same_accuracy_verdict(acc, "depth")
+        same_accuracy_verdict(ScenarioSummary.from_json(acc), "depth")
 
 
 def test_margin_is_zero_when_the_reference_error_is_not_positive():
@@ -203,6 +205,7 @@ def test_faster_reading_agrees_with_the_claims_table(shift):
     import pandas as pd
 
     from opnav.core.verdicts import REPRODUCED
+    from opnav.landing.bsummary import BSummary
     from opnav.report.landing.summary import rows_paper_b
     claim = None
     rng = np.random.default_rng(4)
@@ -215,8 +218,8 @@ def test_faster_reading_agrees_with_the_claims_table(shift):
           "methods": {"depth": {"equivalent": True, "verdict": "equivalent", "same_pick_pct": 10.0, "text": "",
                                 "lastlm_pos_err_m": {"mean": 0.0}}}}
     rows = rows_paper_b(pd.DataFrame({"method": ["depth"]}),
-                        {**summary, "equivalence": eq, "controls": [], "controls_equivalent": [],
-                         "same_pick_max_pct": 90.0}, {})
+                        BSummary.from_json({**summary, "equivalence": eq, "controls": [], "controls_equivalent": [],
+                         "same_pick_max_pct": 90.0}), {})
     ours = next(r for r in rows if "converges a bit faster" in r["item"])["verdict"]
     assert (ours == REPRODUCED) == (claim == "reproduced")
     assert (ours == REPRODUCED) == (shift <= -1.5)
@@ -318,6 +321,7 @@ def test_scorecard_reading_agrees_with_the_claims_table(case):
     one margin, one same-pick threshold (a margin back on the runs' random gap splits them in
     the random_far case: tried once)."""
     from opnav.core.verdicts import REPRODUCED
+    from opnav.landing.bsummary import ScenarioSummary
     from opnav.report.landing.summary import same_accuracy_verdict
     from opnav.report import claims as C
     from opnav.report.claims import load_plan
@@ -331,7 +335,7 @@ def test_scorecard_reading_agrees_with_the_claims_table(case):
         st = {**st, "random": st["random"] + 50.0}
     plan = load_plan()
     acc = _accuracy(st, plan.margin("B-C1", "same_pick_max_pct"), 95.0 if case == "same_picks" else 40.0)
-    ours = same_accuracy_verdict(acc, "depth")
+    ours = same_accuracy_verdict(ScenarioSummary.from_json(acc), "depth")
     j = _judge_b("B-C1", acc, full=True)
     if case == "same_picks":
         assert j.verdict == C.NOT_TESTED and "not tested" in ours.reason

@@ -70,13 +70,14 @@ def test_rows_paper_a_pairs_pub_columns_and_uses_crlb():
 def test_rows_paper_b_timing():
     import pandas as pd
 
+    from opnav.landing.bsummary import BSummary
     from opnav.report.landing.summary import rows_paper_b
 
     t3 = pd.DataFrame([
         {"method": "depth", "time_reduction_vs_svd_pct": 80.0, "rms_pos_err_m_mean": 100.0},
         {"method": "svd", "time_reduction_vs_svd_pct": float("nan"), "rms_pos_err_m_mean": 130.0},
     ])
-    df = score_rows(rows_paper_b(t3, {}, {"depth_time_reduction_vs_svd_pct": 29.03}))
+    df = score_rows(rows_paper_b(t3, BSummary.from_json({}), {"depth_time_reduction_vs_svd_pct": 29.03}))
     assert df.loc[0, "verdict"] == NOT_REPRODUCED                 # 80 % vs 29.03 %
 
 
@@ -89,6 +90,7 @@ def test_wide_band_does_not_count_as_reproduced():
 def test_rows_paper_b_per_scenario_from_the_summary():
     import pandas as pd
 
+    from opnav.landing.bsummary import BSummary
     from opnav.report.landing.summary import rows_paper_b
 
     def methods(pick):
@@ -115,7 +117,7 @@ def test_rows_paper_b_per_scenario_from_the_summary():
                              "open": {"methods": methods(40.0), **accuracy(40.0, True)}},
                "initial_tilt_deg": 9.2, "initial_azimuth_deg": 16.5}
     pub = {"depth_time_reduction_vs_svd_pct": 29.03, "table1_initial_state": {"att_deg": [-25.7, -9.8, 0.0]}}
-    df = score_rows(rows_paper_b(pd.DataFrame(), summary, pub)).set_index("item")
+    df = score_rows(rows_paper_b(pd.DataFrame(), BSummary.from_json(summary), pub)).set_index("item")
     item = "depth vs svd: 'almost the same' accuracy (paired equivalence, negative controls)"
     assert df.loc[f"[site-tilt] {item}", "verdict"] == NOT_REPRODUCED     # the same picks: not tested
     assert df.loc[f"[interior] {item}", "verdict"] == REPRODUCED
@@ -157,6 +159,7 @@ def test_timing_rows_take_the_plans_band():
     in score_rows fails this: tried once)."""
     import pandas as pd
 
+    from opnav.landing.bsummary import BSummary
     from opnav.report.landing.summary import rows_paper_b
     from opnav.report.claims import load_plan
 
@@ -166,12 +169,12 @@ def test_timing_rows_take_the_plans_band():
     band = {"rel_tol": plan.margin("B-C4", "rel_tol"), "k_spread": plan.margin("B-C4", "spread_k"),
             "max_band_rel": plan.margin("B-C4", "max_band_rel")}
     item = "median planning time, depth vs SVD: reduction"
-    assert score_rows(rows_paper_b(t3, {}, pub, band)).set_index("item").loc[item, "verdict"] == NOT_REPRODUCED
-    wide = score_rows(rows_paper_b(t3, {}, pub, {**band, "rel_tol": 0.2})).set_index("item")
+    assert score_rows(rows_paper_b(t3, BSummary.from_json({}), pub, band)).set_index("item").loc[item, "verdict"] == NOT_REPRODUCED
+    wide = score_rows(rows_paper_b(t3, BSummary.from_json({}), pub, {**band, "rel_tol": 0.2})).set_index("item")
     assert wide.loc[item, "verdict"] == REPRODUCED and "within tolerance 5.81" in wide.loc[item, "reason"]
     # a spread wider than the plan's max_band_rel reads 'wide', with the plan's k in the reason
     t3w = t3.assign(time_reduction_vs_svd_pct_std=4.0)
-    r = score_rows(rows_paper_b(t3w, {}, pub, {**band, "max_band_rel": 0.2})).set_index("item").loc[item]
+    r = score_rows(rows_paper_b(t3w, BSummary.from_json({}), pub, {**band, "max_band_rel": 0.2})).set_index("item").loc[item]
     assert r["verdict"] == NOT_REPRODUCED and f"{band['k_spread']:g} sd = 8" in r["reason"]
 
 
@@ -181,6 +184,7 @@ def test_the_timing_row_reads_the_spread_between_replays_not_one_replays_bootstr
     B-T3's bootstrap sd of one replay (0.5) would read it not reproduced (mutation tried once)."""
     import pandas as pd
 
+    from opnav.landing.bsummary import BSummary
     from opnav.report.landing.summary import rows_paper_b
 
     t3 = pd.DataFrame([{"method": "depth", "time_reduction_vs_svd_pct": 24.0, "time_reduction_vs_svd_pct_std": 0.5}])
@@ -188,7 +192,7 @@ def test_the_timing_row_reads_the_spread_between_replays_not_one_replays_bootstr
     band = {"rel_tol": 0.1, "k_spread": 2.0, "max_band_rel": 0.5}
     summ = {"planning_time": {"reduction_pct": {"depth_vs_svd": {"per_replay": [18.0, 24.0, 30.0], "mean": 24.0,
                                                                 "sd_between": 6.0, "interval": "between_replays"}}}}
-    df = score_rows(rows_paper_b(t3, summ, pub, band))
+    df = score_rows(rows_paper_b(t3, BSummary.from_json(summ), pub, band))
     row = df[df["item"].str.contains("mean of 3 replays")].iloc[0]
     assert row["verdict"] == REPRODUCED and row["ours (spread)"] == 6.0
-    assert score_rows(rows_paper_b(t3, {}, pub, band)).iloc[0]["verdict"] == NOT_REPRODUCED
+    assert score_rows(rows_paper_b(t3, BSummary.from_json({}), pub, band)).iloc[0]["verdict"] == NOT_REPRODUCED

@@ -85,7 +85,7 @@ rule paper_claims:
         optima=B_OPTIMA,
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # one path: the script reads it as a file
-        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "report/evidence.py",
+        code=src("report/claims.py", "report/approach_claims.py", "report/landing_claims.py", "landing/bsummary.py", "report/evidence.py",
                  "report/plan.py", "report/scorer.py", "report/would_take_plot.py", "report/manuscript.py", "core/wording.py",
                  "core/published.py"),
     output:
@@ -196,7 +196,7 @@ rule paper_scorecard:
         **{f"summary_{k}": p for k, p in SUMMARIES.items()},
         published=src("data/published.yaml"),
         plan=src("data/analysis_plan.yaml")[0],  # B-C4's band for the timing rows
-        code=src("report/scorecard.py", "core/verdicts.py", "report/approach_scorecard.py", "approach/summaries.py", "report/landing/summary.py", "report/landing/timing_text.py", "core/published.py"),
+        code=src("report/scorecard.py", "core/verdicts.py", "report/approach_scorecard.py", "approach/summaries.py", "report/landing/summary.py", "report/landing/timing_text.py", "landing/bsummary.py", "core/published.py"),
     output:
         table=report_table(f"{PAPER}/scorecard", "scorecard", "Scorecard"),
         longtable=f"{PAPER}/scorecard_longtable.tex",

@@ -18,6 +18,7 @@ from opnav.report.approach_claims import HEADLINE_IDS as A_HEAD
 from opnav.report.approach_claims import evidence_rows as rows_a
 from opnav.report.approach_claims import input_rows as inputs_a
 from opnav.report.approach_claims import published_rows as pub_a
+from opnav.landing.bsummary import BSummary
 from opnav.report.landing_claims import HEADLINE_IDS as B_HEAD
 from opnav.report.landing_claims import evidence_rows as rows_b
 from opnav.report.landing_claims import input_rows as inputs_b
@@ -37,7 +38,7 @@ def sample_rows(inp, prefix, sample, plan, windows, optima):
         out += rows_a(load_table(inp[f"{prefix}a_table1"]), summ["A"], sample, inp[f"{prefix}a_table1"],
                       inp[f"{prefix}summary_A"], windows)
     if f"{prefix}summary_B" in keys:
-        summ["B"] = load_json(inp[f"{prefix}summary_B"])
+        summ["B"] = BSummary.from_json(load_json(inp[f"{prefix}summary_B"]))   # read by meaning (typed)
         out += rows_b(summ["B"], sample, inp[f"{prefix}summary_B"], plan, optima if not prefix else None)
     return summ, out
 

@@ -7,6 +7,7 @@ from opnav.approach.summaries import HeadlineSummary
 from opnav.core import published
 from opnav.core.snakeio import load_json, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text, write_table
+from opnav.landing.bsummary import BSummary
 from opnav.report.landing.summary import rows_paper_b
 from opnav.report import scorecard
 from opnav.report.approach_scorecard import rows_paper_a
@@ -27,7 +28,8 @@ with script_context(snakemake) as log:
         plan = load_plan(inp["plan"])
         band = {"rel_tol": plan.margin("B-C4", "rel_tol"), "k_spread": plan.margin("B-C4", "spread_k"),
                 "max_band_rel": plan.margin("B-C4", "max_band_rel")}
-        rows += rows_paper_b(load_table(inp["b_summary_table"]), summary_b, published.paper_b(), band)
+        rows += rows_paper_b(load_table(inp["b_summary_table"]), BSummary.from_json(summary_b), published.paper_b(),
+                             band)
     df = scorecard.score_rows(rows)
     write_table(df, snakemake.output.table, caption=scorecard.CAPTION)
     atomic_write_text(snakemake.output.longtable, scorecard.to_longtable(df))

@@ -35,6 +35,8 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
+from opnav.landing.bsummary import (BSummary, EquivalenceSection, OptimaCount, PlanningTime, ScenarioSummary, Stat,
+                                    num)
 from opnav.report.evidence import NAN, EvidenceRow, quantity, se_from_interval
 from opnav.report.plan import Plan
 
@@ -113,61 +115,64 @@ class _Rows:
             se=_f(se), setting=setting)
 
 
-def _equivalence(r: _Rows, scope: str, sec: Mapping[str, Any], where: str, errors: Mapping[str, Any], n_runs: int):
-    ref = sec.get("reference")
-    alpha = _f(sec.get("alpha"))
+def _equivalence(r: _Rows, scope: str, sec: EquivalenceSection, where: str, errors: Mapping[str, Mapping[str, Stat]],
+                 n_runs: int):
+    ref = sec.reference
+    alpha = num(sec.alpha)
     level = 1.0 - 2.0 * alpha if math.isfinite(alpha) else NAN
     for key, q in ERR_KEYS.items():
-        means = ((sec.get("metrics") or {}).get(key) or {}).get("means") or {}
-        for m, v in means.items():
-            sd = _f(((errors.get(m) or {}).get(key) or {}).get("3sigma")) / 3.0
+        mm = sec.metrics.get(key)
+        for m, v in (mm.means if mm else {}).items():
+            st = errors.get(m, {}).get(key)
+            sd = (num(st.sigma3) if st else NAN) / 3.0
             r.add(scope, m, "", f"err_mean_{q}_m", v, n=n_runs, se=sd / math.sqrt(n_runs) if n_runs else NAN,
                   where=f"{where}.metrics.{key}.means.{m}")
-    for m, res in (sec.get("methods") or {}).items():
+    for m, res in sec.methods.items():
         for key, q in ERR_KEYS.items():
-            t = res.get(key)
-            if not t:
+            t = res.tests.get(key)
+            if t is None:
                 continue
-            n = int(t.get("n") or n_runs or 0)
-            se = _f(t.get("se"))
+            n = int(t.n or n_runs or 0)
+            se = t.se
             if not math.isfinite(se):
-                se = se_from_interval(_f(t.get("lo")), _f(t.get("hi")), n, level)
-            r.add(scope, m, ref, f"err_diff_{q}_m", t.get("mean"), lo=t.get("lo"), hi=t.get("hi"), level=level, n=n,
+                se = se_from_interval(t.lo, t.hi, n, level)
+            r.add(scope, m, ref, f"err_diff_{q}_m", t.mean, lo=t.lo, hi=t.hi, level=level, n=n,
                   se=se, where=f"{where}.methods.{m}.{key}")
-        if res.get("same_pick_pct") is not None:
-            r.add(scope, m, ref, "same_pick_pct", res["same_pick_pct"], n=n_runs, where=f"{where}.methods.{m}.same_pick_pct")
+        if res.same_pick_pct is not None:
+            r.add(scope, m, ref, "same_pick_pct", res.same_pick_pct, n=n_runs, where=f"{where}.methods.{m}.same_pick_pct")
 
 
-def _converges(r: _Rows, scope: str, s: Mapping[str, Any], ref: str):
+def _converges(r: _Rows, scope: str, s: ScenarioSummary, ref: str):
     sections = []
-    for thr, per in (s.get("converges_faster_by_threshold") or {}).items():
+    for thr, per in s.converges_faster_by_threshold.items():
         sections.append((per, f"converges_faster_by_threshold.{thr}"))
-    sections.append((s.get("converges_faster") or {}, "converges_faster"))
+    sections.append((s.converges_faster, "converges_faster"))
     for per, where in sections:
         for m, cf in per.items():
-            thr = _f(cf.get("threshold_m"))
-            level = _f(cf.get("level"))
+            thr = cf.threshold_m
+            level = cf.level
             if not math.isfinite(level):
-                level = 1.0 - _f((s.get("equivalence") or {}).get("alpha", 0.05))
-            n = int(cf.get("n_runs") or 0)
-            se = _f(cf.get("se_s"))
+                alpha = s.equivalence.alpha if s.equivalence is not None else None
+                level = 1.0 - (0.05 if alpha is None else alpha)
+            n = int(cf.n_runs)
+            se = cf.se_s
             if not math.isfinite(se):
-                se = se_from_interval(_f(cf.get("lo_s")), _f(cf.get("hi_s")), n, level)
-            r.add(scope, m, cf.get("versus") or ref, "converge_time_diff_s", cf.get("mean_s"), lo=cf.get("lo_s"),
-                  hi=cf.get("hi_s"), level=level, n=n, se=se, setting=f"threshold_m={thr:g}", where=f"{where}.{m}")
+                se = se_from_interval(cf.lo_s, cf.hi_s, n, level)
+            r.add(scope, m, cf.versus or ref, "converge_time_diff_s", cf.mean_s, lo=cf.lo_s,
+                  hi=cf.hi_s, level=level, n=n, se=se, setting=f"threshold_m={thr:g}", where=f"{where}.{m}")
 
 
 _YAW = re.compile(r"\(([\w-]+)\): ([\d.]+) deg at start, ([\d.]+) deg at touchdown")
 
 
-def _yaw(r: _Rows, scope: str, s: Mapping[str, Any], first: str):
-    y = s.get("yaw_sigma3_deg")
-    n = int(s.get("n_runs") or 0)
+def _yaw(r: _Rows, scope: str, s: ScenarioSummary, first: str):
+    y = s.yaw_sigma3
+    n = s.n_runs
     if y:
-        start, end, m = _f(y.get("start")), _f(y.get("end")), y.get("method", first)
+        start, end, m = y.start, y.end, y.method or first
         where = "yaw_sigma3_deg"
     else:   # a summary before yaw_sigma3_deg: the numbers of its yaw_reason sentence
-        mt = _YAW.search(str(s.get("yaw_reason") or ""))
+        mt = _YAW.search(str(s.yaw_reason or ""))
         if not mt:
             return
         start, end, m, where = float(mt.group(2)), float(mt.group(3)), mt.group(1), "yaw_reason"
@@ -176,16 +181,16 @@ def _yaw(r: _Rows, scope: str, s: Mapping[str, Any], first: str):
         r.add(scope, m, "", "yaw_sigma3_ratio", ratio, n=n, se=ratio * math.sqrt(1.0 / max(n - 1, 1)), where=where)
 
 
-def _envelopes(r: _Rows, scope: str, s: Mapping[str, Any], n_runs: int):
-    env: dict[str, dict[str, float]] = {}
-    for m, e in (s.get("errors") or {}).items():
+def _envelopes(r: _Rows, scope: str, s: ScenarioSummary, n_runs: int):
+    env: dict[str, dict[str, tuple[float, str]]] = {}
+    for m, e in s.errors.items():
         for key, q in (("rms_vel_err_mps", "vel"), ("rms_att_err_deg", "att")):
-            if (e.get(key) or {}).get("3sigma") is not None:
-                env.setdefault(m, {})[q] = (_f(e[key]["3sigma"]), f"errors.{m}.{key}.3sigma")
-    for m, row in (s.get("methods") or {}).items():
+            if key in e and e[key].sigma3 is not None:
+                env.setdefault(m, {})[q] = (num(e[key].sigma3), f"errors.{m}.{key}.3sigma")
+    for m, row in s.methods.items():   # B-T3's rows, by column
         for key, q in (("rms_vel_err_mps_3sigma", "vel"), ("rms_att_err_deg_3sigma", "att")):
             if row.get(key) is not None:
-                env.setdefault(m, {}).setdefault(q, (_f(row[key]), f"methods.{m}.{key}"))
+                env.setdefault(m, {}).setdefault(q, (num(row[key]), f"methods.{m}.{key}"))
     for m, a in env.items():
         for b, bb in env.items():
             if m == b:
@@ -208,46 +213,45 @@ def _stats(vals: list[float]) -> tuple[float, float, int]:
     return m, sd, k
 
 
-def _planning_time(r: _Rows, scope: str, pt: Mapping[str, Any], replay_prefix: str, between: str):
+def _planning_time(r: _Rows, scope: str, pt: PlanningTime, replay_prefix: str, between: str):
     """The timing issue's planning_time block: per replay, between replays, decomposition, curve."""
-    reps = pt.get("replays") or []
-    meds = {}
+    reps = pt.replays
+    meds: dict[str, dict[int, float]] = {}
     for k, rep in enumerate(reps):
-        for m, us in (rep.get("median_us") or {}).items():
-            meds.setdefault(m, {})[k] = _f(us)
-            r.add(scope, m, "", "median_time_us", us, n=int(rep.get("n_calls") or 0),
+        for m, us in rep.median_us.items():
+            meds.setdefault(m, {})[k] = num(us)
+            r.add(scope, m, "", "median_time_us", us, n=rep.n_calls,
                   sample=f"{replay_prefix}{k + 1}", where=f"planning_time.replays.{k}.median_us.{m}")
-    for m, st in (pt.get("median_us") or {}).items():
-        pr = [_f(x) for x in st.get("per_replay") or []]
-        mean, sd, kk = _stats(pr)
-        r.add(scope, m, "", "median_time_us", st.get("mean", mean), lo=st.get("lo"), hi=st.get("hi"),
-              level=st.get("level", NAN), n=kk, se=_f(st.get("sd_between", sd)) / math.sqrt(kk) if kk else NAN,
+    for m, st in pt.median_us.items():
+        mean, sd, kk = _stats(list(st.per_replay))
+        sdb = sd if st.sd_between is None else st.sd_between
+        r.add(scope, m, "", "median_time_us", mean if st.mean is None else st.mean, lo=st.lo, hi=st.hi,
+              level=st.level, n=kk, se=sdb / math.sqrt(kk) if kk else NAN,
               sample=between, where=f"planning_time.median_us.{m}")
     declared = set()
-    for key, st in (pt.get("reduction_pct") or {}).items():
+    for key, st in pt.reduction_pct.items():
         a, _, b = key.partition("_vs_")
-        if st.get("interval") == "bootstrap" or st.get("path"):
+        if st.interval == "bootstrap" or st.path:
             # timed once (beside other jobs): one replay's reading with its bootstrap interval over
             # the calls, never a spread between replays
             vs = b
-            x = (st.get("per_replay") or [st.get("mean")])[0]
-            lvl = _f(st.get("level"))
-            r.add(scope, a, vs, "reduction_pct", x, lo=st.get("lo"), hi=st.get("hi"), level=lvl,
-                  n=int(st.get("n_calls") or 0), sample=f"{replay_prefix}1",
-                  se=se_from_interval(_f(st.get("lo")), _f(st.get("hi")), int(st.get("n_calls") or 0), lvl),
+            x = (st.per_replay or (st.mean,))[0]
+            r.add(scope, a, vs, "reduction_pct", x, lo=st.lo, hi=st.hi, level=st.level,
+                  n=st.n_calls, sample=f"{replay_prefix}1",
+                  se=se_from_interval(st.lo, st.hi, st.n_calls, st.level),
                   where=f"planning_time.reduction_pct.{key}")
             declared.add((a, vs))
             continue
         declared.add((a, b))
-        pr = [_f(x) for x in st.get("per_replay") or []]
+        pr = list(st.per_replay)
         for k, x in enumerate(pr):
-            n = int((reps[k].get("n_calls") if k < len(reps) else 0) or 0)
+            n = reps[k].n_calls if k < len(reps) else 0
             r.add(scope, a, b, "reduction_pct", x, n=n, sample=f"{replay_prefix}{k + 1}",
                   where=f"planning_time.reduction_pct.{key}.per_replay.{k}")
         mean, sd, kk = _stats(pr)
-        sdb = _f(st.get("sd_between", sd))
-        r.add(scope, a, b, "reduction_pct", st.get("mean", mean), lo=st.get("lo"), hi=st.get("hi"),
-              level=st.get("level", NAN), n=kk, se=sdb / math.sqrt(kk) if kk else NAN, sample=between,
+        sdb = sd if st.sd_between is None else st.sd_between
+        r.add(scope, a, b, "reduction_pct", mean if st.mean is None else st.mean, lo=st.lo, hi=st.hi,
+              level=st.level, n=kk, se=sdb / math.sqrt(kk) if kk else NAN, sample=between,
               where=f"planning_time.reduction_pct.{key}")
     # every other pair from the replays' medians (the same replays, so the same spread rule)
     for a, ma in meds.items():
@@ -262,87 +266,88 @@ def _planning_time(r: _Rows, scope: str, pt: Mapping[str, Any], replay_prefix: s
             if kk:
                 r.add(scope, a, b, "reduction_pct", mean, n=kk, se=sd / math.sqrt(kk) if kk > 1 else NAN,
                       sample=between, where=f"planning_time.replays.*.median_us ({a} against {b})")
-    for m, d in (pt.get("decomposition") or {}).items():
+    for m, d in pt.decomposition.items():
         for q in ("per_eval_us", "shared_us", "evals_per_call"):
-            if d.get(q) is not None:
-                r.add(scope, m, "", q, d[q], n=len(reps), sample=between, where=f"planning_time.decomposition.{m}.{q}")
-    curve = pt.get("overhead_curve") or {}
-    ca, cb = curve.get("a", "depth"), curve.get("b", "svd")
-    for x, y in zip(curve.get("shared_us") or [], curve.get("reduction_pct") or []):
-        r.add(scope, ca, cb, "reduction_pct", y, sample=between, setting=f"shared_us={_f(x):.4g}",
+            v = getattr(d, q)
+            if v is not None:
+                r.add(scope, m, "", q, v, n=len(reps), sample=between, where=f"planning_time.decomposition.{m}.{q}")
+    curve = pt.overhead_curve
+    ca, cb = curve.a, curve.b
+    for x, y in zip(curve.shared_us, curve.reduction_pct):
+        r.add(scope, ca, cb, "reduction_pct", y, sample=between, setting=f"shared_us={x:.4g}",
               where="planning_time.overhead_curve")
-    if pt.get("shared_us_at_published") is not None:
-        r.add(scope, ca, cb, "shared_us_at_published", pt["shared_us_at_published"], sample=between,
+    if pt.shared_us_at_published is not None:
+        r.add(scope, ca, cb, "shared_us_at_published", pt.shared_us_at_published, sample=between,
               where="planning_time.shared_us_at_published")
 
 
-def _old_timing(r: _Rows, scope: str, s: Mapping[str, Any], replay: str):
+def _old_timing(r: _Rows, scope: str, s: ScenarioSummary, replay: str):
     """A summary before the planning_time block: one replay (its bootstrap is not a spread
     between replays, so these rows sit in a replay sample, never between_replays)."""
-    for label, v in (s.get("planning_time_vs_depth") or {}).items():
+    for label, v in s.planning_time_vs_depth.items():
         b = VS_LABELS.get(label, label)
-        lo, hi = _f(v.get("depth_reduction_lo_pct")), _f(v.get("depth_reduction_hi_pct"))
-        r.add(scope, "depth", b, "reduction_pct", v.get("depth_reduction_pct"), lo=lo, hi=hi, level=0.95,
+        r.add(scope, "depth", b, "reduction_pct", v.depth_reduction_pct, lo=v.lo, hi=v.hi, level=0.95,
               sample=replay, where=f"planning_time_vs_depth.{label}")
-    for m, row in (s.get("methods") or {}).items():
+    for m, row in s.methods.items():   # B-T3's rows, by column
         n = int(row.get("timed_calls") or 0)
         us = row.get("median_plan_cpu_us", row.get("median_plan_time_us"))
         r.add(scope, m, "", "median_time_us", us, n=n, sample=replay, where=f"methods.{m}.median_plan_cpu_us")
-        for b in (s.get("methods") or {}):
+        for b in s.methods:
             if b == m:
                 continue
             red = row.get(f"cpu_time_reduction_vs_{b}_pct", row.get(f"time_reduction_vs_{b}_pct"))
             r.add(scope, m, b, "reduction_pct", red, n=n, sample=replay, where=f"methods.{m}.cpu_time_reduction_vs_{b}_pct")
-        alt = OTHER_PATH.get(str(s.get("eval_path") or ""), "")
+        alt = OTHER_PATH.get(s.eval_path, "")
         if alt and row.get("time_reduction_vs_svd_alt_pct") is not None:
             r.add(scope, m, "svd", "reduction_pct", row["time_reduction_vs_svd_alt_pct"], se=row.get(
                 "time_reduction_vs_svd_alt_pct_std"), n=int(row.get("timed_calls_alt") or 0), sample=replay,
                 setting=f"path={alt}", where=f"methods.{m}.time_reduction_vs_svd_alt_pct")
 
 
-def _optima(r: _Rows, scope: str, o: Mapping[str, Any]):
-    n = int(o.get("n_calls") or 0)
-    r.add(scope, o.get("method", "depth"), "", "calls_multi_minimum", o.get("calls_multi_minimum"), n=n,
+def _optima(r: _Rows, scope: str, o: OptimaCount):
+    r.add(scope, o.method, "", "calls_multi_minimum", o.calls_multi_minimum, n=o.n_calls,
           where="calls_multi_minimum")
-    if o.get("max_minima_per_call") is not None:
-        r.add(scope, o.get("method", "depth"), "", "max_minima_per_call", o["max_minima_per_call"], n=n,
+    if o.max_minima_per_call is not None:
+        r.add(scope, o.method, "", "max_minima_per_call", o.max_minima_per_call, n=o.n_calls,
               where="max_minima_per_call")
 
 
-def evidence_rows(summary: Mapping[str, Any], sample: str, source: str, plan: Plan,
+def evidence_rows(summary: Mapping[str, Any] | BSummary, sample: str, source: str, plan: Plan,
                   optima: Mapping[str, Mapping[str, Any]] | None = None) -> list[EvidenceRow]:
     """Every evidence row of one sample's B-summary.json (``sample``: main | replication;
     ``source``: its path, for the ``source`` column; ``optima``: scenario -> the B-C8 count of
-    :func:`opnav.landing.optima.count_summary`, where it was run). No verdict logic."""
-    if not isinstance(summary, Mapping):
+    :func:`opnav.landing.optima.count_summary`, where it was run). The document is read through
+    its typed form (``opnav.landing.bsummary.BSummary``). No verdict logic."""
+    if isinstance(summary, BSummary):
+        b = summary
+    elif isinstance(summary, Mapping):
+        b = BSummary.from_json(summary)
+    else:
         raise TypeError(f"landing_claims.evidence_rows: summary must be the B-summary dict, got {type(summary).__name__}")
-    scen = summary.get("scenarios") or {summary.get("scenario", "headline"): summary}
-    head = summary.get("headline_scenario") or next(iter(scen))
-    order = [head] + [k for k in scen if k != head]
+    counts = {n: OptimaCount.from_json(o) for n, o in (optima or {}).items()}
     r = _Rows(sample, source, roles(plan))
     rep_prefix = "replay" if sample == "main" else "replay_rep"
     between = "between_replays" if sample == "main" else sample
-    for name in order:
-        s = scen[name]
-        n_runs = int(s.get("n_runs") or 0)
-        errors = s.get("errors") or {}
-        eq = s.get("equivalence") or {}
-        if eq:
-            _equivalence(r, name, eq, "equivalence", errors, n_runs)
-        for b, sec in (s.get("equivalence_vs_baselines") or {}).items():
-            _equivalence(r, name, sec, f"equivalence_vs_baselines.{b}", errors, n_runs)
-        _converges(r, name, s, eq.get("reference", "svd"))
-        methods = list(s.get("methods") or {})
+    for name in b.headline_first:
+        s = b.scenarios[name]
+        n_runs = s.n_runs
+        eq = s.equivalence
+        if eq is not None:
+            _equivalence(r, name, eq, "equivalence", s.errors, n_runs)
+        for base, sec in s.equivalence_vs_baselines.items():
+            _equivalence(r, name, sec, f"equivalence_vs_baselines.{base}", s.errors, n_runs)
+        _converges(r, name, s, (eq.reference if eq is not None else None) or "svd")
+        methods = list(s.methods)
         _yaw(r, name, s, methods[0] if methods else "depth")
         _envelopes(r, name, s, n_runs)
-        if s.get("planning_time"):
-            _planning_time(r, name, s["planning_time"], rep_prefix, between)
+        if s.planning_time is not None:
+            _planning_time(r, name, s.planning_time, rep_prefix, between)
         else:
             _old_timing(r, name, s, f"{rep_prefix}1")
-        if optima and name in optima:
-            _optima(r, name, optima[name])
-        elif s.get("optima"):
-            _optima(r, name, s["optima"])
+        if name in counts:
+            _optima(r, name, counts[name])
+        elif s.optima is not None:
+            _optima(r, name, s.optima)
     return list(r.rows.values())
 
 
@@ -373,15 +378,17 @@ def terminal_accel_to_match(landing_cfg: Mapping[str, Any], tilt_deg: float, azi
     return [float(sol.x[0]), float(sol.x[1])]
 
 
-def input_rows(summary: Mapping[str, Any], pub: Mapping[str, Any], plan: Plan,
+def input_rows(summary: Mapping[str, Any] | BSummary, pub: Mapping[str, Any], plan: Plan,
                landing_cfg: Mapping[str, Any] | None = None) -> list[dict]:
     """Paper B's derived inputs (inputs.csv): Table 1's initial pitch and yaw, how we derive
-    them and what would match the published values (``summary``: B-summary.json)."""
-    if summary.get("initial_tilt_deg") is None:
+    them and what would match the published values (``summary``: B-summary.json, read through
+    its typed form)."""
+    b = summary if isinstance(summary, BSummary) else BSummary.from_json(summary)
+    if b.initial_tilt_deg is None or math.isnan(b.initial_tilt_deg):
         return []
     att = pub["table1_initial_state"]["att_deg"]
     tilt_pub, az_pub = -float(att[1]), -float(att[0])
-    tilt, az = float(summary["initial_tilt_deg"]), float(summary["initial_azimuth_deg"])
+    tilt, az = float(b.initial_tilt_deg), float(b.initial_azimuth_deg)
     ins = plan.raw.get("inputs", {})
     match = ""
     if landing_cfg is not None:

@@ -20,6 +20,7 @@ import numpy as np
 
 from opnav.core.tables import cell_num, cell_pm
 from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
+from opnav.landing.bsummary import NAN, BSummary, ScenarioSummary, num
 from opnav.report.landing.timing_text import CLOCK_WORDS, less_time_text
 
 # pandas is imported by the functions that build frames: the jobs that only combine the
@@ -265,59 +266,59 @@ def combine_scenarios(parts: dict[str, dict], headline: str, cameras: dict[str, 
 COMPACT_VIEWS = {"B-T3": compact_b_t3, "B-X1": compact_b_x1}
 
 
-def same_accuracy_verdict(accuracy: dict, method: str = "depth") -> Verdict:
+def same_accuracy_verdict(s: ScenarioSummary, method: str = "depth") -> Verdict:
     """Verdict on "almost the same accuracy" (``method`` vs the equivalence
-    reference) from :func:`accuracy_tests`, by the claims table's rule (B-C1 of
-    the analysis plan; its margin and same-pick threshold are the ones recorded
-    in ``accuracy``): not tested when the two methods pick the same landmark in
+    reference) from one scenario's summary (``opnav.landing.bsummary.ScenarioSummary``: the
+    document :func:`opnav.landing.accuracy.accuracy_tests` wrote, read back), by the claims
+    table's rule (B-C1 of the analysis plan; its margin and same-pick threshold are the ones
+    recorded in the summary): not tested when the two methods pick the same landmark in
     ``same_pick_max_pct`` of the planning calls or more (equal accuracy then
     follows by construction) or the margin is 0; else reproduced iff the paired
     equivalence test shows ``method`` equivalent on both primary metrics. A
     negative control (``random``, ``center``, ``closest``) that passes too does
     not change the verdict: the reason says the test cannot credit the metric.
     The reason names margin, metric, same-pick rate and the controls' verdicts."""
-    eq = accuracy["equivalence"]
-    if "same_pick_max_pct" not in accuracy or "margin_rel" not in eq:
+    eq = s.equivalence
+    if eq is None or s.same_pick_max_pct is None or eq.margin_rel is None:
         raise ValueError("landing summary: no same_pick_max_pct / margin_rel from the analysis plan "
                          "(a summary of an older build: rebuild landing_summary)")
-    pick_max = float(accuracy["same_pick_max_pct"])
-    res = eq["methods"][method]
-    ctrl = "; ".join(f"{c} {eq['methods'][c]['verdict']}" for c in accuracy["controls"])
-    why = f"{res['text']}; negative controls vs {eq['reference']}: {ctrl or 'none'}"
-    sp = res["same_pick_pct"]
+    pick_max = float(s.same_pick_max_pct)
+    res = eq.methods[method]
+    ctrl = "; ".join(f"{c} {eq.methods[c].verdict}" for c in s.controls)
+    why = f"{res.text}; negative controls vs {eq.reference}: {ctrl or 'none'}"
+    sp = NAN if res.same_pick_pct is None else res.same_pick_pct
     if not math.isnan(sp) and sp >= pick_max:
         return Verdict(NOT_REPRODUCED, f"not tested (same pick >= {pick_max:g} %): {why}")
     from opnav.landing.equivalence import PRIMARY_METRICS
 
-    if any(eq["metrics"][q]["margin"] <= 0 for q in PRIMARY_METRICS):
-        return Verdict(NOT_REPRODUCED, f"not tested ({eq['reference']}'s mean error is not positive, "
+    if any(eq.metrics[q].margin <= 0 for q in PRIMARY_METRICS):
+        return Verdict(NOT_REPRODUCED, f"not tested ({eq.reference}'s mean error is not positive, "
                                        f"margin 0): {why}")
-    if res["equivalent"] and accuracy["controls_equivalent"]:
-        return Verdict(REPRODUCED, f"{why}; but the controls {', '.join(accuracy['controls_equivalent'])} "
+    if res.equivalent and s.controls_equivalent:
+        return Verdict(REPRODUCED, f"{why}; but the controls {', '.join(s.controls_equivalent)} "
                                    "pass it too, so the test cannot credit the metric")
-    return Verdict(REPRODUCED if res["equivalent"] else NOT_REPRODUCED, why)
+    return Verdict(REPRODUCED if res.equivalent else NOT_REPRODUCED, why)
 
 
-def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: str,
+def _rows_paper_b_scenario(t3: pd.DataFrame, s: ScenarioSummary, pub: dict, label: str,
                            timing_band: dict | None = None) -> list[dict]:
     rows: list[dict] = []
     tag = f"[{label}] " if label else ""
     t3 = t3.set_index("method")
-    between = (((summary.get("planning_time") or {}).get("reduction_pct") or {}).get("depth_vs_svd")
-               if isinstance(summary, dict) else None)
-    if between and between.get("interval", "between_replays") == "between_replays":
+    between = s.planning_time.reduction_pct.get("depth_vs_svd") if s.planning_time is not None else None
+    if between is not None and (between.interval or "between_replays") == "between_replays":
         # judged as the claims table judges B-C4: the mean over independent replays, its spread the
         # sd between them (never one replay's bootstrap over the calls)
         rows.append({"paper": "B", "item": f"{tag}median planning time, depth vs SVD: reduction "
-                                           f"(mean of {len(between.get('per_replay') or [])} replays)",
-                     "published": float(pub["depth_time_reduction_vs_svd_pct"]), "ours": float(between["mean"]),
-                     "spread": float(between.get("sd_between", float("nan"))), "unit": "%",
+                                           f"(mean of {len(between.per_replay)} replays)",
+                     "published": float(pub["depth_time_reduction_vs_svd_pct"]), "ours": num(between.mean),
+                     "spread": num(between.sd_between), "unit": "%",
                      "band": dict(timing_band or {})})
     elif "depth" in t3.index and "time_reduction_vs_svd_pct" in t3.columns:
         # the claim's size depends on how the planning call is implemented: the
         # configured path and the other one (compiled vs the paper's definition
         # interpreted, opnav.landing.planner), each a row
-        path = summary.get("eval_path", "") if isinstance(summary, dict) else ""
+        path = s.eval_path
         other = {"compiled": "paper", "paper": "compiled"}.get(path, "") if path else ""
         for suffix, p in (("", path), ("_alt", other)):
             col = f"time_reduction_vs_svd{suffix}_pct"
@@ -329,57 +330,54 @@ def _rows_paper_b_scenario(t3: pd.DataFrame, summary: dict, pub: dict, label: st
                          "published": float(pub["depth_time_reduction_vs_svd_pct"]),
                          "ours": float(t3.loc["depth", col]),
                          "spread": float(spread), "unit": "%", "band": dict(timing_band or {})})
-    if isinstance(summary, dict) and "equivalence" in summary:
-        ref = summary["equivalence"]["reference"]
-        for m in summary["converges_faster"]:
-            v = same_accuracy_verdict(summary, m)
-            ours = summary["equivalence"]["methods"][m]["lastlm_pos_err_m"]["mean"]
+    if s.equivalence is not None:
+        ref = s.equivalence.reference
+        for m, cf in s.converges_faster.items():
+            v = same_accuracy_verdict(s, m)
+            ours = s.equivalence.methods[m].tests["lastlm_pos_err_m"].mean
             rows.append({"paper": "B", "item": f"{tag}{m} vs {ref}: 'almost the same' accuracy "
                                                "(paired equivalence, negative controls)",
                          "published": float("nan"), "ours": ours, "unit": "m",
                          "verdict": v.verdict, "reason": v.reason})
-            cf = summary["converges_faster"][m]
-            if "min_difference_s" not in cf:
+            if cf.min_difference_s is None:
                 raise ValueError("landing summary: converges_faster has no min_difference_s from the analysis "
                                  "plan (a summary of an older build: rebuild landing_summary)")
             rows.append({"paper": "B", "item": f"{tag}position error converges a bit faster with {m} "
                                                f"than {ref}",
-                         "published": float("nan"), "ours": cf["mean_s"], "unit": "s",
-                         "verdict": REPRODUCED if cf["verdict"] == "faster" else NOT_REPRODUCED,
-                         "reason": cf["text"]})
-    yaw = summary.get("yaw_converges") if isinstance(summary, dict) else None
-    if yaw is not None:
+                         "published": float("nan"), "ours": cf.mean_s, "unit": "s",
+                         "verdict": REPRODUCED if cf.verdict == "faster" else NOT_REPRODUCED,
+                         "reason": cf.text})
+    if s.yaw_converges is not None:
         rows.append({"paper": "B", "item": f"{tag}yaw error does not converge (one known landmark)",
                      "published": float("nan"), "ours": float("nan"), "unit": "",
-                     "verdict": REPRODUCED if not yaw else NOT_REPRODUCED,
-                     "reason": summary.get("yaw_reason", "from the Monte-Carlo attitude envelopes")})
+                     "verdict": REPRODUCED if not s.yaw_converges else NOT_REPRODUCED,
+                     "reason": s.yaw_reason if s.yaw_reason is not None else "from the Monte-Carlo attitude envelopes"})
     return rows
 
 
-def rows_paper_b(t3: pd.DataFrame, summary: dict, pub: dict, timing_band: dict | None = None) -> list[dict]:
-    """Scorecard rows for paper B: per camera scenario (``summary["scenarios"]``,
-    each with its B-T3 rows under ``methods``; else ``t3`` alone) the 29.03 %
-    timing claim and the accuracy claims; once, the initial attitude scored as
-    thrust tilt and azimuth separately (the paper's triple read as
-    -(yaw, pitch, roll), Z-Y-X, roll 0). ``timing_band``: the analysis plan's B-C4
+def rows_paper_b(t3: pd.DataFrame, summary: BSummary, pub: dict, timing_band: dict | None = None) -> list[dict]:
+    """Scorecard rows for paper B: per camera scenario of ``summary`` (B-summary.json read back,
+    ``opnav.landing.bsummary.BSummary``: each scenario with its B-T3 rows; a summary of one
+    scenario, ``combined`` false, with ``t3``) the 29.03 % timing claim and the accuracy claims;
+    once, the initial attitude scored as thrust tilt and azimuth separately (the paper's triple
+    read as -(yaw, pitch, roll), Z-Y-X, roll 0). ``timing_band``: the analysis plan's B-C4
     ``rel_tol``, ``k_spread``, ``max_band_rel`` for the timing rows (passed in by the
     workflow; without it, :mod:`opnav.core.verdicts`' defaults)."""
     import pandas as pd
 
     rows: list[dict] = []
-    scen = summary.get("scenarios") if isinstance(summary, dict) else None
-    if scen:
-        for name, sc in scen.items():
-            rows += _rows_paper_b_scenario(pd.DataFrame(list(sc["methods"].values())), sc, pub, name, timing_band)
+    if summary.combined:
+        for name, sc in summary.scenarios.items():
+            rows += _rows_paper_b_scenario(pd.DataFrame(list(sc.methods.values())), sc, pub, name, timing_band)
     else:
-        rows += _rows_paper_b_scenario(t3, summary, pub, "", timing_band)
-    if isinstance(summary, dict) and "initial_tilt_deg" in summary:
+        rows += _rows_paper_b_scenario(t3, summary.scenarios[summary.headline], pub, "", timing_band)
+    if summary.initial_tilt_deg is not None:
         att = pub["table1_initial_state"]["att_deg"]
         for item, published_v, ours, why in (
                 ("initial thrust tilt from the vertical (paper: -pitch)", -float(att[1]),
-                 float(summary["initial_tilt_deg"]), "set by the Table 1 state and the touchdown"),
+                 float(summary.initial_tilt_deg), "set by the Table 1 state and the touchdown"),
                 ("initial thrust azimuth (paper: -yaw)", -float(att[0]),
-                 float(summary["initial_azimuth_deg"]),
+                 float(summary.initial_azimuth_deg),
                  "depends on the terminal horizontal acceleration (landing.terminal_accel_mps2), "
                  "which the paper does not state")):
             v = judge(published_v, ours, abs_tol=1.0, unit="deg")
