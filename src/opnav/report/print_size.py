@@ -170,8 +170,8 @@ def long_sentence_findings(results: str | Path, used_macros: set[str] | None = N
 _SLIPS = [
     (re.compile(r"(?<![\d.,\-])1 (maps|stars|runs|seeds|samples|cases|images|calls|landmarks|iterations|claims|"
                 r"replays|variants|ratios|windows|segments)\b"), "a plural after 1"),
-    (re.compile(r"[-\u2212]0(?:\.0+)? ?%"), "a signed zero percentage"),
-    (re.compile(r"\b0 ?% (?:lower|higher|less|more)\b"), "a zero change said as a number"),
+    (re.compile(r"(?<![\d.])[-\u2212]0(?:\.0+)? ?%"), "a signed zero percentage"),
+    (re.compile(r"(?<![\d.\-\u2212])0(?:\.0+)? ?% (?:lower|higher|less|more)\b"), "a zero change said as a number"),
 ]
 
 
