@@ -143,6 +143,7 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
     import pandas as pd
 
     from opnav.landing.montecarlo import yaw_convergence
+    from opnav.report.landing.summary import yaw_reason
     from opnav.report.landing.summary import scenario_summary
     from opnav.landing.scenario import initial_attitude_report
 
@@ -162,7 +163,7 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
     assert list(s["pairs"]) == ["depth_vs_svd", "depth_vs_cond", "svd_vs_cond"]
     assert s["pairs"]["svd_vs_cond"]["same_pick_pct"] == 100.0      # the same runs
     yaw = yaw_convergence(d["depth"], 0.5, "depth")
-    assert (s["yaw_converges"], s["yaw_reason"], s["n_runs"]) == (yaw["converges"], yaw["reason"], 2)
+    assert (s["yaw_converges"], s["yaw_reason"], s["n_runs"]) == (yaw.converges, yaw_reason(yaw), 2)
     att = initial_attitude_report(landing)
     assert s["initial_attitude_deg"] == att.paper_convention_deg
     assert s["initial_tilt_deg"] == att.tilt_deg and s["single"] == {"n_plans": 7}

@@ -12,6 +12,8 @@ def _runs(shrink: float) -> MonteCarlo:
 
 
 def test_shrinking_yaw_envelope_reads_converging_and_a_flat_one_does_not():
-    assert yaw_convergence(_runs(0.2), 0.5, "depth")["converges"]
+    from opnav.report.landing.summary import yaw_reason
+
+    assert yaw_convergence(_runs(0.2), 0.5, "depth").converges
     flat = yaw_convergence(_runs(1.0), 0.5, "depth")
-    assert not flat["converges"] and "not below 50%" in flat["reason"] and flat["n_runs"] == 200
+    assert not flat.converges and "not below 50%" in yaw_reason(flat) and flat.n_runs == 200

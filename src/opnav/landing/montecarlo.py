@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 from typing import TYPE_CHECKING
@@ -45,7 +46,7 @@ from opnav.landing import records   # numpy only
 from opnav.landing.records import CALL_KEYS, TRACK_KEYS, Descent, MonteCarlo
 from opnav.landing.setup import Setup
 
-__all__ = ["yaw_convergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
+__all__ = ["yaw_convergence", "YawConvergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality", "first_runs", "end_phase", "landmark_phase", "phase_rms", "time_below",
            "nees_band", "nees_consistency", "MonteCarlo", "Descent"]
@@ -374,14 +375,26 @@ def same_pick_pct(a: MonteCarlo, b: MonteCarlo) -> float:
     return 100.0 * sum(ka[k] == kb[k] for k in common) / len(common)
 
 
-def yaw_convergence(data: MonteCarlo, ratio: float, method: str) -> dict:
+@dataclass(frozen=True)
+class YawConvergence:
+    """The yaw claim's numbers (:func:`yaw_convergence`): the Monte-Carlo 3-sigma of the yaw
+    error at the start and at touchdown (deg) over ``n_runs`` runs of ``method``, the ratio the
+    reading used and whether the envelope fell below it (``converges``). Its words are the
+    report layer's (``opnav.report.landing.summary.yaw_reason``)."""
+
+    converges: bool
+    n_runs: int
+    method: str
+    sigma3_start_deg: float
+    sigma3_end_deg: float
+    ratio: float
+
+
+def yaw_convergence(data: MonteCarlo, ratio: float, method: str) -> YawConvergence:
     """Does the Monte-Carlo 3-sigma envelope of the yaw error shrink (paper B: it
     does not, one known landmark leaves yaw unobservable)? Converging means the
     3-sigma at touchdown is below ``ratio`` times the one at the start (deg)."""
     yaw = data.err_rpy_deg[:, :, 2]
     s_first, s_last = float(3 * yaw[:, 0].std(ddof=1)), float(3 * yaw[:, -1].std(ddof=1))
-    converges = s_last < ratio * s_first
-    return {"converges": bool(converges), "n_runs": int(yaw.shape[0]),
-            "reason": (f"yaw 3-sigma over the {yaw.shape[0]} runs ({method}): "
-                       f"{s_first:.2f} deg at start, {s_last:.2f} deg at touchdown "
-                       f"({'below' if converges else 'not below'} {ratio:.0%} of the start)")}
+    return YawConvergence(bool(s_last < ratio * s_first), int(yaw.shape[0]), str(method), s_first, s_last,
+                          float(ratio))

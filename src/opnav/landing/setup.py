@@ -95,10 +95,6 @@ class CameraSettings(Section):
         """This camera with a scenario's overlay (``landing.scenarios.<name>``) applied."""
         return self.replace(**{k: type(getattr(self, k))(v) for k, v in dict(changes or {}).items()})
 
-    def as_config(self) -> dict:
-        """The camera as ``landing.camera`` holds it (reports)."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "plan_margin_px"}
-
 
 @register
 @dataclass(**_FROZEN)
@@ -319,10 +315,6 @@ class Setup(Section):
     def custom_items(self) -> tuple[tuple[str, str], ...]:
         """``(name, path)`` of every registered method (``planner.PlannerConfig.custom``)."""
         return tuple((s.name, s.path) for s in self.custom_methods)
-
-    @property
-    def custom_entries(self) -> dict[str, CustomSpec]:
-        return {s.name: s for s in self.custom_methods}
 
 
 def scenario_sections(section: Mapping) -> dict[str, dict]:

@@ -28,6 +28,7 @@ from opnav.report.landing.timing_text import CLOCK_WORDS, less_time_text
 if TYPE_CHECKING:
     import pandas as pd
 
+    from opnav.landing.montecarlo import YawConvergence
     from opnav.landing.records import MonteCarlo
     from opnav.landing.setup import Setup
 
@@ -190,18 +191,25 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCa
         "initial_attitude_deg": att.paper_convention_deg,
         "initial_tilt_deg": att.tilt_deg,
         "initial_azimuth_deg": att.azimuth_deg,
-        "yaw_converges": yaw["converges"],
-        "yaw_reason": yaw["reason"],
+        "yaw_converges": yaw.converges,
+        "yaw_reason": yaw_reason(yaw),
         # the numbers behind it (the claims judge them against the analysis plan's ratio)
         "yaw_sigma3_deg": {"method": ym, "start": float(3 * yaw_err[:, 0].std(ddof=1)),
                            "end": float(3 * yaw_err[:, -1].std(ddof=1)), "n_runs": int(yaw_err.shape[0])},
-        "n_runs": yaw["n_runs"],
+        "n_runs": yaw.n_runs,
         "min_same_pick_vs_depth_pct": min(same_pick, default=math.nan),
         "planning_time_vs_depth": (vs := tsum.vs_depth(timing)),
         "planning_time": (ev := tsum.planning_time_evidence(timing, published_reduction_vs_svd)),  # B-C4, B-C9
         "planning_time_text": planning_time_text(vs, tsum.clock_share(timing), ev),
         **(accuracy or {}),
     }
+
+
+def yaw_reason(y: YawConvergence) -> str:
+    """The yaw reading in words (``montecarlo.yaw_convergence``'s numbers)."""
+    return (f"yaw 3-sigma over the {y.n_runs} runs ({y.method}): "
+            f"{y.sigma3_start_deg:.2f} deg at start, {y.sigma3_end_deg:.2f} deg at touchdown "
+            f"({'below' if y.converges else 'not below'} {y.ratio:.0%} of the start)")
 
 
 def compact_b_t3(df: "pd.DataFrame") -> list[tuple[str, "pd.DataFrame"]]:
