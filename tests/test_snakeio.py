@@ -34,9 +34,9 @@ def test_interrupt_is_not_swallowed(tmp_path):
 @pytest.mark.parametrize("cut", [0, 10, -20])
 def test_truncated_intermediates_are_named(tmp_path, cut):
     npz, pkl = tmp_path / "chunk.npz", tmp_path / "mc.pkl"
-    montecarlo.save(npz, {"x": np.arange(50.0)}, "depth")
+    montecarlo.save(npz, montecarlo.MonteCarlo(t=np.arange(50.0)), "depth")
     save_pickle(pkl, {"x": np.arange(50.0)})
-    assert montecarlo.load(npz)["x"][-1] == 49.0 and load_pickle(pkl)["x"][-1] == 49.0
+    assert montecarlo.load(npz).t[-1] == 49.0 and load_pickle(pkl)["x"][-1] == 49.0
     for path, loader in ((npz, montecarlo.load), (pkl, load_pickle)):
         data = path.read_bytes()
         path.write_bytes(data[:cut] if cut else b"")
@@ -57,7 +57,7 @@ def test_atomic_writers_leave_no_partial_file(tmp_path, monkeypatch):
         save_pickle(tmp_path / "a.pkl", {"x": 1})
     monkeypatch.setattr(np, "savez_compressed", die)
     with pytest.raises(KeyboardInterrupt):
-        montecarlo.save(tmp_path / "b.npz", {"x": np.zeros(3)}, "depth")
+        montecarlo.save(tmp_path / "b.npz", montecarlo.MonteCarlo(t=np.zeros(3)), "depth")
     assert list(tmp_path.iterdir()) == []
 
 
