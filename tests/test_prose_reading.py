@@ -124,3 +124,18 @@ def test_quick_build_text_has_short_sentences_and_no_number_slips(quick_results)
     used = print_size.manuscript_macros(REPO / "paper")
     assert print_size.long_sentence_findings(results, used) == []
     assert print_size.slip_findings(results, used) == []
+
+
+def test_shortening_keeps_the_evidence_numbers_longest():
+    """A cause cut to fit page 1 loses its scope and wording before its numbers: a parenthesis
+    without a number (or with an identifier's digits only) goes first, a bracket's commas are not
+    clause breaks, and a parenthesis holding the evidence's numbers goes last."""
+    cause = "last-landmark error of depth minus SVD -0.027 m [-0.0732, +0.0193] against +-0.0186 m (interior)"
+    assert wording.shorter(cause) == cause[:-len(" (interior)")]
+    assert wording.shorter("error 114 km against 70.2 to 87.9 km (T1-13)") == "error 114 km against 70.2 to 87.9 km"
+    nums = "in the interior camera the paired intervals do not show it, as the plan asks (depth minus SVD 0.08 m)"
+    assert wording.shorter(nums) == "in the interior camera the paired intervals do not show it (depth minus SVD 0.08 m)"
+    tail = "in the interior camera depth minus SVD is 0.08 m [0.02, 0.14], which the plan reads as worse"
+    assert wording.shorter(tail) == "in the interior camera depth minus SVD is 0.08 m [0.02, 0.14]"
+    assert wording.shorter("the bound (0.08 m [0.02, 0.14])") == "the bound"
+    assert wording.shorter("one clause") is None

@@ -148,20 +148,44 @@ def long_sentences(text: str, max_words: int = MAX_SENTENCE_WORDS) -> list[str]:
 _PARENS = re.compile(r" \((?:[^()]|\([^()]*\))*\)")
 
 
+def _top_level(text: str, sep: str) -> list[int]:
+    """Where ``sep`` occurs in ``text`` outside brackets."""
+    out, depth = [], 0
+    for i, c in enumerate(text):
+        if c in "([":
+            depth += 1
+        elif c in ")]":
+            depth = max(0, depth - 1)
+        elif depth == 0 and text.startswith(sep, i):
+            out.append(i)
+    return out
+
+
 def shorter(text: str, min_words: int = 6) -> str | None:
-    """``text`` one step shorter the way a reader loses least, or ``None`` when no step is left:
-    its last parenthesis dropped; else what follows its first '; '; else its last clause (after
-    the last ', ') while at least ``min_words`` words remain."""
+    """``text`` one step shorter the way a reader loses least, or ``None`` when no step is left.
+    The evidence's numbers go last: first the last parenthesis without a number (an identifier's
+    digits aside: '(T1-13)', '(interior)'); then a tail without a number, after the first '; ' or
+    the last ', '; then the last parenthesis; then any tail. Separators inside brackets do not
+    count, and a clause is cut only while ``min_words`` words remain."""
     text = " ".join(text.split())
+
+    def numberless(t: str) -> bool:
+        return not re.search(r"\d", re.sub(r"\b[A-Z]+\d*-\d+\b", "", t))
+
     parens = list(_PARENS.finditer(text))
+    plain = [m for m in parens if numberless(m.group(0))]
+    if plain:
+        return text[:plain[-1].start()] + text[plain[-1].end():]
+    tails = [i for i in _top_level(text, "; ")[:1] + _top_level(text, ", ")[-1:] if word_count(text[:i]) >= min_words]
+    for i in tails:
+        if numberless(text[i:]):
+            return text[:i]
+        last = parens[-1] if parens else None
+        if last is not None and last.end() == len(text) and last.start() > i and numberless(text[i:last.start()]):
+            return text[:i] + last.group(0)   # the clause goes, its closing numbers stay
     if parens:
         return text[:parens[-1].start()] + text[parens[-1].end():]
-    if "; " in text:
-        return text.split("; ")[0]
-    head, sep, _ = text.rpartition(", ")
-    if sep and word_count(head) >= min_words:
-        return head
-    return None
+    return text[:tails[0]] if tails else None
 
 
 def shorten(text: str, max_words: int) -> str:

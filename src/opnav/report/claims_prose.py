@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # annotations only
 ABSTRACT_MAX_WORDS = 200
 #: the words of the framing sentence main.tex writes before the generated findings, as printed
 #: ("paper A [1]:" three words)
-ABSTRACT_FRAMING_WORDS = 34
+ABSTRACT_FRAMING_WORDS = 30
 #: verdicts a reader counts as "not reproduced" in the broad sense (each group gets its cause)
 #: (in the order the abstract gives them: what an information bound excludes, what needs an addition first)
 NOT_OK = ("not_reproducible", "reproduced_with_addition", "suspect", "unstable", "not_reproduced",
@@ -91,7 +91,9 @@ def claim_cause(r: Mapping) -> str:
     text = cell_text(r, "cause").rstrip(".")
     for pat in _CAUSE_FRAME:
         text = pat.sub("", text)
-    return text.strip()
+    text = text.strip()
+    # after 'is not reproduced:' the cause goes on in lower case (not an acronym: 'SVD', 'EM')
+    return text[0].lower() + text[1:] if len(text) > 1 and text[0].isupper() and text[1].islower() else text
 
 
 def take_text(take: str) -> str:
@@ -253,6 +255,10 @@ def abstract_findings(df: pd.DataFrame, budget: int | None = None) -> str:
         cut = sorted((c for c in chosen if c[2] == 1), key=lambda c: -word_count(c[3].text))
         if not any(c[3].shorter() for c in cut[:1]) and not any(c[3].shorter() for c in cut[1:]):
             break
+    if words(chosen) > budget:  # still too long: a claim not reproduced is said to fail, in fewer words
+        for c in chosen:
+            if c[3].verdict == "not_reproduced":
+                c[3].head = f"{c[3].ids[0]} fails"
     if words(chosen) > budget:  # more required findings than page 1 holds: the causes go to Appendix A
         pointer = (papers[-1], 10 ** 6, 1, _Said([], "Appendix A gives each cause"))
         # what differs or is suspect is said by the verdict's own words; a choice and a cause last
