@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from opnav.core import wording
 from opnav.core.tables import cell_num, cell_pm
 from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
 from opnav.landing.bsummary import NAN, BSummary, ScenarioSummary, num
@@ -556,7 +557,7 @@ def planning_time_text(vs: dict, clock: dict, ev: dict | None = None) -> str:
         v = vs.get(label)
         if not v:
             return None
-        return (f"Against {name}: {v['depth_median_us']:.2f} against {v['median_us']:.2f} us (depth "
+        return (f"Against {name}: {wording.num(v['depth_median_us'])} against {wording.num(v['median_us'])} us (depth "
                 f"{less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
                 f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %).")
     parts = [p for p in (part("svd_closed_form", "the closed-form SVD"),
@@ -600,9 +601,10 @@ def evidence_text(ev: dict) -> str:
     if all(math.isfinite(x) for x in (d["shared_us"], s["shared_us"], d["eval_us"], s["eval_us"])):
         c = ev.get("overhead_curve", {})
         out += (f"A call is a part both methods share (numba's dispatch, argument unpacking, the search's own "
-                f"steps: {d['shared_us']:.2f} and {s['shared_us']:.2f} us) and its evaluations ({d['evals_per_call']:.0f} "
-                f"and {s['evals_per_call']:.0f} of {1e3 * d['per_eval_us']:.0f} and {1e3 * s['per_eval_us']:.0f} ns: "
-                f"{d['eval_us']:.2f} against {s['eval_us']:.2f} us). Without the shared part depth's median call "
+                f"steps: {d['shared_us']:.2f} us for depth, {s['shared_us']:.2f} us for SVD) and its evaluations. "
+                f"Depth's {d['evals_per_call']:.0f} evaluations of {1e3 * d['per_eval_us']:.0f} ns take "
+                f"{d['eval_us']:.2f} us, SVD's {s['evals_per_call']:.0f} of {1e3 * s['per_eval_us']:.0f} ns "
+                f"{s['eval_us']:.2f} us. Without the shared part depth's median call "
                 f"would take {less_time_text(c.get('no_shared_reduction_pct', math.nan))} time. ")
         sp = ev.get("shared_us_at_published")
         pub = ev.get("published_pct")
