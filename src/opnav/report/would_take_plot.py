@@ -46,14 +46,15 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
             ax.set_axis_off()
             return figures.save(fig, path)
         s0 = sw[0]
-        styles = ["-", "--", ":", "-."]
+        styles, markers = ["-", "--", ":", "-."], ["o", "s", "^", "D"]   # per scope (camera, case)
         scopes = list(dict.fromkeys(s["scope"] for s in sw))
         for s in sw:
             xs = [p[0] for p in s["points"]]
             ys = [p[1] for p in s["points"]]
             lab = names.get(s["method"], s["method"]) + (f", {s['scope']}" if len(sw) > 1 and s["scope"] else "")
             c = figures.color(s["method"].split("+")[0])
-            ax.plot(xs, ys, marker="o", ms=3, color=c, label=lab, ls=styles[scopes.index(s["scope"]) % len(styles)])
+            k = scopes.index(s["scope"])
+            ax.plot(xs, ys, marker=markers[k % len(markers)], ms=3, color=c, label=lab, ls=styles[k % len(styles)])
             lo = [p[2] for p in s["points"]]
             hi = [p[3] for p in s["points"]]
             if all(math.isfinite(v) for v in lo + hi):
@@ -86,6 +87,12 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
         if xs_all and min(xs_all) > 0 and max(xs_all) / min(xs_all) > 8:
             ax.set_xscale("log")
             figures.plain_log_labels(ax.xaxis)
+            swept = sorted(set(xs_all))
+            if len(swept) <= 8:   # few swept values: a tick at each, so the ends are labelled too
+                from matplotlib.ticker import NullLocator
+
+                ax.set_xticks(swept, [f"{x:,.4g}" for x in swept])
+                ax.xaxis.set_minor_locator(NullLocator())
             if ys_all and min(ys_all) > 0 and max(ys_all) / min(ys_all) > 8:
                 ax.set_yscale("log")     # a power law is a line, as the flip is interpolated
                 figures.plain_log_labels(ax.yaxis)
