@@ -84,6 +84,11 @@ onstart:
     import opnav
 
     compileall.compile_dir(str(Path(opnav.__file__).parent), quiet=1)
+    # The jobs' libraries (numpy, scipy, pandas, matplotlib, numba) imported once for the build,
+    # not once per job: a local build's jobs run in forks of one server (opnav.core.jobserver).
+    from opnav.core import jobserver
+
+    jobserver.start(workflow)
 
 
 # Snakemake's scheduler re-checks its job-rate limit with a timer per scheduling round
@@ -92,10 +97,16 @@ onstart:
 # and these handlers cancel the timers still pending, which would hold the exit.
 onsuccess:
     stop_rate_limit_timers()
+    from opnav.core import jobserver
+
+    jobserver.stop()
 
 
 onerror:
     stop_rate_limit_timers()
+    from opnav.core import jobserver
+
+    jobserver.stop()
     from opnav.core.runguard import interrupted_exit
 
     interrupted_exit()  # after a signal: "interrupted", not "a job did not complete"

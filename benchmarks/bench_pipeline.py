@@ -337,16 +337,18 @@ def report_profile(r: dict, cores: int, ref_ms: float) -> None:
                   key=lambda kv: -r["per_rule"].get(kv[0], 0.0))
     for rule, n in rows:
         print(f"{rule:28s} {n:5d} {r['per_rule'].get(rule, 0.0):12.0f}")
-    print(f"{'benchmark files':28s} {'files':>5s} {'wall s':>8s} {'CPU s':>8s}")
-    bench_cpu = 0.0
+    # a benchmark file's CPU is the job's own process tree: with the build's job server
+    # (opnav.core.jobserver) only the job's client, the work being in the server's fork
+    print(f"{'benchmark files':28s} {'files':>5s} {'wall s':>8s} {'CPU s':>8s}  (CPU: the job's own processes)")
     for k, (n, w, c) in sorted(r["bench"].items(), key=lambda kv: -kv[1][1]):
-        bench_cpu += c
         print(f"{k:28s} {n:5d} {w:8.1f} {c:8.1f}")
-    n = max(jobs.get("total", 1), 1)
-    print(f"CPU: {run['cpu_s']:.0f} CPU-s in all, {bench_cpu:.0f} in benchmarked jobs' own measurement, "
-          f"{(run['cpu_s'] - bench_cpu) / n:.2f} CPU-s per job for the rest (other jobs, imports, snakemake)")
     sys.path.insert(0, str(REPO / "benchmarks"))
-    from job_costs import startup_lines
+    from job_costs import costs, startup_lines
+
+    logged = costs(r["wd"] / "results")
+    log_cpu = sum(c for _, c, _ in logged)
+    print(f"CPU: {run['cpu_s']:.0f} CPU-s in all, {log_cpu:.0f} in the {len(logged)} jobs' logs (each job's whole "
+          f"CPU, start-up included), {run['cpu_s'] - log_cpu:.0f} for snakemake itself and the job server")
 
     for line in startup_lines(r["wd"] / "results"):
         print(line)

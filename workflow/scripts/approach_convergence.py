@@ -1,5 +1,9 @@
 """Plain EM vs SQUAREM iterations to the maximum-likelihood estimate (headline case, one window), every variant."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

@@ -1,6 +1,10 @@
 """CRLB of (tx, ty, tz) vs data length for every scenario variant (headline case), with Q and Q = 0;
 the roll variant's bound against the roll rate (pipeline.roll_rate_study)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

@@ -1,6 +1,10 @@
 """A-X8: every registered misalignment estimator (approach.custom_estimators) on the Table-1 cases
 of one variant (one Snakemake job)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

@@ -1,6 +1,10 @@
 """A-X8: the registered misalignment estimators' table (every Table-1 case, scored against the
 truth and the bound of the data used) and convergence figure (headline case)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.approach import estimator_summary

@@ -1,6 +1,10 @@
 """Monte Carlo of one Table-1 case group under one scenario variant, every EM scheme of the job;
 or, in a pack (rules approach_mc_pack*, jobs.approach_mc_per_job), several such units in turn."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

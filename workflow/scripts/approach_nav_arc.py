@@ -3,6 +3,10 @@ tz bias on and off (opnav.approach.navfloor): tz's effect under the paper as wri
 ``literal`` variant: paper A's claim, A-C12), the arc lengths under the configured nav-floor
 variant."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

@@ -1,5 +1,9 @@
 """A-P1 figure: the peer UKF's (tx, ty) over the arc with its own 3 sigma, against the others' end values."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 

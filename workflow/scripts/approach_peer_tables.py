@@ -1,5 +1,9 @@
 """A-P1 table and summary: the peer UKF beside the EM-EKF, augmented EKF, batch ML and the CRLB."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.approach import peers

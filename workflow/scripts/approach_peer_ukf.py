@@ -1,5 +1,9 @@
 """A-P1: Basilisk's pixelLineBiasUKF on each A-P1 variant's headline-case measurements (one Snakemake job)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

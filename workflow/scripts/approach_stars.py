@@ -1,5 +1,9 @@
 """The stars variant (beyond the paper): bound and estimates per number of stars per image."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

@@ -1,6 +1,10 @@
 """A-X6: the stars study (beyond the paper) as a table and a figure against attitude knowledge
 and stars per image."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.core import figures

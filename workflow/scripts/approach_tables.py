@@ -1,5 +1,9 @@
 """A-T1 (Table 1 beside the published values), A-X1 table + verdict text, A-summary.json."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from dataclasses import replace

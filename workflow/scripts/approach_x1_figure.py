@@ -1,5 +1,9 @@
 """A-X1 figure: the CRLB per variant beside the EM estimates; EM iterations plain vs SQUAREM."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 

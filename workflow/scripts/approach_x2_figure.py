@@ -1,5 +1,9 @@
 """A-X2 figure: EM-EKF vs augmented EKF vs batch ML, per scenario variant (from the long-form CSV)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 

@@ -1,5 +1,9 @@
 """A-X2: augmented EKF and batch ML on one Table-1 case group under one variant (one Snakemake job)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

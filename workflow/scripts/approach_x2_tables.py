@@ -1,5 +1,9 @@
 """A-X2 table (EM-EKF vs augmented EKF vs batch ML), long form per case, A-X2-summary.json."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from dataclasses import replace
 

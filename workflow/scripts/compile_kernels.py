@@ -1,5 +1,9 @@
 """Fills numba's on-disk cache with a paper's kernels (rule compile_kernels, opnav.core.compiled)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import importlib
 import sys
 

@@ -2,6 +2,10 @@
 name, with each scenario's camera), ``headline_scenario``, and the headline
 scenario's keys also at the top level (the manuscript's default numbers)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.report.landing.summary import combine_scenarios

@@ -1,6 +1,10 @@
 """One Monte-Carlo job of paper B: runs `params.runs` of `wildcards.method` (scatter), or of
 each of `params.methods` in turn (rules landing_mc_pack*, landing.mc.methods_per_job)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import hashlib
 import sys
 from pathlib import Path

@@ -1,5 +1,9 @@
 """Gather the Monte-Carlo chunks of one method of paper B (in run order)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.landing.montecarlo import gather, load, save

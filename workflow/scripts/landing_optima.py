@@ -2,6 +2,10 @@
 side of the velocity, per recorded planning call of one camera scenario's depth Monte Carlo
 (opnav.landing.optima)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.core.snakeio import mock_snakemake, script_context

@@ -2,6 +2,10 @@
 the scale chosen on the tuning runs, flown on the Monte Carlo's own runs) beside the paper
 tuning's Monte Carlo: its record (JSON) and the NEES table."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.landing.montecarlo import load, nees_consistency

@@ -1,6 +1,10 @@
 """The single descent of one camera scenario of paper B (headline numbers) and
 B-F5 (depth-error maps: detected landmarks, whole field, in-plane curve)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import json
 import sys
 

@@ -3,6 +3,10 @@ on, planning time beside the published 29.03 %), its summary JSON (headline
 numbers for the manuscript and the scorecard), B-F6 (navigation-error 3-sigma
 envelopes) and B-F7 (planning-time box plots)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 import pandas as pd

@@ -1,5 +1,9 @@
 """B-T1, B-T2: the descent's initial state and Monte-Carlo error bounds, from the config."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.report.landing.tables import error_bounds_table, initial_state_table

@@ -10,6 +10,10 @@ paper's definition on its subset) once, on the same calls. The consumers read bo
 (``timing.load`` of the list merges them, ``timing.merge``).
 """
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 import tempfile
 

@@ -1,5 +1,9 @@
 """B-F4: the truth trajectory of paper B's descent (camera-independent)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 import numpy as np

@@ -2,6 +2,10 @@
 a separate seed stream in every camera scenario, the one tuning for all, checked
 against the configured landing.filter."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.landing.setup import Setup, Tuning

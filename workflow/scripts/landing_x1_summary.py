@@ -2,6 +2,10 @@
 Carlo: 3-sigma envelopes figure, ranking table with paired comparison against
 the reference (depth), and B-X1-summary.json for the manuscript macros."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import json
 import sys
 

@@ -6,6 +6,10 @@ of the plan, its verdicts before and after on this evidence), the would_take fig
 as a table (analysis_plan.csv), the derived inputs (inputs.csv) and claims.json (counts and the
 generated abstract, conclusion, limitations and sample sentence)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import json
 import sys
 from pathlib import Path

@@ -5,6 +5,10 @@ defined (opnav.report.manuscript.COMPACT_VIEWS), with wrapped headers and, when 
 than long, transposed (opnav.report.manuscript.legible_latex).
 """
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

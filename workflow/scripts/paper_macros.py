@@ -1,6 +1,10 @@
 """results/paper/macros.tex: one \\newcommand per number the manuscript quotes; results/paper/tables.tex:
 the tables the text sets where a sentence would repeat itself per method (opnav.report.text_tables)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 from opnav.core import published

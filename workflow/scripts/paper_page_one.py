@@ -3,6 +3,10 @@ abstract (abstract.tex), the verdict figure (one row per claim), the claims at a
 CSV for the HTML report's first page, and the table of what we did differently
 (differences.tex: every open or changed choice, ours from the run's configuration)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from pathlib import Path
 

@@ -1,5 +1,9 @@
 """Build the manuscript PDF with latexmk, reproducibly (fixed SOURCE_DATE_EPOCH)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import os
 import re
 import shutil

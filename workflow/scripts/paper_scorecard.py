@@ -1,5 +1,9 @@
 """The reproduced-vs-published scorecard from the generated tables and summaries."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import json
 import sys
 

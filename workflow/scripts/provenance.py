@@ -1,6 +1,10 @@
 """results/provenance.{csv,md,json} and results/paper/provenance.tex: the
 Python, package versions and git commit of this run (opnav.core.provenance)."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 from datetime import datetime, timezone
 

@@ -3,6 +3,10 @@ per value, method and metric, and its page view; the log-log slopes if asked), t
 generated caption (opnav.studies), and its figure: each metric against the swept value,
 one line per method, drawn from the summary table as written."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 import pandas as pd

@@ -4,6 +4,10 @@ a method; paper A: variant__estimator) with one study value's simulation config
 study_runs_pack*, jobs.study_values_per_job), several such (value, chunk) jobs in turn,
 one output each."""
 
+from opnav.core.jobserver import delegate
+
+delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+
 import sys
 
 import pandas as pd

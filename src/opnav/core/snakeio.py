@@ -101,15 +101,19 @@ RESOURCE_PREFIX = "job resources:"
 
 def resource_line() -> str:
     """``job resources: cpu_s=<user+sys> user_s=... sys_s=... max_rss_mb=...`` of this
-    process so far, its finished child processes included (LaTeX, say):
+    process so far, its finished child processes included (LaTeX, say), and in a job the build's
+    job server ran (:mod:`opnav.core.jobserver`) its client process's CPU before it delegated:
     ``resource.getrusage``; the peak memory is ``VmHWM`` of ``/proc/self/status``
     (``ru_maxrss`` keeps the forking parent's peak across ``exec`` on Linux), else
     ``ru_maxrss`` (KiB on Linux). A job that called compiled kernels also gets the kernel
     signatures it loaded from numba's cache and compiled itself
     (:func:`opnav.core.compiled.cache_stats`; after rule ``compile_kernels``, none compiled),
     and last the job's start-up CPU (:func:`opnav.core.startup.fields`)."""
+    from opnav.core.jobserver import client_cpu
+
     me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    user, sys_ = me.ru_utime + kids.ru_utime, me.ru_stime + kids.ru_stime
+    c_user, c_sys = client_cpu()       # a job the build's job server ran: its client's CPU too
+    user, sys_ = me.ru_utime + kids.ru_utime + c_user, me.ru_stime + kids.ru_stime + c_sys
     rss_kib = float(me.ru_maxrss)
     with contextlib.suppress(OSError, ValueError):
         for line in Path("/proc/self/status").read_text().splitlines():
@@ -117,6 +121,8 @@ def resource_line() -> str:
                 rss_kib = float(line.split()[1])
     out = (f"{RESOURCE_PREFIX} cpu_s={user + sys_:.3f} user_s={user:.3f} "
            f"sys_s={sys_:.3f} max_rss_mb={rss_kib / 1024:.1f}")
+    if c_user or c_sys:  # its peak memory counts the job server's pages it shares
+        out += " job_server=1"
     if compiled.used():  # a job that called kernels
         stats = compiled.cache_stats()
         out += f" kernels_loaded={stats['loaded']} kernels_compiled={stats['compiled']}"

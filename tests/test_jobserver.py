@@ -1,0 +1,169 @@
+"""The build's job server (opnav.core.jobserver): a delegated job runs the same script, with the
+job's directory, environment, command line and streams, and leaves with its exit status; without
+a server (or with a job of several threads) the script runs in its own process; a job stopped
+by Snakemake (its client killed) ends."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from opnav.core import jobserver
+
+# the server's imports (about 2 CPU-s) and ten job processes: the quick build (tests/test_workflow.py,
+# slow too) runs every job of the quick profile through it
+pytestmark = pytest.mark.slow
+
+SRC = Path(jobserver.__file__).resolve().parents[2]
+
+# A stand-in for a Snakemake script job: a `snakemake` object of a Snakemake type (what
+# delegate() looks for), then the job's own work, which reports where it ran.
+JOB = textwrap.dedent("""
+    from snakemake.iocontainers import Snakemake
+    snakemake = Snakemake.__new__(Snakemake)
+    from opnav.core.jobserver import delegate
+
+    delegate()
+    import json, os, sys
+    from opnav.core.snakeio import resource_line
+    what = sys.argv[1]
+    print(json.dumps({"pid": os.getpid(), "ppid": os.getppid(), "cwd": os.getcwd(), "argv": sys.argv[1:],
+                      "env": os.environ.get("JOB_VAR"), "stdin": sys.stdin.read(),
+                      "numpy_preloaded": "numpy" in sys.modules}), flush=True)
+    print(resource_line(), flush=True)
+    if what == "fail":
+        raise SystemExit("the job failed: one line")
+    if what == "exit3":
+        sys.exit(3)
+    if what == "raise":
+        raise ValueError("boom")
+    if what == "sleep":
+        import time
+        open(sys.argv[2], "w").write(str(os.getpid()))
+        time.sleep(60)
+""")
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("jobserver")
+    path = str(folder / "s")
+    env = dict(os.environ, **dict.fromkeys(jobserver.THREAD_VARS, "1"))
+    env.pop(jobserver.ENV, None)
+    proc = subprocess.Popen([sys.executable, jobserver.__file__, path], env=env, stdin=subprocess.DEVNULL)
+    for _ in range(1200):                     # its imports: about 2 CPU-s (a minute at most when loaded)
+        if os.path.exists(path):
+            break
+        time.sleep(0.05)
+    assert os.path.exists(path), "the job server did not start"
+    yield path
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=10)
+
+
+def _job(tmp_path, server, *args, env_extra=None, stdin="", timeout=60):
+    script = tmp_path / "job.py"
+    script.write_text(JOB)
+    env = dict(os.environ, PYTHONPATH=str(SRC), JOB_VAR="from the job", **dict.fromkeys(jobserver.THREAD_VARS, "1"))
+    if server is not None:
+        env[jobserver.ENV] = server
+    else:
+        env.pop(jobserver.ENV, None)
+    env.update(env_extra or {})
+    return subprocess.run([sys.executable, str(script), *args], cwd=tmp_path, env=env, input=stdin,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def _report(proc):
+    import json
+
+    return json.loads(proc.stdout.splitlines()[0]), proc.stdout.splitlines()[1]
+
+
+def test_a_delegated_job_runs_in_a_fork_with_the_jobs_context(tmp_path, server):
+    proc = _job(tmp_path, server, "ok", "x y", stdin="from stdin")
+    assert proc.returncode == 0, proc.stderr
+    out, line = _report(proc)
+    assert out["numpy_preloaded"]              # ran in the server's fork: its libraries already there
+    assert out["cwd"] == str(tmp_path) and out["argv"] == ["ok", "x y"]
+    assert out["env"] == "from the job" and out["stdin"] == "from stdin"
+    assert " job_server=1" in line             # the job's resource line says so, with the client's CPU
+    cpu = float(line.split("cpu_s=")[1].split()[0])
+    assert cpu > 0.02                           # the client's interpreter start alone is more
+
+
+def test_without_a_server_the_job_runs_in_its_own_process(tmp_path):
+    proc = _job(tmp_path, None, "ok")
+    out, line = _report(proc)
+    assert proc.returncode == 0 and not out["numpy_preloaded"] and "job_server" not in line
+
+
+def test_a_server_that_is_gone_leaves_the_job_in_its_own_process(tmp_path):
+    proc = _job(tmp_path, str(tmp_path / "no-such-socket"), "ok")
+    out, _ = _report(proc)
+    assert proc.returncode == 0 and not out["numpy_preloaded"]
+
+
+def test_a_job_of_several_threads_is_not_delegated(tmp_path, server):
+    proc = _job(tmp_path, server, "ok", env_extra={"OPENBLAS_NUM_THREADS": "2"})
+    out, _ = _report(proc)
+    assert proc.returncode == 0 and not out["numpy_preloaded"]
+
+
+@pytest.mark.parametrize("what, code, err", [("fail", 1, "the job failed: one line"), ("exit3", 3, ""),
+                                             ("raise", 1, "ValueError: boom")])
+def test_exit_status_and_message_come_back(tmp_path, server, what, code, err):
+    proc = _job(tmp_path, server, what)
+    out, _ = _report(proc)
+    assert out["numpy_preloaded"]
+    assert proc.returncode == code
+    assert err in proc.stderr
+
+
+def test_a_stopped_job_ends_in_the_server_too(tmp_path, server):
+    """Snakemake stops a job by killing its process: the server's child running it ends."""
+    script = tmp_path / "job.py"
+    script.write_text(JOB)
+    pidfile = tmp_path / "pid"
+    env = dict(os.environ, PYTHONPATH=str(SRC), **dict.fromkeys(jobserver.THREAD_VARS, "1"))
+    env[jobserver.ENV] = server
+    client = subprocess.Popen([sys.executable, str(script), "sleep", str(pidfile)], cwd=tmp_path, env=env,
+                              stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+    for _ in range(400):
+        if pidfile.exists() and pidfile.read_text():
+            break
+        time.sleep(0.05)
+    child = int(pidfile.read_text())
+    assert child != client.pid
+    client.kill()
+    client.wait()
+    for _ in range(100):
+        try:
+            os.kill(child, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.05)
+    else:
+        pytest.fail("the server's child outlived its killed client by 5 s")
+
+
+def test_a_job_waits_for_a_server_still_starting(tmp_path):
+    """The build's first jobs start while the server imports: they wait for it while it lives."""
+    path = str(tmp_path / "late")
+    env = dict(os.environ, **dict.fromkeys(jobserver.THREAD_VARS, "1"))
+    env.pop(jobserver.ENV, None)
+    srv = subprocess.Popen([sys.executable, jobserver.__file__, path], env=env, stdin=subprocess.DEVNULL)
+    try:
+        proc = _job(tmp_path, path, "ok", env_extra={jobserver.PID_ENV: str(srv.pid)})
+        out, _ = _report(proc)
+        assert proc.returncode == 0 and out["numpy_preloaded"]
+    finally:
+        srv.send_signal(signal.SIGTERM)
+        srv.wait(timeout=30)
+    gone = _job(tmp_path, path, "ok", env_extra={jobserver.PID_ENV: str(srv.pid)})   # ended: run here
+    assert gone.returncode == 0 and not _report(gone)[0]["numpy_preloaded"]
