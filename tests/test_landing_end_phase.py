@@ -76,9 +76,13 @@ def test_end_phase_on_hand_made_records_and_its_sentences():
 
 
 def test_nees_reading_names_under_and_overconfidence():
-    band = [2.73, 3.28]
-    base = {"n_runs": 300, "band": band, "pos_in_band_pct": 13.6, "vel_in_band_pct": 2.0}
-    r = nees_reading({**base, "pos_mean": 1.76, "vel_mean": 1.93})
+    from opnav.landing.montecarlo import NeesConsistency
+
+    def nees(pos_mean, vel_mean):
+        return NeesConsistency(n_runs=300, level=0.95, band=(2.73, 3.28), pos_in_band_pct=13.6, pos_mean=pos_mean,
+                               pos_median=pos_mean, vel_in_band_pct=2.0, vel_mean=vel_mean, vel_median=vel_mean)
+
+    r = nees_reading(nees(1.76, 1.93))
     assert r["verdict"] == "underconfident" and "underconfident" in r["text"] and "1.76" in r["text"]
-    assert nees_reading({**base, "pos_mean": 3.0, "vel_mean": 3.5})["verdict"] == \
+    assert nees_reading(nees(3.0, 3.5))["verdict"] == \
         "consistent in position, overconfident in velocity"

@@ -318,6 +318,7 @@ rule landing_summary:
         code=with_kernels("landing", src(
             "landing/montecarlo.py", "landing/timing.py", "landing/timing_summary.py", "landing/scenario.py", "report/landing/plots.py",
             "report/landing/summary.py", "report/landing/timing_text.py", "landing/accuracy.py", "landing/equivalence.py",
+            "landing/tuning.py",
             "landing/ranking.py", "landing/trajectory.py",
             "landing/setup.py", "core/sections.py",
             "core/tables.py", "core/figures.py", "opnav.mplstyle", "core/published.py", "data/published.yaml")),

@@ -11,7 +11,7 @@ import sys
 from opnav.landing.montecarlo import load, nees_consistency
 from opnav.report.landing.summary import nees_table
 from opnav.landing.setup import Setup
-from opnav.landing.tuning import errors, retuned_record
+from opnav.landing.tuning import HeldOut, TuningReport, errors, retuned_record
 from opnav.core.snakeio import load_json, mock_snakemake, script_context
 from opnav.core.tables import write_json, write_table
 
@@ -22,14 +22,14 @@ with script_context(snakemake) as log:
     scn = snakemake.wildcards.bscn
     d = load(snakemake.input.mc)
     n = d.n_runs
-    rec = retuned_record(load_json(snakemake.input.tuning), scn, Setup.from_config(snakemake.params.landing),
-                         snakemake.params.method, n, {**nees_consistency(d), **errors(d)})
+    rec = retuned_record(TuningReport.from_json(load_json(snakemake.input.tuning)), scn, Setup.from_config(snakemake.params.landing),
+                         snakemake.params.method, n, HeldOut(nees_consistency(d), errors(d)))
     write_json(snakemake.output.record, rec)
     table = nees_table(rec)
     write_table(table, snakemake.output.table,
                 caption=(f"B-T3 NEES ({scn} camera): {snakemake.params.method} with the paper's filter tuning "
                          "(flown by default) and with the bearing-noise scale retuned on the tuning runs alone "
-                         f"(closest to the band's centre). Columns: mean NEES on the {rec['tuning_n_runs']} tuning "
+                         f"(closest to the band's centre). Columns: mean NEES on the {rec.tuning_n_runs} tuning "
                          f"runs; held-out mean NEES and share of filter times in the 95 % band on the {n} "
                          "Monte-Carlo runs; the reading; median position errors at the last landmark update and "
                          "at touchdown."))

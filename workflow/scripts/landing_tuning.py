@@ -21,5 +21,4 @@ with script_context(snakemake) as log:
     out = tuning_report({n: Setup.from_config(c) for n, c in snakemake.params.scenarios.items()},
                         Tuning.from_config(snakemake.params.tuning))
     write_json(snakemake.output[0], out)
-    log.info("tuning: chosen %s (configured %s, matches: %s)", out["chosen"], out["configured"],
-             out["config_matches"])
+    log.info("tuning: chosen %s (configured %s, matches: %s)", out.chosen, out.configured, out.config_matches)

@@ -49,7 +49,7 @@ from opnav.landing.setup import Setup
 __all__ = ["yaw_convergence", "YawConvergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality", "first_runs", "end_phase", "landmark_phase", "phase_rms", "time_below",
-           "nees_band", "nees_consistency", "MonteCarlo", "Descent"]
+           "nees_band", "nees_consistency", "NeesConsistency", "MonteCarlo", "Descent"]
 
 
 def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
@@ -287,21 +287,43 @@ def nees_band(n_runs: int, dof: int = 3, level: float = 0.95) -> tuple[float, fl
     return float(special.chdtri(v, 1.0 - a)) / n_runs, float(special.chdtri(v, a)) / n_runs
 
 
-def nees_consistency(data: MonteCarlo, level: float = 0.95) -> dict:
+@dataclass(frozen=True)
+class NeesConsistency:
+    """Filter consistency on a Monte Carlo (:func:`nees_consistency`): runs, the band's level and
+    the band of an ``n_runs`` mean, and per state (position, velocity) the share of filter times
+    whose run mean lies in it (%), its time average and median."""
+
+    n_runs: int
+    level: float
+    band: tuple[float, float]
+    pos_in_band_pct: float
+    pos_mean: float
+    pos_median: float
+    vel_in_band_pct: float
+    vel_mean: float
+    vel_median: float
+
+    @classmethod
+    def from_json(cls, d) -> "NeesConsistency":
+        """The record of its JSON object (null read as NaN)."""
+        num = lambda v: math.nan if v is None else float(v)  # noqa: E731
+        return cls(int(d["n_runs"]), num(d["level"]), tuple(num(x) for x in d["band"]),
+                   *(num(d[f"{q}_{k}"]) for q in ("pos", "vel") for k in ("in_band_pct", "mean", "median")))
+
+
+def nees_consistency(data: MonteCarlo, level: float = 0.95) -> NeesConsistency:
     """Filter consistency on the Monte Carlo (held-out evidence when the tuning
     was chosen on other runs): per state (position, velocity; 3 dof each) the
     NEES averaged over the runs at each filter time after the start, the share
     of those times whose average lies in the :func:`nees_band` of an
     ``n_runs`` mean (%), its time average and median, and the band."""
-    out = {"n_runs": int(len(data.nees_r)), "level": float(level)}
-    lo, hi = nees_band(out["n_runs"], 3, level)
-    out["band"] = [lo, hi]
-    for key, name in (("nees_r", "pos"), ("nees_v", "vel")):
+    n = int(len(data.nees_r))
+    lo, hi = nees_band(n, 3, level)
+    per = []
+    for key in ("nees_r", "nees_v"):
         avg = np.asarray(getattr(data, key), float)[:, 1:].mean(axis=0)
-        out[f"{name}_in_band_pct"] = float(100.0 * np.mean((avg >= lo) & (avg <= hi)))
-        out[f"{name}_mean"] = float(avg.mean())
-        out[f"{name}_median"] = float(np.median(avg))
-    return out
+        per += [float(100.0 * np.mean((avg >= lo) & (avg <= hi))), float(avg.mean()), float(np.median(avg))]
+    return NeesConsistency(n, float(level), (lo, hi), *per)
 
 
 def last_update_index(updated: np.ndarray):

@@ -29,9 +29,10 @@ from opnav.report.landing.timing_text import CLOCK_WORDS, less_time_text
 if TYPE_CHECKING:
     import pandas as pd
 
-    from opnav.landing.montecarlo import YawConvergence
+    from opnav.landing.montecarlo import NeesConsistency, YawConvergence
     from opnav.landing.records import MonteCarlo
     from opnav.landing.setup import Setup
+    from opnav.landing.tuning import RetunedRecord
 
 
 def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction_vs_svd: float | None = None,
@@ -457,28 +458,27 @@ def end_phase_text(end: dict[str, dict], scenario: str, min_update_alt_m: float,
                 f" for {ms[0]}).")
 
 
-def nees_reading(nees: dict, scenario: str | None = None) -> dict:
+def nees_reading(nees: "NeesConsistency", scenario: str | None = None) -> dict:
     """The filter's consistency read from its held-out NEES (``montecarlo.nees_consistency``):
     per state (pos, vel) ``consistent`` if the time-averaged NEES of the run mean lies inside
     the 95 % band of an n-run mean, ``underconfident`` below it (the covariance larger than the
     errors), ``overconfident`` above it; and a sentence saying so with the numbers."""
-    lo, hi = nees["band"]
+    lo, hi = nees.band
     out = {}
-    for q in ("pos", "vel"):
-        x = nees[f"{q}_mean"]
+    for q, x in (("pos", nees.pos_mean), ("vel", nees.vel_mean)):
         out[q] = "consistent" if lo <= x <= hi else "underconfident" if x < lo else "overconfident"
     verdict = out["pos"] if out["pos"] == out["vel"] else f"{out['pos']} in position, {out['vel']} in velocity"
     out["verdict"] = verdict
     where = f" of the {scenario} camera" if scenario else ""
-    out["text"] = (f"On the held-out runs{where} the filter is {verdict}. Its mean NEES over {nees['n_runs']} runs "
-                   f"is {nees['pos_mean']:.2f} in position and {nees['vel_mean']:.2f} in velocity, against the 95 % "
-                   f"band [{lo:.2f}, {hi:.2f}] of a {nees['n_runs']}-run mean for 3 degrees of freedom. The run mean "
-                   f"lies in the band at {nees['pos_in_band_pct']:.1f} % of the filter times in position and "
-                   f"{nees['vel_in_band_pct']:.1f} % in velocity.")
+    out["text"] = (f"On the held-out runs{where} the filter is {verdict}. Its mean NEES over {nees.n_runs} runs "
+                   f"is {nees.pos_mean:.2f} in position and {nees.vel_mean:.2f} in velocity, against the 95 % "
+                   f"band [{lo:.2f}, {hi:.2f}] of a {nees.n_runs}-run mean for 3 degrees of freedom. The run mean "
+                   f"lies in the band at {nees.pos_in_band_pct:.1f} % of the filter times in position and "
+                   f"{nees.vel_in_band_pct:.1f} % in velocity.")
     return out
 
 
-def nees_table(retuned: dict) -> "pd.DataFrame":
+def nees_table(retuned: "RetunedRecord") -> "pd.DataFrame":
     """The NEES table of one camera scenario from ``landing_retuned``'s record: one row per
     tuning (the paper's, flown by default; the retuned scale, :func:`opnav.landing.tuning.retune`),
     its bearing-noise scale and iterations, the tuning runs' mean NEES (position, velocity),
@@ -488,50 +488,52 @@ def nees_table(retuned: dict) -> "pd.DataFrame":
     import pandas as pd
 
     rows = []
-    for name in ("paper", "retuned"):
-        r = retuned[name]
-        rows.append({"tuning": name, "meas_noise_scale": r["meas_noise_scale"], "iterations": r["iterations"],
-                     "tuning_nees_pos": r["tuning_nees_pos"], "tuning_nees_vel": r["tuning_nees_vel"],
-                     "heldout_nees_pos": r["pos_mean"], "heldout_nees_vel": r["vel_mean"],
-                     "in_band_pct_pos": r["pos_in_band_pct"], "in_band_pct_vel": r["vel_in_band_pct"],
-                     "reading": nees_reading(r)["verdict"],
-                     "lastlm_pos_err_m_median": r["lastlm_pos_err_m_median"],
-                     "final_pos_err_m_median": r["final_pos_err_m_median"]})
+    for name, r in (("paper", retuned.paper), ("retuned", retuned.retuned)):
+        h, e = r.heldout.nees, r.heldout.errors
+        rows.append({"tuning": name, "meas_noise_scale": r.meas_noise_scale, "iterations": r.iterations,
+                     "tuning_nees_pos": r.tuning_nees_pos, "tuning_nees_vel": r.tuning_nees_vel,
+                     "heldout_nees_pos": h.pos_mean, "heldout_nees_vel": h.vel_mean,
+                     "in_band_pct_pos": h.pos_in_band_pct, "in_band_pct_vel": h.vel_in_band_pct,
+                     "reading": nees_reading(h)["verdict"],
+                     "lastlm_pos_err_m_median": e.lastlm_pos_err_m_median,
+                     "final_pos_err_m_median": e.final_pos_err_m_median})
     return pd.DataFrame(rows)
 
 
-def nees_retuned_text(retuned: dict) -> str:
+def nees_retuned_text(retuned: "RetunedRecord") -> str:
     """The manuscript's sentence on the retuned filter (``landing_retuned``'s record): the
     scale chosen on the tuning runs, its held-out NEES and shares in the band beside the
     paper tuning's errors, and, when the retuned filter is not consistent in both states,
     what the tuning runs show about why (their median and largest run against the mean)."""
-    p, r = retuned["paper"], retuned["retuned"]
-    lo, hi = r["band"]
-    rd = nees_reading(r)
-    n = retuned["tuning_n_runs"]
-    s = (f"Retuned within the same protocol, the {retuned['scenario']} camera's bearing-noise scale is "
-         f"{r['meas_noise_scale']:.3g} against the paper tuning's {p['meas_noise_scale']:.3g}: the scale whose NEES "
+    p, r = retuned.paper, retuned.retuned
+    ph, rh = p.heldout.nees, r.heldout.nees
+    pe, re_ = p.heldout.errors, r.heldout.errors
+    lo, hi = rh.band
+    rd = nees_reading(rh)
+    n = retuned.tuning_n_runs
+    s = (f"Retuned within the same protocol, the {retuned.scenario} camera's bearing-noise scale is "
+         f"{r.meas_noise_scale:.3g} against the paper tuning's {p.meas_noise_scale:.3g}: the scale whose NEES "
          f"on the {n} tuning runs lies closest to the band's centre. Held out, its NEES is position "
-         f"{r['pos_mean']:.2f} ({rd['pos']}) and velocity {r['vel_mean']:.2f} ({rd['vel']}) against "
-         f"[{lo:.2f}, {hi:.2f}], in the band at {r['pos_in_band_pct']:.1f} % and {r['vel_in_band_pct']:.1f} % of "
+         f"{rh.pos_mean:.2f} ({rd['pos']}) and velocity {rh.vel_mean:.2f} ({rd['vel']}) against "
+         f"[{lo:.2f}, {hi:.2f}], in the band at {rh.pos_in_band_pct:.1f} % and {rh.vel_in_band_pct:.1f} % of "
          f"the filter times. The median position error at the last landmark update goes from "
-         f"{_fmt(p['lastlm_pos_err_m_median'], '{:.2f}')} to {_fmt(r['lastlm_pos_err_m_median'], '{:.2f}')} m, "
-         f"and at touchdown from {_fmt(p['final_pos_err_m_median'], '{:.2f}')} to "
-         f"{_fmt(r['final_pos_err_m_median'], '{:.2f}')} m.")
+         f"{_fmt(pe.lastlm_pos_err_m_median, '{:.2f}')} to {_fmt(re_.lastlm_pos_err_m_median, '{:.2f}')} m, "
+         f"and at touchdown from {_fmt(pe.final_pos_err_m_median, '{:.2f}')} to "
+         f"{_fmt(re_.final_pos_err_m_median, '{:.2f}')} m.")
     if rd["verdict"] == "consistent":
         return s
-    tlo, thi = retuned["tuning_band"]
-    if r["tuning_in_band"]:
+    tlo, thi = retuned.tuning_band
+    if r.tuning_in_band:
         why = [f"On the {n} tuning runs both lay in their band [{tlo:.2f}, {thi:.2f}] "
-               f"({r['tuning_nees_pos']:.2f}, {r['tuning_nees_vel']:.2f}): that sample does not pin the mean"]
+               f"({r.tuning_nees_pos:.2f}, {r.tuning_nees_vel:.2f}): that sample does not pin the mean"]
     else:
         why = [f"No scale tried puts both in the band on the tuning runs either (closest: position "
-               f"{r['tuning_nees_pos']:.2f}, velocity {r['tuning_nees_vel']:.2f} against [{tlo:.2f}, {thi:.2f}])"]
+               f"{r.tuning_nees_pos:.2f}, velocity {r.tuning_nees_vel:.2f} against [{tlo:.2f}, {thi:.2f}])"]
     if rd["pos"] != rd["vel"]:
-        why.append(f"Held out, the velocity NEES is {r['vel_mean'] / r['pos_mean']:.2f} times the position's "
-                   f"({p['vel_mean'] / p['pos_mean']:.2f} with the paper tuning), and one scale on the bearing noise "
+        why.append(f"Held out, the velocity NEES is {rh.vel_mean / rh.pos_mean:.2f} times the position's "
+                   f"({ph.vel_mean / ph.pos_mean:.2f} with the paper tuning), and one scale on the bearing noise "
                    "moves both together")
-    med, big = r["tuning_nees_pos_run_median"], r["tuning_nees_pos_run_max"]
+    med, big = r.tuning_nees_pos_run_median, r.tuning_nees_pos_run_max
     if big > HEAVY_TAIL_RATIO * med:
         why.append(f"The mean over runs rests on a few runs (position NEES of the median tuning run {med:.2f}, "
                    f"of the largest {big:.1f}): errors heavier-tailed than the Gaussian the filter assumes")
