@@ -57,40 +57,40 @@ def main() -> None:
         t0 = time.perf_counter()
         c0 = time.process_time()
         tm = timing.replay(scn, rec, methods, a.calls, decompose=True)
-        print(f"[{name}] replay: {len(tm['source'])} of {int(tm['n_pool'])} calls x "
-              f"{tm['wall_ns'].shape[1]} variants in {time.perf_counter() - t0:.2f} s wall, "
-              f"{time.process_time() - c0:.2f} s CPU; pick mismatches {int(tm['mismatch'].sum())} "
-              f"of {int(tm['checked'].sum())}")
+        print(f"[{name}] replay: {len(tm.source)} of {int(tm.n_pool)} calls x "
+              f"{tm.wall_ns.shape[1]} variants in {time.perf_counter() - t0:.2f} s wall, "
+              f"{time.process_time() - c0:.2f} s CPU; pick mismatches {int(tm.mismatch.sum())} "
+              f"of {int(tm.checked.sum())}")
         print(timing_text.summary_frame(tm)[["method", "path", "eval_path", "calls",
                                         "cpu_median_us", "cpu_p05_us", "cpu_p95_us",
                                         "median_evals"]].to_string(index=False))
         for m in methods:                  # the call's two parts (timing_summary.decomposition)
             d = timing_summary.decomposition(tm, m)
-            if d["n_calls"]:
-                print(f"[{name}] {m:10s} shared {d['shared_us']:6.2f} us + {d['evals_per_call']:.0f} evaluations x "
-                      f"{1e3 * d['per_eval_us']:5.0f} ns = {d['eval_us']:6.2f} us (least squares: shared "
-                      f"{d['fit_shared_us']:.2f} us, {1e3 * d['fit_per_eval_us']:.0f} ns an evaluation)")
+            if d.n_calls:
+                print(f"[{name}] {m:10s} shared {d.shared_us:6.2f} us + {d.evals_per_call:.0f} evaluations x "
+                      f"{1e3 * d.per_eval_us:5.0f} ns = {d.eval_us:6.2f} us (least squares: shared "
+                      f"{d.fit_shared_us:.2f} us, {1e3 * d.fit_per_eval_us:.0f} ns an evaluation)")
         if "svd" in methods:
             red = timing_summary.time_reduction(tm, "depth", "svd")
             print(f"[{name}] depth vs svd median reduction ({timing_text.CLOCK_WORDS}): {red[0]:.1f} % "
                   f"+- {red[1]:.1f} (one replay's bootstrap; the claims read the spread between replays)")
         ov = timing.call_overhead(scn, rec, "depth", a.calls, reps=a.reps)
-        call, ev = ov["call_ns"] / 1e3, ov["evals_ns"] / 1e3
-        r = float(np.median(ov["overhead_ratio"]))
+        call, ev = ov.call_ns / 1e3, ov.evals_ns / 1e3
+        r = float(np.median(ov.overhead_ratio))
         ratios.append(r)
         print(f"[{name}] compiled depth planning call, thread CPU, {len(call)} calls "
-              f"({int(ov['edge'].sum())} edge calls: detected landmarks scored, counted as "
+              f"({int(ov.edge.sum())} edge calls: detected landmarks scored, counted as "
               f"evaluations); per call min of 3 averages of {a.reps}, median over calls:")
         print(f"    call                        {np.median(call):8.2f} us")
         print(f"    objective evaluations       {np.median(ev):8.2f} us  "
-              f"({np.median(ov['n_evals']):.0f} evaluations)")
+              f"({np.median(ov.n_evals):.0f} evaluations)")
         print(f"    overhead (call - evals)     {np.median(call - ev):8.2f} us")
-        print(f"    overhead / evaluations      {r:8.2f}     (p90 {np.quantile(ov['overhead_ratio'], 0.9):.2f}; "
+        print(f"    overhead / evaluations      {r:8.2f}     (p90 {np.quantile(ov.overhead_ratio, 0.9):.2f}; "
               "target <= 2)")
-        wr = np.median(ov["wrapped_ns"]) / 1e3
+        wr = np.median(ov.wrapped_ns) / 1e3
         print(f"    plan() from Python, hot     {wr:8.2f} us  (the call + the Python wrapper the Monte "
               f"Carlo adds; overhead / evaluations {(wr - np.median(ev)) / np.median(ev):.2f})")
-        print(f"    plan() once, cold           {np.median(ov['cold_ns']) / 1e3:8.2f} us")
+        print(f"    plan() once, cold           {np.median(ov.cold_ns) / 1e3:8.2f} us")
     print(f"depth overhead ratio: {max(ratios):.2f}")
 
 

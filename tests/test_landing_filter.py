@@ -114,7 +114,7 @@ def test_methods_are_paired_and_the_table_is_complete(paired):
     d, tm, df = paired
     np.testing.assert_array_equal(d["depth"].init_error, d["svd"].init_error)
     np.testing.assert_array_equal(d["depth"].err_r[:, 0], d["svd"].err_r[:, 0])
-    assert tm["mismatch"].tolist() == [0, 0]
+    assert tm.mismatch.tolist() == [0, 0]
     for col in ("final_pos_err_m_mean", "final_pos_err_m_3sigma", "rms_vel_err_mps_mean",
                 "rms_att_err_deg_3sigma", "median_plan_time_us", "metric_evals_per_call",
                 "time_reduction_vs_svd_pct", "time_reduction_vs_svd_pct_published"):
@@ -142,6 +142,7 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
 
     import pandas as pd
 
+    from opnav.core.tables import json_ready
     from opnav.landing.montecarlo import yaw_convergence
     from opnav.report.landing.summary import yaw_reason
     from opnav.report.landing.summary import scenario_summary
@@ -167,8 +168,8 @@ def test_scenario_summary_reads_the_table_and_the_runs(landing, paired):
     att = initial_attitude_report(landing)
     assert s["initial_attitude_deg"] == att.paper_convention_deg
     assert s["initial_tilt_deg"] == att.tilt_deg and s["single"] == {"n_plans": 7}
-    assert s["timing"]["checked_calls"] == int(tm["checked"].sum())
-    json.dumps(s, default=float)
+    assert s["timing"].summary.checked_calls == int(tm.checked.sum())
+    json.dumps(json_ready(s), default=float)     # the file edge: typed sections as their fields
     alone = scenario_summary("interior", df[df["method"] == "depth"], {"depth": d["depth"]}, tm, {},
                              landing, **kw)
     assert alone["time_reduction_vs_svd_pct"] is None and np.isnan(alone["min_same_pick_vs_depth_pct"])

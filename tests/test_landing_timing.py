@@ -53,9 +53,9 @@ def test_replay_reproduces_every_recorded_pick(recorded):
     tm = timing.replay(scn, {m: rec[m] for m in ("depth", "random", "center")},
                        ["depth", "random", "center"], max_calls=0)
     n = sum(len(rec[m].plan_index) for m in ("depth", "random", "center"))
-    assert len(tm["source"]) == n and tm["checked"].sum() == n
-    assert tm["mismatch"].tolist() == [0, 0, 0]
-    assert (tm["wall_ns"] > 0).all() and (tm["cpu_ns"] >= 0).all()
+    assert len(tm.source) == n and tm.checked.sum() == n
+    assert tm.mismatch.tolist() == [0, 0, 0]
+    assert (tm.wall_ns > 0).all() and (tm.cpu_ns >= 0).all()
 
 
 @pytest.mark.slow  # ~1.3 CPU-s (issue 56: the default run <= 90 s)
@@ -66,7 +66,7 @@ def test_the_pick_check_can_fail(recorded):
     for key, bad in (("plan_step", lambda x: x + 3), ("plan_exclude", lambda x: np.full_like(x, -1))):
         d = rec["depth"].replace(**{key: bad(getattr(rec["depth"], key))})
         tm = timing.replay(scn, {"depth": d}, ["depth"], max_calls=0)
-        assert tm["mismatch"][0] > 0, key
+        assert tm.mismatch[0] > 0, key
 
 
 @pytest.mark.slow
@@ -78,31 +78,31 @@ def test_replay_deterministic_and_order_independent(recorded):
     a = timing.replay(scn, rec, list(METHODS), max_calls=12)
     b = timing.replay(scn, rec, list(METHODS)[::-1], max_calls=12)
     full = timing.replay(scn, rec, ["svd"], max_calls=0)
-    assert a["mismatch"].sum() == 0 and b["mismatch"].sum() == 0
+    assert a.mismatch.sum() == 0 and b.mismatch.sum() == 0
     for m in METHODS:
         ja = timing_summary.variant_index(a, m, "main")
         jb = timing_summary.variant_index(b, m, "main")
-        np.testing.assert_array_equal(a["pick"][:, ja], b["pick"][:, jb], err_msg=m)
+        np.testing.assert_array_equal(a.pick[:, ja], b.pick[:, jb], err_msg=m)
     for m in ("depth", "svd"):     # compiled and the paper's definition pick alike here
-        np.testing.assert_array_equal(a["pick"][:, timing_summary.variant_index(a, m, "alt")],
-                                      a["pick"][:, timing_summary.variant_index(a, m, "main")])
+        np.testing.assert_array_equal(a.pick[:, timing_summary.variant_index(a, m, "alt")],
+                                      a.pick[:, timing_summary.variant_index(a, m, "main")])
     # the subset's calls are the full pool's calls at the selected indices
-    sel = timing.select_calls(int(a["n_pool"]), 12)
+    sel = timing.select_calls(int(a.n_pool), 12)
     pool_src = np.concatenate([np.full(len(rec[m].plan_index), i) for i, m in enumerate(METHODS)])
-    np.testing.assert_array_equal(a["source"], pool_src[sel])
-    svd_calls = a["source"] == list(METHODS).index("svd")
+    np.testing.assert_array_equal(a.source, pool_src[sel])
+    svd_calls = a.source == list(METHODS).index("svd")
     # (the full replay's rows are every source's calls in pool order: find svd's)
-    row = {(int(s), int(c)): q for q, (s, c) in enumerate(zip(full["source"], full["call"]))}
+    row = {(int(s), int(c)): q for q, (s, c) in enumerate(zip(full.source, full.call))}
     src_svd = list(METHODS).index("svd")
-    np.testing.assert_array_equal(a["pick"][svd_calls, timing_summary.variant_index(a, "svd", "main")],
-                                  full["pick"][[row[(src_svd, int(c))] for c in a["call"][svd_calls]], 0])
+    np.testing.assert_array_equal(a.pick[svd_calls, timing_summary.variant_index(a, "svd", "main")],
+                                  full.pick[[row[(src_svd, int(c))] for c in a.call[svd_calls]], 0])
     # one pass per (path, compiled or interpreted): a variant's slot is its place among
     # its own pass's variants, and each of them comes first in turn
     keys = timing.pass_keys(timing.variants(list(METHODS), scn.planner))
     assert keys == [(0, 0), (1, 1), (0, 0), (1, 1), (0, 1), (0, 1)]   # depth, svd: main + alt; pickers
     for key in set(keys):
         g = np.flatnonzero([k == key for k in keys])
-        assert set(a["slot"][:g.size, g[0]]) == set(range(g.size)), key
+        assert set(a.slot[:g.size, g[0]]) == set(range(g.size)), key
 
 
 def _fake_timing(wall_us: dict, cpu_us: dict, runs):
@@ -210,19 +210,19 @@ def test_replay_times_the_paper_path_on_its_subset_only(recorded):
     a = timing.replay(scn, rec, list(METHODS), max_calls=12, max_calls_paper=4)
     full = timing.replay(scn, rec, list(METHODS), max_calls=12, max_calls_paper=0)
     sub = timing.select_calls(12, 4)
-    paper = (a["variant_path"] == "alt") & (a["variant_eval_path"] == "paper")
+    paper = (a.variant_path == "alt") & (a.variant_eval_path == "paper")
     np.testing.assert_array_equal(paper, timing.paper_limited(timing.variants(list(METHODS), scn.planner)))
-    assert paper.sum() == 2 and set(a["variant_eval_path"][paper]) == {"paper"}
-    tmd = a["timed"]
+    assert paper.sum() == 2 and set(a.variant_eval_path[paper]) == {"paper"}
+    tmd = a.timed
     assert tmd[:, ~paper].all()
     np.testing.assert_array_equal(np.flatnonzero(tmd[:, paper].all(axis=1)), sub)
     assert not tmd[np.setdiff1d(np.arange(12), sub)][:, paper].any()
     off = ~tmd
-    assert (a["wall_ns"][off] == -1).all() and (a["cpu_ns"][off] == -1).all()
-    assert (a["pick"][off] == -2).all() and (a["slot"][off] == -1).all() and (a["n_evals"][off] == -1).all()
-    assert (a["wall_ns"][tmd] > 0).all()
-    np.testing.assert_array_equal(a["pick"][tmd], full["pick"][tmd])
-    assert full["timed"].all() and a["mismatch"].sum() == 0
+    assert (a.wall_ns[off] == -1).all() and (a.cpu_ns[off] == -1).all()
+    assert (a.pick[off] == -2).all() and (a.slot[off] == -1).all() and (a.n_evals[off] == -1).all()
+    assert (a.wall_ns[tmd] > 0).all()
+    np.testing.assert_array_equal(a.pick[tmd], full.pick[tmd])
+    assert full.timed.all() and a.mismatch.sum() == 0
     # passes (timing.pass_keys): compiled searches of the configured path, its
     # interpreted pickers, then the paper's definition on its subset; the t-th call
     # of a pass runs that pass's variants rotated left by t
@@ -230,13 +230,13 @@ def test_replay_times_the_paper_path_on_its_subset_only(recorded):
     for key in sorted(set(keys)):
         g = np.flatnonzero([k == key for k in keys])
         calls = sub if key[0] == 1 else np.arange(12)
-        firsts = [int(g[np.flatnonzero(a["slot"][q, g] == 0)[0]]) for q in calls]
+        firsts = [int(g[np.flatnonzero(a.slot[q, g] == 0)[0]]) for q in calls]
         assert firsts == [int(g[t % g.size]) for t in range(len(calls))], key
-        assert (a["slot"][np.ix_(calls, g)] < g.size).all()
+        assert (a.slot[np.ix_(calls, g)] < g.size).all()
     s = timing_summary.method_summary(a)
-    assert s["timed_calls"] == 12 and s["timed_calls_paper"] == 4 and s["max_calls_paper"] == 4
+    assert s.timed_calls == 12 and s.timed_calls_paper == 4 and s.max_calls_paper == 4
     assert "on 4 of them" in timing_text.method_text(a)
-    assert timing_summary.method_summary(full)["timed_calls_paper"] == 12
+    assert timing_summary.method_summary(full).timed_calls_paper == 12
 
 
 def _subset_timing(n=40, every=4):
@@ -251,17 +251,16 @@ def _subset_timing(n=40, every=4):
                             "svd@": alt_s * 1e3},
                            {"depth": main_d * 1e3, "svd": main_s * 1e3, "depth@": alt_d * 1e3,
                             "svd@": alt_s * 1e3}, runs, n_evals=7)
-    tm["variant_method"] = np.array(["depth", "svd", "depth", "svd"])
-    tm["variant_path"] = np.array(["main", "main", "alt", "alt"])
-    tm["variant_eval_path"] = np.array(["compiled", "compiled", "paper", "paper"])
-    tm["methods"] = np.array(["depth", "svd"])
-    tm["mismatch"], tm["checked"] = np.zeros(2, np.int64), np.zeros(2, np.int64)
+    tm = tm.replace(variant_method=np.array(["depth", "svd", "depth", "svd"]),
+                    variant_path=np.array(["main", "main", "alt", "alt"]),
+                    variant_eval_path=np.array(["compiled", "compiled", "paper", "paper"]),
+                    methods=np.array(["depth", "svd"]), mismatch=np.zeros(2, np.int64),
+                    checked=np.zeros(2, np.int64), max_calls_paper=np.int64(n // every))
     sub = np.arange(n) % every == 0
-    tm["timed"][~sub, 2:] = False
+    tm.timed[~sub, 2:] = False
     for k in ("wall_ns", "cpu_ns", "n_evals", "slot"):
-        tm[k][~sub, 2:] = -1
-    tm["n_evals"][sub, 2:] = 31
-    tm["max_calls_paper"] = np.int64(n // every)
+        getattr(tm, k)[~sub, 2:] = -1
+    tm.n_evals[sub, 2:] = 31
     return tm, sub
 
 
@@ -284,7 +283,7 @@ def test_consumers_ignore_untimed_entries(recorded):
     assert f.loc[("svd", "alt"), "calls"] == 10 and f.loc[("svd", "alt"), "cpu_p05_us"] == pytest.approx(5000)
     assert f.loc[("depth", "alt"), "median_evals"] == 31
     assert set(timing_summary.per_run_median_us(tm, "svd", path="alt").values()) == {5000.0}
-    assert timing_summary.method_summary(tm)["timed_calls_paper"] == 10
+    assert timing_summary.method_summary(tm).timed_calls_paper == 10
     _, rec = recorded
     t = summary_table({m: copy.copy(rec[m]) for m in ("depth", "svd")}, tm).set_index("method")
     assert t.loc["svd", "median_plan_time_alt_us"] == pytest.approx(5000.0)
@@ -304,13 +303,13 @@ def test_reductions_across_paths_use_the_common_subset():
     from the calls timed on both; the main-path depth times outside the subset
     (here 1 us) would move the result if they were used."""
     tm, sub = _subset_timing()
-    tm["cpu_ns"][~sub, 0] = 1000                                   # 1 us off the subset
+    tm.cpu_ns[~sub, 0] = 1000                                   # 1 us off the subset
     red, sd = timing_summary.time_reduction(tm, "depth", "svd", path_a="main", path_b="alt", n_boot=50)
     assert red == pytest.approx(100 * (1 - 100 / 5000)) and sd == pytest.approx(0.0, abs=1e-9)
     assert timing_summary.time_reduction(tm, "depth", "svd", path_a="alt", path_b="alt", n_boot=0)[0] \
         == pytest.approx(80.0)
     assert timing_summary.median_us(tm, "depth") == pytest.approx(1.0)      # its own median: every call
-    tm["timed"][:, 3] = False
+    tm.timed[:, 3] = False
     assert np.isnan(timing_summary.time_reduction(tm, "depth", "svd", path_b="alt")[0])
 
 
@@ -344,9 +343,9 @@ def test_compiled_calls_are_timed_warm_and_interpreted_ones_once(recorded, monke
     var = timing.variants(list(METHODS), scn.planner)
     keys = timing.pass_keys(var)
     for v, ((m, _, cfg), key) in enumerate(zip(var, keys)):
-        n_timed = int(a["timed"][:, v].sum())
+        n_timed = int(a.timed[:, v].sum())
         compiled = key[1] == 0
-        reps = a["reps"][a["timed"][:, v], v]
+        reps = a.reps[a.timed[:, v], v]
         assert (reps >= 1).all()
         # the pick's untimed plan, then the timed brackets (1, 2, 4, ... calls back to back)
         timed_plans = 0 if compiled else int(np.sum(2 * reps - 1))
@@ -407,24 +406,24 @@ def test_repetitions_keep_the_clock_below_5_pct_of_a_recorded_call(recorded, tmp
     scn, rec = recorded
     a = timing.replay(scn, rec, ["depth", "svd", "svd_lapack"], max_calls=8, alt=False)
     cs = timing_summary.clock_share(a)
-    assert 0 < a["clock_ns"] < 50_000
-    assert cs["share_pct_max"] < 5.0
-    ok = a["timed"] & (a["reps"] > 0)
-    assert np.all(a["reps"][ok] * a["cpu_ns"][ok] >= 0.95 * timing.CLOCK_SHARE_INV * a["clock_ns"])
-    assert cs["reps_max"] > 1                                   # a compiled call needs repeating
+    assert 0 < a.clock_ns < 50_000
+    assert cs.share_pct_max < 5.0
+    ok = a.timed & (a.reps > 0)
+    assert np.all(a.reps[ok] * a.cpu_ns[ok] >= 0.95 * timing.CLOCK_SHARE_INV * a.clock_ns)
+    assert cs.reps_max > 1                                   # a compiled call needs repeating
     assert "below 5 %" in timing_text.method_text(a)
     # the machine's load during the replay is kept and stated with the times (other processes
     # on the cores lengthen microsecond calls), and survives the file round trip
     import os
 
-    assert a["load_avg"].shape == (2,) and np.all(np.isfinite(a["load_avg"])) and a["n_cpu"] == os.cpu_count()
-    lo, hi = a["load_avg"]
+    assert a.load_avg.shape == (2,) and np.all(np.isfinite(a.load_avg)) and a.n_cpu == os.cpu_count()
+    lo, hi = a.load_avg
     assert f"load average was {lo:.1f} at the start and {hi:.1f} at the end" in timing_text.method_text(a)
     timing.save(tmp_path / "t.npz", a)
     assert timing_text.method_text(timing.load(tmp_path / "t.npz")) == timing_text.method_text(a)
     # the closed form and the LAPACK SVD of the same H pick alike
-    v = list(a["variant_method"])
-    assert np.array_equal(a["pick"][:, v.index("svd")], a["pick"][:, v.index("svd_lapack")])
+    v = list(a.variant_method)
+    assert np.array_equal(a.pick[:, v.index("svd")], a.pick[:, v.index("svd_lapack")])
 
 
 def test_main_and_replication_timing_time_one_list():

@@ -23,13 +23,13 @@ def _synthetic(shared_us, eval_us, n_evals, jitter=None):
     j = np.zeros(n) if jitter is None else np.asarray(jitter, float)
     cpu = {m: (shared_us[m] + j + n_evals * eval_us[m]) * 1e3 for m in ("depth", "svd")}
     tm = timing.from_times({m: 1.7 * v for m, v in cpu.items()}, cpu, np.repeat(np.arange(n // 5 + 1), 5)[:n])
-    tm["n_evals"] = np.column_stack([n_evals, n_evals]).astype(np.int64)
-    tm["eval_ns"] = np.column_stack([n_evals * eval_us["depth"] * 1e3,
-                                     n_evals * eval_us["svd"] * 1e3]).round().astype(np.int64)
-    tm["cpu_ns"] = tm["cpu_ns"].round().astype(np.int64)
-    tm["variant_eval_path"] = np.array(["compiled", "compiled"])
-    tm["clock_ns"], tm["load_avg"], tm["dispatch_ns"] = 100.0, np.array([0.5, 0.6]), 700.0
-    return tm
+    return tm.replace(
+        n_evals=np.column_stack([n_evals, n_evals]).astype(np.int64),
+        eval_ns=np.column_stack([n_evals * eval_us["depth"] * 1e3,
+                                 n_evals * eval_us["svd"] * 1e3]).round().astype(np.int64),
+        cpu_ns=tm.cpu_ns.round().astype(np.int64),
+        variant_eval_path=np.array(["compiled", "compiled"]),
+        clock_ns=100.0, load_avg=np.array([0.5, 0.6]), dispatch_ns=700.0)
 
 
 def _merged(shared, eval_us=None, n=40, seed=0):
@@ -50,15 +50,15 @@ def test_decomposition_of_a_synthetic_kernel_known_answer():
     tm = _synthetic({"depth": 2.0, "svd": 2.5}, {"depth": 0.04, "svd": 0.08}, n_evals)
     for m, s, e in (("depth", 2.0, 0.04), ("svd", 2.5, 0.08)):
         d = ts.decomposition(tm, m)
-        assert d["shared_us"] == pytest.approx(s, abs=2e-3)
-        assert d["per_eval_us"] == pytest.approx(e, rel=1e-3)
-        assert d["eval_us"] == pytest.approx(e * np.median(n_evals), rel=1e-3)
-        assert d["fit_shared_us"] == pytest.approx(s, abs=2e-3) and d["fit_per_eval_us"] == pytest.approx(e, rel=1e-3)
-        assert d["evals_per_call"] == np.median(n_evals) and d["n_calls"] == 50
+        assert d.shared_us == pytest.approx(s, abs=2e-3)
+        assert d.per_eval_us == pytest.approx(e, rel=1e-3)
+        assert d.eval_us == pytest.approx(e * np.median(n_evals), rel=1e-3)
+        assert d.fit_shared_us == pytest.approx(s, abs=2e-3) and d.fit_per_eval_us == pytest.approx(e, rel=1e-3)
+        assert d.evals_per_call == np.median(n_evals) and d.n_calls == 50
     # counts that do not vary: no line, the measured split still holds
     flat = _synthetic({"depth": 2.0, "svd": 2.5}, {"depth": 0.04, "svd": 0.08}, np.full(50, 31))
     d = ts.decomposition(flat, "depth")
-    assert math.isnan(d["fit_shared_us"]) and d["shared_us"] == pytest.approx(2.0, abs=2e-3)
+    assert math.isnan(d.fit_shared_us) and d.shared_us == pytest.approx(2.0, abs=2e-3)
 
 
 @given(st.floats(0.01, 10.0), st.floats(0.1, 5.0), st.floats(1.05, 5.0), st.floats(1.0, 80.0))
@@ -84,37 +84,37 @@ def test_evidence_of_three_replays_known_answer():
     overhead curve passes through them and the published value holds at the computed shared
     part."""
     tm = _merged([1.5, 2.0, 3.0])
-    n_ev = np.median(tm["n_evals"][:40, 0])
+    n_ev = np.median(tm.n_evals[:40, 0])
     ed, es = 0.04 * n_ev, 0.08 * n_ev
     ev = ts.planning_time_evidence(tm, 29.03)
-    assert ev["clock"] == "thread_cpu" and ev["n_replays"] == 3 and ev["methods"] == ["depth", "svd"]
+    assert ev.clock == "thread_cpu" and ev.n_replays == 3 and ev.methods == ["depth", "svd"]
     want = [100 * (1 - (s + ed) / (s + es)) for s in (1.5, 2.0, 3.0)]
-    r = ev["reduction_pct"]["depth_vs_svd"]
-    assert r["per_replay"] == pytest.approx(want, abs=0.05)
-    assert r["mean"] == pytest.approx(np.mean(want), abs=0.05)
-    assert r["sd_between"] == pytest.approx(np.std(want, ddof=1), abs=0.05)
+    r = ev.reduction_pct["depth_vs_svd"]
+    assert r.per_replay == pytest.approx(want, abs=0.05)
+    assert r.mean == pytest.approx(np.mean(want), abs=0.05)
+    assert r.sd_between == pytest.approx(np.std(want, ddof=1), abs=0.05)
     from scipy import stats
 
     h = stats.t.ppf(0.975, 2) * np.std(want, ddof=1) / math.sqrt(3)
-    assert (r["lo"], r["hi"]) == pytest.approx((np.mean(want) - h, np.mean(want) + h), abs=0.1)
-    assert r["level"] == 0.95
-    dec = ev["decomposition"]
-    assert dec["depth"]["shared_us_per_replay"] == pytest.approx([1.5, 2.0, 3.0], abs=2e-3)
-    assert dec["svd"]["per_eval_us"] == pytest.approx(0.08, rel=1e-3)
-    c = ev["overhead_curve"]
-    assert c["replay_reduction_pct"] == pytest.approx(want, abs=0.05)
-    assert np.interp(c["replay_shared_us"], c["shared_us"], c["reduction_pct"]) == pytest.approx(want, abs=0.2)
-    s = ev["shared_us_at_published"]
+    assert (r.lo, r.hi) == pytest.approx((np.mean(want) - h, np.mean(want) + h), abs=0.1)
+    assert r.level == 0.95
+    dec = ev.decomposition
+    assert dec["depth"].shared_us_per_replay == pytest.approx([1.5, 2.0, 3.0], abs=2e-3)
+    assert dec["svd"].per_eval_us == pytest.approx(0.08, rel=1e-3)
+    c = ev.overhead_curve
+    assert c.replay_reduction_pct == pytest.approx(want, abs=0.05)
+    assert np.interp(c.replay_shared_us, c.shared_us, c.reduction_pct) == pytest.approx(want, abs=0.2)
+    s = ev.shared_us_at_published
     assert s == pytest.approx(((1 - 0.2903) * es - ed) / 0.2903, rel=1e-3)
-    assert float(ts.reduction_at(s, c["unshared_a_us"], c["unshared_b_us"])) == pytest.approx(29.03, abs=1e-6)
-    assert c["unshared_a_us"] == pytest.approx(ed, rel=1e-3) and c["mean_shared_us"] == pytest.approx(6.5 / 3, rel=1e-3)
-    assert [rp["n_calls"] for rp in ev["replays"]] == [40, 40, 40]
+    assert float(ts.reduction_at(s, c.unshared_a_us, c.unshared_b_us)) == pytest.approx(29.03, abs=1e-6)
+    assert c.unshared_a_us == pytest.approx(ed, rel=1e-3) and c.mean_shared_us == pytest.approx(6.5 / 3, rel=1e-3)
+    assert [rp.n_calls for rp in ev.replays] == [40, 40, 40]
     # on the evaluations alone the shared part's moves are gone: 50 % in every replay, no spread
-    e = ev["eval_reduction_pct"]["depth_vs_svd"]
-    assert e["per_replay"] == pytest.approx([50.0] * 3, abs=0.05) and e["sd_between"] == pytest.approx(0, abs=0.05)
-    assert ev["replays"][0]["load_avg"] == [0.5, 0.6] and ev["replays"][0]["dispatch_us"] == 0.7
-    lo, hi = ev["replays"][0]["median_interval_us"]["depth"]
-    assert lo <= ev["replays"][0]["median_us"]["depth"] <= hi
+    e = ev.eval_reduction_pct["depth_vs_svd"]
+    assert e.per_replay == pytest.approx([50.0] * 3, abs=0.05) and e.sd_between == pytest.approx(0, abs=0.05)
+    assert ev.replays[0].load_avg == [0.5, 0.6] and ev.replays[0].dispatch_us == 0.7
+    lo, hi = ev.replays[0].median_interval_us["depth"]
+    assert lo <= ev.replays[0].median_us["depth"] <= hi
 
 
 def test_spread_is_between_replays_not_one_replays_bootstrap():
@@ -126,13 +126,13 @@ def test_spread_is_between_replays_not_one_replays_bootstrap():
                        for s in (1.0, 2.0, 4.0)])
     one = ts.one_replay(tm, 0)
     assert ts.time_reduction(one, "depth", "svd", n_boot=200)[1] == pytest.approx(0.0, abs=1e-9)   # within: none
-    assert ts.planning_time_evidence(tm, 29.03)["reduction_pct"]["depth_vs_svd"]["sd_between"] > 3.0
+    assert ts.planning_time_evidence(tm, 29.03).reduction_pct["depth_vs_svd"].sd_between > 3.0
     jit = np.random.default_rng(3).normal(0, 0.5, 40)                        # noisy within, alike between
     n_evals = np.random.default_rng(4).integers(20, 61, 40)
     reps = [_synthetic({"depth": 2.0, "svd": 2.0}, {"depth": 0.04, "svd": 0.08}, n_evals, jit) for _ in range(3)]
     tm2 = timing.merge(reps)
     ev = ts.planning_time_evidence(tm2, 29.03)
-    assert ev["reduction_pct"]["depth_vs_svd"]["sd_between"] == pytest.approx(0.0, abs=1e-9)
+    assert ev.reduction_pct["depth_vs_svd"].sd_between == pytest.approx(0.0, abs=1e-9)
     assert ts.time_reduction(ts.one_replay(tm2, 0), "depth", "svd", n_boot=200)[1] > 0.1
 
 
@@ -150,17 +150,17 @@ def test_text_and_tables_read_the_verdicts_clock():
 
     tm = _merged([2.0, 2.0, 2.0])
     ev = ts.planning_time_evidence(tm, 29.03)
-    assert ev["clock"] == ts.CLOCK_NAME == "thread_cpu" and ts.CLOCK == "cpu"
+    assert ev.clock == ts.CLOCK_NAME == "thread_cpu" and ts.CLOCK == "cpu"
     d_cpu = ts.median_us(tm, "depth", clock="cpu")
     d_wall = ts.median_us(tm, "depth", clock="wall")
     assert d_wall == pytest.approx(1.7 * d_cpu, rel=1e-3)
-    assert ev["median_us"]["depth"]["mean"] == pytest.approx(d_cpu)
+    assert ev.median_us["depth"].mean == pytest.approx(d_cpu)
     vs = ts.vs_depth(tm)["svd_closed_form"]
-    assert vs["depth_median_us"] == pytest.approx(d_cpu)
+    assert vs.depth_median_us == pytest.approx(d_cpu)
     text = planning_time_text(ts.vs_depth(tm), ts.clock_share(tm), ev)
     assert f"{d_cpu:.2f} against" in text and f"{d_wall:.2f}" not in text
     assert f"clock: {tt.CLOCK_WORDS}" in text and "(thread CPU" in text and "wall" not in text
-    red = ev["reduction_pct"]["depth_vs_svd"]["mean"]
+    red = ev.reduction_pct["depth_vs_svd"].mean
     assert f"took {tt.less_time_text(red)} time" in text
     assert ts.time_reduction(tm, "depth", "svd", n_boot=0)[0] == pytest.approx(red, abs=1e-9)
     assert tt.less_time_text(red) in tt.less_time_text(ts.time_reduction(tm, "depth", "svd", n_boot=0)[0])
@@ -177,17 +177,17 @@ def test_merge_pools_replays_and_times_the_rest_once():
     replay 0's rows only (untimed elsewhere), so pooled medians read every timed row and a pair of
     variants compares on the rows timed on both; a replay of other calls is refused."""
     reps = [_synthetic({"depth": s, "svd": s}, {"depth": 0.04, "svd": 0.08}, np.full(10, 30)) for s in (1, 2, 3)]
-    extra = timing.from_times({"logdet": np.full(10, 9e4)}, {"logdet": np.full(10, 8e4)}, reps[0]["run"])
-    extra["sources"] = reps[0]["sources"]                  # the same pool of recorded calls
+    extra = timing.from_times({"logdet": np.full(10, 9e4)}, {"logdet": np.full(10, 8e4)}, reps[0].run)
+    extra = extra.replace(sources=reps[0].sources)                  # the same pool of recorded calls
     tm = timing.merge(reps, extra)
-    assert tm["cpu_ns"].shape == (30, 3) and list(tm["replay"]) == [0] * 10 + [1] * 10 + [2] * 10
-    assert tm["timed"][:10, 2].all() and not tm["timed"][10:, 2].any()
+    assert tm.cpu_ns.shape == (30, 3) and list(tm.replay) == [0] * 10 + [1] * 10 + [2] * 10
+    assert tm.timed[:10, 2].all() and not tm.timed[10:, 2].any()
     assert ts.timed_calls(tm, "depth") == 30 and ts.timed_calls(tm, "logdet") == 10
-    assert ts.replay_calls(tm) == 10 and ts.method_summary(tm)["timed_calls"] == 10
+    assert ts.replay_calls(tm) == 10 and ts.method_summary(tm).timed_calls == 10
     assert ts.replayed_methods(tm) == ["depth", "svd"]
     assert ts.median_us(tm, "logdet") == pytest.approx(80.0)
     bad = copy.deepcopy(reps[1])
-    bad["call"] = bad["call"] + 1
+    bad = bad.replace(call=bad.call + 1)
     with pytest.raises(ValueError, match="same recorded calls"):
         timing.merge([reps[0], bad])
     with pytest.raises(ValueError, match="times a variant of the replays again"):
@@ -212,11 +212,11 @@ def test_decomposition_of_the_real_call(recorded):
     than the whole call in most calls; the shared part is positive)."""
     _, scn, rec = recorded
     tm = timing.replay(scn, rec, ["depth", "svd"], max_calls=8, alt=False, decompose=True)
-    ev = np.asarray(tm["eval_ns"])
-    assert (ev > 0).all() and np.mean(ev < tm["cpu_ns"]) >= 0.75
+    ev = np.asarray(tm.eval_ns)
+    assert (ev > 0).all() and np.mean(ev < tm.cpu_ns) >= 0.75
     d = ts.decomposition(tm, "depth")
-    assert d["n_calls"] == 8 and d["shared_us"] > 0 and d["evals_per_call"] == np.median(tm["n_evals"][:, 0])
-    assert tm["dispatch_ns"] > 0
+    assert d.n_calls == 8 and d.shared_us > 0 and d.evals_per_call == np.median(tm.n_evals[:, 0])
+    assert tm.dispatch_ns > 0
     q = timing.evaluation_inputs("depth", *_inputs(scn, rec["depth"], 0))
     assert q is not None and q[3] == q[1].size + q[2].size
 
@@ -245,8 +245,8 @@ def test_replays_in_processes_pick_what_the_monte_carlo_picked(recorded, tmp_pat
         save(mc[m], d, m)
     spec = timing.replay_spec(cfg, mc, ["depth", "svd"], 6, alt=False, decompose=True)
     reps = timing.replays_in_processes(spec, 2, tmp_path / "work")
-    assert len(reps) == 2 and all(int(np.sum(r["mismatch"])) == 0 and int(np.sum(r["checked"])) > 0 for r in reps)
-    np.testing.assert_array_equal(reps[0]["pick"], reps[1]["pick"])
+    assert len(reps) == 2 and all(int(np.sum(r.mismatch)) == 0 and int(np.sum(r.checked)) > 0 for r in reps)
+    np.testing.assert_array_equal(reps[0].pick, reps[1].pick)
     other = timing.run_spec(timing.replay_spec(cfg, mc, ["depth", "svd", "random"], 6, alt=["depth", "svd"],
                                                main=["random"], max_calls_paper=2))
     tm = timing.merge(reps, other)
@@ -255,12 +255,12 @@ def test_replays_in_processes_pick_what_the_monte_carlo_picked(recorded, tmp_pat
         paths.append(tmp_path / f"part{i}.npz")
         timing.save(paths[-1], t)
     loaded = timing.load([str(x) for x in paths])
-    assert all(np.array_equal(loaded[k], tm[k]) for k in ("cpu_ns", "timed", "pick", "replay", "variant_method"))
-    assert int(np.sum(tm["mismatch"])) == 0
-    assert int(np.sum(tm["checked"])) == sum(int(np.sum(r["checked"])) for r in [*reps, other])
-    own = tm["source"] == list(tm["sources"]).index("depth")
+    assert all(np.array_equal(getattr(loaded, k), getattr(tm, k)) for k in ("cpu_ns", "timed", "pick", "replay", "variant_method"))
+    assert int(np.sum(tm.mismatch)) == 0
+    assert int(np.sum(tm.checked)) == sum(int(np.sum(r.checked)) for r in [*reps, other])
+    own = tm.source == list(tm.sources).index("depth")
     j = ts.variant_index(tm, "depth", "main")
-    np.testing.assert_array_equal(tm["pick"][own, j], rec["depth"].plan_index[tm["call"][own]])
+    np.testing.assert_array_equal(tm.pick[own, j], rec["depth"].plan_index[tm.call[own]])
 
 
 def test_a_call_of_milliseconds_is_timed_as_it_comes_and_picks_alike(recorded, monkeypatch):
@@ -272,11 +272,11 @@ def test_a_call_of_milliseconds_is_timed_as_it_comes_and_picks_alike(recorded, m
     warm = timing.replay(scn, rec, ["depth", "svd", "random"], max_calls=8, alt=False)
     monkeypatch.setattr(timing, "COLD_OK_NS", 0)
     cold = timing.replay(scn, rec, ["depth", "svd", "random"], max_calls=8, alt=False, warm_compiled=False)
-    np.testing.assert_array_equal(cold["pick"], warm["pick"])
-    np.testing.assert_array_equal(cold["n_evals"], warm["n_evals"])
-    assert int(np.sum(cold["mismatch"])) == 0 and int(np.sum(cold["checked"])) > 0
+    np.testing.assert_array_equal(cold.pick, warm.pick)
+    np.testing.assert_array_equal(cold.n_evals, warm.n_evals)
+    assert int(np.sum(cold.mismatch)) == 0 and int(np.sum(cold.checked)) > 0
     j = ts.variant_index(cold, "depth", "main")
-    assert (cold["reps"][:, j] == 1).all() and (cold["cpu_ns"][:, j] > 0).all()
+    assert (cold.reps[:, j] == 1).all() and (cold.cpu_ns[:, j] > 0).all()
 
 
 def test_evidence_of_one_replay_and_without_svd_has_no_spread_and_no_curve():
@@ -287,15 +287,15 @@ def test_evidence_of_one_replay_and_without_svd_has_no_spread_and_no_curve():
 
     one = _merged([2.0])
     ev = ts.planning_time_evidence(one, 29.03)
-    r = ev["reduction_pct"]["depth_vs_svd"]
-    assert ev["n_replays"] == 1 and len(r["per_replay"]) == 1 and math.isnan(r["sd_between"])
-    assert math.isnan(r["lo"]) and "between-replay sd" not in evidence_text(ev)
+    r = ev.reduction_pct["depth_vs_svd"]
+    assert ev.n_replays == 1 and len(r.per_replay) == 1 and math.isnan(r.sd_between)
+    assert math.isnan(r.lo) and "between-replay sd" not in evidence_text(ev)
     tm = _merged([1.0, 2.0, 3.0])
-    keep = np.asarray(tm["variant_method"]) == "depth"
+    keep = np.asarray(tm.variant_method) == "depth"
     for k in ("wall_ns", "cpu_ns", "pick", "n_evals", "slot", "timed", "eval_ns", "reps"):
-        tm[k] = tm[k][:, keep]
+        tm = tm.replace(**{k: getattr(tm, k)[:, keep]})
     for k in ("variant_method", "variant_path", "variant_eval_path"):
-        tm[k] = np.asarray(tm[k])[keep]
+        tm = tm.replace(**{k: np.asarray(getattr(tm, k))[keep]})
     ev = ts.planning_time_evidence(tm, 29.03)
-    assert ev["methods"] == ["depth"] and ev["reduction_pct"] == {} and ev["overhead_curve"]["shared_us"] == []
-    assert math.isnan(ev["shared_us_at_published"]) and evidence_text(ev) == ""
+    assert ev.methods == ["depth"] and ev.reduction_pct == {} and ev.overhead_curve.shared_us == []
+    assert math.isnan(ev.shared_us_at_published) and evidence_text(ev) == ""

@@ -43,8 +43,8 @@ with script_context(snakemake) as log:
         ev = timing_summary.planning_time_evidence(tm, published.load()["paper_b"]["depth_time_reduction_vs_svd_pct"])
         log.info("%s", timing_text.method_text(tm))
         log.info("reductions between replays (mean, sd): %s; shared part at the published reduction: %.3f us",
-                 {k: (round(v["mean"], 2), round(v["sd_between"], 2)) for k, v in ev["reduction_pct"].items()},
-                 ev["shared_us_at_published"])
+                 {k: (round(v.mean, 2), round(v.sd_between, 2)) for k, v in ev.reduction_pct.items()},
+                 ev.shared_us_at_published)
         if "f7o" in snakemake.output.keys():
             from opnav.core import figures
             from opnav.report.landing import timing_plots

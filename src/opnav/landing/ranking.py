@@ -36,6 +36,7 @@ import pandas as pd
 from scipy import special
 
 from opnav.landing.montecarlo import MonteCarlo, per_run_stats, same_pick_pct
+from opnav.landing.records import Replay
 
 __all__ = ["paired_t_interval", "bootstrap_mean_interval", "paired_difference",
            "competition_rank", "ranking_table", "headline", "median_abs_dbeta_deg",
@@ -187,7 +188,7 @@ def _rank_by(stats: pd.DataFrame) -> str:
     return RANK_BY if f"{RANK_BY}_err_m" in stats else "rms_pos"
 
 
-def ranking_table(data: dict[str, MonteCarlo], timing: dict, reference: str = "depth", n_boot: int = 2000,
+def ranking_table(data: dict[str, MonteCarlo], timing: Replay, reference: str = "depth", n_boot: int = 2000,
                   seed: int = 0, level: float = 0.95, rtol: float = 0.0,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-X1: one row per method of ``data`` (gathered Monte Carlo records, same

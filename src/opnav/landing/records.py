@@ -39,7 +39,7 @@ from typing import Mapping
 
 import numpy as np
 
-__all__ = ["PLAN_KEYS", "RECORD_KEYS", "CALL_KEYS", "TRACK_KEYS", "Descent", "MonteCarlo", "CallLog",
+__all__ = ["PLAN_KEYS", "RECORD_KEYS", "CALL_KEYS", "TRACK_KEYS", "Descent", "MonteCarlo", "CallLog", "Replay",
            "rng_words", "rng_from_words", "save", "load"]
 
 #: per planning call, what it returned: key -> dtype
@@ -292,3 +292,78 @@ class MonteCarlo:
     def of_descent(cls, run: Descent, run_index: int = 0) -> "MonteCarlo":
         """One :class:`Descent` as a record of one run (its calls' ``plan_run`` = ``run_index``)."""
         return cls.of_runs([run_index], [run], run.t)
+
+
+@dataclass(frozen=True, eq=False)
+class Replay:
+    """A planning-time replay (``timing.replay``; several merged by ``timing.merge``), the arrays
+    of its ``.npz`` file by name. Per replayed call (rows): ``source`` (position in ``sources``),
+    ``run``, ``call``, ``step`` and, merged, ``replay`` (which replay) and ``row_clock_ns``; per row
+    and variant (cells): ``wall_ns``, ``cpu_ns``, ``pick``, ``n_evals``, ``slot``, ``timed``,
+    ``eval_ns``, ``reps``; per variant ``variant_method``, ``variant_path``,
+    ``variant_eval_path``; per method of ``methods`` ``mismatch`` and ``checked``; scalars
+    ``n_pool``, ``max_calls``, ``max_calls_paper``, ``clock_ns``, ``dispatch_ns``, ``n_cpu``,
+    ``n_replays``, the load averages and ``part`` (``"replay"``: one of the claims' replays).
+    Times ns. A field is None where the replay does not hold it (a file saved before it was
+    recorded, a test's replay of given times): its readers say what None means."""
+
+    sources: np.ndarray | None = None
+    methods: np.ndarray | None = None
+    source: np.ndarray | None = None
+    call: np.ndarray | None = None
+    run: np.ndarray | None = None
+    step: np.ndarray | None = None
+    wall_ns: np.ndarray | None = None
+    cpu_ns: np.ndarray | None = None
+    pick: np.ndarray | None = None
+    n_evals: np.ndarray | None = None
+    slot: np.ndarray | None = None
+    timed: np.ndarray | None = None
+    eval_ns: np.ndarray | None = None
+    reps: np.ndarray | None = None
+    variant_method: np.ndarray | None = None
+    variant_path: np.ndarray | None = None
+    variant_eval_path: np.ndarray | None = None
+    mismatch: np.ndarray | None = None
+    checked: np.ndarray | None = None
+    n_pool: np.ndarray | None = None
+    max_calls: np.ndarray | None = None
+    max_calls_paper: np.ndarray | None = None
+    clock_ns: np.ndarray | None = None
+    dispatch_ns: np.ndarray | None = None
+    load_avg: np.ndarray | None = None
+    n_cpu: np.ndarray | None = None
+    replay: np.ndarray | None = None
+    n_replays: np.ndarray | None = None
+    replay_clock_ns: np.ndarray | None = None
+    replay_dispatch_ns: np.ndarray | None = None
+    replay_load_avg: np.ndarray | None = None
+    row_clock_ns: np.ndarray | None = None
+    extra_load_avg: np.ndarray | None = None
+    extra_clock_ns: np.ndarray | None = None
+    part: np.ndarray | None = None
+
+    #: per-call arrays (first axis: the replayed calls)
+    ROW_KEYS = ("source", "call", "run", "step")
+    #: per (call, variant) arrays
+    CELL_KEYS = ("wall_ns", "cpu_ns", "pick", "n_evals", "slot", "timed", "eval_ns", "reps")
+
+    def has(self, name: str) -> bool:
+        """Whether the replay holds the array ``name`` (a field that is not None)."""
+        return getattr(self, name) is not None
+
+    def replace(self, **changes) -> "Replay":
+        return dataclasses.replace(self, **changes)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The replay as its ``.npz`` file holds it (the file edge, :func:`save`): every array held."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if getattr(self, f.name) is not None}
+
+    @classmethod
+    def from_arrays(cls, arrays: Mapping[str, np.ndarray]) -> "Replay":
+        """The record of a file's arrays (:func:`load`); an array of another name is refused."""
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(arrays) - names)
+        if unknown:
+            raise ValueError(f"not a timing replay: unknown arrays {unknown}")
+        return cls(**arrays)

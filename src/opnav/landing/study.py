@@ -22,10 +22,11 @@ import numpy as np
 import pandas as pd
 
 from opnav.landing.montecarlo import MonteCarlo, per_run_stats, run_chunk
+from opnav.landing.records import Replay
 from opnav.landing.setup import Setup
 
 
-def per_run_metrics(data: MonteCarlo, timing: dict, method: str) -> pd.DataFrame:
+def per_run_metrics(data: MonteCarlo, timing: Replay, method: str) -> pd.DataFrame:
     """One row per run of a chunk or gathered Monte Carlo (module docstring);
     ``timing``: the replay of its planning calls (``timing.replay_own``)."""
     from opnav.landing.timing_summary import per_run_median_us

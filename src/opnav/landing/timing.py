@@ -98,15 +98,18 @@ import math
 import os
 import time
 from dataclasses import dataclass
+from typing import Mapping
 
 import numpy as np
 
-from opnav.landing.records import RECORD_KEYS, MonteCarlo, load as _load_one, rng_from_words, save
+from opnav.landing.records import RECORD_KEYS, MonteCarlo, Replay, load as _load_arrays, rng_from_words
+from opnav.landing.records import save as _save_arrays
 from opnav.landing.setup import Setup
 
 __all__ = ["select_calls", "COMPILED_ONLY", "timed_methods", "variants", "pass_keys", "paper_limited", "replay",
            "evaluation_inputs", "null_dispatch_ns", "merge", "REPLAY_BEST_OF", "COLD_OK_NS", "CALL_INPUT_KEYS", "load_calls", "ReplaySpec", "run_spec", "replay_spec", "replays_in_processes",
-           "CLOCK_SHARE_INV", "clock_cost_ns", "replay_own", "from_times", "call_overhead", "save", "load"]
+           "CLOCK_SHARE_INV", "clock_cost_ns", "replay_own", "from_times", "call_overhead", "CallOverhead", "Replay",
+           "save", "load"]
 
 
 # ----------------------------------------------------------------- replay
@@ -256,12 +259,13 @@ def null_dispatch_ns(args: tuple, n: int = 2000, repeats: int = 5) -> float:
 
 def replay(scn, recorded: dict[str, MonteCarlo], methods, max_calls: int = 0, alt=True,
            max_calls_paper: int = 0, main=None, decompose: bool = False, best_of: int = 1,
-           warm_compiled: bool = True) -> dict:
+           warm_compiled: bool = True) -> Replay:
     """Replay recorded planning calls through every method (module docstring).
 
     ``scn``: the descent's scenario (``descent.build_scenario``); ``recorded``:
     method -> gathered Monte Carlo (``records.MonteCarlo``, its calls), the sources of
-    the calls; ``methods``: the methods timed. Returns arrays: per replayed call
+    the calls; ``methods``: the methods timed. Returns the :class:`~opnav.landing.records.Replay`
+    of arrays: per replayed call
     ``source`` (position in ``sources``), ``run``, ``call`` (position in its
     source's calls), ``step``; per call and variant ``wall_ns``, ``cpu_ns``,
     ``pick``, ``n_evals``, ``slot`` (position in that call's order), ``timed``
@@ -437,18 +441,19 @@ def replay(scn, recorded: dict[str, MonteCarlo], methods, max_calls: int = 0, al
             recorded_pick = recorded[m].plan_index[pos[sel][mine]]
             checked[j] = int(mine.sum())
             mismatch[j] = int(np.sum(pick[mine, v] != recorded_pick))
-    return {"sources": np.array(names), "methods": np.array(methods),
-            "source": src[sel], "call": pos[sel], "run": run, "step": step,
-            "wall_ns": wall, "cpu_ns": cpu, "pick": pick, "n_evals": evals, "slot": slot,
-            "timed": timed_, "eval_ns": eval_ns, "dispatch_ns": np.float64(dispatch),
-            "variant_method": np.array([v[0] for v in var]),
-            "variant_path": np.array([v[1] for v in var]),
-            # a user's own method: its path named (methods.eval_path: the search interpreted, the score compiled or not)
-            "variant_eval_path": np.array([eval_path(v[0], v[2]) for v in var]),
-            "mismatch": mismatch, "checked": checked, "reps": reps, "clock_ns": np.float64(clock_ns),
-            "load_avg": np.array([load_start, os.getloadavg()[0]]), "n_cpu": np.int64(os.cpu_count() or 0),
-            "n_pool": np.int64(len(src)), "max_calls": np.int64(max_calls),
-            "max_calls_paper": np.int64(max_calls_paper)}
+    return Replay(sources=np.array(names), methods=np.array(methods),
+                  source=src[sel], call=pos[sel], run=run, step=step,
+                  wall_ns=wall, cpu_ns=cpu, pick=pick, n_evals=evals, slot=slot,
+                  timed=timed_, eval_ns=eval_ns, dispatch_ns=np.float64(dispatch),
+                  variant_method=np.array([v[0] for v in var]),
+                  variant_path=np.array([v[1] for v in var]),
+                  # a user's own method: its path named (methods.eval_path: the search interpreted, the score
+                  # compiled or not)
+                  variant_eval_path=np.array([eval_path(v[0], v[2]) for v in var]),
+                  mismatch=mismatch, checked=checked, reps=reps, clock_ns=np.float64(clock_ns),
+                  load_avg=np.array([load_start, os.getloadavg()[0]]), n_cpu=np.int64(os.cpu_count() or 0),
+                  n_pool=np.int64(len(src)), max_calls=np.int64(max_calls),
+                  max_calls_paper=np.int64(max_calls_paper))
 
 
 def _kernel_result(call):
@@ -521,15 +526,29 @@ def clock_cost_ns(n: int = 2000, repeats: int = 5) -> float:
     return float(best)
 
 
-def load(path):
+def save(path, tm: Replay) -> None:
+    """Write a replay (the file edge: ``records.save`` of :meth:`Replay.arrays`, ``.npz``, atomically)."""
+    _save_arrays(path, tm.arrays())
+
+
+def _load_one(path) -> Replay:
+    return Replay.from_arrays(_load_arrays(path))
+
+
+def _is_replay(tm: Replay) -> bool:
+    """Whether ``tm`` is one of the claims' replays (its ``part`` is ``"replay"``)."""
+    return tm.part is not None and str(tm.part) == "replay"
+
+
+def load(path) -> Replay:
     """A replay saved by :func:`save` (``records.load``), or, given several paths (a Snakemake input
     list), their :func:`merge`: the files whose ``part`` is ``"replay"`` (the claims' replays, in
     the given order) with the one other file (the variants timed once) as ``extra``."""
     if isinstance(path, (str, os.PathLike)):
         return _load_one(path)
     parts = [_load_one(p) for p in path]
-    reps = [t for t in parts if str(t.get("part", "")) == "replay"]
-    other = [t for t in parts if str(t.get("part", "")) != "replay"]
+    reps = [t for t in parts if _is_replay(t)]
+    other = [t for t in parts if not _is_replay(t)]
     if len(other) > 1:
         raise ValueError(f"timing.load: {len(other)} files are not replays of the claims' calls; at most one may be")
     if not reps:
@@ -537,15 +556,13 @@ def load(path):
     return merge(reps, other[0] if other else None)
 
 
-#: per-call arrays of a replay (first axis: the replayed calls)
-_ROW_KEYS = ("source", "call", "run", "step")
-#: per (call, variant) arrays of a replay
-_CELL_KEYS = ("wall_ns", "cpu_ns", "pick", "n_evals", "slot", "timed", "eval_ns", "reps")
+_ROW_KEYS = Replay.ROW_KEYS
+_CELL_KEYS = Replay.CELL_KEYS
 _CELL_FILL = {"timed": False, "pick": -2}
 
 
-def merge(replays: list[dict], extra: dict | None = None) -> dict:
-    """One replay-shaped dict of several independent replays of the same calls (separate
+def merge(replays: list[Replay], extra: Replay | None = None) -> Replay:
+    """One replay of several independent replays of the same calls (separate
     processes, :func:`replay` each) and, optionally, one more replay ``extra`` of other variants
     on the same calls (the millisecond calls and the paper's definition, timed once).
 
@@ -560,10 +577,10 @@ def merge(replays: list[dict], extra: dict | None = None) -> dict:
     if not replays:
         raise ValueError("timing.merge: no replay")
     first = replays[0]
-    key = lambda tm: [(str(m), str(p)) for m, p in zip(tm["variant_method"], tm["variant_path"])]  # noqa: E731
+    key = lambda tm: [(str(m), str(p)) for m, p in zip(tm.variant_method, tm.variant_path)]  # noqa: E731
     for tm in replays[1:] + ([extra] if extra is not None else []):
-        if not all(np.array_equal(tm[k], first[k]) for k in ("source", "call")) \
-                or int(tm["n_pool"]) != int(first["n_pool"]) or list(tm["sources"]) != list(first["sources"]):
+        if not all(np.array_equal(getattr(tm, k), getattr(first, k)) for k in ("source", "call")) \
+                or int(tm.n_pool) != int(first.n_pool) or list(tm.sources) != list(first.sources):
             raise ValueError("timing.merge: the replays did not replay the same recorded calls")
     for tm in replays[1:]:
         if key(tm) != key(first):
@@ -572,44 +589,47 @@ def merge(replays: list[dict], extra: dict | None = None) -> dict:
         raise ValueError("timing.merge: the extra replay times a variant of the replays again")
     parts = list(replays) + ([extra] if extra is not None else [])
     var = [v for tm in parts[:1] + parts[len(replays):] for v in key(tm)]
-    nv, nc, nr = len(var), len(first["source"]), len(replays)
-    out = {"sources": first["sources"], "n_pool": first["n_pool"], "max_calls": first["max_calls"],
-           "max_calls_paper": (extra if extra is not None else first).get("max_calls_paper", np.int64(0))}
+    nv, nc, nr = len(var), len(first.source), len(replays)
+    paper_of = extra if extra is not None else first
+    out = {"sources": first.sources, "n_pool": first.n_pool, "max_calls": first.max_calls,
+           "max_calls_paper": paper_of.max_calls_paper if paper_of.has("max_calls_paper") else np.int64(0)}
     for k in _ROW_KEYS:
-        out[k] = np.concatenate([np.asarray(tm[k]) for tm in replays])
+        out[k] = np.concatenate([np.asarray(getattr(tm, k)) for tm in replays])
     out["replay"] = np.repeat(np.arange(nr, dtype=np.int64), nc)
     for k in _CELL_KEYS:
         dtype = bool if k == "timed" else np.int64
         arr = np.full((nc * nr, nv), _CELL_FILL.get(k, -1), dtype)
         for r, tm in enumerate(replays):
-            if k in tm:
-                arr[r * nc:(r + 1) * nc, :len(key(first))] = tm[k]
-        if extra is not None and k in extra:
-            arr[:nc, len(key(first)):] = extra[k]
+            if tm.has(k):
+                arr[r * nc:(r + 1) * nc, :len(key(first))] = getattr(tm, k)
+        if extra is not None and extra.has(k):
+            arr[:nc, len(key(first)):] = getattr(extra, k)
         out[k] = arr
     for k in ("variant_method", "variant_path", "variant_eval_path"):
-        out[k] = np.concatenate([np.asarray(tm[k]) for tm in [first] + ([extra] if extra is not None else [])])
-    methods = list(dict.fromkeys(str(m) for tm in parts for m in tm["methods"]))
+        out[k] = np.concatenate([np.asarray(getattr(tm, k)) for tm in [first] + ([extra] if extra is not None else [])])
+    methods = list(dict.fromkeys(str(m) for tm in parts for m in tm.methods))
     out["methods"] = np.array(methods)
     for k in ("mismatch", "checked"):
         out[k] = np.zeros(len(methods), np.int64)
         for tm in parts:
-            for m, x in zip(tm["methods"], tm[k]):
+            for m, x in zip(tm.methods, getattr(tm, k)):
                 out[k][methods.index(str(m))] += int(x)
+    nan2 = [math.nan] * 2
     out["n_replays"] = np.int64(nr)
-    out["replay_clock_ns"] = np.array([float(tm.get("clock_ns", math.nan)) for tm in replays])
+    out["replay_clock_ns"] = np.array([float(tm.clock_ns) if tm.has("clock_ns") else math.nan for tm in replays])
     out["clock_ns"] = np.float64(np.nanmax(out["replay_clock_ns"]) if nr else math.nan)
-    out["replay_dispatch_ns"] = np.array([float(tm.get("dispatch_ns", math.nan)) for tm in replays])
-    out["replay_load_avg"] = np.array([np.asarray(tm.get("load_avg", [math.nan] * 2), float)[:2]
+    out["replay_dispatch_ns"] = np.array([float(tm.dispatch_ns) if tm.has("dispatch_ns") else math.nan
+                                          for tm in replays])
+    out["replay_load_avg"] = np.array([np.asarray(tm.load_avg if tm.has("load_avg") else nan2, float)[:2]
                                        for tm in replays])
     out["load_avg"] = np.array([np.nanmin(out["replay_load_avg"][:, 0]), np.nanmax(out["replay_load_avg"][:, 1])])
-    out["n_cpu"] = np.int64(first.get("n_cpu", 0))
+    out["n_cpu"] = np.int64(first.n_cpu if first.has("n_cpu") else 0)
     if extra is not None:
-        out["extra_load_avg"] = np.asarray(extra.get("load_avg", [math.nan] * 2), float)[:2]
-        out["extra_clock_ns"] = np.float64(extra.get("clock_ns", math.nan))
+        out["extra_load_avg"] = np.asarray(extra.load_avg if extra.has("load_avg") else nan2, float)[:2]
+        out["extra_clock_ns"] = np.float64(extra.clock_ns if extra.has("clock_ns") else math.nan)
     # the clock's cost of the bracket each row was timed in (clock_share): a replay's own
     out["row_clock_ns"] = np.repeat(out["replay_clock_ns"], nc)
-    return out
+    return Replay(**out)
 
 
 #: what a replay reads of a Monte-Carlo file: the recorded inputs, the pick (the check) and the run
@@ -683,7 +703,7 @@ class ReplaySpec:
         return cls(**{k: tuples.get(k, lambda v: v)(v) for k, v in json.loads(text).items()})
 
 
-def run_spec(spec: ReplaySpec) -> dict:
+def run_spec(spec: ReplaySpec) -> Replay:
     """:func:`replay` of a spec (:func:`replay_spec`): its scenario, the recorded calls read from
     its ``mc`` files (the pool's order; :func:`load_calls`), the variants and limits as given."""
     recorded = {m: load_calls(path) for m, path in spec.mc}
@@ -707,7 +727,7 @@ def replay_spec(setup: Setup, mc, methods, max_calls: int, *, alt=True, main=Non
                       setup=setup)
 
 
-def replays_in_processes(spec: ReplaySpec, n: int, workdir, log=None) -> list[dict]:
+def replays_in_processes(spec: ReplaySpec, n: int, workdir, log=None) -> list[Replay]:
     """``n`` independent replays of ``spec``, each in a fresh Python process run one after the
     other (its own address-space layout, hash seed and caches: pyperf's reason for spawning
     worker processes, CONVENTIONS.md; a fork would share this process's layout), each process
@@ -747,7 +767,7 @@ def replays_in_processes(spec: ReplaySpec, n: int, workdir, log=None) -> list[di
         if proc.returncode:
             raise RuntimeError(f"timing replay {r} failed (exit {proc.returncode}): "
                                + (proc.stderr.strip().splitlines() or ["no output"])[-1])
-        out.append({**_load_one(target), "part": np.array("replay")})   # load() merges these as replays
+        out.append(_load_one(target).replace(part=np.array("replay")))   # load() merges these as replays
     return out
 
 
@@ -760,7 +780,7 @@ def _replay_process(spec_path: str, target: str) -> None:
     print(resource_line(), flush=True)
 
 
-def replay_own(scn, data, method: str, max_calls: int = 0) -> dict:
+def replay_own(scn, data, method: str, max_calls: int = 0) -> Replay:
     """Replay a Monte Carlo's (``records.MonteCarlo``) or one descent's (``records.Descent``,
     its calls counted as run 0) own calls through its own method, configured evaluation path
     only (parameter studies, the CLI: no other methods to interleave with)."""
@@ -768,27 +788,43 @@ def replay_own(scn, data, method: str, max_calls: int = 0) -> dict:
     return replay(scn, {method: d}, [method], max_calls, alt=False)
 
 
-def from_times(wall_ns: dict, cpu_ns: dict, run, n_evals: int = 0) -> dict:
-    """A :func:`replay`-shaped result from given per-call times (ns) per
+def from_times(wall_ns: Mapping, cpu_ns: Mapping, run, n_evals: int = 0) -> Replay:
+    """A :func:`replay`-shaped record from given per-call times (ns) per
     method, all on the configured path, calls of one source with run indices
     ``run`` (for tests and times measured elsewhere)."""
     methods = list(wall_ns)
     n, k = len(run), len(methods)
-    return {"sources": np.array(methods[:1]), "methods": np.array(methods),
-            "source": np.zeros(n, np.int64), "call": np.arange(n, dtype=np.int64),
-            "run": np.asarray(run, np.int64), "step": np.zeros(n, np.int64),
-            "wall_ns": np.column_stack([np.asarray(wall_ns[m]) for m in methods]).astype(np.int64),
-            "cpu_ns": np.column_stack([np.asarray(cpu_ns[m]) for m in methods]).astype(np.int64),
-            "pick": np.full((n, k), -2, np.int64), "n_evals": np.full((n, k), int(n_evals), np.int64),
-            "slot": np.zeros((n, k), np.int64), "timed": np.ones((n, k), bool),
-            "variant_method": np.array(methods),
-            "variant_path": np.array(["main"] * k), "variant_eval_path": np.array(["main"] * k),
-            "mismatch": np.zeros(k, np.int64), "checked": np.zeros(k, np.int64),
-            "n_pool": np.int64(n), "max_calls": np.int64(0), "max_calls_paper": np.int64(0)}
+    return Replay(sources=np.array(methods[:1]), methods=np.array(methods),
+                  source=np.zeros(n, np.int64), call=np.arange(n, dtype=np.int64),
+                  run=np.asarray(run, np.int64), step=np.zeros(n, np.int64),
+                  wall_ns=np.column_stack([np.asarray(wall_ns[m]) for m in methods]).astype(np.int64),
+                  cpu_ns=np.column_stack([np.asarray(cpu_ns[m]) for m in methods]).astype(np.int64),
+                  pick=np.full((n, k), -2, np.int64), n_evals=np.full((n, k), int(n_evals), np.int64),
+                  slot=np.zeros((n, k), np.int64), timed=np.ones((n, k), bool),
+                  variant_method=np.array(methods),
+                  variant_path=np.array(["main"] * k), variant_eval_path=np.array(["main"] * k),
+                  mismatch=np.zeros(k, np.int64), checked=np.zeros(k, np.int64),
+                  n_pool=np.int64(n), max_calls=np.int64(0), max_calls_paper=np.int64(0))
+
+
+@dataclass(frozen=True, eq=False)
+class CallOverhead:
+    """:func:`call_overhead`'s measurement, per replayed call (ns): the whole compiled call
+    (``call_ns``), its objective evaluations alone (``evals_ns``), their count (``n_evals``),
+    whether the optimum was on an edge (``edge``), ``planner.plan`` once cold (``cold_ns``) and hot
+    (``wrapped_ns``), and ``overhead_ratio = (call - evals) / evals``."""
+
+    call_ns: np.ndarray
+    evals_ns: np.ndarray
+    n_evals: np.ndarray
+    edge: np.ndarray
+    cold_ns: np.ndarray
+    wrapped_ns: np.ndarray
+    overhead_ratio: np.ndarray
 
 
 def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0,
-                  repeats: int = 3, reps: int = 50) -> dict:
+                  repeats: int = 3, reps: int = 50) -> CallOverhead:
     """The compiled planning call's overhead beyond its objective evaluations, by replay.
 
     For each selected recorded call of ``recorded[method]`` (:func:`select_calls`)
@@ -863,5 +899,5 @@ def call_overhead(scn, recorded: dict, method: str = "depth", max_calls: int = 0
                                                     else [np.zeros(0)] * 6)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = (call_ns - evals_ns) / evals_ns
-    return {"call_ns": call_ns, "evals_ns": evals_ns, "n_evals": n_ev.astype(np.int64),
-            "edge": edge.astype(bool), "cold_ns": cold, "wrapped_ns": wrapped, "overhead_ratio": ratio}
+    return CallOverhead(call_ns=call_ns, evals_ns=evals_ns, n_evals=n_ev.astype(np.int64),
+                        edge=edge.astype(bool), cold_ns=cold, wrapped_ns=wrapped, overhead_ratio=ratio)

@@ -11,7 +11,12 @@ import math
 
 import numpy as np
 
+from typing import TYPE_CHECKING
+
 from opnav.core import figures
+
+if TYPE_CHECKING:
+    from opnav.landing.records import Replay
 
 __all__ = ["fig_true_states", "fig_depth_error_map", "fig_nav_error_envelopes",
            "fig_planning_time"]
@@ -194,7 +199,7 @@ def fig_nav_error_envelopes(t, data: dict, labels: dict | None = None, colors: d
         return fig
 
 
-def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float | None = None,
+def fig_planning_time(timing: "Replay", methods, published_reduction_vs_svd: float | None = None,
                       labels: dict | None = None, colors: dict | None = None):
     """B-F7: planning-call thread CPU time (us, ``timing_summary.CLOCK``) per method on the replayed planning
     calls (``timing``: ``opnav.landing.timing.replay``, the same calls for every
@@ -213,9 +218,9 @@ def fig_planning_time(timing: dict, methods, published_reduction_vs_svd: float |
 
     methods = list(methods)
     # the built-in methods' paths (a user's own method names its own: methods.eval_path)
-    paths = {str(p): str(e) for p, e in zip(timing["variant_path"], timing["variant_eval_path"])
+    paths = {str(p): str(e) for p, e in zip(timing.variant_path, timing.variant_eval_path)
              if not str(e).startswith("custom")}
-    own = {str(m): str(e) for m, e in zip(timing["variant_method"], timing["variant_eval_path"])
+    own = {str(m): str(e) for m, e in zip(timing.variant_method, timing.variant_eval_path)
            if str(e).startswith("custom")}
     main_name, alt_name = paths.get("main", ""), paths.get("alt", "")
     with figures.style():

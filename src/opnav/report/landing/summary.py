@@ -14,6 +14,7 @@ scored by :mod:`opnav.report.scorecard` with the rule of :mod:`opnav.core.verdic
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -22,20 +23,23 @@ from opnav.core import wording
 from opnav.core.tables import cell_num, cell_pm
 from opnav.core.verdicts import NOT_REPRODUCED, REPRODUCED, Verdict, judge
 from opnav.landing.bsummary import NAN, BSummary, ScenarioSummary, num
-from opnav.report.landing.timing_text import CLOCK_WORDS, less_time_text
+from opnav.report.landing.timing_text import CLOCK_WORDS, less_time_text, sources_text
 
 # pandas is imported by the functions that build frames: the jobs that only combine the
 # scenarios' summaries (combine_scenarios) do without its ~0.13 s of import
 if TYPE_CHECKING:
+    from typing import Mapping
+
     import pandas as pd
 
     from opnav.landing.montecarlo import NeesConsistency, YawConvergence
-    from opnav.landing.records import MonteCarlo
+    from opnav.landing.records import MonteCarlo, Replay
     from opnav.landing.setup import Setup
+    from opnav.landing.timing_summary import ClockShare, MethodSummary, PlanningTimeEvidence, VsDepthReading
     from opnav.landing.tuning import RetunedRecord
 
 
-def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction_vs_svd: float | None = None,
+def summary_table(data: dict[str, MonteCarlo], timing: "Replay", published_reduction_vs_svd: float | None = None,
                   converged_pos_err_m: float = 100.0) -> pd.DataFrame:
     """B-T3 (paper B sec. 3, Table 3): one row per method of ``data`` (method ->
     gathered Monte Carlo, ``opnav.landing.montecarlo.gather``).
@@ -69,7 +73,7 @@ def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction
     from opnav.landing.ranking import pair_comparison
 
     methods = list(data)
-    missing = [m for m in methods if tsum.times_ns(timing, m).size == 0 and len(timing["source"])]
+    missing = [m for m in methods if tsum.times_ns(timing, m).size == 0 and len(timing.source)]
     if missing:
         raise ValueError(f"the planning-time replay did not time {missing}")
     rows = []
@@ -104,7 +108,7 @@ def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction
         # for methods without it)
         row["median_plan_time_alt_us"] = tsum.median_us(timing, m, alt_m)
         row["median_plan_cpu_alt_us"] = tsum.median_us(timing, m, alt_m, clock="cpu")
-        row["timed_calls"] = int(len(timing["source"]))
+        row["timed_calls"] = int(len(timing.source))
         # the alternative path's medians rest on its own calls (the paper path: a subset,
         # landing.timing.max_calls_paper), its reductions on the calls timed on both
         row["timed_calls_alt"] = tsum.timed_calls(timing, m, alt_m)
@@ -141,7 +145,16 @@ def summary_table(data: dict[str, MonteCarlo], timing: dict, published_reduction
     return df
 
 
-def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCarlo], timing: dict,
+@dataclass(frozen=True)
+class TimingSection:
+    """B-summary's ``timing``: the replay's method in numbers (``timing_summary.method_summary``,
+    its fields at the top level) and the replayed calls' sources in words."""
+
+    summary: "MethodSummary" = field(metadata={"json_flatten": True})
+    sources_text: str
+
+
+def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCarlo], timing: "Replay",
                      single: dict, setup: Setup, *, eval_path: str, yaw_ratio: float,
                      published_reduction_vs_svd: float, accuracy: dict | None = None) -> dict:
     """The summary JSON of one camera scenario (``B-summary.json`` per scenario,
@@ -188,7 +201,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCa
                                    for p, x in (("path", ""), ("alt", "_alt"))
                                    if {"svd", "depth"} <= set(t.index)
                                    and f"time_reduction_vs_svd{x}_pct" in t.columns},
-        "timing": tsum.method_summary(timing),
+        "timing": TimingSection(ms := tsum.method_summary(timing), sources_text(ms.sources)),
         "published_time_reduction_vs_svd_pct": published_reduction_vs_svd,
         "initial_attitude_deg": att.paper_convention_deg,
         "initial_tilt_deg": att.tilt_deg,
@@ -545,7 +558,8 @@ def nees_retuned_text(retuned: "RetunedRecord") -> str:
 HEAVY_TAIL_RATIO = 3.0
 
 
-def planning_time_text(vs: dict, clock: dict, ev: dict | None = None) -> str:
+def planning_time_text(vs: "Mapping[str, VsDepthReading]", clock: "ClockShare",
+                       ev: "PlanningTimeEvidence | None" = None) -> str:
     """The manuscript's sentence on planning time (thread CPU, per call; ``timing_summary.CLOCK``, the
     clock the verdicts read) from ``timing_summary.vs_depth`` and ``timing_summary.clock_share``: depth
     against SVD's closed form, a LAPACK SVD of the same H and the paper's definition, each with its
@@ -553,63 +567,60 @@ def planning_time_text(vs: dict, clock: dict, ev: dict | None = None) -> str:
     (``timing_summary.planning_time_evidence``) first the reading between independent replays, the
     call's shared part and evaluations, the shared part at which the published reduction would hold,
     and why the compiled and the paper's paths differ."""
-    from opnav.landing import timing_summary as tsum
-
     def part(label, name):   # one sentence per baseline (issue 55 item 4)
         v = vs.get(label)
         if not v:
             return None
-        return (f"Against {name}: {wording.num(v['depth_median_us'])} against {wording.num(v['median_us'])} us (depth "
-                f"{less_time_text(v['depth_reduction_pct'])} time, 95 % interval of the reduction "
-                f"[{v['depth_reduction_lo_pct']:+.1f}, {v['depth_reduction_hi_pct']:+.1f}] %).")
+        return (f"Against {name}: {wording.num(v.depth_median_us)} against {wording.num(v.median_us)} us (depth "
+                f"{less_time_text(v.depth_reduction_pct)} time, 95 % interval of the reduction "
+                f"[{v.depth_reduction_lo_pct:+.1f}, {v.depth_reduction_hi_pct:+.1f}] %).")
     parts = [p for p in (part("svd_closed_form", "the closed-form SVD"),
                          part("svd_lapack", "a LAPACK SVD of the same H"),
                          part("svd_paper", "the paper's definition of SVD (interpreted, depth likewise)")) if p]
     if not parts:
         return ""
-    ck = ("" if clock.get("share_pct_max") is None else
-          f" Each call is the mean of back-to-back repetitions; the clock ({clock['clock_ns']:.0f} ns a "
-          f"reading pair) is at most {clock['share_pct_max']:.1f} % of a timed bracket.")
+    ck = ("" if clock.share_pct_max is None else
+          f" Each call is the mean of back-to-back repetitions; the clock ({clock.clock_ns:.0f} ns a "
+          f"reading pair) is at most {clock.share_pct_max:.1f} % of a timed bracket.")
     head = evidence_text(ev) if ev else ""
     return head + "Median planning call of depth (thread CPU, all replays pooled). " + " ".join(parts) + ck
 
 
-def evidence_text(ev: dict) -> str:
+def evidence_text(ev: "PlanningTimeEvidence") -> str:
     """The planning-time evidence (``timing_summary.planning_time_evidence``) in words: depth against
     SVD between independent replays, the shared part and the evaluations of a call, the shared part
     at which the published reduction would hold, and why the two paths differ. Empty without
     replayed depth and SVD."""
     import math
 
-    from opnav.landing import timing_summary as tsum
-
-    r = ev.get("reduction_pct", {}).get("depth_vs_svd")
-    dec = ev.get("decomposition", {})
+    r = ev.reduction_pct.get("depth_vs_svd")
+    dec = ev.decomposition
     if not r or "depth" not in dec or "svd" not in dec:
         return ""
-    per = ", ".join(f"{x:.1f}" for x in r["per_replay"])
-    sd = r["sd_between"]
-    out = (f"Over {ev['n_replays']} independent replays (each a separate process, alone on the machine; "
-           f"clock: {CLOCK_WORDS}) depth's median call on the {ev.get('eval_path') or ev['path']} path took "
-           f"{less_time_text(r['mean'])} time than the closed-form SVD's on average. Per replay: {per} %"
-           + (f"; between-replay sd {sd:.1f} points, {100 * r['level']:.0f} % interval [{r['lo']:.1f}, {r['hi']:.1f}] %"
+    per = ", ".join(f"{x:.1f}" for x in r.per_replay)
+    sd = r.sd_between
+    out = (f"Over {ev.n_replays} independent replays (each a separate process, alone on the machine; "
+           f"clock: {CLOCK_WORDS}) depth's median call on the {ev.eval_path or ev.path} path took "
+           f"{less_time_text(r.mean)} time than the closed-form SVD's on average. Per replay: {per} %"
+           + (f"; between-replay sd {sd:.1f} points, {100 * r.level:.0f} % interval [{r.lo:.1f}, {r.hi:.1f}] %"
               if math.isfinite(sd) else "") + ". ")
-    rp = ev.get("replays") or [{}]
-    lo_hi = rp[0].get("median_interval_us", {}).get("depth")
+    rp = ev.replays[0] if ev.replays else None
+    lo_hi = rp.median_interval_us.get("depth") if rp else None
     if lo_hi and all(x is not None and math.isfinite(x) for x in lo_hi):
-        out += (f"Each replay's median rests on {rp[0]['n_calls']} calls (depth's in the first replay "
-                f"{rp[0]['median_us']['depth']:.2f} us, distribution-free 95 % interval [{lo_hi[0]:.2f}, {lo_hi[1]:.2f}] us). ")
+        out += (f"Each replay's median rests on {rp.n_calls} calls (depth's in the first replay "
+                f"{rp.median_us['depth']:.2f} us, distribution-free 95 % interval [{lo_hi[0]:.2f}, {lo_hi[1]:.2f}] us). ")
     d, s = dec["depth"], dec["svd"]
-    if all(math.isfinite(x) for x in (d["shared_us"], s["shared_us"], d["eval_us"], s["eval_us"])):
-        c = ev.get("overhead_curve", {})
+    if all(math.isfinite(x) for x in (d.shared_us, s.shared_us, d.eval_us, s.eval_us)):
+        c = ev.overhead_curve
+        no_shared = c.no_shared_reduction_pct if c.no_shared_reduction_pct is not None else math.nan
         out += (f"A call is a part both methods share (numba's dispatch, argument unpacking, the search's own "
-                f"steps: {d['shared_us']:.2f} us for depth, {s['shared_us']:.2f} us for SVD) and its evaluations. "
-                f"Depth's {d['evals_per_call']:.0f} evaluations of {1e3 * d['per_eval_us']:.0f} ns take "
-                f"{d['eval_us']:.2f} us, SVD's {s['evals_per_call']:.0f} of {1e3 * s['per_eval_us']:.0f} ns "
-                f"{s['eval_us']:.2f} us. Without the shared part depth's median call "
-                f"would take {less_time_text(c.get('no_shared_reduction_pct', math.nan))} time. ")
-        sp = ev.get("shared_us_at_published")
-        pub = ev.get("published_pct")
+                f"steps: {d.shared_us:.2f} us for depth, {s.shared_us:.2f} us for SVD) and its evaluations. "
+                f"Depth's {d.evals_per_call:.0f} evaluations of {1e3 * d.per_eval_us:.0f} ns take "
+                f"{d.eval_us:.2f} us, SVD's {s.evals_per_call:.0f} of {1e3 * s.per_eval_us:.0f} ns "
+                f"{s.eval_us:.2f} us. Without the shared part depth's median call "
+                f"would take {less_time_text(no_shared)} time. ")
+        sp = ev.shared_us_at_published
+        pub = ev.published_pct
         if sp is not None and math.isfinite(sp):
             out += f"The published {pub:g} % would hold with a shared part of {sp:.2f} us. "
         elif pub is not None:
