@@ -3,6 +3,8 @@ helper (opnav.core.wording), and no generated sentence longer than 40 words; the
 find what e19e33d's outputs held (the ~313-word navigation sentence of pp. 4-5, '1 maps',
 '1 stars per image', '-0 % lower', a velocity 3-sigma ratio of 0.9999 printed as 1)."""
 
+import re
+
 import pytest
 
 from opnav.core import wording
@@ -139,3 +141,152 @@ def test_shortening_keeps_the_evidence_numbers_longest():
     assert wording.shorter(tail) == "in the interior camera depth minus SVD is 0.08 m [0.02, 0.14]"
     assert wording.shorter("the bound (0.08 m [0.02, 0.14])") == "the bound"
     assert wording.shorter("one clause") is None
+
+
+# ------------------------------------------------------------ the hand-written manuscript
+_FLOATS = ("table", "table*", "figure", "figure*")
+_DROP_ENVS = ("tabular", "tabular*", "tabularx", "longtable", "thebibliography", "equation", "equation*",
+              "align", "align*", "gather", "gather*", "multline", "multline*", "displaymath", "eqnarray")
+
+
+def _group_end(text: str, i: int) -> int:
+    """The index just past the brace group opening at ``text[i] == '{'``."""
+    depth = 0
+    for j in range(i, len(text)):
+        c = text[j]
+        if c == "\\":
+            continue
+        if c == "{" and text[j - 1] != "\\":
+            depth += 1
+        elif c == "}" and text[j - 1] != "\\":
+            depth -= 1
+            if depth == 0:
+                return j + 1
+    return len(text)
+
+
+def _env_spans(text: str, names: tuple[str, ...]):
+    """(start, end, body) of each outermost environment named in ``names``."""
+    pat = re.compile(r"\\begin\{(" + "|".join(re.escape(n) for n in names) + r")\}")
+    pos = 0
+    while (m := pat.search(text, pos)) is not None:
+        end_tag = "\\end{" + m.group(1) + "}"
+        e = text.find(end_tag, m.end())
+        e = len(text) if e < 0 else e + len(end_tag)
+        yield m.start(), e, text[m.end():e - len(end_tag)]
+        pos = e
+
+
+def _replace_envs(text: str, names: tuple[str, ...], keep) -> str:
+    out, pos = [], 0
+    for a, b, body in _env_spans(text, names):
+        out += [text[pos:a], keep(body)]
+        pos = b
+    return "".join(out + [text[pos:]])
+
+
+def _captions(body: str) -> str:
+    """A float's captions as their own paragraphs (the caption's text is prose; its cells are not)."""
+    out = []
+    for m in re.finditer(r"\\caption\*?(?:\[[^\]]*\])?\{", body):
+        out.append(body[m.end():_group_end(body, m.end() - 1) - 1])
+    return "\n\n" + "\n\n".join(out) + "\n\n"
+
+
+def _math_as_words(math: str) -> str:
+    """Inline math as the words it prints ("x" each): ``$z_k = H (X_M - r_k)$`` is four
+    ("zk", "H", "XM", "rk"), ``$\\R{A} \\pm \\R{B}$`` two, a Greek letter one."""
+    m = re.sub(r"\\R\{[^{}]*\}", " v ", math)
+    m = re.sub(r"\\(?:text|mathrm|mathit|mathbf|operatorname)\{([^{}]*)\}", r" \1 ", m)
+    m = re.sub(r"\\(?:pm|mp|times|cdot|leq?|geq?|approx|to|rightarrow|left|right|quad|qquad)(?![A-Za-z])|\\[,;:! ]",
+               " ", m)
+    m = re.sub(r"\\[A-Za-z]+", "g", m)
+    m = re.sub(r"[_^{}]", "", m)
+    return " ".join("x" for _ in re.findall(r"[A-Za-z0-9.]+", m)) or "x"
+
+
+def hand_written_prose(tex: str) -> str:
+    """The running text a reader reads of a hand-written LaTeX file, for cutting into
+    sentences (opnav.core.wording.sentences): the body only (after ``\\begin{document}`` where
+    there is one); comments, tables and the bibliography dropped; a float's caption kept as its
+    own paragraph; math as the words it prints (:func:`_math_as_words`); a generated macro
+    (``\\R{Name}``, ``\\CfgName``, ``\\ATextName``: a number or a generated sentence) one word
+    ("value"); ``\\ref`` a number, ``\\cite`` a bracket; a heading and an item break a
+    paragraph (a run-in ``\\paragraph{Title.}`` is its own sentence)."""
+    t = re.sub(r"(?<!\\)%.*$", "", tex, flags=re.M)
+    if "\\begin{document}" in t:
+        t = t.split("\\begin{document}", 1)[1]
+    t = _replace_envs(t, _FLOATS, _captions)
+    t = _replace_envs(t, _DROP_ENVS, lambda body: " x ")
+    t = re.sub(r"\\\[(.*?)\\\]", lambda m: " " + _math_as_words(m.group(1)) + " ", t, flags=re.S)
+    t = re.sub(r"(?<!\\)\$\$(.*?)\$\$", lambda m: " " + _math_as_words(m.group(1)) + " ", t, flags=re.S)
+    t = re.sub(r"(?<!\\)\$((?:\\\$|[^$])*)\$", lambda m: _math_as_words(m.group(1)), t)
+    t = re.sub(r"\\\((.*?)\\\)", lambda m: _math_as_words(m.group(1)), t, flags=re.S)
+    t = re.sub(r"\\R\{[^{}]*\}", "value", t)
+    t = re.sub(r"\\ifcsname\s*\w+\s*\\endcsname", "\n\n", t)
+    t = re.sub(r"\\(?:else|fi|par|maketitle|noindent)\b", "\n\n", t)
+    t = re.sub(r"\\(?:label|input|include|includegraphics|setlength|url|bibliography\w*)\*?"
+               r"(?:\[[^\]]*\])?(?:\{[^{}]*\})*", " ", t)
+    t = re.sub(r"\\(?:eq)?ref\{[^{}]*\}", "1", t)
+    t = re.sub(r"\\cite[pt]?(?:\[[^\]]*\])?\{[^{}]*\}", "[1]", t)
+    t = re.sub(r"\\href\{[^{}]*\}", " ", t)
+    t = re.sub(r"\\(?:part|chapter|(?:sub)*section)\*?(?:\[[^\]]*\])?\{[^{}]*\}", "\n\n", t)
+    t = re.sub(r"\\(?:sub)?paragraph\*?\{([^{}]*)\}", "\n\n\\1 ", t)
+    t = re.sub(r"\\(?:begin|end)\{[^{}]*\}", "\n\n", t)
+    t = re.sub(r"\\item\s*(?:\[([^\]]*)\])?", "\n\n\\1 ", t)
+    t = re.sub(r"\\['`\"^~=.]\{?([A-Za-z])\}?", "\\1", t)          # accents: Cram\'er
+    t = re.sub(r"\\[,;:! ]", " ", t)                                # TeX's spaces
+    for esc, plain in ((r"\%", "%"), (r"\_", "_"), (r"\&", "&"), (r"\#", "#"), (r"\$", "$")):
+        t = t.replace(esc, plain)
+    t = re.sub(r"\\[A-Z][A-Za-z@]*(?:\{\})?", "value", t)          # a generated macro: one word
+    t = re.sub(r"\\[A-Za-z@]+\*?", " ", t)                          # \emph, \texttt, \small: their text stays
+    t = re.sub(r"[{}\\]", " ", t).replace("~", " ")
+    # a generated macro that stands where a sentence starts and is followed by the next sentence
+    # (or the paragraph's end) is a generated sentence: its own one-word sentence, so the text
+    # around it is not read as one run-on sentence
+    stand_alone = re.compile(r"((?:^|[.!?]|\n\s*\n)\s*)value(?=\s+(?:value\b|[A-Z(])|\s*(?:\n\s*\n|$))")
+    while (n := stand_alone.sub(r"\1Value.", t)) != t:
+        t = n
+    return t
+
+
+def _manuscript_files(paper):
+    """paper/**/*.tex but the files main.tex reads in its preamble (macro code, not text)."""
+    main = (paper / "main.tex").read_text()
+    preamble = re.sub(r"(?<!\\)%.*$", "", main.split("\\begin{document}", 1)[0], flags=re.M)
+    code = {(paper / (n if n.endswith(".tex") else n + ".tex")).resolve()
+            for n in re.findall(r"\\input\{([^{}\\]+)\}", preamble)}
+    return [p for p in sorted(paper.rglob("*.tex")) if p.resolve() not in code]
+
+
+def hand_written_long_sentences(paper) -> list[str]:
+    """``file (N words): sentence`` for every hand-written sentence over
+    wording.MAX_SENTENCE_WORDS words in the manuscript folder ``paper``."""
+    out = []
+    for p in _manuscript_files(paper):
+        for s in wording.long_sentences(hand_written_prose(p.read_text())):
+            out.append(f"{p.relative_to(paper)} ({wording.word_count(s)} words): {s}")
+    return out
+
+
+def test_hand_written_sentences_are_short():
+    """A reader does not care which sentences were generated: the hand-written manuscript
+    (paper/main.tex, paper/sections/*.tex) keeps every sentence of its running text and its
+    captions at most 40 words too, each generated number or sentence counted as one word.
+    1e33587's files held 25 longer ones (up to 110 words, all of approach_peers.tex's)."""
+    from conftest import REPO
+
+    tex = (r"\documentclass{article}\newcommand{\A}{1}\begin{document}"
+           r"\section{A heading} % a comment with words words words" "\n"
+           r"The bound is \R{ABound}\,\arcsec{} (Table~\ref{tab:x}, Cram\'er--Rao~\cite{a}); $z_k = H x$ holds. "
+           r"\paragraph{Labels.} Short."
+           r"\begin{table}\caption{A caption.}\begin{tabular}{ll}" + " & ".join(["cell"] * 60)
+           + r"\end{tabular}\end{table}\end{document}")
+    assert wording.sentences(hand_written_prose(tex)) == [
+        "The bound is value (Table 1, Cramer--Rao [1]); x x x holds.", "Labels.", "Short.", "A caption."]
+    # a generated sentence between two hand-written ones is a sentence of its own
+    two = hand_written_prose(r"It is \R{A}\,km. \R{ATextB} \ATextC{} It ends.")
+    assert wording.sentences(two) == ["It is value km.", "Value.", "Value.", "It ends."]
+    assert wording.long_sentences(hand_written_prose(r"\begin{document}" + "word " * 41 + r".\end{document}"))
+    found = hand_written_long_sentences(REPO / "paper")
+    assert found == [], "\n".join(found)
