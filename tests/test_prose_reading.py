@@ -186,10 +186,11 @@ def _replace_envs(text: str, names: tuple[str, ...], keep) -> str:
 
 
 def _captions(body: str) -> str:
-    """A float's captions as their own paragraphs (the caption's text is prose; its cells are not)."""
+    """A float's captions as their own paragraphs, opening with the label the reader reads
+    ("Table 1:"): the caption's text is prose, its cells are not."""
     out = []
     for m in re.finditer(r"\\caption\*?(?:\[[^\]]*\])?\{", body):
-        out.append(body[m.end():_group_end(body, m.end() - 1) - 1])
+        out.append("Table 1: " + body[m.end():_group_end(body, m.end() - 1) - 1])
     return "\n\n" + "\n\n".join(out) + "\n\n"
 
 
@@ -213,15 +214,15 @@ def hand_written_prose(tex: str) -> str:
     (``\\R{Name}``, ``\\CfgName``, ``\\ATextName``: a number or a generated sentence) one word
     ("value"); ``\\ref`` a number, ``\\cite`` a bracket; a heading and an item break a
     paragraph (a run-in ``\\paragraph{Title.}`` is its own sentence)."""
-    t = re.sub(r"(?<!\\)%.*$", "", tex, flags=re.M)
+    t = re.sub(r"(?<!\\)%.*$", "", tex, flags=re.MULTILINE)
     if "\\begin{document}" in t:
         t = t.split("\\begin{document}", 1)[1]
     t = _replace_envs(t, _FLOATS, _captions)
     t = _replace_envs(t, _DROP_ENVS, lambda body: " x ")
-    t = re.sub(r"\\\[(.*?)\\\]", lambda m: " " + _math_as_words(m.group(1)) + " ", t, flags=re.S)
-    t = re.sub(r"(?<!\\)\$\$(.*?)\$\$", lambda m: " " + _math_as_words(m.group(1)) + " ", t, flags=re.S)
+    t = re.sub(r"\\\[(.*?)\\\]", lambda m: " " + _math_as_words(m.group(1)) + " ", t, flags=re.DOTALL)
+    t = re.sub(r"(?<!\\)\$\$(.*?)\$\$", lambda m: " " + _math_as_words(m.group(1)) + " ", t, flags=re.DOTALL)
     t = re.sub(r"(?<!\\)\$((?:\\\$|[^$])*)\$", lambda m: _math_as_words(m.group(1)), t)
-    t = re.sub(r"\\\((.*?)\\\)", lambda m: _math_as_words(m.group(1)), t, flags=re.S)
+    t = re.sub(r"\\\((.*?)\\\)", lambda m: _math_as_words(m.group(1)), t, flags=re.DOTALL)
     t = re.sub(r"\\R\{[^{}]*\}", "value", t)
     t = re.sub(r"\\ifcsname\s*\w+\s*\\endcsname", "\n\n", t)
     t = re.sub(r"\\(?:else|fi|par|maketitle|noindent)\b", "\n\n", t)
@@ -253,7 +254,7 @@ def hand_written_prose(tex: str) -> str:
 def _manuscript_files(paper):
     """paper/**/*.tex but the files main.tex reads in its preamble (macro code, not text)."""
     main = (paper / "main.tex").read_text()
-    preamble = re.sub(r"(?<!\\)%.*$", "", main.split("\\begin{document}", 1)[0], flags=re.M)
+    preamble = re.sub(r"(?<!\\)%.*$", "", main.split("\\begin{document}", 1)[0], flags=re.MULTILINE)
     code = {(paper / (n if n.endswith(".tex") else n + ".tex")).resolve()
             for n in re.findall(r"\\input\{([^{}\\]+)\}", preamble)}
     return [p for p in sorted(paper.rglob("*.tex")) if p.resolve() not in code]
@@ -283,7 +284,7 @@ def test_hand_written_sentences_are_short():
            r"\begin{table}\caption{A caption.}\begin{tabular}{ll}" + " & ".join(["cell"] * 60)
            + r"\end{tabular}\end{table}\end{document}")
     assert wording.sentences(hand_written_prose(tex)) == [
-        "The bound is value (Table 1, Cramer--Rao [1]); x x x holds.", "Labels.", "Short.", "A caption."]
+        "The bound is value (Table 1, Cramer--Rao [1]); x x x holds.", "Labels.", "Short.", "Table 1: A caption."]
     # a generated sentence between two hand-written ones is a sentence of its own
     two = hand_written_prose(r"It is \R{A}\,km. \R{ATextB} \ATextC{} It ends.")
     assert wording.sentences(two) == ["It is value km.", "Value.", "Value.", "It ends."]
