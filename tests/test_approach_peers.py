@@ -313,3 +313,22 @@ def test_the_a_p1_table_holds_keys_and_the_report_words_them():
     assert list(page["estimator"]) == ["EM-EKF (plain)", "EM-EKF (SQUAREM)", "EM-EKF (growing windows, SQUAREM)",
                                        "augmented EKF"] + ["Basilisk pixelLineBiasUKF"] * 3
     assert list(page["run"])[-2:] == ["zero misalignment (sanity)", "prior mean at the truth (diagnostic)"]
+
+
+@pytest.mark.parametrize("ratio,word", [(14.77, "above one"), (0.4, "below one"), (1.04, "about one"),
+                                        (float("nan"), "not computed")])
+def test_the_peer_bound_ratio_is_read_from_its_value(ratio, word):
+    """A-P1's sentence on the UKF's bound over its own 3-sigma follows the ratio (it was fixed
+    text, 'a ratio above one', beside the number whatever the number)."""
+    from opnav.report.approach.text import bound_over_own_reading
+
+    assert word in bound_over_own_reading(ratio)
+
+
+def test_figure_reasons_quote_the_published_file():
+    """Figs. 5 and 6's reasons take the published numbers from published.yaml, not the code."""
+    from opnav.core import published
+    from opnav.report.approach.text import figure_reasons
+
+    h = published.paper_a()["headline"]
+    assert f"{h['nav_err_before_km_text']:g} km before" in figure_reasons()["A-F6"]

@@ -31,5 +31,5 @@ with script_context(snakemake) as log:
                         "the augmented EKF, batch ML and the Cramer-Rao bound (headline case; arcsec; "
                         "mean and sd over seeds, own 3-sigma: median of the estimator's covariance).")
     peers.seed_frame(peer).to_csv(snakemake.output.long, index=False)
-    write_json(snakemake.output.summary, peers.summary(table, peer))
+    write_json(snakemake.output.summary, words.p1_summary_words(peers.summary(table, peer)))
     log.info("A-P1: %d rows", len(table))

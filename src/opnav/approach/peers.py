@@ -632,6 +632,8 @@ class P1Variant:
     ukf_bias_quantum_arcsec: float | None = field(default=None, metadata=OMIT_NONE)
     ukf_bias_free_within_own_3sigma_all: bool | None = field(default=None, metadata=OMIT_NONE)
     ukf_bound_over_own_3sigma_x: float | None = field(default=None, metadata=OMIT_NONE)
+    #: its reading in words (the report layer's: opnav.report.approach.text.p1_summary_words)
+    ukf_bound_over_own_reading: str | None = field(default=None, metadata=OMIT_NONE)
 
 
 @dataclass(frozen=True)

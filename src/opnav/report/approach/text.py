@@ -200,13 +200,38 @@ def p1_words(table: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-#: why each of paper A's Figs. 5 and 6 is read as it is (issue 54, item 7)
-FIGURE_REASONS = {
-    "A-F5": ("states no number of its own: the text reads it together with Fig. 4 (tx and ty estimated "
-             "effectively: A-C1); rows: the position error at the end of the first and the last EM segment"),
-    "A-F6": ("its numbers (79.13 km before, 18.43 km after) are Table 1's, judged as A-C6 and A-C7 by the table's "
-             "rule; rows add the errors at the arc's last sample"),
-}
+def figure_reasons() -> dict[str, str]:
+    """Why each of paper A's Figs. 5 and 6 is read as it is (issue 54, item 7); the published
+    numbers from published.yaml (the text's 79.13 km and Table 1's 18.43 km)."""
+    from opnav.core import published
+
+    h = published.paper_a()["headline"]
+    return {
+        "A-F5": ("states no number of its own: the text reads it together with Fig. 4 (tx and ty estimated "
+                 "effectively: A-C1); rows: the position error at the end of the first and the last EM segment"),
+        "A-F6": (f"its numbers ({h['nav_err_before_km_text']:g} km before, {h['nav_err_after_km']:g} km after) are "
+                 "Table 1's, judged as A-C6 and A-C7 by the table's rule; rows add the errors at the arc's last sample"),
+    }
+
+
+def bound_over_own_reading(ratio: float, tol: float = 0.1) -> str:
+    """How a peer's bound over its own 3-sigma reads (A-P1): above one, the estimator claims more
+    precision than the data hold; below one, less; within ``tol`` of one, about what they hold."""
+    if not (isinstance(ratio, (int, float)) and math.isfinite(ratio)):
+        return "not computed"
+    if ratio > 1.0 + tol:
+        return "a ratio above one: the UKF claims more than the data hold"
+    if ratio < 1.0 - tol:
+        return "a ratio below one: the UKF claims less than the data hold"
+    return "a ratio of about one: the UKF claims what the data hold"
+
+
+def p1_summary_words(summ):
+    """A-P1-summary.json with its words: each variant's ``ukf_bound_over_own_reading``
+    (:func:`bound_over_own_reading` of ``ukf_bound_over_own_3sigma_x``)."""
+    variants = {k: replace(v, ukf_bound_over_own_reading=bound_over_own_reading(v.ukf_bound_over_own_3sigma_x))
+                if v.ukf_bound_over_own_3sigma_x is not None else v for k, v in summ.variants.items()}
+    return replace(summ, variants=variants)
 
 
 def with_words(summ: ASummary, t1: pd.DataFrame) -> ASummary:
@@ -230,8 +255,8 @@ def with_words(summ: ASummary, t1: pd.DataFrame) -> ASummary:
         out = out.replace(tz_nav_effect=replace(tz, rule=tz_rule(tz.variant, tz.tz_arcsec, tz.last_fraction)))
     if out.figures_5_6 is not None:
         f = out.figures_5_6
-        out = out.replace(figures_5_6=replace(f, f5=replace(f.f5, reason=FIGURE_REASONS["A-F5"]),
-                                              f6=replace(f.f6, reason=FIGURE_REASONS["A-F6"])))
+        why = figure_reasons()
+        out = out.replace(figures_5_6=replace(f, f5=replace(f.f5, reason=why["A-F5"]), f6=replace(f.f6, reason=why["A-F6"])))
     if out.installation is not None:
         out = out.replace(installation=replace(out.installation, why=installation_why(out.installation)))
     return out
