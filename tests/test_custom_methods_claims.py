@@ -9,7 +9,6 @@ import copy
 
 import test_claims as T
 
-from opnav.landing.own import with_own
 from opnav.report import landing_claims as B
 
 OWN = "mine"
@@ -17,7 +16,8 @@ OWN = "mine"
 
 def _with_own(sb: dict, diff: float = -5.0) -> dict:
     """``sb`` (a B-summary) with OWN compared against SVD and depth (landing.methods.compare_own's
-    sections, through with_own), in the error and envelope blocks, all of it much better than depth."""
+    sections, merged as landing.own.with_own merges them), in the error and envelope blocks, all of it
+    much better than depth."""
     sb = copy.deepcopy(sb)
     for s in sb["scenarios"].values():
         q = ("lastlm_pos_err_m", "lmrms_pos_err_m")
@@ -26,7 +26,10 @@ def _with_own(sb: dict, diff: float = -5.0) -> dict:
             own[ref] = {"reference": ref, "alpha": 0.05,
                         "metrics": {q[0]: {"means": {ref: 0.4, OWN: 0.01}}, q[1]: {"means": {ref: 2.0, OWN: 0.05}}},
                         "methods": {OWN: {q[0]: T._iv(diff, 0.001), q[1]: T._iv(diff, 0.001), "same_pick_pct": 1.0}}}
-        s.update(with_own({"equivalence_vs_baselines": s["equivalence_vs_baselines"]}, own))
+        by_base = dict(s["equivalence_vs_baselines"])
+        for b, sec in own.items():      # a baseline's existing section gains the own methods
+            by_base[b] = {**by_base[b], "methods": {**by_base[b]["methods"], **sec["methods"]}} if b in by_base else sec
+        s["equivalence_vs_baselines"] = by_base
         s["methods"][OWN] = {"rms_vel_err_mps_3sigma": 0.01, "rms_att_err_deg_3sigma": 0.01}
         s["errors"][OWN] = {"lastlm_pos_err_m": {"3sigma": 0.01}, "lmrms_pos_err_m": {"3sigma": 0.02}}
     return sb

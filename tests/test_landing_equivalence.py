@@ -21,19 +21,19 @@ def test_tost_is_two_one_sided_t_tests(n, shift, margin, seed):
     r = eqv.tost(d, margin, alpha=0.05)
     p_lo = stats.ttest_1samp(d, -margin, alternative="greater").pvalue
     p_hi = stats.ttest_1samp(d, margin, alternative="less").pvalue
-    assert r["p"] == pytest.approx(max(p_lo, p_hi), rel=1e-8, abs=1e-12)
-    assert r["equivalent"] == (max(p_lo, p_hi) < 0.05)
+    assert r.p == pytest.approx(max(p_lo, p_hi), rel=1e-8, abs=1e-12)
+    assert r.equivalent == (max(p_lo, p_hi) < 0.05)
     # the same decision as the 90 % interval inside the margin
     lo, hi = stats.t.interval(0.90, n - 1, loc=d.mean(), scale=stats.sem(d))
-    assert (r["lo"], r["hi"]) == pytest.approx((lo, hi), rel=1e-9, abs=1e-12)
+    assert (r.lo, r.hi) == pytest.approx((lo, hi), rel=1e-9, abs=1e-12)
     if abs(lo + margin) > 1e-9 and abs(hi - margin) > 1e-9:
-        assert r["equivalent"] == (lo > -margin and hi < margin)
+        assert r.equivalent == (lo > -margin and hi < margin)
 
 
 def test_tost_never_equivalent_without_a_margin():
-    assert not eqv.tost(np.zeros(10), 0.0)["equivalent"]
-    assert eqv.tost(np.full(10, 0.1), 0.2)["equivalent"]       # zero spread, inside
-    assert not eqv.tost(np.full(10, 0.3), 0.2)["equivalent"]
+    assert not eqv.tost(np.zeros(10), 0.0).equivalent
+    assert eqv.tost(np.full(10, 0.1), 0.2).equivalent       # zero spread, inside
+    assert not eqv.tost(np.full(10, 0.3), 0.2).equivalent
 
 
 def _runs(seed=0, n=300):
@@ -66,18 +66,20 @@ def test_controls_are_not_equivalent_and_a_real_pair_is():
     rel = _plan_rel()
     out = eqv.equivalence(st, "svd", ["depth", "random", "center", "closest"], margin_rel=rel,
                           same_pick_pct={"depth": 40.0, "random": 0.1, "center": 2.0, "closest": 7.0})
-    v = {m: r["verdict"] for m, r in out["methods"].items()}
+    v = {m: r.verdict for m, r in out.methods.items()}
     assert v == {"depth": "equivalent", "random": "not equivalent", "center": "not equivalent",
                  "closest": "not equivalent"}
     for q in eqv.PRIMARY_METRICS:
-        mg = out["metrics"][q]
-        assert mg["best"] == ["svd"] and mg["margin"] == pytest.approx(rel * st["svd"][q].mean())
-    text = out["methods"]["depth"]["text"]
+        mg = out.metrics[q]
+        assert mg.best == ["svd"] and mg.margin == pytest.approx(rel * st["svd"][q].mean())
+    from opnav.report.landing.equivalence_text import equivalence_text
+
+    text = equivalence_text("depth", out)
     assert "margin" in text and "last landmark update" in text and "40 %" in text
     assert f"{rel:g} x svd's mean error" in text
     # a wide margin (the baseline's whole mean error) lets a control pass: the verdict moves
     wide = eqv.equivalence(st, "svd", ["closest"], margin_rel=1.0)
-    assert wide["methods"]["closest"]["equivalent"]
+    assert wide.methods["closest"].equivalent
 
 
 def test_margin_does_not_come_from_the_controls_runs():
@@ -91,16 +93,18 @@ def test_margin_does_not_come_from_the_controls_runs():
     a = eqv.equivalence(st, "svd", tested, margin_rel=rel)
     b = eqv.equivalence({**st, "random": st["random"] + 50.0}, "svd", tested, margin_rel=rel)
     for q in eqv.PRIMARY_METRICS:
-        assert b["metrics"][q]["margin"] == a["metrics"][q]["margin"] == pytest.approx(rel * st["svd"][q].mean())
-    assert {m: r["equivalent"] for m, r in b["methods"].items()} == {"depth": True, "center": False,
+        assert b.metrics[q].margin == a.metrics[q].margin == pytest.approx(rel * st["svd"][q].mean())
+    assert {m: r.equivalent for m, r in b.methods.items()} == {"depth": True, "center": False,
                                                                       "closest": False}
 
 
 def _accuracy(st, pick_max, same_pick=40.0):
     eq = eqv.equivalence(st, "svd", ["depth", "random", "center", "closest"], _plan_rel(),
                          same_pick_pct={"depth": same_pick})
-    return {"equivalence": eq, "controls": ["random", "center", "closest"], "same_pick_max_pct": pick_max,
-            "controls_equivalent": [c for c in ("random", "center", "closest") if eq["methods"][c]["equivalent"]]}
+    from opnav.core.tables import json_ready
+
+    return {"equivalence": json_ready(eq), "controls": ["random", "center", "closest"], "same_pick_max_pct": pick_max,
+            "controls_equivalent": [c for c in ("random", "center", "closest") if eq.methods[c].equivalent]}
 
 
 def test_claim_reproduced_and_flagged_when_a_control_passes():
@@ -141,9 +145,9 @@ def test_same_pick_threshold_is_the_recorded_plan_number():
 
 def test_margin_is_zero_when_the_reference_error_is_not_positive():
     m = eqv.margins({"svd": 0.0, "depth": 1.0, "random": 0.9}, "svd", 0.1)
-    assert m["margin"] == 0.0 and m["best"] == ["svd"]
+    assert m.margin == 0.0 and m.best == ["svd"]
     m = eqv.margins({"svd": 2.0, "depth": 1.0, "random": 0.5}, "svd", 0.1)    # random better: no matter
-    assert m["margin"] == pytest.approx(0.2) and m["best"] == ["random"]
+    assert m.margin == pytest.approx(0.2) and m.best == ["random"]
     with pytest.raises(ValueError, match="margin_rel"):
         eqv.margins({"svd": 1.0}, "svd", 0.0)
 
@@ -160,14 +164,14 @@ def test_converges_faster_rule():
     step = _step()
     fast = eqv.converges_faster(tb - 1.5 * step + 0.1 * rng.standard_normal(200), tb, "depth", "svd", 100.0,
                                 min_difference_s=step)
-    assert fast["verdict"] == "faster" and fast["hi_s"] < 0 and fast["min_difference_s"] == step
+    assert fast.verdict == "faster" and fast.hi_s < 0 and fast.min_difference_s == step
     same = eqv.converges_faster(tb + 0.3 * rng.standard_normal(200), tb, "depth", "svd", 100.0,
                                 min_difference_s=step)
-    assert same["verdict"] == "no difference shown"
+    assert same.verdict == "no difference shown"
     ta = tb + 1.5 * step
     ta[:50] = np.nan                       # runs that never get there are left out, counted
     slow = eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=step)
-    assert slow["verdict"] == "slower" and slow["n_runs"] == 150
+    assert slow.verdict == "slower" and slow.n_runs == 150
 
 
 def test_faster_needs_the_plans_smallest_difference():
@@ -178,8 +182,8 @@ def test_faster_needs_the_plans_smallest_difference():
     step = _step()
     ta = tb - 0.6 * step + 0.05 * rng.standard_normal(300)
     r = eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=step)
-    assert r["hi_s"] < 0 and r["verdict"] == "no difference shown"
-    assert eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=0.5 * step)["verdict"] == "faster"
+    assert r.hi_s < 0 and r.verdict == "no difference shown"
+    assert eqv.converges_faster(ta, tb, "depth", "svd", 100.0, min_difference_s=0.5 * step).verdict == "faster"
 
 
 def _judge_b(cid, scenario, full=False):
@@ -212,7 +216,9 @@ def test_faster_reading_agrees_with_the_claims_table(shift):
     tb = 10 + rng.uniform(0, 5, 300)
     cf = eqv.converges_faster(tb + shift * _step() + 0.05 * rng.standard_normal(300), tb, "depth", "svd", 100.0,
                               min_difference_s=_step())
-    summary = {"converges_faster": {"depth": cf}}
+    from opnav.core.tables import json_ready
+
+    summary = {"converges_faster": {"depth": json_ready(cf)}}
     claim = _judge_b("B-C2", summary)
     eq = {"reference": "svd", "margin_rel": 0.1, "metrics": {q: {"margin": 1.0} for q in eqv.PRIMARY_METRICS},
           "methods": {"depth": {"equivalent": True, "verdict": "equivalent", "same_pick_pct": 10.0, "text": "",
@@ -342,3 +348,34 @@ def test_scorecard_reading_agrees_with_the_claims_table(case):
     else:
         assert (j.verdict == C.REPRODUCED) == (ours.verdict == REPRODUCED)
         assert any(f[0] == "control_also_meets" for f in j.flags) == ("cannot credit" in ours.reason)
+
+
+def test_the_summary_writes_the_records_keys_and_the_report_layers_sentences():
+    """B-summary.json keeps its keys (issue 56: typed in memory, serialised at the edge): a
+    method's paired tests by metric key beside equivalent / same_pick_pct / verdict and the
+    sentence, each metric's margin with its name in words, converges-faster's numbers and its
+    sentence (the words are the report layer's: no 'text' field on the records)."""
+    import dataclasses
+
+    from opnav.core.tables import json_ready
+    from opnav.report.landing.equivalence_text import METRIC_TEXT, Worded, converges_text, worded_section
+
+    st = _runs()
+    sec = eqv.equivalence(st, "svd", ["depth"], margin_rel=_plan_rel(), same_pick_pct={"depth": 40.0})
+    doc = json_ready(worded_section(sec))
+    assert set(doc) == {"reference", "alpha", "margin_rel", "metrics", "methods"}
+    assert set(doc["methods"]["depth"]) == {*eqv.PRIMARY_METRICS, eqv.TOUCHDOWN_METRIC, "equivalent",
+                                            "same_pick_pct", "verdict", "text"}
+    assert set(doc["methods"]["depth"]["lastlm_pos_err_m"]) == {"mean", "lo", "hi", "p", "equivalent", "margin",
+                                                                "n", "se", "level"}
+    assert doc["metrics"]["lmrms_pos_err_m"]["text"] == METRIC_TEXT["lmrms_pos_err_m"]
+    assert {"margin", "rel", "reference_mean", "best", "means"} < set(doc["metrics"]["lmrms_pos_err_m"])
+    assert "depth vs svd: equivalent" in doc["methods"]["depth"]["text"]
+    for rec in (eqv.PairedTest, eqv.MethodEquivalence, eqv.EquivalenceSection, eqv.ConvergesFaster):
+        assert "text" not in {f.name for f in dataclasses.fields(rec)}
+    rng = np.random.default_rng(2)
+    tb = 10 + rng.uniform(0, 5, 50)
+    cf = eqv.converges_faster(tb - 3.0, tb, "depth", "svd", 100.0, min_difference_s=1.0)
+    d = json_ready(Worded(cf, converges_text(cf)))
+    assert "method" not in d and d["verdict"] == "faster" and d["versus"] == "svd"
+    assert d["text"].startswith("first time below 100 m, depth minus svd: -3 s") and d["text"].endswith(": faster")

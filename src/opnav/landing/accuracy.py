@@ -10,19 +10,62 @@ Units: m, s, deg.
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Mapping
+
+from opnav.core.tables import json_key
+from opnav.landing.equivalence import ConvergesFaster, EquivalenceSection
+from opnav.landing.montecarlo import NeesConsistency
 
 if TYPE_CHECKING:
     from opnav.landing.records import MonteCarlo
     from opnav.landing.setup import Equivalence
 
-__all__ = ["accuracy_tests"]
+__all__ = ["accuracy_tests", "ErrorStat", "AccuracyTests"]
+
+
+@dataclass(frozen=True)
+class ErrorStat:
+    """Mean, median and 3-sigma over the runs of one per-run error (m, m/s or deg; 3-sigma NaN
+    below two runs)."""
+
+    mean: float
+    median: float
+    sigma3: float = field(metadata=json_key("3sigma"))
+
+
+@dataclass(frozen=True)
+class AccuracyTests:
+    """The accuracy claims of one scenario (:func:`accuracy_tests`): the equivalence section against
+    the reference and against each H baseline, the plan's same-pick threshold, the controls and
+    those that passed, converges-faster per method (at the threshold and per threshold of the
+    sweep), per method its error statistics by quantity and its held-out NEES. B-summary.json
+    writes its fields at the top level."""
+
+    equivalence: EquivalenceSection
+    equivalence_vs_baselines: dict[str, EquivalenceSection]
+    same_pick_max_pct: float
+    controls: list[str]
+    controls_equivalent: list[str]
+    converges_faster: dict[str, ConvergesFaster]
+    converges_faster_by_threshold: dict[str, dict[str, ConvergesFaster]]
+    errors: dict[str, dict[str, ErrorStat]]
+    nees: dict[str, NeesConsistency]
+
+    def with_baselines(self, sections: Mapping[str, EquivalenceSection]) -> "AccuracyTests":
+        """These tests with more sections against baselines (a baseline's existing section gains
+        the new section's methods)."""
+        by_base = dict(self.equivalence_vs_baselines)
+        for b, sec in sections.items():
+            by_base[b] = by_base[b].with_methods(sec.methods) if b in by_base else sec
+        return dataclasses.replace(self, equivalence_vs_baselines=by_base)
 
 
 def accuracy_tests(data: dict[str, MonteCarlo], eq: Equivalence, converged_pos_err_m: float, *,
                    margin_rel: float, same_pick_max_pct: float, min_difference_s: float,
-                   thresholds_m: tuple[float, ...] = ()) -> dict:
+                   thresholds_m: tuple[float, ...] = ()) -> AccuracyTests:
     """The accuracy claims of one scenario as tests that can fail
     (:mod:`opnav.landing.equivalence`), from the gathered Monte Carlo of every
     method flown (``data``, the controls included), ``landing.equivalence``
@@ -66,8 +109,8 @@ def accuracy_tests(data: dict[str, MonteCarlo], eq: Equivalence, converged_pos_e
             if q not in st:
                 continue
             col = st[q]
-            errors[m][q] = {"mean": float(col.mean()), "median": float(col.median()),
-                            "3sigma": float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan}
+            errors[m][q] = ErrorStat(float(col.mean()), float(col.median()),
+                                     float(3.0 * col.std(ddof=1)) if len(col) > 1 else math.nan)
     t_ref = time_below(data[ref], converged_pos_err_m)
     faster = {m: eqv.converges_faster(time_below(data[m], converged_pos_err_m), t_ref, m, ref,
                                       converged_pos_err_m, alpha,
@@ -85,10 +128,8 @@ def accuracy_tests(data: dict[str, MonteCarlo], eq: Equivalence, converged_pos_e
             tested_b = [m for m in eq.methods if m != b]
             by_base[b] = eqv.equivalence(stats, b, tested_b, float(margin_rel), alpha,
                                          {m: same_pick_pct(data[m], data[b]) for m in tested_b})
-    return {"equivalence": res,
-            "equivalence_vs_baselines": by_base,
-            "same_pick_max_pct": float(same_pick_max_pct),
-            "controls": list(eq.controls),
-            "controls_equivalent": [c for c in eq.controls if res["methods"][c]["equivalent"]],
-            "converges_faster": faster, "converges_faster_by_threshold": by_thr, "errors": errors,
-            "nees": {m: nees_consistency(d) for m, d in data.items()}}
+    return AccuracyTests(equivalence=res, equivalence_vs_baselines=by_base,
+                         same_pick_max_pct=float(same_pick_max_pct), controls=list(eq.controls),
+                         controls_equivalent=[c for c in eq.controls if res.methods[c].equivalent],
+                         converges_faster=faster, converges_faster_by_threshold=by_thr, errors=errors,
+                         nees={m: nees_consistency(d) for m, d in data.items()})

@@ -42,25 +42,118 @@ difference ``a - b`` over runs where both get there, with its two-sided
 mean difference is at least ``min_difference_s`` (the analysis plan's B-C2: one
 filter step; a smaller difference is below the time resolution), "slower" in
 the mirror case, else "no difference shown".
+
+The results are typed records (:class:`PairedTest`, :class:`Margin`, :class:`MetricMargin`,
+:class:`MethodEquivalence`, :class:`EquivalenceSection`, :class:`ConvergesFaster`) holding numbers
+and outcomes; their sentences are the report layer's (``opnav.report.landing.equivalence_text``).
+B-summary.json writes them with their fields as keys (``core.tables.json_ready``) and the
+sentences beside them.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from typing import Mapping
 
 import numpy as np
 from scipy import special
 
-__all__ = ["tost", "margins", "equivalence", "converges_faster", "PRIMARY_METRICS",
-           "TOUCHDOWN_METRIC", "METRIC_TEXT"]
+from opnav.core.tables import JSON_SKIP
+
+__all__ = ["tost", "margins", "equivalence", "converges_faster", "PRIMARY_METRICS", "TOUCHDOWN_METRIC",
+           "PairedTest", "Margin", "MetricMargin", "MethodEquivalence", "EquivalenceSection", "ConvergesFaster"]
 
 #: the per-run metrics the equivalence verdict needs (both), m
 PRIMARY_METRICS = ("lastlm_pos_err_m", "lmrms_pos_err_m")
 #: reported beside them, not part of the verdict, m
 TOUCHDOWN_METRIC = "final_pos_err_m"
-METRIC_TEXT = {"lastlm_pos_err_m": "position error at the last landmark update",
-               "lmrms_pos_err_m": "RMS position error over the landmark-tracking phase",
-               "final_pos_err_m": "position error at touchdown"}
+
+
+@dataclass(frozen=True)
+class PairedTest:
+    """A paired TOST of ``|mean d| < margin`` (:func:`tost`; m): the mean difference, its
+    ``level`` interval ``lo``/``hi``, the larger one-sided p-value, the outcome, the margin, the
+    runs and the standard error."""
+
+    mean: float
+    lo: float
+    hi: float
+    p: float
+    equivalent: bool
+    margin: float
+    n: int
+    se: float
+    level: float
+
+
+@dataclass(frozen=True)
+class Margin:
+    """The equivalence margin of one metric (:func:`margins`; m): ``rel`` times the reference's
+    mean, that mean, and the methods sharing the smallest mean (ties are ties)."""
+
+    margin: float
+    rel: float
+    reference_mean: float
+    best: list[str]
+
+
+@dataclass(frozen=True, kw_only=True)
+class MetricMargin(Margin):
+    """One metric of an equivalence section: its :class:`Margin` and every method's mean (m)."""
+
+    means: dict[str, float]
+
+
+@dataclass(frozen=True)
+class MethodEquivalence:
+    """One tested method against the section's reference: a :class:`PairedTest` per metric
+    (``tests``, by metric key: written as the method's own keys), ``equivalent`` (both primary
+    metrics), the same-pick rate (%) and the outcome word."""
+
+    tests: dict[str, PairedTest] = field(metadata={"json_flatten": True})
+    equivalent: bool
+    same_pick_pct: float
+    verdict: str
+
+
+@dataclass(frozen=True)
+class EquivalenceSection:
+    """Every tested method against one ``reference`` (:func:`equivalence`): the one-sided tests'
+    alpha, the relative margin, per metric its :class:`MetricMargin` and per method its
+    :class:`MethodEquivalence`."""
+
+    reference: str
+    alpha: float
+    margin_rel: float
+    metrics: dict[str, MetricMargin]
+    methods: dict[str, MethodEquivalence]
+
+    def with_methods(self, methods: Mapping[str, MethodEquivalence]) -> "EquivalenceSection":
+        """This section with more tested methods (the same reference, margins and alpha)."""
+        import dataclasses
+
+        return dataclasses.replace(self, methods={**self.methods, **methods})
+
+
+@dataclass(frozen=True)
+class ConvergesFaster:
+    """First time below ``threshold_m``, ``method`` minus ``versus`` (:func:`converges_faster`; s):
+    the mean over the runs where both get there, its ``level`` paired-t interval and standard
+    error, the runs used and flown, the smallest difference counted and the outcome."""
+
+    mean_s: float
+    lo_s: float
+    hi_s: float
+    se_s: float
+    level: float
+    versus: str
+    n_runs: int
+    n_total: int
+    threshold_m: float
+    min_difference_s: float
+    verdict: str
+    method: str = field(default="", metadata=JSON_SKIP)
 
 
 def _t_interval(d: np.ndarray, level: float) -> tuple[float, float, float, float]:
@@ -72,7 +165,7 @@ def _t_interval(d: np.ndarray, level: float) -> tuple[float, float, float, float
     return m, se, m - q * se, m + q * se
 
 
-def tost(d, margin: float, alpha: float = 0.05) -> dict:
+def tost(d, margin: float, alpha: float = 0.05) -> PairedTest:
     """Paired two-one-sided test of ``|mean d| < margin`` (``d``: per-run
     differences, m; ``margin``: m). Returns ``mean``, the ``1 - 2 alpha``
     interval ``lo``/``hi`` (its ``level``) and the standard error ``se``, ``p`` (the larger one-sided p-value; equivalence
@@ -93,11 +186,11 @@ def tost(d, margin: float, alpha: float = 0.05) -> dict:
         p_high = float(special.stdtr(d.size - 1, (m - margin) / se))     # H0: mean >= +margin
         p = max(p_low, p_high)
     ok = margin > 0.0 and p < alpha
-    return {"mean": m, "lo": lo, "hi": hi, "p": p, "equivalent": bool(ok), "margin": margin,
-            "n": int(d.size), "se": se, "level": 1.0 - 2.0 * alpha}
+    return PairedTest(mean=m, lo=lo, hi=hi, p=p, equivalent=bool(ok), margin=margin, n=int(d.size), se=se,
+                      level=1.0 - 2.0 * alpha)
 
 
-def margins(means: dict[str, float], reference: str, margin_rel: float) -> dict:
+def margins(means: Mapping[str, float], reference: str, margin_rel: float) -> Margin:
     """The equivalence margin of one metric (m): ``margin_rel`` times the
     reference's mean of ``means`` (method -> mean, m), 0 if that mean is not
     positive. Returns ``margin``, ``rel``, ``reference_mean`` and ``best`` (the
@@ -111,20 +204,19 @@ def margins(means: dict[str, float], reference: str, margin_rel: float) -> dict:
     lo = min(means.values())
     best = sorted(m for m, v in means.items() if v == lo)
     r = float(means[reference])
-    return {"margin": float(margin_rel) * r if r > 0 else 0.0, "rel": float(margin_rel),
-            "reference_mean": r, "best": best}
+    return Margin(margin=float(margin_rel) * r if r > 0 else 0.0, rel=float(margin_rel), reference_mean=r, best=best)
 
 
-def equivalence(stats: dict, reference: str, tested: list[str], margin_rel: float,
-                alpha: float = 0.05, same_pick_pct: dict | None = None) -> dict:
+def equivalence(stats: Mapping, reference: str, tested: list[str], margin_rel: float,
+                alpha: float = 0.05, same_pick_pct: Mapping[str, float] | None = None) -> EquivalenceSection:
     """Equivalence of each method of ``tested`` with ``reference`` on paired
     runs. ``stats``: method -> per-run table (``montecarlo.per_run_stats``, the
     same runs in the same order) of every method flown; ``margin_rel``: the
     plan's fraction of the reference's mean (:func:`margins`); ``same_pick_pct``: method -> share of
     planning calls picking the reference's landmark (%). Returns per metric its
-    margin (:func:`margins`), and per tested method the :func:`tost` of every
-    metric (primary and touchdown), ``equivalent`` (both primary metrics),
-    ``same_pick_pct`` and a ``text`` naming margin, metric and same-pick rate."""
+    margin (:func:`margins`) and every method's mean, and per tested method the :func:`tost` of
+    every metric (primary and touchdown), ``equivalent`` (both primary metrics) and
+    ``same_pick_pct``."""
     if reference not in stats:
         raise ValueError(f"equivalence: reference {reference!r} not among {sorted(stats)}")
     runs = stats[reference].index
@@ -132,33 +224,24 @@ def equivalence(stats: dict, reference: str, tested: list[str], margin_rel: floa
         if not s.index.equals(runs):
             raise ValueError(f"equivalence: {m!r} did not fly the runs of {reference!r}")
     same_pick_pct = same_pick_pct or {}
-    out = {"reference": reference, "alpha": float(alpha), "margin_rel": float(margin_rel),
-           "metrics": {}, "methods": {}}
+    metrics = {}
     for q in PRIMARY_METRICS + (TOUCHDOWN_METRIC,):
         means = {m: float(s[q].mean()) for m, s in stats.items()}
-        out["metrics"][q] = {**margins(means, reference, margin_rel), "means": means,
-                             "text": METRIC_TEXT[q]}
+        mg = margins(means, reference, margin_rel)
+        metrics[q] = MetricMargin(mg.margin, mg.rel, mg.reference_mean, mg.best, means=means)
     ref = stats[reference]
+    methods = {}
     for m in tested:
-        res = {q: tost(stats[m][q].to_numpy() - ref[q].to_numpy(), out["metrics"][q]["margin"], alpha)
-               for q in out["metrics"]}
-        eq = all(res[q]["equivalent"] for q in PRIMARY_METRICS)
-        sp = same_pick_pct.get(m, math.nan)
-        parts = "; ".join(
-            f"{METRIC_TEXT[q]} {res[q]['mean']:+.3g} m [{res[q]['lo']:+.3g}, {res[q]['hi']:+.3g}] "
-            f"vs margin +-{res[q]['margin']:.3g} m" for q in PRIMARY_METRICS)
-        out["methods"][m] = {
-            **{q: res[q] for q in res}, "equivalent": bool(eq), "same_pick_pct": sp,
-            "verdict": "equivalent" if eq else "not equivalent",
-            "text": (f"{m} vs {reference}: {'equivalent' if eq else 'not equivalent'} "
-                     f"({100 * (1 - 2 * alpha):.0f} % paired intervals, {m} minus {reference}: {parts}; "
-                     f"margin {margin_rel:g} x {reference}'s mean error; same landmark as "
-                     f"{reference} in {sp:.3g} % of the planning calls)")}
-    return out
+        res = {q: tost(stats[m][q].to_numpy() - ref[q].to_numpy(), metrics[q].margin, alpha) for q in metrics}
+        eq = all(res[q].equivalent for q in PRIMARY_METRICS)
+        methods[m] = MethodEquivalence(tests=res, equivalent=bool(eq), same_pick_pct=same_pick_pct.get(m, math.nan),
+                                       verdict="equivalent" if eq else "not equivalent")
+    return EquivalenceSection(reference=reference, alpha=float(alpha), margin_rel=float(margin_rel), metrics=metrics,
+                              methods=methods)
 
 
 def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float = 0.05, *,
-                     min_difference_s: float) -> dict:
+                     min_difference_s: float) -> ConvergesFaster:
     """Paired comparison of the first times below ``threshold_m`` (s; NaN:
     never) of methods ``a`` and ``b`` on the same runs: mean of ``t_a - t_b``
     over the runs where both get there, its two-sided ``1 - alpha`` paired-t
@@ -180,9 +263,6 @@ def converges_faster(t_a, t_b, a: str, b: str, threshold_m: float, alpha: float 
         raise ValueError(f"converges_faster: min_difference_s must be >= 0 s, got {min_difference_s!r}")
     verdict = ("faster" if hi < 0 and m <= -step else "slower" if lo > 0 and m >= step
                else "no difference shown")
-    return {"mean_s": m, "lo_s": lo, "hi_s": hi, "se_s": se, "level": 1.0 - alpha, "versus": b,
-            "n_runs": int(d.size), "n_total": int(t_a.size),
-            "threshold_m": float(threshold_m), "min_difference_s": step, "verdict": verdict,
-            "text": (f"first time below {threshold_m:g} m, {a} minus {b}: {m:+.3g} s "
-                     f"[{lo:+.3g}, {hi:+.3g}] ({100 * (1 - alpha):.0f} % paired interval, "
-                     f"{d.size} of {t_a.size} runs; smallest difference counted {step:g} s): {verdict}")}
+    return ConvergesFaster(mean_s=m, lo_s=lo, hi_s=hi, se_s=se, level=1.0 - alpha, versus=b, n_runs=int(d.size),
+                           n_total=int(t_a.size), threshold_m=float(threshold_m), min_difference_s=step,
+                           verdict=verdict, method=a)

@@ -2,7 +2,12 @@
 with the paper's: the paired comparison behind their evidence rows (role ``beyond``, no verdict)."""
 from __future__ import annotations
 
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
+
+if TYPE_CHECKING:
+    from opnav.landing.accuracy import AccuracyTests
+    from opnav.landing.equivalence import EquivalenceSection
+    from opnav.landing.records import MonteCarlo
 
 __all__ = ["VERSUS", "compare_own", "with_own"]
 
@@ -12,8 +17,8 @@ __all__ = ["VERSUS", "compare_own", "with_own"]
 VERSUS = ("svd", "depth")
 
 
-def compare_own(data: Mapping[str, dict], names, margin_rel: float, alpha: float,
-                versus=VERSUS) -> dict:
+def compare_own(data: Mapping[str, "MonteCarlo"], names, margin_rel: float, alpha: float,
+                versus=VERSUS) -> dict[str, "EquivalenceSection"]:
     """The paired comparison of each of a user's own methods ``names`` against each baseline of
     ``versus`` flown in ``data`` (method -> gathered Monte Carlo): per baseline the
     equivalence section of ``opnav.landing.equivalence.equivalence`` (the B-C1 test's paired
@@ -35,13 +40,7 @@ def compare_own(data: Mapping[str, dict], names, margin_rel: float, alpha: float
     return out
 
 
-def with_own(accuracy: dict, own: Mapping[str, dict]) -> dict:
+def with_own(accuracy: "AccuracyTests", own: Mapping[str, "EquivalenceSection"]) -> "AccuracyTests":
     """``accuracy`` (``landing.accuracy.accuracy_tests``) with :func:`compare_own`'s sections in
     its ``equivalence_vs_baselines`` (a baseline's existing section gains the own methods)."""
-    by_base = dict(accuracy.get("equivalence_vs_baselines") or {})
-    for b, sec in own.items():
-        if b in by_base:
-            by_base[b] = {**by_base[b], "methods": {**by_base[b]["methods"], **sec["methods"]}}
-        else:
-            by_base[b] = sec
-    return {**accuracy, "equivalence_vs_baselines": by_base}
+    return accuracy.with_baselines(own)

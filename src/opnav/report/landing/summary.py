@@ -32,6 +32,7 @@ if TYPE_CHECKING:
 
     import pandas as pd
 
+    from opnav.landing.accuracy import AccuracyTests
     from opnav.landing.montecarlo import NeesConsistency, YawConvergence
     from opnav.landing.records import MonteCarlo, Replay
     from opnav.landing.setup import Setup
@@ -156,7 +157,7 @@ class TimingSection:
 
 def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCarlo], timing: "Replay",
                      single: dict, setup: Setup, *, eval_path: str, yaw_ratio: float,
-                     published_reduction_vs_svd: float, accuracy: dict | None = None) -> dict:
+                     published_reduction_vs_svd: float, accuracy: "AccuracyTests | None" = None) -> dict:
     """The summary JSON of one camera scenario (``B-summary.json`` per scenario,
     read by the manuscript macros and the scorecard, :func:`rows_paper_b`).
 
@@ -172,7 +173,9 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCa
     method: does the 3-sigma envelope fall below ``yaw_ratio`` of its start?),
     the number of runs and the smallest same-pick rate of a method against
     depth (%, the check that an accuracy comparison could fail; nan without one),
-    and ``accuracy``: :func:`accuracy_tests` (its keys at the top level).
+    and ``accuracy``: ``landing.accuracy.accuracy_tests`` (its fields at the top level, the
+    equivalence results and converges-faster readings with their sentences,
+    ``report.landing.equivalence_text``).
     """
     from opnav.landing import timing_summary as tsum
     from opnav.landing.montecarlo import yaw_convergence
@@ -188,7 +191,7 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCa
     t = table.set_index("method")
     same_pick = [float(t.loc[m, "same_pick_as_depth_pct"]) for m in methods
                  if m != "depth" and "same_pick_as_depth_pct" in t.columns]
-    return {
+    out = {
         "scenario": scenario,
         "single": single,
         "methods": {r["method"]: dict(r) for r in table.to_dict("records")},
@@ -216,8 +219,19 @@ def scenario_summary(scenario: str, table: pd.DataFrame, data: dict[str, MonteCa
         "planning_time_vs_depth": (vs := tsum.vs_depth(timing)),
         "planning_time": (ev := tsum.planning_time_evidence(timing, published_reduction_vs_svd)),  # B-C4, B-C9
         "planning_time_text": planning_time_text(vs, tsum.clock_share(timing), ev),
-        **(accuracy or {}),
     }
+    if accuracy is not None:     # the tests' records at the top level, their sentences beside them
+        import dataclasses
+
+        from opnav.report.landing.equivalence_text import Worded, converges_text, worded_section
+
+        out.update((f.name, getattr(accuracy, f.name)) for f in dataclasses.fields(accuracy))
+        out["equivalence"] = worded_section(accuracy.equivalence)
+        out["equivalence_vs_baselines"] = {b: worded_section(v) for b, v in accuracy.equivalence_vs_baselines.items()}
+        out["converges_faster"] = {m: Worded(v, converges_text(v)) for m, v in accuracy.converges_faster.items()}
+        out["converges_faster_by_threshold"] = {t: {m: Worded(v, converges_text(v)) for m, v in per.items()}
+                                                for t, per in accuracy.converges_faster_by_threshold.items()}
+    return out
 
 
 def yaw_reason(y: YawConvergence) -> str:
