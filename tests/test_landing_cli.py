@@ -35,7 +35,7 @@ def test_cli_scenario_flag_flies_that_camera(capsys):
     cfg = scenario_setups(load_config(overlays=[quick])["landing"])["site-tilt"]
     want = summarize_run(run_descent(build_scenario(cfg), "depth", 1))
     assert out["scenario"] == "site-tilt"
-    assert out["final_pos_err_m"] == pytest.approx(want["final_pos_err_m"], rel=1e-9)
+    assert out["final_pos_err_m"] == pytest.approx(want.stats["final_pos_err_m"], rel=1e-9)
     assert main(["landing", "--scenario", "nope"]) == 2
     assert "--scenario 'nope'" in capsys.readouterr().err
     assert out["n_landmarks"] > 10 and out["median_plan_time_us"] > 0

@@ -2,6 +2,7 @@
 of a small Monte Carlo say when counted one run and one step at a time; the NEES reading and
 the manuscript's generated sentences follow the numbers."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -41,14 +42,14 @@ def test_end_phase_equals_the_per_step_records_counted_by_hand(small_run):
         below1 += any(z[k] < 1.0 for k in vis)
         belowm += any(z[k] < margin for k in vis)
         lowest = min([lowest] + [z[k] for k in vis])
-    assert got["n_runs"] == 2
-    assert got["last_lm_t_s_median"] == pytest.approx(np.median(last_lm))
-    assert got["last_vis_t_s_median"] == pytest.approx(np.median(last_vis))
-    assert (got["last_lm_t_s_min"], got["last_lm_t_s_max"]) == (min(last_lm), max(last_lm))
-    assert got["vision_after_last_lm_s_median"] == pytest.approx(np.median(np.subtract(last_vis, last_lm)))
-    assert (got["runs_vision_below_ground_m"], got["runs_vision_below_margin"]) == (below1, belowm)
-    assert got["min_true_alt_vision_m"] == pytest.approx(lowest)
-    assert got["last_vis_t_s_median"] >= got["last_lm_t_s_median"]
+    assert got.n_runs == 2
+    assert got.last_lm_t_s_median == pytest.approx(np.median(last_lm))
+    assert got.last_vis_t_s_median == pytest.approx(np.median(last_vis))
+    assert (got.last_lm_t_s_min, got.last_lm_t_s_max) == (min(last_lm), max(last_lm))
+    assert got.vision_after_last_lm_s_median == pytest.approx(np.median(np.subtract(last_vis, last_lm)))
+    assert (got.runs_vision_below_ground_m, got.runs_vision_below_margin) == (below1, belowm)
+    assert got.min_true_alt_vision_m == pytest.approx(lowest)
+    assert got.last_vis_t_s_median >= got.last_lm_t_s_median
 
 
 def _rec(updated, lm_updated, t):
@@ -65,14 +66,14 @@ def test_end_phase_on_hand_made_records_and_its_sentences():
     z = np.array([10.0, 8.0, 6.0, 3.0, 0.5])
     d = _rec([[1, 1, 1, 1, 1], [1, 1, 1, 1, 0]], [[1, 1, 1, 0, 0], [1, 1, 1, 1, 0]], t)
     e = end_phase(d, z, margin_m=5.0)
-    assert (e["last_lm_t_s_min"], e["last_lm_t_s_max"], e["last_vis_t_s_max"]) == (2.0, 3.0, 4.0)
-    assert e["vision_after_last_lm_s_median"] == pytest.approx(1.0)   # (2 + 0) / 2
-    assert (e["runs_vision_below_ground_m"], e["runs_vision_below_margin"]) == (1, 2)
-    assert e["min_true_alt_vision_m"] == 0.5
-    txt = end_phase_text({"depth": e}, "site-tilt", 3.0)
+    assert (e.last_lm_t_s_min, e.last_lm_t_s_max, e.last_vis_t_s_max) == (2.0, 3.0, 4.0)
+    assert e.vision_after_last_lm_s_median == pytest.approx(1.0)   # (2 + 0) / 2
+    assert (e.runs_vision_below_ground_m, e.runs_vision_below_margin) == (1, 2)
+    assert e.min_true_alt_vision_m == 0.5
+    txt = end_phase_text({"depth": dataclasses.asdict(e)}, "site-tilt", 3.0)
     assert "1 take vision updates with the true altitude below 1 m" in txt and "2 below 5 m" in txt
     none = end_phase(_rec([[1, 1, 0, 0, 0]], [[1, 0, 0, 0, 0]], t), z, 5.0)
-    assert "no run of 1 takes a vision update" in end_phase_text({"depth": none}, "interior", 3.0)
+    assert "no run of 1 takes a vision update" in end_phase_text({"depth": dataclasses.asdict(none)}, "interior", 3.0)
 
 
 def test_nees_reading_names_under_and_overconfidence():

@@ -57,9 +57,9 @@ def test_single_descent_converges_in_position_and_velocity(landing):
     run = run_descent(scn, "depth", 0)
     s = summarize_run(run)
     e0 = np.linalg.norm(run.init_error[0:3])
-    assert s["final_pos_err_m"] < 0.1 * e0
-    assert s["final_vel_err_mps"] < 0.2 * np.linalg.norm(run.init_error[3:6])
-    assert s["n_landmarks"] >= 30
+    assert s.stats["final_pos_err_m"] < 0.1 * e0
+    assert s.stats["final_vel_err_mps"] < 0.2 * np.linalg.norm(run.init_error[3:6])
+    assert s.stats["n_landmarks"] >= 30
     assert np.all(run.plan_evals > 0)
     # the filter's own 1-sigma shrinks with the errors
     assert np.linalg.norm(run.sig_r[-1]) < 0.1 * np.linalg.norm(run.sig_r[0])

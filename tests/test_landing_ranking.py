@@ -87,11 +87,11 @@ def test_pairing_removes_shared_run_spread():
     a = base + 2.0 + rng.normal(0, 0.5, 60)
     b = base + rng.normal(0, 0.5, 60)
     d = paired_difference(a, b, n_boot=500)
-    assert 0 < d["t_lo"] < 2.0 < d["t_hi"] < 2.6
-    assert d["boot_lo"] > 0
+    assert 0 < d.t_lo < 2.0 < d.t_hi < 2.6
+    assert d.boot_lo > 0
     welch = stats.ttest_ind(a, b, equal_var=False)
-    assert welch.pvalue > 0.05 and d["p"] < 1e-10
-    assert d["a_lower_pct"] < 5.0 and d["equal_pct"] == 0.0
+    assert welch.pvalue > 0.05 and d.p < 1e-10
+    assert d.a_lower_pct < 5.0 and d.equal_pct == 0.0
 
 
 @settings(max_examples=30, deadline=None)
@@ -151,6 +151,14 @@ def _records(data):
     return {m: MonteCarlo(**{k: v for k, v in d.items() if k in names}) for m, d in data.items()}
 
 
+def worded(h):
+    """The headline as B-X1-summary.json holds it (its fields and its words)."""
+    from opnav.core.tables import json_ready
+    from opnav.report.landing.ranking_text import worded_headline
+
+    return json_ready(worded_headline(h))
+
+
 def _timing(data):
     """The replay result of the fake Monte Carlos' planning times (same calls)."""
     from opnav.landing.timing import from_times
@@ -184,7 +192,7 @@ def test_ranking_table_ties_and_paired_difference():
     assert t.loc["svd", "ref_better_pct"] == 100.0
     assert t.loc["depth", "d_rms_pos_vs_ref_mean"] == 0.0 and t.loc["depth", "vs_ref"] == "reference"
     assert t.loc["svd", "same_pick_as_ref_pct"] == 100.0
-    h = headline(df, "depth")
+    h = worded(headline(df, "depth"))
     assert h["best_accuracy_method"] == "random" and h["fastest_method"] == "random"
     assert h["reference_rank_accuracy"] == 2
     assert set(h["reference_more_accurate_than"]) == {"svd", "gdop"}
@@ -215,7 +223,7 @@ def test_headline_feeds_manuscript_macros():
     df = ranking_table(_records(data), _timing(data), "depth", n_boot=50, rtol=1e-3)
     t = df.set_index("method")
     assert t.loc["svd", "rank_accuracy"] == t.loc["depth", "rank_accuracy"] == 1   # within 0.1 %
-    h = json.loads(json.dumps(headline(df, "depth")))
+    h = json.loads(json.dumps(worded(headline(df, "depth"))))
     macros = macros_from_summary(h, "BXone")
     assert macros and all(k.isalpha() for k in macros)
     # svd is 1e-5 worse in EVERY run: a shared rank (tolerance) but a significant paired difference
@@ -235,7 +243,7 @@ def test_tied_order_is_by_method_name_not_timing():
         data = {m: _fake_mc(base + (0.0 if m in ("depth", "svd", "cond") else 1.0), runs, times[m], i)
                 for i, m in enumerate(["svd", "depth", "mineig", "cond", "gdop"])}
         df = ranking_table(_records(data), _timing(data), "depth", n_boot=20, rtol=1e-3)
-        return df, headline(df, "depth")
+        return df, worded(headline(df, "depth"))
 
     df1, h1 = build({"svd": 900.0, "depth": 100.0, "mineig": 50.0, "cond": 400.0, "gdop": 60.0})
     df2, h2 = build({"svd": 10.0, "depth": 700.0, "mineig": 800.0, "cond": 5.0, "gdop": 900.0})
@@ -270,12 +278,14 @@ def test_pair_comparison_on_hand_made_calls():
     a = _calls_record([0, 0, 1, 1], [1, 4, 1, 4], [5, 6, 7, 8], [0.1, 0.2, 0.3, 0.4], [1.0, 2.0])
     b = _calls_record([0, 0, 1, 1], [1, 4, 1, 4], [5, 9, 7, 9], [0.1, 0.25, 0.3, 0.5], [2.0, 4.0])
     pc = pair_comparison(a, b)
-    assert pc["same_pick_pct"] == pytest.approx(50.0)
+    assert pc.same_pick_pct == pytest.approx(50.0)
     # |dbeta| = 0, 0.05, 0, 0.1 rad: median 0.025 rad
-    assert pc["median_abs_dbeta_deg"] == pytest.approx(np.degrees(0.025))
-    assert pc["d_final_pos_m"] == pytest.approx(-1.5)          # (1-2 + 2-4) / 2
-    assert pc["d_final_pos_rel_pct"] == pytest.approx(-50.0)    # of b's mean 3 m
-    assert pc["d_final_pos_lo_m"] < -1.5 < pc["d_final_pos_hi_m"]
+    assert pc.median_abs_dbeta_deg == pytest.approx(np.degrees(0.025))
+    assert pc.diffs["final_pos"].m == pytest.approx(-1.5)          # (1-2 + 2-4) / 2
+    assert pc.diffs["final_pos"].rel_pct == pytest.approx(-50.0)    # of b's mean 3 m
+    assert pc.diffs["final_pos"].lo_m < -1.5 < pc.diffs["final_pos"].hi_m
+    cols = dict(pc.columns())                                   # B-T3's pairs, by column
+    assert cols["d_final_pos_m"] == pc.diffs["final_pos"].m and cols["same_pick_pct"] == pc.same_pick_pct
 
 
 def test_first_runs_keeps_the_paired_runs_and_their_calls():

@@ -18,6 +18,7 @@ rule landing_x1_summary:
         timing=lambda wc: expand(B_TIMING, bscn=wc.bscn),   # replays + other (landing_timing.smk)
         code=with_kernels("landing", src("landing/ranking.py", "landing/montecarlo.py", "landing/timing.py",
                                          "landing/timing_summary.py", "report/landing/plots.py", "report/landing/timing_text.py",
+                                         "report/landing/ranking_text.py", "landing/records.py",
                                          "core/tables.py", "core/figures.py", "opnav.mplstyle")),
         kernels=kernels("landing"),
     output:

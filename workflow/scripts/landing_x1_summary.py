@@ -6,18 +6,20 @@ from opnav.core.jobserver import delegate
 
 delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
 
+import dataclasses
 import json
 import sys
 
 from opnav.core import figures
 from opnav.landing import timing, timing_summary
 from opnav.report.landing import plots
+from opnav.report.landing.ranking_text import worded_headline
 from opnav.report.landing.timing_text import method_text
 from opnav.landing.methods import colors as method_colors, labels as method_labels
 from opnav.landing.montecarlo import first_runs, load
 from opnav.landing.ranking import headline, ranking_table
 from opnav.core.snakeio import mock_snakemake, script_context
-from opnav.core.tables import write_table
+from opnav.core.tables import json_ready, write_table
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_x1_summary", argv=sys.argv[1:], bscn="site-tilt")
@@ -49,8 +51,7 @@ with script_context(snakemake) as log:
     figures.save(plots.fig_nav_error_envelopes(t, data, method_labels(own),
                                                figures.own_colors(list(own), method_colors(own))),
                  snakemake.output.f)
-    out = headline(df, ref)
-    out["n_boot"] = n_boot
-    with open(snakemake.output.summary, "w") as fh:
-        json.dump(out, fh, indent=2, sort_keys=True)
+    out = worded_headline(dataclasses.replace(headline(df, ref), n_boot=n_boot))
+    with open(snakemake.output.summary, "w") as fh:      # the file edge: the record's fields as keys
+        json.dump(json_ready(out), fh, indent=2, sort_keys=True)
     log.info("B-X1:\n%s", df.to_string())

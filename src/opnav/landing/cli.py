@@ -37,16 +37,17 @@ def _run(args, rc) -> int:
                           f"({', '.join(scenarios)})")
     scn = build_scenario(scenarios[name])
     run = run_descent(scn, args.method, args.seed)
-    s = summarize_run(run)
+    from opnav.core.tables import json_ready
     from opnav.landing.timing import replay_own
     from opnav.landing.timing_summary import median_us
 
     tm = replay_own(scn, run, args.method)       # planning time by replay of the run's calls
-    s["median_plan_time_us"] = median_us(tm, args.method)
-    s.update(method=args.method, seed=args.seed, scenario=name,
-             final_pos_err_m_xyz=[round(float(x), 4) for x in run.err_r[-1]],
-             final_vel_err_mps_xyz=[round(float(x), 5) for x in run.err_v[-1]],
-             final_rpy_err_deg=[round(float(x), 5) for x in run.err_rpy_deg[-1]])
+    # the edge: the run's summary as JSON keys, with its planning time and what was flown
+    s = {**json_ready(summarize_run(run), nan_as_none=False), "median_plan_time_us": median_us(tm, args.method),
+         "method": args.method, "seed": args.seed, "scenario": name,
+         "final_pos_err_m_xyz": [round(float(x), 4) for x in run.err_r[-1]],
+         "final_vel_err_mps_xyz": [round(float(x), 5) for x in run.err_v[-1]],
+         "final_rpy_err_deg": [round(float(x), 5) for x in run.err_rpy_deg[-1]]}
     print_json(s, indent=2, sort_keys=True)
     return 0
 

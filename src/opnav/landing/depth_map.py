@@ -14,6 +14,7 @@ in-plane optimum with its ground point. Units: m, deg (outputs), s.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,10 +24,48 @@ from opnav.landing.planning.reference import depth_error_at_landmarks, signed_de
 from opnav.landing.planner import golden_section, visible_intervals
 from opnav.landing.scenario import Scenario
 
-__all__ = ["depth_map"]
+__all__ = ["depth_map", "DepthMap"]
 
 
-def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
+@dataclass(frozen=True, eq=False)
+class DepthMap:
+    """B-F5's data at one filter time ``time_s`` (:func:`depth_map`; m, deg, px). In the image:
+    each detected landmark's pixel ``uv_px``, depth error ``dr_m`` and ground point ``points``,
+    the best one's index ``best``, the detector's half size ``half_px``, the in-plane curve
+    (``beta_deg``, ``curve_dr``), the visible intervals and the golden-section optimum (``opt_*``)
+    with its pixel and ground point, the error ball ``r_e_m`` and the detected count. Over the
+    field: every landmark's ground point and depth error, the best one, the unconstrained in-plane
+    optimum with its ground point, the lander's ground point, the image footprint and whether the
+    unconstrained optimum lies in the image."""
+
+    time_s: float
+    uv_px: np.ndarray
+    dr_m: np.ndarray
+    best: int
+    points: np.ndarray
+    half_px: float
+    beta_deg: np.ndarray
+    curve_dr: np.ndarray
+    interval_deg: list[tuple[float, float]]
+    opt_beta_deg: float
+    opt_dr: float
+    opt_uv_px: np.ndarray
+    opt_ground_xy: np.ndarray
+    r_e_m: float
+    n_visible: int
+    field_xy: np.ndarray
+    field_dr: np.ndarray
+    field_best_xy: np.ndarray
+    field_best_dr: float
+    unconstrained_beta_deg: float
+    unconstrained_dr: float
+    unconstrained_ground_xy: np.ndarray
+    lander_xy: np.ndarray
+    footprint_xy: np.ndarray
+    optimum_inside_image: bool
+
+
+def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> DepthMap:
     """B-F5 data: the depth estimation error of every landmark in the image at
     ``time_s`` (truth state; error ball from the Table 2 velocity bound,
     ``eps_v = n_sigma_v * bound_v / sqrt(3)``), the single optimum, and the
@@ -82,15 +121,15 @@ def depth_map(scn: Scenario, time_s: float, n_curve: int = 721) -> dict:
     with np.errstate(divide="ignore", invalid="ignore"):
         tcut = np.where(rays[:, 2] < 0, -r[2] / rays[:, 2], np.nan)
     footprint = (r + tcut[:, None] * rays)[:, :2]
-    return {"time_s": k * scn.Dt, "uv_px": uv, "dr_m": dr, "best": best, "points": pts,
-            "half_px": cam.half_px, "beta_deg": np.degrees(betas), "curve_dr": curve,
-            "interval_deg": [(math.degrees(lo), math.degrees(hi)) for lo, hi in ivs],
-            "opt_beta_deg": math.degrees(best_b), "opt_dr": best_f, "opt_uv_px": opt_uv,
-            "opt_ground_xy": opt_xy, "r_e_m": r_e, "n_visible": int(vis.sum()),
-            "field_xy": scn.field.xyz[fin, :2], "field_dr": dr_all[fin],
-            "field_best_xy": scn.field.xyz[best_all, :2], "field_best_dr": float(dr_all[best_all]),
-            "unconstrained_beta_deg": math.degrees(unc_b), "unconstrained_dr": float(unc_f),
-            "unconstrained_ground_xy": ground_points(unc_b, geom)[0, :2],
-            "lander_xy": r[:2].copy(), "footprint_xy": footprint,
-            "optimum_inside_image": bool(any(lo < unc_b < hi for lo, hi in
-                                             visible_intervals(geom, R, cam, 0.0)))}
+    return DepthMap(time_s=k * scn.Dt, uv_px=uv, dr_m=dr, best=best, points=pts,
+                    half_px=cam.half_px, beta_deg=np.degrees(betas), curve_dr=curve,
+                    interval_deg=[(math.degrees(lo), math.degrees(hi)) for lo, hi in ivs],
+                    opt_beta_deg=math.degrees(best_b), opt_dr=best_f, opt_uv_px=opt_uv,
+                    opt_ground_xy=opt_xy, r_e_m=r_e, n_visible=int(vis.sum()),
+                    field_xy=scn.field.xyz[fin, :2], field_dr=dr_all[fin],
+                    field_best_xy=scn.field.xyz[best_all, :2], field_best_dr=float(dr_all[best_all]),
+                    unconstrained_beta_deg=math.degrees(unc_b), unconstrained_dr=float(unc_f),
+                    unconstrained_ground_xy=ground_points(unc_b, geom)[0, :2],
+                    lander_xy=r[:2].copy(), footprint_xy=footprint,
+                    optimum_inside_image=bool(any(lo < unc_b < hi for lo, hi in
+                                                  visible_intervals(geom, R, cam, 0.0))))

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from typing import TYPE_CHECKING
@@ -49,7 +49,8 @@ from opnav.landing.setup import Setup
 __all__ = ["yaw_convergence", "YawConvergence", "run_chunk", "stack_runs", "summarize_run", "last_update_index", "save", "load", "gather", "per_run_stats",
            "chunks", "chunk_label", "chunk_runs", "earlier_chunks", "run_chunk_reusing", "CHUNK_PATTERN",
            "same_pick_pct", "pick_quality", "first_runs", "end_phase", "landmark_phase", "phase_rms", "time_below",
-           "nees_band", "nees_consistency", "NeesConsistency", "MonteCarlo", "Descent"]
+           "nees_band", "nees_consistency", "NeesConsistency", "RunSummary",
+           "EndPhase", "PickQuality", "MonteCarlo", "Descent"]
 
 
 def chunks(n_runs: int, runs_per_job: int) -> list[list[int]]:
@@ -162,19 +163,29 @@ def stack_runs(run_indices, runs: list[Descent], t: np.ndarray) -> MonteCarlo:
     return MonteCarlo.of_runs(run_indices, runs, t)
 
 
-def summarize_run(run: Descent, run_index: int = 0) -> dict:
+@dataclass(frozen=True)
+class RunSummary:
+    """One run in numbers (:func:`summarize_run`): its :func:`per_run_stats` row by column
+    (``stats``: final, last-vision and RMS error norms, mean NEES, landmarks used; written as the
+    summary's own keys), the final yaw error (deg), the planning calls and their median
+    evaluation count."""
+
+    stats: dict[str, float] = field(metadata={"json_flatten": True})
+    final_yaw_err_deg: float
+    n_plans: int
+    median_plan_evals: float
+
+
+def summarize_run(run: Descent, run_index: int = 0) -> RunSummary:
     """One run of :func:`opnav.landing.descent.run_descent`: its
     :func:`per_run_stats` row (final, last-vision and RMS error norms, mean
     NEES, landmarks used) plus the final yaw error (deg), the number of
     planning calls and their median evaluation count (planning time: replay
     the run's calls, ``opnav.landing.timing.replay_own``)."""
     data = MonteCarlo.of_descent(run, run_index)
-    out = {k: (int(v) if k == "n_landmarks" else float(v))
-           for k, v in per_run_stats(data).iloc[0].items()}
-    out["final_yaw_err_deg"] = float(run.err_rpy_deg[-1, 2])
-    out["n_plans"] = int(len(run.plan_t))
-    out["median_plan_evals"] = float(np.median(run.plan_evals)) if len(run.plan_evals) else math.nan
-    return out
+    stats = {k: (int(v) if k == "n_landmarks" else float(v)) for k, v in per_run_stats(data).iloc[0].items()}
+    return RunSummary(stats, float(run.err_rpy_deg[-1, 2]), int(len(run.plan_t)),
+                      float(np.median(run.plan_evals)) if len(run.plan_evals) else math.nan)
 
 
 def save(path, data: MonteCarlo, method: str) -> None:
@@ -336,7 +347,33 @@ def last_update_index(updated: np.ndarray):
     return int(out) if u.ndim == 1 else out
 
 
-def end_phase(data: MonteCarlo, alt_true_m: np.ndarray, margin_m: float, ground_m: float = 1.0) -> dict:
+@dataclass(frozen=True)
+class EndPhase:
+    """The end of the descent over the runs (:func:`end_phase`; s, m; None: no run has one): the
+    runs, the ground and margin altitudes, per kind of update (the last landmark update,
+    ``last_lm``; the last vision update, ``last_vis``) its time's median, minimum and maximum and
+    the runs that have one, the median gap between the two, the runs updating below the ground
+    altitude and below the margin, and the lowest true altitude of a vision update. Fields in
+    B-T3 end-phase's column order."""
+
+    n_runs: int
+    ground_m: float
+    margin_m: float
+    last_lm_t_s_median: float | None
+    last_lm_t_s_min: float | None
+    last_lm_t_s_max: float | None
+    last_lm_runs: int
+    last_vis_t_s_median: float | None
+    last_vis_t_s_min: float | None
+    last_vis_t_s_max: float | None
+    last_vis_runs: int
+    vision_after_last_lm_s_median: float | None
+    runs_vision_below_ground_m: int
+    runs_vision_below_margin: int
+    min_true_alt_vision_m: float | None
+
+
+def end_phase(data: MonteCarlo, alt_true_m: np.ndarray, margin_m: float, ground_m: float = 1.0) -> EndPhase:
     """The end of the descent counted from the per-step records of ``data`` (gathered
     Monte Carlo: ``t`` (s), ``updated`` and ``lm_updated`` (runs, times)) and the true
     altitude at each filter time ``alt_true_m`` (m; the truth is the same in every run):
@@ -352,38 +389,43 @@ def end_phase(data: MonteCarlo, alt_true_m: np.ndarray, margin_m: float, ground_
     upd, lm = np.asarray(data.updated, bool), np.asarray(data.lm_updated, bool)
     if z.shape != t.shape or upd.shape[-1] != t.size:
         raise ValueError(f"end_phase: {t.size} filter times, {z.size} true altitudes, {upd.shape[-1]} records")
-    out = {"n_runs": int(upd.shape[0]), "ground_m": float(ground_m), "margin_m": float(margin_m)}
-    last = {}
-    for key, u in (("last_lm_t_s", lm), ("last_vis_t_s", upd)):
+    last, per = [], []
+    for u in (lm, upd):
         tl = np.where(u.any(axis=1), t[last_update_index(u)], np.nan)
-        last[key] = tl
+        last.append(tl)
         ok = np.isfinite(tl)
-        out[f"{key}_median"] = float(np.median(tl[ok])) if ok.any() else None
-        out[f"{key}_min"] = float(tl[ok].min()) if ok.any() else None
-        out[f"{key}_max"] = float(tl[ok].max()) if ok.any() else None
-        out[f"{key.split('_t_')[0]}_runs"] = int(ok.sum())
-    gap = last["last_vis_t_s"] - last["last_lm_t_s"]
-    out["vision_after_last_lm_s_median"] = float(np.nanmedian(gap)) if np.isfinite(gap).any() else None
-    out["runs_vision_below_ground_m"] = int((upd & (z < ground_m)[None, :]).any(axis=1).sum())
-    out["runs_vision_below_margin"] = int((upd & (z < margin_m)[None, :]).any(axis=1).sum())
+        per += ([float(np.median(tl[ok])), float(tl[ok].min()), float(tl[ok].max())] if ok.any() else [None] * 3)
+        per.append(int(ok.sum()))
+    gap = last[1] - last[0]
     zu = np.where(upd, z[None, :], np.inf)
-    out["min_true_alt_vision_m"] = float(zu.min()) if upd.any() else None
-    return out
+    return EndPhase(int(upd.shape[0]), float(ground_m), float(margin_m), *per,
+                    vision_after_last_lm_s_median=float(np.nanmedian(gap)) if np.isfinite(gap).any() else None,
+                    runs_vision_below_ground_m=int((upd & (z < ground_m)[None, :]).any(axis=1).sum()),
+                    runs_vision_below_margin=int((upd & (z < margin_m)[None, :]).any(axis=1).sum()),
+                    min_true_alt_vision_m=float(zu.min()) if upd.any() else None)
 
 
-def pick_quality(d: MonteCarlo) -> dict:
+@dataclass(frozen=True)
+class PickQuality:
+    """A method's picks (:func:`pick_quality`): the share of calls on the edge of the visible
+    interval (%) and the median / max over calls of the picked landmark's metric over the best
+    detected one's (1 = best); NaN where not recorded."""
+
+    edge_calls_pct: float = math.nan
+    pick_ratio_median: float = math.nan
+    pick_ratio_max: float = math.nan
+
+
+def pick_quality(d: MonteCarlo) -> PickQuality:
     """Per method: share of planning calls whose in-plane optimum fell on an end
     of the visible interval (edge rule, %), and the median / max over calls of
     the picked landmark's metric over the best detected landmark's (1 = best)."""
-    out = {"edge_calls_pct": math.nan, "pick_ratio_median": math.nan, "pick_ratio_max": math.nan}
-    if d.plan_edge is not None and len(d.plan_edge):
-        out["edge_calls_pct"] = float(100.0 * np.mean(d.plan_edge))
+    edge = float(100.0 * np.mean(d.plan_edge)) if d.plan_edge is not None and len(d.plan_edge) else math.nan
     r = np.asarray(d.plan_ratio if d.plan_ratio is not None else [], float)
     r = r[np.isfinite(r)]
     if r.size:
-        out["pick_ratio_median"] = float(np.median(r))
-        out["pick_ratio_max"] = float(r.max())
-    return out
+        return PickQuality(edge, float(np.median(r)), float(r.max()))
+    return PickQuality(edge)
 
 
 def same_pick_pct(a: MonteCarlo, b: MonteCarlo) -> float:

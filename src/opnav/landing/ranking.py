@@ -28,6 +28,7 @@ All functions are pure (no I/O).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -38,9 +39,91 @@ from scipy import special
 from opnav.landing.montecarlo import MonteCarlo, per_run_stats, same_pick_pct
 from opnav.landing.records import Replay
 
+from opnav.core.tables import JSON_SKIP, OMIT_NONE
+
 __all__ = ["paired_t_interval", "bootstrap_mean_interval", "paired_difference",
            "competition_rank", "ranking_table", "headline", "median_abs_dbeta_deg",
-           "pair_comparison", "pair_table"]
+           "pair_comparison", "pair_table", "PairedDifference", "ErrorDifference", "PairComparison", "Headline"]
+
+
+@dataclass(frozen=True)
+class PairedDifference:
+    """A paired comparison of per-run values ``a - b`` (:func:`paired_difference`): the mean, its
+    paired-t interval and p-value, the bootstrap interval, the share of runs with ``a < b`` and with
+    ``a == b`` (%) and the runs."""
+
+    mean: float
+    t_lo: float
+    t_hi: float
+    p: float
+    boot_lo: float
+    boot_hi: float
+    a_lower_pct: float
+    equal_pct: float
+    n: int
+
+
+@dataclass(frozen=True)
+class ErrorDifference:
+    """One per-run error's paired difference ``a - b`` in a :class:`PairComparison` (m): mean, its
+    interval and p-value, and the same relative to b's mean (%)."""
+
+    m: float
+    lo_m: float
+    hi_m: float
+    p: float
+    rel_pct: float
+    rel_lo_pct: float
+    rel_hi_pct: float
+
+
+@dataclass(frozen=True)
+class PairComparison:
+    """What a comparison of two methods' accuracy rests on (:func:`pair_comparison`): the same-pick
+    rate (%), the median |delta beta*| (deg) and per error (``rms_pos``, ``final_pos``, ``lastlm_pos``,
+    ``lmrms_pos``: those the runs record) its :class:`ErrorDifference`."""
+
+    same_pick_pct: float
+    median_abs_dbeta_deg: float
+    diffs: dict[str, ErrorDifference]
+
+    def columns(self):
+        """The comparison as table columns, in order (``same_pick_pct``, ..., ``d_<error>_m``,
+        ``d_<error>_lo_m``, ...: B-T3's pairs, ``pair_table``)."""
+        yield "same_pick_pct", self.same_pick_pct
+        yield "median_abs_dbeta_deg", self.median_abs_dbeta_deg
+        for name, d in self.diffs.items():
+            yield from ((f"d_{name}_m", d.m), (f"d_{name}_lo_m", d.lo_m), (f"d_{name}_hi_m", d.hi_m),
+                        (f"d_{name}_p", d.p), (f"d_{name}_rel_pct", d.rel_pct),
+                        (f"d_{name}_rel_lo_pct", d.rel_lo_pct), (f"d_{name}_rel_hi_pct", d.rel_hi_pct))
+
+
+@dataclass(frozen=True)
+class Headline:
+    """The headline of a B-X1 ranking (:func:`headline`; B-X1-summary.json): the reference, each
+    method's table row by column (NaN as None), the orders by accuracy and by time, the methods of
+    accuracy rank 1 (and whether several tie), the fastest, the reference's ranks, methods and runs,
+    the methods the reference is shown more / less accurate than or not significantly different
+    from, those it is faster than, each searching method's median |beta*| (deg) and the bootstrap
+    resamples behind the intervals (set by the caller)."""
+
+    reference: str
+    methods: dict[str, dict]
+    ranking_by_accuracy: list[str]
+    ranking_by_time: list[str]
+    best_accuracy_methods: list[str]
+    best_accuracy_tie: bool
+    fastest_method: str
+    reference_rank_accuracy: int
+    reference_rank_time: int
+    n_methods: int
+    n_runs: int
+    reference_more_accurate_than: list[str]
+    reference_less_accurate_than: list[str]
+    not_significant_vs_reference: list[str]
+    reference_faster_than: list[str]
+    median_abs_beta_deg: dict[str, float] = field(metadata=JSON_SKIP)   # for the words, not the document
+    n_boot: int | None = field(default=None, metadata=OMIT_NONE)
 
 
 def paired_t_interval(d, level: float = 0.95) -> tuple[float, float, float, float]:
@@ -82,7 +165,7 @@ def bootstrap_mean_interval(d, n_boot: int = 2000, seed: int = 0, level: float =
     return float(lo), float(hi)
 
 
-def paired_difference(a, b, n_boot: int = 2000, seed: int = 0, level: float = 0.95) -> dict:
+def paired_difference(a, b, n_boot: int = 2000, seed: int = 0, level: float = 0.95) -> PairedDifference:
     """Paired comparison of per-run values ``a`` and ``b`` (same runs, same
     order): ``mean`` of ``a - b``, paired-t ``t_lo``/``t_hi``/``p``, bootstrap
     ``boot_lo``/``boot_hi``, ``a_lower_pct`` (share of runs with ``a < b``,
@@ -94,12 +177,13 @@ def paired_difference(a, b, n_boot: int = 2000, seed: int = 0, level: float = 0.
     d = a - b
     m, lo, hi, p = paired_t_interval(d, level)
     blo, bhi = bootstrap_mean_interval(d, n_boot, seed, level)
-    return {"mean": m, "t_lo": lo, "t_hi": hi, "p": p, "boot_lo": blo, "boot_hi": bhi,
-            "a_lower_pct": float(100.0 * np.mean(a < b)),
-            "equal_pct": float(100.0 * np.mean(a == b)), "n": int(d.size)}
+    return PairedDifference(mean=m, t_lo=lo, t_hi=hi, p=p, boot_lo=blo, boot_hi=bhi,
+                            a_lower_pct=float(100.0 * np.mean(a < b)), equal_pct=float(100.0 * np.mean(a == b)),
+                            n=int(d.size))
 
 
-def _calls(d: MonteCarlo) -> dict:
+def _calls(d: MonteCarlo) -> dict[tuple[int, float], tuple[int, float]]:
+    """The planning calls of ``d`` by (run, filter time): (picked landmark, optimum beta (rad))."""
     beta = d.plan_beta if d.has("plan_beta") else np.full(len(d.plan_index), np.nan)
     return {(int(r), float(t)): (int(i), float(b)) for r, t, i, b in
             zip(d.plan_run, d.plan_t, d.plan_index, beta)}
@@ -114,7 +198,7 @@ def median_abs_dbeta_deg(a: MonteCarlo, b: MonteCarlo) -> float:
     return float(np.degrees(np.median(d))) if d else math.nan
 
 
-def pair_comparison(a: MonteCarlo, b: MonteCarlo, level: float = 0.95) -> dict:
+def pair_comparison(a: MonteCarlo, b: MonteCarlo, level: float = 0.95) -> PairComparison:
     """What a comparison of two methods' accuracy rests on (same paired runs):
     the share of planning calls where they chose the same landmark (%), the
     median |delta beta*| (deg), and the paired difference a - b of the per-run
@@ -123,7 +207,7 @@ def pair_comparison(a: MonteCarlo, b: MonteCarlo, level: float = 0.95) -> dict:
     landmark update (``d_lastlm_pos``) and RMS over the landmark phase (``d_lmrms_pos``) where
     the runs record landmark updates."""
     sa, sb = per_run_stats(a), per_run_stats(b)
-    out = {"same_pick_pct": same_pick_pct(a, b), "median_abs_dbeta_deg": median_abs_dbeta_deg(a, b)}
+    diffs = {}
     for key, name in (("rms_pos_err_m", "rms_pos"), ("final_pos_err_m", "final_pos"),
                       ("lastlm_pos_err_m", "lastlm_pos"), ("lmrms_pos_err_m", "lmrms_pos")):
         if key not in sa or key not in sb:
@@ -133,16 +217,14 @@ def pair_comparison(a: MonteCarlo, b: MonteCarlo, level: float = 0.95) -> dict:
             raise ValueError("pair_comparison: the two methods must have flown the same runs")
         m, lo, hi, p = paired_t_interval(x - y, level)
         base = float(np.mean(y))
-        out.update({f"d_{name}_m": m, f"d_{name}_lo_m": lo, f"d_{name}_hi_m": hi, f"d_{name}_p": p,
-                    f"d_{name}_rel_pct": 100.0 * m / base,
-                    f"d_{name}_rel_lo_pct": 100.0 * lo / base, f"d_{name}_rel_hi_pct": 100.0 * hi / base})
-    return out
+        diffs[name] = ErrorDifference(m, lo, hi, p, 100.0 * m / base, 100.0 * lo / base, 100.0 * hi / base)
+    return PairComparison(same_pick_pct(a, b), median_abs_dbeta_deg(a, b), diffs)
 
 
 def pair_table(data: dict[str, MonteCarlo], level: float = 0.95) -> pd.DataFrame:
     """:func:`pair_comparison` for every unordered pair of methods (in order)."""
     names = list(data)
-    rows = [{"method_a": a, "method_b": b, **pair_comparison(data[a], data[b], level)}
+    rows = [{"method_a": a, "method_b": b, **dict(pair_comparison(data[a], data[b], level).columns())}
             for i, a in enumerate(names) for b in names[i + 1:]]
     return pd.DataFrame(rows)
 
@@ -244,10 +326,10 @@ def ranking_table(data: dict[str, MonteCarlo], timing: Replay, reference: str = 
             pdiff = paired_difference(s[key].to_numpy(), st[reference][key].to_numpy(),
                                       n_boot=n_boot, seed=seed, level=level)
             for k in ("mean", "t_lo", "t_hi", "boot_lo", "boot_hi", "p"):
-                row[f"d_{name}_vs_ref_{k}"] = pdiff[k]
+                row[f"d_{name}_vs_ref_{k}"] = getattr(pdiff, k)
             if name == rank_by:
-                row["ref_better_pct"] = 100.0 - pdiff["a_lower_pct"] - pdiff["equal_pct"]
-                row["equal_to_ref_pct"] = pdiff["equal_pct"]
+                row["ref_better_pct"] = 100.0 - pdiff.a_lower_pct - pdiff.equal_pct
+                row["equal_to_ref_pct"] = pdiff.equal_pct
         row["same_pick_as_ref_pct"] = (100.0 if m == reference
                                        else same_pick_pct(d, data[reference]))
         row["median_abs_dbeta_vs_ref_deg"] = (0.0 if m == reference
@@ -269,8 +351,9 @@ def ranking_table(data: dict[str, MonteCarlo], timing: Replay, reference: str = 
     return df.sort_values(["rank_accuracy", "method"], kind="stable").reset_index(drop=True)
 
 
-def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
-    """Headline numbers of a :func:`ranking_table` for the manuscript macros."""
+def headline(df: pd.DataFrame, reference: str = "depth") -> Headline:
+    """Headline numbers of a :func:`ranking_table` for the manuscript macros (their lists in words:
+    ``opnav.report.landing.ranking_text.worded_headline``)."""
     def clean(x):
         if isinstance(x, (float, np.floating)):
             return None if math.isnan(float(x)) else float(x)
@@ -285,32 +368,24 @@ def headline(df: pd.DataFrame, reference: str = "depth") -> dict:
     # change from build to build)
     by_acc = list(t.reset_index().sort_values(["rank_accuracy", "method"], kind="stable")["method"])
     by_time = list(t.reset_index().sort_values(["rank_time", "method"], kind="stable")["method"])
-    out = {
-        "reference": reference,
-        "methods": {m: {k: clean(v) for k, v in t.loc[m].items()} for m in t.index},
-        "ranking_by_accuracy": by_acc,
-        "ranking_by_time": by_time,
-        # ties are ties: every method of rank 1, never one chosen by its name
-        "best_accuracy_methods": [m for m in by_acc if int(t.loc[m, "rank_accuracy"]) == 1],
-        "best_accuracy_tie": sum(int(t.loc[m, "rank_accuracy"]) == 1 for m in by_acc) > 1,
-        "best_accuracy_method": " = ".join(m for m in by_acc if int(t.loc[m, "rank_accuracy"]) == 1),
-
-        "fastest_method": by_time[0],
-        "reference_rank_accuracy": int(ref["rank_accuracy"]),
-        "reference_rank_time": int(ref["rank_time"]),
-        "n_methods": int(len(t)),
-        "n_runs": int(ref["n_runs"]),
-        "reference_more_accurate_than": [m for m in others if t.loc[m, "vs_ref"] == "worse"],
-        "reference_less_accurate_than": [m for m in others if t.loc[m, "vs_ref"] == "better"],
-        "not_significant_vs_reference": [m for m in others if t.loc[m, "vs_ref"] == "not significant"],
-        "reference_faster_than": [m for m in others
-                                  if t.loc[m, "median_plan_cpu_us"] > ref["median_plan_cpu_us"]],
-    }
-    for k in ("ranking_by_accuracy", "ranking_by_time", "reference_more_accurate_than",
-              "reference_less_accurate_than", "not_significant_vs_reference", "reference_faster_than"):
-        out[f"{k}_text"] = ", ".join(out[k]) if out[k] else "none"
     # the optimum's median angle to the estimated velocity (0: no parallax), methods that search
-    beta = [(m, float(t.loc[m, "median_abs_beta_deg"])) for m in by_acc if "median_abs_beta_deg" in t
-            and math.isfinite(float(t.loc[m, "median_abs_beta_deg"]))]
-    out["median_abs_beta_text"] = ", ".join(f"{m} {v:.3g} deg" for m, v in beta) if beta else "none"
-    return out
+    beta = {m: float(t.loc[m, "median_abs_beta_deg"]) for m in by_acc if "median_abs_beta_deg" in t
+            and math.isfinite(float(t.loc[m, "median_abs_beta_deg"]))}
+    return Headline(
+        reference=reference,
+        methods={m: {k: clean(v) for k, v in t.loc[m].items()} for m in t.index},
+        ranking_by_accuracy=by_acc,
+        ranking_by_time=by_time,
+        # ties are ties: every method of rank 1, never one chosen by its name
+        best_accuracy_methods=[m for m in by_acc if int(t.loc[m, "rank_accuracy"]) == 1],
+        best_accuracy_tie=sum(int(t.loc[m, "rank_accuracy"]) == 1 for m in by_acc) > 1,
+        fastest_method=by_time[0],
+        reference_rank_accuracy=int(ref["rank_accuracy"]),
+        reference_rank_time=int(ref["rank_time"]),
+        n_methods=int(len(t)),
+        n_runs=int(ref["n_runs"]),
+        reference_more_accurate_than=[m for m in others if t.loc[m, "vs_ref"] == "worse"],
+        reference_less_accurate_than=[m for m in others if t.loc[m, "vs_ref"] == "better"],
+        not_significant_vs_reference=[m for m in others if t.loc[m, "vs_ref"] == "not significant"],
+        reference_faster_than=[m for m in others if t.loc[m, "median_plan_cpu_us"] > ref["median_plan_cpu_us"]],
+        median_abs_beta_deg=beta)

@@ -66,22 +66,22 @@ def fig_depth_error_map(dm: dict):
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
 
-    uv_px, dr_m, best_idx, half_px = dm["uv_px"], dm["dr_m"], dm["best"], dm["half_px"]
+    uv_px, dr_m, best_idx, half_px = dm.uv_px, dm.dr_m, dm.best, dm.half_px
     with figures.style():
         fig, axs = plt.subplots(1, 3, figsize=(figures.PAGE_WIDTH_IN, 3.4), constrained_layout=True,
                                 gridspec_kw={"width_ratios": [1.1, 1.1, 1]})
         fin = np.isfinite(dr_m)
-        lo_c = float(min(np.nanmin(dr_m[fin]), dm["field_best_dr"]))
+        lo_c = float(min(np.nanmin(dr_m[fin]), dm.field_best_dr))
         norm = LogNorm(vmin=lo_c, vmax=float(np.nanpercentile(dr_m[fin], 99)))
         ax = axs[0]
         sc = ax.scatter(uv_px[fin, 0], uv_px[fin, 1], c=dr_m[fin], s=3, cmap="viridis", norm=norm,
                         rasterized=True)
         ax.plot(*uv_px[best_idx], marker="*", ms=12, mfc="red", mec="k", ls="none", zorder=5,
                 clip_on=False, label=f"best detected ({dr_m[best_idx]:.0f} m)")
-        opt_uv = dm.get("opt_uv_px")
+        opt_uv = dm.opt_uv_px
         if opt_uv is not None and np.all(np.isfinite(opt_uv)):
             ax.plot(*opt_uv, marker="+", ms=12, mew=2.0, color="red", ls="none", zorder=5,
-                    clip_on=False, label=f"golden section ({dm['opt_dr']:.0f} m)")
+                    clip_on=False, label=f"golden section ({dm.opt_dr:.0f} m)")
         ax.plot([-half_px, half_px, half_px, -half_px, -half_px],
                 [-half_px, -half_px, half_px, half_px, -half_px], color="k", lw=0.6)
         ax.set_xlim(-1.06 * half_px, 1.06 * half_px)
@@ -91,19 +91,19 @@ def fig_depth_error_map(dm: dict):
         ax.set_ylabel("image v (px)")
         ax.set_title("(a) detected landmarks", fontsize="small")
         ax = axs[1]
-        fx, fd = dm["field_xy"], dm["field_dr"]
+        fx, fd = dm.field_xy, dm.field_dr
         ax.scatter(fx[:, 0] / 1e3, fx[:, 1] / 1e3, c=fd, s=1, cmap="viridis", norm=norm,
                    rasterized=True)
-        fp = np.vstack([dm["footprint_xy"], dm["footprint_xy"][:1]]) / 1e3
+        fp = np.vstack([dm.footprint_xy, dm.footprint_xy[:1]]) / 1e3
         ax.plot(fp[:, 0], fp[:, 1], color="k", lw=0.8, label="image footprint")
-        lx, ly = dm["lander_xy"] / 1e3
+        lx, ly = dm.lander_xy / 1e3
         ax.plot(lx, ly, marker="^", color="k", ls="none", ms=6, label="lander (nadir)")
-        ax.plot(*(dm["field_best_xy"] / 1e3), marker="*", ms=12, mfc="orange", mec="k", ls="none",
-                zorder=5, label=f"best in field ({dm['field_best_dr']:.0f} m)")
-        ug = dm["unconstrained_ground_xy"] / 1e3
+        ax.plot(*(dm.field_best_xy / 1e3), marker="*", ms=12, mfc="orange", mec="k", ls="none",
+                zorder=5, label=f"best in field ({dm.field_best_dr:.0f} m)")
+        ug = dm.unconstrained_ground_xy / 1e3
         ax.plot(*ug, marker="x", ms=9, mew=2.0, color="orange", ls="none", zorder=5,
-                label=f"unconstrained in-plane opt. ({dm['unconstrained_dr']:.0f} m)")
-        og = dm.get("opt_ground_xy")
+                label=f"unconstrained in-plane opt. ({dm.unconstrained_dr:.0f} m)")
+        og = dm.opt_ground_xy
         if og is not None and np.all(np.isfinite(og)):
             ax.plot([lx, og[0] / 1e3], [ly, og[1] / 1e3], color="red", lw=1.0, ls="--",
                     label="golden-section direction")
@@ -123,14 +123,14 @@ def fig_depth_error_map(dm: dict):
         cb.set_ticks(ticks, labels=[figures.plain_number(x) for x in ticks])
         cb.ax.minorticks_off()
         ax = axs[2]
-        ax.semilogy(dm["beta_deg"], dm["curve_dr"], color="C0")
+        ax.semilogy(dm.beta_deg, dm.curve_dr, color="C0")
         figures.plain_log_labels(ax.yaxis)
-        for lo, hi in dm["interval_deg"]:
+        for lo, hi in dm.interval_deg:
             ax.axvspan(lo, hi, color="0.9", zorder=0)
-        ax.axvline(dm["opt_beta_deg"], color="red", ls="--", lw=0.8,
-                   label=rf"golden section $\beta$ = {dm['opt_beta_deg']:.1f}°")
-        ax.axvline(dm["unconstrained_beta_deg"], color="orange", ls=":", lw=1.0,
-                   label=rf"unconstrained $\beta$ = {dm['unconstrained_beta_deg']:.1f}°")
+        ax.axvline(dm.opt_beta_deg, color="red", ls="--", lw=0.8,
+                   label=rf"golden section $\beta$ = {dm.opt_beta_deg:.1f}°")
+        ax.axvline(dm.unconstrained_beta_deg, color="orange", ls=":", lw=1.0,
+                   label=rf"unconstrained $\beta$ = {dm.unconstrained_beta_deg:.1f}°")
         ax.set_xlabel(r"signed $\beta$ (deg)")
         ax.set_ylabel("in-plane depth error (m)")
         ax.set_title("(c) velocity's plane (grey: visible)", fontsize="small")

@@ -116,19 +116,21 @@ def summary_table(data: dict[str, MonteCarlo], timing: "Replay", published_reduc
         ev = data[m].plan_evals
         row["metric_evals_per_call"] = float(np.median(ev)) if len(ev) else math.nan
         row["plan_calls"] = int(len(ev))
-        row.update(pick_quality(data[m]))
+        pq = pick_quality(data[m])
+        row.update(edge_calls_pct=pq.edge_calls_pct, pick_ratio_median=pq.pick_ratio_median,
+                   pick_ratio_max=pq.pick_ratio_max)
         if m != methods[0]:
             row[f"same_pick_as_{methods[0]}_pct"] = same_pick_pct(data[m], data[methods[0]])
         for b in methods:
             if b == m:
                 continue
             pc = pair_comparison(data[m], data[b])
-            row[f"same_pick_vs_{b}_pct"] = pc["same_pick_pct"]
-            row[f"median_abs_dbeta_vs_{b}_deg"] = pc["median_abs_dbeta_deg"]
-            for k in ("d_rms_pos", "d_final_pos"):
-                row[f"{k}_vs_{b}_m"] = pc[f"{k}_m"]
-                row[f"{k}_vs_{b}_lo_m"] = pc[f"{k}_lo_m"]
-                row[f"{k}_vs_{b}_hi_m"] = pc[f"{k}_hi_m"]
+            row[f"same_pick_vs_{b}_pct"] = pc.same_pick_pct
+            row[f"median_abs_dbeta_vs_{b}_deg"] = pc.median_abs_dbeta_deg
+            for k in ("rms_pos", "final_pos"):
+                row[f"d_{k}_vs_{b}_m"] = pc.diffs[k].m
+                row[f"d_{k}_vs_{b}_lo_m"] = pc.diffs[k].lo_m
+                row[f"d_{k}_vs_{b}_hi_m"] = pc.diffs[k].hi_m
             red, sd = tsum.time_reduction(timing, m, b)
             row[f"time_reduction_vs_{b}_pct"] = red
             row[f"time_reduction_vs_{b}_pct_std"] = sd
@@ -434,7 +436,10 @@ def end_phase_table(data: dict[str, dict], alt_true_m: np.ndarray, margin_m: flo
 
     from opnav.landing.montecarlo import end_phase
 
-    return pd.DataFrame([{"method": m, **end_phase(d, alt_true_m, margin_m, ground_m)} for m, d in data.items()])
+    import dataclasses
+
+    return pd.DataFrame([{"method": m, **dataclasses.asdict(end_phase(d, alt_true_m, margin_m, ground_m))}
+                         for m, d in data.items()])
 
 
 def _fmt(x, f="{:.0f}") -> str:
