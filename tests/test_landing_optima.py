@@ -33,7 +33,13 @@ def test_a_curve_with_k_dips_has_k_minima(k, depth):
 
 
 def test_summary_counts_calls_with_a_second_minimum():
-    s = optima.count_summary({"per_call": [[1, 1], [1], [2, 1], [1, 3]], "skipped": 2, "n_recorded": 6,
-                              "n_grid": 181}, "interior")
-    assert s["calls_multi_minimum"] == 2 and s["n_calls"] == 4 and s["max_minima_per_call"] == 3
-    assert "2 of 4 planning calls" in s["text"]
+    from opnav.core.tables import json_ready
+    from opnav.report.landing.equivalence_text import Worded
+    from opnav.report.landing.optima_text import optima_text
+
+    s = optima.count_summary(optima.OptimaCounts([[1, 1], [1], [2, 1], [1, 3]], 2, 6, 181), "interior")
+    assert s.calls_multi_minimum == 2 and s.n_calls == 4 and s.max_minima_per_call == 3
+    assert "2 of 4 planning calls" in optima_text(s)
+    doc = json_ready(Worded(s, optima_text(s)))        # optima/<camera>.json: the count's keys and its sentence
+    assert set(doc) == {"scenario", "method", "n_calls", "calls_multi_minimum", "max_minima_per_call",
+                        "sides_counted", "calls_skipped", "n_recorded", "n_grid", "text"}

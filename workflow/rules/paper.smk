@@ -50,7 +50,7 @@ rule landing_optima:
     input:
         mc=lambda wc: b_mc(wc.bscn, ["depth"])[0],
         plan=src("data/analysis_plan.yaml")[0],
-        code=B_SRC + src("landing/optima.py"),
+        code=B_SRC + src("landing/optima.py", "report/landing/optima_text.py", "report/landing/equivalence_text.py"),
     output:
         f"{LANDING}/optima/{{bscn}}.json",
     wildcard_constraints:

@@ -14,6 +14,8 @@ from opnav.landing import optima
 from opnav.landing.descent import build_scenario
 from opnav.landing.montecarlo import load
 from opnav.landing.setup import Setup
+from opnav.report.landing.equivalence_text import Worded
+from opnav.report.landing.optima_text import optima_text
 
 if "snakemake" not in globals():  # by hand, as the real job (workflow/scripts/README.md)
     snakemake = mock_snakemake("landing_optima", argv=sys.argv[1:], bscn="site-tilt")
@@ -23,5 +25,6 @@ with script_context(snakemake) as log:
     counts = optima.count_calls(scn, load(snakemake.input.mc), int(snakemake.params.n_grid),
                                 int(snakemake.params.max_calls))
     out = optima.count_summary(counts, snakemake.wildcards.bscn)
-    write_json(snakemake.output[0], out)
-    log.info("%s", out["text"])
+    text = optima_text(out)
+    write_json(snakemake.output[0], Worded(out, text))     # the count's keys and its sentence
+    log.info("%s", text)

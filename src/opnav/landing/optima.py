@@ -18,8 +18,7 @@ relative ``1e-12`` are not minima (a flat run is one minimum at most). Units: ra
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -85,7 +84,37 @@ def call_minima(state, cfg, camera, n_grid: int) -> list[int] | None:
     return out
 
 
-def count_calls(scn, data: MonteCarlo, n_grid: int, max_calls: int = 0) -> dict:
+@dataclass(frozen=True)
+class OptimaCounts:
+    """The minima of every counted call (:func:`count_calls`): per call the minima on each side of
+    the velocity, the calls left out (no plane or baseline), the calls recorded and the angles a
+    side."""
+
+    per_call: list[list[int]]
+    skipped: int
+    n_recorded: int
+    n_grid: int
+
+
+@dataclass(frozen=True)
+class OptimaSummary:
+    """B-C8's count of one scenario (:func:`count_summary`; ``optima/<camera>.json``): calls
+    counted, calls with more than one local minimum on a side, the most minima on a side of one
+    call, the sides counted, the calls left out and recorded, and the angles a side. Its sentence is
+    the report layer's (``opnav.report.landing.optima_text``)."""
+
+    scenario: str
+    method: str
+    n_calls: int
+    calls_multi_minimum: int
+    max_minima_per_call: int
+    sides_counted: int
+    calls_skipped: int
+    n_recorded: int
+    n_grid: int
+
+
+def count_calls(scn, data: MonteCarlo, n_grid: int, max_calls: int = 0) -> OptimaCounts:
     """Every recorded planning call of one Monte Carlo (``data``: the gathered record of the
     depth method, ``montecarlo.gather``) in scenario ``scn`` (``descent.build_scenario``):
     per call the minima on each side. ``max_calls``: at most that many calls, evenly spaced
@@ -103,19 +132,16 @@ def count_calls(scn, data: MonteCarlo, n_grid: int, max_calls: int = 0) -> dict:
             skipped += 1
             continue
         per_call.append(m)
-    return {"per_call": per_call, "skipped": skipped, "n_recorded": int(n), "n_grid": int(n_grid)}
+    return OptimaCounts(per_call, skipped, int(n), int(n_grid))
 
 
-def count_summary(counts: Mapping[str, Any], scenario: str, method: str = "depth") -> dict:
+def count_summary(counts: OptimaCounts, scenario: str, method: str = "depth") -> OptimaSummary:
     """The optima count of one scenario for the summary and the claims: calls counted, calls
     with more than one local minimum on a side (``calls_multi_minimum``), the most minima on a
     side of one call, the sides counted and the calls left out (no plane or baseline)."""
-    per = counts["per_call"]
-    multi = sum(1 for m in per if max(m) > 1)
-    return {"scenario": scenario, "method": method, "n_calls": len(per), "calls_multi_minimum": int(multi),
-            "max_minima_per_call": int(max((max(m) for m in per), default=0)),
-            "sides_counted": int(sum(len(m) for m in per)), "calls_skipped": int(counts["skipped"]),
-            "n_recorded": int(counts["n_recorded"]), "n_grid": int(counts["n_grid"]),
-            "text": (f"{scenario} camera: {multi} of {len(per)} planning calls ({method}) show more than one "
-                     f"local minimum of the depth error on a side of the velocity ({counts['n_grid']} angles a "
-                     f"side; {counts['skipped']} calls without a plane or baseline left out)")}
+    per = counts.per_call
+    return OptimaSummary(scenario=scenario, method=method, n_calls=len(per),
+                         calls_multi_minimum=int(sum(1 for m in per if max(m) > 1)),
+                         max_minima_per_call=int(max((max(m) for m in per), default=0)),
+                         sides_counted=int(sum(len(m) for m in per)), calls_skipped=int(counts.skipped),
+                         n_recorded=int(counts.n_recorded), n_grid=int(counts.n_grid))
