@@ -124,23 +124,23 @@ def test_batch_least_squares_reaches_the_bound_of_its_data(scored):
     that data (the bound counts the small process noise the estimator ignores: within 3 %), and
     its errors are of that size."""
     for r in scored:
-        e = r["estimators"]["batch_ls"]
-        sig, b = e["sigma_seg_arcsec"][:, :, :2], r["bound_seg_arcsec"][None, :, :2]
+        e = r.estimators["batch_ls"]
+        sig, b = e.sigma_seg_arcsec[:, :, :2], r.bound_seg_arcsec[None, :, :2]
         np.testing.assert_allclose(sig, np.broadcast_to(b, sig.shape), rtol=0.03)
-        err = e["theta_final_arcsec"][:, :2] - r["truth_arcsec"][:2]
-        assert np.all(np.abs(err) < 4 * r["bound_seg_arcsec"][-1, :2])
-        assert e["runtime_s_per_call"] > 0 and np.all(e["nav_err_after_km"] > 0)
+        err = e.theta_final_arcsec[:, :2] - r.truth_arcsec[:2]
+        assert np.all(np.abs(err) < 4 * r.bound_seg_arcsec[-1, :2])
+        assert e.runtime_s_per_call > 0 and np.all(e.nav_err_after_km > 0)
 
 
 def test_the_table_and_curves(scored):
     df = ES.long_frame(scored)
     assert list(df["case_id"]) == ["T1-01", "T1-02"] and set(df["estimator"]) == {"batch_ls"}
-    r, e = scored[0], scored[0]["estimators"]["batch_ls"]
+    r, e = scored[0], scored[0].estimators["batch_ls"]
     row = df.iloc[0]
-    err = e["theta_final_arcsec"][:, 0] - r["truth_arcsec"][0]
+    err = e.theta_final_arcsec[:, 0] - r.truth_arcsec[0]
     assert row["err_x_mean_arcsec"] == pytest.approx(err.mean())
-    assert row["err_over_bound_x"] == pytest.approx(np.sqrt(np.mean(err ** 2)) / r["bound_seg_arcsec"][-1, 0])
-    assert row["sigma_x_mean_arcsec"] == pytest.approx(e["sigma_final_arcsec"][:, 0].mean())
+    assert row["err_over_bound_x"] == pytest.approx(np.sqrt(np.mean(err ** 2)) / r.bound_seg_arcsec[-1, 0])
+    assert row["sigma_x_mean_arcsec"] == pytest.approx(e.sigma_final_arcsec[:, 0].mean())
     c = ES.curves(scored)["prior"]
     assert c.estimators["batch_ls"].shape == (3, len(c.data), 3)
 

@@ -53,7 +53,7 @@ import numpy as np
 from opnav.core import registry
 from opnav.core.registry import CustomSpec, MethodError
 
-__all__ = ["Problem", "Estimator", "BUILTIN", "specs", "load", "problems", "probe", "run_case",
+__all__ = ["Problem", "Estimator", "BUILTIN", "specs", "load", "problems", "probe", "run_case", "EstimatorRun", "CaseRun",
            "run_variant", "call", "labels", "colors", "source_files"]
 
 #: the built-in estimators' names (EM schemes, their growing-window forms, the A-X2 alternatives,
@@ -177,7 +177,44 @@ def problem(setup, geo, win, z_s, x0_s, P0_s, theta0_rad, n_data: int) -> Proble
                    float(setup.crlb_prior_sigma_rad))
 
 
-def run_case(setup, variant: str, case, seeds, geo, estimators) -> dict:
+@dataclass(frozen=True, eq=False)
+class EstimatorRun:
+    """One estimator on one case (:func:`run_case`): its label and path, the estimates after each
+    growing window (seeds x L x 3, arcsec) and the final one, its sigmas where it returns a
+    covariance (NaN where not), the data to converge per seed (samples), the navigation error after
+    compensation (km, per seed) and the run time per call (s)."""
+
+    label: str
+    path: str
+    theta_seg_arcsec: np.ndarray
+    theta_final_arcsec: np.ndarray
+    sigma_seg_arcsec: np.ndarray
+    sigma_final_arcsec: np.ndarray
+    data_to_converge: np.ndarray
+    nav_err_after_km: np.ndarray
+    runtime_s_per_call: float
+
+
+@dataclass(frozen=True, eq=False)
+class CaseRun:
+    """Every estimator on one Table-1 case and variant (:func:`run_case`): the case, its seeds, the
+    truth and start (arcsec), the data each window used (samples after N0) and its bound (L x 3,
+    arcsec), the navigation error before compensation (km, per seed) and per estimator its
+    :class:`EstimatorRun`."""
+
+    variant: str
+    case: object
+    case_id: str
+    seed_indices: np.ndarray
+    truth_arcsec: np.ndarray
+    init_arcsec: np.ndarray
+    seg_data_used: np.ndarray
+    bound_seg_arcsec: np.ndarray
+    nav_err_before_km: np.ndarray
+    estimators: dict[str, EstimatorRun]
+
+
+def run_case(setup, variant: str, case, seeds, geo, estimators) -> CaseRun:
     """Every estimator of ``estimators`` on one case and variant (module docstring): per
     estimator the estimates after each growing window (arcsec), their sigmas where returned,
     the data to converge, the navigation error after compensation and the run time per call;
@@ -193,13 +230,11 @@ def run_case(setup, variant: str, case, seeds, geo, estimators) -> dict:
     Rvar, z, dx0, x0, P0, win = _prepare(setup, variant, case, seeds, geo)
     th0 = sc.rad(case.init_arcsec)
     bound = bounds.bound_curve(setup, geo, Rvar, case.truth_arcsec, variant)[seg_data]     # (L, 3) arcsec
-    out = {"variant": variant, "case": case, "case_id": case.case_id, "seed_indices": np.asarray(seeds),
-           "truth_arcsec": np.asarray(case.truth_arcsec, float), "init_arcsec": np.asarray(case.init_arcsec, float),
-           "seg_data_used": seg_data, "bound_seg_arcsec": bound, "estimators": {}}
+    runs = {}
     frac, tol = setup.nav_last_fraction, setup.em.converge_tol_arcsec
     f_before = run_filter(z, np.zeros((len(seeds), 3)), dx0, geo.P0, win, predicted=False)
     err_b = np.linalg.norm(f_before.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
-    out["nav_err_before_km"] = cases.rms_last(err_b, frac)
+    nav_before = cases.rms_last(err_b, frac)
     for est in estimators:
         th = np.empty((len(seeds), L, 3))
         sig = np.full((len(seeds), L, 3), np.nan)
@@ -216,18 +251,17 @@ def run_case(setup, variant: str, case, seeds, geo, estimators) -> dict:
         f = run_filter(z, th[:, -1], dx0, geo.P0, win, predicted=False)
         err = np.linalg.norm(f.xf[:, :, :3] - geo.dx_true[None, :, :3], axis=-1)
         th_as = sc.arcsec(th)
-        out["estimators"][est.name] = {
-            "label": est.label, "path": est.path,
-            "theta_seg_arcsec": th_as, "theta_final_arcsec": th_as[:, -1],
-            "sigma_seg_arcsec": sc.arcsec(sig), "sigma_final_arcsec": sc.arcsec(sig[:, -1]),
-            "data_to_converge": cases.data_to_converge(th_as, seg_data, tol),
-            "nav_err_after_km": cases.rms_last(err, frac),
-            "runtime_s_per_call": runtime,
-        }
-    return out
+        runs[est.name] = EstimatorRun(
+            label=est.label, path=est.path, theta_seg_arcsec=th_as, theta_final_arcsec=th_as[:, -1],
+            sigma_seg_arcsec=sc.arcsec(sig), sigma_final_arcsec=sc.arcsec(sig[:, -1]),
+            data_to_converge=cases.data_to_converge(th_as, seg_data, tol),
+            nav_err_after_km=cases.rms_last(err, frac), runtime_s_per_call=runtime)
+    return CaseRun(variant=variant, case=case, case_id=case.case_id, seed_indices=np.asarray(seeds),
+                   truth_arcsec=np.asarray(case.truth_arcsec, float), init_arcsec=np.asarray(case.init_arcsec, float),
+                   seg_data_used=seg_data, bound_seg_arcsec=bound, nav_err_before_km=nav_before, estimators=runs)
 
 
-def run_variant(approach_cfg: Mapping, variant: str, log=None) -> list[dict]:
+def run_variant(approach_cfg: Mapping, variant: str, log=None) -> list[CaseRun]:
     """Every registered estimator on every Table-1 case of ``variant`` (one job)."""
     from . import cases
     from . import scenario as sc
@@ -243,7 +277,7 @@ def run_variant(approach_cfg: Mapping, variant: str, log=None) -> list[dict]:
         res.append(r)
         if log:
             log.info("%s %s: %s", variant, case.case_id,
-                     {n: np.round(e["theta_final_arcsec"].mean(0), 3).tolist() for n, e in r["estimators"].items()})
+                     {n: np.round(e.theta_final_arcsec.mean(0), 3).tolist() for n, e in r.estimators.items()})
     return res
 
 
