@@ -5,11 +5,21 @@ subscripts, ``.get("k")`` calls and lines of presentation in the paper packages.
 
 SRC is the package folder (default ``src/opnav``). What is counted, per module:
 
-* **dict-returning function** (column ``dict_functions``): a function (or method) one of whose
-  own ``return`` statements (not a nested function's) returns a dict display (``{...}``), a dict
-  comprehension or a ``dict(...)`` call, or whose return annotation is ``dict`` / ``dict[...]`` /
-  ``Dict[...]`` / ``Mapping`` (with or without ``| None``). A function returning ``list[dict]``
-  counts too (its annotation names ``dict`` inside ``list[...]``/``tuple[...]``);
+* **dict-returning function** (column ``dict_functions``, issue 56's target): a function (or
+  method) one of whose own ``return`` statements (not a nested function's) returns a dict display
+  (``{...}``), a dict comprehension or a ``dict(...)`` call, or whose return annotation is
+  ``dict`` / ``dict[...]`` / ``Dict[...]`` / ``Mapping`` (with or without ``| None``), unless it
+  is a keyed map (below). A function returning ``list[dict]`` counts too (its annotation names
+  ``dict`` inside ``list[...]``/``tuple[...]``);
+* **keyed map** (column ``keyed_maps``, not in ``dict_functions``): a function annotated as
+  returning ``dict[K, V]`` / ``Mapping[K, V]`` whose values ``V`` are typed (a record class, a
+  number, ``str``, an array: not ``Any``, ``object``, a bare or nested dict) and none of whose
+  returns is a dict display with a constant string key or a ``dict(k=...)`` call: a map keyed by
+  data (method name -> record, run -> median, label -> reading). Such a function is counted here
+  whatever its key: the ``.npz`` edges (``MonteCarlo.arrays``, ``Replay.arrays``,
+  ``records.load``: array name -> array) are keyed maps by this rule too, as are config helpers
+  annotated with typed values. ``all_dicts`` is both columns together (the count before this rule
+  existed);
 * **record-as-dict function** (column ``record_dicts``, a subset): one that hands a *record* over
   as a dict: it returns a dict display with a constant string key or a ``dict(k=...)`` call, or
   its annotation is an untyped dict (``dict``, ``Mapping``, ``dict[str, Any]``, a dict of dicts,
@@ -109,6 +119,42 @@ def _untyped_dict_annotation(ann: ast.AST | None) -> bool:
     return False
 
 
+def keyed_map(fn) -> bool:
+    """A function returning a map keyed by data with typed values (module docstring)."""
+    ann = fn.returns
+    if ann is None:
+        return False
+    if isinstance(ann, ast.Constant) and isinstance(ann.value, str):
+        try:
+            ann = ast.parse(ann.value, mode="eval").body
+        except SyntaxError:
+            return False
+    if isinstance(ann, ast.BinOp):      # X | None
+        sides = [x for x in (ann.left, ann.right) if not (isinstance(x, ast.Constant) and x.value is None)]
+        if len(sides) != 1:
+            return False
+        ann = sides[0]
+    if not isinstance(ann, ast.Subscript):
+        return False
+    outer = ann.value.id if isinstance(ann.value, ast.Name) else (
+        ann.value.attr if isinstance(ann.value, ast.Attribute) else "")
+    if outer not in ("dict", "Dict", "Mapping"):
+        return False
+    args = ann.slice.elts if isinstance(ann.slice, ast.Tuple) else [ann.slice]
+    if len(args) != 2:
+        return False
+    value = args[1]
+    if ast.unparse(value) in ("Any", "object") or _mentions_dict(value):
+        return False
+    for r in _own_returns(fn):
+        v = r.value
+        if isinstance(v, ast.Dict) and any(isinstance(k, ast.Constant) and isinstance(k.value, str) for k in v.keys):
+            return False
+        if isinstance(v, ast.Call) and isinstance(v.func, ast.Name) and v.func.id == "dict" and v.keywords:
+            return False
+    return True
+
+
 def returns_record_dict(fn) -> bool:
     if _untyped_dict_annotation(fn.returns):
         return True
@@ -150,9 +196,15 @@ def count_module(path: Path) -> dict:
     for node in ast.walk(tree):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             if returns_dict(node):
-                rec = returns_record_dict(node)
-                c["record_dicts"] += rec
-                dict_fns.append(f"{node.name}:{node.lineno}{' (record)' if rec else ''}")
+                c["all_dicts"] += 1
+                if keyed_map(node):
+                    c["keyed_maps"] += 1
+                    dict_fns.append(f"{node.name}:{node.lineno} (keyed map)")
+                else:
+                    rec = returns_record_dict(node)
+                    c["record_dicts"] += rec
+                    c["dict_functions"] += 1
+                    dict_fns.append(f"{node.name}:{node.lineno}{' (record)' if rec else ''}")
             if _is_text_function(node):
                 text_lines += node.end_lineno - node.lineno + 1
         elif isinstance(node, ast.Subscript):
@@ -164,7 +216,6 @@ def count_module(path: Path) -> dict:
             if (isinstance(f, ast.Attribute) and f.attr == "get" and node.args
                     and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
                 c["get_calls"] += 1
-    c["dict_functions"] = len(dict_fns)
     c["lines"] = len(src.splitlines())
     c["plot_lines"] = c["lines"] if _imports_matplotlib(tree) else 0
     c["text_lines"] = 0 if c["plot_lines"] else text_lines
@@ -190,7 +241,8 @@ def main(argv=None) -> int:
         r = count_module(p)
         files[rel] = r
         parts[part_of(rel)].update(r["counts"])
-    keys = ("dict_functions", "record_dicts", "str_subscripts", "get_calls", "plot_lines", "text_lines", "lines")
+    keys = ("dict_functions", "record_dicts", "keyed_maps", "all_dicts", "str_subscripts", "get_calls", "plot_lines",
+            "text_lines", "lines")
     print(f"{'part':<10}" + "".join(f"{k:>15}" for k in keys))
     total = Counter()
     for name in ("approach", "landing", "studies", "core", "report", "other"):
@@ -203,8 +255,8 @@ def main(argv=None) -> int:
         print()
         for rel, r in files.items():
             c = r["counts"]
-            if any(c[k] for k in keys[:6]):
-                print(f"{str(rel):<44}" + "".join(f"{c[k]:>8}" for k in keys[:6]))
+            if any(c[k] for k in keys[:8]):
+                print(f"{str(rel):<44}" + "".join(f"{c[k]:>8}" for k in keys[:8]))
     if a.list:
         print()
         for rel, r in files.items():

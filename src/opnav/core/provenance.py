@@ -29,7 +29,7 @@ def _git(root: Path, *args: str) -> str | None:
     return out.stdout.strip() if out.returncode == 0 else None
 
 
-def collect(root: str | Path) -> dict:
+def collect(root: str | Path) -> dict[str, str]:
     """Versions and commit, as a flat ``{name: text}`` mapping (sorted keys).
 
     ``git_commit`` is ``"unknown"`` outside a git checkout (e.g. an unpacked

@@ -15,11 +15,14 @@ units as in the config.
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
 from opnav.core.checks import MAX_LANDING_IMU_SAMPLES, multiple as _multiple
+
+if TYPE_CHECKING:
+    from opnav.landing.setup import CameraSettings
 
 __all__ = ["landing_problems"]
 
@@ -88,7 +91,7 @@ def landing_problems(section: Mapping) -> list[str]:
     return out
 
 
-def _scenario_cameras(c, out: list[str]) -> dict:
+def _scenario_cameras(c, out: list[str]) -> dict[str, CameraSettings]:
     """``{scenario: merged camera}`` of the camera scenarios (``landing.scenarios``) whose
     camera differs from ``landing.camera`` (each is checked as the base camera is); a
     ``landing.headline_scenario`` that names none of them is appended to ``out``."""

@@ -135,7 +135,7 @@ def save(path, data: dict) -> None:
         np.savez_compressed(tmp, **data)
 
 
-def load(path) -> dict:
+def load(path) -> dict[str, np.ndarray]:
     """Read a :func:`save` file; a truncated or corrupt one raises
     :class:`opnav.core.snakeio.CorruptIntermediate` naming it and its rebuild command."""
     import zipfile
