@@ -34,6 +34,11 @@ from pathlib import Path
 
 import pandas as pd
 
+REPO_SRC = Path(__file__).resolve().parents[1] / "src"
+if str(REPO_SRC) not in sys.path:
+    sys.path.insert(0, str(REPO_SRC))
+from opnav.core.snakeio import benchmark_table  # noqa: E402
+
 REPO = Path(__file__).resolve().parents[1]
 BEGIN, END = "# BEGIN measured", "# END measured"
 
@@ -68,7 +73,9 @@ def measure(rules: dict[str, str], workdir: Path) -> pd.DataFrame:
         if not tsvs:
             rows.append({"rule": name, "files": 0, "max_s": nan, "max_rss_mb": nan, "max_cpu_ratio": nan})
             continue
-        df = pd.concat([pd.read_csv(workdir / f, sep="\t") for f in tsvs])
+        # a job the build's job server ran: its CPU and peak memory from its log (the benchmark
+        # file measured its client process only; opnav.core.snakeio.benchmark_table)
+        df = pd.concat([benchmark_table(workdir / f) for f in tsvs])
         rss = pd.to_numeric(df["max_rss"], errors="coerce")
         cpu = pd.to_numeric(df.get("cpu_time", pd.Series(dtype=float)), errors="coerce")
         # jobs under ~2 s are all start-up: their CPU/wall ratio says nothing of threads

@@ -15,9 +15,9 @@ import pytest
 
 from opnav.core import jobserver
 
-# the server's imports (about 2 CPU-s) and ten job processes: the quick build (tests/test_workflow.py,
-# slow too) runs every job of the quick profile through it
-pytestmark = pytest.mark.slow
+# the tests that start a server are slow: its imports (about 2 CPU-s) and ten job processes; the
+# quick build (tests/test_workflow.py, slow too) runs every job of the quick profile through it
+slow = pytest.mark.slow
 
 SRC = Path(jobserver.__file__).resolve().parents[2]
 
@@ -85,6 +85,7 @@ def _report(proc):
     return json.loads(proc.stdout.splitlines()[0]), proc.stdout.splitlines()[1]
 
 
+@slow
 def test_a_delegated_job_runs_in_a_fork_with_the_jobs_context(tmp_path, server):
     proc = _job(tmp_path, server, "ok", "x y", stdin="from stdin")
     assert proc.returncode == 0, proc.stderr
@@ -97,24 +98,28 @@ def test_a_delegated_job_runs_in_a_fork_with_the_jobs_context(tmp_path, server):
     assert cpu > 0.02                           # the client's interpreter start alone is more
 
 
+@slow
 def test_without_a_server_the_job_runs_in_its_own_process(tmp_path):
     proc = _job(tmp_path, None, "ok")
     out, line = _report(proc)
     assert proc.returncode == 0 and not out["numpy_preloaded"] and "job_server" not in line
 
 
+@slow
 def test_a_server_that_is_gone_leaves_the_job_in_its_own_process(tmp_path):
     proc = _job(tmp_path, str(tmp_path / "no-such-socket"), "ok")
     out, _ = _report(proc)
     assert proc.returncode == 0 and not out["numpy_preloaded"]
 
 
+@slow
 def test_a_job_of_several_threads_is_not_delegated(tmp_path, server):
     proc = _job(tmp_path, server, "ok", env_extra={"OPENBLAS_NUM_THREADS": "2"})
     out, _ = _report(proc)
     assert proc.returncode == 0 and not out["numpy_preloaded"]
 
 
+@slow
 @pytest.mark.parametrize("what, code, err", [("fail", 1, "the job failed: one line"), ("exit3", 3, ""),
                                              ("raise", 1, "ValueError: boom")])
 def test_exit_status_and_message_come_back(tmp_path, server, what, code, err):
@@ -125,6 +130,7 @@ def test_exit_status_and_message_come_back(tmp_path, server, what, code, err):
     assert err in proc.stderr
 
 
+@slow
 def test_a_stopped_job_ends_in_the_server_too(tmp_path, server):
     """Snakemake stops a job by killing its process: the server's child running it ends."""
     script = tmp_path / "job.py"
@@ -152,6 +158,7 @@ def test_a_stopped_job_ends_in_the_server_too(tmp_path, server):
         pytest.fail("the server's child outlived its killed client by 5 s")
 
 
+@slow
 def test_a_job_waits_for_a_server_still_starting(tmp_path):
     """The build's first jobs start while the server imports: they wait for it while it lives."""
     path = str(tmp_path / "late")
@@ -167,3 +174,41 @@ def test_a_job_waits_for_a_server_still_starting(tmp_path):
         srv.wait(timeout=30)
     gone = _job(tmp_path, path, "ok", env_extra={jobserver.PID_ENV: str(srv.pid)})   # ended: run here
     assert gone.returncode == 0 and not _report(gone)[0]["numpy_preloaded"]
+
+
+def test_every_workflow_script_delegates_first():
+    """A script's first statement after its docstring is the delegate() call (and its import):
+    anything before it would run in the job's process, then again in the server's fork."""
+    import ast
+
+    scripts = sorted((SRC.parent / "workflow" / "scripts").glob("*.py"))
+    assert scripts
+    bad = []
+    for f in scripts:
+        body = ast.parse(f.read_text()).body
+        if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+            body = body[1:]                      # the docstring
+        ok = (len(body) >= 2 and isinstance(body[0], ast.ImportFrom) and body[0].module == "opnav.core.jobserver"
+              and isinstance(body[1], ast.Expr) and ast.unparse(body[1].value) == "delegate()")
+        if not ok:
+            bad.append(f.name)
+    assert not bad, f"workflow scripts without delegate() first: {bad}"
+
+
+def test_a_benchmark_of_a_job_the_server_ran_reads_its_logs_cpu_and_memory(tmp_path):
+    """Snakemake's benchmark file measures the job's own process tree, which holds only the
+    client when the work ran in the server's fork: the manuscript's run information and the
+    SLURM resources read the job's log instead (opnav.core.snakeio.benchmark_table)."""
+    from opnav.core.snakeio import benchmark_table
+
+    (tmp_path / "benchmarks").mkdir()
+    (tmp_path / "logs").mkdir()
+    head = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    for name, line in (("served", "cpu_s=12.500 user_s=12.000 sys_s=0.500 max_rss_mb=321.0 job_server=1"),
+                       ("own", "cpu_s=12.500 user_s=12.000 sys_s=0.500 max_rss_mb=321.0")):
+        (tmp_path / "benchmarks" / f"{name}.tsv").write_text(head + "14.0\t0:00:14\t25.1\t30\t20\t21\t0\t0\t5\t0.08\n")
+        (tmp_path / "logs" / f"{name}.log").write_text(f"2026-12-07 INFO started\n2026-12-07 INFO job resources: {line}\n")
+    served = benchmark_table(tmp_path / "benchmarks" / "served.tsv")
+    own = benchmark_table(tmp_path / "benchmarks" / "own.tsv")
+    assert served["cpu_time"].iloc[0] == 12.5 and served["max_rss"].iloc[0] == 321.0 and served["s"].iloc[0] == 14.0
+    assert own["cpu_time"].iloc[0] == 0.08 and own["max_rss"].iloc[0] == 25.1      # its own process: as measured

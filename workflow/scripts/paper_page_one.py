@@ -13,7 +13,7 @@ from pathlib import Path
 import pandas as pd
 
 from opnav.core import figures, published
-from opnav.core.snakeio import load_table, mock_snakemake, script_context
+from opnav.core.snakeio import benchmark_table, load_table, mock_snakemake, script_context
 from opnav.core.tables import atomic_write_text
 from opnav.report import claims_prose, differences, manuscript, verdict_plot
 
@@ -45,6 +45,6 @@ with script_context(snakemake) as log:
     bench = sorted(Path(snakemake.params.results).glob("*/benchmarks/*.tsv"))
     jobs = manuscript.snakemake_jobs(Path(".snakemake") / "metadata", snakemake.params.results)
     atomic_write_text(out.runinfo, manuscript.run_info_tex(
-        (pd.read_csv(b, sep="\t") for b in bench), manuscript.machine_text(), jobs))
+        (benchmark_table(b) for b in bench), manuscript.machine_text(), jobs))   # a job in the job server: its log's CPU
     log.info("page 1: abstract %d words, %d claims, %d choices", claims_prose.word_count(
         claims_prose.page_one_abstract_tex(df, sample)), len(df), len(rows))

@@ -129,6 +129,39 @@ def resource_line() -> str:
     return f"{out} {startup.fields()}"
 
 
+def resource_fields(log_path) -> dict | None:
+    """The last :func:`resource_line` of a job's log as numbers (``cpu_s``, ``user_s``, ``sys_s``,
+    ``max_rss_mb``; ``job_server`` 1 where the job ran in the build's job server), or None."""
+    import re
+
+    try:
+        text = Path(log_path).read_text(errors="replace")
+    except OSError:
+        return None
+    lines = [ln for ln in text.splitlines() if RESOURCE_PREFIX in ln]
+    if not lines:
+        return None
+    out = {k: float(v) for k, v in re.findall(r"(\w+)=([0-9.]+)", lines[-1].split(RESOURCE_PREFIX, 1)[1])}
+    out.setdefault("job_server", 0.0)
+    return out
+
+
+def benchmark_table(path):
+    """A job's Snakemake ``benchmark:`` file (a one-row TSV) as a table. Where the job ran in
+    the build's job server (:mod:`opnav.core.jobserver`), Snakemake measured only the job's
+    own process (its client) and the work ran in the server's fork: ``cpu_time`` and
+    ``max_rss`` are then its log's (``logs/<the same name>.log`` beside ``benchmarks/``:
+    :func:`resource_fields`); wall time ``s`` is the job's either way."""
+    import pandas as pd
+
+    t = pd.read_csv(path, sep="\t")
+    res = resource_fields(Path(path).parent.parent / "logs" / (Path(path).stem + ".log"))
+    if res and res["job_server"] and len(t):
+        t["cpu_time"] = res["cpu_s"]
+        t["max_rss"] = res["max_rss_mb"]
+    return t
+
+
 def stand_in(input=None, output=None, params=None, log=None, wildcards=None,
              threads: int = 1, config: dict | None = None) -> SimpleNamespace:
     """A bare object shaped like a script's ``snakemake`` (named lists), for unit tests of
