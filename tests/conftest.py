@@ -9,6 +9,7 @@ os.environ["OPENBLAS_NUM_THREADS"] = "1"
 import atexit  # noqa: E402
 import json  # noqa: E402
 import re  # noqa: E402
+import resource  # noqa: E402
 import shutil  # noqa: E402
 import signal  # noqa: E402
 import subprocess  # noqa: E402
@@ -206,9 +207,92 @@ def pytest_itemcollected(item):
         item.add_marker(pytest.mark.slow)
 
 
+#: test files whose tests call the papers' compiled kernels most, by paper, in the order the
+#: background warm-up fills the cache (below): run after the others, so the kernels are ready
+#: by the time they start (only the order changes, and only for speed)
+#: (measured at 2e5e1d9+: each test file alone, the kernel modules it made callable)
+KERNEL_FILES = (("test_approach_", "test_custom_estimators"),
+                ("test_landing_", "test_timing_", "test_custom_methods", "test_chunk_", "test_cli_overlays",
+                 "test_kernel_references", "test_studies"))
+
+
+def _kernel_rank(item) -> int:
+    name = Path(str(item.fspath)).name
+    return next((i + 1 for i, prefixes in enumerate(KERNEL_FILES) if name.startswith(prefixes)), 0)
+
+
 def pytest_collection_modifyitems(config, items):
-    """Tests that read the shared quick build run after all others (order kept otherwise)."""
-    items.sort(key=_uses_quick_build)
+    """Tests that read the shared quick build run after all others; before them, the test files
+    that call the papers' kernels most (KERNEL_FILES), paper A's first (order kept otherwise)."""
+    items.sort(key=lambda it: (_uses_quick_build(it), _kernel_rank(it)))
+
+
+# ------------------------------------------------------------ the kernels, on the second core
+# A fresh clone (CI) has an empty numba cache: the first tests that call compiled kernels would
+# compile them (about 50 CPU-s) one after the other in this process. A run of many tests instead
+# starts one process at collection that warms every kernel module into the cache
+# (opnav.core.compiled.warm, module by module, core and paper A first), on the second core while
+# the first tests run; a test that needs a module's kernels before they are warm waits for them
+# (opnav.core.startup.wait_for_kernels, named by its environment variable) rather than compiling
+# them again. On a filled cache it only loads them (a few CPU-s, beside the tests).
+WARM_MIN_TESTS = 300
+_WARM_CODE = """
+import importlib, sys
+import opnav.approach, opnav.landing
+from opnav.core import compiled
+todo = compiled.kernel_modules()
+with open(sys.argv[1], "w") as f:
+    f.write("todo: " + " ".join(todo) + "\\n")
+for m in todo:
+    importlib.import_module(m)
+    compiled.warm([m])
+    with open(sys.argv[1], "a") as f:
+        f.write(m + "\\n")
+"""
+_warm: dict = {}
+
+
+def pytest_collection_finish(session):
+    """Start the background warm-up (above) for a run of at least WARM_MIN_TESTS tests
+    (``OPNAV_TESTS_WARM=0``: never)."""
+    from opnav.core import startup
+
+    if (len(session.items) < WARM_MIN_TESTS or os.environ.get("OPNAV_TESTS_WARM") == "0"
+            or os.environ.get(startup.WARMING_ENV)):
+        return
+    import opnav
+
+    folder = Path(tempfile.mkdtemp(prefix="opnav-warm-"))
+    progress = folder / "done"
+    progress.touch()
+    env = {k: v for k, v in os.environ.items() if k != startup.WARMING_ENV}
+    with open(folder / "warm.log", "w") as log:
+        proc = subprocess.Popen([sys.executable, "-c", _WARM_CODE, str(progress)], env=env, stdin=subprocess.DEVNULL,
+                                stdout=log, stderr=subprocess.STDOUT)
+    _warm.update(proc=proc, folder=folder)
+    atexit.register(_stop_warm)      # a session that ends before its summary stops it too
+    os.environ[startup.WARMING_ENV] = json.dumps({"pid": proc.pid, "progress": str(progress),
+                                                  "package": str(Path(opnav.__file__).parent),
+                                                  "cache": os.environ.get("NUMBA_CACHE_DIR", "")})
+
+
+def _stop_warm() -> dict:
+    """End the background warm-up (if still running: what it saved stays in the cache); its CPU-s."""
+    proc = _warm.pop("proc", None)
+    if proc is None:
+        return {}
+    from opnav.core import startup
+
+    os.environ.pop(startup.WARMING_ENV, None)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if proc.poll() is None:
+        proc.terminate()
+    proc.wait()
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    done = (_warm["folder"] / "done").read_text().splitlines()[1:]
+    shutil.rmtree(_warm.pop("folder"), ignore_errors=True)
+    return {"cpu_s": after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, "modules": len(done),
+            "rc": proc.returncode}
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -318,6 +402,12 @@ def _compile_cpu() -> float:
     return startup.seconds()["compile_s"] if startup is not None else 0.0
 
 
+def _warm_wait() -> float:
+    """Seconds this process waited for the background warm-up of the kernels so far."""
+    startup = sys.modules.get("opnav.core.startup")
+    return startup.seconds()["wait_s"] if startup is not None else 0.0
+
+
 def wall_limit_s() -> float:
     """UNMARKED_LIMIT_WALL_S, times the 1-minute load average per core when above 1 (a test
     gets a share of a core on a shared machine)."""
@@ -325,10 +415,11 @@ def wall_limit_s() -> float:
 
 
 def unmarked_too_slow(cpu_s: float, wall_s: float, compile_s: float = 0.0,
-                      wall_limit: float | None = None) -> str | None:
+                      wall_limit: float | None = None, wait_s: float = 0.0) -> str | None:
     """Why an unmarked test's call is too slow for the default run, or None; ``compile_s``
-    (numba compiling kernels during the call) is taken out of both figures."""
-    own_cpu, own_wall = cpu_s - compile_s, wall_s - compile_s
+    (numba compiling kernels during the call) is taken out of both figures, ``wait_s`` (waiting
+    for the background warm-up of the kernels) out of the wall time."""
+    own_cpu, own_wall = cpu_s - compile_s, wall_s - compile_s - wait_s
     limit = UNMARKED_LIMIT_WALL_S if wall_limit is None else wall_limit
     if own_cpu > UNMARKED_LIMIT_CPU_S:
         return f"took {own_cpu:.1f} CPU-s (> {UNMARKED_LIMIT_CPU_S:g}; kernel compiling aside)"
@@ -337,7 +428,7 @@ def unmarked_too_slow(cpu_s: float, wall_s: float, compile_s: float = 0.0,
     return None
 
 
-_session_compile = {"cpu_s": 0.0, "tests": 0}
+_session_compile = {"cpu_s": 0.0, "tests": 0, "waits": []}
 
 
 @pytest.hookimpl(wrapper=True)
@@ -346,20 +437,29 @@ def pytest_runtest_call(item):
 
     if item.get_closest_marker("slow") or item.get_closest_marker("cluster"):
         return (yield)
-    cpu0, wall0, comp0 = _cpu_now(), time.perf_counter(), _compile_cpu()
+    cpu0, wall0, comp0, wait0 = _cpu_now(), time.perf_counter(), _compile_cpu(), _warm_wait()
     result = yield
-    comp = _compile_cpu() - comp0
+    comp, wait = _compile_cpu() - comp0, _warm_wait() - wait0
+    if wait > 0.5:
+        _session_compile["waits"].append((wait, item.nodeid))
     if comp:
         _session_compile["cpu_s"] += comp
         _session_compile["tests"] += 1
-    why = unmarked_too_slow(_cpu_now() - cpu0, time.perf_counter() - wall0, comp, wall_limit_s())
+    why = unmarked_too_slow(_cpu_now() - cpu0, time.perf_counter() - wall0, comp, wall_limit_s(), wait)
     if why:
         pytest.fail(f"unmarked test {why}: mark it @pytest.mark.slow or make it faster", pytrace=False)
     return result
 
 
 def pytest_terminal_summary(terminalreporter):
-    """One line when unmarked tests compiled kernels (an empty or stale cache): how much."""
+    """One line when unmarked tests compiled kernels (an empty or stale cache): how much; one on
+    the background warm-up of the kernels, if there was one."""
+    warm = _stop_warm()
+    if warm:
+        terminalreporter.write_line(
+            f"kernels warmed beside the tests: {warm['modules']} modules, {warm['cpu_s']:.1f} CPU-s in the "
+            f"background process (exit {warm['rc']}); the tests waited {_warm_wait():.1f} s for it"
+            + "".join(f"; {w:.1f} s in {n}" for w, n in sorted(_session_compile["waits"], reverse=True)[:3]))
     if _session_compile["tests"]:
         terminalreporter.write_line(
             f"numba compiled kernels in {_session_compile['tests']} unmarked tests: "

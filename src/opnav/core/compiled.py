@@ -167,6 +167,7 @@ class LazyKernel:
 def _dispatcher(f, settings: dict):
     """The numba dispatcher of kernel ``f`` (:func:`numba_adapter.dispatcher`): its cache
     stamped with its package's :func:`kernel_set_digest`, its loads and compiles timed."""
+    startup.wait_for_kernels(f.__module__)  # a test run's background warm-up of this module, if any
     with startup.overhead("kernels_s"):
         numba_adapter.register_proxy_type(LazyKernel, LazyKernel.dispatcher)
         numba_adapter.install_compile_timer(_compile_started, startup.stop)

@@ -33,7 +33,7 @@ import contextlib
 import time
 from typing import Iterator
 
-_state = {"before_work_s": None, "kernels_s": 0.0, "compile_s": 0.0}
+_state = {"before_work_s": None, "kernels_s": 0.0, "compile_s": 0.0, "wait_s": 0.0}
 _open: list = []  # [kind, CPU at start] of the outermost open block, then one entry per nested block
 
 
@@ -83,10 +83,11 @@ def begin() -> float:
 
 def seconds() -> dict[str, float]:
     """``before_work_s``, ``kernels_s`` and their sum ``startup_s``, and ``compile_s`` (CPU
-    seconds; before :func:`begin`, ``before_work_s`` is the CPU so far)."""
+    seconds; before :func:`begin`, ``before_work_s`` is the CPU so far); ``wait_s``, the wall
+    seconds spent waiting for a background warm-up (:func:`wait_for_kernels`)."""
     before = _state["before_work_s"]
     out = {"before_work_s": _cpu_so_far() if before is None else before,
-           "kernels_s": _state["kernels_s"], "compile_s": _state["compile_s"]}
+           "kernels_s": _state["kernels_s"], "compile_s": _state["compile_s"], "wait_s": _state["wait_s"]}
     out["startup_s"] = out["before_work_s"] + out["kernels_s"]
     return out
 
@@ -106,3 +107,56 @@ def line() -> str:
             f"interpreter, Snakemake's preamble, the script's imports; {s['kernels_s']:.2f} making "
             "compiled kernels callable)"
             + (f"; {s['compile_s']:.2f} CPU-s compiling kernels besides" if s["compile_s"] else ""))
+
+
+#: names a background warm-up of the kernel cache this process may wait for, as JSON:
+#: ``{"pid", "progress", "package", "cache"}`` (tests/conftest.py starts one for a whole test run,
+#: so the kernels compile on the second core while the first tests run): its process, a file whose
+#: first line is ``todo:`` and the kernel modules it will warm, then one line per module once its
+#: warm-up has filled the cache, the ``opnav`` package folder it warms and its ``NUMBA_CACHE_DIR``
+WARMING_ENV = "OPNAV_KERNELS_WARMING"
+
+
+def wait_for_kernels(module: str, poll_s: float = 0.05) -> float:
+    """Before a kernel of ``module`` is first made callable: where :data:`WARMING_ENV` names a
+    warm-up of this very package and kernel cache (not a copy's, not another cache's) that is
+    still running, will warm ``module`` and has not yet, wait until it has (or has ended), so
+    this process loads the kernels instead of compiling them a second time. Returns the seconds
+    waited (also summed in ``seconds()["wait_s"]``)."""
+    import json
+    import os
+    import sys
+
+    try:
+        spec = json.loads(os.environ.get(WARMING_ENV) or "null")
+        pid, progress, package, cache = int(spec["pid"]), spec["progress"], spec["package"], spec["cache"]
+    except (ValueError, TypeError, KeyError):
+        return 0.0
+    here = sys.modules.get("opnav")
+    if here is None or os.path.realpath(os.path.dirname(here.__file__)) != os.path.realpath(package) \
+            or os.environ.get("NUMBA_CACHE_DIR", "") != cache:
+        return 0.0                   # another copy of the sources or another cache: its own kernels
+    t0 = time.perf_counter()
+    while True:
+        try:
+            with open(progress) as f:
+                lines = f.read().splitlines()
+            if lines and lines[0].startswith("todo:") and (module not in lines[0].split()[1:] or module in lines[1:]):
+                break                # not one it warms, or warmed
+        except OSError:
+            pass
+        try:
+            with open(f"/proc/{pid}/stat", "rb") as f:
+                if f.read().rsplit(b")", 1)[1].split()[0] == b"Z":
+                    break            # ended, not yet reaped
+        except (OSError, IndexError):
+            try:
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                break                # ended: what it did not warm, this process compiles
+            except OSError:
+                pass
+        time.sleep(poll_s)
+    waited = time.perf_counter() - t0
+    _state["wait_s"] += waited
+    return waited
