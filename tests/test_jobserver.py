@@ -34,7 +34,8 @@ JOB = textwrap.dedent("""
     what = sys.argv[1]
     print(json.dumps({"pid": os.getpid(), "ppid": os.getppid(), "cwd": os.getcwd(), "argv": sys.argv[1:],
                       "env": os.environ.get("JOB_VAR"), "stdin": sys.stdin.read(),
-                      "numpy_preloaded": "numpy" in sys.modules}), flush=True)
+                      "numpy_preloaded": "numpy" in sys.modules,
+                      "client_cpu_env": os.environ.get("OPNAV_JOB_CLIENT_CPU_S")}), flush=True)
     print(resource_line(), flush=True)
     if what == "fail":
         raise SystemExit("the job failed: one line")
@@ -94,6 +95,7 @@ def test_a_delegated_job_runs_in_a_fork_with_the_jobs_context(tmp_path, server):
     assert out["cwd"] == str(tmp_path) and out["argv"] == ["ok", "x y"]
     assert out["env"] == "from the job" and out["stdin"] == "from stdin"
     assert " job_server=1" in line             # the job's resource line says so, with the client's CPU
+    assert out["client_cpu_env"] is None       # which the job's own subprocesses do not inherit
     cpu = float(line.split("cpu_s=")[1].split()[0])
     assert cpu > 0.02                           # the client's interpreter start alone is more
 
@@ -189,7 +191,7 @@ def test_every_workflow_script_delegates_first():
         if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
             body = body[1:]                      # the docstring
         ok = (len(body) >= 2 and isinstance(body[0], ast.ImportFrom) and body[0].module == "opnav.core.jobserver"
-              and isinstance(body[1], ast.Expr) and ast.unparse(body[1].value) == "delegate()")
+              and isinstance(body[1], ast.Expr) and ast.unparse(body[1].value).startswith("delegate("))
         if not ok:
             bad.append(f.name)
     assert not bad, f"workflow scripts without delegate() first: {bad}"

@@ -12,7 +12,8 @@ paper's definition on its subset) once, on the same calls. The consumers read bo
 
 from opnav.core.jobserver import delegate
 
-delegate()  # in a local build the job runs in the build's job server (opnav.core.jobserver); by hand, here
+# the replays' rule takes every core only to run alone; its timed processes are fresh (started here)
+delegate(any_threads=True)  # in a local build the job runs in the build's job server (opnav.core.jobserver)
 
 import sys
 import tempfile

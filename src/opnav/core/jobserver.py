@@ -54,16 +54,20 @@ _server: dict = {}
 
 
 # ---------------------------------------------------------------- the client (a workflow job)
-def delegate() -> None:
+def delegate(any_threads: bool = False) -> None:
     """Called first by every workflow script. In a job of a build whose server is up, send the
     job to the server, wait for it and leave with its exit status (never returns); otherwise
-    (and in the server's child itself) return at once, and the script runs here."""
+    (and in the server's child itself) return at once, and the script runs here.
+
+    A job of several threads runs in its own process (the server's numpy has one BLAS thread),
+    unless ``any_threads``: a job that takes every core only to run alone and whose own numerics
+    do not use them (the timing replays: their timed processes are fresh, started by the job)."""
     path = os.environ.get(ENV)
     main = sys.modules.get("__main__")
     smk = getattr(main, "snakemake", None)
     if not path or path == "0" or smk is None or not type(smk).__module__.startswith("snakemake"):
         return
-    if any(os.environ.get(v, "1") != "1" for v in THREAD_VARS):
+    if not any_threads and any(os.environ.get(v, "1") != "1" for v in THREAD_VARS):
         return                                   # a job of several threads: its own process
     import resource
     import signal
@@ -126,10 +130,15 @@ def _alive(pid: str) -> bool:
         return True
 
 
+#: read once, when the job's script first imports this module in the server's child, and taken
+#: out of the environment: the job's own subprocesses (the timing replays) are not the job
+_CLIENT_CPU = os.environ.pop(CLIENT_CPU_ENV, "")
+
+
 def client_cpu() -> tuple[float, float]:
     """(user, system) CPU-s the job's client process spent before it delegated to this process
     (0, 0 in a job that runs in its own process)."""
-    text = os.environ.get(CLIENT_CPU_ENV, "")
+    text = _CLIENT_CPU
     try:
         user, sys_ = (float(x) for x in text.split(","))
     except ValueError:
@@ -232,7 +241,10 @@ def _preload() -> None:
     import numba.np.linalg  # noqa: F401
     import numpy  # noqa: F401
     import pandas  # noqa: F401
+    import pandas.io.formats.csvs  # noqa: F401  (DataFrame.to_csv)
+    import pandas.io.formats.string  # noqa: F401
     import pandas.io.formats.style  # noqa: F401  (DataFrame.to_latex)
+    import PIL.Image
     import scipy.integrate  # noqa: F401
     import scipy.interpolate  # noqa: F401
     import scipy.linalg  # noqa: F401
@@ -244,6 +256,7 @@ def _preload() -> None:
     import snakemake.iocontainers  # noqa: F401
     import snakemake.logging  # noqa: F401
     import snakemake.script  # noqa: F401
+    import tabulate  # noqa: F401  (DataFrame.to_markdown; wcwidth)
     import threadpoolctl  # noqa: F401
     import yaml  # noqa: F401
 
@@ -258,6 +271,10 @@ def _preload() -> None:
     import matplotlib.font_manager
 
     matplotlib.font_manager.fontManager  # noqa: B018
+    PIL.Image.init()                             # the image plugins a PNG save registers
+    import fontTools.subset  # noqa: F401  (the PDF backend's font subsetting)
+    import resource  # noqa: F401  (the jobs' resource line)
+    import runpy  # noqa: F401
     import gc
 
     gc.collect()
