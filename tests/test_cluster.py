@@ -37,10 +37,13 @@ CLUSTER_ARGS = ("--workflow-profile", "profiles/slurm", "--configfile", "config/
                 "--slurm-init-seconds-before-status-checks", "10")
 RUN_TIMEOUT_S = 1800
 # Measured times differ between any two runs (on a shared node more so): columns named
-# for a time or CPU time ("timed_calls" is a count), and rows of long tables whose text
-# names one (metric "median_plan_time_us", the scorecard's planning-time rows). Every
-# other cell must be equal.
+# for a time or CPU time ("timed_calls" is a count), rows of long tables whose text
+# names one (metric "median_plan_time_us", the scorecard's planning-time rows), the
+# evidence read from the timing replays (sample "replay<k>" or "between_replays") and
+# the rows of the claims whose plan test reads them (opnav.report.readme.timing_claims:
+# B-C4, B-C9, B-C11), and the build's date stamp. Every other cell must be equal.
 TIMING = re.compile(r"time(?!d)|cpu", re.IGNORECASE)
+STAMPS = re.compile(r"^built_utc$")
 
 
 def _why_not() -> str | None:
@@ -133,10 +136,20 @@ def _tables(root: Path) -> dict[str, pd.DataFrame]:
             if "benchmarks" not in p.parts}
 
 
+def _timing_claims() -> set[str]:
+    from opnav.report.plan import load_plan
+    from opnav.report.readme import timing_claims
+
+    plan = load_plan()
+    return set(timing_claims(pd.DataFrame({"claim_id": list(plan.tests())}), plan))
+
+
 def _untimed(df: pd.DataFrame) -> pd.DataFrame:
     """``df`` without its timing columns and timing rows (see TIMING)."""
     text = df.select_dtypes(exclude="number").astype(str)
-    timed_row = text.apply(lambda col: col.str.contains(TIMING)).any(axis=1)
+    timed_claims = _timing_claims()
+    timed_row = text.apply(lambda col: col.str.contains(TIMING) | col.isin(timed_claims)
+                           | col.str.match(r"^(replay\d+|between_replays)$") | col.str.match(STAMPS)).any(axis=1)
     return df.loc[~timed_row, [c for c in df.columns if not TIMING.search(str(c))]]
 
 
