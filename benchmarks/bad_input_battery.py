@@ -34,7 +34,6 @@ from __future__ import annotations
 import argparse
 import collections
 import contextlib
-import copy
 import io
 import os
 import sys

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from opnav.core import published
 from opnav.core.planvalues import accuracy_target_arcsec
-from opnav.approach import cases, labels, pipeline, summaries
+from opnav.approach import cases, pipeline, summaries
 from opnav.approach import scenario as sc
 from opnav.approach.setup import Setup
 from opnav.report import approach_text

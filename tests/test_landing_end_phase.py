@@ -84,6 +84,6 @@ def test_nees_reading_names_under_and_overconfidence():
                                pos_median=pos_mean, vel_in_band_pct=2.0, vel_mean=vel_mean, vel_median=vel_mean)
 
     r = nees_reading(nees(1.76, 1.93))
-    assert r["verdict"] == "underconfident" and "underconfident" in r["text"] and "1.76" in r["text"]
-    assert nees_reading(nees(3.0, 3.5))["verdict"] == \
+    assert r.verdict == "underconfident" and "underconfident" in r.text and "1.76" in r.text
+    assert nees_reading(nees(3.0, 3.5)).verdict == \
         "consistent in position, overconfident in velocity"

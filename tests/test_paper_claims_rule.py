@@ -2,7 +2,6 @@
 the claims table with the contract's columns, the analysis-plan table, the inputs table and,
 given a replication sample, its verdicts beside the main ones."""
 
-import pytest
 import json
 import runpy
 from pathlib import Path
@@ -11,7 +10,7 @@ import pandas as pd
 import yaml
 
 from opnav.report import claims as C
-from test_claims import SUMMARY_A, planning_time, summary_b, table
+from test_claims import SUMMARY_A, summary_b, table
 
 REPO = Path(__file__).resolve().parents[1]
 CFG = yaml.safe_load((REPO / "config" / "config.yaml").read_text())

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 
-import pytest
 
 from opnav.report import approach_claims  # noqa: F401  (registers paper A's quantities)
 from opnav.report import landing_claims  # noqa: F401  (registers paper B's quantities)
@@ -258,7 +257,7 @@ def test_superiority_needs_a_whole_step_and_sweeps_the_threshold():
     j = S.judge(PLAN, "B-C2", rows(-0.5))
     assert j.verdict == C.NOT_REPRODUCED
     wt, sweeps = S.would_take(PLAN, "B-C2", rows(-0.5), j)
-    flip = sweeps[0]["flip"]
+    flip = sweeps[0].flip
     assert 50 <= flip <= 100 and "threshold" in wt
     assert "minimum difference of 0.5 s instead of 1" in wt, "the step at which it would count at the plan's threshold"
 
@@ -299,7 +298,7 @@ def test_sweep_interpolates_where_the_bound_reaches_the_target():
                setting=f"roll_rate_deg_s={x:g}", unit="arcsec", n=0) for x, b in ((0.1, 5.0), (0.2, 2.5), (0.4, 1.25))]
     j = S.judge(PLAN, "A-C1", rows)
     wt, sw = S.would_take(PLAN, "A-C1", rows, j)
-    assert sw and abs(sw[0]["flip"] - 0.25) < 0.03 and "0.25" in wt
+    assert sw and abs(sw[0].flip - 0.25) < 0.03 and "0.25" in wt
     half = PLAN.amended({"claims.A-C1.margins.target_arcsec": {"value": 1.0, "reason": "test"}})
     wt2, sw2 = S.would_take(half, "A-C1", rows, S.judge(half, "A-C1", rows))
-    assert sw2[0]["flip"] is None and "no roll rate from 0.1 to 0.4 deg/s" in wt2
+    assert sw2[0].flip is None and "no roll rate from 0.1 to 0.4 deg/s" in wt2

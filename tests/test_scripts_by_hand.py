@@ -3,7 +3,6 @@ the rule's inputs, outputs, params and log from the Snakefile and the overlays g
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pandas as pd
 import pytest

@@ -127,8 +127,6 @@ def test_kernels_compiled_once_then_only_loaded(quick_results):
     import json
     import re
 
-    import opnav.approach
-    import opnav.landing
     from opnav.core import compiled
 
     out = quick_results / "results" / "quick"

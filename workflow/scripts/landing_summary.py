@@ -12,7 +12,7 @@ import sys
 import pandas as pd
 
 from opnav.core import figures, published
-from opnav.landing import timing, timing_summary
+from opnav.landing import timing
 from opnav.report.landing import plots
 from opnav.report.landing.timing_text import method_text
 from opnav.landing.methods import colors as method_colors, labels as method_labels
@@ -77,7 +77,7 @@ with script_context(snakemake) as log:
     out["tuning"] = TuningReport.from_json(load_json(snakemake.input.tuning))
     # NEES read as it is (held out): consistent, under- or overconfident
     out["nees_reading"] = {m: nees_reading(v, scn) for m, v in out["nees"].items()}
-    out["nees_text"] = out["nees_reading"].get("depth", {}).get("text", "")
+    out["nees_text"] = out["nees_reading"]["depth"].text if "depth" in out["nees_reading"] else ""
     if snakemake.input.get("retuned"):      # the main sample: the retuned filter beside the paper's
         out["nees_retuned"] = RetunedRecord.from_json(load_json(snakemake.input.retuned))
         out["nees_retuned_text"] = nees_retuned_text(out["nees_retuned"])

@@ -11,7 +11,7 @@ import json
 import sys
 
 from opnav.core import figures
-from opnav.landing import timing, timing_summary
+from opnav.landing import timing
 from opnav.report.landing import plots
 from opnav.report.landing.ranking_text import worded_headline
 from opnav.report.landing.timing_text import method_text

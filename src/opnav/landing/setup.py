@@ -21,11 +21,9 @@ Units: as the config keys say (m, m/s, m/s^2, s, deg, px, Hz).
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import Mapping
 
-from opnav.core.registry import CustomSpec
 from opnav.core.sections import Missing, Pairs, Section, conversion, register
 
 __all__ = ["Setup", "InitialState", "Imu", "CameraSettings", "NearSite", "Landmarks", "FilterSettings",

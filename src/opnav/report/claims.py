@@ -310,7 +310,7 @@ def _small(j: S.Judgement, plan: Plan) -> list[tuple[str, str]]:
     return [("sample_too_small", f"{n} seeds or runs")] if n < plan.guard("min_full_seeds") else []
 
 
-def claim_row(plan: Plan, cid: str, ev: list[EvidenceRow], replicated: bool, profile: str = "full") -> tuple[ClaimRow, S.Judgement, list[dict]]:
+def claim_row(plan: Plan, cid: str, ev: list[EvidenceRow], replicated: bool, profile: str = "full") -> tuple[ClaimRow, S.Judgement, list[S.Sweep]]:
     """One claim's row, its judgement and the sweeps behind its would_take."""
     j = S.judge(plan, cid, ev, replicated=replicated)
     wt, sweeps = S.would_take(plan, cid, ev, j)
@@ -373,7 +373,7 @@ def claim_row(plan: Plan, cid: str, ev: list[EvidenceRow], replicated: bool, pro
 
 
 def build(plan: Plan, evidence: Iterable[EvidenceRow], replicated: Iterable[str] = (),
-          profile: str = "full") -> tuple[list[ClaimRow], list[S.Judgement], list[dict]]:
+          profile: str = "full") -> tuple[list[ClaimRow], list[S.Judgement], list[S.Sweep]]:
     """Every claim of the plan scored on the evidence table (:func:`evidence_table`'s rows):
     the claim rows, the judgements and the would_take sweeps (for the figures). The numbers
     the scorer computes (would_take's flips and margins) are each judgement's ``derived`` rows

@@ -746,7 +746,7 @@ def _cause(rd: Reading, test: ClaimTest, plan: Plan, scopes: list[str] | None = 
     if v == NOT_TESTED:
         return f"Not tested: {rd.named}"
     o = rd.lit.worst() if rd.lit else None
-    tail = f", and no faithful variant passes" if any(u.role == "faithful" for u in rd.units) else ""
+    tail = ", and no faithful variant passes" if any(u.role == "faithful" for u in rd.units) else ""
     return f"As written it fails: {_q(rd, o, plan)}{tail}"
 
 
@@ -892,10 +892,32 @@ def _dedup_rows(rows: list[EvidenceRow]) -> list[EvidenceRow]:
 
 
 # ------------------------------------------------------------ would_take
-def would_take(plan: Plan, claim_id: str, evidence: Evidence | Iterable[EvidenceRow], j: Judgement) -> tuple[str, list[dict]]:
+@dataclass(frozen=True)
+class Sweep:
+    """One curve of a claim's would_take sweep (:func:`would_take`; the figures'): the claim, the
+    swept setting, the unit (method, versus, scope) and quantity, the points ``(value, estimate, lo,
+    hi, status)`` in setting order, the setting at which the verdict flips (None: none), the test's
+    threshold in words, its limit, the quantity's unit, the band (two numbers where the test is a
+    band, else empty) and the published target (NaN: none)."""
+
+    claim_id: str
+    setting: str
+    method: str
+    versus: str
+    scope: str
+    quantity: str
+    points: list[tuple]
+    flip: float | None
+    threshold: str
+    limit: float
+    unit: str
+    band: tuple
+    target: float
+
+
+def would_take(plan: Plan, claim_id: str, evidence: Evidence | Iterable[EvidenceRow], j: Judgement) -> tuple[str, list[Sweep]]:
     """What a claim not reproduced as written would take (the plan's ``would_take`` entries),
-    as one text and the sweeps behind it (for the figures): [{setting, method, scope, points:
-    [(value, estimate, lo, hi)], limit, flip, threshold}]."""
+    as one text and the sweeps behind it (:class:`Sweep`, for the figures)."""
     test = plan.test(claim_id)
     rows = [r for r in evidence if r.claim_id == claim_id]
     idx = _Index(rows)
@@ -929,7 +951,7 @@ def would_take(plan: Plan, claim_id: str, evidence: Evidence | Iterable[Evidence
     return "; ".join(dict.fromkeys(parts)), sweeps
 
 
-def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[str, Any], j: Judgement) -> tuple[str, list[dict]]:
+def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[str, Any], j: Judgement) -> tuple[str, list[Sweep]]:
     name, q = w["sweep"], w["quantity"]
     cond0 = test.conditions[w["like"]]
     cond = Condition(q, cond0.comparison, {k: v for k, v in cond0.params.items() if k != "setting"}, cond0.index)
@@ -984,32 +1006,32 @@ def _sweep(plan: Plan, test: ClaimTest, idx: _Index, level: float, w: Mapping[st
                 break
         if flip is None and pts and pts[0][4] == PASS and not math.isfinite(outs[0].target):
             flip = pts[0][0]
-        sweeps.append({"claim_id": test.claim_id, "setting": name, "method": method, "versus": versus, "scope": scope,
-                       "quantity": q, "points": pts, "flip": flip, "threshold": outs[0].threshold if outs else "",
-                       "limit": outs[0].limit if outs else math.nan, "unit": rs[0].unit,
-                       "band": tuple(outs[0].numbers) if outs and outs[0].cond.comparison == "band" else (),
-                       "target": outs[0].target if outs else math.nan})
+        sweeps.append(Sweep(claim_id=test.claim_id, setting=name, method=method, versus=versus, scope=scope,
+                            quantity=q, points=pts, flip=flip, threshold=outs[0].threshold if outs else "",
+                            limit=outs[0].limit if outs else math.nan, unit=rs[0].unit,
+                            band=tuple(outs[0].numbers) if outs and outs[0].cond.comparison == "band" else (),
+                            target=outs[0].target if outs else math.nan))
         j.quoted += rs
     if not sweeps:
         return "", []
     if meth == "best":
-        with_flip = [s for s in sweeps if s["flip"] is not None]
-        pick = min(with_flip, key=lambda s: s["flip"]) if with_flip else min(
-            sweeps, key=lambda s: (s["points"][-1][1], s["method"]))
+        with_flip = [s for s in sweeps if s.flip is not None]
+        pick = min(with_flip, key=lambda s: s.flip) if with_flip else min(
+            sweeps, key=lambda s: (s.points[-1][1], s.method))
         shown = [pick]
     else:
         shown = sweeps
     texts = []
     for s in shown:
-        vals = [p[0] for p in s["points"]]
-        who = f"{plan.name(s['method'])}" + (f", {s['scope']}" if s["scope"] else "")
-        if s["flip"] is not None:
-            texts.append(w.get("text", "{value}").format(value=fmt(s["flip"])) + f" ({who})")
+        vals = [p[0] for p in s.points]
+        who = f"{plan.name(s.method)}" + (f", {s.scope}" if s.scope else "")
+        if s.flip is not None:
+            texts.append(w.get("text", "{value}").format(value=fmt(s.flip)) + f" ({who})")
             q = quantity(f"flip_{name}", "", "none", f"{name} at which the verdict flips")
             j.derived.append(EvidenceRow(
-                claim_id=test.claim_id, sample=test.samples["main"], scope=s["scope"], method=s["method"],
-                versus=s["versus"], role="derived", quantity=q, estimate=float(s["flip"]),
-                n=len(s["points"]), source=f"scorer: the sweep of {s['quantity']} over {name}"))
+                claim_id=test.claim_id, sample=test.samples["main"], scope=s.scope, method=s.method,
+                versus=s.versus, role="derived", quantity=q, estimate=float(s.flip),
+                n=len(s.points), source=f"scorer: the sweep of {s.quantity} over {name}"))
         else:
             words, unit = wording.key_words(name)
             texts.append(f"no {words} from {fmt(min(vals))} to {fmt(max(vals))}{_u(unit)} gives it ({who})")

@@ -13,10 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from opnav.core import figures
 from opnav.report import approach_claims, landing_claims  # noqa: F401  (their quantities' names)
+
+if TYPE_CHECKING:
+    from opnav.report.scorer import Sweep
 
 
 _UNITS = (("_deg_s", "deg/s"), ("_arcsec", "arcsec"), ("_km", "km"), ("_us", "us"), ("_m", "m"), ("_s", "s"))
@@ -30,14 +33,14 @@ def setting_label(name: str) -> str:
     return name.replace("_", " ")
 
 
-def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, names: Mapping[str, str] | None = None):
+def plot(claim_id: str, sweeps: "Iterable[Sweep]", path: str | Path, names: Mapping[str, str] | None = None):
     """Save the would_take figure of ``claim_id`` (``sweeps``: the scorer's sweeps of that
     claim) to ``path`` (a stem: PDF and PNG); a claim without sweep evidence in this build gets
     a figure that says so."""
     import matplotlib.pyplot as plt
 
     names = dict(names or {})
-    sw = [s for s in sweeps if s["claim_id"] == claim_id]
+    sw = [s for s in sweeps if s.claim_id == claim_id]
     with figures.style():
         fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH_IN, 2.4))
         if not sw:
@@ -47,43 +50,43 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
             return figures.save(fig, path)
         s0 = sw[0]
         styles, markers = ["-", "--", ":", "-."], ["o", "s", "^", "D"]   # per scope (camera, case)
-        scopes = list(dict.fromkeys(s["scope"] for s in sw))
+        scopes = list(dict.fromkeys(s.scope for s in sw))
         for s in sw:
-            xs = [p[0] for p in s["points"]]
-            ys = [p[1] for p in s["points"]]
-            lab = names.get(s["method"], s["method"]) + (f", {s['scope']}" if len(sw) > 1 and s["scope"] else "")
-            c = figures.color(s["method"].split("+")[0])
-            k = scopes.index(s["scope"])
+            xs = [p[0] for p in s.points]
+            ys = [p[1] for p in s.points]
+            lab = names.get(s.method, s.method) + (f", {s.scope}" if len(sw) > 1 and s.scope else "")
+            c = figures.color(s.method.split("+")[0])
+            k = scopes.index(s.scope)
             ax.plot(xs, ys, marker=markers[k % len(markers)], ms=3, color=c, label=lab, ls=styles[k % len(styles)])
-            lo = [p[2] for p in s["points"]]
-            hi = [p[3] for p in s["points"]]
+            lo = [p[2] for p in s.points]
+            hi = [p[3] for p in s.points]
             if all(math.isfinite(v) for v in lo + hi):
                 ax.fill_between(xs, lo, hi, color=c, alpha=0.2, lw=0)
-            if s["flip"] is not None:
-                ax.axvline(s["flip"], color=c, ls=":", lw=1)
-        lim = s0.get("limit", math.nan)
-        band = [x for x in s0.get("band") or () if math.isfinite(x)]
+            if s.flip is not None:
+                ax.axvline(s.flip, color=c, ls=":", lw=1)
+        lim = s0.limit
+        band = [x for x in s0.band or () if math.isfinite(x)]
         if len(band) == 2:
-            ax.axhspan(band[0], band[1], color="0.85", zorder=0, label=f"test: {s0.get('threshold', '')}")
+            ax.axhspan(band[0], band[1], color="0.85", zorder=0, label=f"test: {s0.threshold}")
         elif lim is not None and math.isfinite(lim):
-            ax.axhline(lim, color="0.3", ls="--", lw=1, label=f"test: {s0.get('threshold', '')}")
-        tgt = s0.get("target", math.nan)
+            ax.axhline(lim, color="0.3", ls="--", lw=1, label=f"test: {s0.threshold}")
+        tgt = s0.target
         if tgt is not None and math.isfinite(tgt):
             ax.axhline(tgt, color="0.3", ls="--", lw=1, label=f"published {tgt:g}")
         from opnav.report.evidence import QUANTITIES
 
-        unit = s0.get("unit", "")
-        q = QUANTITIES.get(s0["quantity"])
-        ax.set_xlabel(setting_label(s0["setting"]))
+        unit = s0.unit
+        q = QUANTITIES.get(s0.quantity)
+        ax.set_xlabel(setting_label(s0.setting))
         import textwrap
 
-        ylab = q.text if q is not None else s0["quantity"].replace("_", " ")
-        if s0.get("versus") and "diff" in s0["quantity"]:   # a paired difference: say which minus which
-            ylab += f", {names.get(s0['method'], s0['method'])} minus {names.get(s0['versus'], s0['versus'])}"
+        ylab = q.text if q is not None else s0.quantity.replace("_", " ")
+        if s0.versus and "diff" in s0.quantity:   # a paired difference: say which minus which
+            ylab += f", {names.get(s0.method, s0.method)} minus {names.get(s0.versus, s0.versus)}"
         ylab += f" ({unit})" if unit else ""
         ax.set_ylabel("\n".join(textwrap.wrap(ylab, 28)))
-        xs_all = [p[0] for s in sw for p in s["points"]]
-        ys_all = [p[1] for s in sw for p in s["points"]] + ([lim] if lim is not None and math.isfinite(lim) else [])
+        xs_all = [p[0] for s in sw for p in s.points]
+        ys_all = [p[1] for s in sw for p in s.points] + ([lim] if lim is not None and math.isfinite(lim) else [])
         if xs_all and min(xs_all) > 0 and max(xs_all) / min(xs_all) > 8:
             ax.set_xscale("log")
             figures.plain_log_labels(ax.xaxis)
@@ -101,7 +104,7 @@ def plot(claim_id: str, sweeps: Iterable[Mapping[str, Any]], path: str | Path, n
         return figures.save(fig, path)
 
 
-def caption(claim_id: str, sweeps: Iterable[Mapping[str, Any]], row: Mapping[str, Any] | None = None,
+def caption(claim_id: str, sweeps: "Iterable[Sweep]", row: Mapping[str, Any] | None = None,
             names: Mapping[str, str] | None = None) -> str:
     """The figure's caption (plain text, every sentence short): which claim, what is drawn
     against what, how the test and the flip are marked, and what the claims table says it
@@ -113,25 +116,25 @@ def caption(claim_id: str, sweeps: Iterable[Mapping[str, Any]], row: Mapping[str
     row = dict(row or {})
     title = str(row.get("claim", "")).split(" (")[0].strip()
     out = [f"{claim_id}" + (f", {title[0].lower() + title[1:]}" if title else "") + ": what it would take."]
-    sw = [s for s in sweeps if s["claim_id"] == claim_id]
+    sw = [s for s in sweeps if s.claim_id == claim_id]
     if not sw:
         return " ".join(out + [f"This build has no swept evidence for {claim_id}."])
     s0 = sw[0]
-    q = QUANTITIES.get(s0["quantity"])
-    what = q.text if q is not None else s0["quantity"].replace("_", " ")
-    if s0.get("versus"):
-        how = "minus" if "diff" in s0["quantity"] else "against"
-        what += f" of {names.get(s0['method'], s0['method'])} {how} {names.get(s0['versus'], s0['versus'])}"
-    lines = wording.join([names.get(s["method"], s["method"]) + (f" ({s['scope']})" if s["scope"] else "") for s in sw])
-    out.append(f"The {what} against the {setting_label(s0['setting'])}, for {lines}.")
+    q = QUANTITIES.get(s0.quantity)
+    what = q.text if q is not None else s0.quantity.replace("_", " ")
+    if s0.versus:
+        how = "minus" if "diff" in s0.quantity else "against"
+        what += f" of {names.get(s0.method, s0.method)} {how} {names.get(s0.versus, s0.versus)}"
+    lines = wording.join([names.get(s.method, s.method) + (f" ({s.scope})" if s.scope else "") for s in sw])
+    out.append(f"The {what} against the {setting_label(s0.setting)}, for {lines}.")
     marks = []
-    if len([x for x in s0.get("band") or () if math.isfinite(x)]) == 2:
-        marks.append(f"the grey band is the test ({s0.get('threshold', '')})")
-    elif s0.get("limit") is not None and math.isfinite(s0.get("limit", math.nan)):
-        marks.append(f"the dashed line is the test ({s0.get('threshold', '')})")
-    if s0.get("target") is not None and math.isfinite(s0.get("target", math.nan)):
-        marks.append(f"the dashed line marks the published {wording.num(s0['target'])}")
-    if any(s["flip"] is not None for s in sw):
+    if len([x for x in s0.band or () if math.isfinite(x)]) == 2:
+        marks.append(f"the grey band is the test ({s0.threshold})")
+    elif s0.limit is not None and math.isfinite(s0.limit):
+        marks.append(f"the dashed line is the test ({s0.threshold})")
+    if s0.target is not None and math.isfinite(s0.target):
+        marks.append(f"the dashed line marks the published {wording.num(s0.target)}")
+    if any(s.flip is not None for s in sw):
         marks.append("a dotted line marks where the verdict flips")
     if marks:
         out.append(wording.join(marks).capitalize() + ".")
@@ -142,7 +145,7 @@ def caption(claim_id: str, sweeps: Iterable[Mapping[str, Any]], row: Mapping[str
     return " ".join(out)
 
 
-def latex(claim_ids: Iterable[str], sweeps: Iterable[Mapping[str, Any]], rows: Mapping[str, Mapping[str, Any]],
+def latex(claim_ids: Iterable[str], sweeps: "Iterable[Sweep]", rows: Mapping[str, Mapping[str, Any]],
           directory: str = r"\results/paper/would_take", names: Mapping[str, str] | None = None) -> str:
     """The manuscript's would_take figures (an appendix block of figure floats, one per swept
     claim, each with its :func:`caption`); ``directory``: where LaTeX finds ``<claim>.pdf``."""

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 
-from opnav.studies.metrics import METRICS, TIMING_METRICS
+from opnav.studies.metrics import TIMING_METRICS
 from opnav.studies.values import slug
 
 __all__ = ["caption", "slopes_caption"]

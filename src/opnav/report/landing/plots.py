@@ -7,7 +7,6 @@ with ``opnav.core.figures.save``. Units are on every axis.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 

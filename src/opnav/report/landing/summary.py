@@ -490,24 +490,36 @@ def end_phase_text(end: dict[str, dict], scenario: str, min_update_alt_m: float,
                 f" for {ms[0]}).")
 
 
-def nees_reading(nees: "NeesConsistency", scenario: str | None = None) -> dict:
+@dataclass(frozen=True)
+class NeesReading:
+    """The filter's consistency in words (:func:`nees_reading`; B-summary ``nees_reading``): per
+    state its reading, the two together (``verdict``) and the sentence."""
+
+    pos: str
+    vel: str
+    verdict: str
+    text: str
+
+
+def nees_reading(nees: "NeesConsistency", scenario: str | None = None) -> NeesReading:
     """The filter's consistency read from its held-out NEES (``montecarlo.nees_consistency``):
     per state (pos, vel) ``consistent`` if the time-averaged NEES of the run mean lies inside
     the 95 % band of an n-run mean, ``underconfident`` below it (the covariance larger than the
     errors), ``overconfident`` above it; and a sentence saying so with the numbers."""
     lo, hi = nees.band
-    out = {}
-    for q, x in (("pos", nees.pos_mean), ("vel", nees.vel_mean)):
-        out[q] = "consistent" if lo <= x <= hi else "underconfident" if x < lo else "overconfident"
-    verdict = out["pos"] if out["pos"] == out["vel"] else f"{out['pos']} in position, {out['vel']} in velocity"
-    out["verdict"] = verdict
+
+    def reading(x: float) -> str:
+        return "consistent" if lo <= x <= hi else "underconfident" if x < lo else "overconfident"
+
+    pos, vel = reading(nees.pos_mean), reading(nees.vel_mean)
+    verdict = pos if pos == vel else f"{pos} in position, {vel} in velocity"
     where = f" of the {scenario} camera" if scenario else ""
-    out["text"] = (f"On the held-out runs{where} the filter is {verdict}. Its mean NEES over {nees.n_runs} runs "
-                   f"is {nees.pos_mean:.2f} in position and {nees.vel_mean:.2f} in velocity, against the 95 % "
-                   f"band [{lo:.2f}, {hi:.2f}] of a {nees.n_runs}-run mean for 3 degrees of freedom. The run mean "
-                   f"lies in the band at {nees.pos_in_band_pct:.1f} % of the filter times in position and "
-                   f"{nees.vel_in_band_pct:.1f} % in velocity.")
-    return out
+    return NeesReading(pos, vel, verdict, (
+        f"On the held-out runs{where} the filter is {verdict}. Its mean NEES over {nees.n_runs} runs "
+        f"is {nees.pos_mean:.2f} in position and {nees.vel_mean:.2f} in velocity, against the 95 % "
+        f"band [{lo:.2f}, {hi:.2f}] of a {nees.n_runs}-run mean for 3 degrees of freedom. The run mean "
+        f"lies in the band at {nees.pos_in_band_pct:.1f} % of the filter times in position and "
+        f"{nees.vel_in_band_pct:.1f} % in velocity."))
 
 
 def nees_table(retuned: "RetunedRecord") -> "pd.DataFrame":
@@ -526,7 +538,7 @@ def nees_table(retuned: "RetunedRecord") -> "pd.DataFrame":
                      "tuning_nees_pos": r.tuning_nees_pos, "tuning_nees_vel": r.tuning_nees_vel,
                      "heldout_nees_pos": h.pos_mean, "heldout_nees_vel": h.vel_mean,
                      "in_band_pct_pos": h.pos_in_band_pct, "in_band_pct_vel": h.vel_in_band_pct,
-                     "reading": nees_reading(h)["verdict"],
+                     "reading": nees_reading(h).verdict,
                      "lastlm_pos_err_m_median": e.lastlm_pos_err_m_median,
                      "final_pos_err_m_median": e.final_pos_err_m_median})
     return pd.DataFrame(rows)
@@ -546,13 +558,13 @@ def nees_retuned_text(retuned: "RetunedRecord") -> str:
     s = (f"Retuned within the same protocol, the {retuned.scenario} camera's bearing-noise scale is "
          f"{r.meas_noise_scale:.3g} against the paper tuning's {p.meas_noise_scale:.3g}: the scale whose NEES "
          f"on the {n} tuning runs lies closest to the band's centre. Held out, its NEES is position "
-         f"{rh.pos_mean:.2f} ({rd['pos']}) and velocity {rh.vel_mean:.2f} ({rd['vel']}) against "
+         f"{rh.pos_mean:.2f} ({rd.pos}) and velocity {rh.vel_mean:.2f} ({rd.vel}) against "
          f"[{lo:.2f}, {hi:.2f}], in the band at {rh.pos_in_band_pct:.1f} % and {rh.vel_in_band_pct:.1f} % of "
          f"the filter times. The median position error at the last landmark update goes from "
          f"{_fmt(pe.lastlm_pos_err_m_median, '{:.2f}')} to {_fmt(re_.lastlm_pos_err_m_median, '{:.2f}')} m, "
          f"and at touchdown from {_fmt(pe.final_pos_err_m_median, '{:.2f}')} to "
          f"{_fmt(re_.final_pos_err_m_median, '{:.2f}')} m.")
-    if rd["verdict"] == "consistent":
+    if rd.verdict == "consistent":
         return s
     tlo, thi = retuned.tuning_band
     if r.tuning_in_band:
@@ -561,7 +573,7 @@ def nees_retuned_text(retuned: "RetunedRecord") -> str:
     else:
         why = [f"No scale tried puts both in the band on the tuning runs either (closest: position "
                f"{r.tuning_nees_pos:.2f}, velocity {r.tuning_nees_vel:.2f} against [{tlo:.2f}, {thi:.2f}])"]
-    if rd["pos"] != rd["vel"]:
+    if rd.pos != rd.vel:
         why.append(f"Held out, the velocity NEES is {rh.vel_mean / rh.pos_mean:.2f} times the position's "
                    f"({ph.vel_mean / ph.pos_mean:.2f} with the paper tuning), and one scale on the bearing noise "
                    "moves both together")
