@@ -451,6 +451,8 @@ def test_every_kernel_module_registers_a_warm_up_and_a_warmed_cache_compiles_not
     fails (modules); ``landing.planning.warmup``'s -> fails (its package's families)."""
     import importlib
 
+    import opnav.approach  # noqa: F401  (registers its kernel modules)
+    import opnav.landing  # noqa: F401  (registers its kernel modules)
     from opnav.core import compiled
 
     for m in compiled.kernel_modules():

@@ -127,6 +127,8 @@ def test_kernels_compiled_once_then_only_loaded(quick_results):
     import json
     import re
 
+    import opnav.approach  # noqa: F401  (registers its kernel modules)
+    import opnav.landing  # noqa: F401  (registers its kernel modules)
     from opnav.core import compiled
 
     out = quick_results / "results" / "quick"
