@@ -146,6 +146,20 @@ def test_a_replication_that_is_only_wider_is_underpowered_not_unstable():
     assert S.judge(old, "B-C1", ev).verdict == C.UNSTABLE
 
 
+def test_a_pooled_reading_says_it_is_pooled():
+    """The cause of a claim read on the pooled sample quotes the pooled interval and says so: the
+    full build of d1501f2 quoted B-C7's pooled interior interval (+0.00227 m [-0.0648, +0.0693])
+    beside the main sample's (-0.00167 m) with only '(interior)', two numbers for one quantity.
+    Mutation tried once: the sample left out of the quote fails it."""
+    main = b_c1(d={"svd": 0.02}, half=0.015)
+    rep = b_c1(sample="replication", d={"svd": 0.02}, half=0.03, n=100)
+    ev = C.evidence_table(PLAN, C.raw_rows(main + rep))
+    j = S.judge(PLAN, "B-C1", ev)
+    assert j.pooled is not None and j.verdict == j.pooled.verdict
+    assert "both samples pooled" in j.cause
+    assert all("pooled" not in S.quote(u.first(), PLAN) for u in j.main.units if u.first() is not None)
+
+
 def _a_rows(claim="A-C1", sample="main", err=20.0, bound=20.6, roll_err=0.08, roll_bound=0.06, n=20):
     rows = []
     for m, role, e, b in (("literal", "as_written", err, bound), ("roll+growing+squarem", "faithful", roll_err, roll_bound)):
@@ -219,6 +233,22 @@ def test_the_timing_band_is_built_from_the_spread_between_replays():
     assert only_one.verdict == C.NOT_TESTED and "between independent replays" in only_one.named
     tight = S.judge(PLAN, "B-C4", _timing(replays=(23.9, 24.0, 24.1)))
     assert tight.verdict == C.NOT_REPRODUCED and "24" in tight.cause
+
+
+def test_the_seed_guard_counts_seeds_not_replays():
+    """min_full_seeds guards Monte-Carlo samples: B-C4's three replays of 200 recorded calls are
+    the plan's design, not three seeds (d1501f2's full build flagged B-C4 and B-C9
+    'sample_too_small: 3 seeds or runs'); a Monte-Carlo claim of 5 runs is still flagged.
+    Mutation tried once: without the planning-time exemption the first assertion fails."""
+    # the replication's replays of its own recorded calls: sample 'replication', n = 3 replays
+    rep = [R("B-C4", "reduction_pct", 25.0, sample="replication", scope="interior", versus="svd", se=2.4, n=3,
+             unit="%")]
+    ev = C.evidence_table(PLAN, C.raw_rows(_timing(replays=(18.0, 24.0, 30.0)) + rep))
+    row, _, _ = C.claim_row(PLAN, "B-C4", ev, replicated=True)
+    assert "sample_too_small" not in (row.flags or "")
+    small = b_c1(n=5)
+    row, _, _ = C.claim_row(PLAN, "B-C1", C.evidence_table(PLAN, C.raw_rows(small)), replicated=False)
+    assert "sample_too_small: 5 seeds or runs" in (row.flags or "")
 
 
 def test_timing_depends_on_the_svd_implementation_where_another_meets_the_band():

@@ -302,6 +302,12 @@ def _ours(u: S.UnitReading | None, plan: Plan, cited: list | None = None) -> str
 
 
 def _small(j: S.Judgement, plan: Plan) -> list[tuple[str, str]]:
+    """``sample_too_small`` when a quoted reading rests on fewer Monte-Carlo seeds or runs than
+    the plan's ``min_full_seeds``. A planning-time claim (its main sample ``between_replays``) is
+    exempt: its ``n`` counts independent replays of the recorded calls (the plan's design, whose
+    spread widens the band), not seeds."""
+    if plan.test(j.claim_id).samples.get("main") == "between_replays":
+        return []
     ns = [r.n for r in j.quoted if r.role in ("as_written", "faithful") and r.sample in ("main", "replication")
           and r.n > 0]
     if not ns:

@@ -710,8 +710,10 @@ def quote(o: Outcome | None, plan: Plan | None = None, with_scope: bool = True) 
     s = (f"{what} of {who}" if who else what) + f" {val}{_u(r.unit)}{iv}"
     if o.threshold:
         s += f" against {o.threshold}"
-    if with_scope and r.scope:
-        s += f" ({r.scope})"
+    pooled = "both samples pooled" if r.sample == "pooled" else ""
+    where = ", ".join(x for x in ((r.scope if with_scope else ""), pooled) if x)
+    if where:
+        s += f" ({where})"
     return s
 
 
