@@ -332,3 +332,17 @@ def test_sweep_interpolates_where_the_bound_reaches_the_target():
     half = PLAN.amended({"claims.A-C1.margins.target_arcsec": {"value": 1.0, "reason": "test"}})
     wt2, sw2 = S.would_take(half, "A-C1", rows, S.judge(half, "A-C1", rows))
     assert sw2[0].flip is None and "no roll rate from 0.1 to 0.4 deg/s" in wt2
+
+
+def test_an_undecided_band_writes_the_ends_it_quotes():
+    """A band too wide to decide (A-C11's per-case navigation error: its 2-sd spread wider than
+    the plan's max_band_rel) still quotes its ends ('113 km against 6.03 to 30.8 km (T1-01)'),
+    so they are derived evidence rows like a decided band's (the full build of aeaf765 quoted
+    them in no row). Mutation tried once: numbers set only for decided bands fails it."""
+    rows = [R("A-C11", "nav_err_after_km", 113.0, scope="T1-01", method="literal", se=2.8, n=20, unit="km"),
+            pub("A-C11", "nav_err_after_km", 18.43, scope="T1-01", unit="km")]
+    row, j, _ = C.claim_row(PLAN, "A-C11", C.evidence_table(PLAN, C.raw_rows(rows)), replicated=False)
+    assert "too wide to decide" in (j.main.units[0].outcomes[0].why or "")
+    quoted = S.numbers_in(row.ours_as_written.split("against", 1)[1].replace("T1-01", ""))
+    limits = {S.fmt(d.estimate) for d in j.derived if d.quantity == "limit_nav_err_after_km"}
+    assert len(quoted) == 2 and set(quoted) <= limits, (row.ours_as_written, limits)

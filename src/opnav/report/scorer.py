@@ -275,12 +275,12 @@ def evaluate(ctx: _Ctx, cond: Condition, scope: str, method: str, versus: str) -
         lo_b, hi_b, text, why = _band(ctx, cond, scope, row)
         if cond.get("center") is not None and not cond.get("upper_factor") and not cond.get("factor"):
             o.target = ctx.num(cond.get("center"), cond, scope, row)[0]
+        o.threshold = text
+        o.numbers = tuple(x for x in (lo_b, hi_b) if math.isfinite(x))  # quoted even when undecided
         if why:
-            o.status, o.why, o.threshold = UNDECIDED, why, text
+            o.status, o.why = UNDECIDED, why
             return o
         ok = lo_b <= est <= hi_b
-        o.threshold = text
-        o.numbers = tuple(x for x in (lo_b, hi_b) if math.isfinite(x))
         if est > hi_b:
             o.limit, o.severity = hi_b, (est - hi_b) / max(abs(hi_b), 1e-300)
         elif est < lo_b:
