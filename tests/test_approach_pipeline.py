@@ -106,7 +106,7 @@ def test_manuscript_findings_follow_the_flags_and_numbers(lit_bound, roll_stalle
     }}
     pub = published.paper_a()["headline"]
     txt = approach_text.findings(cfg, summaries.HeadlineSummary.from_json(summ), pub, TARGET)
-    assert ("no variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
+    assert ("No variant gets below it" in txt["bound"]) is (lit_bound > 2.0 and roll_stalled)
     assert ("add almost nothing to the prior" in txt["bound"]) is bool(lit_bound > 0.8 * summ["prior_bound_arcsec"])
     # the row's reading opens its own sentence (capitalised)
     assert ("stalled (4/4)" in txt["headline_roll"].lower()) is roll_stalled
@@ -149,6 +149,22 @@ def test_nav_error_split_range_is_set_by_the_range_channel_not_theta():
     assert np.all(r.nav_err_true_theta_lat_km < 0.1 * r.nav_err_before_lat_km)
     lat, rng = r.err_split_t_km.after
     np.testing.assert_allclose(np.hypot(lat, rng), r.err_after_t_km, rtol=1e-9)
+
+
+def test_the_bound_sentence_of_every_variant_stays_short():
+    """The full profile's five variants made \\ATextBound one 42-word sentence (the final full build
+    of this round; the quick build's long-sentence test has fewer variants): the bound list and
+    which variants get below the target are two sentences, each <= 40 words. Mutation tried once:
+    the old '; only ...' join fails it."""
+    from opnav.core import wording
+
+    cfg = approach_setup()
+    rows = {v: _summary_row(v, (0.0, 0.0), b, "converged") for v, b in
+            (("literal", 20.6), ("prior", 20.6), ("roll", 0.142), ("reference-start", 0.0407), ("stars", 1.9))}
+    summ = {"prior_bound_arcsec": summaries.prior_bound_arcsec(cfg), "convergence_max_maps": 40, "variants": rows}
+    txt = approach_text.findings(cfg, summaries.HeadlineSummary.from_json(summ), published.paper_a()["headline"], TARGET)
+    assert "Only the roll variant, the reference-start diagnostic and the stars variant get below it." in txt["bound"]
+    assert wording.long_sentences(txt["bound"]) == []
 
 
 def test_roll_rate_bounds_agree_with_the_roll_variant_and_the_target_rate_meets_the_target():

@@ -198,3 +198,19 @@ def test_wide_text_tables_wrap_their_words_then_split_by_width():
         heads = re.findall(r"quantity \d", p.split(r"\midrule")[0])
         cols = ["variant", "estimator", "run"] + [c for c in df.columns if c[:10] in heads]
         assert M._width_chars(fitted[[c for c in cols if c in fitted.columns]]) <= M.LINE_CHARS, cols
+
+
+def test_a_float_takes_the_most_specific_caption_its_rule_gives():
+    """B-F7's overhead curve printed B-F7's box-plot caption in the final full build's PDF (Fig. 28):
+    the float looked up ``<ID>.rst`` only, while its rule gives the HTML report
+    ``B-F7.overhead.rst``. Mutation tried once: the ``<ID>.<part>.rst`` candidates removed fails it."""
+    from opnav.report.manuscript import caption_file, caption_path
+
+    caps = Path(__file__).resolve().parents[1] / "workflow" / "report"
+    assert caption_path("results/landing/B-F7_overhead_interior.pdf", caps).name == "B-F7.overhead.rst"
+    assert caption_path("results/landing/B-F7_interior.pdf", caps).name == "B-F7.rst"
+    assert caption_path("results/landing/B-X1_ranking_interior.tex", caps).name == "B-X1.table.rst"
+    assert caption_path("results/landing/B-X1_envelopes_interior.pdf", caps).name == "B-X1.rst"
+    assert caption_path("results/approach/A-F4_bias_estimate_roll.pdf", caps).name == "A-F4.rst"
+    assert caption_path("results/studies/Z-X9_nothing.pdf", caps) is None
+    assert caption_file("results/landing/B-F7_overhead_site-tilt.pdf", caps).name == "B-F7.overhead.rst"

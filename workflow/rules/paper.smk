@@ -152,10 +152,8 @@ def _float_captions():
     parameter study's caption is written by its rule (opnav.studies.captions), not here."""
     out = {}
     for p in PDF_FLOATS["approach"] + PDF_FLOATS["landing"]:
-        cap = CAPTIONS / f"{manuscript.output_id(p)}.rst"
-        if p.endswith(".tex") and (CAPTIONS / f"{manuscript.output_id(p)}.table.rst").is_file():
-            cap = CAPTIONS / f"{manuscript.output_id(p)}.table.rst"
-        if cap.is_file():
+        cap = manuscript.caption_path(p, CAPTIONS)
+        if cap is not None:
             ctx = manuscript.CaptionContext(config, **_producing_job(p))
             out[p] = manuscript.render_caption(cap.read_text(), ctx, source=str(cap.relative_to(workflow.basedir)))
     return out

@@ -297,9 +297,9 @@ def findings(setup: Setup, summ: HeadlineSummary, pub_headline: dict, target_arc
     lit = base["literal"].crlb_all_x_arcsec if "literal" in base else None
     s = ("With the paper's prior, the bound of tx after all the data is "
          + _join([f"{nice(r.crlb_all_x_arcsec)} arcsec ({k})" for k, r in base.items()])
-         + f", against the claimed {target:g} arcsec; "
-         + (f"only {_join(names)} {'gets' if len(names) == 1 else 'get'} below it." if below and len(below) < len(base)
-            else "every variant gets below it." if below else "no variant gets below it."))
+         + f", against the claimed {target:g} arcsec. "
+         + (f"Only {_join(names)} {'gets' if len(names) == 1 else 'get'} below it." if below and len(below) < len(base)
+            else "Every variant gets below it." if below else "No variant gets below it."))
     if lit is not None:
         ratio = lit / pb
         s += (f" The prior alone bounds theta to sigma_r / rho = {nice(pb)} arcsec "

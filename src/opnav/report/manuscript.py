@@ -183,19 +183,25 @@ def output_variant(path: str | Path) -> str:
     return stem.split("_", 1)[1].replace("_", " ") if "_" in stem else ""
 
 
-def caption_file(path: str | Path, captions_dir: str | Path) -> Path:
-    """The caption of an output: ``<captions_dir>/<ID>.rst`` (a table's own ``<ID>.table.rst``
-    where a figure shares its id), else a caption generated beside the output (a parameter
-    study's ``<ID>.rst``)."""
+def caption_path(path: str | Path, captions_dir: str | Path) -> Path | None:
+    """The caption file of an output in ``captions_dir``, the most specific that exists: a
+    table's own ``<ID>.table.rst`` where a figure shares its id; ``<ID>.<part>.rst`` for a part
+    of the file name after the id (``B-F7_overhead_interior.pdf`` -> ``B-F7.overhead.rst``, the
+    caption its rule gives the HTML report); else ``<ID>.rst``. None when none exists."""
     p, captions_dir = Path(path), Path(captions_dir)
     cid = output_id(p)
-    cap = captions_dir / f"{cid}.rst"
-    if p.suffix == ".tex" and (captions_dir / f"{cid}.table.rst").is_file():
-        cap = captions_dir / f"{cid}.table.rst"
-    if not cap.is_file():
-        cap = p.parent / f"{cid}.rst"
-    if not cap.is_file():
-        raise FileNotFoundError(f"no caption file {captions_dir / f'{cid}.rst'} for {p}")
+    names = ([f"{cid}.table.rst"] if p.suffix == ".tex" else []) + [
+        f"{cid}.{part}.rst" for part in p.stem.split("_")[1:] if part and part != "table"] + [f"{cid}.rst"]
+    return next((captions_dir / n for n in names if (captions_dir / n).is_file()), None)
+
+
+def caption_file(path: str | Path, captions_dir: str | Path) -> Path:
+    """The caption of an output: :func:`caption_path` in ``captions_dir``, else a caption
+    generated beside the output (a parameter study's ``<ID>.rst``)."""
+    p = Path(path)
+    cap = caption_path(p, captions_dir) or caption_path(p, p.parent)
+    if cap is None:
+        raise FileNotFoundError(f"no caption file {Path(captions_dir) / f'{output_id(p)}.rst'} for {p}")
     return cap
 
 
