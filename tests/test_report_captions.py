@@ -91,6 +91,16 @@ def sentences(text: str) -> list[str]:
     return out + ([tail] if tail else [])
 
 
+@pytest.mark.parametrize("path", [p for p in CAPTIONS if p.name not in NOT_FLOATS], ids=lambda p: p.name)
+def test_caption_sentences_are_at_most_40_words(path: Path, tmp_path):
+    """Every caption as rendered, each sentence <= 40 words (issue 55 item 4): the build's prose
+    test reads only the captions a build prints, and B-F7.overhead.rst's 41-word sentence hid
+    behind the wrong caption there. Mutation tried once: that sentence back fails it."""
+    from opnav.core import wording
+
+    assert wording.long_sentences(" ".join(_rendered(path, tmp_path).split())) == []
+
+
 def test_sentence_counter():
     assert len(sentences("One (Fig. 4, eq. 19-26). Two, e.g. this. Three 1.5 s! Four")) == 4
     assert len(sentences("Paper A Fig. 5 re-run: a, b. The C.")) == 2
