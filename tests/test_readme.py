@@ -87,3 +87,14 @@ def test_from_a_build_stamps_its_commit_and_date_and_the_timing_claims(tmp_path,
     # a table without timing claims says nothing about machines
     no_timing = readme.findings_block(ref[~ref["claim_id"].isin(timing)], {"git_commit": "x"})
     assert "machine" not in no_timing
+
+
+def test_docs_name_no_path_of_the_machine_they_were_written_on():
+    """Issue 55 item 10: the user docs and the developers' work log hold no absolute path of a
+    machine (a work folder, a scratch folder, a home), which a reader cannot open. Four such
+    paths had come back into docs/dev/performance-log.md with a measurement section. Mutation
+    tried once: one of them restored fails it."""
+    pat = re.compile(r"(?<![\w.])/(?:work|tmp|root|home|scratch)/")
+    found = [f"{p.relative_to(REPO)}:{n}" for p in [REPO / "README.md", *sorted((REPO / "docs").rglob("*.md"))]
+             for n, line in enumerate(p.read_text().splitlines(), 1) if pat.search(line)]
+    assert found == [], found
