@@ -5,8 +5,9 @@
    cause must equal the build's claims.csv.
 2. Quoted numbers: every number in a claim row's cause, would_take, ours (as written, best,
    replication), bound and named is an estimate, lo or hi of one of that claim's evidence rows,
-   a published value (or a plan margin times it), or a number of the plan; the same rule as
-   tests/test_claims.py's hand-made test, applied to the build. With ``--rescored`` the derived
+   a published value (or a plan margin times it), or a number of the plan
+   (:func:`opnav.report.claims.unquoted_numbers`, the rule tests/test_claims.py checks on
+   hand-made summaries), applied to the build. With ``--rescored`` the derived
    rows are the re-scoring's (this checkout's scorer), else the build's own.
 
 Use::
@@ -21,25 +22,13 @@ any.
 from __future__ import annotations
 
 import argparse
-import math
-import re
 import sys
 
 import pandas as pd
 
 from opnav.report import approach_claims, landing_claims  # noqa: F401  (register the quantities)
 from opnav.report import claims as C
-from opnav.report import scorer as S
 from opnav.report.evidence import read_csv
-
-
-def plan_numbers(plan) -> set[float]:
-    nums = set()
-    for c in plan.claims.values():
-        nums |= {float(m["value"]) for m in (c.get("margins") or {}).values()}
-    for s in plan.raw["settings"].values():
-        nums |= {float(v) for v in s.get("values", [s.get("value", 0)])}
-    return nums
 
 
 def main(argv=None) -> int:
@@ -62,22 +51,10 @@ def main(argv=None) -> int:
         if r is None or r.verdict != c.verdict or r.cause != c.cause:
             differ += 1
             print("differs:", c.claim_id, c.verdict, "->", r.verdict if r else "no row")
-    pn = plan_numbers(plan)
-    missing = 0
-    for _, c in cl.iterrows():
-        mine = [e for e in ev if e.claim_id == c.claim_id]
-        nums = {S.fmt(x) for e in mine for x in (e.estimate, e.lo, e.hi) if math.isfinite(x)}
-        nums |= {S.fmt(abs(x)) for e in mine for x in (e.estimate, e.lo, e.hi) if math.isfinite(x)}
-        nums |= {S.fmt(x) for x in pn} | {S.fmt(x * abs(p.estimate)) for x in pn for p in mine if p.role == "published"}
-        nums |= {S.fmt(p.estimate * (1 + s * f)) for f in pn for s in (-1, 1) for p in mine if p.role == "published"}
-        nums |= {S.fmt(m.estimate * f) for f in pn for m in mine if m.quantity.startswith("err_mean")}
-        for col in ("cause", "would_take", "ours_as_written", "ours_best", "ours_replication", "bound", "named"):
-            text = re.sub(r"T1-\d+|B-C\d+|A-C\d+|v\d+ sha256:\w+|O\(n\^3\)|O\(1\)|\b3-sigma\b", "", str(c[col]))
-            for x in S.numbers_in(text):
-                v = x.lstrip("+")
-                if not (v in nums or S.fmt(float(v)) in nums or v.lstrip("-") in nums):
-                    missing += 1
-                    print(f"in no evidence row: {c.claim_id}.{col} quotes {x}")
+    missing = C.unquoted_numbers(plan, C.records(cl), ev)
+    for m in missing:
+        print(m)
+    missing = len(missing)
     print(f"{len(cl)} claims: {len(cl) - differ} re-scored alike, {differ} differ; "
           f"quoted numbers in no evidence row: {missing}")
     return 1 if differ or missing else 0

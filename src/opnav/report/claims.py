@@ -40,6 +40,7 @@ CSV and JSON only at the scripts' edge. Verdicts (:data:`VERDICTS`):
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, fields
@@ -186,6 +187,42 @@ def records(df: pd.DataFrame) -> list[ClaimRow]:
     """The claims table's rows as records (claims.csv read back)."""
     return [ClaimRow(**{k: ("" if pd.isna(v) else str(v)) for k, v in r.items() if k in COLUMNS})
             for r in df.to_dict("records")]
+
+
+#: the claim row columns whose numbers must be rows of the evidence (or of the plan)
+QUOTING_COLUMNS = ("cause", "would_take", "ours_as_written", "ours_best", "ours_replication", "bound", "named")
+#: ids and symbols a row quotes that are not numbers of the evidence
+_NOT_NUMBERS = re.compile(r"T1-\d+|B-C\d+|A-C\d+|v\d+ sha256:\w+|O\(n\^3\)|O\(1\)|\b3-sigma\b")
+
+
+def unquoted_numbers(plan: Plan, rows: Iterable[ClaimRow], evidence: Iterable[EvidenceRow]) -> list[str]:
+    """Each number a claim row quotes (:data:`QUOTING_COLUMNS`) that is not an estimate, lo or
+    hi of one of that claim's evidence rows, a published value (or the plan's margins applied to
+    it, or to a compared method's mean error), or a number of the plan: issue 52's rule that
+    every number a verdict quotes is in the evidence table. ``[]`` when all are."""
+    ev = list(evidence)
+    plan_nums = set()
+    for c in plan.claims.values():
+        plan_nums |= {float(m["value"]) for m in (c.get("margins") or {}).values()}
+    for st in plan.raw["settings"].values():
+        plan_nums |= {float(v) for v in st.get("values", [st.get("value", 0)])}
+    fmt = S.fmt
+    out = []
+    for r in rows:
+        mine = [e for e in ev if e.claim_id == r.claim_id]
+        pubs = [p.estimate for p in mine if p.role == "published"]
+        nums = {fmt(x) for e in mine for x in (e.estimate, e.lo, e.hi) if math.isfinite(x)}
+        nums |= {fmt(abs(x)) for e in mine for x in (e.estimate, e.lo, e.hi) if math.isfinite(x)}
+        nums |= {fmt(x) for x in plan_nums} | {fmt(x * abs(p)) for x in plan_nums for p in pubs}
+        nums |= {fmt(p * (1 + sg * f)) for f in plan_nums for sg in (-1, 1) for p in pubs}
+        nums |= {fmt(m.estimate * f) for f in plan_nums for m in mine if m.quantity.startswith("err_mean")}
+        for col in QUOTING_COLUMNS:
+            text = _NOT_NUMBERS.sub("", str(getattr(r, col)))
+            for x in S.numbers_in(text):
+                v = x.lstrip("+")
+                if not (v in nums or fmt(float(v)) in nums or v.lstrip("-") in nums):
+                    out.append(f"{r.claim_id}.{col} quotes {x}, in no evidence row: {text}")
+    return out
 
 
 # ------------------------------------------------------------ evidence -> claims
