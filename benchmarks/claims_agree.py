@@ -40,8 +40,8 @@ def main(argv=None) -> int:
     ev = list(read_csv(f"{a.paper}/evidence.csv"))
     cl = pd.read_csv(f"{a.paper}/claims.csv").fillna("")
     base = [e for e in ev if e.role != "derived"]
-    replicated = set(cl.loc[cl["verdict_replication"] != "", "claim_id"])
-    rows, js, _ = C.build(plan, base, C.replication_plan(plan, {}) if not replicated else replicated)
+    replicated = set(cl.loc[cl["verdict_replication"] != "", "claim_id"])   # as the build judged them
+    rows, js, _ = C.build(plan, base, replicated)
     if a.rescored:
         ev = base + C.derived_rows(js)
     got = {r.claim_id: r for r in rows}
